@@ -1,0 +1,105 @@
+"""System description (ch. 2, eqs. 3.1-3.3, 3.19-3.22): geometry, topology, files."""
+import numpy as np
+import pytest
+
+from tmfem.errors import InputError
+from tmfem.system import (SymmetricConfig, System, dump_system, load_preset, load_system,
+                          tendon_topology)
+from tmfem.system.geometry import beta
+
+
+def test_frame_origin_and_x_axis_follow_section_2_2():
+    s = load_preset("1-4")
+    A = s.nodes()[:, :4]
+    np.testing.assert_allclose(A[:, 3], 0.0, atol=1e-15)            # A_1N at the origin
+    assert A[1, 0] == pytest.approx(0.0, abs=1e-15) and A[0, 0] > 0  # A_11 on +x
+    # regular base of circumradius r_1: edge 2 r_1 sin(pi/N)
+    np.testing.assert_allclose(np.linalg.norm(A - np.roll(A, 1, axis=1), axis=0),
+                               2 * 0.4286 * np.sin(np.pi / 4))
+
+
+def test_tendon_counts_match_section_3_3_2():
+    # (6M-5)N tendons; T_q has (6M-2)N-6 entries once the 3N-6 corner forces are added
+    for M, N in [(1, 3), (1, 4), (2, 3), (3, 5)]:
+        n = len(tendon_topology(M, N, False))
+        assert n == (6 * M - 5) * N
+        assert n + 3 * N - 6 == (6 * M - 2) * N - 6
+    assert len(tendon_topology(1, 6, True)) == 12
+
+
+def test_S_tendon_length_matches_eq_3_29():
+    s = load_preset("1-4")
+    th, ps, r, l, N = np.radians(60), np.radians(10), 0.4286, 2.015, 4
+    S = np.sqrt(l**2 + 4 * r**2 * np.sin(np.pi / N)**2
+                - 4 * r * l * np.sin(np.pi / N) * np.sin(th) * np.cos(ps))
+    np.testing.assert_allclose(s.tendon_lengths(), S, rtol=1e-13)
+
+
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_delta_eq_3_22_matches_corner_geometry(preset):
+    s = load_preset(preset)
+    B = s.membrane_corners_inertial()
+    centre = B.mean(axis=1)
+    radius = np.linalg.norm(B - centre[:, None], axis=0)
+    np.testing.assert_allclose(radius - s.r_mb, s.symmetric.membrane_delta(s.N, s.r_mb), rtol=1e-12)
+    np.testing.assert_allclose(B[2], B[2, 0])  # the top of a symmetric system is horizontal
+
+
+def test_membrane_corners_in_floating_frame():
+    s = load_preset("1-4")
+    # the square of side r_mb*sqrt(2) = 2 m with O_f at corner N and x_f through corner 1 (3.2)
+    np.testing.assert_allclose(s.membrane_corners, [[2, 2, 0, 0], [0, 2, 2, 0]], atol=1e-4)
+    b = beta(4)
+    np.testing.assert_allclose(np.degrees(b), [-45, 45, 135, 225])  # eq. 3.21
+
+
+def test_q_round_trip_and_symmetric_recovery():
+    s = load_preset("2-3")
+    cfg = s.symmetric_from_q()
+    for k in ("theta", "psi", "sigma", "z", "r", "l"):
+        np.testing.assert_allclose(getattr(cfg, k), getattr(s.symmetric, k), atol=1e-12)
+    np.testing.assert_allclose(cfg.to_q(3), s.q, atol=1e-12)
+    q = s.q.copy()
+    q[s.q_names.index("theta_12")] += 0.01
+    with pytest.raises(InputError, match="stage 1 is not symmetric"):
+        s.symmetric_from_q(q)
+
+
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_toml_round_trip(preset, tmp_path):
+    s = load_preset(preset, as_printed=True)
+    dump_system(s, tmp_path / "s.toml")
+    t = load_system(tmp_path / "s.toml")
+    np.testing.assert_allclose(t.q, s.q, rtol=1e-15)
+    np.testing.assert_allclose(t.rest_lengths, s.rest_lengths)
+    np.testing.assert_allclose(t.nodes(), s.nodes(), atol=1e-14)
+    assert t.tendon_names() == s.tendon_names()
+
+
+def test_general_system_file_round_trip(tmp_path):
+    s = load_preset("2-3")
+    g = System(name="g", M=s.M, N=s.N, deployable=False, base=s.base, l=s.l, q=s.q,
+               membrane=s.membrane, membrane_corners=s.membrane_corners, bar=s.bar,
+               tendon_sections=s.tendon_sections)
+    dump_system(g, tmp_path / "g.toml")
+    t = load_system(tmp_path / "g.toml")
+    np.testing.assert_allclose(t.nodes(), s.nodes(), atol=1e-14)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("N = 4\n[symmetric\n", "not valid TOML"),
+    ('N = 2\n', "N >= 3"),
+    ('N = 4\n[membrane]\n', "missing number 'E'"),
+])
+def test_malformed_files_give_clear_errors(tmp_path, text, match):
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(InputError, match=match):
+        load_system(p)
+
+
+def test_negative_lengths_are_rejected():
+    with pytest.raises(InputError, match="expected l > 0"):
+        SymmetricConfig(theta=[1.0], psi=[0.1], sigma=[0], z=[0], r=[0.4], l=[-2.0])
+    with pytest.raises(InputError, match="0 < theta < 90 deg"):
+        SymmetricConfig(theta=[2.0], psi=[0.1], sigma=[0], z=[0], r=[0.4], l=[2.0])

@@ -1,0 +1,5 @@
+import sys
+
+from tmfem.cli import main
+
+sys.exit(main())

@@ -1,0 +1,76 @@
+"""The ``tmfem`` command line.
+
+Every module of this package that defines ``NAME``, ``HELP``, ``configure(parser)`` and
+``run(args) -> dict`` is a subcommand. ``run`` returns a JSON-serialisable result; with
+``--json`` it is printed as one JSON document on stdout, otherwise the module's
+``format_text(result) -> str`` (or a default rendering) is printed. A
+:class:`tmfem.errors.TmfemError` becomes a one-line message on stderr and a non-zero
+exit code, never a traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import json
+import pkgutil
+import sys
+
+from tmfem.errors import TmfemError
+
+
+def _subcommands() -> dict:
+    mods = {}
+    for info in pkgutil.iter_modules(__path__):
+        if info.name.startswith("_") or info.name == "common":
+            continue
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        if all(hasattr(mod, a) for a in ("NAME", "HELP", "configure", "run")):
+            mods[mod.NAME] = mod
+    return dict(sorted(mods.items()))
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="tmfem", description="Tensegrity-membrane systems: "
+                                     "equilibrium, finite-element and control-oriented models, control.")
+    sub = parser.add_subparsers(dest="command", metavar="<command>")
+    sub.required = True
+    for name, mod in _subcommands().items():
+        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
+        p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+        mod.configure(p)
+        p.set_defaults(_module=mod)
+    return parser
+
+
+def _default_text(result) -> str:
+    return json.dumps(result, indent=2, default=str)
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``tmfem`` console script; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    mod = args._module
+    try:
+        result = mod.run(args)
+    except TmfemError as exc:
+        print(f"tmfem {args.command}: error: {exc}", file=sys.stderr)
+        return exc.exit_code
+    if args.json:
+        print(json.dumps(result, default=_json_default))
+    else:
+        print(getattr(mod, "format_text", _default_text)(result))
+    return 0
+
+
+def _json_default(obj):
+    import numpy as np
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,132 @@
+"""Geometry of symmetric systems and the generalised coordinates q (eqs. 3.1-3.3, 3.19-3.22).
+
+Conventions (dissertation 2.2, 3.2): the inertial frame has its origin at A_1N and its x
+axis through A_11, so the base polygon runs counter-clockwise A_11, ..., A_1N. Seen from
+the centre of a regular N-gon, vertex j lies at the angle beta_j of eq. 3.21,
+
+    beta_j = -(N + 2) pi / (2N) + 2 j pi / N,
+
+which is also the direction of membrane corner j from the membrane centre. A bar with
+declination theta (from Oz) and azimuth psi (from Ox) points along
+``(sin theta cos psi, sin theta sin psi, cos theta)``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tmfem.errors import InputError
+
+
+def beta(N: int) -> np.ndarray:
+    """Polar angles beta_j (j = 1..N) of the polygon vertices about the centre (eq. 3.21)."""
+    j = np.arange(1, N + 1)
+    return -(N + 2) * np.pi / (2 * N) + 2 * j * np.pi / N
+
+
+def wrap_angle(a):
+    """Map angles to (-pi, pi], the range of the azimuths psi_ij (3.2)."""
+    return np.pi - np.mod(np.pi - np.asarray(a, dtype=float), 2 * np.pi)
+
+
+def bar_direction(theta, psi) -> np.ndarray:
+    """Unit vector of a bar with declination theta and azimuth psi, shape (3, ...)."""
+    theta = np.asarray(theta, dtype=float)
+    psi = np.asarray(psi, dtype=float)
+    return np.array([np.sin(theta) * np.cos(psi), np.sin(theta) * np.sin(psi), np.cos(theta)])
+
+
+def base_centre(N: int, r1: float) -> np.ndarray:
+    """Centre of the stage-1 base polygon in the inertial frame: (r_1 sin(pi/N), r_1 cos(pi/N), 0)."""
+    return np.array([r1 * np.sin(np.pi / N), r1 * np.cos(np.pi / N), 0.0])
+
+
+def regular_polygon(N: int, radius: float, centre, rotation: float = 0.0) -> np.ndarray:
+    """Vertices (3, N) of a horizontal regular N-gon at angles beta_j + rotation."""
+    b = beta(N) + rotation
+    c = np.asarray(centre, dtype=float)
+    return c[:, None] + radius * np.array([np.cos(b), np.sin(b), np.zeros(N)])
+
+
+def membrane_corners_regular(N: int, r_mb: float) -> np.ndarray:
+    """Undeformed corners (2, N) of the regular membrane in the floating frame O_f (3.2).
+
+    O_f is at corner N and x_f runs from corner N through corner 1.
+    """
+    b = beta(N)
+    xy = r_mb * np.array([np.cos(b), np.sin(b)])
+    return xy - xy[:, [-1]]
+
+
+@dataclass(frozen=True)
+class SymmetricConfig:
+    """Symmetric parametrisation of an M-N or 1-N(D) configuration (3.3.1, eqs. 3.19-3.20).
+
+    All arrays have length M; angles are in radians. ``psi[i]`` is the absolute azimuth of
+    bar b_iN, so bar b_ij has azimuth psi_i + 2 j pi / N (eq. 3.20); ``sigma[i]`` is the
+    rotation of the base of stage i about the vertical axis and ``z[i]`` its height
+    (sigma_1 = z_1 = 0); ``r[i]`` is the circumradius of the base of stage i and ``l[i]``
+    the bar length.
+    """
+
+    theta: np.ndarray
+    psi: np.ndarray
+    sigma: np.ndarray
+    z: np.ndarray
+    r: np.ndarray
+    l: np.ndarray
+
+    def __post_init__(self):
+        arrays = {k: np.atleast_1d(np.asarray(getattr(self, k), dtype=float))
+                  for k in ("theta", "psi", "sigma", "z", "r", "l")}
+        M = len(arrays["theta"])
+        for k, v in arrays.items():
+            if v.shape != (M,):
+                raise InputError(f"symmetric configuration: expected {k} of length M={M}, "
+                                 f"found shape {v.shape}")
+            if not np.all(np.isfinite(v)):
+                raise InputError(f"symmetric configuration: {k} has non-finite entries {v}")
+            object.__setattr__(self, k, v)
+        for k in ("r", "l"):
+            if np.any(arrays[k] <= 0):
+                raise InputError(f"symmetric configuration: expected {k} > 0, found {arrays[k]}")
+        th = arrays["theta"]
+        if np.any((th <= 0) | (th >= np.pi / 2)):
+            raise InputError("symmetric configuration: expected 0 < theta < 90 deg, found "
+                             f"{np.degrees(th)} deg")
+        if arrays["sigma"][0] != 0 or arrays["z"][0] != 0:
+            raise InputError("symmetric configuration: stage 1 has sigma_1 = z_1 = 0, found "
+                             f"sigma_1={arrays['sigma'][0]}, z_1={arrays['z'][0]}")
+
+    @property
+    def M(self) -> int:
+        return len(self.theta)
+
+    def base_nodes(self, N: int) -> np.ndarray:
+        """Lower bar ends A_ij, shape (3, M, N)."""
+        c = base_centre(N, self.r[0])
+        return np.stack([regular_polygon(N, self.r[i], c + [0, 0, self.z[i]], self.sigma[i])
+                         for i in range(self.M)], axis=1)
+
+    def angles(self, N: int) -> tuple[np.ndarray, np.ndarray]:
+        """theta_ij and psi_ij, each (M, N), from eqs. 3.19-3.20."""
+        j = np.arange(1, N + 1)
+        theta = np.repeat(self.theta[:, None], N, axis=1)
+        psi = wrap_angle(self.psi[:, None] + 2 * np.pi * j[None, :] / N)
+        return theta, psi
+
+    def to_q(self, N: int) -> np.ndarray:
+        """Generalised coordinates q of eqs. 3.1-3.2."""
+        theta, psi = self.angles(N)
+        A = self.base_nodes(N)
+        parts = [np.column_stack([theta[0], psi[0]]).ravel()]
+        for i in range(1, self.M):
+            parts.append(np.column_stack([A[0, i], A[1, i], A[2, i], theta[i], psi[i]]).ravel())
+        return np.concatenate(parts)
+
+    def membrane_delta(self, N: int, r_mb: float) -> float:
+        """Radial membrane corner displacement Delta of eq. 3.22."""
+        L = self.l[-1] * np.sin(self.theta[-1])
+        rM = self.r[-1]
+        return -r_mb + np.sqrt(L**2 + rM**2 - 2 * rM * L * np.sin(self.psi[-1] - self.sigma[-1] + np.pi / N))

@@ -1,0 +1,226 @@
+"""System files in TOML: read, validate and write (round trip).
+
+A file describes either a symmetric system (table ``[symmetric]``, eqs. 3.19-3.20) or a
+general one (table ``[general]`` with the base nodes A_1j, bar lengths and q of eqs.
+3.1-3.2, optionally a custom ``[[tendon]]`` list). Angles are given in degrees and named
+so (``theta_deg``). A preset may carry a table ``[as_printed]`` whose entries override
+the rest of the file when the dissertation's printed values are requested; see
+:func:`tmfem.system.presets.load_preset`. Example::
+
+    name = "1-4"
+    N = 4
+    [symmetric]
+    theta_deg = [60.0]
+    psi_deg = [10.0]
+    r = [0.4286]
+    l = [2.015]
+    [membrane]
+    r_mb = 1.4142
+    E = 165e6
+    nu = 0.34
+    rho = 1400.0
+    h = 51e-6
+    [bar]
+    E = 200e9
+    rho = 7800.0
+    d = 0.03
+    [tendons.S]
+    E = 2e9
+    d = 0.6e-3
+"""
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import tomli_w
+
+from tmfem.errors import InputError
+from tmfem.system.geometry import SymmetricConfig
+from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
+from tmfem.system.system import System
+from tmfem.system.topology import Tendon
+
+_TOP_KEYS = {"name", "description", "N", "deployable", "k_H", "notes", "symmetric", "general",
+             "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed"}
+
+
+def deep_merge(base: dict, override: dict) -> dict:
+    """Return ``base`` with ``override`` merged in, tables recursively."""
+    out = copy.deepcopy(base)
+    for k, v in override.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = deep_merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def _table(d: dict, key: str, where: str) -> dict:
+    if key not in d:
+        raise InputError(f"{where}: missing table [{key}]")
+    if not isinstance(d[key], dict):
+        raise InputError(f"{where}: expected [{key}] to be a table, found {type(d[key]).__name__}")
+    return d[key]
+
+
+def _num(d: dict, key: str, where: str, default=None):
+    if key not in d:
+        if default is not None:
+            return default
+        raise InputError(f"{where}: missing number '{key}'")
+    v = d[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise InputError(f"{where}: expected '{key}' to be a finite number, found {v!r}")
+    return float(v)
+
+
+def _floats(d: dict, key: str, where: str, n: int | None = None, default=None) -> np.ndarray:
+    if key not in d:
+        if default is not None:
+            return np.asarray(default, dtype=float)
+        raise InputError(f"{where}: missing list '{key}'")
+    try:
+        a = np.asarray(d[key], dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: expected '{key}' to be a list of numbers, found {d[key]!r}") from None
+    a = np.atleast_1d(a)
+    if n is not None and a.shape[0] != n:
+        raise InputError(f"{where}: expected '{key}' to have {n} entries, found {a.shape[0]}")
+    return a
+
+
+def _materials(d: dict, where: str):
+    m = _table(d, "membrane", where)
+    membrane = MembraneMaterial(E=_num(m, "E", f"{where} [membrane]"),
+                                nu=_num(m, "nu", f"{where} [membrane]"),
+                                rho=_num(m, "rho", f"{where} [membrane]"),
+                                h=_num(m, "h", f"{where} [membrane]"),
+                                yield_stress=m.get("yield_stress"))
+    b = _table(d, "bar", where)
+    bar = BarSection(E=_num(b, "E", f"{where} [bar]"), rho=_num(b, "rho", f"{where} [bar]"),
+                     d=_num(b, "d", f"{where} [bar]"))
+    sections = {}
+    for key, t in _table(d, "tendons", where).items():
+        w = f"{where} [tendons.{key}]"
+        if not isinstance(t, dict):
+            raise InputError(f"{w}: expected a table, found {t!r}")
+        sections[key] = TendonSection(E=_num(t, "E", w), d=_num(t, "d", w), rho=t.get("rho"),
+                                      yield_stress=t.get("yield_stress"))
+    return membrane, bar, sections
+
+
+def system_from_dict(d: dict, where: str = "system") -> System:
+    """Build a :class:`System` from the parsed contents of a system file."""
+    unknown = set(d) - _TOP_KEYS
+    if unknown:
+        raise InputError(f"{where}: unknown keys {sorted(unknown)}; expected some of {sorted(_TOP_KEYS)}")
+    N = d.get("N")
+    if not isinstance(N, int) or isinstance(N, bool) or N < 3:
+        raise InputError(f"{where}: expected integer N >= 3 (bars per stage), found {N!r}")
+    deployable = bool(d.get("deployable", False))
+    k_H = d.get("k_H")
+    membrane, bar, sections = _materials(d, where)
+    mtab = d["membrane"]
+    rest = d.get("rest_lengths") or None
+    common = dict(name=str(d.get("name", where)), description=str(d.get("description", "")),
+                  notes=tuple(d.get("notes", ())), printed=dict(d.get("printed", {})))
+    if ("symmetric" in d) == ("general" in d):
+        raise InputError(f"{where}: expected exactly one of [symmetric] or [general]")
+    if "symmetric" in d:
+        s = _table(d, "symmetric", where)
+        w = f"{where} [symmetric]"
+        theta = np.radians(_floats(s, "theta_deg", w))
+        M = theta.size
+        cfg = SymmetricConfig(theta=theta, psi=np.radians(_floats(s, "psi_deg", w, M)),
+                              sigma=np.radians(_floats(s, "sigma_deg", w, M, np.zeros(M))),
+                              z=_floats(s, "z", w, M, np.zeros(M)), r=_floats(s, "r", w, M),
+                              l=_floats(s, "l", w, M))
+        r_mb = _num(mtab, "r_mb", f"{where} [membrane]")
+        return System.symmetric_system(N=N, config=cfg, r_mb=r_mb, membrane=membrane, bar=bar,
+                                       tendon_sections=sections, deployable=deployable, k_H=k_H,
+                                       rest_lengths=rest, **common)
+    g = _table(d, "general", where)
+    w = f"{where} [general]"
+    base = _floats(g, "base", w).reshape(-1, 3).T if np.size(g.get("base", [])) else None
+    if base is None or base.shape != (3, N):
+        raise InputError(f"{w}: expected 'base' as {N} rows [x, y, z], found {g.get('base')!r}")
+    q = _floats(g, "q", w)
+    M = 1 + (q.size - 2 * N) // (5 * N)
+    l = _floats(g, "l", w)
+    l = np.broadcast_to(l.reshape(M, -1) if l.size == M * N else l.reshape(-1)[0], (M, N))
+    if "corners" in mtab:
+        corners = _floats(mtab, "corners", f"{where} [membrane]").reshape(-1, 2).T
+        r_mb = None
+    else:
+        from tmfem.system.geometry import membrane_corners_regular
+        r_mb = _num(mtab, "r_mb", f"{where} [membrane]")
+        corners = membrane_corners_regular(N, r_mb)
+    tendons = tuple(Tendon(name=t["name"], family=t["family"], stage=int(t.get("stage", 1)),
+                           j=int(t.get("j", 1)), ends=tuple(t["ends"])) for t in d.get("tendon", ()))
+    sys = System(M=M, N=N, deployable=deployable, base=base, l=l, q=q, membrane=membrane,
+                 membrane_corners=corners, bar=bar, tendon_sections=sections, k_H=k_H,
+                 tendons=tendons, r_mb=r_mb, **common)
+    return sys.with_rest_lengths(rest) if rest else sys
+
+
+def load_system(path) -> System:
+    """Read a system file (TOML); errors name the file and what is wrong."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InputError(f"cannot read system file {path}: {exc.strerror}") from None
+    try:
+        d = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: not valid TOML: {exc}") from None
+    d.pop("as_printed", None)
+    return system_from_dict(d, where=str(path))
+
+
+def system_to_dict(system: System) -> dict:
+    """The system-file contents of ``system`` (inverse of :func:`system_from_dict`)."""
+    d: dict = {"name": system.name, "N": system.N}
+    if system.description:
+        d["description"] = system.description
+    if system.notes:
+        d["notes"] = list(system.notes)
+    if system.deployable:
+        d["deployable"] = True
+        d["k_H"] = float(system.k_H)
+    if system.symmetric is not None:
+        c = system.symmetric
+        d["symmetric"] = {"theta_deg": np.degrees(c.theta).tolist(), "psi_deg": np.degrees(c.psi).tolist(),
+                          "sigma_deg": np.degrees(c.sigma).tolist(), "z": c.z.tolist(),
+                          "r": c.r.tolist(), "l": c.l.tolist()}
+    else:
+        d["general"] = {"base": system.base.T.tolist(), "l": system.l.tolist(), "q": system.q.tolist()}
+    m = system.membrane
+    mem = {"E": m.E, "nu": m.nu, "rho": m.rho, "h": m.h}
+    if m.yield_stress is not None:
+        mem["yield_stress"] = m.yield_stress
+    if system.r_mb is not None:
+        mem["r_mb"] = system.r_mb
+    else:
+        mem["corners"] = system.membrane_corners.T.tolist()
+    d["membrane"] = mem
+    d["bar"] = {"E": system.bar.E, "rho": system.bar.rho, "d": system.bar.d}
+    d["tendons"] = {k: {kk: vv for kk, vv in vars(s).items() if vv is not None}
+                    for k, s in system.tendon_sections.items()}
+    if system.symmetric is None and system.tendons:
+        d["tendon"] = [{"name": t.name, "family": t.family, "stage": t.stage, "j": t.j,
+                        "ends": list(t.ends)} for t in system.tendons]
+    if system.rest_lengths is not None:
+        d["rest_lengths"] = dict(zip(system.tendon_names(), system.rest_lengths.tolist()))
+    if system.printed:
+        d["printed"] = system.printed
+    return d
+
+
+def dump_system(system: System, path) -> None:
+    """Write ``system`` as a system file."""
+    Path(path).write_bytes(tomli_w.dumps(system_to_dict(system)).encode())

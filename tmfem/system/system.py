@@ -1,0 +1,278 @@
+"""The :class:`System`: one description of a tensegrity-membrane system for every model.
+
+A system is its topology (M stages of N bars, tendon families of 2.2, or the SL/SU
+tendons of a 1-N(D) system), the fixed base A_1j, the bar lengths, the undeformed
+membrane polygon, the materials, and a design configuration q (eqs. 3.1-3.2). Rest
+lengths are optional: an equilibrium design (``tmfem.equilibrium``) computes them.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.system.geometry import (SymmetricConfig, bar_direction, base_centre, beta,
+                                   membrane_corners_regular, wrap_angle)
+from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
+from tmfem.system.topology import Tendon, label, node_labels, tendon_topology
+
+
+@dataclass(frozen=True)
+class System:
+    """A tensegrity-membrane system and its design configuration.
+
+    Parameters
+    ----------
+    name : str
+        Short name, e.g. ``"1-4"``.
+    M, N : int
+        Number of stages and of bars per stage.
+    deployable : bool
+        True for a 1-N(D) system (tendons SL, SU through the points H_1j).
+    base : ndarray (3, N)
+        Fixed lower ends A_1j of the first-stage bars, inertial frame.
+    l : ndarray (M, N)
+        Bar lengths l_ij.
+    q : ndarray
+        Design configuration, generalised coordinates of eqs. 3.1-3.2.
+    membrane, membrane_corners :
+        Membrane material and its undeformed corners (2, N) in the floating frame O_f.
+    bar : BarSection
+    tendon_sections : dict
+        Cross sections keyed by group (``"S1"``, ``"V2"``, ``"SL"``), by family (``"S"``)
+        or ``"*"``; the most specific key wins.
+    k_H : float, optional
+        Position of H_1j along the bars of a 1-N(D) system, 0 < k_H < 1.
+    tendons : tuple of Tendon, optional
+        Connectivity; defaults to the families of 2.2.
+    rest_lengths : ndarray, optional
+        Rest length of each tendon, aligned with ``tendons``.
+    symmetric : SymmetricConfig, optional
+        The symmetric parametrisation of ``q`` when the system is symmetric.
+    r_mb : float, optional
+        Circumradius of a regular membrane.
+    """
+
+    name: str
+    M: int
+    N: int
+    deployable: bool
+    base: np.ndarray
+    l: np.ndarray
+    q: np.ndarray
+    membrane: MembraneMaterial
+    membrane_corners: np.ndarray
+    bar: BarSection
+    tendon_sections: dict
+    k_H: float | None = None
+    tendons: tuple = ()
+    rest_lengths: np.ndarray | None = None
+    symmetric: SymmetricConfig | None = None
+    r_mb: float | None = None
+    description: str = ""
+    notes: tuple = ()
+    printed: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        M, N = self.M, self.N
+        if not (isinstance(M, int) and M >= 1):
+            raise InputError(f"expected M >= 1 stages, found M={M!r}")
+        if not (isinstance(N, int) and N >= 3):
+            raise InputError(f"expected N >= 3 bars per stage, found N={N!r}")
+        if self.deployable and M != 1:
+            raise InputError(f"a 1-N(D) system has one stage, found M={M}")
+        if self.deployable and not (self.k_H is not None and 0 < self.k_H < 1):
+            raise InputError(f"a 1-N(D) system needs 0 < k_H < 1, found k_H={self.k_H!r}")
+        base = np.asarray(self.base, dtype=float)
+        l = np.broadcast_to(np.asarray(self.l, dtype=float), (M, N)).copy()
+        q = np.asarray(self.q, dtype=float)
+        corners = np.asarray(self.membrane_corners, dtype=float)
+        if base.shape != (3, N):
+            raise InputError(f"expected base A_1j of shape (3, {N}), found {base.shape}")
+        if np.any(~np.isfinite(l)) or np.any(l <= 0):
+            raise InputError(f"expected bar lengths l > 0, found {l.ravel()}")
+        nq = 2 * N + 5 * N * (M - 1)
+        if q.shape != (nq,) or not np.all(np.isfinite(q)):
+            raise InputError(f"expected q of length {nq} (eqs. 3.1-3.2) with finite entries, "
+                             f"found shape {q.shape}")
+        if corners.shape != (2, N):
+            raise InputError(f"expected membrane corners of shape (2, {N}), found {corners.shape}")
+        tendons = tuple(self.tendons) or tuple(tendon_topology(M, N, self.deployable))
+        labels = set(node_labels(M, N, self.deployable))
+        for t in tendons:
+            for e in t.ends:
+                if e not in labels:
+                    raise InputError(f"tendon {t.name}: unknown end node {e!r}")
+        object.__setattr__(self, "base", base)
+        object.__setattr__(self, "l", l)
+        object.__setattr__(self, "q", q)
+        object.__setattr__(self, "membrane_corners", corners)
+        object.__setattr__(self, "tendons", tendons)
+        for t in tendons:
+            self.tendon_section(t)
+        if self.rest_lengths is not None:
+            r = np.asarray(self.rest_lengths, dtype=float)
+            if r.shape != (len(tendons),) or np.any(~np.isfinite(r)) or np.any(r <= 0):
+                raise InputError(f"expected {len(tendons)} positive rest lengths, found {r}")
+            object.__setattr__(self, "rest_lengths", r)
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def symmetric_system(cls, *, name: str, N: int, config: SymmetricConfig, r_mb: float,
+                         membrane: MembraneMaterial, bar: BarSection, tendon_sections: dict,
+                         deployable: bool = False, k_H: float | None = None,
+                         rest_lengths: dict | None = None, description: str = "",
+                         notes=(), printed: dict | None = None) -> "System":
+        """Build a symmetric system (3.3.1) from its parametrisation.
+
+        ``rest_lengths`` may be given per group (``{"S1": 1.5}``) or per tendon name.
+        """
+        if not (r_mb > 0):
+            raise InputError(f"expected membrane radius r_mb > 0, found {r_mb!r}")
+        M = config.M
+        base = config.base_nodes(N)[:, 0, :]
+        sys = cls(name=name, M=M, N=N, deployable=deployable, base=base,
+                  l=np.repeat(config.l[:, None], N, axis=1), q=config.to_q(N), membrane=membrane,
+                  membrane_corners=membrane_corners_regular(N, r_mb), bar=bar,
+                  tendon_sections=dict(tendon_sections), k_H=k_H, symmetric=config, r_mb=r_mb,
+                  description=description, notes=tuple(notes), printed=dict(printed or {}))
+        if rest_lengths:
+            sys = sys.with_rest_lengths(rest_lengths)
+        return sys
+
+    def replace(self, **changes) -> "System":
+        """A copy with fields changed (``dataclasses.replace``)."""
+        return dataclasses.replace(self, **changes)
+
+    def with_rest_lengths(self, rest: dict | np.ndarray) -> "System":
+        """A copy with rest lengths given per tendon (array or name map) or per group."""
+        if isinstance(rest, dict):
+            values = []
+            for t in self.tendons:
+                v = rest.get(t.name, rest.get(t.group))
+                if v is None:
+                    raise InputError(f"no rest length for tendon {t.name} (group {t.group}); "
+                                     f"given keys: {sorted(rest)}")
+                values.append(float(v))
+            rest = np.array(values)
+        return self.replace(rest_lengths=np.asarray(rest, dtype=float))
+
+    # ------------------------------------------------------------------ coordinates
+    @property
+    def q_names(self) -> list[str]:
+        """Names of the generalised coordinates, e.g. ``theta_11``, ``psi_11``, ``x_21``."""
+        names = []
+        for j in range(1, self.N + 1):
+            names += [label("theta", 1, j), label("psi", 1, j)]
+        for i in range(2, self.M + 1):
+            for j in range(1, self.N + 1):
+                names += [label(c, i, j) for c in ("x", "y", "z", "theta", "psi")]
+        return names
+
+    def split_q(self, q=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Lower ends A (3, M, N), declinations theta (M, N) and azimuths psi (M, N) from q."""
+        q = self.q if q is None else np.asarray(q, dtype=float)
+        M, N = self.M, self.N
+        A = np.empty((3, M, N))
+        theta = np.empty((M, N))
+        psi = np.empty((M, N))
+        A[:, 0, :] = self.base
+        s1 = q[: 2 * N].reshape(N, 2)
+        theta[0], psi[0] = s1[:, 0], s1[:, 1]
+        if M > 1:
+            rest = q[2 * N:].reshape(M - 1, N, 5)
+            A[:, 1:, :] = np.moveaxis(rest[..., :3], -1, 0)
+            theta[1:], psi[1:] = rest[..., 3], rest[..., 4]
+        return A, theta, psi
+
+    def bar_ends(self, q=None) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper bar ends A_ij, B_ij, each (3, M, N)."""
+        A, theta, psi = self.split_q(q)
+        return A, A + self.l[None] * bar_direction(theta, psi)
+
+    @property
+    def node_labels(self) -> list[str]:
+        return node_labels(self.M, self.N, self.deployable)
+
+    def node_index(self, name: str) -> int:
+        try:
+            return self.node_labels.index(name)
+        except ValueError:
+            raise InputError(f"unknown node {name!r}; nodes are {self.node_labels}") from None
+
+    def nodes(self, q=None) -> np.ndarray:
+        """Coordinates (3, n_nodes) of all labelled nodes, in :attr:`node_labels` order."""
+        A, B = self.bar_ends(q)
+        parts = [A.reshape(3, -1), B.reshape(3, -1)]
+        if self.deployable:
+            parts.append(A[:, 0, :] + self.k_H * (B[:, 0, :] - A[:, 0, :]))
+        return np.concatenate(parts, axis=1)
+
+    @property
+    def tendon_connectivity(self) -> np.ndarray:
+        """Tendon end-node indices, shape (2, n_tendons)."""
+        idx = {n: k for k, n in enumerate(self.node_labels)}
+        return np.array([[idx[t.ends[0]] for t in self.tendons],
+                         [idx[t.ends[1]] for t in self.tendons]], dtype=int)
+
+    @property
+    def bar_connectivity(self) -> np.ndarray:
+        """Bar end-node indices (A_ij, B_ij), shape (2, M N)."""
+        n = self.M * self.N
+        return np.array([np.arange(n), n + np.arange(n)])
+
+    def tendon_vectors(self, q=None) -> np.ndarray:
+        """Vectors from the first to the second end of each tendon, (3, n_tendons)."""
+        X = self.nodes(q)
+        c = self.tendon_connectivity
+        return X[:, c[1]] - X[:, c[0]]
+
+    def tendon_lengths(self, q=None) -> np.ndarray:
+        return np.linalg.norm(self.tendon_vectors(q), axis=0)
+
+    def tendon_section(self, tendon: Tendon) -> TendonSection:
+        for key in (tendon.group, tendon.family, "*"):
+            if key in self.tendon_sections:
+                return self.tendon_sections[key]
+        raise InputError(f"no cross section for tendon {tendon.name}: expected a key "
+                         f"{tendon.group!r}, {tendon.family!r} or '*' in tendon_sections, "
+                         f"found {sorted(self.tendon_sections)}")
+
+    @property
+    def tendon_EA(self) -> np.ndarray:
+        return np.array([self.tendon_section(t).EA for t in self.tendons])
+
+    def tendon_names(self) -> list[str]:
+        return [t.name for t in self.tendons]
+
+    def membrane_corners_inertial(self, q=None) -> np.ndarray:
+        """Positions (3, N) of the membrane corners B_Mj for configuration q."""
+        return self.bar_ends(q)[1][:, -1, :]
+
+    # ------------------------------------------------------------------ symmetry
+    def symmetric_from_q(self, q=None, tol: float = 1e-9) -> SymmetricConfig:
+        """Recover the symmetric parametrisation (3.19-3.20) from q, or raise InputError."""
+        A, theta, psi = self.split_q(q)
+        N = self.N
+        r1 = np.linalg.norm(self.base[:, 0] - self.base[:, -1]) / (2 * np.sin(np.pi / N))
+        c = base_centre(N, r1)
+        th, ps, sg, zz, rr = [], [], [], [], []
+        j = np.arange(1, N + 1)
+        for i in range(self.M):
+            rel = A[:, i, :] - c[:, None]
+            rad = np.hypot(rel[0], rel[1])
+            ang = np.arctan2(rel[1], rel[0])
+            sig = wrap_angle(ang - beta(N))
+            psi0 = wrap_angle(psi[i] - 2 * np.pi * j / N)
+            checks = {"theta": np.ptp(theta[i]), "base radius": np.ptp(rad),
+                      "base height": np.ptp(rel[2]), "base rotation": np.ptp(np.unwrap(sig)),
+                      "azimuth": np.ptp(np.unwrap(psi0)), "bar length": np.ptp(self.l[i])}
+            bad = {k: v for k, v in checks.items() if v > tol * max(1.0, rad.max())}
+            if bad:
+                raise InputError(f"stage {i + 1} is not symmetric (eqs. 3.19-3.20): spread of "
+                                 + ", ".join(f"{k} {v:.3g}" for k, v in bad.items()))
+            th.append(theta[i, 0]); ps.append(psi0[-1]); sg.append(0.0 if i == 0 else sig[-1])
+            zz.append(0.0 if i == 0 else rel[2, 0]); rr.append(rad[0])
+        return SymmetricConfig(theta=th, psi=ps, sigma=sg, z=zz, r=rr, l=self.l[:, 0])
