@@ -1,0 +1,1 @@
+"""Pictures and plots: pyvista renders (off screen) and matplotlib line plots (Agg)."""

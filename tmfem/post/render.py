@@ -1,0 +1,245 @@
+"""Off-screen pictures of tensegrity-membrane systems and their mode shapes (pyvista).
+
+Bars are thick black tubes, tendons blue tubes whose colour and width follow the tendon
+force (slack tendons thin and red), the membrane a surface coloured by a field when one is
+given. Everything renders off screen, so it works on a machine without a display.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.io.vtk import (MembraneField, _normalise_cells, check_path, member_data,
+                          membrane_corner_nodes)
+
+_VTK_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "polygon": 7}
+BACKGROUND = "white"
+
+
+def _pv():
+    import pyvista as pv
+    import vtk
+
+    vtk.vtkObject.GlobalWarningDisplayOff()
+    pv.OFF_SCREEN = True
+    return pv
+
+
+def _tendon_cmap():
+    from matplotlib.colors import LinearSegmentedColormap
+    return LinearSegmentedColormap.from_list("tendon", ["#9ecae1", "#2171b5", "#08306b"])
+
+
+def _ugrid(pv, points: np.ndarray, blocks: list):
+    """A pyvista UnstructuredGrid from points (3, n) and (type, conn (nv, nc)) blocks."""
+    cells, types = [], []
+    for ctype, conn in blocks:
+        nv, nc = conn.shape
+        cells.append(np.vstack([np.full(nc, nv), conn]).T.ravel())
+        types.append(np.full(nc, _VTK_TYPES[ctype], dtype=np.uint8))
+    return pv.UnstructuredGrid(np.concatenate(cells).astype(np.int64), np.concatenate(types),
+                               np.ascontiguousarray(points.T, dtype=float))
+
+
+def _segments(pv, X: np.ndarray, conn: np.ndarray):
+    """PolyData with one line cell per column of conn (2, m)."""
+    lines = np.vstack([np.full(conn.shape[1], 2), conn]).T.ravel()
+    return pv.PolyData(np.ascontiguousarray(X.T, dtype=float), lines=lines)
+
+
+def _screenshot(plotter, png_path: Path) -> Path:
+    plotter.screenshot(str(png_path))
+    plotter.close()
+    if not png_path.is_file() or png_path.stat().st_size == 0:
+        raise RuntimeError(f"pyvista wrote no image to {png_path}")
+    return png_path
+
+
+def render_configuration(png_path, system, *, q=None, tendon_forces=None, membrane=None,
+                         title=None, window_size=(1200, 900), membrane_field: str | None = None,
+                         labels: bool | None = None) -> Path:
+    """Render a configuration of ``system`` to a PNG, off screen.
+
+    Parameters
+    ----------
+    png_path : str or Path
+        Output ``.png``.
+    system : System
+    q : ndarray, optional
+        Generalised coordinates (eqs. 3.1-3.2); default ``system.q``.
+    tendon_forces : ndarray (n_tendons,), optional
+        Tendon forces [N]: colour and width of the tendons, slack (<= 0) ones in red.
+    membrane : MembraneField, optional
+        The membrane mesh in its current position; without it the membrane polygon
+        B_M1..B_MN is drawn.
+    title : str, optional
+    window_size : (int, int)
+    membrane_field : str, optional
+        Name of a cell or point array of ``membrane`` to colour the membrane by; default
+        the first cell array, if any.
+    labels : bool, optional
+        Draw node labels A_ij, B_ij, H_1j (default: when there are at most 40 nodes).
+    """
+    png_path = check_path(png_path, suffixes=(".png",))
+    pv = _pv()
+    X = system.nodes(q)
+    md = member_data(system, q=q, tendon_forces=tendon_forces)
+    nb = system.M * system.N
+    size = float(np.ptp(X, axis=1).max()) or 1.0
+    r_bar = 0.009 * size
+    r_ten = 0.0035 * size
+
+    p = pv.Plotter(off_screen=True, window_size=list(window_size))
+    p.set_background(BACKGROUND)
+    p.add_mesh(_segments(pv, X, system.bar_connectivity).tube(radius=r_bar, n_sides=16),
+               color="black", smooth_shading=True)
+
+    con = system.tendon_connectivity
+    if tendon_forces is None:
+        p.add_mesh(_segments(pv, X, con).tube(radius=r_ten, n_sides=12), color="#2171b5",
+                   smooth_shading=True)
+    else:
+        f = md["axial_force"][nb:]
+        taut = f > 0
+        fmax = float(f[taut].max()) if np.any(taut) else 1.0
+        if np.any(taut):
+            # one tube per tendon so that the width follows its force (n_tendons is small)
+            tubes = []
+            for k in np.nonzero(taut)[0]:
+                seg = _segments(pv, X, con[:, [k]])
+                tube = seg.tube(radius=r_ten * (0.5 + 1.0 * f[k] / fmax), n_sides=12)
+                tube.point_data["tendon force [N]"] = np.full(tube.n_points, f[k])
+                tubes.append(tube)
+            merged = tubes[0].merge(tubes[1:]) if len(tubes) > 1 else tubes[0]
+            lo = float(f[taut].min())
+            p.add_mesh(merged, scalars="tendon force [N]", cmap=_tendon_cmap(),
+                       clim=[lo, fmax] if fmax > lo else [0.0, fmax], smooth_shading=True,
+                       scalar_bar_args={"title": "tendon force [N]", "color": "black",
+                                        "vertical": True, "position_x": 0.88,
+                                        "position_y": 0.1})
+        if np.any(~taut):
+            p.add_mesh(_segments(pv, X, con[:, ~taut]).tube(radius=0.5 * r_ten, n_sides=8),
+                       color="red")
+
+    if membrane is not None:
+        if not isinstance(membrane, MembraneField):
+            raise InputError(f"membrane: expected a MembraneField, found {type(membrane).__name__}")
+        grid = _ugrid(pv, membrane.x, [("quad", membrane.mesh.t)])
+        name = membrane_field
+        if name is None and membrane.cell_data:
+            name = next(iter(membrane.cell_data))
+        if name is not None:
+            if name in membrane.cell_data:
+                grid.cell_data[name] = membrane.cell_data[name]
+            elif name in membrane.point_data:
+                grid.point_data[name] = membrane.point_data[name]
+            else:
+                raise InputError(f"membrane_field {name!r}: expected one of "
+                                 f"{sorted(membrane.cell_data) + sorted(membrane.point_data)}")
+            p.add_mesh(grid, scalars=name, cmap="viridis", opacity=0.9, show_edges=True,
+                       edge_color="#555555", line_width=0.5,
+                       scalar_bar_args={"title": name, "color": "black", "vertical": True,
+                                        "position_x": 0.04, "position_y": 0.1})
+        else:
+            p.add_mesh(grid, color="#f4c27a", opacity=0.75, show_edges=True,
+                       edge_color="#9a6a2a", line_width=0.5)
+    else:
+        poly = _ugrid(pv, X, [("polygon", membrane_corner_nodes(system)[:, None])])
+        p.add_mesh(poly, color="#f4c27a", opacity=0.6, show_edges=True, edge_color="#9a6a2a")
+
+    p.add_mesh(pv.PolyData(np.ascontiguousarray(X.T)), color="black", point_size=8,
+               render_points_as_spheres=True)
+    if labels is None:
+        labels = X.shape[1] <= 40
+    if labels:
+        p.add_point_labels(np.ascontiguousarray(X.T), system.node_labels, font_size=12,
+                           point_size=1, shape_opacity=0.0, text_color="#222222",
+                           always_visible=True, show_points=False)
+    if title:
+        p.add_text(title, position="upper_edge", font_size=12, color="black")
+    _set_view(p, X)
+    p.camera.zoom(1.1)
+    return _screenshot(p, png_path)
+
+
+VIEW_DIRECTION = np.array([0.8, -1.5, 0.75])   # from the focal point toward the camera
+
+
+def _set_view(plotter, X: np.ndarray) -> None:
+    """Oblique view from the front right and above, z up, the whole model in frame."""
+    c = 0.5 * (X.min(axis=1) + X.max(axis=1))
+    d = VIEW_DIRECTION / np.linalg.norm(VIEW_DIRECTION)
+    size = float(np.ptp(X, axis=1).max()) or 1.0
+    plotter.camera_position = [tuple(c + 3 * size * d), tuple(c), (0.0, 0.0, 1.0)]
+    plotter.reset_camera()
+
+
+def _mode_scale(points: np.ndarray, shape: np.ndarray) -> float:
+    """Scale making the largest displacement 15% of the model's size."""
+    size = float(np.ptp(points, axis=1).max()) or 1.0
+    amax = float(np.linalg.norm(shape.reshape(-1, 3), axis=1).max())
+    return 0.15 * size / amax if amax > 0 else 0.0
+
+
+def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
+                 scale: float | None = None, title: str | None = None,
+                 window_size=None) -> Path:
+    """Render the first ``k`` mode shapes in a grid of views, off screen.
+
+    Parameters
+    ----------
+    points : ndarray (3, n)
+        Prestressed positions about which the modes are computed.
+    cells : dict or list of (type, connectivity (nv, n_cells))
+        As for :func:`tmfem.io.write_modes`.
+    shapes : ndarray (3 n, kk)
+        Node-interleaved mode shapes (dof = 3 node + component), kk >= k.
+    freq_hz : ndarray (kk,)
+    k : int
+        Number of modes drawn.
+    scale : float, optional
+        Displacement scale; default makes each mode's largest displacement 15% of the
+        model size. Colour: displacement magnitude; grey: the undeformed state.
+    """
+    png_path = check_path(png_path, suffixes=(".png",))
+    pv = _pv()
+    X = np.asarray(points, dtype=float)
+    if X.ndim != 2 or X.shape[0] != 3:
+        raise InputError(f"points: expected shape (3, n), found {X.shape}")
+    n = X.shape[1]
+    S = np.asarray(shapes, dtype=float)
+    if S.ndim != 2 or S.shape[0] != 3 * n:
+        raise InputError(f"shapes: expected shape ({3 * n}, k) for {n} points, found {S.shape}")
+    f = np.atleast_1d(np.asarray(freq_hz, dtype=float))
+    if f.shape != (S.shape[1],):
+        raise InputError(f"freq_hz: expected {S.shape[1]} values, found shape {f.shape}")
+    if not (isinstance(k, (int, np.integer)) and 1 <= k <= S.shape[1]):
+        raise InputError(f"k: expected 1 <= k <= {S.shape[1]} modes, found {k!r}")
+    blocks = _normalise_cells(cells, n)
+    cols = min(k, 3 if k <= 6 else 4)
+    rows = math.ceil(k / cols)
+    if window_size is None:
+        window_size = (500 * cols, 420 * rows)
+    base = _ugrid(pv, X, blocks)
+    p = pv.Plotter(off_screen=True, shape=(rows, cols), window_size=list(window_size),
+                   border=False)
+    for m in range(k):
+        p.subplot(m // cols, m % cols)
+        p.set_background(BACKGROUND)
+        u = S[:, m].reshape(n, 3).T
+        s = _mode_scale(X, S[:, m]) if scale is None else float(scale)
+        g = _ugrid(pv, X + s * u, blocks)
+        g.point_data["|u|"] = np.linalg.norm(u, axis=0)
+        p.add_mesh(base, color="#bbbbbb", style="wireframe", line_width=1)
+        p.add_mesh(g, scalars="|u|", cmap="plasma", show_scalar_bar=False, line_width=3,
+                   show_edges=False)
+        p.add_text(f"mode {m + 1}: {f[m]:.4g} Hz", position="upper_edge", font_size=10,
+                   color="black")
+        _set_view(p, X)
+    if title:
+        p.subplot(0, 0)
+        p.add_text(title, position="lower_left", font_size=9, color="black")
+    return _screenshot(p, png_path)
