@@ -1,0 +1,1 @@
+"""Total-Lagrangian finite elements (dissertation ch. 4): truss, membrane, assembly."""

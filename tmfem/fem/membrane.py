@@ -1,0 +1,277 @@
+"""Four-node total-Lagrangian membrane element (dissertation 4.4.1, eqs. 4.25-4.28).
+
+The reference configuration is the flat, undeformed membrane polygon (the mesh in the
+floating frame O_f, coordinates X = (x_f, y_f)). The current position x(X) of each
+material point is three-dimensional and interpolated with the bilinear functions of
+eq. 4.26, so the deformation gradient F = dx/dX is 3 x 2 and the covariant base vectors of
+eq. 4.8 are its columns. The in-plane Green-Lagrange strain (eq. 4.7) is
+
+    E = (F^T F - I) / 2                          (2 x 2),
+
+the plane-stress St.Venant-Kirchhoff law (eq. 4.9 with the isotropic plane-stress
+constitutive tensor) gives the second Piola-Kirchhoff stress
+
+    S = lam tr(E) I + 2 mu E,   lam = E_mod nu / (1 - nu^2),   mu = E_mod / (2 (1 + nu)),
+
+and the linearised virtual work of eq. 4.4 gives the internal force and tangent
+
+    f(v)      = h int  (F S) : grad v  dA,
+    K(du, v)  = h int  sym(F^T grad du) : C : sym(F^T grad v)      (material, K_L)
+              + h int  S : (grad du^T grad v)  dA                  (initial stress, K_NL).
+
+There is no bending or transverse-shear stiffness (assumption a of 4.4). Both forms are
+scikit-fem forms on ``ElementVector(ElementQuad1(), dim=3)`` over the 2-D mesh, where
+``grad(u)`` has shape (3, 2, ne, nqp). Integration is 2 x 2 Gauss.
+
+Two implementations of the same residual and tangent are kept: the scikit-fem forms
+(:meth:`MembraneTL.internal_forms`, the readable reference) and an einsum B-matrix kernel
+assembled with a cached CSR pattern (:meth:`MembraneTL.internal`, used by the solvers; about
+ten times faster since scikit-fem evaluates a vector form once per pair of the 12 local
+dofs). The test suite checks that they agree to round-off.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.errors import InputError
+from tmfem.mesh.polygon import MembraneMesh
+from tmfem.system.materials import MembraneMaterial
+
+
+def _forms():
+    """The scikit-fem forms (built lazily so that importing this module stays cheap)."""
+    from skfem import BilinearForm, LinearForm
+    from skfem.helpers import dot, grad
+
+    @LinearForm
+    def residual(v, w):
+        # w['P'] = h F S (3, 2, ne, nqp): first Piola-Kirchhoff stress resultant
+        return np.einsum("ia...,ia...->...", w["P"], grad(v))
+
+    @BilinearForm
+    def tangent(du, v, w):
+        F, S, lam, mu2, h = w["F"], w["S"], w["lam"], w["mu2"], w["h"]
+        gu, gv = grad(du), grad(v)
+        au = np.einsum("ia...,ib...->ab...", F, gu)
+        av = np.einsum("ia...,ib...->ab...", F, gv)
+        eu = 0.5 * (au + np.swapaxes(au, 0, 1))
+        ev = 0.5 * (av + np.swapaxes(av, 0, 1))
+        tru = eu[0, 0] + eu[1, 1]
+        trv = ev[0, 0] + ev[1, 1]
+        material = lam * tru * trv + mu2 * np.einsum("ab...,ab...->...", eu, ev)
+        geometric = np.einsum("ab...,ib...,ia...->...", S, gu, gv)
+        return h * (material + geometric)
+
+    @BilinearForm
+    def mass(u, v, w):
+        return w["rhoh"] * dot(u, v)
+
+    return residual, tangent, mass
+
+
+@dataclass
+class MembraneStresses:
+    """Stresses of the membrane at the 2 x 2 Gauss points of each element.
+
+    Attributes
+    ----------
+    S : (3, ne, nqp)
+        Second Piola-Kirchhoff stress (S_11, S_22, S_12) in the reference (floating-frame) axes.
+    cauchy : (3, ne, nqp)
+        Cauchy stress (sigma_11, sigma_22, sigma_12) in the reference axes rotated with the
+        material (R^T sigma R, F = R U): the in-plane stress "in the floating frame".
+    principal : (3, ne, nqp)
+        Principal Cauchy stresses sigma_p1 >= sigma_p2 >= sigma_p3; the normal stress of the
+        membrane is zero and enters as one of the three (eqs. 5.29-5.30).
+    von_mises : (ne, nqp)
+        von Mises stress of eq. 5.30.
+    points : (2, ne, nqp)
+        Reference coordinates of the Gauss points.
+    """
+
+    S: np.ndarray
+    cauchy: np.ndarray
+    principal: np.ndarray
+    von_mises: np.ndarray
+    points: np.ndarray
+
+    @property
+    def principal_elem(self) -> np.ndarray:
+        """Element averages (3, ne) of the principal stresses."""
+        return self.principal.mean(axis=-1)
+
+    @property
+    def von_mises_elem(self) -> np.ndarray:
+        """Element averages (ne,) of the von Mises stress."""
+        return self.von_mises.mean(axis=-1)
+
+
+class MembraneTL:
+    """Total-Lagrangian membrane on a flat reference mesh (eqs. 4.25-4.28).
+
+    Parameters
+    ----------
+    mesh : MembraneMesh
+        Flat reference mesh; ``mesh.p`` (2, nn) are the reference coordinates.
+    material : MembraneMaterial
+        E, nu, rho, h.
+
+    Attributes
+    ----------
+    X : ndarray (3, nn)
+        Reference positions (x_f, y_f, 0).
+    basis : skfem.Basis
+        ``Basis(mesh, ElementVector(ElementQuad1(), dim=3), intorder=3)``; its dofs are
+        node-interleaved (dof = 3 node + component), as everywhere in tmfem.
+    """
+
+    def __init__(self, *, mesh: MembraneMesh, material: MembraneMaterial):
+        from skfem import Basis, ElementQuad1, ElementVector
+
+        p = np.asarray(mesh.p, dtype=float)
+        if p.ndim != 2 or p.shape[0] != 2:
+            raise InputError(f"membrane: expected a flat reference mesh with p of shape (2, nn), "
+                             f"found {p.shape}")
+        self.mesh = mesh
+        self.material = material
+        self.skmesh = mesh.to_skfem()
+        self.basis = Basis(self.skmesh, ElementVector(ElementQuad1(), dim=3), intorder=3)
+        nd = self.basis.nodal_dofs
+        if not np.array_equal(nd, 3 * np.arange(p.shape[1])[None, :] + np.arange(3)[:, None]):
+            raise RuntimeError("scikit-fem changed its vector dof numbering: expected "
+                               "node-interleaved nodal_dofs (dof = 3 node + component)")
+        self.nn = p.shape[1]
+        self.ndof = 3 * self.nn
+        self.X = np.vstack([p, np.zeros((1, self.nn))])
+        E, nu = material.E, material.nu
+        self.lam = E * nu / (1.0 - nu**2)       # plane-stress Lame constant
+        self.mu2 = E / (1.0 + nu)               # 2 mu
+        self._residual, self._tangent, self._mass = _forms()
+        self._M = None
+        from skfem import ElementQuad1 as _Q1
+        sb = Basis(self.skmesh, _Q1(), intorder=3)
+        self._dN = np.stack([np.array(sb.basis[k][0].grad) for k in range(4)])  # (4, 2, ne, nqp)
+        self._dx = np.array(sb.dx)                                              # (ne, nqp)
+        from tmfem.fem.assembly import Assembler, element_dofs
+        self._asm = Assembler(element_dofs(self.skmesh.t, 3), self.ndof)
+        if not np.array_equal(np.asarray(self.skmesh.t), np.asarray(mesh.t)):
+            raise RuntimeError("scikit-fem reordered the quadrilateral connectivity")
+        # element areas, for checks
+        detJ = np.abs(self.basis.mapping.detDF(self.basis.X))
+        if np.any(detJ <= 0):
+            raise InputError("membrane: degenerate element (zero Jacobian) in the reference mesh")
+
+    # ------------------------------------------------------------------ kinematics
+    def _check_x(self, x) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        if x.shape != (3, self.nn):
+            raise InputError(f"membrane: expected current positions of shape (3, {self.nn}), "
+                             f"found {x.shape}")
+        return x
+
+    def kinematics(self, x):
+        """Deformation gradient F (3, 2, ne, nqp), Green-Lagrange E (2, 2, ...) and 2nd PK S
+        (2, 2, ...) at the Gauss points (eqs. 4.7, 4.9)."""
+        x = self._check_x(x)
+        u = (x - self.X).T.ravel()
+        F = np.array(self.basis.interpolate(u).grad)
+        F[0, 0] += 1.0
+        F[1, 1] += 1.0
+        C = np.einsum("ia...,ib...->ab...", F, F)
+        Eg = 0.5 * C
+        Eg[0, 0] -= 0.5
+        Eg[1, 1] -= 0.5
+        tr = Eg[0, 0] + Eg[1, 1]
+        S = 0.5 * self.mu2 * 2.0 * Eg
+        S[0, 0] += self.lam * tr
+        S[1, 1] += self.lam * tr
+        return F, Eg, S
+
+    # ------------------------------------------------------------------ residual/tangent
+    def internal(self, x, *, tangent: bool = True):
+        """Internal nodal forces f (3 nn,) and tangent K (csr) at current positions x (3, nn).
+
+        Eq. 4.4-4.6: f = F (element stresses), K = K_L + K_NL. Vectorised B-matrix kernel:
+        the variation of the Green-Lagrange strain of node k, component i is (Voigt)
+        B = [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1].
+        """
+        F, _, S = self.kinematics(x)
+        h = self.material.h
+        dN, dx = self._dN, self._dx
+        P = h * np.einsum("ia...,ab...->ib...", F, S)                 # (3, 2, ne, nqp)
+        fe = np.einsum("ibeq,kbeq,eq->eki", P, dN, dx).reshape(-1, 12)
+        f = self._asm.vector(fe)
+        if not tangent:
+            return f, None
+        B = np.empty((4, 3, 3) + dx.shape)
+        B[:, :, 0] = F[None, :, 0] * dN[:, None, 0]
+        B[:, :, 1] = F[None, :, 1] * dN[:, None, 1]
+        B[:, :, 2] = F[None, :, 0] * dN[:, None, 1] + F[None, :, 1] * dN[:, None, 0]
+        lam, mu = self.lam, 0.5 * self.mu2
+        D = np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
+        hdx = h * dx
+        DB = np.einsum("vw,kiweq->kiveq", D, B)
+        Km = np.einsum("kiveq,ljveq,eq->ekilj", B, DB, hdx, optimize=True)
+        # initial-stress part: delta_ij N_k,a S_ab N_l,b
+        g = np.einsum("kaeq,abeq,lbeq,eq->ekl", dN, S, dN, hdx, optimize=True)
+        Km += g[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
+        K = self._asm.matrix(Km.reshape(-1, 12, 12))
+        return f, K
+
+    def internal_forms(self, x, *, tangent: bool = True):
+        """Same as :meth:`internal`, assembled with the scikit-fem forms (reference)."""
+        F, _, S = self.kinematics(x)
+        h = self.material.h
+        P = h * np.einsum("ia...,ab...->ib...", F, S)
+        f = self._residual.assemble(self.basis, P=P)
+        if not tangent:
+            return f, None
+        K = self._tangent.assemble(self.basis, F=F, S=S, lam=self.lam, mu2=self.mu2, h=h)
+        return f, K.tocsr()
+
+    def mass(self) -> sp.csr_matrix:
+        """Consistent mass matrix (rho h int u.v dA)."""
+        if self._M is None:
+            self._M = self._mass.assemble(self.basis, rhoh=self.material.rho * self.material.h).tocsr()
+        return self._M
+
+    def area(self) -> float:
+        """Reference area of the membrane."""
+        return float(np.sum(self.basis.dx))
+
+    # ------------------------------------------------------------------ stresses
+    def stresses(self, x) -> MembraneStresses:
+        """Second Piola-Kirchhoff and Cauchy stresses, principal and von Mises (eqs. 5.29-5.30).
+
+        The Cauchy stress is sigma = F S F^T / J with J = j lambda_3, j = sqrt(det F^T F) the
+        area ratio and lambda_3 = sqrt(1 + 2 E_33), E_33 = -nu/(1-nu) (E_11 + E_22) the
+        thickness stretch of plane-stress SVK. It is reported in the reference axes rotated with
+        the material, R^T sigma R = U S U / J with U = sqrt(F^T F).
+        """
+        F, Eg, S = self.kinematics(x)
+        C = np.einsum("ia...,ib...->ab...", F, F)
+        detC = C[0, 0] * C[1, 1] - C[0, 1] ** 2
+        j = np.sqrt(detC)
+        nu = self.material.nu
+        E33 = -nu / (1.0 - nu) * (Eg[0, 0] + Eg[1, 1])
+        J = j * np.sqrt(1.0 + 2.0 * E33)
+        # U = sqrt(C) for 2x2 SPD C: (C + sqrt(det C) I) / sqrt(tr C + 2 sqrt(det C))
+        U = C.copy()
+        U[0, 0] += j
+        U[1, 1] += j
+        U /= np.sqrt(C[0, 0] + C[1, 1] + 2.0 * j)
+        sig = np.einsum("ab...,bc...,cd...->ad...", U, S, U) / J
+        s11, s22, s12 = sig[0, 0], sig[1, 1], sig[0, 1]
+        c = 0.5 * (s11 + s22)
+        r = np.sqrt((0.5 * (s11 - s22)) ** 2 + s12**2)
+        three = np.stack([c + r, c - r, np.zeros_like(c)])
+        principal = -np.sort(-three, axis=0)
+        p1, p2, p3 = principal
+        vm = np.sqrt(((p1 - p2) ** 2 + (p2 - p3) ** 2 + (p3 - p1) ** 2) / 2.0)
+        points = np.array(self.basis.mapping.F(self.basis.X))
+        return MembraneStresses(S=np.stack([S[0, 0], S[1, 1], S[0, 1]]),
+                                cauchy=np.stack([s11, s22, s12]),
+                                principal=principal, von_mises=vm, points=points)

@@ -1,0 +1,163 @@
+"""Two-node total-Lagrangian truss element for bars and tendons (dissertation 4.3.3).
+
+Geometry is linear between the end nodes (eqs. 4.23-4.24, h_k = (1 + r_1^k r_1)/2), so
+the covariant base vector g_1 = (x_2 - x_1)/2 is constant along the element and the
+Green-Lagrange strain of eq. 4.7, referred to the *rest* length L (the reference
+configuration of a tendon is its unstretched state), is
+
+    E = (l^2 - L^2) / (2 L^2),            l = |x_2 - x_1|.
+
+With the St.Venant-Kirchhoff law S = E_mod E (eq. 4.9) and the reference volume A L the
+strain energy is W = EA L E^2 / 2, which gives the internal force and the tangent of
+eqs. 4.4-4.6 (material part K_L plus initial-stress part K_NL):
+
+    f_2 = -f_1 = (EA E / L) d,             d = x_2 - x_1,
+    K_22 = (EA / L^3) d d^T + (EA E / L) I,   K = [[K_22, -K_22], [-K_22, K_22]].
+
+The true (Cauchy) axial force is N = EA E l / L (first Piola-Kirchhoff stress times A).
+Tension-only members (tendons) carry zero force and stiffness when E <= 0 and are
+reported as slack. Everything is vectorised over elements; assembly is sparse CSR.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.errors import InputError
+from tmfem.fem.assembly import Assembler, element_dofs
+
+
+@dataclass
+class TrussSet:
+    """A set of two-node truss elements.
+
+    Attributes
+    ----------
+    conn : ndarray (2, ne) int
+        End nodes of each element.
+    L : ndarray (ne,)
+        Reference (rest) lengths [m].
+    EA : ndarray (ne,)
+        Axial stiffness [N].
+    rhoA : ndarray (ne,)
+        Mass per unit reference length [kg/m].
+    tension_only : ndarray (ne,) bool
+        True for tendons (no compression).
+    """
+
+    conn: np.ndarray
+    L: np.ndarray
+    EA: np.ndarray
+    rhoA: np.ndarray
+    tension_only: np.ndarray
+    _assemblers: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        self.conn = np.asarray(self.conn, dtype=np.int64)
+        if self.conn.ndim != 2 or self.conn.shape[0] != 2:
+            raise InputError(f"truss: expected conn of shape (2, ne), found {self.conn.shape}")
+        ne = self.conn.shape[1]
+        for name in ("L", "EA", "rhoA", "tension_only"):
+            v = np.asarray(getattr(self, name))
+            if v.ndim == 0:
+                v = np.full(ne, v)
+            if v.shape != (ne,):
+                raise InputError(f"truss: expected {name} of shape ({ne},), found {v.shape}")
+            setattr(self, name, v.astype(bool) if name == "tension_only" else v.astype(float))
+        if ne and not np.all(self.L > 0):
+            raise InputError(f"truss: expected rest lengths L > 0, found min {self.L.min()!r}")
+        if ne and not (np.all(self.EA > 0) and np.all(self.rhoA >= 0)):
+            raise InputError(f"truss: expected EA > 0 and rhoA >= 0, found min EA {self.EA.min()!r}, "
+                             f"min rhoA {self.rhoA.min()!r}")
+        if ne and np.any(self.conn[0] == self.conn[1]):
+            k = int(np.flatnonzero(self.conn[0] == self.conn[1])[0])
+            raise InputError(f"truss: element {k} connects node {self.conn[0, k]} to itself")
+
+    @property
+    def ne(self) -> int:
+        return self.conn.shape[1]
+
+    def assembler(self, nn: int) -> Assembler:
+        """Cached sparse assembler for ``nn`` nodes (3 nn dofs)."""
+        a = self._assemblers.get(nn)
+        if a is None:
+            if self.ne and self.conn.max() >= nn:
+                raise InputError(f"truss: expected node indices < {nn}, found {self.conn.max()}")
+            a = self._assemblers[nn] = Assembler(element_dofs(self.conn, 3), 3 * nn)
+        return a
+
+
+@dataclass
+class TrussResponse:
+    """Internal force vector, tangent and member state of a :class:`TrussSet`.
+
+    f : (3 nn,) internal nodal forces; K : csr (3 nn, 3 nn) tangent; N : (ne,) true axial
+    force (tension positive); strain : (ne,) Green-Lagrange strain w.r.t. L;
+    slack : (ne,) True for tension-only members with strain <= 0; length : (ne,) current l.
+    """
+
+    f: np.ndarray
+    K: sp.csr_matrix
+    N: np.ndarray
+    strain: np.ndarray
+    slack: np.ndarray
+    length: np.ndarray
+
+
+def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True) -> TrussResponse:
+    """Total-Lagrangian internal force and tangent of all truss elements (eqs. 4.4-4.7, 4.23-4.24).
+
+    Parameters
+    ----------
+    x : ndarray (3, nn)
+        Current nodal positions.
+    trusses : TrussSet
+    tangent : bool
+        If False, ``K`` is None (residual only, e.g. inside a line search).
+    """
+    x = np.asarray(x, dtype=float)
+    if x.ndim != 2 or x.shape[0] != 3:
+        raise InputError(f"truss: expected positions of shape (3, nn), found {x.shape}")
+    nn = x.shape[1]
+    asm = trusses.assembler(nn)
+    d = x[:, trusses.conn[1]] - x[:, trusses.conn[0]]          # (3, ne)
+    l2 = np.einsum("ie,ie->e", d, d)
+    L = trusses.L
+    E = (l2 - L**2) / (2.0 * L**2)
+    slack = trusses.tension_only & (E <= 0.0)
+    active = ~slack
+    EAe = np.where(active, trusses.EA, 0.0)
+    s = EAe * E / L                                            # f_2 = s d
+    f2 = (s * d).T                                             # (ne, 3)
+    fe = np.concatenate([-f2, f2], axis=1)
+    f = asm.vector(fe)
+    l = np.sqrt(l2)
+    N = EAe * E * l / L
+    K = None
+    if tangent:
+        K22 = (EAe / L**3)[:, None, None] * np.einsum("ie,je->eij", d, d) \
+            + s[:, None, None] * np.eye(3)[None]
+        Ke = np.empty((trusses.ne, 6, 6))
+        Ke[:, :3, :3] = K22
+        Ke[:, 3:, 3:] = K22
+        Ke[:, :3, 3:] = -K22
+        Ke[:, 3:, :3] = -K22
+        K = asm.matrix(Ke)
+    return TrussResponse(f=f, K=K, N=N, strain=E, slack=slack, length=l)
+
+
+def truss_mass(trusses: TrussSet, nn: int, *, lumped: bool = False) -> sp.csr_matrix:
+    """Mass matrix of the truss elements, total mass rho A L per element.
+
+    Consistent (eq. 4.6 with the shape functions of eq. 4.24): (rho A L / 6) [[2I, I], [I, 2I]];
+    lumped: (rho A L / 2) I at each end.
+    """
+    asm = trusses.assembler(nn)
+    m = trusses.rhoA * trusses.L
+    if lumped:
+        pattern = np.kron(np.eye(2), np.eye(3)) / 2.0
+    else:
+        pattern = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3)) / 6.0
+    return asm.matrix(m[:, None, None] * pattern[None])
