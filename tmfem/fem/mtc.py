@@ -1,0 +1,492 @@
+"""The membrane-truss-cable (MTC) model of a tensegrity-membrane system (dissertation 4.4, 6.2-6.4).
+
+Built from a :class:`~tmfem.system.System`: the membrane is the flat polygon meshed by
+``polygon_quad_mesh`` (N quadrilaterals of n x n four-node total-Lagrangian membrane elements,
+4.4.1); every bar is one two-node truss (assumption b of 4.4: axial deformation only, EA and
+rho A of ``system.bar``); every tendon is ``k`` tension-only truss elements with ``k - 1``
+internal nodes carrying its mass, reference length = rest length / k. The bar bases A_1j are
+pinned (their three translations fixed) and nothing else is constrained: the top membrane
+floats on the bar tops, which are the membrane corners (``attachment="point"``), or the
+weighted centroids of small corner patches (``attachment="distributed"``, see
+:mod:`tmfem.fem.mtc_topology`).
+
+Statics (6.2) start from the *undeformed* membrane (flat, unstressed, placed in the plane of
+the design bar tops) and let the rest lengths pull the system into equilibrium. That start is
+singular twice over: an unstressed flat membrane has no transverse stiffness and the bars
+pinned at their bases form a mechanism until the tendons and membrane are stressed. The
+solver is Newton's method regularised by pseudo-transient continuation,
+
+    (K_T + M / dt^2) du = -r,      dt^2 <- dt^2 |r_prev| / |r|   (switched evolution relaxation)
+
+with a backtracking line search on |r|; as the residual falls dt grows without bound and the
+iteration becomes Newton's, with its quadratic convergence (the test suite checks that the
+last steps are Newton steps). Modal analysis solves (K_T - omega^2 M) phi = 0 about the
+converged state (eq. 5.32).
+"""
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
+from tmfem.fem.membrane import MembraneTL
+from tmfem.fem.mtc_topology import (MTCTopology, build_topology, floating_frame,
+                                    membrane_placement, to_floating)
+from tmfem.fem.truss import TrussSet, truss_internal, truss_mass
+from tmfem.system.topology import label
+
+
+def green_rest_length(length, tension, EA):
+    """Rest length r of a total-Lagrangian truss that carries ``tension`` at ``length``.
+
+    The truss of :mod:`tmfem.fem.truss` has N = EA E l / r with E = (l^2 - r^2) / (2 r^2);
+    with s = l / r this is the cubic s^3 - s - 2 N / EA = 0 (one positive root for N > -EA/3),
+    solved by Newton's method from the linear-spring value s = 1 + N / EA (eq. 3.8).
+    """
+    length = np.asarray(length, dtype=float)
+    c = 2.0 * np.asarray(tension, dtype=float) / np.asarray(EA, dtype=float)
+    s = 1.0 + 0.5 * c
+    for _ in range(50):
+        g = s**3 - s - c
+        s = s - g / (3 * s**2 - 1)
+        if np.all(np.abs(g) < 1e-15):
+            break
+    return length / s
+
+
+def linear_rest_length(length, tension, EA):
+    """Rest length of the linear spring of eqs. 3.8-3.9: T = EA (|d| - r) / r."""
+    return np.asarray(EA) * np.asarray(length) / (np.asarray(tension) + np.asarray(EA))
+
+
+@dataclass
+class StaticResult:
+    """Equilibrium of an MTC model and the history of the iteration.
+
+    Attributes
+    ----------
+    x : ndarray (3, n_nodes)
+        Converged positions of all nodes.
+    iterations : int
+    residual_history : list of float
+        Euclidean norm of the free residual [N] after each iteration (first = start).
+    monitor : dict
+        Label -> array (iterations + 1, 3) of the positions of monitored nodes.
+    dt2_history : list of float
+        The pseudo-time regularisation dt^2 of each step (inf once it is pure Newton).
+    time : float
+        Wall time [s].
+    """
+
+    x: np.ndarray
+    iterations: int
+    residual_history: list
+    monitor: dict
+    dt2_history: list
+    time: float
+    newton_iterations_tangent: list = field(default_factory=list)
+
+
+class MTCModel:
+    """Membrane-truss-cable model of a ``System`` (4.4, 6.2).
+
+    Parameters
+    ----------
+    system : System
+        An M-N system (1-N(D) systems are rejected: their H_1j nodes need bending bars).
+    mesh_n : int
+        Membrane elements along each side of the N quadrilaterals (10 -> 4 x 10 x 10 for 1-4).
+    tendon_elements : int
+        Truss elements per tendon (6.2 uses 3).
+    attachment : {"point", "distributed"}
+        How the bar tops hold the membrane corners.
+    patch : float, optional
+        Radius of the distributed attachment patch [m] (default 5 % of r_mb).
+    rest_lengths : ndarray or {"system", "design", "mtc"}, optional
+        Tendon rest lengths. Default: ``system.rest_lengths`` when set, else ``"design"``:
+        the design of ``tmfem.equilibrium.design_equilibrium`` (eq. 3.8). ``"mtc"``: the
+        rest lengths for which the design configuration is an exact equilibrium of this model
+        (:meth:`consistent_rest_lengths`).
+    lumped_tendon_mass : bool
+        Lumped instead of consistent truss mass for the tendons (bars always consistent: it
+        gives a pinned rigid bar its exact rotary inertia m l^2 / 3).
+    """
+
+    def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3,
+                 attachment: str = "point", patch: float | None = None, rest_lengths=None,
+                 lumped_tendon_mass: bool = False):
+        self.system = system
+        self.topology: MTCTopology = build_topology(system, mesh_n=mesh_n,
+                                                    tendon_elements=tendon_elements,
+                                                    attachment=attachment, patch=patch)
+        topo = self.topology
+        self.membrane = MembraneTL(mesh=topo.mesh, material=system.membrane)
+        bar = system.bar
+        nb = system.M * system.N
+        self.bars = TrussSet(conn=topo.bar_conn, L=system.l.ravel().copy(),
+                             EA=np.full(nb, bar.E * bar.area), rhoA=np.full(nb, bar.rho * bar.area),
+                             tension_only=np.zeros(nb, dtype=bool))
+        secs = [system.tendon_section(t) for t in system.tendons]
+        self.tendon_EA = np.array([s.EA for s in secs])
+        self.tendon_area = np.array([s.area for s in secs])
+        self.tendon_rhoA = np.array([(s.rho or 0.0) * s.area for s in secs])
+        self.tendon_yield = np.array([s.yield_stress if s.yield_stress else np.nan for s in secs])
+        self.lumped_tendon_mass = lumped_tendon_mass
+        free = np.ones(3 * topo.n_red, dtype=bool)
+        for n in topo.fixed_nodes:
+            free[3 * topo.red_node[n]: 3 * topo.red_node[n] + 3] = False
+        self.free = free
+        self._M = None
+        self.rest_lengths_source = None
+        if rest_lengths is None:
+            rest_lengths = "system" if system.rest_lengths is not None else "design"
+        self.set_rest_lengths(rest_lengths)
+
+    # ------------------------------------------------------------------ set-up
+    def set_rest_lengths(self, rest) -> None:
+        """Set the tendon rest lengths: an array (one per tendon) or ``"system"``,
+        ``"design"`` or ``"mtc"`` (see the class docstring)."""
+        n_t = len(self.system.tendons)
+        if isinstance(rest, str):
+            source = rest
+            if rest == "system":
+                if self.system.rest_lengths is None:
+                    raise InputError("rest_lengths='system': the system has no rest lengths")
+                r = self.system.rest_lengths
+            elif rest == "design":
+                r = self._design_rest_lengths()
+            elif rest == "mtc":
+                self._set_tendons(np.full(n_t, 1.0))   # placeholder lengths for the solve
+                r = self.consistent_rest_lengths()["rest_lengths"]
+            else:
+                raise InputError(f"rest_lengths: expected an array or one of 'system', 'design', "
+                                 f"'mtc', found {rest!r}")
+        else:
+            source = "given"
+            r = np.asarray(rest, dtype=float)
+        r = np.asarray(r, dtype=float)
+        if r.shape != (n_t,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
+            raise InputError(f"expected {n_t} positive tendon rest lengths, found {r}")
+        self.rest_lengths = r
+        self.rest_lengths_source = source
+        self._set_tendons(r)
+
+    def _set_tendons(self, r) -> None:
+        k = self.topology.tendon_elements
+        e = self.topology.tendon_of_element
+        self.tendons = TrussSet(conn=self.topology.tendon_conn, L=r[e] / k, EA=self.tendon_EA[e],
+                                rhoA=self.tendon_rhoA[e], tension_only=np.ones(e.size, dtype=bool))
+        self._M = None
+
+    def _design_rest_lengths(self) -> np.ndarray:
+        try:
+            from tmfem.equilibrium import design_equilibrium
+        except ImportError as exc:  # the equilibrium package has not got it
+            raise InputError("the system has no rest lengths and tmfem.equilibrium."
+                             "design_equilibrium is unavailable; pass rest_lengths='mtc' or an "
+                             f"array ({exc})") from exc
+        d = design_equilibrium(self.system)
+        return np.asarray(d.rest_lengths, dtype=float)
+
+    # ------------------------------------------------------------------ positions
+    @property
+    def n_nodes(self) -> int:
+        return self.topology.n_nodes
+
+    @property
+    def ndof(self) -> int:
+        """Number of free degrees of freedom."""
+        return int(self.free.sum())
+
+    def full(self, xr: np.ndarray) -> np.ndarray:
+        """Full positions (3, n_nodes) from the independent ones (flat, 3 n_red)."""
+        return (self.topology.T @ xr).reshape(-1, 3).T
+
+    def reduce(self, x: np.ndarray) -> np.ndarray:
+        """Independent positions (flat) of full positions (3, n_nodes)."""
+        keep = self.topology.red_node >= 0
+        return np.ascontiguousarray(x[:, keep].T).ravel()
+
+    def _straight_tendons(self, x: np.ndarray) -> None:
+        topo = self.topology
+        k = topo.tendon_elements
+        if k == 1:
+            return
+        c = self.system.tendon_connectivity
+        a = x[:, topo.system_node[c[0]]]
+        b = x[:, topo.system_node[c[1]]]
+        s = np.arange(1, k) / k
+        x[:, topo.tendon_internal] = a[:, :, None] + (b - a)[:, :, None] * s[None, None, :]
+
+    def initial_positions(self, start: str = "undeformed") -> np.ndarray:
+        """Start configuration (3, n_nodes) of the static solve.
+
+        ``"undeformed"``: the unstressed flat membrane, centred in the plane of the design
+        bar tops (its corners lie Delta inside the design corners); bars and lower nodes at the
+        design; the top bars reach the membrane corners. ``"design"``: the design bar
+        configuration with the membrane stretched affinely onto the design corners.
+        """
+        topo, sysm = self.topology, self.system
+        x = np.zeros((3, topo.n_nodes))
+        X = sysm.nodes()
+        x[:, topo.system_node] = X
+        Btop = X[:, [sysm.node_index(label("B", sysm.M, j)) for j in range(1, sysm.N + 1)]]
+        if start not in ("undeformed", "design"):
+            raise InputError(f"start: expected 'undeformed' or 'design', found {start!r}")
+        x[:, :topo.n_mesh] = membrane_placement(sysm, topo.mesh, Btop,
+                                                stretch_to_corners=(start == "design"))
+        x = self.full(self.reduce(x))          # the bar tops follow the attachment
+        self._straight_tendons(x)
+        return x
+
+    # ------------------------------------------------------------------ operators
+    def internal_full(self, x: np.ndarray, *, tangent: bool = True):
+        """Internal force (3 n_nodes,) and tangent of the full model at positions x (3, n_nodes)."""
+        nm = self.topology.n_mesh
+        fm, Km = self.membrane.internal(x[:, :nm], tangent=tangent)
+        tb = truss_internal(x, self.bars, tangent=tangent)
+        tt = truss_internal(x, self.tendons, tangent=tangent)
+        n = 3 * self.n_nodes
+        f = tb.f + tt.f
+        f[:3 * nm] += fm
+        K = None
+        if tangent:
+            K = _pad(Km, n) + tb.K + tt.K
+        return f, K
+
+    def residual(self, xr: np.ndarray, *, tangent: bool = True):
+        """Reduced internal force T^T f and tangent T^T K T at independent positions xr."""
+        T = self.topology.T
+        f, K = self.internal_full(self.full(xr), tangent=tangent)
+        r = T.T @ f
+        if not tangent:
+            return r, None
+        return r, (T.T @ K @ T).tocsr()
+
+    def mass(self) -> sp.csr_matrix:
+        """Reduced mass matrix T^T M T (membrane consistent, bars consistent, tendons
+        consistent or lumped)."""
+        if self._M is None:
+            n = 3 * self.n_nodes
+            Mm = _pad(self.membrane.mass(), n)
+            M = Mm + truss_mass(self.bars, self.n_nodes) \
+                + truss_mass(self.tendons, self.n_nodes, lumped=self.lumped_tendon_mass)
+            T = self.topology.T
+            self._M = (T.T @ M @ T).tocsr()
+        return self._M
+
+    def energy(self, xr: np.ndarray) -> float:
+        """Total strain energy [J] of membrane, bars and tendons at independent positions xr.
+
+        Truss: EA L E^2 / 2 (zero when a tendon is slack); membrane: h int (lam tr(E)^2 / 2
+        + mu E:E) dA (plane-stress St.Venant-Kirchhoff, the potential of eq. 4.9).
+        """
+        x = self.full(xr)
+        W = 0.0
+        for ts in (self.bars, self.tendons):
+            d = x[:, ts.conn[1]] - x[:, ts.conn[0]]
+            E = (np.einsum("ie,ie->e", d, d) - ts.L**2) / (2 * ts.L**2)
+            E = np.where(ts.tension_only & (E <= 0), 0.0, E)
+            W += 0.5 * float(np.sum(ts.EA * ts.L * E**2))
+        _, Eg, _ = self.membrane.kinematics(x[:, :self.topology.n_mesh])
+        tr = Eg[0, 0] + Eg[1, 1]
+        dens = 0.5 * self.membrane.lam * tr**2 + 0.5 * self.membrane.mu2 * np.einsum(
+            "ab...,ab...->...", Eg, Eg)
+        W += self.system.membrane.h * float(np.sum(dens * np.asarray(self.membrane.basis.dx)))
+        return W
+
+    # ------------------------------------------------------------------ statics
+    def solve_static(self, *, start: str = "undeformed", x0: np.ndarray | None = None,
+                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress: bool = False
+                     ) -> StaticResult:
+        """Equilibrium reached from ``start`` (6.2): Newton regularised by a mass-scaled
+        Levenberg-Marquardt trust region on the strain energy (module docstring).
+
+        Parameters
+        ----------
+        start : {"undeformed", "design"}
+        x0 : ndarray (3, n_nodes), optional
+            Explicit start (overrides ``start``).
+        tol : float
+            Converged when |r_free| <= tol * (sum of |member forces| + 1 N), the last step
+            being a pure Newton step (mu = 0).
+        monitor : sequence of str
+            Node labels (``"B_14"``) whose positions are recorded at every iteration.
+        """
+        t0 = time.perf_counter()
+        x = self.initial_positions(start) if x0 is None else np.asarray(x0, dtype=float)
+        xr = self.reduce(x)
+        free = self.free
+        idx = {lab: self.topology.system_node[self.system.node_index(lab)] for lab in monitor}
+        hist = {lab: [x[:, n].copy()] for lab, n in idx.items()}
+        Md = np.asarray(self.mass().diagonal())[free]
+        Md = np.maximum(Md, 1e-9 * Md.max())
+        Dm = sp.diags(Md)
+        r, K = self.residual(xr)
+        rn = np.linalg.norm(r[free])
+        W = self.energy(xr)
+        res_hist, mu_hist = [rn], []
+        Kd = np.abs(K.diagonal()[free])
+        mu_scale = float(np.median(Kd[Kd > 0]) / np.median(Md)) if np.any(Kd > 0) else 1.0
+        mu = 1e-3 * mu_scale
+        it = 0
+        converged = False
+        for it in range(1, max_iter + 1):
+            Kf = K[free][:, free]
+            g = r[free]
+            for _attempt in range(40):
+                A = (Kf + mu * Dm) if mu > 0 else Kf
+                du = spla.spsolve(A.tocsc(), -g)
+                ok = np.all(np.isfinite(du)) and float(g @ du) < 0
+                if ok:
+                    xt = xr.copy()
+                    xt[free] += du
+                    Wt = self.energy(xt)
+                    pred = -(float(g @ du) + 0.5 * float(du @ (Kf @ du)))
+                    actual = W - Wt
+                    rt, Kt = self.residual(xt)
+                    rtn = np.linalg.norm(rt[free])
+                    # near the solution energy differences drown in round-off: accept a
+                    # step that reduces the residual there
+                    tiny = abs(pred) < 1e-11 * max(abs(W), 1e-30)
+                    if np.isfinite(Wt) and (actual > 0 or (tiny and rtn < rn)):
+                        rho = actual / pred if pred > 0 and not tiny else 1.0
+                        break
+                mu = max(4.0 * mu, 1e-8 * mu_scale)
+            else:
+                raise ConvergenceError(f"MTC static solve: no descent step at iteration {it} "
+                                       f"(|r| = {rn:.3e} N, mu = {mu:.3e}); residual history "
+                                       f"{np.array(res_hist[-6:])} N")
+            mu_used = mu
+            xr, r, K, W, rn = xt, rt, Kt, Wt, rtn
+            if rho > 0.75:
+                mu = 0.0 if mu < 1e-10 * mu_scale else mu / 8.0
+            elif rho < 0.25:
+                mu = max(4.0 * mu, 1e-8 * mu_scale)
+            res_hist.append(rn)
+            mu_hist.append(mu_used)
+            xf = self.full(xr)
+            for lab, n in idx.items():
+                hist[lab].append(xf[:, n].copy())
+            if progress:
+                print(f"  static it {it:3d}  |r| = {rn:.3e} N  mu = {mu_used:.3g}  rho = {rho:.3g}",
+                      file=sys.stderr)
+            scale = 1.0 + float(np.sum(np.abs(truss_internal(xf, self.tendons, tangent=False).N))
+                                + np.sum(np.abs(truss_internal(xf, self.bars, tangent=False).N)))
+            if rn <= tol * scale and mu_used == 0.0:
+                converged = True
+                break
+        if not converged:
+            raise ConvergenceError(f"MTC static solve: no equilibrium after {max_iter} iterations; "
+                                   f"residual history {np.array(res_hist[-8:])} N, mu = {mu:.3g}")
+        return StaticResult(x=self.full(xr), iterations=it, residual_history=res_hist,
+                            monitor={k: np.array(v) for k, v in hist.items()},
+                            dt2_history=mu_hist, time=time.perf_counter() - t0)
+
+    # ------------------------------------------------------------------ modes
+    def modes(self, x: np.ndarray, *, k: int = 12):
+        """Lowest ``k`` natural modes about the prestressed state x (eq. 5.32).
+
+        Returns a ``Modes`` of :func:`tmfem.solvers.lowest_modes` whose ``shapes`` are the
+        reduced vectors; :meth:`full_shapes` maps them to all nodes.
+        """
+        from tmfem.solvers import lowest_modes
+        _, K = self.residual(self.reduce(x))
+        return lowest_modes(K, self.mass(), k=k, free=self.free)
+
+    def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
+        """Mode shapes (3, n_nodes, k) from reduced vectors (3 n_red, k)."""
+        S = self.topology.T @ shapes
+        return S.reshape(self.n_nodes, 3, -1).transpose(1, 0, 2)
+
+    # ------------------------------------------------------------------ design consistency
+    def consistent_rest_lengths(self, *, tol: float = 1e-10) -> dict:
+        """Rest lengths for which the design configuration is an equilibrium of this model.
+
+        An independent formulation of the design of 3.2: (1) the membrane alone, its corners
+        held at the design bar tops B_Mj, is solved with the nonlinear membrane element;
+        (2) the forces it exerts on the corners and the bar and tendon forces along the
+        design member directions must balance at every free system node (A_ij, i >= 2, and
+        B_ij) — a linear system for the member forces, solved by least squares; a residual
+        above round-off means the design geometry is not an equilibrium; (3) the rest
+        lengths follow from the truss law (:func:`green_rest_length`).
+        Only for ``attachment="point"``.
+        """
+        if self.topology.attachment != "point":
+            raise InputError("consistent_rest_lengths: defined for attachment='point' only")
+        topo, sysm = self.topology, self.system
+        x = self.initial_positions("design")
+        nm = topo.n_mesh
+        corners = topo.mesh.corners
+        freem = np.ones(3 * nm, dtype=bool)
+        for c in corners:
+            freem[3 * c:3 * c + 3] = False
+        xm = x[:, :nm].T.ravel().copy()
+        for it in range(50):
+            f, K = self.membrane.internal(xm.reshape(-1, 3).T)
+            fn = np.linalg.norm(f[freem])
+            scale = np.linalg.norm(f[~freem]) + 1e-30
+            if fn <= tol * scale:
+                break
+            du = spla.spsolve(K[freem][:, freem].tocsc(), -f[freem])
+            xm[freem] += du
+        else:
+            raise ConvergenceError(f"membrane with prescribed corners: |r| = {fn:.3e} N after 50 "
+                                   f"iterations")
+        Fc = -f.reshape(-1, 3)[corners].T                  # force of the membrane on corner j (3, N)
+        X = sysm.nodes()
+        labels = sysm.node_labels
+        fixed = {sysm.node_index(label("A", 1, j)) for j in range(1, sysm.N + 1)}
+        rows = [i for i in range(len(labels)) if i not in fixed]
+        row_of = {n: r for r, n in enumerate(rows)}
+        bc = sysm.bar_connectivity
+        tc = sysm.tendon_connectivity
+        nb, nt = bc.shape[1], tc.shape[1]
+        A = np.zeros((3 * len(rows), nb + nt))
+        for m, (a, b) in enumerate(np.concatenate([bc, tc], axis=1).T):
+            e = X[:, b] - X[:, a]
+            e = e / np.linalg.norm(e)
+            # tension t > 0 pulls node a towards b and node b towards a
+            if a in row_of:
+                A[3 * row_of[a]:3 * row_of[a] + 3, m] += e
+            if b in row_of:
+                A[3 * row_of[b]:3 * row_of[b] + 3, m] -= e
+        rhs = np.zeros(3 * len(rows))
+        for j in range(sysm.N):
+            n = sysm.node_index(label("B", sysm.M, j + 1))
+            rhs[3 * row_of[n]:3 * row_of[n] + 3] -= Fc[:, j]
+        sol, *_ = np.linalg.lstsq(A, rhs, rcond=None)
+        res = np.linalg.norm(A @ sol - rhs) / max(np.linalg.norm(rhs), 1e-30)
+        s, _ = np.linalg.svd(A, compute_uv=False), None
+        bar_force, T = sol[:nb], sol[nb:]
+        L = sysm.tendon_lengths()
+        out = {"tendon_force": T, "bar_force": bar_force, "corner_force": Fc,
+               "equilibrium_residual": float(res), "rank_deficiency": int(np.sum(s < 1e-10 * s[0]))
+               + max(0, A.shape[1] - A.shape[0]), "tendon_length": L}
+        if np.any(T <= 0):
+            bad = [sysm.tendons[i].name for i in np.flatnonzero(T <= 0)]
+            raise SlackTendon(f"the design geometry needs non-positive tendon forces in {bad}: "
+                              f"{T[T <= 0]} N (expected > 0)")
+        if np.any(np.einsum("ij,ij->j", Fc, X[:, [sysm.node_index(label('B', sysm.M, j))
+                                                   for j in range(1, sysm.N + 1)]]
+                                     - X[:, [sysm.node_index(label('B', sysm.M, j))
+                                             for j in range(1, sysm.N + 1)]].mean(axis=1,
+                                                                                   keepdims=True)) >= 0):
+            raise SlackMembrane("the membrane does not pull the corners inwards at the design "
+                                "(Delta <= 0, eq. 3.36)")
+        out["rest_lengths"] = green_rest_length(L, T, self.tendon_EA)
+        out["rest_lengths_linear"] = linear_rest_length(L, T, self.tendon_EA)
+        return out
+
+
+def _pad(K: sp.csr_matrix, n: int) -> sp.csr_matrix:
+    """A square csr matrix K embedded in the top-left corner of an n x n one."""
+    K = K.tocsr()
+    m = K.shape[0]
+    indptr = np.concatenate([K.indptr, np.full(n - m, K.indptr[-1])])
+    return sp.csr_matrix((K.data, K.indices, indptr), shape=(n, n))
