@@ -1,0 +1,418 @@
+"""Equilibrium conditions of general systems (dissertation 3.2) and their symmetric reduction (3.3.2).
+
+The membrane corner constraints (eq. 3.5) tie the upper bar ends B_Mi to the floating frame
+O_f (3-2-1 Euler angles gamma, eq. 3.3) and the free corner displacements Delta of eq. 3.4:
+
+    B_Mi(q) - B_MN(q) = R^ef(gamma) (P_i + Delta_i),   i = 1, ..., N-1,
+
+with P_i the undeformed corner in O_f and the free components Delta_u1; Delta_ui, Delta_vi,
+Delta_wi (2 <= i <= N-2); Delta_u,N-1, Delta_v,N-1 (3N-6 in all). The virtual work of the
+tendon forces and the membrane corner forces (eqs. 3.6-3.15) gives the matrix A(q) of eq.
+3.16 whose columns are d|d_k|/dq (tendons) and dDelta_c/dq (membrane corner forces, from
+implicit differentiation of eq. 3.5, eq. 3.11); rows are the generalised coordinates q of
+eqs. 3.1-3.2. All derivatives are analytic.
+
+For symmetric systems the rows of bar b_iN and the column sums over the tendons of each
+family and stage, with the membrane column F_Delta (cos beta_i, sin beta_i) of eq. 3.21,
+give the (5M-3) x (6M-4) matrix of 3.3.2 acting on the force vector of eq. 3.26.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import linprog
+
+from tmfem.errors import ConvergenceError, InputError
+from tmfem.system.geometry import beta
+from tmfem.system.topology import FAMILIES_MN
+
+
+# ---------------------------------------------------------------------------- kinematics
+def _bar_q_index(system) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Indices into q of (x, y, z) (-1 for stage 1), theta and psi of each bar, (M, N) each."""
+    M, N = system.M, system.N
+    xyz = -np.ones((3, M, N), dtype=int)
+    th = np.empty((M, N), dtype=int)
+    ps = np.empty((M, N), dtype=int)
+    j = np.arange(N)
+    th[0], ps[0] = 2 * j, 2 * j + 1
+    for i in range(1, M):
+        off = 2 * N + 5 * N * (i - 1) + 5 * j
+        xyz[:, i, :] = off[None, :] + np.arange(3)[:, None]
+        th[i], ps[i] = off + 3, off + 4
+    return xyz, th, ps
+
+
+def node_jacobian(system, q=None) -> np.ndarray:
+    """Derivatives dX/dq of all node coordinates, shape (3, n_nodes, n_q) (eqs. 3.1-3.2)."""
+    q = system.q if q is None else np.asarray(q, dtype=float)
+    M, N = system.M, system.N
+    _, theta, psi = system.split_q(q)
+    l = system.l
+    xyz, th, ps = _bar_q_index(system)
+    nq = q.size
+    st, ct, sp, cp = np.sin(theta), np.cos(theta), np.sin(psi), np.cos(psi)
+    du_dth = np.array([ct * cp, ct * sp, -st])        # (3, M, N)
+    du_dps = np.array([-st * sp, st * cp, np.zeros_like(st)])
+    JA = np.zeros((3, M, N, nq))
+    JB = np.zeros((3, M, N, nq))
+    ii, jj = np.meshgrid(np.arange(M), np.arange(N), indexing="ij")
+    for c in range(3):
+        mask = xyz[c] >= 0
+        JA[c, ii[mask], jj[mask], xyz[c][mask]] = 1.0
+    JB[:] = JA
+    for c in range(3):
+        JB[c, ii, jj, th] += l * du_dth[c]
+        JB[c, ii, jj, ps] += l * du_dps[c]
+    parts = [JA.reshape(3, M * N, nq), JB.reshape(3, M * N, nq)]
+    if system.deployable:
+        parts.append(JA[:, 0] + system.k_H * (JB[:, 0] - JA[:, 0]))
+    return np.concatenate(parts, axis=1)
+
+
+def tendon_length_gradient(system, q=None) -> np.ndarray:
+    """d|d_k|/dq of every tendon, shape (n_q, n_tendons) (the tendon columns of eq. 3.16)."""
+    J = node_jacobian(system, q)
+    d = system.tendon_vectors(q)
+    L = np.linalg.norm(d, axis=0)
+    if np.any(L <= 0):
+        raise InputError(f"tendons of zero length: {np.flatnonzero(L <= 0)}")
+    n = d / L
+    c = system.tendon_connectivity
+    dJ = J[:, c[1], :] - J[:, c[0], :]                   # (3, n_t, n_q)
+    return np.einsum("ck,ckq->qk", n, dJ)
+
+
+# ---------------------------------------------------------------------------- corner constraints
+def euler_R(gamma) -> np.ndarray:
+    """R^ef of the 3-2-1 Euler angles (gamma_1, gamma_2, gamma_3) (eq. 3.3): O_f -> O-xyz."""
+    g1, g2, g3 = gamma
+    c1, s1, c2, s2, c3, s3 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2), np.cos(g3), np.sin(g3)
+    return np.array([[c1 * c2, c1 * s2 * s3 - c3 * s1, c1 * c3 * s2 + s1 * s3],
+                     [c2 * s1, c1 * c3 + s1 * s2 * s3, c3 * s1 * s2 - c1 * s3],
+                     [-s2, c2 * s3, c2 * c3]])
+
+
+def euler_R_derivatives(gamma) -> np.ndarray:
+    """dR^ef/dgamma_k, shape (3, 3, 3) with k last."""
+    g1, g2, g3 = gamma
+    c1, s1, c2, s2, c3, s3 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2), np.cos(g3), np.sin(g3)
+    Rz = np.array([[c1, -s1, 0], [s1, c1, 0], [0, 0, 1]])
+    Ry = np.array([[c2, 0, s2], [0, 1, 0], [-s2, 0, c2]])
+    Rx = np.array([[1, 0, 0], [0, c3, -s3], [0, s3, c3]])
+    dRz = np.array([[-s1, -c1, 0], [c1, -s1, 0], [0, 0, 0]])
+    dRy = np.array([[-s2, 0, c2], [0, 0, 0], [-c2, 0, -s2]])
+    dRx = np.array([[0, 0, 0], [0, -s3, -c3], [0, c3, -s3]])
+    return np.stack([dRz @ Ry @ Rx, Rz @ dRy @ Rx, Rz @ Ry @ dRx], axis=-1)
+
+
+def euler_angles(R: np.ndarray) -> np.ndarray:
+    """3-2-1 Euler angles of a rotation matrix R^ef (inverse of eq. 3.3)."""
+    return np.array([np.arctan2(R[1, 0], R[0, 0]), -np.arcsin(np.clip(R[2, 0], -1, 1)),
+                     np.arctan2(R[2, 1], R[2, 2])])
+
+
+def free_corner_components(N: int) -> list[tuple[int, int]]:
+    """(corner index 0..N-1, component 0=u 1=v 2=w) of the free corner displacements (3.2)."""
+    out = [(0, 0)]
+    for i in range(1, N - 2):
+        out += [(i, 0), (i, 1), (i, 2)]
+    out += [(N - 2, 0), (N - 2, 1)]
+    return out
+
+
+def corner_force_names(N: int) -> list[str]:
+    """Names of the membrane corner forces of T_q (eqs. 3.16-3.17): F_u1, F_u2, F_v2, ..."""
+    return [f"F_{'uvw'[c]}{i + 1}" for i, c in free_corner_components(N)]
+
+
+@dataclass(frozen=True)
+class CornerState:
+    """Solution of the corner constraints (eq. 3.5) for one q.
+
+    ``R`` is R^ef, ``gamma`` its 3-2-1 Euler angles, ``delta`` (3, N) the corner
+    displacements in O_f (corner N is the origin, its displacement is zero), ``free`` the
+    3N-6 free components in the order of :func:`free_corner_components`.
+    """
+
+    R: np.ndarray
+    gamma: np.ndarray
+    delta: np.ndarray
+    free: np.ndarray
+    iterations: int = 0
+
+
+def _corner_data(system, q):
+    B = system.membrane_corners_inertial(q)
+    N = system.N
+    P = np.vstack([system.membrane_corners, np.zeros((1, N))])
+    X = B[:, :N - 1] - B[:, [N - 1]]
+    return X, P
+
+
+def corner_state(system, q=None) -> CornerState:
+    """Solve eq. 3.5 in closed form: x_f along B_MN -> B_M1, z_f normal to the plane of
+    B_MN, B_M1, B_M,N-1; the corner displacements are then R^fe (B_Mi - B_MN) - P_i."""
+    q = system.q if q is None else np.asarray(q, dtype=float)
+    X, P = _corner_data(system, q)
+    N = system.N
+    ex = X[:, 0] / np.linalg.norm(X[:, 0])
+    ez = np.cross(ex, X[:, N - 2])
+    nz = np.linalg.norm(ez)
+    if nz < 1e-12 * np.linalg.norm(X[:, N - 2]):
+        raise InputError("corners B_MN, B_M1, B_M,N-1 are collinear: the floating frame O_f "
+                         "of 3.2 is undefined")
+    ez /= nz
+    ey = np.cross(ez, ex)
+    R = np.column_stack([ex, ey, ez])
+    delta = np.zeros((3, N))
+    delta[:, :N - 1] = R.T @ X - P[:, :N - 1]
+    comps = free_corner_components(N)
+    free = np.array([delta[c, i] for i, c in comps])
+    return CornerState(R=R, gamma=euler_angles(R), delta=delta, free=free)
+
+
+def _G(gamma, free, P, N):
+    """Right-hand side R(gamma) (P_i + Delta_i) of eq. 3.5, shape (3, N-1)."""
+    D = np.zeros((3, N - 1))
+    for k, (i, c) in enumerate(free_corner_components(N)):
+        D[c, i] = free[k]
+    return euler_R(gamma) @ (P[:, :N - 1] + D)
+
+
+def _G_jacobian(gamma, free, P, N) -> np.ndarray:
+    """d vec(G)/d(gamma, free), shape (3(N-1), 3N-3); vec is column-major over corners."""
+    D = np.zeros((3, N - 1))
+    comps = free_corner_components(N)
+    for k, (i, c) in enumerate(comps):
+        D[c, i] = free[k]
+    R = euler_R(gamma)
+    dR = euler_R_derivatives(gamma)
+    Y = P[:, :N - 1] + D
+    J = np.zeros((3, N - 1, 3 + len(comps)))
+    J[:, :, :3] = np.einsum("abk,bi->aik", dR, Y)
+    for k, (i, c) in enumerate(comps):
+        J[:, i, 3 + k] = R[:, c]
+    return J.transpose(1, 0, 2).reshape(3 * (N - 1), -1)
+
+
+def solve_corner_constraints(system, q=None, *, gamma0=None, free0=None, tol: float = 1e-12,
+                             maxiter: int = 50) -> CornerState:
+    """Solve eq. 3.5 for (gamma, Delta) by Newton's method (independent of :func:`corner_state`).
+
+    Raises
+    ------
+    ConvergenceError
+        if the residual |B_Mi - B_MN - R (P_i + Delta_i)| does not fall below
+        ``tol`` times the membrane size within ``maxiter`` iterations.
+    """
+    q = system.q if q is None else np.asarray(q, dtype=float)
+    X, P = _corner_data(system, q)
+    N = system.N
+    nfree = 3 * N - 6
+    y = np.zeros(3 + nfree)
+    # default start: x_f along the horizontal projection of B_MN -> B_M1, no tilt
+    y[0] = np.arctan2(X[1, 0], X[0, 0])
+    if gamma0 is not None:
+        y[:3] = gamma0
+    if free0 is not None:
+        y[3:] = free0
+    scale = max(np.abs(P).max(), 1.0)
+    x = X.T.ravel()
+    res = np.inf
+    for it in range(1, maxiter + 1):
+        r = _G(y[:3], y[3:], P, N).T.ravel() - x
+        res = np.abs(r).max()
+        if res < tol * scale:
+            R = euler_R(y[:3])
+            delta = np.zeros((3, N))
+            for k, (i, c) in enumerate(free_corner_components(N)):
+                delta[c, i] = y[3 + k]
+            return CornerState(R=R, gamma=y[:3].copy(), delta=delta, free=y[3:].copy(),
+                               iterations=it - 1)
+        J = _G_jacobian(y[:3], y[3:], P, N)
+        try:
+            y = y - np.linalg.solve(J, r)
+        except np.linalg.LinAlgError:
+            break
+    raise ConvergenceError(f"corner constraints (eq. 3.5): expected residual < {tol * scale:.3g} m "
+                           f"within {maxiter} Newton iterations, found {res:.3g} m")
+
+
+def delta_gradient(system, q=None, state: CornerState | None = None) -> np.ndarray:
+    """dDelta_c/dq of the 3N-6 free corner displacements, shape (n_q, 3N-6) (eq. 3.11).
+
+    Implicit differentiation of eq. 3.5: dX(q) = dG(gamma, Delta), so
+    d(gamma, Delta)/dq = G_(gamma,Delta)^-1 X_q.
+    """
+    q = system.q if q is None else np.asarray(q, dtype=float)
+    st = corner_state(system, q) if state is None else state
+    N = system.N
+    _, P = _corner_data(system, q)
+    J = node_jacobian(system, q)
+    M = system.M
+    b = system.M * system.N + (M - 1) * N        # index of B_M1 in the node order
+    JB = J[:, b:b + N, :]
+    Xq = (JB[:, :N - 1, :] - JB[:, [N - 1], :]).transpose(1, 0, 2).reshape(3 * (N - 1), -1)
+    Gy = _G_jacobian(st.gamma, st.free, P, N)
+    dy = np.linalg.solve(Gy, Xq)
+    return dy[3:].T
+
+
+# ---------------------------------------------------------------------------- A(q)
+@dataclass(frozen=True)
+class EquilibriumMatrix:
+    """A(q) of eq. 3.16 with row and column names.
+
+    Columns: the 3N-6 membrane corner forces, then the tendon forces (T_q of eq. 3.16);
+    rows: the generalised coordinates q. ``n_F`` is the number of corner-force columns.
+    """
+
+    A: np.ndarray
+    rows: list
+    cols: list
+    n_F: int
+    state: CornerState = field(repr=False, default=None)
+
+    @property
+    def A_F(self) -> np.ndarray:
+        return self.A[:, :self.n_F]
+
+    @property
+    def A_T(self) -> np.ndarray:
+        return self.A[:, self.n_F:]
+
+
+def equilibrium_matrix(system, q=None) -> EquilibriumMatrix:
+    """The matrix A(q) of eq. 3.16 from the virtual work of tendon and corner forces.
+
+    delta U = sum_c F_c dDelta_c/dq dq + sum_k T_k d|d_k|/dq dq = 0 for every dq, so the
+    column of force c is its generalised-force contribution (eqs. 3.7, 3.10-3.15).
+    """
+    q = system.q if q is None else np.asarray(q, dtype=float)
+    st = corner_state(system, q)
+    AF = delta_gradient(system, q, st)
+    AT = tendon_length_gradient(system, q)
+    return EquilibriumMatrix(A=np.hstack([AF, AT]), rows=list(system.q_names),
+                             cols=corner_force_names(system.N) + system.tendon_names(),
+                             n_F=AF.shape[1], state=st)
+
+
+def symmetric_corner_direction(N: int) -> np.ndarray:
+    """Free corner-force components for F_Delta = 1 (eq. 3.21: F_ui = cos beta_i, F_vi = sin beta_i)."""
+    b = beta(N)
+    f = np.vstack([np.cos(b), np.sin(b), np.zeros(N)])
+    return np.array([f[c, i] for i, c in free_corner_components(N)])
+
+
+def symmetric_groups(system) -> list[str]:
+    """Tendon groups in the order of the force vector of eq. 3.26 (S1, then S V D C P R of
+    each stage i >= 2), or SL, SU for a 1-N(D) system."""
+    if system.deployable:
+        return ["SL", "SU"]
+    return ["S1"] + [f"{f}{i}" for i in range(2, system.M + 1) for f in FAMILIES_MN]
+
+
+@dataclass(frozen=True)
+class SymmetricMatrix:
+    """The (5M-3) x (6M-4) matrix of 3.3.2 acting on T_MN (eq. 3.26); last column F_Delta."""
+
+    A: np.ndarray
+    rows: list
+    cols: list
+
+
+def symmetric_matrix(system, q=None) -> SymmetricMatrix:
+    """Reduce A(q) by symmetry (3.3.2): rows of bar b_iN (eq. 3.24), columns summed per
+    tendon group (eq. 3.23) and the membrane column for F_Delta (eq. 3.21)."""
+    if system.symmetric is None:
+        raise InputError(f"system {system.name!r} is not symmetric (3.3.1)")
+    E = equilibrium_matrix(system, q)
+    xyz, th, ps = _bar_q_index(system)
+    rows = [th[0, -1], ps[0, -1]]
+    for i in range(1, system.M):
+        rows += [xyz[0, i, -1], xyz[1, i, -1], xyz[2, i, -1], th[i, -1], ps[i, -1]]
+    groups = symmetric_groups(system)
+    gid = np.array([t.group for t in system.tendons])
+    cols = [E.A_T[:, gid == g].sum(axis=1) for g in groups]
+    cols.append(E.A_F @ symmetric_corner_direction(system.N))
+    A = np.column_stack(cols)[rows]
+    return SymmetricMatrix(A=A, rows=[system.q_names[r] for r in rows], cols=groups + ["F_Delta"])
+
+
+def expand_symmetric_forces(system, T_groups: np.ndarray, F_delta: float) -> np.ndarray:
+    """The full T_q of eq. 3.16 from group forces (eq. 3.23) and F_Delta (eq. 3.21)."""
+    groups = symmetric_groups(system)
+    g = {k: v for k, v in zip(groups, T_groups)}
+    T = np.array([g[t.group] for t in system.tendons])
+    return np.concatenate([F_delta * symmetric_corner_direction(system.N), T])
+
+
+# ---------------------------------------------------------------------------- null space
+@dataclass(frozen=True)
+class NullVector:
+    """Result of the positive null-space search.
+
+    ``x`` maximises min_i x_i over ``positive`` entries subject to A x = 0 and
+    sum of the positive entries = 1; ``margin`` is that minimum (> 0 when a vector with all
+    required entries positive exists); ``dim`` the dimension of the numerical null space;
+    ``sv`` the singular values of A (relative to the largest).
+    """
+
+    x: np.ndarray
+    margin: float
+    dim: int
+    sv: np.ndarray
+
+    @property
+    def exists(self) -> bool:
+        return self.dim > 0 and self.margin > 0
+
+
+def null_space(A: np.ndarray, rtol: float = 1e-9) -> tuple[np.ndarray, np.ndarray]:
+    """Orthonormal basis Z (n, k) of the numerical null space of A and its relative singular values."""
+    A = np.atleast_2d(A)
+    n = A.shape[1]
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    As = A / scale                                         # column scaling: forces of any unit
+    U, s, Vt = np.linalg.svd(As)
+    sfull = np.zeros(n)
+    sfull[:s.size] = s
+    rel = sfull / max(sfull.max(), 1e-300)
+    k = int(np.sum(rel <= rtol))
+    Z = Vt[n - k:].T / scale[:, None]
+    if k:
+        Z /= np.linalg.norm(Z, axis=0)
+    return Z, rel
+
+
+def positive_null_vector(A: np.ndarray, positive=None, *, rtol: float = 1e-9) -> NullVector:
+    """Search the null space of A for a vector whose ``positive`` entries are all > 0.
+
+    A linear programme (scipy HiGHS) over the null-space coordinates c, x = Z c, maximises
+    t subject to x_i >= t (i in ``positive``) and sum_i x_i = 1; ``margin`` = t. This is
+    the search of 3.2 / 3.3.2 (tendons taut, membrane tensioned).
+    """
+    A = np.atleast_2d(np.asarray(A, dtype=float))
+    n = A.shape[1]
+    pos = np.ones(n, dtype=bool) if positive is None else np.asarray(positive, dtype=bool)
+    Z, rel = null_space(A, rtol)
+    k = Z.shape[1]
+    if k == 0:
+        return NullVector(x=np.zeros(n), margin=-np.inf, dim=0, sv=rel)
+    Zp = Z[pos]
+    # variables (c_1..c_k, t); maximise t
+    c = np.zeros(k + 1)
+    c[-1] = -1.0
+    A_ub = np.hstack([-Zp, np.ones((Zp.shape[0], 1))])     # t - Zp c <= 0
+    b_ub = np.zeros(Zp.shape[0])
+    A_eq = np.hstack([Zp.sum(axis=0)[None, :], [[0.0]]])
+    res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=[1.0],
+                  bounds=[(None, None)] * k + [(None, 1.0)], method="highs")
+    if res.status != 0:
+        # the normalisation is infeasible only when every null vector sums to zero on `pos`
+        return NullVector(x=np.zeros(n), margin=-np.inf, dim=k, sv=rel)
+    x = Z @ res.x[:k]
+    return NullVector(x=x, margin=float(res.x[-1]), dim=k, sv=rel)
