@@ -1,0 +1,331 @@
+"""Nonlinear static solvers: Newton-Raphson with line search, adaptive load stepping, and
+Crisfield's cylindrical arc-length method (dissertation eqs. 4.5-4.6).
+
+All solvers work on a global vector ``u`` (any unknowns: displacements or positions) with a
+set of *free* dofs; the others keep the values they have in ``u0`` (prescribed). They know
+nothing of elements: a residual callback returns the residual vector and its tangent.
+Linear solves go through a backend (:mod:`tmfem.solvers.backends`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.errors import ConvergenceError, InputError
+from tmfem.solvers.backends import get_backend
+
+
+def free_index(free, n: int) -> np.ndarray:
+    """Integer indices of the free dofs from ``None`` (all), a boolean mask (n,) or indices."""
+    if free is None:
+        return np.arange(n)
+    free = np.asarray(free)
+    if free.dtype == bool:
+        if free.shape != (n,):
+            raise InputError(f"free: expected a boolean mask of shape ({n},), found {free.shape}")
+        return np.flatnonzero(free)
+    idx = np.unique(free.astype(np.int64))
+    if idx.size and (idx[0] < 0 or idx[-1] >= n):
+        raise InputError(f"free: expected dof indices in [0, {n}), found [{idx[0]}, {idx[-1]}]")
+    return idx
+
+
+def _sub(K, idx):
+    if sp.issparse(K):
+        K = sp.csr_matrix(K)
+        return K[idx][:, idx]
+    return np.asarray(K)[np.ix_(idx, idx)]
+
+
+def _fail(message, *, step=None, history=(), load_factor=None, u=None):
+    err = ConvergenceError(message)
+    err.step = step
+    err.residual_history = list(history)
+    err.load_factor = load_factor
+    err.u = u
+    return err
+
+
+@dataclass
+class NewtonResult:
+    """Outcome of :func:`newton`: solution, iterations, residual norms (free dofs, 2-norm,
+    one per evaluated iterate including the start), convergence flag, last residual and tangent."""
+
+    u: np.ndarray
+    iterations: int
+    residual_history: list
+    converged: bool
+    r: np.ndarray | None = None
+    K: object = None
+
+
+def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float = 0.0,
+           scale: float | None = None, max_iter: int = 50, line_search: bool = True,
+           backend=None, callback: Callable | None = None, load_factor: float | None = None,
+           step: int | None = None) -> NewtonResult:
+    """Newton-Raphson iteration K du = -r on the free dofs, with backtracking line search.
+
+    Parameters
+    ----------
+    residual : callable
+        ``residual(u) -> (r, K)``: residual (n,) (internal minus external forces) and tangent
+        (n, n) (sparse or dense), eq. 4.6.
+    u0 : array (n,)
+        Start; the entries of the fixed dofs are kept (prescribed values).
+    free : bool mask, index array or None
+        Free dofs (default all).
+    tol, atol, scale : float
+        Converged when ||r_free|| <= max(tol * scale, atol); ``scale`` defaults to ||r_free(u0)||
+        (pass a force scale when starting near equilibrium, e.g. in load stepping).
+    max_iter : int
+    line_search : bool
+        Backtracking (halving, Armijo on ||r||) when the full step does not reduce the residual.
+    callback : callable, optional
+        ``callback(iteration, u, rnorm)`` after every accepted iterate (iteration histories).
+    load_factor, step : optional
+        Only reported in a :class:`ConvergenceError`.
+
+    Raises
+    ------
+    ConvergenceError
+        With attributes ``step``, ``residual_history``, ``load_factor`` and ``u`` (last iterate)
+        when the residual is not finite, the tangent is singular or ``max_iter`` is exceeded.
+    """
+    be = get_backend(backend)
+    u = np.array(u0, dtype=float, copy=True)
+    n = u.size
+    idx = free_index(free, n)
+    r, K = residual(u)
+    r = np.asarray(r, dtype=float)
+    rn = float(np.linalg.norm(r[idx]))
+    history = [rn]
+    where = (f" (load step {step}, load factor {load_factor:g})" if load_factor is not None
+             else (f" (step {step})" if step is not None else ""))
+    if not np.isfinite(rn):
+        raise _fail(f"newton{where}: expected a finite residual at the start, found {rn}",
+                    step=step, history=history, load_factor=load_factor, u=u)
+    ref = rn if scale is None else float(scale)
+    target = max(tol * ref, atol)
+    if callback is not None:
+        callback(0, u, rn)
+    for it in range(1, max_iter + 1):
+        if rn <= target:
+            return NewtonResult(u=u, iterations=it - 1, residual_history=history, converged=True, r=r, K=K)
+        try:
+            solve = be.factorize(_sub(K, idx))
+        except ConvergenceError as exc:
+            raise _fail(f"newton{where}: iteration {it}: {exc}; residual history "
+                        f"{[f'{h:.3e}' for h in history]}", step=step, history=history,
+                        load_factor=load_factor, u=u) from None
+        du = -solve(r[idx])
+        alpha, best = 1.0, None
+        while True:
+            ut = u.copy()
+            ut[idx] += alpha * du
+            rt, Kt = residual(ut)
+            rt = np.asarray(rt, dtype=float)
+            rnt = float(np.linalg.norm(rt[idx]))
+            ok = np.isfinite(rnt)
+            if ok and (best is None or rnt < best[0]):
+                best = (rnt, ut, rt, Kt)
+            if not line_search or (ok and rnt <= (1.0 - 1e-4 * alpha) * rn) or alpha < 1.0 / 64:
+                break
+            alpha *= 0.5
+        if best is None:
+            raise _fail(f"newton{where}: iteration {it}: expected a finite residual after the update, "
+                        f"found {rnt}; residual history {[f'{h:.3e}' for h in history]}",
+                        step=step, history=history, load_factor=load_factor, u=u)
+        rn, u, r, K = best
+        history.append(rn)
+        if callback is not None:
+            callback(it, u, rn)
+    if rn <= target:
+        return NewtonResult(u=u, iterations=max_iter, residual_history=history, converged=True, r=r, K=K)
+    raise _fail(f"newton{where}: expected ||r|| <= {target:.3e} within {max_iter} iterations, found "
+                f"{rn:.3e}; residual history {[f'{h:.3e}' for h in history[-8:]]}",
+                step=step, history=history, load_factor=load_factor, u=u)
+
+
+@dataclass
+class LoadPath:
+    """Converged states of a continuation: load factors (m,), solutions (m, n), Newton
+    iterations per step, and the final :class:`NewtonResult`."""
+
+    lam: np.ndarray
+    u: np.ndarray
+    iterations: list
+    last: NewtonResult | None = None
+    rejected: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
+                  dlam_min: float = 1e-4, tol: float = 1e-9, atol: float = 0.0,
+                  scale: float | None = None, max_iter: int = 25, target_iter: int = 6,
+                  line_search: bool = True, backend=None, store: bool = True,
+                  callback: Callable | None = None) -> LoadPath:
+    """Adaptive load stepping from load factor 0 to 1 with Newton at each step.
+
+    ``residual_lam(u, lam) -> (r, K)``. A step whose Newton solve fails is retried with half the
+    increment; an easy step (fewer than ``target_iter`` iterations) lets the next grow by 1.5.
+    The Newton tolerance is relative to ``scale`` (default: the residual norm of the first
+    evaluation at lam = dlam0, i.e. of the first load increment).
+
+    Raises
+    ------
+    ConvergenceError
+        When the increment falls below ``dlam_min``; carries the step, the residual history
+        of the last failure and the load factor that could not be reached.
+    """
+    u = np.array(u0, dtype=float, copy=True)
+    idx = free_index(free, u.size)
+    lam, dlam = 0.0, min(float(dlam0), 1.0)
+    lams, us, its = [0.0], [u.copy()] if store else [], []
+    if scale is None:
+        r1, _ = residual_lam(u, dlam)
+        r0, _ = residual_lam(u, 0.0)
+        scale = max(float(np.linalg.norm(np.asarray(r1)[idx])), float(np.linalg.norm(np.asarray(r0)[idx])))
+        if scale == 0.0:
+            scale = 1.0
+    rejected, step, last = 0, 0, None
+    while lam < 1.0 - 1e-14:
+        dlam = min(dlam, 1.0 - lam)
+        target = lam + dlam
+        step += 1
+        try:
+            res = newton(lambda v: residual_lam(v, target), u, free=idx, tol=tol, atol=atol,
+                         scale=scale, max_iter=max_iter, line_search=line_search, backend=backend,
+                         load_factor=target, step=step)
+        except ConvergenceError as exc:
+            rejected += 1
+            dlam *= 0.5
+            if dlam < dlam_min:
+                raise _fail(f"load stepping: expected to reach load factor 1, stuck at {lam:g} (increment "
+                            f"{2 * dlam:.2e} < {dlam_min:g} failed): {exc}", step=step,
+                            history=getattr(exc, "residual_history", []), load_factor=target, u=u) from None
+            continue
+        u, lam, last = res.u, target, res
+        lams.append(lam)
+        its.append(res.iterations)
+        if store:
+            us.append(u.copy())
+        if callback is not None:
+            callback(lam, u)
+        if res.iterations < target_iter:
+            dlam *= 1.5
+    return LoadPath(lam=np.array(lams), u=np.array(us) if store else u[None], iterations=its,
+                    last=last, rejected=rejected)
+
+
+def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: int = 100,
+               lam_max: float | None = None, stop: Callable | None = None, tol: float = 1e-9,
+               max_iter: int = 25, target_iter: int = 5, dl_min: float | None = None,
+               dl_max: float | None = None, backend=None) -> LoadPath:
+    """Crisfield's cylindrical arc-length method: f_int(u) = lam f_ext with ||Delta u|| = dl.
+
+    Parameters
+    ----------
+    internal : callable
+        ``internal(u) -> (f_int, K)`` internal force and tangent.
+    f_ext : array (n,)
+        Reference external load; the load factor lam scales it (may become negative: the
+        method follows the path through limit points and snap-backs).
+    u0 : array (n,)
+        Equilibrium start at lam = 0 (fixed dofs keep their values).
+    dl : float
+        Arc length (2-norm of the displacement increment on the free dofs).
+    n_steps, lam_max, stop :
+        Stop after ``n_steps`` steps, when lam exceeds ``lam_max``, or when ``stop(u, lam)`` is True.
+    tol : float
+        Converged when ||f_int - lam f_ext|| <= tol ||f_ext|| (free dofs).
+    target_iter, dl_min, dl_max :
+        The arc length adapts as dl *= sqrt(target_iter / iterations) within [dl_min, dl_max];
+        a failed step is retried with half the arc length.
+
+    The predictor follows the previous increment's direction (sign of Delta u_prev . du_t), so
+    the path goes through limit points; of the two roots of the constraint in each corrector
+    iteration the one closer to the previous increment direction is taken.
+
+    Returns
+    -------
+    LoadPath with ``lam`` (m,) and ``u`` (m, n), the starting state included.
+    """
+    be = get_backend(backend)
+    u = np.array(u0, dtype=float, copy=True)
+    f_ext = np.asarray(f_ext, dtype=float)
+    idx = free_index(free, u.size)
+    q = f_ext[idx]
+    qn = float(np.linalg.norm(q))
+    if qn == 0.0:
+        raise InputError("arc length: expected a non-zero reference load on the free dofs, found 0")
+    dl_min = dl * 1e-4 if dl_min is None else dl_min
+    dl_max = dl * 10 if dl_max is None else dl_max
+    lam = 0.0
+    lams, us, its = [lam], [u.copy()], []
+    fint, K = internal(u)
+    prev = None            # previous converged increment (du, dlam)
+    rejected = 0
+    for step in range(1, n_steps + 1):
+        while True:
+            try:
+                solve = be.factorize(_sub(K, idx))
+                dut = solve(q)
+                if prev is None:
+                    sign = 1.0
+                else:
+                    sign = 1.0 if dut @ prev[0] >= 0 else -1.0
+                Du = sign * dl * dut / np.linalg.norm(dut)
+                Dlam = sign * dl / np.linalg.norm(dut)
+                history = []
+                ok = False
+                for it in range(1, max_iter + 1):
+                    ut = u.copy()
+                    ut[idx] += Du
+                    fi, Kt = internal(ut)
+                    r = fi[idx] - (lam + Dlam) * q
+                    rn = float(np.linalg.norm(r))
+                    history.append(rn)
+                    if not np.isfinite(rn):
+                        break
+                    if rn <= tol * qn:
+                        ok = True
+                        break
+                    solve = be.factorize(_sub(Kt, idx))
+                    dur = -solve(r)
+                    dut = solve(q)
+                    a = dut @ dut
+                    w = Du + dur
+                    b = 2.0 * dut @ w
+                    c = w @ w - dl**2
+                    disc = b * b - 4.0 * a * c
+                    if disc < 0:
+                        break
+                    roots = [(-b + np.sqrt(disc)) / (2 * a), (-b - np.sqrt(disc)) / (2 * a)]
+                    cands = [w + s * dut for s in roots]
+                    k = int(np.argmax([cand @ Du for cand in cands]))
+                    Du, Dlam = cands[k], Dlam + roots[k]
+            except ConvergenceError:
+                ok = False
+            if ok:
+                break
+            rejected += 1
+            dl *= 0.5
+            if dl < dl_min:
+                raise _fail(f"arc length: step {step}: expected convergence, found none down to arc "
+                            f"length {2 * dl:.3e} (< dl_min {dl_min:.3e}) at load factor {lam:g}; "
+                            f"residual history {[f'{h:.3e}' for h in history]}", step=step,
+                            history=history, load_factor=lam, u=u)
+        u = ut
+        lam += Dlam
+        K = Kt
+        prev = (Du, Dlam)
+        lams.append(lam)
+        us.append(u.copy())
+        its.append(it)
+        dl = float(np.clip(dl * np.sqrt(target_iter / max(it, 1)), dl_min, dl_max))
+        if (lam_max is not None and lam >= lam_max) or (stop is not None and stop(u, lam)):
+            break
+    return LoadPath(lam=np.array(lams), u=np.array(us), iterations=its, rejected=rejected)
