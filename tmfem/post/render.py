@@ -118,11 +118,12 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
             p.add_mesh(merged, scalars="tendon force [N]", cmap=_tendon_cmap(),
                        clim=[lo, fmax] if fmax > lo else [0.0, fmax], smooth_shading=True,
                        scalar_bar_args={"title": "tendon force [N]", "color": "black",
-                                        "vertical": True, "position_x": 0.88,
-                                        "position_y": 0.1})
+                                        "vertical": True, "position_x": 0.9,
+                                        "position_y": 0.1, "width": 0.05,
+                                        "height": 0.5})
         if np.any(~taut):
-            p.add_mesh(_segments(pv, X, con[:, ~taut]).tube(radius=0.5 * r_ten, n_sides=8),
-                       color="red")
+            p.add_mesh(_segments(pv, X, con[:, ~taut]).tube(radius=0.8 * r_ten, n_sides=8),
+                       color="#e41a1c", ambient=0.6)
 
     if membrane is not None:
         if not isinstance(membrane, MembraneField):
@@ -142,7 +143,8 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
             p.add_mesh(grid, scalars=name, cmap="viridis", opacity=0.9, show_edges=True,
                        edge_color="#555555", line_width=0.5,
                        scalar_bar_args={"title": name, "color": "black", "vertical": True,
-                                        "position_x": 0.04, "position_y": 0.1})
+                                        "position_x": 0.03, "position_y": 0.1,
+                                        "width": 0.05, "height": 0.5})
         else:
             p.add_mesh(grid, color="#f4c27a", opacity=0.75, show_edges=True,
                        edge_color="#9a6a2a", line_width=0.5)

@@ -1,0 +1,63 @@
+"""Membrane fields for output: the designed membrane placed on the bar tops.
+
+:func:`membrane_design_field` solves the linear plane-stress problem of the membrane
+(:class:`tmfem.fem.plane_stress.PlaneStressMembrane`, eq. 5.8) for the corner displacements
+that a configuration q imposes (corners B_Mj expressed in the floating frame O_f of 3.2)
+and returns the deformed mesh with its displacement and stresses (principal, von Mises
+of eqs. 5.29-5.30) as a :class:`tmfem.io.MembraneField` ready for the VTK writer and the
+renderer.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.io.vtk import MembraneField, floating_frame
+
+
+def corner_displacements(system, q=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """In-plane corner displacements delta (2, N) in O_f, with O_f's origin and rotation.
+
+    O_f is at B_MN with x_f toward B_M1 and z_f normal to the plane of B_MN, B_M1, B_M,N-1
+    (3.2); delta_j = (position of B_Mj in O_f) - (undeformed corner j).
+    """
+    corners3 = system.membrane_corners_inertial(q)
+    o, R = floating_frame(corners3)
+    local = R.T @ (corners3 - o[:, None])
+    return local[:2] - system.membrane_corners, o, R
+
+
+def membrane_design_field(system, *, q=None, n: int = 10) -> MembraneField:
+    """The membrane of configuration q: linear plane-stress state for its corner positions.
+
+    Parameters
+    ----------
+    system : System
+    q : ndarray, optional
+        Configuration; default ``system.q``.
+    n : int
+        Elements per side of each of the N quadrilateral patches (6.2 uses 10).
+
+    Returns
+    -------
+    MembraneField with point data ``displacement`` (inertial frame) and cell data
+    ``von_mises`` and ``sigma_p1`` (element maxima over the quadrature points, as the maxima
+    of Tables 6.3 / 6.5 are taken), ``sigma_p2`` (element minimum) and ``von_mises_mean``.
+    """
+    from tmfem.fem.plane_stress import PlaneStressMembrane
+
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise InputError(f"membrane mesh: expected n >= 1, found {n!r}")
+    delta, o, R = corner_displacements(system, q)
+    model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane, n=n)
+    sol = model.solve(delta)
+    mesh = model.mesh
+    xf = np.vstack([mesh.p + sol.u, np.zeros(mesh.p.shape[1])])
+    x = o[:, None] + R @ xf
+    u = x - (o[:, None] + R @ np.vstack([mesh.p, np.zeros(mesh.p.shape[1])]))
+    vm = sol.von_mises()
+    pr = sol.principal()
+    return MembraneField(mesh=mesh, x=x, point_data={"displacement": u},
+                         cell_data={"von_mises": vm.max(axis=1), "sigma_p1": pr[0].max(axis=1),
+                                    "sigma_p2": pr[1].min(axis=1),
+                                    "von_mises_mean": vm.mean(axis=1)})

@@ -1,0 +1,169 @@
+"""Line plots for studies (matplotlib, Agg backend: no display needed).
+
+Small and generic: histories over time, convergence over mesh size, a computed-vs-printed
+comparison. Each function writes one PNG and returns its path.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.io.vtk import check_path
+
+
+def _plt():
+    import matplotlib
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def _save(fig, png: Path) -> Path:
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+    _plt().close(fig)
+    return png
+
+
+def _finite_1d(name: str, v, n: int | None = None) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.ndim != 1 or (n is not None and a.shape[0] != n):
+        raise InputError(f"{name}: expected a 1-D array" + (f" of length {n}" if n is not None else "")
+                         + f", found shape {a.shape}")
+    return a
+
+
+def plot_histories(png, t, series: dict, *, ylabel: str, title: str | None = None,
+                   xlabel: str = "t [s]", subplots: bool = False) -> Path:
+    """Plot time histories ``series = {label: values (len(t),)}`` against t.
+
+    With ``subplots=True`` each series gets its own axes (shared t), as in the stacked
+    history figures of 6.5; otherwise all share one axes.
+    """
+    png = check_path(png, suffixes=(".png",))
+    t = _finite_1d("t", t)
+    if not series:
+        raise InputError("series: expected at least one history")
+    data = {k: _finite_1d(f"series {k!r}", v, t.size) for k, v in series.items()}
+    plt = _plt()
+    if subplots:
+        fig, axes = plt.subplots(len(data), 1, sharex=True,
+                                 figsize=(7, 1.8 * len(data) + 0.8), squeeze=False)
+        for ax, (k, v) in zip(axes[:, 0], data.items()):
+            ax.plot(t, v, lw=1.2)
+            ax.set_ylabel(k)
+            ax.grid(True, alpha=0.3)
+        axes[-1, 0].set_xlabel(xlabel)
+        axes[0, 0].set_title(title or "")
+        fig.supylabel(ylabel)
+    else:
+        fig, ax = plt.subplots(figsize=(7, 4.2))
+        for k, v in data.items():
+            ax.plot(t, v, lw=1.2, label=k)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        if title:
+            ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+        if len(data) > 1:
+            ax.legend(fontsize=8)
+    return _save(fig, png)
+
+
+def fit_rates(h, values, reference) -> np.ndarray:
+    """Convergence rates p of |v - ref| ~ C h^p per column, least squares on log h
+    (``np.polyfit``); NaN where fewer than two errors are non-zero."""
+    h = _finite_1d("h", h)
+    V = np.asarray(values, dtype=float).reshape(h.size, -1)
+    ref = _finite_1d("reference", reference, V.shape[1])
+    err = np.abs(V - ref) / np.where(ref == 0, 1.0, np.abs(ref))
+    rates = np.full(V.shape[1], np.nan)
+    for c in range(V.shape[1]):
+        ok = err[:, c] > 0
+        if ok.sum() >= 2:
+            rates[c] = np.polyfit(np.log(h[ok]), np.log(err[ok, c]), 1)[0]
+    return rates
+
+
+def plot_convergence(png, h, values, *, labels, xlabel: str = "h", ylabel: str = "value",
+                     title: str | None = None, reference=None, loglog: bool = False) -> Path:
+    """Plot quantities against a mesh parameter h.
+
+    Parameters
+    ----------
+    h : array (m,)
+        Mesh sizes (or numbers of elements).
+    values : array (m, k)
+        Column c is the quantity ``labels[c]`` on each mesh.
+    reference : array (k,), optional
+        Values to converge to; then the relative error |v - ref| / |ref| is plotted on
+        log-log axes with the fitted rate (``np.polyfit`` on log h) in the legend.
+    loglog : bool
+        Log-log axes for the values themselves.
+    """
+    png = check_path(png, suffixes=(".png",))
+    h = _finite_1d("h", h)
+    V = np.asarray(values, dtype=float)
+    if V.ndim == 1:
+        V = V[:, None]
+    if V.shape[0] != h.size:
+        raise InputError(f"values: expected {h.size} rows (one per h), found shape {V.shape}")
+    labels = list(labels)
+    if len(labels) != V.shape[1]:
+        raise InputError(f"labels: expected {V.shape[1]} labels, found {len(labels)}")
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    if reference is not None:
+        ref = _finite_1d("reference", reference, V.shape[1])
+        err = np.abs(V - ref) / np.where(ref == 0, 1.0, np.abs(ref))
+        rates = fit_rates(h, V, ref)
+        for c, lab in enumerate(labels):
+            ok = err[:, c] > 0
+            ax.loglog(h[ok], err[ok, c], "o-", label=f"{lab} (rate {rates[c]:.2f})")
+        ax.set_ylabel("relative error")
+    else:
+        for c, lab in enumerate(labels):
+            ax.plot(h, V[:, c], "o-", label=lab)
+        if loglog:
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+        ax.set_ylabel(ylabel)
+    ax.set_xlabel(xlabel)
+    if title:
+        ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8, ncol=2 if len(labels) > 6 else 1)
+    return _save(fig, png)
+
+
+def plot_table_comparison(png, names, computed, printed, *, ylabel: str,
+                          title: str | None = None, labels=("tmfem", "dissertation")) -> Path:
+    """Grouped bars of computed vs printed values per row, with the relative difference
+    printed above each pair (printed NaN = not given)."""
+    png = check_path(png, suffixes=(".png",))
+    names = list(names)
+    a = _finite_1d("computed", computed, len(names))
+    b = np.asarray(printed, dtype=float)
+    if b.shape != a.shape:
+        raise InputError(f"printed: expected shape {a.shape}, found {b.shape}")
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(max(6.0, 0.7 * len(names) + 2), 4.5))
+    x = np.arange(len(names))
+    ax.bar(x - 0.2, a, 0.4, label=labels[0], color="#2171b5")
+    ax.bar(x + 0.2, np.nan_to_num(b), 0.4, label=labels[1], color="#bbbbbb")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = (a - b) / np.abs(b)
+    top = np.nanmax(np.abs(np.concatenate([a, b]))) or 1.0
+    for k in range(len(names)):
+        if np.isfinite(rel[k]):
+            ax.text(x[k], max(a[k], np.nan_to_num(b[k])) + 0.02 * top, f"{100 * rel[k]:+.1f}%",
+                    ha="center", va="bottom", fontsize=7)
+    ax.set_xticks(x, names, rotation=45 if len(names) > 6 else 0)
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title)
+    ax.legend(fontsize=8)
+    ax.grid(True, axis="y", alpha=0.3)
+    return _save(fig, png)
