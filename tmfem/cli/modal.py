@@ -1,0 +1,98 @@
+"""``tmfem modal``: natural frequencies and mode shapes about the prestressed state (6.4, eq. 5.32)."""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.static import add_model_args, build_model, default_monitor
+
+NAME = "modal"
+HELP = "natural frequencies and mode shapes (MTC finite-element or control-oriented model)"
+
+
+def configure(parser) -> None:
+    add_system_args(parser)
+    parser.add_argument("--model", choices=("mtc", "com"), default="mtc",
+                        help="mtc: membrane-truss-cable FE model (4.4); com: control-oriented "
+                             "model (ch. 5)")
+    add_model_args(parser)
+    parser.add_argument("--modes", type=int, default=12, help="number of modes (default 12)")
+    parser.add_argument("--membrane-modes", type=int, default=None,
+                        help="membrane modes of the control-oriented model (--model com)")
+    parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu")
+    parser.add_argument("--png", help="render the first six mode shapes to this PNG")
+
+
+def mtc_modes(model, *, k: int, start: str = "undeformed"):
+    """Static equilibrium of ``model`` and its ``k`` lowest modes (eq. 5.32)."""
+    res = model.solve_static(start=start, monitor=default_monitor(model.system))
+    modes = model.modes(res.x, k=k)
+    return res, modes
+
+
+def run(args) -> dict:
+    system_name = None
+    if args.model == "com":
+        from tmfem.reduced.modal import modal_summary
+        system = system_from_args(args)
+        return modal_summary(system, modes=args.modes, membrane_modes=args.membrane_modes)
+    from tmfem.fem.mtc_post import DISSERTATION_FREQUENCIES, model_cells, static_summary
+    model = build_model(args)
+    system_name = model.system.name
+    print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
+    res, modes = mtc_modes(model, k=args.modes, start=args.start)
+    st = static_summary(model, res.x, result=res)
+    out = {"system": system_name, "model": "mtc", "dofs": model.ndof, "mesh_n": args.mesh,
+           "tendon_elements": args.tendon_elements, "attachment": args.attachment,
+           "rest_lengths_source": model.rest_lengths_source,
+           "rest_lengths": st["rest_lengths"], "static_iterations": res.iterations,
+           "tendon_stress_max": st["tendon_stress_max"], "bar_load_max": st["bar_load_max"],
+           "Delta_mean": float(np.mean(st["Delta"])),
+           "freq_hz": modes.freq_hz.tolist()}
+    ref = DISSERTATION_FREQUENCIES.get(system_name)
+    if ref is not None:
+        n = min(len(ref["MTC"]), args.modes)
+        out["dissertation"] = {"source": ref["source"], "MTC": ref["MTC"][:n], "SBC": ref["SBC"][:n]}
+        out["relative_difference_to_MTC"] = (modes.freq_hz[:n] / np.array(ref["MTC"][:n]) - 1).tolist()
+    if args.vtk or args.png:
+        shapes = model.topology.T @ modes.shapes
+        cells = model_cells(model)
+        if args.vtk:
+            from tmfem.io.vtk import write_modes
+            out["vtk"] = str(write_modes(args.vtk, res.x, cells, shapes, modes.freq_hz))
+        if args.png:
+            from tmfem.post.render import render_modes
+            out["png"] = str(render_modes(args.png, points=res.x, cells=cells, shapes=shapes,
+                                          freq_hz=modes.freq_hz, k=min(6, args.modes),
+                                          title=f"{system_name} MTC modes"))
+    return out
+
+
+def format_text(r: dict) -> str:
+    if r.get("model") != "mtc":
+        import json
+        return json.dumps(r, indent=2, default=str)
+    lines = [f"MTC modes of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
+             f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",
+             f"prestress: rest lengths ({r['rest_lengths_source']}) "
+             + ", ".join(f"{k}={v:.5f}" for k, v in list(r["rest_lengths"].items())[:4])
+             + f"; max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, bar load "
+               f"{r['bar_load_max']:.3f} N, Delta {r['Delta_mean'] * 1e3:.4f} mm"]
+    d = r.get("dissertation")
+    if d:
+        lines.append(f"{'mode':>4s} {'ours [Hz]':>10s} {'MTC paper':>10s} {'SBC paper':>10s} {'diff':>8s}"
+                     f"   ({d['source']})")
+        for i, f in enumerate(r["freq_hz"]):
+            if i < len(d["MTC"]):
+                lines.append(f"{i + 1:4d} {f:10.4f} {d['MTC'][i]:10.4f} {d['SBC'][i]:10.4f} "
+                             f"{100 * r['relative_difference_to_MTC'][i]:7.2f}%")
+            else:
+                lines.append(f"{i + 1:4d} {f:10.4f}")
+    else:
+        lines += [f"{i + 1:4d} {f:10.4f} Hz" for i, f in enumerate(r["freq_hz"])]
+    for k in ("vtk", "png"):
+        if k in r:
+            lines.append(f"wrote {r[k]}")
+    return "\n".join(lines)

@@ -1,0 +1,147 @@
+"""``tmfem static``: equilibrium of a finite-element model reached from the undeformed membrane (6.2)."""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.errors import InputError
+
+NAME = "static"
+HELP = "static equilibrium of the membrane-truss-cable model (dissertation 6.2)"
+
+
+def add_model_args(parser) -> None:
+    """Options shared by ``static``, ``modal`` and ``converge`` for the MTC model."""
+    parser.add_argument("--mesh", type=int, default=10,
+                        help="membrane elements per side of each of the N quadrilaterals (default 10)")
+    parser.add_argument("--tendon-elements", type=int, default=3,
+                        help="truss elements per tendon (default 3, as in 6.2)")
+    parser.add_argument("--attachment", choices=("point", "distributed"), default="point",
+                        help="membrane corners pinned to the bar tops (point) or spread over a "
+                             "small corner patch (distributed)")
+    parser.add_argument("--rest-lengths", choices=("system", "design", "mtc"), default=None,
+                        help="tendon rest lengths: the system's (default when it has them), the "
+                             "equilibrium design (eq. 3.8), or those that make the design an exact "
+                             "equilibrium of this model (mtc)")
+    parser.add_argument("--start", choices=("undeformed", "design"), default="undeformed",
+                        help="start of the static iteration (default: the undeformed membrane)")
+
+
+def build_model(args):
+    """The MTC model named by the command-line arguments."""
+    from tmfem.fem.mtc import MTCModel
+    if getattr(args, "model", "mtc") != "mtc":
+        raise InputError(f"model: expected 'mtc', found {args.model!r}")
+    system = system_from_args(args)
+    return MTCModel(system, mesh_n=args.mesh, tendon_elements=args.tendon_elements,
+                    attachment=args.attachment, rest_lengths=args.rest_lengths)
+
+
+def configure(parser) -> None:
+    add_system_args(parser)
+    parser.add_argument("--model", choices=("mtc",), default="mtc",
+                        help="finite-element model (mtc: membrane-truss-cable, 4.4)")
+    add_model_args(parser)
+    parser.add_argument("--monitor", default=None,
+                        help="comma-separated node labels whose iteration history is reported "
+                             "(default B_M1 and, for 1-4, B_14 as in Fig. 6.1)")
+    parser.add_argument("--vtk", help="write the equilibrium (bars, tendons with forces, membrane "
+                                      "with displacement and stresses) to this .vtu file")
+    parser.add_argument("--png", help="render the equilibrium to this PNG")
+    parser.add_argument("--progress", action="store_true", help="iteration progress on stderr")
+
+
+def default_monitor(system) -> list[str]:
+    """Monitored nodes of Figures 6.1 (B_14 of 1-4) and 6.5-6.7 (B_11, A_21, B_21 of 2-3)."""
+    if system.M == 1:
+        return [f"B_1{system.N}"] if system.N < 10 else [f"B_1,{system.N}"]
+    return ["B_11", "A_21", "B_21"]
+
+
+def solve(args, model):
+    from tmfem.fem.mtc_post import static_summary
+    monitor = args.monitor.split(",") if getattr(args, "monitor", None) else default_monitor(model.system)
+    print(f"tmfem static: {model.system.name}, {model.ndof} free dofs, solving from the "
+          f"{args.start} state", file=sys.stderr)
+    res = model.solve_static(start=args.start, monitor=monitor,
+                             progress=getattr(args, "progress", False))
+    return res, static_summary(model, res.x, result=res)
+
+
+def write_outputs(args, model, x, summary) -> None:
+    from tmfem.fem.mtc_post import membrane_field, member_state, q_from_positions
+    if not (getattr(args, "vtk", None) or getattr(args, "png", None)):
+        return
+    system = model.system
+    X = x[:, model.topology.system_node]
+    q = q_from_positions(system, X)
+    ms = member_state(model, x)
+    mf = membrane_field(model, x)
+    if args.vtk:
+        from tmfem.io.vtk import write_configuration
+        p = write_configuration(args.vtk, system, q=q, tendon_forces=ms["tendon_force"],
+                                rest_lengths=model.rest_lengths, membrane=mf,
+                                bar_forces=ms["bar_force"])
+        summary["vtk"] = str(p)
+    if args.png:
+        from tmfem.post.render import render_configuration
+        p = render_configuration(args.png, system, q=q, tendon_forces=ms["tendon_force"],
+                                 membrane=mf, membrane_field="von_mises",
+                                 title=f"{system.name} MTC equilibrium")
+        summary["png"] = str(p)
+
+
+def run(args) -> dict:
+    model = build_model(args)
+    res, summary = solve(args, model)
+    write_outputs(args, model, res.x, summary)
+    return summary
+
+
+def format_text(r: dict) -> str:
+    pr = r.get("printed", {})
+    lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
+             f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",
+             f"rest lengths ({r['rest_lengths_source']}): "
+             + ", ".join(f"{k}={v:.5f}" for k, v in list(r["rest_lengths"].items())[:8])
+             + (" ..." if len(r["rest_lengths"]) > 8 else ""),
+             f"converged in {r.get('iterations')} iterations ({r.get('static_time_s', 0):.2f} s); "
+             f"residual {r['residual_history'][0]:.3e} -> {r['residual_history'][-1]:.3e} N",
+             f"max distance of a node from the design: {r['max_deviation_from_design'] * 1e3:.3f} mm",
+             "theta [deg] (design): " + ", ".join(f"{a:.3f} ({b:.3f})" for a, b in
+                                                   zip(r["theta_deg"], r["theta_design_deg"])),
+             "psi   [deg] (design): " + ", ".join(f"{a:.3f} ({b:.3f})" for a, b in
+                                                   zip(r["psi_deg"], r["psi_design_deg"])),
+             "Delta [mm] (design):  " + ", ".join(f"{a * 1e3:.4f} ({b * 1e3:.4f})" for a, b in
+                                                   zip(r["Delta"], r["Delta_design"]))]
+    for lab, h in r.get("monitor", {}).items():
+        h = np.asarray(h)
+        lines.append(f"history of {lab}: start {np.round(h[0], 5).tolist()} -> "
+                     f"{np.round(h[-1], 5).tolist()} (design {np.round(r['nodes'][lab]['design'], 5).tolist()})")
+    rows = [("membrane max sigma_p1 [MPa]", r["membrane_max_sigma_p1"] / 1e6,
+             pr.get("membrane_max_sigma_p1", np.nan) / 1e6),
+            ("membrane max von Mises [MPa]", r["membrane_max_von_mises"] / 1e6,
+             pr.get("membrane_max_von_mises", np.nan) / 1e6),
+            ("tendon max stress [MPa]", r["tendon_stress_max"] / 1e6,
+             pr.get("tendon_max_stress", np.nan) / 1e6)]
+    if "bar_load_by_stage" in r:
+        for i, v in enumerate(r["bar_load_by_stage"]):
+            rows.append((f"bar load, stage {i + 1} [N]", v, pr.get(f"bar_load_stage{i + 1}", np.nan)))
+    else:
+        rows.append(("bar load [N]", r["bar_load_max"], pr.get("bar_load", np.nan)))
+    rows.append(("bar critical load [N]", r["bar_critical_load"], pr.get("bar_critical_load", np.nan)))
+    lines.append(f"{'':32s} {'MTC':>12s} {'dissertation':>12s}")
+    lines += [f"{a:32s} {b:12.4g} {c:12.4g}" for a, b, c in rows]
+    lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.3f}" for k, v in
+                                                   list(r["tendon_force"].items())[:12]))
+    if r["tendon_slack"]:
+        lines.append(f"SLACK tendons: {r['tendon_slack']}")
+    for c in r["checks"]:
+        lines.append(f"check {c['check']:36s} {'ok' if c['ok'] else 'VIOLATED'}  "
+                     f"({c['value']:.4g} vs {c['limit']:.4g}, eq. {c['equation']})")
+    for k in ("vtk", "png"):
+        if k in r:
+            lines.append(f"wrote {r[k]}")
+    return "\n".join(lines)

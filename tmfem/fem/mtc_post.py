@@ -1,0 +1,200 @@
+"""Post-processing of MTC results: landing vs design, member forces, membrane stresses in the
+floating frame, design checks (dissertation 6.2, Tables 6.2-6.7, eqs. 3.22, 5.29-5.31).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tmfem.fem.mtc_topology import floating_frame, to_floating
+from tmfem.fem.truss import truss_internal
+from tmfem.system.geometry import wrap_angle
+from tmfem.system.topology import label
+
+# Natural frequencies [Hz] printed in the dissertation, Tables 6.6 (1-4) and 6.7 (2-3):
+# shell-beam-cable (SBC), membrane-truss-cable (MTC) and control-oriented (COM) models.
+DISSERTATION_FREQUENCIES = {
+    "1-4": {
+        "source": "dissertation Table 6.6",
+        "SBC": [0.1386, 0.3076, 0.3076, 1.5598, 1.8590, 2.0571, 2.0571, 2.0770, 2.1793, 2.2130,
+                2.2130, 2.2523],
+        "MTC": [0.1386, 0.3076, 0.3076, 1.5599, 1.8679, 2.0569, 2.0569, 2.0763, 2.1803, 2.2277,
+                2.2277, 2.2653],
+        "COM": [0.1367, 0.2997, 0.2997, 1.5401, 1.8552, 2.0288, 2.0289, 2.0471, 2.1507, 2.2062,
+                2.2119, 2.2479],
+    },
+    "2-3": {
+        "source": "dissertation Table 6.7",
+        "SBC": [0.2527, 0.4116, 0.4116, 1.0942, 1.3164, 1.3164, 1.5230, 1.5230, 1.7399, 1.8186,
+                1.9834, 1.9834],
+        "MTC": [0.2527, 0.4116, 0.4116, 1.0953, 1.3174, 1.3174, 1.5264, 1.5264, 1.7404, 1.8224,
+                1.9876, 1.9876],
+        "COM": [0.2503, 0.4076, 0.4076, 1.0843, 1.3020, 1.3020, 1.5110, 1.5121, 1.7258, 1.8053,
+                1.9712, 1.9720],
+    },
+}
+
+
+def q_from_positions(system, X: np.ndarray) -> np.ndarray:
+    """Generalised coordinates q (eqs. 3.1-3.2) of labelled node positions X (3, n_labels).
+
+    theta_ij = arccos(d_z / |d|), psi_ij = atan2(d_y, d_x) of the bar vector d = B_ij - A_ij
+    (3.2, Fig. 3.1); x, y, z of A_ij for i >= 2.
+    """
+    M, N = system.M, system.N
+    n = M * N
+    A = X[:, :n].reshape(3, M, N)
+    d = X[:, n:2 * n].reshape(3, M, N) - A
+    theta = np.arccos(d[2] / np.linalg.norm(d, axis=0))
+    psi = wrap_angle(np.arctan2(d[1], d[0]))
+    parts = [np.column_stack([theta[0], psi[0]]).ravel()]
+    for i in range(1, M):
+        parts.append(np.column_stack([A[0, i], A[1, i], A[2, i], theta[i], psi[i]]).ravel())
+    return np.concatenate(parts)
+
+
+def member_state(model, x: np.ndarray) -> dict:
+    """Bar and tendon forces at positions x (3, n_nodes).
+
+    Tendon force = mean axial force of its k elements (equal in statics: no gravity);
+    slack = any element slack.
+    """
+    tb = truss_internal(x, model.bars, tangent=False)
+    tt = truss_internal(x, model.tendons, tangent=False)
+    e = model.topology.tendon_of_element
+    nt = len(model.system.tendons)
+    T = np.bincount(e, weights=tt.N, minlength=nt) / np.bincount(e, minlength=nt)
+    slack = np.bincount(e, weights=tt.slack.astype(float), minlength=nt) > 0
+    return {"bar_force": tb.N, "tendon_force": T, "tendon_slack": slack,
+            "tendon_stress": T / model.tendon_area}
+
+
+def membrane_stress_summary(model, x: np.ndarray) -> dict:
+    """Membrane stresses (Cauchy, in the floating frame: reference axes rotated with the
+    material) and their maxima at the Gauss points (eqs. 5.29-5.30, Tables 6.3, 6.5)."""
+    st = model.membrane.stresses(x[:, :model.topology.n_mesh])
+    p1 = st.principal[0]
+    vm = st.von_mises
+    return {"stresses": st,
+            "max_sigma_p1": float(p1.max()), "max_von_mises": float(vm.max()),
+            "min_minor_principal": float((st.principal[1] + st.principal[2]).min()),
+            "wrinkled_fraction": float(np.mean(st.principal[1] + st.principal[2] < 0)),
+            "max_sigma_p1_element_mean": float(st.principal_elem[0].max()),
+            "max_von_mises_element_mean": float(st.von_mises_elem.max())}
+
+
+def static_summary(model, x: np.ndarray, *, result=None) -> dict:
+    """JSON-able summary of an MTC equilibrium: landing vs design, forces, stresses, checks.
+
+    Parameters
+    ----------
+    model : MTCModel
+    x : ndarray (3, n_nodes)
+    result : StaticResult, optional
+        Adds the iteration count, residual history and the monitored-node history.
+    """
+    sysm = model.system
+    topo = model.topology
+    labels = sysm.node_labels
+    X = x[:, topo.system_node]
+    Xd = sysm.nodes()
+    dev = np.linalg.norm(X - Xd, axis=0)
+    q = q_from_positions(sysm, X)
+    _, th, ps = sysm.split_q(q)
+    _, thd, psd = sysm.split_q()
+    M, N = sysm.M, sysm.N
+    top = [labels.index(label("B", M, j)) for j in range(1, N + 1)]
+    corners = X[:, top]
+    centre = corners.mean(axis=1)
+    r_mb = sysm.r_mb if sysm.r_mb else float(np.mean(np.linalg.norm(
+        sysm.membrane_corners - sysm.membrane_corners.mean(axis=1, keepdims=True), axis=0)))
+    delta = np.linalg.norm(corners - centre[:, None], axis=0) - r_mb
+    cd = Xd[:, top]
+    delta_design = np.linalg.norm(cd - cd.mean(axis=1, keepdims=True), axis=0) - r_mb
+    ms = member_state(model, x)
+    ss = membrane_stress_summary(model, x)
+    bar_load = -ms["bar_force"]                                   # compression positive
+    Fcrit = np.array([sysm.bar.euler_critical_load(l) for l in sysm.l.ravel()])
+    mat = sysm.membrane
+    checks = []
+
+    def check(name, value, limit, ok, eq):
+        checks.append({"check": name, "value": float(value), "limit": float(limit),
+                       "ok": bool(ok), "equation": eq})
+
+    if mat.yield_stress:
+        check("membrane max sigma_p1 <= yield", ss["max_sigma_p1"], mat.yield_stress,
+              ss["max_sigma_p1"] <= mat.yield_stress, "5.29")
+        check("membrane max von Mises <= yield", ss["max_von_mises"], mat.yield_stress,
+              ss["max_von_mises"] <= mat.yield_stress, "5.30")
+    ty = model.tendon_yield
+    if np.any(np.isfinite(ty)):
+        s = ms["tendon_stress"]
+        k = int(np.nanargmax(s / ty))
+        check("tendon stress <= yield", s[k], ty[k], np.all(s[np.isfinite(ty)] <= ty[np.isfinite(ty)]),
+              "6.2")
+    check("no slack tendon", int(ms["tendon_slack"].sum()), 0, not ms["tendon_slack"].any(), "3.18")
+    k = int(np.argmax(bar_load / Fcrit))
+    check("bar load <= Euler critical load", bar_load[k], Fcrit[k], np.all(bar_load <= Fcrit), "5.31")
+
+    out = {
+        "system": sysm.name, "mesh_n": int(topo.mesh.n), "tendon_elements": topo.tendon_elements,
+        "attachment": topo.attachment, "dofs": model.ndof,
+        "rest_lengths_source": model.rest_lengths_source,
+        "rest_lengths": {t.name: float(r) for t, r in zip(sysm.tendons, model.rest_lengths)},
+        "nodes": {lab: {"x": X[:, i].tolist(), "design": Xd[:, i].tolist(),
+                        "deviation": float(dev[i])} for i, lab in enumerate(labels)},
+        "max_deviation_from_design": float(dev.max()),
+        "theta_deg": np.degrees(th).ravel().tolist(), "theta_design_deg": np.degrees(thd).ravel().tolist(),
+        "psi_deg": np.degrees(ps).ravel().tolist(), "psi_design_deg": np.degrees(psd).ravel().tolist(),
+        "Delta": delta.tolist(), "Delta_design": delta_design.tolist(),
+        "bar_force": ms["bar_force"].tolist(), "bar_load_max": float(bar_load.max()),
+        "bar_critical_load": float(Fcrit.min()),
+        "tendon_force": {t.name: float(f) for t, f in zip(sysm.tendons, ms["tendon_force"])},
+        "tendon_stress_max": float(ms["tendon_stress"].max()),
+        "tendon_slack": [t.name for t, s in zip(sysm.tendons, ms["tendon_slack"]) if s],
+        "membrane_max_sigma_p1": ss["max_sigma_p1"], "membrane_max_von_mises": ss["max_von_mises"],
+        "membrane_max_sigma_p1_element_mean": ss["max_sigma_p1_element_mean"],
+        "membrane_min_minor_principal": ss["min_minor_principal"],
+        "membrane_wrinkled_fraction": ss["wrinkled_fraction"],
+        "membrane_max_von_mises_element_mean": ss["max_von_mises_element_mean"],
+        "checks": checks, "printed": dict(sysm.printed),
+    }
+    if M >= 2:
+        out["bar_load_by_stage"] = [float(bar_load.reshape(M, N)[i].max()) for i in range(M)]
+    if result is not None:
+        out["iterations"] = int(result.iterations)
+        out["residual_history"] = [float(v) for v in result.residual_history]
+        out["static_time_s"] = float(result.time)
+        out["monitor"] = {k: v.tolist() for k, v in result.monitor.items()}
+    return out
+
+
+def membrane_field(model, x: np.ndarray):
+    """The membrane of positions x as a :class:`tmfem.io.vtk.MembraneField` with displacement
+    in the floating frame (point data) and sigma_p1, sigma_p2, von Mises and the floating-frame
+    Cauchy components (cell data, element means)."""
+    from tmfem.io.vtk import MembraneField
+    topo = model.topology
+    nm = topo.n_mesh
+    xm = x[:, :nm]
+    corners = xm[:, topo.mesh.corners]
+    xf = to_floating(xm, corners)
+    ref = np.vstack([topo.mesh.p, np.zeros(nm)])
+    st = model.membrane.stresses(xm)
+    cd = {"sigma_p1": st.principal_elem[0], "sigma_p2": st.principal_elem[1],
+          "von_mises": st.von_mises_elem,
+          "sigma_xf": st.cauchy[0].mean(axis=-1), "sigma_yf": st.cauchy[1].mean(axis=-1),
+          "tau_xfyf": st.cauchy[2].mean(axis=-1)}
+    return MembraneField(mesh=topo.mesh, x=xm, point_data={"displacement_floating": xf - ref},
+                         cell_data=cd)
+
+
+def model_cells(model) -> list:
+    """Cells of the full MTC mesh: bars, tendon elements (lines) and membrane quads."""
+    return [("line", model.topology.bar_conn), ("line", model.topology.tendon_conn),
+            ("quad", model.topology.mesh.t)]
+
+
+def frame_of(x: np.ndarray, model) -> tuple[np.ndarray, np.ndarray]:
+    """Floating frame (origin, R) of the current membrane corners of positions x."""
+    return floating_frame(x[:, model.topology.mesh.corners])
