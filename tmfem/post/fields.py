@@ -27,6 +27,22 @@ def corner_displacements(system, q=None) -> tuple[np.ndarray, np.ndarray, np.nda
     return local[:2] - system.membrane_corners, o, R
 
 
+def corner_radial_displacements(system, q=None) -> np.ndarray:
+    """Outward radial displacement (N,) of each membrane corner relative to the centroid.
+
+    The corner displacements of :func:`corner_displacements` with the rigid translation
+    that keeps the centroid fixed removed, projected on the direction from the centroid to
+    the undeformed corner. For a symmetric system every entry equals Delta of eq. 3.22;
+    a membrane is stretched only if all are positive (eq. 3.36).
+    """
+    delta, _, _ = corner_displacements(system, q)
+    ref = system.membrane_corners
+    e = ref - ref.mean(axis=1, keepdims=True)
+    e /= np.linalg.norm(e, axis=0)
+    d = delta - delta.mean(axis=1, keepdims=True)
+    return np.sum(d * e, axis=0)
+
+
 def membrane_design_field(system, *, q=None, n: int = 10) -> MembraneField:
     """The membrane of configuration q: linear plane-stress state for its corner positions.
 
