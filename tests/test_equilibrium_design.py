@@ -1,0 +1,114 @@
+"""Design pipeline: F from the plane-stress FE, tendon forces, rest lengths, checks (3.2, 5.29-5.31)."""
+import numpy as np
+import pytest
+
+from tmfem.equilibrium.design import design_equilibrium, forces_from_rest_lengths
+from tmfem.equilibrium.general import corner_state, positive_null_vector, symmetric_matrix
+from tmfem.equilibrium.symmetric import r1_1N, tendon_force_1N
+from tmfem.errors import InfeasibleDesign, SlackMembrane, SlackTendon
+from tmfem.fem.plane_stress import symmetric_corner_force
+from tmfem.system import SymmetricConfig, load_preset
+
+MESH = 4   # coarse membrane mesh: the tests compare formulations on the same mesh
+
+
+def one_stage(theta_deg=60.0, psi_deg=10.0, *, r1=None, r_mb=1.4142, l1=2.015):
+    s = load_preset("1-4")
+    th, ps = np.radians(theta_deg), np.radians(psi_deg)
+    if r1 is None:
+        r1 = float(r1_1N(l1=l1, theta1=th, psi1=ps, N=4))       # eq. 3.33
+    cfg = SymmetricConfig(theta=[th], psi=[ps], sigma=[0], z=[0], r=[r1], l=[l1])
+    return s.replace(q=cfg.to_q(4), symmetric=cfg, base=cfg.base_nodes(4)[:, 0, :],
+                     r_mb=r_mb, membrane_corners=_corners(r_mb), rest_lengths=None)
+
+
+def _corners(r_mb):
+    from tmfem.system.geometry import membrane_corners_regular
+    return membrane_corners_regular(4, r_mb)
+
+
+def test_1N_design_matches_closed_form_null_vector():
+    s = one_stage()
+    d = design_equilibrium(s, mesh_n=MESH)
+    assert d.residual < 1e-9
+    # F_Delta of the FE (A2's symmetric_corner_force, same mesh) and T_S of eq. 3.34
+    F = symmetric_corner_force(s, n=MESH)
+    assert d.F_Delta == pytest.approx(F, rel=1e-9)
+    np.testing.assert_allclose(d.tendon_forces, tendon_force_1N(s, F), rtol=1e-8)
+    # rest lengths of eqs. 3.8-3.9 give back the same forces (reverse direction)
+    back = forces_from_rest_lengths(s, d.rest_lengths, mesh_n=MESH)
+    np.testing.assert_allclose(back["forces"], d.tendon_forces, rtol=1e-10)
+    assert back["residual"] < 1e-9 and not back["slack"].any()
+    # force density T/|S| (eq. 3.30)
+    np.testing.assert_allclose(d.force_densities, d.tendon_forces / d.tendon_lengths)
+
+
+def test_bar_load_is_axial_and_balances_the_bar_top():
+    # stage-1 bar pinned at A: moment equilibrium needs the resultant at B along the bar
+    s = one_stage()
+    d = design_equilibrium(s, mesh_n=MESH)
+    X = d.nodes
+    A, B = s.bar_ends()
+    u = (B - A)[:, 0, 0] / s.l[0, 0]
+    # resultant on B_11 from S_12 (A_12 - B_11) and the membrane corner 1
+    k = s.tendon_names().index("S_12")
+    c = s.tendon_connectivity[:, k]
+    t = X[:, c[0]] - X[:, c[1]]
+    f = d.tendon_forces[k] * t / np.linalg.norm(t)
+    st = corner_state(s)
+    f = f - st.R @ np.append(d.corner_forces[:, 0], 0.0)
+    assert np.linalg.norm(np.cross(f, u)) < 1e-6 * np.linalg.norm(f)
+    assert d.bar_loads[0, 0] == pytest.approx(-f @ u, rel=1e-9)
+    crit = np.pi**2 * s.bar.E * np.pi * s.bar.d**4 / 64 / s.l[0, 0]**2     # eq. 5.31, K = 1
+    assert d.bar_critical[0, 0] == pytest.approx(crit)
+
+
+def test_2_3_design_agrees_with_reduced_null_vector_scaled_to_F_delta():
+    # a 2-3 configuration with a positive null vector and Delta > 0 (found with the map of
+    # tmfem.equilibrium.symmetric_map); tendon forces = null vector scaled to F_Delta (3.2)
+    s = load_preset("2-3")
+    c = s.symmetric
+    cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(157.84)],
+                          sigma=[0, np.radians(145.67)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
+    s = s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
+    nv = positive_null_vector(symmetric_matrix(s).A)
+    assert nv.exists
+    d = design_equilibrium(s, mesh_n=MESH)
+    assert d.ok or all(ch.name in ("bar buckling", "tendon yield", "membrane von Mises stress",
+                                    "membrane max principal stress") for ch in d.failed)
+    x = nv.x * d.F_Delta / nv.x[-1]
+    got = d.group_values(d.tendon_forces)
+    for g, v in zip(symmetric_matrix(s).cols[:-1], x[:-1]):
+        assert got[g] == pytest.approx(v, rel=1e-6), g
+
+
+def test_named_errors():
+    with pytest.raises(SlackMembrane, match=r"membrane stretched \(eq. 3.22/3.36\).*Delta = -"):
+        design_equilibrium(one_stage(r_mb=2.0), mesh_n=MESH)
+    # a 1-N system with cot psi_1 < tan(pi/N) also has Delta < 0 (eq. 3.36), so take a 2-3
+    # configuration with Delta > 0 whose unique null vector (3.3.2) has negative entries
+    s = load_preset("2-3")
+    c = s.symmetric
+    cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(120)],
+                          sigma=[0, np.radians(100)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
+    s = s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
+    with pytest.raises(SlackTendon, match=r"tendons taut.*= -\d.*slack\)"):
+        design_equilibrium(s, mesh_n=MESH)
+    with pytest.raises(InfeasibleDesign, match=r"eq. 3.33 requires r_1 = 0.42854"):
+        design_equilibrium(one_stage(r1=0.40), mesh_n=MESH)
+
+
+def test_non_strict_reports_every_failed_check():
+    d = design_equilibrium(one_stage(r_mb=2.0), mesh_n=MESH, strict=False)
+    names = {c.name for c in d.failed}
+    assert {"membrane stretched", "tendons taut"} <= names
+    for c in d.failed:
+        assert any(ch.isdigit() for ch in c.message)
+
+
+def test_printed_rest_length_of_table_6_2_is_slack_or_taut_by_strain():
+    # Table 6.2: r_1^S = 1.529 m against |S_1| = 1.5311 m (eq. 3.29): strain +0.14 %, taut
+    s = load_preset("1-4", as_printed=True)
+    out = forces_from_rest_lengths(s, mesh_n=MESH)
+    np.testing.assert_allclose(out["strain"], 1.531113642924252 / 1.529 - 1, rtol=1e-9)
+    assert not out["slack"].any()
