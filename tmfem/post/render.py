@@ -114,10 +114,10 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
                 tube.point_data["tendon force [N]"] = np.full(tube.n_points, f[k])
                 tubes.append(tube)
             merged = tubes[0].merge(tubes[1:]) if len(tubes) > 1 else tubes[0]
-            lo = float(f[taut].min())
+            # colour scale from zero: nearly equal forces look equal, not noise-amplified
             p.add_mesh(merged, scalars="tendon force [N]", cmap=_tendon_cmap(),
-                       clim=[lo, fmax] if fmax > lo else [0.0, fmax], smooth_shading=True,
-                       scalar_bar_args={"title": "tendon force [N]", "color": "black",
+                       clim=[0.0, fmax], smooth_shading=True,
+                       scalar_bar_args={"title": "tendon force [N]", "color": "black", "fmt": "%.3g",
                                         "vertical": True, "position_x": 0.9,
                                         "position_y": 0.1, "width": 0.05,
                                         "height": 0.5})
@@ -142,7 +142,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
                                  f"{sorted(membrane.cell_data) + sorted(membrane.point_data)}")
             p.add_mesh(grid, scalars=name, cmap="viridis", opacity=0.9, show_edges=True,
                        edge_color="#555555", line_width=0.5,
-                       scalar_bar_args={"title": name, "color": "black", "vertical": True,
+                       scalar_bar_args={"title": name, "color": "black", "vertical": True, "fmt": "%.3g",
                                         "position_x": 0.03, "position_y": 0.1,
                                         "width": 0.05, "height": 0.5})
         else:
@@ -157,13 +157,15 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
     if labels is None:
         labels = X.shape[1] <= 40
     if labels:
-        p.add_point_labels(np.ascontiguousarray(X.T), system.node_labels, font_size=12,
+        # labels a little above their node, so the node marker does not hide them
+        at = X + np.array([[0.0], [0.0], [0.025 * size]])
+        p.add_point_labels(np.ascontiguousarray(at.T), system.node_labels, font_size=12,
                            point_size=1, shape_opacity=0.0, text_color="#222222",
                            always_visible=True, show_points=False)
     if title:
         p.add_text(title, position="upper_edge", font_size=12, color="black")
     _set_view(p, X)
-    p.camera.zoom(1.1)
+    p.camera.zoom(1.3)
     return _screenshot(p, png_path)
 
 
