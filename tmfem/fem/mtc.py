@@ -106,7 +106,7 @@ class MTCModel:
     attachment : {"point", "distributed"}
         How the bar tops hold the membrane corners.
     patch : float, optional
-        Radius of the distributed attachment patch [m] (default 5 % of r_mb).
+        Radius of the distributed attachment patch [m] (default 10 % of r_mb).
     rest_lengths : ndarray or {"system", "design", "mtc"}, optional
         Tendon rest lengths. Default: ``system.rest_lengths`` when set, else ``"design"``:
         the design of ``tmfem.equilibrium.design_equilibrium`` (eq. 3.8). ``"mtc"``: the
@@ -185,7 +185,7 @@ class MTCModel:
 
     def _design_rest_lengths(self) -> np.ndarray:
         try:
-            from tmfem.equilibrium import design_equilibrium
+            from tmfem.equilibrium.design import design_equilibrium
         except ImportError as exc:  # the equilibrium package has not got it
             raise InputError("the system has no rest lengths and tmfem.equilibrium."
                              "design_equilibrium is unavailable; pass rest_lengths='mtc' or an "

@@ -83,9 +83,15 @@ def attachment_weights(mesh: MembraneMesh, *, attachment: str, patch: float) -> 
     """Nodes and weights of the membrane patch each corner load is spread over.
 
     ``"point"``: the corner node alone (weight 1). ``"distributed"``: the membrane nodes
-    within ``patch`` [m] of the corner, weighted by their lumped area times a linear taper
-    ``1 - r / patch`` (a traction that vanishes continuously at the patch boundary, so the
-    stress field it causes stays bounded as the mesh is refined); weights sum to one.
+    within ``patch`` [m] of the corner. The bar top is the value at the corner of the affine
+    map x(p) = a + B p fitted by weighted least squares to the patch nodes (weights omega_i =
+    lumped nodal area times the taper 1 - r / patch): x_top = sum_i w_i x_i with
+    w_i = omega_i [1, p_i] G^-1 [1, p_c], G = sum_i omega_i [1, p_i][1, p_i]^T. Hence
+    sum w_i = 1 and sum w_i p_i = p_c: the link is exact for rigid motions (objective) and
+    for any affine deformation of the patch, the attachment point stays at the design corner,
+    and the corner force is spread over the patch as a smooth body-force density
+    taper(r) (alpha + beta . p) that does not depend on the mesh. The stresses it causes stay
+    bounded under refinement, unlike a point load (log-singular displacement, 1/r stress).
     """
     if attachment == "point":
         return [(np.array([c]), np.array([1.0])) for c in mesh.corners]
@@ -103,12 +109,16 @@ def attachment_weights(mesh: MembraneMesh, *, attachment: str, patch: float) -> 
     for c in mesh.corners:
         r = np.hypot(p[0] - p[0, c], p[1] - p[1, c])
         nodes = np.flatnonzero(r < patch)
-        w = nodal[nodes] * (1.0 - r[nodes] / patch)
-        if nodes.size < 3 or w.sum() <= 0:
-            raise InputError(f"distributed attachment: the patch of radius {patch} m holds only "
-                             f"{nodes.size} membrane nodes; expected >= 3 (refine the mesh or "
-                             f"enlarge the patch)")
-        out.append((nodes, w / w.sum()))
+        omega = nodal[nodes] * (1.0 - r[nodes] / patch)
+        P = np.vstack([np.ones(nodes.size), p[:, nodes]])          # (3, n)
+        G = (P * omega) @ P.T
+        if nodes.size < 3 or np.linalg.cond(G) > 1e12:
+            raise InputError(f"distributed attachment: the patch of radius {patch} m holds "
+                             f"{nodes.size} membrane nodes; expected >= 3 not on a line (refine "
+                             f"the mesh or enlarge the patch)")
+        # weighted least-squares affine fit of the patch, evaluated at the corner
+        w = omega * (P.T @ np.linalg.solve(G, np.array([1.0, p[0, c], p[1, c]])))
+        out.append((nodes, w))
     return out
 
 
@@ -125,7 +135,7 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
         Truss elements per tendon (>= 1).
     attachment : {"point", "distributed"}
     patch : float, optional
-        Patch radius of the distributed attachment [m]; default 5 % of r_mb (or of the
+        Patch radius of the distributed attachment [m]; default 10 % of r_mb (or of the
         polygon's circumradius).
     """
     if system.deployable:
@@ -155,7 +165,7 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
     if patch is None:
         R = system.r_mb if system.r_mb else float(np.max(np.linalg.norm(
             system.membrane_corners - system.membrane_corners.mean(axis=1, keepdims=True), axis=0)))
-        patch = 0.05 * R
+        patch = 0.1 * R
     weights = attachment_weights(mesh, attachment=attachment, patch=patch)
 
     dependent = np.zeros(n_nodes, dtype=bool)
