@@ -112,3 +112,31 @@ def test_printed_rest_length_of_table_6_2_is_slack_or_taut_by_strain():
     out = forces_from_rest_lengths(s, mesh_n=MESH)
     np.testing.assert_allclose(out["strain"], 1.531113642924252 / 1.529 - 1, rtol=1e-9)
     assert not out["slack"].any()
+
+
+def test_equilibrium_map_agrees_with_pointwise_design():
+    # the map of eq. 5.97 near the configuration of the test above (sigma_2 = 145.67 deg):
+    # feasibility must agree with the LP at the same point, and the null-vector ratios with
+    # the design's tendon forces / F_Delta (unique: A_T is square and regular for 2-3)
+    from tmfem.equilibrium.symmetric_map import (configuration_5_97, equilibrium_map,
+                                                 with_configuration)
+    s = load_preset("2-3")
+    c = s.symmetric
+    sg = np.radians(145.67)
+    cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(12.17), np.radians(12.17) + sg],
+                          sigma=[0, sg], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
+    s = with_configuration(s, cfg)
+    th, ps = np.radians([60.0, 63.0]), np.radians([12.17, 40.0])
+    m = equilibrium_map(s, theta=th, psi=ps)
+    assert m.ratios.shape == (2, 2, 8) and m.columns[-1] == "F_Delta"
+    for a in range(2):
+        for b in range(2):
+            sp = with_configuration(s, configuration_5_97(s, th[a], ps[b]))
+            assert m.positive[a, b] == positive_null_vector(symmetric_matrix(sp).A).exists
+            assert m.Delta[a, b] == pytest.approx(sp.symmetric.membrane_delta(3, sp.r_mb))
+    np.testing.assert_array_equal(m.feasible, m.positive & (m.Delta > 0))
+    d = design_equilibrium(with_configuration(s, configuration_5_97(s, th[1], ps[0])),
+                           mesh_n=MESH, strict=False)
+    got = d.group_values(d.tendon_forces)
+    for g, v in zip(m.columns[:-1], m.ratios[1, 0, :-1]):
+        assert got[g] / d.F_Delta == pytest.approx(v, rel=1e-6), g

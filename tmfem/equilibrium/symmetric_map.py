@@ -1,0 +1,152 @@
+"""Region of symmetric equilibria over (theta, psi) (3.3.2, eq. 5.97).
+
+Degrees of freedom. A symmetric M-N system is described by theta_i, psi_i, l_i, r_i of
+each stage, sigma_i, z_i of stages i >= 2 and r_mb. The reduced equilibrium matrix of
+3.3.2 has 5M-3 rows and 6M-4 columns, so for M >= 2 it always has a null space of
+dimension >= M-1 (1 for a 2-3 system): every geometry has a force ratio that balances it,
+and equilibrium is the *inequality* that this null vector is positive (tendons taut,
+F_Delta > 0) together with Delta > 0 (eq. 3.22). The equilibria of a 2-3 system with l,
+r_1 and r_mb fixed therefore form an open region in the 7 parameters (theta_1, psi_1,
+theta_2, psi_2, r_2, z_2, sigma_2), not a surface; r_2, z_2 and sigma_2 of Table 6.4 are
+free choices, not results of the method.
+
+Eq. 5.97 (ch. 8) parametrises symmetric configurations by two numbers: theta_ij = theta and
+psi_ij = psi + sigma_i + 2 j pi / N, i.e. theta_1 = theta_2 = theta and the azimuth of each
+stage relative to its own base equal to psi. The map below evaluates that family on a
+(theta, psi) grid with everything else (l_i, r_i, z_i, sigma_i, r_mb) held at the values
+of the given system: these are what the axes fix.
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
+from tmfem.equilibrium.symmetric import membrane_delta
+from tmfem.errors import InputError
+from tmfem.system.geometry import SymmetricConfig
+
+
+def configuration_5_97(system, theta: float, psi: float) -> SymmetricConfig:
+    """The symmetric configuration of eq. 5.97 for (theta, psi), other parameters from ``system``."""
+    c = system.symmetric
+    if c is None:
+        raise InputError(f"system {system.name!r} is not symmetric (3.3.1)")
+    M = c.M
+    return SymmetricConfig(theta=np.full(M, theta), psi=psi + c.sigma, sigma=c.sigma, z=c.z,
+                           r=c.r, l=c.l)
+
+
+def with_configuration(system, cfg: SymmetricConfig):
+    """A copy of a symmetric system at another symmetric configuration (rest lengths dropped)."""
+    if system.M != cfg.M:
+        raise InputError(f"expected a configuration with M = {system.M} stages, found {cfg.M}")
+    return system.replace(q=cfg.to_q(system.N), symmetric=cfg,
+                          base=cfg.base_nodes(system.N)[:, 0, :], rest_lengths=None)
+
+
+@dataclass
+class EquilibriumMap:
+    """Result of :func:`equilibrium_map`.
+
+    Attributes
+    ----------
+    theta, psi : (n_theta,), (n_psi,) grid axes [rad].
+    feasible : (n_theta, n_psi) bool: positive null vector and Delta > 0.
+    positive : (n_theta, n_psi) bool: positive null vector of the reduced matrix.
+    margin : (n_theta, n_psi) smallest entry of the null vector (LP of 3.2, entries
+        normalised to sum 1; > 0 when positive).
+    Delta : (n_theta, n_psi) eq. 3.22 [m].
+    ratios : (n_theta, n_psi, 6M-4) null vector scaled to F_Delta = 1 (NaN where none).
+    columns : names of the null-vector entries (eq. 3.26).
+    fixed : the parameters the axes hold fixed.
+    """
+
+    theta: np.ndarray
+    psi: np.ndarray
+    feasible: np.ndarray
+    positive: np.ndarray
+    margin: np.ndarray
+    Delta: np.ndarray
+    ratios: np.ndarray
+    columns: list
+    fixed: dict
+
+    def to_dict(self) -> dict:
+        return {"theta_deg": np.degrees(self.theta).tolist(), "psi_deg": np.degrees(self.psi).tolist(),
+                "feasible": self.feasible.tolist(), "positive": self.positive.tolist(),
+                "margin": np.where(np.isfinite(self.margin), self.margin, None).tolist(),
+                "Delta": self.Delta.tolist(), "columns": self.columns, "fixed": self.fixed}
+
+
+def equilibrium_map(system, *, theta, psi, progress: bool = False) -> EquilibriumMap:
+    """Evaluate the family of eq. 5.97 on a (theta, psi) grid [rad].
+
+    At each point: the reduced (5M-3) x (6M-4) matrix of 3.3.2, the LP search for a
+    positive null vector, and Delta of eq. 3.22.
+    """
+    theta = np.atleast_1d(np.asarray(theta, dtype=float))
+    psi = np.atleast_1d(np.asarray(psi, dtype=float))
+    c = system.symmetric
+    if c is None or system.r_mb is None:
+        raise InputError(f"system {system.name!r}: the map needs a symmetric system with r_mb")
+    shape = (theta.size, psi.size)
+    positive = np.zeros(shape, dtype=bool)
+    margin = np.full(shape, -np.inf)
+    Delta = np.zeros(shape)
+    cols = None
+    ratios = None
+    for a, th in enumerate(theta):
+        for b, ps in enumerate(psi):
+            cfg = configuration_5_97(system, th, ps)
+            s = with_configuration(system, cfg)
+            S = symmetric_matrix(s)
+            if ratios is None:
+                cols = S.cols
+                ratios = np.full(shape + (len(cols),), np.nan)
+            nv = positive_null_vector(S.A)
+            positive[a, b] = nv.exists
+            margin[a, b] = nv.margin
+            if nv.dim == 1 and abs(nv.x[-1]) > 1e-12 * np.abs(nv.x).max():
+                ratios[a, b] = nv.x / nv.x[-1]
+            Delta[a, b] = membrane_delta(l_M=cfg.l[-1], theta_M=th, psi_M=cfg.psi[-1],
+                                         sigma_M=cfg.sigma[-1], r_M=cfg.r[-1], r_mb=system.r_mb,
+                                         N=system.N)
+        if progress:
+            print(f"equilibrium map: theta {a + 1}/{theta.size}", file=sys.stderr)
+    fixed = {"l": c.l.tolist(), "r": c.r.tolist(), "z": c.z.tolist(),
+             "sigma_deg": np.degrees(c.sigma).tolist(), "r_mb": system.r_mb,
+             "rule": "eq. 5.97: theta_i = theta, psi_i = psi + sigma_i"}
+    return EquilibriumMap(theta=theta, psi=psi, feasible=positive & (Delta > 0), positive=positive,
+                          margin=margin, Delta=Delta, ratios=ratios, columns=cols, fixed=fixed)
+
+
+def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
+    """Plot the map: feasible region shaded, Delta = 0 and margin = 0 contours.
+
+    ``mark`` = (theta, psi) [rad] of a point to mark (e.g. the design).
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    th, ps = np.degrees(emap.theta), np.degrees(emap.psi)
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    ax.contourf(ps, th, emap.feasible.astype(float), levels=[0.5, 1.5], colors=["#9fd49f"])
+    if emap.theta.size > 1 and emap.psi.size > 1:
+        m = np.where(np.isfinite(emap.margin), emap.margin, -1.0)
+        ax.contour(ps, th, m, levels=[0.0], colors="C0", linewidths=1.2)
+        ax.contour(ps, th, emap.Delta, levels=[0.0], colors="C3", linewidths=1.2, linestyles="--")
+    if mark is not None:
+        ax.plot(np.degrees(mark[1]), np.degrees(mark[0]), "k*", ms=12, label="design")
+        ax.legend(loc="best")
+    ax.set_xlabel("psi [deg] (azimuth relative to the stage base, eq. 5.97)")
+    ax.set_ylabel("theta [deg]")
+    ax.set_title(title or "symmetric equilibria (green); blue: null vector positive "
+                 "boundary, red dashed: Delta = 0", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(png, dpi=120)
+    plt.close(fig)
+    return png
