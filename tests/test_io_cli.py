@@ -117,3 +117,22 @@ def test_membrane_design_field_lands_on_the_bar_tops():
     # stretched membrane (Delta > 0): tension everywhere on average
     assert np.all(corner_radial_displacements(s) > 0)
     assert mf.cell_data["sigma_p1"].min() > 0
+
+
+def test_export_writes_the_equilibrium_design(tmp_path, capsys):
+    pytest.importorskip("tmfem.equilibrium.design")
+    assert main(["export", "--preset", "1-4", str(tmp_path / "d.vtu"), "--mesh", "4",
+                 "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["forces_from"] == "design_equilibrium" and r["warnings"] == []
+    m = meshio.read(tmp_path / "d.vtu")
+    k = [i for i, b in enumerate(m.cells) if b.type == "line"]
+    d = {name: np.concatenate([v[i] for i in k]) for name, v in m.cell_data.items()}
+    T, L, r0 = d["axial_force"][4:], d["length"][4:], d["rest_length"][4:]
+    np.testing.assert_allclose(T, list(r["tendon_forces"].values()))
+    assert np.all(T > 0) and np.all(d["slack"][4:] == 0)
+    s = load_preset("1-4")
+    EA = s.tendon_EA
+    np.testing.assert_allclose(r0, EA * L / (T + EA), rtol=1e-12)          # eq. 3.9
+    np.testing.assert_allclose(T, T[0], rtol=1e-9)                          # symmetric design
+    assert np.all(d["axial_force"][:4] < 0)                                 # bars compressed

@@ -31,21 +31,22 @@ def configure(parser) -> None:
 
 
 def design_forces(system, *, mesh_n: int) -> dict:
-    """Tendon forces and rest lengths from ``tmfem.equilibrium.design_equilibrium``.
+    """Tendon forces, rest lengths and bar forces of the equilibrium design.
 
-    Returns an empty dict when that module is not available yet; errors of the design
-    itself (an infeasible system) propagate as the named tmfem errors.
+    Uses ``tmfem.equilibrium.design_equilibrium`` (3.2, eqs. 3.8-3.9, 3.16); returns an
+    empty dict when that module is not available. Bar forces are axial forces, negative in
+    compression, in stage-major order. Errors of the design itself (an infeasible
+    system) propagate as the named tmfem errors.
     """
     try:
-        from tmfem.equilibrium import design_equilibrium
+        from tmfem.equilibrium.design import design_equilibrium
     except ImportError:
         return {}
-    d = design_equilibrium(system, mesh_n=max(mesh_n, 1) if mesh_n else 10)
-    out = {}
-    for key in ("tendon_forces", "rest_lengths", "bar_forces"):
-        v = getattr(d, key, None)
-        if v is not None:
-            out[key] = np.asarray(v, dtype=float)
+    d = design_equilibrium(system, mesh_n=mesh_n if mesh_n > 0 else 10)
+    out = {"tendon_forces": np.asarray(d.tendon_forces, dtype=float),
+           "rest_lengths": np.asarray(d.rest_lengths, dtype=float)}
+    if getattr(d, "bar_loads", None) is not None:
+        out["bar_forces"] = -np.asarray(d.bar_loads, dtype=float).ravel()
     return out
 
 
