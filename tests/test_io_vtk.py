@@ -203,6 +203,11 @@ def test_series_survives_an_interrupted_run(tmp_path, sys14):
     w.append_configuration(0.0, s)
     w.append_configuration(0.5, s, tendon_forces=np.ones(4))
     assert len(read_pvd(w.pvd)) == 2
+    pv = pytest.importorskip("pyvista")
+    reader = pv.get_reader(str(w.pvd))          # VTK's own PVD reader accepts the collection
+    assert reader.time_values == pytest.approx([0.0, 0.5])
+    reader.set_active_time_value(0.5)
+    np.testing.assert_allclose(reader.read()[0].cell_data["axial_force"][4:8], 1.0)
     with pytest.raises(InputError, match="increase"):
         w.append_configuration(0.5, s)
 
