@@ -1,0 +1,120 @@
+"""Natural frequencies of the control-oriented model (6.4, eq. 5.33) and studies.
+
+The COM is linearised about its equilibrium (eq. 5.33); the undamped natural frequencies
+are sqrt(eig(M_hat^-1 K)) / 2 pi. The dissertation's COM columns (Tables 6.6, 6.7) and the
+highest COM frequencies quoted in 6.5 (2.4322 Hz for 1-4 with 13 coordinates, 4.4607 Hz
+for 2-3) are printed beside ours.
+"""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from tmfem.errors import InputError
+
+# Numbers of membrane modes used by the dissertation (6.4.1, 6.4.2, 7.4).
+DISSERTATION_K = {"1-4": 5, "2-3": 4, "1-4D": 3, "1-6D": 5}
+# Highest COM frequency quoted in 6.5.1 / 6.5.2 (all coordinates of the COM).
+DISSERTATION_HIGHEST = {"1-4": 2.4322, "2-3": 4.4607}
+
+
+def dissertation_com_frequencies(name: str):
+    """COM column of Table 6.6 (1-4) or 6.7 (2-3), or None."""
+    from tmfem.fem.mtc_post import DISSERTATION_FREQUENCIES
+    ref = DISSERTATION_FREQUENCIES.get(name)
+    return None if ref is None else (ref["source"], list(ref["COM"]))
+
+
+def default_membrane_modes(system) -> int:
+    """K of the dissertation for its systems (5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6(D))."""
+    base = system.name.split("-initial")[0].replace("(D)", "D")
+    return DISSERTATION_K.get(base, 4)
+
+
+def printed_prestress_scale(model) -> float | None:
+    """Prestress factor implied by the printed maximum tendon stress (Tables 6.3, 6.5):
+    s = sigma_printed A / max(T_design) for the model's own design tendon forces."""
+    p = model.system.printed.get("tendon_max_stress")
+    if p is None or model.design is None:
+        return None
+    A = np.array([model.system.tendon_section(t).area for t in model.system.tendons])
+    return float(p * A[np.argmax(model.design.tendon_forces / A)] /
+                 np.max(model.design.tendon_forces) / model.prestress_scale)
+
+
+def com_frequencies(system, *, membrane_modes: int, prestress_scale: float = 1.0,
+                    mesh_n: int = 10, rest_lengths="design"):
+    """(frequencies in Hz, model) of the COM linearised about its equilibrium (eq. 5.33)."""
+    from tmfem.reduced.linearize import linearize
+    from tmfem.reduced.model import ControlOrientedModel
+    m = ControlOrientedModel(system, membrane_modes=membrane_modes, mesh_n=mesh_n,
+                             prestress_scale=prestress_scale, rest_lengths=rest_lengths)
+    lin = linearize(m)
+    return lin.frequencies_hz(), m
+
+
+def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
+                  prestress_scale: float = 1.0, mesh_n: int = 10) -> dict:
+    """Natural frequencies of the COM beside Tables 6.6/6.7 (JSON-able dict).
+
+    Parameters
+    ----------
+    system : System
+    modes : int
+        Number of frequencies reported (at most the number of coordinates nq + K).
+    membrane_modes : int, optional
+        K; default the dissertation's (5 for 1-4, 4 for 2-3).
+    prestress_scale : float
+        Factor on the designed membrane prestress (1 = designed, see ControlOrientedModel).
+    """
+    K = default_membrane_modes(system) if membrane_modes is None else int(membrane_modes)
+    if not (isinstance(modes, int) and modes >= 1):
+        raise InputError(f"--modes: expected an integer >= 1, found {modes!r}")
+    print(f"tmfem modal: {system.name} COM, K = {K} membrane modes", file=sys.stderr)
+    f, m = com_frequencies(system, membrane_modes=K, prestress_scale=prestress_scale,
+                           mesh_n=mesh_n)
+    n = min(modes, len(f))
+    out = {"system": system.name, "model": "com", "membrane_modes": K, "mesh_n": mesh_n,
+           "prestress_scale": prestress_scale, "sizes": m.summary(),
+           "freq_hz": f[:n].tolist(), "highest_hz": float(f[-1]),
+           "design_tendon_forces": dict(zip(system.tendon_names(), m.design.tendon_forces.tolist())),
+           "design_rest_lengths": dict(zip(system.tendon_names(), m.design.rest_lengths.tolist()))}
+    s_pr = printed_prestress_scale(m)
+    if s_pr is not None:
+        out["printed_stress_prestress_scale"] = s_pr
+    ref = dissertation_com_frequencies(system.name)
+    if ref is not None and K == DISSERTATION_K.get(system.name):
+        src, com = ref
+        k = min(n, len(com))
+        out["dissertation"] = {"source": src, "COM": com[:k],
+                               "highest_hz": DISSERTATION_HIGHEST.get(system.name)}
+        out["relative_difference"] = (f[:k] / np.array(com[:k]) - 1).tolist()
+    return out
+
+
+def format_summary(r: dict) -> str:
+    lines = [f"COM of {r['system']}: {r['sizes']['n_z']} coordinates (nq = {r['sizes']['n_q']}, "
+             f"K = {r['membrane_modes']}), prestress x{r['prestress_scale']:g}"]
+    ref = r.get("dissertation", {}).get("COM", [])
+    lines.append(f"{'mode':>4} {'ours [Hz]':>10} {'printed':>10} {'rel.diff':>9}")
+    for i, f in enumerate(r["freq_hz"]):
+        if i < len(ref):
+            lines.append(f"{i + 1:>4} {f:>10.4f} {ref[i]:>10.4f} {f / ref[i] - 1:>+9.2%}")
+        else:
+            lines.append(f"{i + 1:>4} {f:>10.4f}")
+    return "\n".join(lines)
+
+
+def frequency_study(system, *, K_values, prestress_scales=(1.0,), modes: int = 12,
+                    mesh_n: int = 10, progress=True) -> list[dict]:
+    """Frequencies vs number of membrane modes K and prestress factor (rows of dicts)."""
+    rows = []
+    for s in prestress_scales:
+        for K in K_values:
+            if progress:
+                print(f"frequency study {system.name}: prestress x{s:g}, K = {K}", file=sys.stderr)
+            f, m = com_frequencies(system, membrane_modes=K, prestress_scale=s, mesh_n=mesh_n)
+            rows.append({"prestress_scale": s, "K": K, "freq_hz": f[:modes].tolist(),
+                         "highest_hz": float(f[-1])})
+    return rows
