@@ -104,3 +104,12 @@ def test_plots(tmp_path):
         plot_histories(tmp_path / "x.png", t, {"a": t[:-1]}, ylabel="x")
     with pytest.raises(InputError, match=r"labels: expected 2 labels, found 1"):
         plot_convergence(tmp_path / "x.png", h, v, labels=["f1"])
+
+
+def test_membrane_colour_range_ignores_corner_peaks():
+    from tmfem.post.render import _robust_range
+
+    v = np.concatenate([np.linspace(1.0, 2.0, 200), [50.0, 60.0]])   # two singular corners
+    lo, hi = _robust_range(v)
+    assert lo == 1.0 and hi == pytest.approx(np.percentile(v, 98)) and hi < 3.0
+    assert _robust_range(np.linspace(1.0, 2.0, 50)) == [1.0, 2.0]     # no outliers: full range
