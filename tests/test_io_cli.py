@@ -136,3 +136,16 @@ def test_export_writes_the_equilibrium_design(tmp_path, capsys):
     np.testing.assert_allclose(r0, EA * L / (T + EA), rtol=1e-12)          # eq. 3.9
     np.testing.assert_allclose(T, T[0], rtol=1e-9)                          # symmetric design
     assert np.all(d["axial_force"][:4] < 0)                                 # bars compressed
+
+
+def test_export_from_a_system_file(tmp_path, capsys):
+    from tmfem.system import dump_system
+
+    s = load_preset("1-4")
+    dump_system(s, tmp_path / "s.toml")
+    assert main(["export", str(tmp_path / "s.toml"), str(tmp_path / "s.vtu"), "--mesh", "2",
+                 "--no-equilibrium", "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["system"] == "1-4" and r["membrane_elements"] == 4 * 2 * 2
+    m = meshio.read(tmp_path / "s.vtu")
+    np.testing.assert_allclose(m.points[:8], s.nodes().T, atol=1e-12)
