@@ -161,6 +161,10 @@ def test_xdmf_and_vtk_reader(tmp_path, sys14):
     g = pv.read(write_configuration(tmp_path / "c.vtu", s, tendon_forces=np.full(4, 7.0)))
     assert g.n_cells == 4 + 4 + 1 and g.n_points == 8
     np.testing.assert_allclose(g.cell_data["axial_force"][4:8], 7.0)
+    # legacy .vtk: VTK's reader rejects meshio's int32 type names, so codes are int64
+    g = pv.read(write_configuration(tmp_path / "c.vtk", s, tendon_forces=np.full(4, 7.0)))
+    np.testing.assert_array_equal(g.cell_data["kind"], [0] * 4 + [1] * 4 + [2])
+    np.testing.assert_array_equal(g.point_data["node_kind"], [0] * 4 + [1] * 4)
 
 
 def test_modes_file(tmp_path, sys14):

@@ -124,10 +124,10 @@ def _split_label(name: str) -> tuple[str, int, int]:
 def node_codes(system) -> dict:
     """Integer point data identifying the labelled nodes of ``system``."""
     parts = [_split_label(s) for s in system.node_labels]
-    return {"node_id": np.arange(len(parts), dtype=np.int32),
-            "node_kind": np.array([NODE_KIND_CODES[p[0]] for p in parts], dtype=np.int32),
-            "node_stage": np.array([p[1] for p in parts], dtype=np.int32),
-            "node_j": np.array([p[2] for p in parts], dtype=np.int32)}
+    return {"node_id": np.arange(len(parts), dtype=np.int64),
+            "node_kind": np.array([NODE_KIND_CODES[p[0]] for p in parts], dtype=np.int64),
+            "node_stage": np.array([p[1] for p in parts], dtype=np.int64),
+            "node_j": np.array([p[2] for p in parts], dtype=np.int64)}
 
 
 # ---------------------------------------------------------------------------- member data
@@ -168,27 +168,27 @@ def member_data(system, *, q=None, tendon_forces=None, rest_lengths=None,
     area = np.concatenate([np.full(nb, system.bar.area),
                            [system.tendon_section(t).area for t in system.tendons]])
     if tf is not None:
-        slack_t = (tf <= 0).astype(np.int32)
+        slack_t = (tf <= 0).astype(np.int64)
     elif r is not None:
-        slack_t = (ten_len < r).astype(np.int32)
+        slack_t = (ten_len < r).astype(np.int64)
     else:
-        slack_t = np.full(nt, -1, dtype=np.int32)
+        slack_t = np.full(nt, -1, dtype=np.int64)
     rest = np.concatenate([nan_b, nan_t if r is None else r])
     stage_b = np.repeat(np.arange(1, system.M + 1), system.N)
     j_b = np.tile(np.arange(1, system.N + 1), system.M)
     return {
-        "kind": np.concatenate([np.zeros(nb), np.ones(nt)]).astype(np.int32),
-        "member_id": np.concatenate([np.arange(nb), np.arange(nt)]).astype(np.int32),
+        "kind": np.concatenate([np.zeros(nb), np.ones(nt)]).astype(np.int64),
+        "member_id": np.concatenate([np.arange(nb), np.arange(nt)]).astype(np.int64),
         "family": np.concatenate([np.full(nb, -1),
                                   [FAMILY_CODES.index(t.family) for t in system.tendons]]
-                                 ).astype(np.int32),
-        "stage": np.concatenate([stage_b, [t.stage for t in system.tendons]]).astype(np.int32),
-        "j": np.concatenate([j_b, [t.j for t in system.tendons]]).astype(np.int32),
+                                 ).astype(np.int64),
+        "stage": np.concatenate([stage_b, [t.stage for t in system.tendons]]).astype(np.int64),
+        "j": np.concatenate([j_b, [t.j for t in system.tendons]]).astype(np.int64),
         "length": length,
         "axial_force": force,
         "force_density": force / length,
         "axial_stress": force / area,
-        "slack": np.concatenate([np.full(nb, -1, dtype=np.int32), slack_t]),
+        "slack": np.concatenate([np.full(nb, -1, dtype=np.int64), slack_t]),
         "rest_length": rest,
         "strain": (length - rest) / rest,
     }
@@ -324,7 +324,7 @@ def write_configuration(path, system, *, q=None, tendon_forces=None, rest_length
     pdata = {}
     codes = node_codes(system)
     for k, a in codes.items():
-        pdata[k] = np.concatenate([a, np.full(n_mem_points, -1, dtype=np.int32)])
+        pdata[k] = np.concatenate([a, np.full(n_mem_points, -1, dtype=np.int64)])
     extra = {}
     for k, v in (point_data or {}).items():
         extra[k] = _check_data(f"point data {k!r}", v, n_nodes).astype(float)
