@@ -371,7 +371,7 @@ def mean_value_coordinates(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
     on_edge = (np.abs(cross) <= 1e-12 * r * rn) & (dot < 0)
     w = np.where(np.isfinite(w), w, 0.0)
     lam = w / np.where(w.sum(axis=0) == 0, 1.0, w.sum(axis=0))
-    N = corners.shape[0 + 1]
+    N = corners.shape[1]
     for k in range(N):                       # loops over the N corners only
         e = on_edge[k]
         if np.any(e):
