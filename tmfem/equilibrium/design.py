@@ -66,6 +66,7 @@ class EquilibriumDesign:
     corner_forces : (2, N) forces on the membrane corners in O_f; ``F_Delta`` their mean
         radial component.
     tendon_forces, tendon_lengths, force_densities, rest_lengths, tendon_stress : (n_t,)
+        (rest length NaN for a tendon with T <= 0: no rest length makes it push)
     bar_loads : (M, N) compressive bar loads (positive = compression); bar_critical: Euler.
     residual : relative equilibrium residual |A_T T + A_F F| / |A_F F| of eq. 3.16.
     checks : list of :class:`Check`.
@@ -124,7 +125,8 @@ class EquilibriumDesign:
             "corner_delta": self.corner_delta.tolist(),
             "corner_forces": self.corner_forces.tolist(),
             "tendons": [{"name": n, "group": t.group, "length": float(L), "force": float(T),
-                         "force_density": float(fd), "rest_length": float(r),
+                         "force_density": float(fd),
+                         "rest_length": float(r) if np.isfinite(r) else None,
                          "stress": float(sg)}
                         for n, t, L, T, fd, r, sg in zip(self.tendon_names, s.tendons,
                                                          self.tendon_lengths, self.tendon_forces,
@@ -132,7 +134,7 @@ class EquilibriumDesign:
                                                          self.tendon_stress)],
             "groups": {g: {"length": L, "force": self.group_values(self.tendon_forces)[g],
                            "force_density": self.group_values(self.force_densities)[g],
-                           "rest_length": self.group_values(self.rest_lengths)[g]}
+                           "rest_length": _finite(self.group_values(self.rest_lengths)[g])}
                        for g, L in self.group_values(self.tendon_lengths).items()},
             "bar_loads": self.bar_loads.tolist(), "bar_critical": self.bar_critical.tolist(),
             "membrane_max_principal": self.membrane_max_principal,
@@ -147,6 +149,10 @@ class EquilibriumDesign:
             d["given_rest_lengths"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                                        for k, v in self.given_rest_lengths.items()}
         return d
+
+
+def _finite(v):
+    return float(v) if np.isfinite(v) else None
 
 
 # ---------------------------------------------------------------------------- pieces
@@ -299,7 +305,7 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     checks: list[Check] = []
     scale = float(np.abs(system.membrane_corners).max())
     dw = float(np.abs(st.delta[2]).max())
-    checks.append(Check("membrane corners coplanar", "3.4-3.5", dw, 1e-9 * scale,
+    checks.append(Check("membrane corners coplanar", "eq. 3.4-3.5", dw, 1e-9 * scale,
                         dw <= 1e-9 * scale,
                         f"out-of-plane corner displacement max |Delta_w| = {dw:.3g} m; the "
                         f"plane-stress membrane needs coplanar corners (<= {1e-9 * scale:.1g} m)"))
@@ -311,11 +317,11 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     F_Delta = float(radial.mean())
     Delta = _radial_delta(system, st.delta)
     if Delta is not None:
-        checks.append(Check("membrane stretched", "3.22/3.36", Delta, 0.0, Delta > 0,
+        checks.append(Check("membrane stretched", "eq. 3.22/3.36", Delta, 0.0, Delta > 0,
                             f"expected membrane corner displacement Delta > 0, found Delta = "
                             f"{Delta:.6g} m (F_Delta = {F_Delta:.4g} N)"))
     else:
-        checks.append(Check("membrane stretched", "3.21", float(radial.min()), 0.0,
+        checks.append(Check("membrane stretched", "eq. 3.21", float(radial.min()), 0.0,
                             bool(radial.min() > 0),
                             "expected every membrane corner force pointing outward, found "
                             f"radial components {np.array2string(radial, precision=4)} N"))
@@ -323,7 +329,7 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     L = system.tendon_lengths(q)
     names = system.tendon_names()
     slack = np.flatnonzero(T <= 0)
-    checks.append(Check("tendons taut", "3.16/3.35", float(T.min()), 0.0, slack.size == 0,
+    checks.append(Check("tendons taut", "eq. 3.16/3.35", float(T.min()), 0.0, slack.size == 0,
                         "expected all tendon forces > 0, found " + (", ".join(
                             f"{names[k]} = {T[k]:.4g} N" for k in slack[:8]) if slack.size
                             else f"min {T.min():.4g} N") + (
@@ -335,15 +341,16 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     if cf is not None and not system.deployable:
         extra = (f"; for a 1-N system eq. 3.33 requires r_1 = {cf['r1_equilibrium']:.6g} m, "
                  f"found {system.symmetric.r[0]:.6g} m")
-    checks.append(Check("equilibrium residual", "3.16", residual, residual_tol,
+    checks.append(Check("equilibrium residual", "eq. 3.16", residual, residual_tol,
                         residual <= residual_tol,
                         f"expected |A_T T + A_F F| / |A_F F| <= {residual_tol:g}, found "
                         f"{residual:.3g}" + ("" if residual <= residual_tol else
                                               f": no tendon forces balance the membrane at this "
                                               f"q{extra}")))
     EA = system.tendon_EA
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rest = EA * L / (T + EA)
+    # eqs. 3.8-3.9; a tendon that would have to push has no rest length (NaN)
+    rest = np.full_like(T, np.nan)
+    rest[T > 0] = EA[T > 0] * L[T > 0] / (T[T > 0] + EA[T > 0])
     sections = [system.tendon_section(t) for t in system.tendons]
     area = np.array([s.area for s in sections])
     stress = T / area
@@ -351,17 +358,17 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     if np.any(np.isfinite(ys)):
         ratio = np.where(np.isfinite(ys), stress / ys, -np.inf)
         k = int(np.argmax(ratio))
-        checks.append(Check("tendon yield", "6.2 (Table 6.3)", float(stress[k]), float(ys[k]),
+        checks.append(Check("tendon yield", "section 6.2", float(stress[k]), float(ys[k]),
                             bool(ratio[k] <= 1),
                             f"max tendon stress {stress[k] / 1e6:.4g} MPa in {names[k]} vs "
                             f"yield {ys[k] / 1e6:.4g} MPa"))
     sy = system.membrane.yield_stress
     if sy is not None:
-        checks.append(Check("membrane max principal stress", "5.29", sol.max_principal, sy,
+        checks.append(Check("membrane max principal stress", "eq. 5.29", sol.max_principal, sy,
                             sol.max_principal <= sy,
                             f"max sigma_p1 = {sol.max_principal / 1e6:.4g} MPa vs yield "
                             f"{sy / 1e6:.4g} MPa"))
-        checks.append(Check("membrane von Mises stress", "5.30", sol.max_von_mises, sy,
+        checks.append(Check("membrane von Mises stress", "eq. 5.30", sol.max_von_mises, sy,
                             sol.max_von_mises <= sy,
                             f"max sigma_v = {sol.max_von_mises / 1e6:.4g} MPa vs yield "
                             f"{sy / 1e6:.4g} MPa"))
@@ -369,7 +376,7 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     loads = bar_axial_loads(system, q, T, -(st.R @ F3))
     crit = np.vectorize(system.bar.euler_critical_load)(system.l)
     k = np.unravel_index(np.argmax(loads / crit), loads.shape)
-    checks.append(Check("bar buckling", "5.31", float(loads[k]), float(crit[k]),
+    checks.append(Check("bar buckling", "eq. 5.31", float(loads[k]), float(crit[k]),
                         bool(loads[k] <= crit[k]),
                         f"max bar compression {loads[k]:.4g} N (b_{k[0] + 1}{k[1] + 1}) vs Euler "
                         f"load {crit[k]:.6g} N"))
@@ -387,7 +394,7 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
         for name, exc in _RAISES:
             if name in failed:
                 others = [n for n in failed if n != name]
-                msg = f"{name} (eq. {failed[name].equation}) violated: {failed[name].message}"
+                msg = f"{name} ({failed[name].equation}) violated: {failed[name].message}"
                 if others:
                     msg += "; also failed: " + ", ".join(others)
                 raise exc(msg)

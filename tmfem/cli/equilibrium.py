@@ -1,0 +1,114 @@
+"""``tmfem equilibrium``: the prestressed equilibrium design of a system (dissertation ch. 3).
+
+Prints node coordinates, Delta, tendon lengths, forces, force densities, rest lengths and
+the design checks (eqs. 3.16, 3.22, 3.35, 5.29-5.31). A violated equilibrium condition
+(slack membrane, slack tendon, no equilibrium) is a one-line error and exit code 1 unless
+``--allow-infeasible`` is given. When the system carries rest lengths (e.g. ``--as-printed``)
+the forces they imply at the design geometry are shown beside the designed ones.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.errors import InputError
+
+NAME = "equilibrium"
+HELP = "design the prestressed equilibrium of a system (ch. 3): forces, rest lengths, checks"
+
+
+def configure(parser) -> None:
+    add_system_args(parser)
+    parser.add_argument("--mesh", type=int, default=10, metavar="n",
+                        help="membrane mesh n x n per quadrilateral patch (default 10, as in 6.2)")
+    parser.add_argument("--allow-infeasible", action="store_true",
+                        help="print the design even when an equilibrium condition is violated")
+
+
+def design_result(system, *, mesh_n: int, strict: bool) -> tuple[dict, object]:
+    """Run the design and return (JSON-able result, EquilibriumDesign)."""
+    from tmfem.equilibrium.design import design_equilibrium
+
+    if mesh_n < 1:
+        raise InputError(f"--mesh: expected n >= 1, found {mesh_n}")
+    d = design_equilibrium(system, mesh_n=mesh_n, strict=strict)
+    out = d.to_dict()
+    out["mesh_n"] = mesh_n
+    out["node_labels"] = list(system.node_labels)
+    out["printed"] = dict(system.printed)
+    if d.given_rest_lengths is not None:
+        g = d.given_rest_lengths
+        out["given_rest_lengths"] = {
+            "residual": g["residual"],
+            "tendons": [{"name": n, "rest_length": float(r), "strain": float(e),
+                         "force": float(T), "slack": bool(sl)}
+                        for n, r, e, T, sl in zip(system.tendon_names(), g["rest_lengths"],
+                                                  g["strain"], g["forces"], g["slack"])]}
+    return out, d
+
+
+def run(args) -> dict:
+    system = system_from_args(args)
+    out, _ = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible)
+    out["as_printed"] = bool(args.as_printed)
+    return out
+
+
+def _groups(r: dict) -> dict:
+    """Per-group rows: tendons of a symmetric group share their values."""
+    rows = {}
+    for t in r["tendons"]:
+        rows.setdefault(t["group"], []).append(t)
+    return rows
+
+
+def format_text(r: dict) -> str:
+    L = [f"system {r['system']} ({r['M']}-{r['N']}{'(D)' if r['deployable'] else ''}), "
+         f"membrane mesh {r['mesh_n']}x{r['mesh_n']} per patch: "
+         + ("all checks passed" if r["ok"] else "CHECKS FAILED")]
+    L.append("")
+    L.append("nodes [m]:")
+    for lab, x in r["nodes"].items():
+        L.append(f"  {lab:<6} {x[0]:10.5f} {x[1]:10.5f} {x[2]:10.5f}")
+    L.append("")
+    if r["Delta"] is not None:
+        L.append(f"membrane corner displacement Delta (eq. 3.22) = {r['Delta'] * 1e3:.5g} mm")
+    L.append(f"membrane corner force F_Delta (mean radial)   = {r['F_Delta']:.5g} N")
+    L.append(f"equilibrium residual (eq. 3.16)               = {r['residual']:.3g}")
+    L.append("")
+    given = {t["name"]: t for t in r.get("given_rest_lengths", {}).get("tendons", [])}
+    head = (f"  {'tendon':<8}{'length [m]':>12}{'force [N]':>12}{'T/L [N/m]':>12}"
+            f"{'rest [m]':>12}{'stress [MPa]':>14}")
+    if given:
+        head += f"{'given rest':>12}{'strain %':>10}{'force [N]':>11}"
+    L.append("tendons (one row per symmetric group when all members agree):")
+    L.append(head)
+    for g, ts in _groups(r).items():
+        same = all(abs(t["force"] - ts[0]["force"]) <= 1e-9 * max(1.0, abs(ts[0]["force"]))
+                   and abs(t["length"] - ts[0]["length"]) <= 1e-12 for t in ts)
+        for t in ([ts[0]] if same else ts):
+            name = f"{g} x{len(ts)}" if same and len(ts) > 1 else t["name"]
+            rest = f"{t['rest_length']:12.5f}" if t["rest_length"] is not None else f"{'-':>12}"
+            line = (f"  {name:<8}{t['length']:12.5f}{t['force']:12.5g}{t['force_density']:12.5g}"
+                    + rest + f"{t['stress'] / 1e6:14.5g}")
+            if given:
+                gt = given[t["name"]]
+                line += (f"{gt['rest_length']:12.5f}{gt['strain'] * 100:10.4f}{gt['force']:11.4g}"
+                         + ("  slack" if gt["slack"] else ""))
+            L.append(line)
+    if given:
+        L.append(f"  given rest lengths: equilibrium residual with their forces "
+                 f"{r['given_rest_lengths']['residual']:.3g} (0 = in equilibrium)")
+    L.append("")
+    bl = np.asarray(r["bar_loads"])
+    L.append("bar compressive loads [N] by stage: "
+             + "; ".join(f"stage {i + 1}: " + ", ".join(f"{v:.4g}" for v in row)
+                         for i, row in enumerate(bl)))
+    L.append(f"membrane max sigma_p1 = {r['membrane_max_principal'] / 1e6:.4g} MPa, "
+             f"max von Mises = {r['membrane_max_von_mises'] / 1e6:.4g} MPa")
+    L.append("")
+    L.append("checks:")
+    for c in r["checks"]:
+        L.append(f"  [{'ok' if c['ok'] else 'FAIL'}] {c['name']} ({c['equation']}): "
+                 f"{c['message']}")
+    return "\n".join(L)
