@@ -140,3 +140,39 @@ def test_equilibrium_map_agrees_with_pointwise_design():
     got = d.group_values(d.tendon_forces)
     for g, v in zip(m.columns[:-1], m.ratios[1, 0, :-1]):
         assert got[g] / d.F_Delta == pytest.approx(v, rel=1e-6), g
+
+
+def test_1ND_design_matches_null_vector_of_eq_3_40():
+    # 1-4(D) inside the bounds of eq. 3.41: forces = averaged null vector of 3.40 times
+    # |SL|, |SU| and F_Delta / (Delta + r_mb) (eq. 3.39)
+    from tmfem.equilibrium.symmetric import closed_form_1ND
+    from tmfem.system import System, TendonSection
+    base = load_preset("1-4")
+    cfg = SymmetricConfig(theta=[np.radians(50)], psi=[np.radians(15)], sigma=[0], z=[0],
+                          r=[0.5], l=[2.2])
+    s = System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
+                                bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
+                                deployable=True, k_H=0.3)
+    d = design_equilibrium(s, mesh_n=MESH)
+    cf = closed_form_1ND(s)
+    scale = d.F_Delta / (cf["delta"] + s.r_mb) / cf["null"][2]
+    np.testing.assert_allclose(d.tendon_forces[:4], cf["null"][0] * cf["SL"] * scale, rtol=1e-8)
+    np.testing.assert_allclose(d.tendon_forces[4:], cf["null"][1] * cf["SU"] * scale, rtol=1e-8)
+    assert d.residual < 1e-9 and d.Delta == pytest.approx(cf["delta"], rel=1e-12)
+    # bar b_11 pinned at A_11: forces at H_11 (SL_2, SU_2) and B_11 (SU_1, membrane) must
+    # have zero moment about A_11; the compression of segment A-H is -(f_B + f_H).u
+    X = d.nodes
+    lab = s.node_labels
+    f = {n: np.zeros(3) for n in ("B_11", "H_11")}
+    for k, t in enumerate(s.tendons):
+        for a, b in (t.ends, t.ends[::-1]):
+            if a in f:
+                v = X[:, lab.index(b)] - X[:, lab.index(a)]
+                f[a] += d.tendon_forces[k] * v / np.linalg.norm(v)
+    f["B_11"] -= corner_state(s).R @ np.append(d.corner_forces[:, 0], 0.0)
+    A = X[:, lab.index("A_11")]
+    mom = sum(np.cross(X[:, lab.index(n)] - A, f[n]) for n in f)
+    assert np.linalg.norm(mom) < 1e-8 * s.l[0, 0] * np.linalg.norm(f["B_11"])
+    u = (X[:, lab.index("B_11")] - A) / s.l[0, 0]
+    seg = max(-(f["B_11"] + f["H_11"]) @ u, -f["B_11"] @ u)
+    assert d.bar_loads[0, 0] == pytest.approx(seg, rel=1e-9)
