@@ -130,3 +130,37 @@ def test_positive_null_vector_lp():
     # nonsingular: no null space
     nv = positive_null_vector(np.eye(2))
     assert nv.dim == 0 and not nv.exists
+
+
+def test_design_of_a_non_symmetric_2_3_makes_virtual_work_vanish():
+    # general (non-symmetric) q: A_T is square for 2-3, so tendon forces exist for the FE
+    # corner forces; check delta U = T . d|d| + F . dDelta = 0 by finite differences
+    from tmfem.equilibrium.design import design_equilibrium, free_forces
+    s, q = perturbed("2-3", amp=0.01)
+    s = s.replace(q=q, symmetric=None, rest_lengths=None)
+    d = design_equilibrium(s, mesh_n=3, strict=False)
+    assert d.Delta is None and d.residual < 1e-9
+    F = free_forces(d.corner_forces)
+
+    def work(qq):
+        return d.tendon_forces @ s.tendon_lengths(qq) + F @ corner_state(s, qq).free
+
+    for _ in range(3):
+        dq = rng.standard_normal(q.size)
+        dW = (work(q + H * dq) - work(q - H * dq)) / (2 * H)
+        assert abs(dW) < 1e-6 * np.abs(d.tendon_forces).max()
+
+
+def test_non_coplanar_corners_are_reported():
+    # a general 1-4 with one bar tilted: the four corners leave the plane of B_4, B_1, B_3
+    from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.errors import InfeasibleDesign
+    s = load_preset("1-4")
+    q = s.q.copy()
+    q[2] += 0.05                                   # theta_12
+    s = s.replace(q=q, symmetric=None, rest_lengths=None)
+    d = design_equilibrium(s, mesh_n=3, strict=False)
+    bad = [c for c in d.failed if c.name == "membrane corners coplanar"]
+    assert bad and bad[0].value > 1e-3
+    with pytest.raises(InfeasibleDesign):
+        design_equilibrium(s, mesh_n=3)
