@@ -1,0 +1,137 @@
+"""``tmfem converge``: mesh and tendon-subdivision convergence of the MTC model (6.3)."""
+from __future__ import annotations
+
+import csv
+import sys
+
+from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.errors import InputError
+
+NAME = "converge"
+HELP = "mesh / tendon-subdivision convergence of frequencies and stresses (dissertation 6.3)"
+
+
+def _ints(text: str, what: str) -> list[int]:
+    try:
+        v = [int(s) for s in text.split(",") if s.strip()]
+    except ValueError:
+        raise InputError(f"{what}: expected comma-separated integers, found {text!r}") from None
+    if not v or min(v) < 1:
+        raise InputError(f"{what}: expected integers >= 1, found {text!r}")
+    return v
+
+
+def configure(parser) -> None:
+    add_system_args(parser)
+    parser.add_argument("--model", choices=("mtc",), default="mtc")
+    parser.add_argument("--mesh", default="10",
+                        help="comma-separated membrane subdivisions n (N quads of n x n each)")
+    parser.add_argument("--tendon-elements", default="3",
+                        help="comma-separated numbers of truss elements per tendon")
+    parser.add_argument("--modes", type=int, default=12)
+    parser.add_argument("--attachment", choices=("point", "distributed"), default="point")
+    parser.add_argument("--patch", type=float, default=None,
+                        help="patch radius of the distributed attachment [m] (default 0.1 r_mb)")
+    parser.add_argument("--rest-lengths", choices=("system", "design", "mtc"), default=None,
+                        help="fixed rest lengths (system/design, evaluated once) or the "
+                             "design-consistent ones recomputed on each mesh (mtc)")
+    parser.add_argument("--csv", help="write one row per run, as it finishes")
+    parser.add_argument("--plot", help="PNG: frequencies and peak stresses against h")
+
+
+def run(args) -> dict:
+    from tmfem.fem.mtc_study import ROW_KEYS, convergence_rows, fit_convergence
+    system = system_from_args(args)
+    meshes = _ints(args.mesh, "--mesh")
+    tendons = _ints(args.tendon_elements, "--tendon-elements")
+    rows = []
+    writer = fh = None
+    try:
+        if args.csv:
+            fh = open(args.csv, "w", newline="")
+        for row in convergence_rows(system, meshes=meshes, tendon_elements=tendons,
+                                    attachment=args.attachment, rest_lengths=args.rest_lengths,
+                                    modes=args.modes, patch=args.patch):
+            rows.append(row)
+            if fh is not None:
+                if writer is None:
+                    writer = csv.DictWriter(fh, fieldnames=list(ROW_KEYS) + [
+                        f"f{i + 1}" for i in range(args.modes)])
+                    writer.writeheader()
+                writer.writerow(row)
+                fh.flush()
+    finally:
+        if fh is not None:
+            fh.close()
+    out = {"system": system.name, "attachment": args.attachment, "rows": rows}
+    if len(meshes) >= 3 and len(tendons) == 1:
+        out["fit"] = fit_convergence(rows, modes=args.modes)
+    elif len(tendons) >= 2 and len(meshes) == 1:
+        f0 = [rows[0][f"f{i + 1}"] for i in range(args.modes)]
+        out["max_relative_change_over_tendon_elements"] = max(
+            abs(r[f"f{i + 1}"] / f0[i] - 1) for r in rows for i in range(args.modes))
+    if args.plot:
+        out["plot"] = str(_plot(args.plot, rows, args.modes, system.name, args.attachment,
+                                by_tendons=len(meshes) == 1 and len(tendons) > 1))
+    if args.csv:
+        out["csv"] = args.csv
+    return out
+
+
+def _plot(path, rows, modes, name, attachment, *, by_tendons: bool):
+    import numpy as np
+    from tmfem.io.vtk import check_path
+    from tmfem.post.plots import _plt, _save
+    path = check_path(path, suffixes=(".png",))
+    plt = _plt()
+    x = np.array([r["tendon_elements"] if by_tendons else r["elements"] for r in rows], float)
+    F = np.array([[r[f"f{i + 1}"] for i in range(modes)] for r in rows])
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    for i in range(modes):
+        ax[0].plot(x, F[:, i], "o-", ms=3, label=f"mode {i + 1}")
+    ax[0].set_xlabel("elements per tendon" if by_tendons else "membrane elements")
+    ax[0].set_ylabel("frequency [Hz]")
+    ax[0].set_title(f"{name} MTC, {attachment} attachment")
+    ax[0].legend(fontsize=6, ncol=2)
+    for key, lab in (("sigma_p1_max_MPa", "max sigma_p1 (Gauss pt)"),
+                     ("von_mises_max_MPa", "max von Mises (Gauss pt)"),
+                     ("sigma_p1_elem_max_MPa", "max sigma_p1 (element mean)")):
+        ax[1].plot(x, [r[key] for r in rows], "o-", label=lab)
+    ax[1].set_xlabel(ax[0].get_xlabel())
+    ax[1].set_ylabel("stress [MPa]")
+    if not by_tendons:
+        ax[0].set_xscale("log")
+        ax[1].set_xscale("log")
+    ax[1].legend(fontsize=8)
+    return _save(fig, path)
+
+
+def format_text(r: dict) -> str:
+    rows = r["rows"]
+    if not rows:
+        return "no runs"
+    nf = sum(1 for k in rows[0] if k.startswith("f") and k[1:].isdigit())
+    head = f"{'n':>3s} {'k':>2s} {'elem':>6s} {'dofs':>7s} {'Delta mm':>9s} {'sp1 MPa':>8s} {'vm MPa':>8s} " \
+           + " ".join(f"{'f' + str(i + 1):>7s}" for i in range(nf))
+    lines = [f"{r['system']} MTC convergence, {r['attachment']} attachment", head]
+    for w in rows:
+        lines.append(f"{w['mesh_n']:3d} {w['tendon_elements']:2d} {w['elements']:6d} {w['dofs']:7d} "
+                     f"{w['Delta_mm']:9.4f} {w['sigma_p1_max_MPa']:8.3f} {w['von_mises_max_MPa']:8.3f} "
+                     + " ".join(f"{w[f'f{i + 1}']:7.4f}" for i in range(nf)))
+    fit = r.get("fit")
+    if fit and "frequency_rates" in fit:
+        lines.append("fitted rates |f(h) - f(h_min)| ~ h^p: "
+                     + ", ".join(f"{p:.2f}" for p in fit["frequency_rates"]))
+        lines.append("change between the two finest meshes: "
+                     + ", ".join(f"{100 * c:.3f}%" for c in fit["frequency_change_last"]))
+        lines.append(f"peak stress ~ h^p: sigma_p1 p = {fit['sigma_p1_max_MPa_exponent']:.2f}, "
+                     f"von Mises p = {fit['von_mises_max_MPa_exponent']:.2f}, element-mean sigma_p1 "
+                     f"p = {fit['sigma_p1_elem_max_MPa_exponent']:.2f}; Delta p = "
+                     f"{fit['Delta_mm_exponent']:.3f}")
+    if "max_relative_change_over_tendon_elements" in r:
+        lines.append(f"largest relative frequency change over tendon subdivisions: "
+                     f"{100 * r['max_relative_change_over_tendon_elements']:.4f}%")
+    for k in ("csv", "plot"):
+        if k in r:
+            lines.append(f"wrote {r[k]}")
+    return "\n".join(lines)
