@@ -176,3 +176,23 @@ def test_1ND_design_matches_null_vector_of_eq_3_40():
     u = (X[:, lab.index("B_11")] - A) / s.l[0, 0]
     seg = max(-(f["B_11"] + f["H_11"]) @ u, -f["B_11"] @ u)
     assert d.bar_loads[0, 0] == pytest.approx(seg, rel=1e-9)
+
+
+def test_equilibrium_map_with_a_base_rule():
+    # a rule bases(theta, psi) that returns the system's own values reproduces the default
+    from tmfem.equilibrium.symmetric_map import equilibrium_map
+    s = load_preset("2-3")
+    c = s.symmetric
+    th, ps = np.radians([50.0, 70.0]), np.radians([0.0, 20.0])
+    a = equilibrium_map(s, theta=th, psi=ps)
+    b = equilibrium_map(s, theta=th, psi=ps, bases=lambda t, p: {"r": c.r, "z": c.z,
+                                                                 "sigma": c.sigma})
+    np.testing.assert_array_equal(a.positive, b.positive)
+    np.testing.assert_allclose(a.Delta, b.Delta)
+    # a different stage-2 radius changes Delta as eq. 3.22 says
+    cc = equilibrium_map(s, theta=th, psi=ps, bases=lambda t, p: {"r": [c.r[0], 0.3]})
+    from tmfem.equilibrium.symmetric import membrane_delta
+    assert cc.Delta[0, 0] == pytest.approx(membrane_delta(l_M=c.l[1], theta_M=th[0],
+                                                          psi_M=ps[0] + c.sigma[1],
+                                                          sigma_M=c.sigma[1], r_M=0.3,
+                                                          r_mb=s.r_mb, N=3))

@@ -29,14 +29,20 @@ from tmfem.errors import InputError
 from tmfem.system.geometry import SymmetricConfig
 
 
-def configuration_5_97(system, theta: float, psi: float) -> SymmetricConfig:
-    """The symmetric configuration of eq. 5.97 for (theta, psi), other parameters from ``system``."""
+def configuration_5_97(system, theta: float, psi: float, *, r=None, z=None,
+                       sigma=None) -> SymmetricConfig:
+    """The symmetric configuration of eq. 5.97 for (theta, psi).
+
+    r, z, sigma (length M, stage 1 entries 0 for z and sigma) default to those of
+    ``system``; pass them to follow another rule for the stage bases.
+    """
     c = system.symmetric
     if c is None:
         raise InputError(f"system {system.name!r} is not symmetric (3.3.1)")
     M = c.M
-    return SymmetricConfig(theta=np.full(M, theta), psi=psi + c.sigma, sigma=c.sigma, z=c.z,
-                           r=c.r, l=c.l)
+    sg = c.sigma if sigma is None else np.asarray(sigma, dtype=float)
+    return SymmetricConfig(theta=np.full(M, theta), psi=psi + sg, sigma=sg,
+                           z=c.z if z is None else z, r=c.r if r is None else r, l=c.l)
 
 
 def with_configuration(system, cfg: SymmetricConfig):
@@ -81,11 +87,18 @@ class EquilibriumMap:
                 "Delta": self.Delta.tolist(), "columns": self.columns, "fixed": self.fixed}
 
 
-def equilibrium_map(system, *, theta, psi, progress: bool = False) -> EquilibriumMap:
+def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -> EquilibriumMap:
     """Evaluate the family of eq. 5.97 on a (theta, psi) grid [rad].
 
     At each point: the reduced (5M-3) x (6M-4) matrix of 3.3.2, the LP search for a
     positive null vector, and Delta of eq. 3.22.
+
+    Parameters
+    ----------
+    bases : callable, optional
+        ``bases(theta, psi) -> dict`` with any of ``r``, ``z``, ``sigma`` (arrays of length
+        M) giving the stage bases along the family (e.g. a reconstructed deployment rule);
+        by default they are held at the values of ``system``.
     """
     theta = np.atleast_1d(np.asarray(theta, dtype=float))
     psi = np.atleast_1d(np.asarray(psi, dtype=float))
@@ -100,7 +113,7 @@ def equilibrium_map(system, *, theta, psi, progress: bool = False) -> Equilibriu
     ratios = None
     for a, th in enumerate(theta):
         for b, ps in enumerate(psi):
-            cfg = configuration_5_97(system, th, ps)
+            cfg = configuration_5_97(system, th, ps, **(bases(th, ps) if bases else {}))
             s = with_configuration(system, cfg)
             S = symmetric_matrix(s)
             if ratios is None:
@@ -118,7 +131,8 @@ def equilibrium_map(system, *, theta, psi, progress: bool = False) -> Equilibriu
             print(f"equilibrium map: theta {a + 1}/{theta.size}", file=sys.stderr)
     fixed = {"l": c.l.tolist(), "r": c.r.tolist(), "z": c.z.tolist(),
              "sigma_deg": np.degrees(c.sigma).tolist(), "r_mb": system.r_mb,
-             "rule": "eq. 5.97: theta_i = theta, psi_i = psi + sigma_i"}
+             "rule": "eq. 5.97: theta_i = theta, psi_i = psi + sigma_i"
+                     + ("; bases from a user rule" if bases else "")}
     return EquilibriumMap(theta=theta, psi=psi, feasible=positive & (Delta > 0), positive=positive,
                           margin=margin, Delta=Delta, ratios=ratios, columns=cols, fixed=fixed)
 
