@@ -108,11 +108,11 @@ def test_study_writes_table_plots_and_vtk(tmp_path, capsys):
         assert (out / f).stat().st_size > 0, f
     rows = {r["quantity"]: r for r in csv.DictReader(open(out / "equilibrium.csv"))}
     d = design_equilibrium(load_preset("1-4"), mesh_n=4)
-    assert float(rows["r S1 rest length"]["ours"]) == pytest.approx(d.rest_lengths[0], rel=1e-7)
-    assert float(rows["r S1 rest length"]["printed"]) == 1.529      # Table 6.2
+    assert float(rows["rest length S1"]["ours"]) == pytest.approx(d.rest_lengths[0], rel=1e-7)
+    assert float(rows["rest length S1"]["printed"]) == 1.529      # Table 6.2
     assert float(rows["bar load stage 1 (compression)"]["printed"]) == 14.53   # Table 6.3
     md = (out / "equilibrium.md").read_text()
-    assert "| r S1 rest length | m |" in md and "## Checks" in md
+    assert "| rest length S1 | m |" in md and "## Checks" in md
     import meshio
     m = meshio.read(out / "configuration.vtu")
     assert m.points.shape[0] >= 8

@@ -81,7 +81,8 @@ def table_rows(d, system) -> list[dict]:
                 add(f"z_{i + 1}", "m", c.z[i], None, "input")
         add("r_mb", "m", system.r_mb, None, "input")
     if d.closed_form is not None and "r1_equilibrium" in d.closed_form:
-        add("r_1 of eq. 3.33", "m", d.closed_form["r1_equilibrium"], c.r[0], "eq. 3.33 vs input")
+        add("r_1 of eq. 3.33 (printed column: input r_1)", "m", d.closed_form["r1_equilibrium"], c.r[0],
+            "eq. 3.33")
     if d.Delta is not None:
         add("Delta", "mm", d.Delta * 1e3, None, "eq. 3.22")
     add("F_Delta", "N", d.F_Delta, None, "plane-stress FE (3.2)")
@@ -90,10 +91,10 @@ def table_rows(d, system) -> list[dict]:
     L, T = d.group_values(d.tendon_lengths), d.group_values(d.tendon_forces)
     fd, r = d.group_values(d.force_densities), d.group_values(d.rest_lengths)
     for g in groups:
-        add(f"|{g}| tendon length", "m", L[g], None, "geometry")
-        add(f"T {g} tendon force", "N", T[g], None, "null vector of A(q) scaled to F (3.16)")
-        add(f"T/L {g} force density", "N/m", fd[g], None, "eq. 3.30")
-        add(f"r {g} rest length", "m", r[g], prest.get(g), "eqs. 3.8-3.9")
+        add(f"length {g}", "m", L[g], None, "geometry")
+        add(f"force {g}", "N", T[g], None, "null vector of A(q) scaled to F (3.16)")
+        add(f"force density {g}", "N/m", fd[g], None, "eq. 3.30")
+        add(f"rest length {g}", "m", r[g], prest.get(g), "eqs. 3.8-3.9")
     add("max tendon stress", "MPa", d.tendon_stress.max() / 1e6,
         p.get("tendon_max_stress", None) and p["tendon_max_stress"] / 1e6, "T/A")
     add("membrane max sigma_p1", "MPa", d.membrane_max_principal / 1e6,
