@@ -60,12 +60,13 @@ class NewtonResult:
     converged: bool
     r: np.ndarray | None = None
     K: object = None
+    floor_limited: bool = False
 
 
 def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float = 0.0,
            scale: float | None = None, max_iter: int = 50, line_search: bool = True,
            backend=None, callback: Callable | None = None, load_factor: float | None = None,
-           step: int | None = None) -> NewtonResult:
+           step: int | None = None, floor_factor: float = 100.0, max_stall: int = 5) -> NewtonResult:
     """Newton-Raphson iteration K du = -r on the free dofs, with backtracking line search.
 
     Parameters
@@ -85,6 +86,11 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         Backtracking (halving, Armijo on ||r||) when the full step does not reduce the residual.
     callback : callable, optional
         ``callback(iteration, u, rnorm)`` after every accepted iterate (iteration histories).
+    floor_factor, max_stall :
+        An iteration that reduces ||r|| by less than 1 % makes no progress. If that happens with
+        ||r|| <= floor_factor * target the iterate is accepted (round-off floor of an
+        ill-conditioned problem; ``floor_limited`` is set in the result); ``max_stall``
+        such iterations in a row raise ``ConvergenceError`` (stalled).
     load_factor, step : optional
         Only reported in a :class:`ConvergenceError`.
 
@@ -111,6 +117,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
     target = max(tol * ref, atol)
     if callback is not None:
         callback(0, u, rn)
+    stalled = 0
     for it in range(1, max_iter + 1):
         if rn <= target:
             return NewtonResult(u=u, iterations=it - 1, residual_history=history, converged=True, r=r, K=K)
@@ -138,10 +145,22 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
             raise _fail(f"newton{where}: iteration {it}: expected a finite residual after the update, "
                         f"found {rnt}; residual history {[f'{h:.3e}' for h in history]}",
                         step=step, history=history, load_factor=load_factor, u=u)
+        progress = best[0] <= 0.99 * rn
         rn, u, r, K = best
         history.append(rn)
         if callback is not None:
             callback(it, u, rn)
+        stalled = 0 if progress else stalled + 1
+        if stalled and rn <= floor_factor * target:
+            # round-off floor: the residual cannot be reduced further and is within
+            # floor_factor of the target (ill-conditioned tangent, large internal forces)
+            return NewtonResult(u=u, iterations=it, residual_history=history, converged=True,
+                                r=r, K=K, floor_limited=True)
+        if stalled >= max_stall:
+            raise _fail(f"newton{where}: stalled: no reduction of ||r|| in {stalled} iterations at "
+                        f"{rn:.3e} (target {target:.3e}); residual history "
+                        f"{[f'{h:.3e}' for h in history[-8:]]}", step=step, history=history,
+                        load_factor=load_factor, u=u)
     if rn <= target:
         return NewtonResult(u=u, iterations=max_iter, residual_history=history, converged=True, r=r, K=K)
     raise _fail(f"newton{where}: expected ||r|| <= {target:.3e} within {max_iter} iterations, found "
