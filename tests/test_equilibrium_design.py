@@ -80,6 +80,9 @@ def test_2_3_design_agrees_with_reduced_null_vector_scaled_to_F_delta():
     got = d.group_values(d.tendon_forces)
     for g, v in zip(symmetric_matrix(s).cols[:-1], x[:-1]):
         assert got[g] == pytest.approx(v, rel=1e-6), g
+    sn = d.symmetric_null
+    assert sn["positive"] and sn["dim"] == 1
+    np.testing.assert_allclose(np.array(sn["per_F_Delta"]) * d.F_Delta, x, rtol=1e-6)
 
 
 def test_named_errors():

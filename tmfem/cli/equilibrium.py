@@ -75,6 +75,15 @@ def format_text(r: dict) -> str:
         L.append(f"membrane corner displacement Delta (eq. 3.22) = {r['Delta'] * 1e3:.5g} mm")
     L.append(f"membrane corner force F_Delta (mean radial)   = {r['F_Delta']:.5g} N")
     L.append(f"equilibrium residual (eq. 3.16)               = {r['residual']:.3g}")
+    sn = r.get("symmetric_null")
+    if sn is not None:
+        n = len(sn["rows"])
+        L.append(f"reduced matrix of 3.3.2: {n} x {len(sn['columns'])}, null space dimension "
+                 f"{sn['dim']} (smallest relative singular value {sn['smallest_sv']:.2g}), "
+                 f"positive null vector: {'yes' if sn['positive'] else 'no'}")
+        if sn["per_F_Delta"] is not None:
+            L.append("  forces per unit F_Delta: " + ", ".join(
+                f"{c} {v:.4g}" for c, v in zip(sn["columns"], sn["per_F_Delta"])))
     L.append("")
     given = {t["name"]: t for t in r.get("given_rest_lengths", {}).get("tendons", [])}
     head = (f"  {'tendon':<8}{'length [m]':>12}{'force [N]':>12}{'T/L [N/m]':>12}"

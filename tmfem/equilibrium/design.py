@@ -25,7 +25,8 @@ import numpy as np
 from scipy.optimize import linprog
 
 from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix,
-                                       free_corner_components, null_space)
+                                       free_corner_components, null_space, positive_null_vector,
+                                       symmetric_matrix)
 from tmfem.equilibrium.symmetric import closed_form_1N, closed_form_1ND
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.plane_stress import PlaneStressMembrane, PlaneStressSolution
@@ -97,6 +98,7 @@ class EquilibriumDesign:
     matrix: EquilibriumMatrix = field(repr=False, default=None)
     closed_form: dict | None = None
     given_rest_lengths: dict | None = None
+    symmetric_null: dict | None = None
 
     @property
     def ok(self) -> bool:
@@ -145,6 +147,8 @@ class EquilibriumDesign:
         if self.closed_form is not None:
             d["closed_form"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                                 for k, v in self.closed_form.items()}
+        if self.symmetric_null is not None:
+            d["symmetric_null"] = self.symmetric_null
         if self.given_rest_lengths is not None:
             d["given_rest_lengths"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                                        for k, v in self.given_rest_lengths.items()}
@@ -270,6 +274,24 @@ def forces_from_rest_lengths(system, rest_lengths=None, *, q=None, mesh_n: int =
             "slack": strain <= 0, "residual": residual}
 
 
+def symmetric_null_summary(system, q=None, *, rtol: float = 1e-3) -> dict:
+    """The positive null-vector search on the (5M-3) x (6M-4) matrix of 3.3.2: columns,
+    null-space dimension, LP margin and the null vector scaled to F_Delta = 1 (if 1-D).
+
+    Singular values up to ``rtol`` times the largest (columns scaled to unit norm) count as
+    zero, so that a design given to printed precision (e.g. r_1 of Table 6.2) is recognised;
+    ``smallest_sv`` reports the actual smallest relative singular value.
+    """
+    S = symmetric_matrix(system, q)
+    nv = positive_null_vector(S.A, rtol=rtol)
+    vec = None
+    if nv.dim == 1 and abs(nv.x[-1]) > 1e-12 * np.abs(nv.x).max():
+        vec = (nv.x / nv.x[-1]).tolist()
+    return {"columns": S.cols, "rows": S.rows, "dim": nv.dim, "positive": bool(nv.exists),
+            "margin": float(nv.margin) if np.isfinite(nv.margin) else None,
+            "per_F_Delta": vec, "smallest_sv": float(nv.sv.min()), "rtol": rtol}
+
+
 # ---------------------------------------------------------------------------- pipeline
 def _radial_delta(system, delta: np.ndarray) -> float | None:
     """Radial corner displacement Delta of eq. 3.21 from corner 1, for symmetric systems."""
@@ -387,6 +409,8 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
         bar_loads=loads, bar_critical=crit, membrane_max_principal=sol.max_principal,
         membrane_max_von_mises=sol.max_von_mises, residual=residual, self_stress_dim=kdim,
         checks=checks, membrane=sol, membrane_model=model, matrix=E, closed_form=cf)
+    if system.symmetric is not None:
+        design.symmetric_null = symmetric_null_summary(system, q)
     if system.rest_lengths is not None:
         design.given_rest_lengths = forces_from_rest_lengths(system, q=q, membrane=(E, model, sol))
     if strict:
