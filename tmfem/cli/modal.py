@@ -6,7 +6,7 @@ import sys
 import numpy as np
 
 from tmfem.cli.common import add_system_args, system_from_args
-from tmfem.cli.static import add_model_args, build_model, default_monitor
+from tmfem.cli.static import add_model_args, build_model, default_monitor, sequence_of
 
 NAME = "modal"
 HELP = "natural frequencies and mode shapes (MTC finite-element or control-oriented model)"
@@ -25,9 +25,9 @@ def configure(parser) -> None:
     parser.add_argument("--png", help="render the first six mode shapes to this PNG")
 
 
-def mtc_modes(model, *, k: int, start: str = "undeformed"):
+def mtc_modes(model, *, k: int, start: str = "undeformed", sequence: int | None = None):
     """Static equilibrium of ``model`` and its ``k`` lowest modes (eq. 5.32)."""
-    res = model.solve_static(start=start, monitor=default_monitor(model.system))
+    res = model.solve_static(start=start, monitor=default_monitor(model.system), sequence=sequence)
     modes = model.modes(res.x, k=k)
     return res, modes
 
@@ -42,7 +42,7 @@ def run(args) -> dict:
     model = build_model(args)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
-    res, modes = mtc_modes(model, k=args.modes, start=args.start)
+    res, modes = mtc_modes(model, k=args.modes, start=args.start, sequence=sequence_of(args))
     st = static_summary(model, res.x, result=res)
     out = {"system": system_name, "model": "mtc", "dofs": model.ndof, "mesh_n": args.mesh,
            "tendon_elements": args.tendon_elements, "attachment": args.attachment,

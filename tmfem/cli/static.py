@@ -27,6 +27,17 @@ def add_model_args(parser) -> None:
                              "equilibrium of this model (mtc)")
     parser.add_argument("--start", choices=("undeformed", "design"), default="undeformed",
                         help="start of the static iteration (default: the undeformed membrane)")
+    parser.add_argument("--sequence", type=int, default=None,
+                        help="mesh sequencing of the static solve from this coarse n, halving "
+                             "(default: 10 when --mesh > 20, else none; 0 disables)")
+
+
+def sequence_of(args):
+    """Coarsest mesh of the static mesh sequencing chosen by ``--sequence``."""
+    seq = getattr(args, "sequence", None)
+    if seq is None:
+        return 10 if args.mesh > 20 else None
+    return seq or None
 
 
 def build_model(args):
@@ -66,7 +77,7 @@ def solve(args, model):
     print(f"tmfem static: {model.system.name}, {model.ndof} free dofs, solving from the "
           f"{args.start} state", file=sys.stderr)
     res = model.solve_static(start=args.start, monitor=monitor,
-                             progress=getattr(args, "progress", False))
+                             progress=getattr(args, "progress", False), sequence=sequence_of(args))
     return res, static_summary(model, res.x, result=res)
 
 

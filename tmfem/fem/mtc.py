@@ -244,6 +244,25 @@ class MTCModel:
         self._straight_tendons(x)
         return x
 
+    def interpolate_from(self, other: "MTCModel", x_other: np.ndarray) -> np.ndarray:
+        """Positions (3, n_nodes) of this model from a solution of ``other`` (same system,
+        another mesh or tendon subdivision): membrane nodes by bilinear interpolation on the
+        other mesh (reference coordinates), labelled nodes copied, tendons straight.
+        Used for mesh sequencing (nested iteration) of :meth:`solve_static`."""
+        from skfem import Basis, ElementQuad1
+        if other.system is not self.system:
+            raise InputError("interpolate_from: expected a model of the same system")
+        ot, st = other.topology, self.topology
+        c = st.mesh.p.mean(axis=1, keepdims=True)
+        pts = c + (1.0 - 1e-9) * (st.mesh.p - c)      # boundary points strictly inside
+        P = Basis(ot.mesh.to_skfem(), ElementQuad1()).probes(pts).tocsr()
+        x = np.zeros((3, st.n_nodes))
+        x[:, :st.n_mesh] = (P @ x_other[:, :ot.n_mesh].T).T
+        x[:, st.system_node] = x_other[:, ot.system_node]
+        x = self.full(self.reduce(x))
+        self._straight_tendons(x)
+        return x
+
     # ------------------------------------------------------------------ operators
     def internal_full(self, x: np.ndarray, *, tangent: bool = True):
         """Internal force (3 n_nodes,) and tangent of the full model at positions x (3, n_nodes)."""
@@ -302,8 +321,8 @@ class MTCModel:
 
     # ------------------------------------------------------------------ statics
     def solve_static(self, *, start: str = "undeformed", x0: np.ndarray | None = None,
-                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress: bool = False
-                     ) -> StaticResult:
+                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress: bool = False,
+                     sequence: int | None = None) -> StaticResult:
         """Equilibrium reached from ``start`` (6.2): Newton regularised by a mass-scaled
         Levenberg-Marquardt trust region on the strain energy (module docstring).
 
@@ -317,8 +336,31 @@ class MTCModel:
             being a pure Newton step (mu = 0).
         monitor : sequence of str
             Node labels (``"B_14"``) whose positions are recorded at every iteration.
+        sequence : int, optional
+            Mesh sequencing (nested iteration): first solve the same system on the membrane
+            mesh max(sequence, n // 2) (recursively, down to n = ``sequence``, from the same
+            start), interpolate, then iterate here from that state (Newton converges in a few
+            steps). Histories are concatenated; ``newton_iterations_tangent`` lists the
+            iterations per level.
         """
         t0 = time.perf_counter()
+        if sequence is not None and x0 is None and sequence < self.topology.mesh.n:
+            n_coarse = max(int(sequence), self.topology.mesh.n // 2)
+            coarse = MTCModel(self.system, mesh_n=n_coarse,
+                              tendon_elements=self.topology.tendon_elements,
+                              attachment=self.topology.attachment, rest_lengths=self.rest_lengths,
+                              lumped_tendon_mass=self.lumped_tendon_mass)
+            rc = coarse.solve_static(start=start, tol=tol, max_iter=max_iter, monitor=monitor,
+                                     progress=progress, sequence=sequence)
+            fine = self.solve_static(x0=self.interpolate_from(coarse, rc.x), tol=tol,
+                                     max_iter=max_iter, monitor=monitor, progress=progress)
+            return StaticResult(
+                x=fine.x, iterations=rc.iterations + fine.iterations,
+                residual_history=rc.residual_history + fine.residual_history[1:],
+                monitor={k: np.concatenate([rc.monitor[k], fine.monitor[k][1:]]) for k in fine.monitor},
+                dt2_history=rc.dt2_history + fine.dt2_history, time=time.perf_counter() - t0,
+                newton_iterations_tangent=(rc.newton_iterations_tangent or [rc.iterations])
+                + [fine.iterations])
         x = self.initial_positions(start) if x0 is None else np.asarray(x0, dtype=float)
         xr = self.reduce(x)
         free = self.free
@@ -333,7 +375,8 @@ class MTCModel:
         res_hist, mu_hist = [rn], []
         Kd = np.abs(K.diagonal()[free])
         mu_scale = float(np.median(Kd[Kd > 0]) / np.median(Md)) if np.any(Kd > 0) else 1.0
-        mu = 1e-3 * mu_scale
+        # from the design the tangent is already positive definite: try Newton first
+        mu = 0.0 if (x0 is not None or start == "design") else 1e-3 * mu_scale
         it = 0
         converged = False
         for it in range(1, max_iter + 1):
@@ -341,7 +384,7 @@ class MTCModel:
             g = r[free]
             for _attempt in range(40):
                 A = (Kf + mu * Dm) if mu > 0 else Kf
-                du = spla.spsolve(A.tocsc(), -g)
+                du = _solve_symmetric(A, -g)
                 ok = np.all(np.isfinite(du)) and float(g @ du) < 0
                 if ok:
                     xt = xr.copy()
@@ -496,6 +539,16 @@ class MTCModel:
         out["rest_lengths"] = green_rest_length(L, T, self.tendon_EA)
         out["rest_lengths_linear"] = linear_rest_length(L, T, self.tendon_EA)
         return out
+
+
+def _solve_symmetric(A, b) -> np.ndarray:
+    """Solve A x = b with the default backend's factorisation (symmetric-mode SuperLU);
+    NaN when the matrix is singular (the trust region then regularises harder)."""
+    from tmfem.solvers.backends import SingularMatrix, get_backend
+    try:
+        return get_backend().factorize(A)(b)
+    except SingularMatrix:
+        return np.full(b.shape, np.nan)
 
 
 def _pad(K: sp.csr_matrix, n: int) -> sp.csr_matrix:
