@@ -138,6 +138,12 @@ class ControlOrientedModel:
         self.output_points = [tuple(map(float, p)) for p in pts]
         self._Wout = self.membrane.point_matrix(np.array(self.output_points).T, 2) \
             if self.output_points else np.zeros((0, 1 + self.layout.n_delta + self.K))
+        # fast outputs: [w at the output points, all node coordinates] from z (modal)
+        zs = ca.SX.sym("z", self.nz)
+        zc = self._zeta_closed_form_sx(zs[: self.nq])
+        w = ca.mtimes(ca.DM(self._Wout[:, 1:]), ca.vertcat(zc[: self.layout.n_delta], zs[self.nq:]))
+        from tmfem.reduced.kinematics import nodes_sx
+        self._outfn = ca.Function("com_out", [zs], [ca.vertcat(w, ca.vec(nodes_sx(system, zs[: self.nq])))])
 
     # ------------------------------------------------------------------ names
     @property
@@ -238,6 +244,11 @@ class ControlOrientedModel:
             # coordinate partitioning, eqs. 5.22-5.26
             phi = phi_sx(self.system, self.layout, q, zz)
             Pz, Pq = ca.jacobian(phi, zz), ca.jacobian(phi, q)
+            # numeric pieces for the fast residual (DAE matrices and constraint terms)
+            xcs = ca.vertcat(q, zz); xcds = ca.vertcat(qd, zzd)
+            self._dae = ca.Function("com_dae", [x, xd], [M, F, B])
+            self._con = ca.Function("com_con", [q, zz, qd, zzd],
+                                    [phi, Pz, Pq, ca.jtimes(ca.jtimes(phi, xcs, xcds), xcs, xcds)])
             zq = -ca.solve(Pz, Pq)                                          # eq. 5.23
             Tz = ca.vertcat(ca.horzcat(ca.SX.eye(nq), ca.SX.zeros(nq, K)),
                             ca.horzcat(ca.SX.zeros(K, nq), ca.SX.eye(K)),
@@ -274,6 +285,17 @@ class ControlOrientedModel:
         self._terms = ca.Function("com_terms", args, [Mh, Fh, Bh],
                                   ["z", "zd", "zeta"], ["M_hat", "F_hat", "B_hat"],
                                   {"allow_free": True} if self.formulation == "substituted" else {})
+        # fast path for time integration: one input [z, z'], one output [M_hat, F_hat, B_hat]
+        # (casadi's per-argument conversion costs more than evaluating small graphs), with
+        # zeta(q) evaluated in the graph by its closed form -- an exact root of Phi (eq. 3.5),
+        # equal to the Newton solution (tests) -- instead of a Newton loop in Python.
+        zcf = self._zeta_closed_form_sx(q)
+        outs = [ca.substitute(o, zz, zcf) for o in (Mh, Fh, Bh)] \
+            if self.formulation == "partitioned" else [Mh, Fh, Bh]
+        self._fast = ca.Function("com_fast", [ca.vertcat(z, zd)],
+                                 [ca.vertcat(*[ca.vec(ca.densify(o)) for o in outs])])
+        nd = self.layout.n_delta
+        self._fast_shapes = [(nq + K, nq + K), (nq + K, 1), (nq + K, self.n_t)]
         # residual and Newton matrix for implicit integration (Park, 5.34)
         zdd = ca.SX.sym("zdd", nq + K); u = ca.SX.sym("u", self.n_t)
         cv = ca.SX.sym("cv"); cacc = ca.SX.sym("ca")
@@ -381,10 +403,57 @@ class ControlOrientedModel:
     def matrices(self, z, zd):
         """M_hat, F_hat, B_hat of eq. 5.28 at (z, z'), in the model's coordinates."""
         zm, zdm = self._to_modal(z, zd)
-        zeta = self.zeta(zm[: self.nq])
-        Mh, Fh, Bh = (np.asarray(a) for a in self._terms(zm, zdm, zeta))
+        flat = self._fast(np.concatenate([zm, zdm])).full().ravel()
+        out, k = [], 0
+        for shp in self._fast_shapes:
+            n = shp[0] * shp[1]
+            out.append(flat[k:k + n].reshape(shp, order="F")); k += n
+        Mh, Fh, Bh = out
+        if self.membrane_points is None:
+            return Mh, Fh.ravel(), Bh
         P = self.P
         return P.T @ Mh @ P, P.T @ Fh.ravel(), P.T @ Bh
+
+    def matrices_newton(self, z, zd):
+        """M_hat, F_hat, B_hat with zeta from Newton on Phi and the partitioning of eqs.
+        5.23-5.28 evaluated numerically from the DAE matrices (a check of the fast path)."""
+        zm, zdm = self._to_modal(z, zd)
+        zeta = self.zeta(zm[: self.nq])
+        if self.formulation == "partitioned":
+            Mh, Fh, Bh = self._partitioned_numeric(zm, zdm, zeta)
+        else:
+            Mh, Fh, Bh = (np.asarray(a) for a in self._terms(zm, zdm, zeta))
+        P = self.P
+        return P.T @ Mh @ P, P.T @ Fh.ravel(), P.T @ Bh
+
+    def _partitioned_numeric(self, z, zd, zeta):
+        """Eqs. 5.23-5.28 evaluated numerically from the DAE matrices M, F, B (eq. 5.19)
+        and the constraint Jacobians (AD): zeta_q = -Phi_zeta^-1 Phi_q, zeta' = zeta_q q',
+        g = -Phi_zeta^-1 (Phi_x x')_x x', T_z, then M_hat = T_z^T M T_z, ... (the fast path
+        of the time integration; identical to the symbolic graph, see tests)."""
+        nq, K = self.nq, self.K
+        q, qd = z[:nq], zd[:nq]
+        _, Pz, Pq, _ = self._con(q, zeta, qd, np.zeros(self.layout.n))
+        Pz = np.asarray(Pz)
+        lu = np.linalg.solve(Pz, np.hstack([np.asarray(Pq), np.eye(Pz.shape[0])]))
+        zq = -lu[:, :nq]
+        zetad = zq @ qd
+        acc = np.asarray(self._con(q, zeta, qd, zetad)[3]).ravel()
+        g = -lu[:, nq:] @ acc
+        x = np.concatenate([z, zeta]); xd = np.concatenate([zd, zetad])
+        M, F, B = (np.asarray(a) for a in self._dae(x, xd))
+        F = F.ravel()
+        nz = nq + K
+        # T_z^T A T_z without forming T_z: rows/cols of zeta map onto q through zeta_q
+        Mzz, Mzc, Mcc = M[:nz, :nz], M[:nz, nz:], M[nz:, nz:]
+        Mh = Mzz.copy()
+        Mh[:, :nq] += Mzc @ zq
+        Mh[:nq, :] += (Mzc @ zq).T
+        Mh[:nq, :nq] += zq.T @ Mcc @ zq
+        FG = F + M[:, nz:] @ g
+        Fh = FG[:nz].copy(); Fh[:nq] += zq.T @ FG[nz:]
+        Bh = B[:nz].copy(); Bh[:nq] += zq.T @ B[nz:]
+        return Mh, Fh, Bh
 
     def acceleration(self, z, zd, u=None):
         """z'' = -M_hat^-1 (F_hat + B_hat u) (eq. 5.27)."""
@@ -394,7 +463,11 @@ class ControlOrientedModel:
 
     # interface of tmfem.solvers.park (residual in the model's coordinates)
     def residual(self, z, zd, zdd, t=0.0, u=None):
+        """r = M_hat z'' + F_hat + B_hat u (eq. 5.27) in the model's coordinates."""
         u = self.u0 if u is None else u
+        if self.formulation == "partitioned":
+            M, F, B = self.matrices(z, zd)
+            return M @ zdd + F + B @ u
         zm, zdm = self._to_modal(z, zd)
         zeta = self.zeta(zm[: self.nq])
         r = np.asarray(self._resid(zm, zdm, self.P @ zdd, zeta, u)).ravel()
@@ -444,6 +517,12 @@ class ControlOrientedModel:
                                f"iterations, |F_hat + B_hat u| = {np.linalg.norm(r):.3e}")
 
     # ------------------------------------------------------------------ outputs
+    def fast_outputs(self, z):
+        """(w at the output points, node coordinates (3, n_nodes)) for configuration z."""
+        v = self._outfn(self.P @ np.asarray(z, dtype=float)).full().ravel()
+        nw = len(self.output_points)
+        return v[:nw], v[nw:].reshape(3, -1, order="F")
+
     def membrane_w(self, z) -> np.ndarray:
         """Transverse deflections w (O_f frame, eq. 5.1) at the output points."""
         zm = self.P @ np.asarray(z, dtype=float)

@@ -87,7 +87,7 @@ def initial_acceleration(system, x0, v0, t0=0.0, *, tol=1e-12, max_iter=20) -> n
 
 def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                    a0=None, scheme: str = "park", tol: float = 1e-10,
-                   max_iter: int = 25, jacobian: str = "iteration",
+                   max_iter: int = 25, jacobian: str = "iteration", reuse_iter: int = 4,
                    callback: Callable | None = None, store: bool = True,
                    progress: Callable | None = None) -> ParkResult:
     """Integrate r(x, v, a, t) = 0 with Park's method started by the trapezoidal rule.
@@ -124,8 +124,8 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
     """
     if scheme not in _SCHEMES:
         raise InputError(f"integrator scheme: expected one of {_SCHEMES}, found {scheme!r}")
-    if jacobian not in ("iteration", "step"):
-        raise InputError(f"jacobian: expected 'iteration' or 'step', found {jacobian!r}")
+    if jacobian not in ("iteration", "step", "reuse"):
+        raise InputError(f"jacobian: expected 'iteration', 'step' or 'reuse', found {jacobian!r}")
     if not (np.isfinite(dt) and dt > 0):
         raise InputError(f"time step: expected dt > 0, found {dt!r}")
     if not (isinstance(n_steps, (int, np.integer)) and n_steps >= 0):
@@ -147,6 +147,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
     hv = [v.copy()]
     c_park = 10.0 / (6.0 * dt)
     last = 0
+    solve, kept_coef = None, None
     for k in range(1, n_steps + 1):
         t = t0 + k * dt
         xn, vn, an = hx[-1], hv[-1], a
@@ -165,12 +166,17 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
             cv, ca = 2.0 / dt, 4.0 / dt**2
         # predictor: constant acceleration
         xk = xn + dt * vn + 0.5 * dt**2 * an
-        solve = None
+        if jacobian != "reuse" or kept_coef != (cv, ca):
+            solve = None
+        fresh = False
         for it in range(1, max_iter + 1):
             vk, ak = kin(xk)
             r = system.residual(xk, vk, ak, t)
-            if solve is None or jacobian == "iteration":
+            if (solve is None or jacobian == "iteration"
+                    or (jacobian == "reuse" and it > reuse_iter and not fresh)):
                 solve = _solver(_newton_matrix(system, xk, vk, ak, t, cv, ca))
+                kept_coef = (cv, ca)
+                fresh = True
                 res.jacobian_evaluations += 1
             dx = -solve(r)
             xk = xk + dx
