@@ -240,3 +240,15 @@ def test_energy_conserved_without_damping(sys14):
     park_integrate(md, x0=z0, v0=zd0, dt=0.005, n_steps=300, scheme="trapezoidal",
                    callback=lambda t, x, v, a: Ed.append(md.kinetic_energy(x, v) + md.potential_energy(x)))
     assert Ed[-1] < Ed[0] - 1e-3 * T0
+
+
+def test_fast_path_equals_newton_partitioning(m14):
+    # the integrator's single-call graph (closed-form zeta inside) against zeta from
+    # Newton on Phi and eqs. 5.23-5.28 evaluated numerically from the DAE matrices
+    for seed in (7, 8):
+        z, zd = _random_state(m14, seed)
+        for a, b in zip(m14.matrices(z, zd), m14.matrices_newton(z, zd)):
+            assert np.allclose(a, b, rtol=1e-10, atol=1e-10 * np.abs(a).max())
+    w, X = m14.fast_outputs(z)
+    assert np.allclose(w, m14.membrane_w(z), atol=1e-14)
+    assert np.allclose(X, m14.system.nodes(z[:m14.nq]), atol=1e-14)

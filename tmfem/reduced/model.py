@@ -293,7 +293,7 @@ class ControlOrientedModel:
         outs = [ca.substitute(o, zz, zcf) for o in (Mh, Fh, Bh)] \
             if self.formulation == "partitioned" else [Mh, Fh, Bh]
         self._fast = ca.Function("com_fast", [ca.vertcat(z, zd)],
-                                 [ca.vertcat(*[ca.vec(ca.densify(o)) for o in outs])])
+                                 [ca.vertcat(*[ca.vec(ca.densify(o)) for o in outs])], {"cse": True})
         nd = self.layout.n_delta
         self._fast_shapes = [(nq + K, nq + K), (nq + K, 1), (nq + K, self.n_t)]
         # residual and Newton matrix for implicit integration (Park, 5.34)
