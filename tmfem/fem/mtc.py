@@ -246,18 +246,24 @@ class MTCModel:
 
     def interpolate_from(self, other: "MTCModel", x_other: np.ndarray) -> np.ndarray:
         """Positions (3, n_nodes) of this model from a solution of ``other`` (same system,
-        another mesh or tendon subdivision): membrane nodes by bilinear interpolation on the
-        other mesh (reference coordinates), labelled nodes copied, tendons straight.
+        another mesh or tendon subdivision): membrane nodes by linear interpolation over the
+        other mesh's nodes (reference coordinates), labelled nodes copied, tendons straight.
         Used for mesh sequencing (nested iteration) of :meth:`solve_static`."""
-        from skfem import Basis, ElementQuad1
+        from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
         if other.system is not self.system:
             raise InputError("interpolate_from: expected a model of the same system")
         ot, st = other.topology, self.topology
         c = st.mesh.p.mean(axis=1, keepdims=True)
-        pts = c + (1.0 - 1e-9) * (st.mesh.p - c)      # boundary points strictly inside
-        P = Basis(ot.mesh.to_skfem(), ElementQuad1()).probes(pts).tocsr()
+        pts = (c + (1.0 - 1e-9) * (st.mesh.p - c)).T     # boundary points strictly inside
+        # piecewise-linear interpolation on a Delaunay triangulation of the other mesh's nodes
+        # (skfem's probes() falls back to a dense points x elements search on boundaries)
+        vals = x_other[:, :ot.n_mesh].T
+        xm = LinearNDInterpolator(ot.mesh.p.T, vals)(pts)
+        bad = ~np.all(np.isfinite(xm), axis=1)
+        if bad.any():
+            xm[bad] = NearestNDInterpolator(ot.mesh.p.T, vals)(pts[bad])
         x = np.zeros((3, st.n_nodes))
-        x[:, :st.n_mesh] = (P @ x_other[:, :ot.n_mesh].T).T
+        x[:, :st.n_mesh] = xm.T
         x[:, st.system_node] = x_other[:, ot.system_node]
         x = self.full(self.reduce(x))
         self._straight_tendons(x)
