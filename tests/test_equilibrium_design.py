@@ -216,3 +216,20 @@ def test_force_ratios_agree_with_mtc_nodal_balance():
     m = MTCModel(s, mesh_n=MESH, rest_lengths=d.rest_lengths)
     T = m.consistent_rest_lengths()["tendon_force"]
     np.testing.assert_allclose(T / T[0], d.tendon_forces / d.tendon_forces[0], rtol=1e-6)
+
+
+def test_best_bases_reports_what_it_found():
+    # the search result, re-evaluated independently (LP on the reduced matrix, eq. 3.22)
+    from tmfem.equilibrium.symmetric import membrane_delta
+    from tmfem.equilibrium.symmetric_map import best_bases, configuration_5_97, with_configuration
+    s = load_preset("2-3")
+    th, ps = np.radians(79.63), np.radians(10.0)
+    b = best_bases(s, th, ps, starts=1, maxiter=60)
+    cfg = configuration_5_97(s, th, ps, r=b["r"], z=b["z"], sigma=b["sigma"])
+    nv = positive_null_vector(symmetric_matrix(with_configuration(s, cfg)).A)
+    assert nv.margin == pytest.approx(b["margin"], abs=1e-9)
+    assert b["Delta"] == pytest.approx(membrane_delta(l_M=cfg.l[-1], theta_M=th, psi_M=cfg.psi[-1],
+                                                      sigma_M=cfg.sigma[-1], r_M=cfg.r[-1],
+                                                      r_mb=s.r_mb, N=3), abs=1e-12)
+    assert b["feasible"] == (nv.exists and b["Delta"] > 0)
+    assert -np.pi < b["sigma"][1] <= np.pi

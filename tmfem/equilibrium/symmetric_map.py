@@ -26,7 +26,7 @@ import numpy as np
 from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
 from tmfem.equilibrium.symmetric import membrane_delta
 from tmfem.errors import InputError
-from tmfem.system.geometry import SymmetricConfig
+from tmfem.system.geometry import SymmetricConfig, wrap_angle
 
 
 def configuration_5_97(system, theta: float, psi: float, *, r=None, z=None,
@@ -164,3 +164,66 @@ def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
     fig.savefig(png, dpi=120)
     plt.close(fig)
     return png
+
+
+def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int = 0,
+               r_bounds=(0.05, 2.0), z_bounds=(0.05, 2.5), maxiter: int = 300) -> dict:
+    """Stage bases (r_i, z_i, sigma_i, i >= 2) that maximise the null-vector margin at
+    (theta, psi) of eq. 5.97 with Delta > 0 (eq. 3.22); a multi-start Nelder-Mead search.
+
+    The bases are the free parameters of a symmetric M-N equilibrium (see the module
+    docstring); this gives one admissible choice, e.g. a rule ``bases`` for
+    :func:`equilibrium_map`. r_1, l_i and r_mb are those of ``system``.
+
+    Returns
+    -------
+    dict with ``r``, ``z``, ``sigma`` (length M), ``margin`` (> 0: a positive null vector
+    exists), ``Delta`` and ``feasible``.
+    """
+    from scipy.optimize import minimize
+
+    c = system.symmetric
+    if c is None or c.M < 2:
+        raise InputError("best_bases: expected a symmetric system with M >= 2 stages")
+    M = c.M
+    rng = np.random.default_rng(seed)
+
+    def unpack(p):
+        p = p.reshape(M - 1, 3)
+        return (np.concatenate([[c.r[0]], p[:, 0]]), np.concatenate([[0.0], p[:, 1]]),
+                np.concatenate([[0.0], p[:, 2]]))
+
+    def evaluate(p):
+        r, z, sg = unpack(p)
+        if np.any(r[1:] < r_bounds[0]) or np.any(r[1:] > r_bounds[1]) or \
+                np.any(z[1:] < z_bounds[0]) or np.any(z[1:] > z_bounds[1]):
+            return -np.inf, -np.inf
+        cfg = configuration_5_97(system, theta, psi, r=r, z=z, sigma=sg)
+        s = with_configuration(system, cfg)
+        nv = positive_null_vector(symmetric_matrix(s).A)
+        D = membrane_delta(l_M=cfg.l[-1], theta_M=theta, psi_M=cfg.psi[-1], sigma_M=sg[-1],
+                           r_M=r[-1], r_mb=system.r_mb, N=system.N)
+        return nv.margin, D
+
+    def objective(p):
+        m, D = evaluate(p)
+        if not np.isfinite(m):
+            return 10.0
+        return -m + 10.0 * max(0.0, -D)
+
+    best = None
+    for k in range(starts):
+        p0 = np.column_stack([rng.uniform(*r_bounds, M - 1), rng.uniform(*z_bounds, M - 1),
+                              rng.uniform(-np.pi, np.pi, M - 1)]).ravel()
+        if k == 0:
+            p0 = np.column_stack([c.r[1:], c.z[1:], c.sigma[1:]]).ravel()
+        res = minimize(objective, p0, method="Nelder-Mead",
+                       options={"maxiter": maxiter, "xatol": 1e-6, "fatol": 1e-9})
+        if best is None or res.fun < best.fun:
+            best = res
+    m, D = evaluate(best.x)
+    r, z, sg = unpack(best.x)
+    sg = wrap_angle(sg)
+    sg[0] = 0.0
+    return {"r": r, "z": z, "sigma": sg, "margin": float(m), "Delta": float(D),
+            "feasible": bool(m > 0 and D > 0)}
