@@ -233,3 +233,15 @@ def test_best_bases_reports_what_it_found():
                                                       r_mb=s.r_mb, N=3), abs=1e-12)
     assert b["feasible"] == (nv.exists and b["Delta"] > 0)
     assert -np.pi < b["sigma"][1] <= np.pi
+
+
+def test_1ND_slack_tendon_names_the_r1_bounds():
+    from tmfem.system import System, TendonSection
+    base = load_preset("1-4")
+    cfg = SymmetricConfig(theta=[np.radians(50)], psi=[np.radians(15)], sigma=[0], z=[0],
+                          r=[0.1], l=[2.2])                    # r_1 below k_H r* = 0.185 m
+    s = System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
+                                bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
+                                deployable=True, k_H=0.3)
+    with pytest.raises(SlackTendon, match=r"0.185059 < r_1 < min\(0.616862"):
+        design_equilibrium(s, mesh_n=MESH)

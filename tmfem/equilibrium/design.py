@@ -351,14 +351,24 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     L = system.tendon_lengths(q)
     names = system.tendon_names()
     slack = np.flatnonzero(T <= 0)
+    cf = None
+    if system.symmetric is not None and system.M == 1:
+        cf = closed_form_1ND(system) if system.deployable else closed_form_1N(system)
+    hint = ""
+    if slack.size and cf is not None:
+        psi = system.symmetric.psi[0]
+        if system.deployable:
+            hint = (f"; the closed form needs {cf['r1_lower']:.6g} < r_1 < min({cf['r1_upper']:.6g}, "
+                    f"{cf['r1_upper_SL']:.6g}) m (eq. 3.41 and the SL bound it omits), found "
+                    f"r_1 = {system.symmetric.r[0]:.6g} m")
+        else:
+            hint = (f"; eq. 3.35 needs cot(psi_1) > tan(pi/N) = {np.tan(np.pi / N):.4g}, found "
+                    f"psi_1 = {np.degrees(psi):.4g} deg")
     checks.append(Check("tendons taut", "eq. 3.16/3.35", float(T.min()), 0.0, slack.size == 0,
                         "expected all tendon forces > 0, found " + (", ".join(
                             f"{names[k]} = {T[k]:.4g} N" for k in slack[:8]) if slack.size
                             else f"min {T.min():.4g} N") + (
-                            f" ({slack.size} of {T.size} slack)" if slack.size else "")))
-    cf = None
-    if system.symmetric is not None and system.M == 1:
-        cf = closed_form_1ND(system) if system.deployable else closed_form_1N(system)
+                            f" ({slack.size} of {T.size} slack)" if slack.size else "") + hint))
     extra = ""
     if cf is not None and not system.deployable:
         extra = (f"; for a 1-N system eq. 3.33 requires r_1 = {cf['r1_equilibrium']:.6g} m, "
