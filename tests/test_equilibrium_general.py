@@ -164,3 +164,20 @@ def test_non_coplanar_corners_are_reported():
     assert bad and bad[0].value > 1e-3
     with pytest.raises(InfeasibleDesign):
         design_equilibrium(s, mesh_n=3)
+
+
+@pytest.mark.parametrize("N", [5, 6])
+def test_corner_constraints_and_derivatives_for_larger_N(N):
+    # N >= 5: corners 2..N-2 have free out-of-plane displacements Delta_w (3.2)
+    from tmfem.system import System, TendonSection
+    base = load_preset("1-4")
+    cfg = SymmetricConfig(theta=[1.0], psi=[0.2], sigma=[0], z=[0], r=[0.6], l=[2.0])
+    s = System.symmetric_system(name="n", N=N, config=cfg, r_mb=1.0, membrane=base.membrane,
+                                bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)})
+    q = s.q + 0.02 * rng.standard_normal(s.q.size)
+    a, b = corner_state(s, q), solve_corner_constraints(s, q)
+    np.testing.assert_allclose(a.free, b.free, atol=1e-10)
+    assert np.abs(a.delta[2]).max() > 1e-4          # non-coplanar corners after perturbation
+    np.testing.assert_allclose(delta_gradient(s, q), fd(lambda x: corner_state(s, x).free, q),
+                               atol=1e-7)
+    assert equilibrium_matrix(s, q).A.shape == (2 * N, 4 * N - 6)

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from tmfem.equilibrium.general import corner_state, positive_null_vector, symmetric_matrix
-from tmfem.equilibrium.symmetric import (A_1N, A_1ND, check_1N, check_1ND, closed_form_1N,
+from tmfem.equilibrium.symmetric import (A_1N, check_1N, check_1ND, closed_form_1N,
                                          closed_form_1ND, delta_1N, r1_bounds_1ND, det_A_1N,
                                          force_density_ratio_1N, membrane_delta_system, r1_1N,
                                          s1_length, sl_su_lengths)
