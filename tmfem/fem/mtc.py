@@ -441,12 +441,27 @@ class MTCModel:
             if rn <= tol * scale and mu_used == 0.0:
                 converged = True
                 break
+            if it >= 60 and min(res_hist[-40:]) > 0.1 * min(res_hist[:-40]):
+                break          # stagnation: no tenfold progress in 40 iterations
         if not converged:
-            raise ConvergenceError(f"MTC static solve: no equilibrium after {max_iter} iterations; "
-                                   f"residual history {np.array(res_hist[-8:])} N, mu = {mu:.3g}")
+            raise ConvergenceError(f"MTC static solve: no equilibrium after {it} iterations "
+                                   f"({self._state_note(xr)}); residual history "
+                                   f"{np.array(res_hist[-6:])} N, mu = {mu:.3g}")
         return StaticResult(x=self.full(xr), iterations=it, residual_history=res_hist,
                             monitor={k: np.array(v) for k, v in hist.items()},
                             dt2_history=mu_hist, time=time.perf_counter() - t0)
+
+    def _state_note(self, xr) -> str:
+        """Slack tendons and stretch of the membrane at independent positions xr, for errors."""
+        x = self.full(xr)
+        tt = truss_internal(x, self.tendons, tangent=False)
+        e = self.topology.tendon_of_element
+        slack = np.bincount(e, weights=tt.slack.astype(float), minlength=len(self.system.tendons)) > 0
+        names = [t.name for t, s_ in zip(self.system.tendons, slack) if s_]
+        c = x[:, self.topology.mesh.corners]
+        return (f"{len(names)} of {slack.size} tendons slack{': ' + ', '.join(names[:9]) if names else ''}"
+                f"{' ...' if len(names) > 9 else ''}; mean corner radius "
+                f"{np.linalg.norm(c - c.mean(axis=1, keepdims=True), axis=0).mean():.4f} m")
 
     # ------------------------------------------------------------------ modes
     def modes(self, x: np.ndarray, *, k: int = 12, sigma: float = -1.0):
