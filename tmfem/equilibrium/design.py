@@ -7,7 +7,8 @@ Pipeline of :func:`design_equilibrium` for the configuration q of a system:
    (:mod:`tmfem.fem.plane_stress`) with those corner displacements;
 3. tendon forces T from A(q) T_q = 0 (eq. 3.16) with F given: A_T T = -A_F F (least
    squares, with the equilibrium residual reported; if the tendon network alone has
-   self-stress states, the one maximising the smallest tendon force is chosen by LP);
+   self-stress states and the minimum-norm forces are not all positive, the combination
+   maximising the smallest tendon force is chosen by LP);
 4. force densities T/|d|, rest lengths r = EA |d| / (T + EA) (eqs. 3.8-3.9);
 5. checks: membrane stretched (Delta > 0, eq. 3.22/3.36), tendons taut (T > 0),
    equilibrium residual of eq. 3.16, maximum principal and von Mises membrane stress vs
@@ -198,8 +199,9 @@ def tendon_forces_for(E: EquilibriumMatrix, F: np.ndarray, *, rtol: float = 1e-9
     nb = max(np.linalg.norm(b), 1e-300)
     Z, _ = null_space(AT, rtol)
     k = Z.shape[1]
-    if k:
-        # self-stress of the tendon network alone: maximise the smallest tendon force
+    if k and T0.min() <= 0:
+        # self-stress of the tendon network alone and the minimum-norm forces are not all
+        # positive: add the self-stress that maximises the smallest tendon force (bounded)
         C = 10.0 * max(np.abs(T0).max(), 1.0)
         c = np.zeros(k + 1)
         c[-1] = -1.0
