@@ -245,3 +245,19 @@ def test_1ND_slack_tendon_names_the_r1_bounds():
                                 deployable=True, k_H=0.3)
     with pytest.raises(SlackTendon, match=r"0.185059 < r_1 < min\(0.616862"):
         design_equilibrium(s, mesh_n=MESH)
+
+
+def test_duplicated_tendon_has_self_stress_and_shares_the_force():
+    # S_11 doubled: A_T gets two equal columns, a 1-D tendon self-stress (T_a - T_b); the
+    # minimum-norm forces split the single-tendon force of eq. 3.34 equally
+    from tmfem.system.topology import Tendon
+    s = one_stage()
+    t0 = s.tendons[0]
+    twin = Tendon("S_11b", t0.family, t0.stage, t0.j, t0.ends)
+    s2 = s.replace(tendons=s.tendons + (twin,))
+    d1 = design_equilibrium(s, mesh_n=MESH)
+    d2 = design_equilibrium(s2, mesh_n=MESH)
+    assert d1.self_stress_dim == 0 and d2.self_stress_dim == 1
+    assert d2.tendon_forces[0] == pytest.approx(d2.tendon_forces[-1], rel=1e-9)
+    assert d2.tendon_forces[0] + d2.tendon_forces[-1] == pytest.approx(d1.tendon_forces[0],
+                                                                        rel=1e-9)
