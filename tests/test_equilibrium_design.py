@@ -261,3 +261,24 @@ def test_duplicated_tendon_has_self_stress_and_shares_the_force():
     assert d2.tendon_forces[0] == pytest.approx(d2.tendon_forces[-1], rel=1e-9)
     assert d2.tendon_forces[0] + d2.tendon_forces[-1] == pytest.approx(d1.tendon_forces[0],
                                                                         rel=1e-9)
+
+
+def test_equilibrium_map_of_a_1ND_system_matches_closed_form_bounds():
+    # 1-N(D): positivity over (theta, psi) must follow r1_bounds_1ND (eq. 3.41 + SL bound)
+    # and Delta of eq. 3.22
+    from tmfem.equilibrium.symmetric import r1_bounds_1ND
+    from tmfem.equilibrium.symmetric_map import equilibrium_map
+    from tmfem.system import System, TendonSection
+    base = load_preset("1-4")
+    cfg = SymmetricConfig(theta=[1.0], psi=[0.3], sigma=[0], z=[0], r=[0.5], l=[2.2])
+    s = System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
+                                bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
+                                deployable=True, k_H=0.3)
+    th = np.radians(np.linspace(20, 85, 9))
+    ps = np.radians(np.linspace(2, 70, 9))
+    m = equilibrium_map(s, theta=th, psi=ps)
+    T, P = np.meshgrid(th, ps, indexing="ij")
+    lo, up, up_sl = r1_bounds_1ND(l1=2.2, theta1=T, psi1=P, k_H=0.3, N=4)
+    expect = (lo < 0.5) & (0.5 < np.minimum(up, up_sl))
+    np.testing.assert_array_equal(m.positive, expect)
+    assert 5 < m.feasible.sum() < m.feasible.size

@@ -11,8 +11,8 @@ equilibrium design (ch. 3, :func:`tmfem.equilibrium.design.design_equilibrium`) 
 * ``configuration.png`` (matplotlib), ``membrane_stress.png`` (von Mises over the mesh);
 * ``configuration.vtu`` for ParaView (bars, tendons with forces, membrane with stresses) and
   ``render.png`` (pyvista, off screen);
-* for symmetric systems with M >= 2: ``equilibrium_map.png`` / ``.json``, the region of
-  symmetric equilibria over (theta, psi) of eq. 5.97.
+* for symmetric systems with M >= 2 and 1-N(D) systems: ``equilibrium_map.png`` / ``.json``,
+  the region of symmetric equilibria over (theta, psi) of eq. 5.97.
 
 Progress goes to stderr.
 """
@@ -42,6 +42,7 @@ def configure(parser) -> None:
                         help="write the study even when an equilibrium condition is violated")
     parser.add_argument("--map-grid", type=int, default=13, metavar="k",
                         help="k x k grid of the (theta, psi) equilibrium map for M >= 2 "
+                             "and 1-N(D) systems "
                              "(default 13; 0 = no map)")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render")
 
@@ -261,7 +262,8 @@ def run(args) -> dict:
         files["render.png"] = str(render_configuration(out / "render.png", system,
                                                        tendon_forces=d.tendon_forces,
                                                        membrane=membrane, title=system.name))
-    if system.symmetric is not None and system.M >= 2 and args.map_grid > 0:
+    if system.symmetric is not None and (system.M >= 2 or system.deployable) \
+            and args.map_grid > 0:
         from tmfem.equilibrium.symmetric_map import equilibrium_map, plot_equilibrium_map
         k = args.map_grid
         c = system.symmetric
