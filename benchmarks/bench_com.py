@@ -60,11 +60,32 @@ def per_call(fn, n):
     return (time.perf_counter() - t0) / n
 
 
+def feasible_2_3():
+    """A stable symmetric 2-3 equilibrium with the Table 6.4 stage 1, bars and membrane but
+    the stage-2 base found by helper A1's ``symmetric_map.best_bases`` at (63, 20) deg
+    (r_2 = 0.364 m, z_2 = 0.551 m, sigma_2 = 162.6 deg, psi_2 = psi_1 + sigma_2; see
+    docs/errata.md): the printed 2-3 geometry has Delta < 0."""
+    from tmfem.system.geometry import SymmetricConfig
+    s = load_preset("2-3")
+    c = s.symmetric
+    th, ps, r2, z2, sg = np.radians(63.0), np.radians(20.0), 0.364, 0.551, np.radians(162.6)
+    cfg = SymmetricConfig(theta=[th, th], psi=[ps, ps + sg], sigma=[0.0, sg], z=[0.0, z2],
+                          r=[c.r[0], r2], l=c.l)
+    return s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
+
+
 def bench(name: str, t_end: float) -> None:
     system = load_preset(name)
     K = default_membrane_modes(system)
     t0 = time.perf_counter()
-    model = ControlOrientedModel(system, membrane_modes=K)
+    try:
+        model = ControlOrientedModel(system, membrane_modes=K)
+    except TmfemError as exc:
+        if name != "2-3":
+            raise
+        print(f"\n(2-3 preset: {exc}; using the feasible stage-2 base of feasible_2_3())")
+        t0 = time.perf_counter()
+        model = ControlOrientedModel(feasible_2_3(), membrane_modes=K)
     t_build = time.perf_counter() - t0
     print(f"\n== {name}: {model.nz} coordinates (nq = {model.nq}, K = {K}), "
           f"{model.n_t} inputs; build {t_build:.2f} s "
@@ -83,10 +104,12 @@ def bench(name: str, t_end: float) -> None:
     c0, w0 = time.process_time(), time.perf_counter()
     res = free_vibration(tm, t_end=t_end, dt=0.01, perturb=PERTURB.get(name, {}), jacobian="reuse")
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    import os
+    load = os.getloadavg()[0]
     print(f"{t_end:g} s free vibration, dt = 0.01 s: wall {wall:.2f} s, CPU {cpu:.2f} s "
-          f"({t_end / max(wall, 1e-9):.1f}x real time); target < {t_end / 10:g} s: "
-          f"{'met' if wall < t_end / 10 else 'NOT met (wall)'}"
-          f"{'' if cpu < t_end / 10 else ', NOT met (CPU)'}")
+          f"({t_end / max(cpu, 1e-9):.1f}x real time on CPU time); target < {t_end / 10:g} s: "
+          f"CPU {'met' if cpu < t_end / 10 else 'NOT met'}, wall {'met' if wall < t_end / 10 else 'NOT met'}"
+          f" (load average {load:.1f} on {os.cpu_count()} cores: wall > CPU means other processes)")
     print(f"  {res.stats['steps']} steps, {res.stats['newton_iterations']} Newton iterations, "
           f"{res.stats['jacobian_evaluations']} Jacobian evaluations")
     for k in tm.t:

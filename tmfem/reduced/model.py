@@ -294,8 +294,11 @@ class ControlOrientedModel:
             if self.formulation == "partitioned" else [Mh, Fh, Bh]
         self._fast = ca.Function("com_fast", [ca.vertcat(z, zd)],
                                  [ca.vertcat(*[ca.vec(ca.densify(o)) for o in outs])], {"cse": True})
-        nd = self.layout.n_delta
         self._fast_shapes = [(nq + K, nq + K), (nq + K, 1), (nq + K, self.n_t)]
+        zdd_f = ca.SX.sym("zdd", nq + K); u_f = ca.SX.sym("u", self.n_t)
+        self._fast_r = ca.Function(
+            "com_fast_r", [ca.vertcat(z, zd, zdd_f, u_f)],
+            [ca.mtimes(outs[0], zdd_f) + outs[1] + ca.mtimes(outs[2], u_f)], {"cse": True})
         # residual and Newton matrix for implicit integration (Park, 5.34)
         zdd = ca.SX.sym("zdd", nq + K); u = ca.SX.sym("u", self.n_t)
         cv = ca.SX.sym("cv"); cacc = ca.SX.sym("ca")
@@ -466,6 +469,8 @@ class ControlOrientedModel:
         """r = M_hat z'' + F_hat + B_hat u (eq. 5.27) in the model's coordinates."""
         u = self.u0 if u is None else u
         if self.formulation == "partitioned":
+            if self.membrane_points is None:
+                return self._fast_r(np.concatenate([z, zd, zdd, u])).full().ravel()
             M, F, B = self.matrices(z, zd)
             return M @ zdd + F + B @ u
         zm, zdm = self._to_modal(z, zd)
