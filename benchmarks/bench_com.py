@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from tmfem.errors import TmfemError
+from tmfem.reduced.examples import feasible_2_3
 from tmfem.reduced.linearize import linearize
 from tmfem.reduced.modal import default_membrane_modes
 from tmfem.reduced.model import ControlOrientedModel
@@ -58,20 +59,6 @@ def per_call(fn, n):
     for _ in range(n):
         fn()
     return (time.perf_counter() - t0) / n
-
-
-def feasible_2_3():
-    """A stable symmetric 2-3 equilibrium with the Table 6.4 stage 1, bars and membrane but
-    the stage-2 base found by helper A1's ``symmetric_map.best_bases`` at (63, 20) deg
-    (r_2 = 0.364 m, z_2 = 0.551 m, sigma_2 = 162.6 deg, psi_2 = psi_1 + sigma_2; see
-    docs/errata.md): the printed 2-3 geometry has Delta < 0."""
-    from tmfem.system.geometry import SymmetricConfig
-    s = load_preset("2-3")
-    c = s.symmetric
-    th, ps, r2, z2, sg = np.radians(63.0), np.radians(20.0), 0.364, 0.551, np.radians(162.6)
-    cfg = SymmetricConfig(theta=[th, th], psi=[ps, ps + sg], sigma=[0.0, sg], z=[0.0, z2],
-                          r=[c.r[0], r2], l=c.l)
-    return s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
 
 
 def bench(name: str, t_end: float) -> None:

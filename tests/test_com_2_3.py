@@ -1,0 +1,84 @@
+"""Control-oriented model of a two-stage, three-bar system (M = 2, N = 3): the stage-2
+translational kinetic energy (eqs. 5.10-5.11), the N = 3 layout of zeta, partitioning,
+design tendon forces and energy conservation. Uses the feasible stage-2 base of
+tmfem.reduced.examples.feasible_2_3 (the printed 2-3 geometry has Delta < 0, docs/errata.md)."""
+import casadi as ca
+import numpy as np
+import pytest
+
+from tmfem.reduced.examples import feasible_2_3
+from tmfem.reduced.kinematics import bar_kinetic_energy_sx
+from tmfem.reduced.linearize import linearize
+from tmfem.reduced.model import ControlOrientedModel
+from tmfem.solvers.park import park_integrate
+
+
+@pytest.fixture(scope="module")
+def s23():
+    return feasible_2_3()
+
+
+@pytest.fixture(scope="module")
+def m23(s23):
+    return ControlOrientedModel(s23, membrane_modes=2)
+
+
+def test_bar_kinetic_energy_literal_eq_5_10_5_11(s23):
+    """Our vector form against eqs. 5.10-5.11 written out term by term."""
+    nq = len(s23.q_names)
+    q = ca.SX.sym("q", nq); qd = ca.SX.sym("qd", nq)
+    f = ca.Function("T", [q, qd], [bar_kinetic_energy_sx(s23, q, qd)])
+    rng = np.random.default_rng(2)
+    qv = s23.q + 0.05 * rng.standard_normal(nq)
+    qdv = rng.standard_normal(nq)
+    N = s23.N
+    T = 0.0
+    for j in range(N):                                   # stage 1 (T_2 absent)
+        th, thd, psd = qv[2 * j], qdv[2 * j], qdv[2 * j + 1]
+        l = s23.l[0, j]; m = s23.bar.mass(l)
+        T += m / 6 * l**2 * (thd**2 + psd**2 * np.sin(th) ** 2)
+    for j in range(N):                                   # stage 2
+        k = 2 * N + 5 * j
+        x, y, z, th, ps = qv[k:k + 5]
+        xd, yd, zd, thd, psd = qdv[k:k + 5]
+        l = s23.l[1, j]; m = s23.bar.mass(l)
+        T1 = l**2 * (thd**2 + psd**2 * np.sin(th) ** 2)
+        T2 = (xd**2 + yd**2 + zd**2
+              + l * xd * (thd * np.cos(th) * np.cos(ps) - psd * np.sin(th) * np.sin(ps))
+              + l * yd * (thd * np.cos(th) * np.sin(ps) + psd * np.sin(th) * np.cos(ps))
+              - l * zd * thd * np.sin(th))
+        T += m * (T1 / 6 + T2 / 2)
+    assert float(f(qv, qdv)) == pytest.approx(T, rel=1e-13)
+
+
+def test_layout_and_partitioning_2_3(s23, m23):
+    assert m23.layout.names == ["Delta_u1", "Delta_u2", "Delta_v2", "gamma_1", "gamma_2", "gamma_3"]
+    assert m23.nz == 21 + 2
+    ms = ControlOrientedModel(s23, membrane_modes=2, formulation="substituted")
+    rng = np.random.default_rng(4)
+    z = m23.z0 + 0.01 * rng.standard_normal(m23.nz); zd = 0.1 * rng.standard_normal(m23.nz)
+    for a, b, c in zip(m23.matrices(z, zd), ms.matrices(z, zd), m23.matrices_newton(z, zd)):
+        assert np.allclose(a, b, rtol=1e-10, atol=1e-10 * np.abs(a).max())
+        assert np.allclose(a, c, rtol=1e-10, atol=1e-10 * np.abs(a).max())
+
+
+def test_design_tendon_forces_match_equilibrium_design(s23, m23):
+    # independent pipeline: A(q) null vector (3.16) scaled to A2's F_Delta (tmfem.equilibrium)
+    from tmfem.equilibrium.design import design_equilibrium
+    d = design_equilibrium(s23, mesh_n=10)
+    assert m23.design.residual < 1e-9
+    assert np.allclose(m23.design.tendon_forces, d.tendon_forces, rtol=1e-6)
+    assert np.allclose(m23.design.rest_lengths, d.rest_lengths, rtol=1e-9)
+
+
+def test_stable_and_energy_conserved(s23, m23):
+    f = linearize(m23).frequencies_hz()
+    assert np.all(f > 0)                          # a stable equilibrium: no imaginary frequency
+    z0 = m23.equilibrium()
+    zd0 = np.zeros(m23.nz); zd0[0] = 0.01         # theta_11_dot = 0.01 rad/s (6.5.2)
+    E = []
+    park_integrate(m23, x0=z0, v0=zd0, dt=0.005, n_steps=200, scheme="trapezoidal",
+                   jacobian="reuse",
+                   callback=lambda t, x, v, a: E.append(m23.kinetic_energy(x, v) + m23.potential_energy(x)))
+    T0 = m23.kinetic_energy(z0, zd0)
+    assert np.max(np.abs(np.array(E) - E[0])) < 1e-4 * T0
