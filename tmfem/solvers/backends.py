@@ -47,8 +47,9 @@ class ScipyBackend:
     #: systems at least this large are reordered by nested dissection before SuperLU
     nd_threshold = 4000
 
-    def __init__(self):
-        self._orderings = {}
+    #: nested-dissection orderings by sparsity pattern, shared by all instances (a model that
+    #: asks ``get_backend()`` at every Newton iteration still orders its pattern only once)
+    _orderings: dict = {}
 
     def factorize(self, A):
         if not sp.issparse(A):
@@ -103,8 +104,8 @@ class ScipyBackend:
             tp = sp.csc_matrix(tag[perm][:, perm])
             tp.sort_indices()
             entry = (perm, tp.data.astype(np.int64) - 1, tp.indices.copy(), tp.indptr.copy())
-            if len(self._orderings) > 8:
-                self._orderings.clear()
+            if len(self._orderings) >= 8:
+                self._orderings.pop(next(iter(self._orderings)))
             self._orderings[key] = entry
         perm, where, indices, indptr = entry
         Ap = sp.csc_matrix((A.data[where], indices, indptr), shape=A.shape)
@@ -127,7 +128,7 @@ class ScipyBackend:
         op = spla.LinearOperator(A.shape, matvec=lu, dtype=float)
         try:
             w, V = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma, which="LM",
-                              OPinv=op, tol=1e-12)
+                              OPinv=op, tol=1e-10)
         except spla.ArpackNoConvergence as exc:
             raise ConvergenceError(f"eigen: ARPACK did not converge for k={k} modes near sigma={sigma:g} "
                                    f"({len(exc.eigenvalues)} converged)") from None
