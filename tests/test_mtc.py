@@ -217,3 +217,18 @@ def test_cli_static_and_modal_json(tmp_path, capsys):
     assert len(out["freq_hz"]) == 4 and out["dissertation"]["source"] == "dissertation Table 6.6"
     assert main(["static", "--preset", "1-4", "--mesh", "0", "--json"]) != 0
     assert "error" in capsys.readouterr().err
+
+
+def test_2_3_printed_rest_lengths_do_not_fit_printed_geometry():
+    # Table 6.4: at the printed geometry the tendons are shorter than their printed rest
+    # lengths (S_1: 1.626 m vs 1.9425 m, V_2: 1.101 m vs 1.9953 m), i.e. slack; the MTC
+    # solve from that state finds no equilibrium and says which tendons are slack
+    from tmfem.errors import ConvergenceError
+    s = load_preset("2-3", as_printed=True)
+    strain = s.tendon_lengths() / s.rest_lengths - 1
+    names = [t.name for t in s.tendons]
+    assert strain[names.index("S_11")] == pytest.approx(1.6261 / 1.9425 - 1, abs=1e-3)
+    assert strain[names.index("V_21")] == pytest.approx(1.1014 / 1.9953 - 1, abs=1e-3)
+    m = MTCModel(s, mesh_n=3, tendon_elements=1)
+    with pytest.raises(ConvergenceError, match="slack"):
+        m.solve_static(start="design", max_iter=80)

@@ -72,8 +72,8 @@ def run(args) -> dict:
 
 def format_text(r: dict) -> str:
     if r.get("model") != "mtc":
-        import json
-        return json.dumps(r, indent=2, default=str)
+        from tmfem.reduced.modal import format_summary
+        return format_summary(r)
     lines = [f"MTC modes of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",
              f"prestress: rest lengths ({r['rest_lengths_source']}) "
