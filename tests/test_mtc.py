@@ -232,3 +232,21 @@ def test_2_3_printed_rest_lengths_do_not_fit_printed_geometry():
     m = MTCModel(s, mesh_n=3, tendon_elements=1)
     with pytest.raises(ConvergenceError, match="slack"):
         m.solve_static(start="design", max_iter=80)
+
+
+def test_two_stage_system_lands_on_its_design():
+    # M = 2: free stage-2 bars (only A_1j pinned). With the design-consistent rest lengths
+    # (node balance of all 27 free-node equations, 6 bars + 21 tendons) the equilibrium
+    # reached from the undeformed membrane is the design; and tmfem.equilibrium's linear
+    # design (independent formulation, eq. 3.16) lands within 0.1 mm of it.
+    from tmfem.reduced.examples import feasible_2_3
+    s = feasible_2_3()
+    m = MTCModel(s, mesh_n=4, tendon_elements=1, rest_lengths="mtc")
+    res = m.solve_static(start="undeformed")
+    st = static_summary(m, res.x)
+    assert st["max_deviation_from_design"] < 1e-5
+    assert not st["tendon_slack"]
+    assert len(st["bar_load_by_stage"]) == 2 and min(st["bar_load_by_stage"]) > 0
+    m2 = MTCModel(s, mesh_n=4, tendon_elements=1, rest_lengths="design")
+    st2 = static_summary(m2, m2.solve_static(start="design").x)
+    assert st2["max_deviation_from_design"] < 1e-3
