@@ -101,12 +101,12 @@ def test_static_lands_on_design_from_undeformed(exact_model):
     assert np.abs(X - Xd).max() < 2e-5      # round-off of the corner-force balance above
     h = res.monitor["B_14"]
     assert np.linalg.norm(h[0] - Xd[:, m.system.node_index("B_14")]) > 5e-4   # it moved
-    # quadratic convergence at the end (pure Newton steps, mu = 0): from 1e-2 N to the
+    # quadratic convergence at the end (mu -> 0, Newton steps): from 1e-2 N to the
     # round-off floor (~1e-8 N: bars with EA = 1.4e8 N) within five iterations
     r = np.array(res.residual_history)
     k = int(np.flatnonzero(r < 1e-2)[0])
     assert r[-1] < 1e-7 and len(r) - 1 - k <= 5
-    assert res.dt2_history[-1] == 0.0
+    assert res.dt2_history[-1] < 1e-6 * res.dt2_history[0]     # regularisation gone
     # the same state from the other start
     res2 = m.solve_static(start="design")
     assert np.abs(res2.x - res.x).max() < 1e-7

@@ -338,8 +338,8 @@ class MTCModel:
         x0 : ndarray (3, n_nodes), optional
             Explicit start (overrides ``start``).
         tol : float
-            Converged when |r_free| <= tol * (sum of |member forces| + 1 N), the last step
-            being a pure Newton step (mu = 0).
+            Converged when |r_free| <= tol * (sum of |member forces| + 1 N) after a pure
+            Newton step (mu = 0) or a step shorter than 1 nm.
         monitor : sequence of str
             Node labels (``"B_14"``) whose positions are recorded at every iteration.
         sequence : int, optional
@@ -438,7 +438,8 @@ class MTCModel:
                       file=sys.stderr)
             scale = 1.0 + float(np.sum(np.abs(truss_internal(xf, self.tendons, tangent=False).N))
                                 + np.sum(np.abs(truss_internal(xf, self.bars, tangent=False).N)))
-            if rn <= tol * scale and mu_used == 0.0:
+            step = float(np.abs(du).max())
+            if rn <= tol * scale and (mu_used == 0.0 or step < 1e-9):
                 converged = True
                 break
             if it >= 60 and min(res_hist[-40:]) > 0.1 * min(res_hist[:-40]):
