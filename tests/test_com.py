@@ -252,3 +252,28 @@ def test_fast_path_equals_newton_partitioning(m14):
     w, X = m14.fast_outputs(z)
     assert np.allclose(w, m14.membrane_w(z), atol=1e-14)
     assert np.allclose(X, m14.system.nodes(z[:m14.nq]), atol=1e-14)
+
+
+def test_nlsys_and_linearization_consistent(m14):
+    # python-control's finite-difference linearisation of our nlsys (independent of the AD
+    # derivatives) against linearize (eq. 5.33)
+    import control
+    lin = linearize(m14)
+    nl = m14.to_nlsys()
+    x_e = np.concatenate([lin.z_e, np.zeros(m14.nz)])
+    assert np.max(np.abs(nl.dynamics(0.0, x_e, lin.u_e))) < 1e-8        # an equilibrium
+    fd = control.linearize(nl, x_e, lin.u_e, eps=1e-7, copy_names=True)
+    assert fd.state_labels == lin.to_ss().state_labels
+    assert np.allclose(fd.A, lin.A, atol=1e-5 * np.abs(lin.A).max())
+    assert np.allclose(fd.B, lin.B, atol=1e-5 * np.abs(lin.B).max())
+    assert np.allclose(fd.C, lin.Cy, atol=1e-6)
+    assert np.allclose(nl.output(0.0, x_e, lin.u_e), lin.y_e)
+
+
+def test_slack_membrane_is_refused(sys14):
+    from tmfem.errors import SlackMembrane
+    from tmfem.system.geometry import membrane_corners_regular
+    # a membrane larger than the bar tops (Delta < 0, eq. 3.36): r_mb = 1.5 m > 1.4155 m
+    big = sys14.replace(membrane_corners=membrane_corners_regular(4, 1.5), r_mb=1.5)
+    with pytest.raises(SlackMembrane, match="Delta > 0"):
+        ControlOrientedModel(big, membrane_modes=2)

@@ -101,6 +101,7 @@ class ControlOrientedModel:
         self.constraints = ConstraintSolver(system, self.layout)
         self.q0 = np.asarray(system.q, dtype=float)
         self.zeta0 = self.constraints.solve(self.q0)
+        self._check_membrane_stretched()
         self.membrane = build_membrane_basis(system, delta0=self.layout.delta_array(self.zeta0),
                                              n_modes=membrane_modes, mesh_n=mesh_n,
                                              prestress_scale=prestress_scale)
@@ -144,6 +145,21 @@ class ControlOrientedModel:
         w = ca.mtimes(ca.DM(self._Wout[:, 1:]), ca.vertcat(zc[: self.layout.n_delta], zs[self.nq:]))
         from tmfem.reduced.kinematics import nodes_sx
         self._outfn = ca.Function("com_out", [zs], [ca.vertcat(w, ca.vec(nodes_sx(system, zs[: self.nq])))])
+
+    def _check_membrane_stretched(self):
+        """The design must pull every corner outward (eqs. 3.21, 3.36): radial corner
+        displacement > 0 relative to the membrane centroid."""
+        d = self.layout.delta_array(self.zeta0)[:2]
+        c = self.system.membrane_corners
+        e = c - c.mean(axis=1, keepdims=True)
+        e = e / np.linalg.norm(e, axis=0)
+        # remove the rigid translation (corner N is the origin of O_f): mean displacement
+        radial = np.sum((d - d.mean(axis=1, keepdims=True)) * e, axis=0)
+        if np.any(radial <= 0):
+            from tmfem.errors import SlackMembrane
+            raise SlackMembrane(f"system {self.system.name!r}: expected every membrane corner "
+                                "displaced outward at the design (Delta > 0, eqs. 3.21-3.22, 3.36), "
+                                f"found radial corner displacements {np.round(radial, 6).tolist()} m")
 
     # ------------------------------------------------------------------ names
     @property
@@ -535,8 +551,6 @@ class ControlOrientedModel:
         xb = np.concatenate([[0.0], zeta[: self.layout.n_delta], zm[self.nq:]])
         return self._Wout @ xb
 
-    def outputs(self, z) -> np.ndarray:
-        return np.concatenate([np.asarray(z, dtype=float)[: self.nq], self.membrane_w(z)])
 
     def kinetic_energy(self, z, zd) -> float:
         M, _, _ = self.matrices(z, zd)
@@ -554,6 +568,29 @@ class ControlOrientedModel:
             (self.prestress_scale - 1.0) * (self.membrane.S @ self._delta0_vec) @ d
         return float(0.5 * np.sum(self.k * (L - u) ** 2) + Um
                      + 0.5 * np.sum(self.membrane.omega**2 * eta**2))
+
+    def to_nlsys(self, name: str = "com"):
+        """The nonlinear model (eq. 5.27) as a python-control ``NonlinearIOSystem``.
+
+        State x = [z, z'], input u = rest lengths (absolute, m), output y = [q, w at the
+        output points]; the same signal names as :func:`tmfem.reduced.linearize.linearize`.
+        """
+        import control
+        nz = self.nz
+
+        def updfcn(t, x, u, params):
+            return np.concatenate([x[nz:], self.acceleration(x[:nz], x[nz:], u)])
+
+        def outfcn(t, x, u, params):
+            return self.outputs(x[:nz])
+
+        return control.nlsys(updfcn, outfcn, states=self.state_names, inputs=self.input_names,
+                             outputs=self.output_names, name=name)
+
+    def outputs(self, z) -> np.ndarray:
+        """y = [q, w at the output points] (the output vector of the state-space models)."""
+        w, _ = self.fast_outputs(z)
+        return np.concatenate([(self.P @ np.asarray(z, dtype=float))[: self.nq], w])
 
     def summary(self) -> dict:
         return {"n_q": self.nq, "K": self.K, "n_z": self.nz, "n_states": 2 * self.nz,
