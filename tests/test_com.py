@@ -277,3 +277,13 @@ def test_slack_membrane_is_refused(sys14):
     big = sys14.replace(membrane_corners=membrane_corners_regular(4, 1.5), r_mb=1.5)
     with pytest.raises(SlackMembrane, match="Delta > 0"):
         ControlOrientedModel(big, membrane_modes=2)
+
+
+def test_membrane_follows_bar_tops(m14, sys14):
+    # eq. 3.5: the membrane corners (static shapes, modes vanish there) sit on the bar tops
+    z, _ = _random_state(m14, seed=11, dz=0.02)
+    x, defl = m14.membrane_positions(z)
+    corners = m14.membrane.mesh.corners
+    assert np.allclose(x[:, corners], sys14.membrane_corners_inertial(z[:m14.nq]), atol=1e-12)
+    # tendon forces T = k (|d| - r) are the design forces at the design
+    assert np.allclose(m14.tendon_forces(m14.z0), m14.design.tendon_forces, rtol=1e-9)

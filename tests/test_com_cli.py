@@ -13,7 +13,8 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     png = tmp_path / "v.png"
     code = main(["vibrate", "--preset", "1-4", "--membrane-modes", "2", "--t-end", "0.3",
                  "--dt", "0.01", "--perturb", "theta_12_dot=0.01", "--csv", str(out),
-                 "--plot", str(png), "--json"])
+                 "--plot", str(png), "--vtk", str(tmp_path / "vtk"), "--vtk-every", "10",
+                 "--json"])
     assert code == 0
     r = json.loads(capsys.readouterr().out)
     assert r["steps"] == 30 and r["perturbation"] == {"theta_12_dot": 0.01}
@@ -26,6 +27,9 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     assert float(rows[1][i]) == pytest.approx(0.01)
     assert float(rows[3][j]) > float(rows[1][j])
     assert png.stat().st_size > 1000
+    from tmfem.io.vtk import read_pvd
+    frames = read_pvd(r["pvd"])
+    assert [round(t, 6) for t, _ in frames] == [0.0, 0.1, 0.2, 0.3]
 
 
 def test_vibrate_cli_errors(capsys):

@@ -29,6 +29,10 @@ def configure(parser) -> None:
     parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park")
     parser.add_argument("--csv", help="write the histories to this CSV file (row by row)")
     parser.add_argument("--plot", help="write a plot of the monitored histories (PNG)")
+    parser.add_argument("--vtk", metavar="DIR",
+                        help="write a ParaView series (.pvd + .vtu frames) to this directory")
+    parser.add_argument("--vtk-every", type=int, default=10,
+                        help="steps between ParaView frames (default 10)")
 
 
 def run(args) -> dict:
@@ -45,7 +49,8 @@ def run(args) -> dict:
                                  prestress_scale=args.prestress_scale)
     pert = parse_perturbation(args.perturb, model.state_names)
     res = free_vibration(model, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
-                         scheme=args.scheme, jacobian="reuse", progress=True)
+                         scheme=args.scheme, jacobian="reuse", progress=True,
+                         vtk_dir=args.vtk, vtk_every=args.vtk_every)
     out = {"system": system.name, "model": "com", "membrane_modes": K, "t_end": args.t_end,
            "dt": args.dt, "perturbation": pert, "scheme": args.scheme,
            "wall_time_s": res.wall_time, "steps": res.stats["steps"],
@@ -56,6 +61,8 @@ def run(args) -> dict:
            "final": dict(zip(model.state_names, np.concatenate([res.z[-1], res.zd[-1]]).tolist()))}
     if args.csv:
         out["csv"] = args.csv
+    if "pvd" in res.stats:
+        out["pvd"] = res.stats["pvd"]
     if args.plot:
         out["plot"] = plot_free_vibration(res, args.plot,
                                           title=f"{system.name} COM free vibration, K = {K}")
@@ -71,7 +78,7 @@ def format_text(r: dict) -> str:
         lines.append(f"max |w_{i + 1}| = {1e3 * w:.4f} mm")
     for k, v in r["node_range_m"].items():
         lines.append(f"{k} peak-to-peak (x, y, z) = " + ", ".join(f"{1e3 * a:.3f}" for a in v) + " mm")
-    for k in ("csv", "plot"):
+    for k in ("csv", "plot", "pvd"):
         if k in r:
             lines.append(f"{k}: {r[k]}")
     return "\n".join(lines)

@@ -544,6 +544,25 @@ class ControlOrientedModel:
         nw = len(self.output_points)
         return v[:nw], v[nw:].reshape(3, -1, order="F")
 
+    def membrane_positions(self, z):
+        """Membrane FE node positions (3, n_nodes) in the inertial frame (eqs. 5.1, 5.3) and
+        the deflections (3, n_nodes) in O_f, for configuration z."""
+        from tmfem.reduced.kinematics import rotation_ef
+        zm = self.P @ np.asarray(z, dtype=float)
+        q = zm[: self.nq]
+        zeta = self.zeta(q)
+        nd = self.layout.n_delta
+        xb = np.concatenate([[1.0], zeta[:nd], zm[self.nq:]])
+        rf = np.einsum("a,aij->ij", xb, self.membrane.shapes)
+        O = self.system.membrane_corners_inertial(q)[:, -1]
+        return O[:, None] + rotation_ef(zeta[nd:]) @ rf, rf - self.membrane.shapes[0]
+
+    def tendon_forces(self, z, u=None) -> np.ndarray:
+        """T = k (|d| - r) (eq. 3.8 with the model's fixed k), aligned with system.tendons."""
+        u = self.u0 if u is None else np.asarray(u, dtype=float)
+        zm = self.P @ np.asarray(z, dtype=float)
+        return self.k * (self.system.tendon_lengths(zm[: self.nq]) - u)
+
     def membrane_w(self, z) -> np.ndarray:
         """Transverse deflections w (O_f frame, eq. 5.1) at the output points."""
         zm = self.P @ np.asarray(z, dtype=float)

@@ -55,7 +55,8 @@ class FreeVibration:
 
 def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | None = None,
                    csv_path=None, scheme: str = "park", jacobian: str = "step",
-                   monitor_nodes=None, progress: bool = False) -> FreeVibration:
+                   monitor_nodes=None, progress: bool = False, vtk_dir=None,
+                   vtk_every: int = 10) -> FreeVibration:
     """Free vibration from the equilibrium with an initial perturbation (6.5).
 
     Parameters
@@ -71,6 +72,10 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
         Passed to :func:`park_integrate` (``jacobian="step"``: modified Newton).
     monitor_nodes : list of str, optional
         Node labels whose positions are recorded (default per preset, see MONITOR_NODES).
+    vtk_dir : path, optional
+        Write every ``vtk_every``-th step as a ParaView frame (bars, tendons with forces,
+        deformed membrane with its deflection in O_f) and a ``.pvd`` collection, as the run
+        goes (tmfem.io.vtk.SeriesWriter).
     """
     if not (t_end > 0 and dt > 0):
         raise InputError(f"expected t_end > 0 and dt > 0, found t_end={t_end!r}, dt={dt!r}")
@@ -100,9 +105,25 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
     if writer:
         writer.writerow(columns)
 
+    series = None
+    if vtk_dir is not None:
+        from tmfem.io.vtk import SeriesWriter
+        if not (isinstance(vtk_every, int) and vtk_every >= 1):
+            raise InputError(f"vtk_every: expected an integer >= 1, found {vtk_every!r}")
+        series = SeriesWriter(vtk_dir, name=f"com_{system.name}".replace("(", "").replace(")", ""))
+    count = [0]
+
     def record(t, z, zd, a):
         w, X = model.fast_outputs(z)
         pos = X[:, idx]
+        if series is not None and count[0] % vtk_every == 0:
+            from tmfem.io.vtk import MembraneField
+            xm, defl = model.membrane_positions(z)
+            series.append_configuration(
+                t, system, q=(model.P @ z)[: model.nq], tendon_forces=model.tendon_forces(z),
+                membrane=MembraneField(mesh=model.membrane.mesh, x=xm,
+                                       point_data={"deflection_Of": defl}))
+        count[0] += 1
         T.append(t); Z.append(z.copy()); ZD.append(zd.copy()); W.append(w); XS.append(pos)
         if writer:
             writer.writerow([f"{t:.6g}"] + [f"{v:.10g}" for v in np.concatenate([z, zd, w, pos.T.ravel()])])
@@ -122,10 +143,12 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
     wall = time.perf_counter() - t0
     Xa = np.array(XS)
     nodes = {n: Xa[:, :, k] for k, n in enumerate(labels)}
+    stats = {"steps": res.steps, "newton_iterations": res.newton_iterations,
+             "jacobian_evaluations": res.jacobian_evaluations}
+    if series is not None:
+        stats["pvd"] = str(series.pvd)
     return FreeVibration(t=np.array(T), z=np.array(Z), zd=np.array(ZD), w=np.array(W), nodes=nodes,
-                         columns=columns, wall_time=wall,
-                         stats={"steps": res.steps, "newton_iterations": res.newton_iterations,
-                                "jacobian_evaluations": res.jacobian_evaluations})
+                         columns=columns, wall_time=wall, stats=stats)
 
 
 def plot_free_vibration(result: FreeVibration, path, *, title: str = "") -> str:
