@@ -198,3 +198,39 @@ def with_symmetric(system, **changes):
     N = system.N
     return system.replace(q=cfg.to_q(N), symmetric=cfg, base=cfg.base_nodes(N)[:, 0, :],
                           l=np.repeat(cfg.l[:, None], N, axis=1), rest_lengths=None, **extra)
+
+
+def top_radius_for_delta(*, l_M: float, theta_M: float, psi_rel: float, r_mb: float,
+                         Delta: float, N: int) -> float:
+    """Base radius r_M of the top stage that gives the corner displacement Delta (eq. 3.22
+    solved for r_M; the smaller root). ``psi_rel`` = psi_M - sigma_M [rad]."""
+    L = l_M * np.sin(theta_M)
+    b = 2 * L * np.sin(psi_rel + np.pi / N)
+    c = L**2 - (r_mb + Delta)**2
+    disc = b * b - 4 * c
+    if disc < 0:
+        raise InputError(f"eq. 3.22: no top radius gives r_mb + Delta = {r_mb + Delta:.6g} m "
+                         f"(bar reach l sin(theta) = {L:.6g} m)")
+    return float((b - np.sqrt(disc)) / 2)
+
+
+def deployment_bases(system, *, z_ratio: float = 0.7, Delta: float = 1e-3, sigma2=None):
+    """Stage-2 base rule reconstructed from Table 7.7 for 2-stage systems (see docs/errata.md).
+
+    sigma_2 fixed (default: that of ``system``), z_2 = z_ratio l_1 cos(theta), r_2 from
+    eq. 3.22 such that the membrane corner displacement is ``Delta``. Returns a callable
+    ``bases(theta, psi) -> {"r", "z", "sigma"}`` for
+    :func:`tmfem.equilibrium.symmetric_map.equilibrium_map` (eq. 5.97 family).
+    """
+    c = system.symmetric
+    if c is None or c.M != 2:
+        raise InputError(f"system {system.name!r}: deployment_bases needs a symmetric 2-stage system")
+    sg2 = float(c.sigma[1]) if sigma2 is None else float(sigma2)
+
+    def bases(theta, psi):
+        r2 = top_radius_for_delta(l_M=c.l[1], theta_M=theta, psi_rel=psi, r_mb=system.r_mb,
+                                  Delta=Delta, N=system.N)
+        return {"r": np.array([c.r[0], r2]), "z": np.array([0.0, z_ratio * c.l[0] * np.cos(theta)]),
+                "sigma": np.array([0.0, sg2])}
+
+    return bases
