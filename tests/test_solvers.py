@@ -175,3 +175,15 @@ def test_nested_dissection_ordering_solves_and_reduces_fill():
     np.testing.assert_allclose(x, spla.splu(A).solve(b), rtol=1e-10, atol=1e-12)
     x2 = be.factorize(2.0 * A)(b)              # cached ordering, new values
     np.testing.assert_allclose(x2, 0.5 * x, rtol=1e-10, atol=1e-12)
+
+
+def test_newton_without_a_root_raises_instead_of_looping():
+    # r(u) = u^2 + 1 has no real root: Newton must stop with a ConvergenceError that carries
+    # its residual history (stalled, singular or max_iter), never return or hang
+    def residual(u):
+        return u**2 + 1.0, sp.csr_matrix(np.diag(2.0 * u))
+    with pytest.raises(ConvergenceError) as info:
+        newton(residual, np.array([0.7]), max_iter=40)
+    h = info.value.residual_history
+    assert len(h) > 1 and min(h) >= 1.0
+    assert any(s in str(info.value) for s in ("stalled", "singular", "within 40 iterations"))
