@@ -287,3 +287,27 @@ def test_membrane_follows_bar_tops(m14, sys14):
     assert np.allclose(x[:, corners], sys14.membrane_corners_inertial(z[:m14.nq]), atol=1e-12)
     # tendon forces T = k (|d| - r) are the design forces at the design
     assert np.allclose(m14.tendon_forces(m14.z0), m14.design.tendon_forces, rtol=1e-9)
+
+
+def test_dae_with_multipliers_equals_partitioned_ode(m14):
+    """Eq. 5.19 solved as an index-1 DAE with Lagrange multipliers,
+    [M Phi_x^T; Phi_x 0] [x''; lambda] = [-F - B u; -gamma], gives the same z'' as the ODE
+    5.27 of the coordinate partitioning; and T_z^T Phi_x^T = 0 (eq. 5.26)."""
+    z, zd = _random_state(m14, seed=21)
+    d = m14.dae_terms(z, zd)
+    assert np.allclose(d["T_z"].T @ d["Phi_x"].T, 0.0, atol=1e-12)
+    nx, nc = d["M"].shape[0], d["Phi_x"].shape[0]
+    A = np.block([[d["M"], d["Phi_x"].T], [d["Phi_x"], np.zeros((nc, nc))]])
+    rhs = np.concatenate([-d["F"] - d["B"] @ m14.u0, -d["gamma"]])
+    xdd = np.linalg.solve(A, rhs)[:nx]
+    assert np.allclose(xdd[:m14.nz], m14.acceleration(z, zd), rtol=1e-8, atol=1e-10)
+
+
+def test_frequencies_interlace_with_K(sys14, m14):
+    # nested modal bases (K = 1 within K = 3) at the same equilibrium: Rayleigh-Ritz /
+    # Cauchy interlacing, each frequency can only decrease when modes are added
+    f3 = linearize(m14).frequencies_hz()
+    m1 = ControlOrientedModel(sys14, membrane_modes=1)
+    f1 = linearize(m1).frequencies_hz()
+    assert np.all(f3[: len(f1)] <= f1 * (1 + 1e-9))
+    assert len(f3) == len(f1) + 2

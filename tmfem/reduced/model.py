@@ -445,6 +445,32 @@ class ControlOrientedModel:
         P = self.P
         return P.T @ Mh @ P, P.T @ Fh.ravel(), P.T @ Bh
 
+    def dae_terms(self, z, zd, zeta=None) -> dict:
+        """The DAE of eq. 5.19 at x = [q, eta, zeta], x' = T_z z' (modal coordinates):
+        M(x), F(x, x'), B(x), Phi_x, the velocity term gamma = (Phi_x x')_x x' of the
+        constraint accelerations (Phi_x x'' + gamma = 0), and T_z of eq. 5.25."""
+        if self.formulation != "partitioned":
+            raise InputError("dae_terms: available for formulation='partitioned'")
+        nq, K = self.nq, self.K
+        z = np.asarray(z, dtype=float); zd = np.asarray(zd, dtype=float)
+        q, qd = z[:nq], zd[:nq]
+        zeta = self.zeta(q) if zeta is None else np.asarray(zeta, dtype=float)
+        _, Pz, Pq, _ = (np.asarray(a) for a in self._con(q, zeta, qd, np.zeros(self.layout.n)))
+        zq = -np.linalg.solve(Pz, Pq)                                      # eq. 5.23
+        zetad = zq @ qd
+        gamma = np.asarray(self._con(q, zeta, qd, zetad)[3]).ravel()
+        x = np.concatenate([z, zeta]); xd = np.concatenate([zd, zetad])
+        M, F, B = (np.asarray(a) for a in self._dae(x, xd))
+        nx = x.size
+        Phi_x = np.zeros((self.layout.n, nx))
+        Phi_x[:, :nq] = Pq
+        Phi_x[:, nq + K:] = Pz
+        Tz = np.zeros((nx, nq + K))
+        Tz[:nq + K] = np.eye(nq + K)
+        Tz[nq + K:, :nq] = zq
+        return {"x": x, "xd": xd, "M": M, "F": F.ravel(), "B": B, "Phi_x": Phi_x,
+                "gamma": gamma, "T_z": Tz}
+
     def _partitioned_numeric(self, z, zd, zeta):
         """Eqs. 5.23-5.28 evaluated numerically from the DAE matrices M, F, B (eq. 5.19)
         and the constraint Jacobians (AD): zeta_q = -Phi_zeta^-1 Phi_q, zeta' = zeta_q q',
