@@ -23,3 +23,18 @@ def test_com_frequencies_close_to_mtc_1_4():
     ratio = f_com / f_mtc
     # dissertation Table 6.6: COM/MTC between 0.974 and 0.993 for modes 1-12
     assert np.all(ratio > 0.97) and np.all(ratio < 1.005), ratio
+
+
+def test_printed_rest_length_1_529_gives_a_soft_system_in_both_models():
+    # Table 6.2's r_1^S = 1.529 m (docs/errata.md): the COM and the MTC model both find a
+    # nearly unstressed system whose first frequency is ~0.04 Hz instead of 0.1367 Hz
+    from tmfem.fem.mtc import MTCModel
+    from tmfem.reduced.modal import modal_summary
+    s = load_preset("1-4", as_printed=True)
+    r = modal_summary(s, modes=3, membrane_modes=5)
+    assert r["rest_lengths_source"] == "system"
+    mtc = MTCModel(s, mesh_n=10, tendon_elements=1)
+    res = mtc.solve_static(start="undeformed")
+    f_mtc = mtc.modes(res.x, k=3).freq_hz
+    assert r["freq_hz"][0] == pytest.approx(f_mtc[0], rel=0.05)
+    assert r["freq_hz"][0] < 0.35 * 0.1367

@@ -44,10 +44,12 @@ def printed_prestress_scale(model) -> float | None:
 
 
 def com_frequencies(system, *, membrane_modes: int, prestress_scale: float = 1.0,
-                    mesh_n: int = 10, rest_lengths="design"):
+                    mesh_n: int = 10, rest_lengths=None):
     """(frequencies in Hz, model) of the COM linearised about its equilibrium (eq. 5.33)."""
     from tmfem.reduced.linearize import linearize
     from tmfem.reduced.model import ControlOrientedModel
+    if rest_lengths is None:       # the system's own (e.g. printed) if it has them
+        rest_lengths = "design" if system.rest_lengths is None else "system"
     m = ControlOrientedModel(system, membrane_modes=membrane_modes, mesh_n=mesh_n,
                              prestress_scale=prestress_scale, rest_lengths=rest_lengths)
     lin = linearize(m)
@@ -75,11 +77,19 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
     f, m = com_frequencies(system, membrane_modes=K, prestress_scale=prestress_scale,
                            mesh_n=mesh_n)
     n = min(modes, len(f))
+    names = system.tendon_names()
     out = {"system": system.name, "model": "com", "membrane_modes": K, "mesh_n": mesh_n,
            "prestress_scale": prestress_scale, "sizes": m.summary(),
            "freq_hz": f[:n].tolist(), "highest_hz": float(f[-1]),
-           "design_tendon_forces": dict(zip(system.tendon_names(), m.design.tendon_forces.tolist())),
-           "design_rest_lengths": dict(zip(system.tendon_names(), m.design.rest_lengths.tolist()))}
+           "rest_lengths_source": "design" if m.design is not None else "system",
+           "rest_lengths": dict(zip(names, m.u0.tolist()))}
+    if m.design is not None:
+        out["design_tendon_forces"] = dict(zip(names, m.design.tendon_forces.tolist()))
+        out["design_rest_lengths"] = dict(zip(names, m.design.rest_lengths.tolist()))
+    else:
+        z_e = m.equilibrium()
+        out["equilibrium_tendon_forces"] = dict(zip(names, m.tendon_forces(z_e).tolist()))
+        out["equilibrium_shift_max"] = float(np.max(np.abs(z_e - m.z0)))
     s_pr = printed_prestress_scale(m)
     if s_pr is not None:
         out["printed_stress_prestress_scale"] = s_pr
@@ -95,7 +105,15 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
 
 def format_summary(r: dict) -> str:
     lines = [f"COM of {r['system']}: {r['sizes']['n_z']} coordinates (nq = {r['sizes']['n_q']}, "
-             f"K = {r['membrane_modes']}), prestress x{r['prestress_scale']:g}"]
+             f"K = {r['membrane_modes']}), prestress x{r['prestress_scale']:g}, rest lengths "
+             f"from the {r.get('rest_lengths_source', 'design')}"]
+    forces = r.get("design_tendon_forces") or r.get("equilibrium_tendon_forces") or {}
+    if forces:
+        lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.4g}" for k, v in list(forces.items())[:6])
+                     + (" ..." if len(forces) > 6 else ""))
+    if "printed_stress_prestress_scale" in r:
+        lines.append(f"prestress implied by the printed tendon stress: x{r['printed_stress_prestress_scale']:.4f}"
+                     " (--prestress-scale in the Python API, docs/com.md)")
     ref = r.get("dissertation", {}).get("COM", [])
     lines.append(f"{'mode':>4} {'ours [Hz]':>10} {'printed':>10} {'rel.diff':>9}")
     for i, f in enumerate(r["freq_hz"]):
