@@ -173,3 +173,12 @@ def test_ch8_grid_is_inside_the_equilibrium_region_of_the_reconstructed_design()
     # psi = 5 deg lies outside (a tendon would push): the band is about 6.0-11.0 deg at 77.32
     out = equilibrium_map(s, theta=rad([77.32]), psi=rad([5.0, 12.0]), bases=deployment_bases(s))
     assert not out.positive.any()
+
+
+def test_comparison_table_format():
+    # rel. diff = (ours - printed) / |printed|; strings and None are shown as given / "-"
+    from tmfem.tables import comparison_row, format_comparison
+    r = comparison_row("bar load", 14.53, 10.9531, "N")
+    assert r[3] == pytest.approx((10.9531 - 14.53) / 14.53)
+    text = format_comparison([r, comparison_row("k_H", "not printed", 0.25)], "t")
+    assert "-24.62 %" in text and "not printed" in text and text.splitlines()[0] == "t"

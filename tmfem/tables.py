@@ -234,3 +234,34 @@ def deployment_bases(system, *, z_ratio: float = 0.7, Delta: float = 1e-3, sigma
                 "sigma": np.array([0.0, sg2])}
 
     return bases
+
+
+def comparison_row(quantity: str, printed, ours, unit: str = "") -> tuple:
+    """One row (quantity, printed, ours, relative difference) for :func:`format_comparison`;
+    ``printed`` or ``ours`` may be None (not printed / not computed) or a string."""
+    rel = None
+    if isinstance(printed, (int, float)) and isinstance(ours, (int, float)) and printed != 0 \
+            and np.isfinite(ours):
+        rel = (ours - printed) / abs(printed)
+    return (quantity + (f" [{unit}]" if unit else ""), printed, ours, rel)
+
+
+def format_comparison(rows, title: str = "") -> str:
+    """Plain-text columns: quantity, printed, ours, rel. diff."""
+    def fmt(v):
+        if v is None:
+            return "-"
+        if isinstance(v, str):
+            return v
+        if not np.isfinite(v):
+            return "n/a"
+        return f"{v:.6g}"
+    table = [("quantity", "printed", "ours", "rel. diff")]
+    table += [(q, fmt(p), fmt(o), "-" if r is None else f"{100 * r:+.2f} %") for q, p, o, r in rows]
+    w = [max(len(r[k]) for r in table) for k in range(4)]
+    lines = [title] if title else []
+    for k, r in enumerate(table):
+        lines.append("  ".join(s.ljust(w[i]) if i == 0 else s.rjust(w[i]) for i, s in enumerate(r)))
+        if k == 0:
+            lines.append("  ".join("-" * x for x in w))
+    return "\n".join(lines)
