@@ -18,6 +18,8 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     assert code == 0
     r = json.loads(capsys.readouterr().out)
     assert r["steps"] == 30 and r["perturbation"] == {"theta_12_dot": 0.01}
+    # taut tendons throughout (design force 8.32 N, small perturbation)
+    assert 7.0 < r["min_tendon_force_N"] < 8.4
     rows = list(csv.reader(open(out)))
     assert len(rows) == 32                       # header + t = 0 .. 0.3
     head = rows[0]

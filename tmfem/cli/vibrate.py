@@ -56,6 +56,8 @@ def run(args) -> dict:
            "wall_time_s": res.wall_time, "steps": res.stats["steps"],
            "newton_iterations": res.stats["newton_iterations"],
            "jacobian_evaluations": res.stats["jacobian_evaluations"],
+           "min_tendon_force_N": res.stats["min_tendon_force"],
+           "min_tendon_force_tendon": res.stats["min_tendon_force_tendon"],
            "w_max_abs_m": np.max(np.abs(res.w), axis=0).tolist() if res.w.size else [],
            "node_range_m": {k: np.ptp(v, axis=0).tolist() for k, v in res.nodes.items()},
            "final": dict(zip(model.state_names, np.concatenate([res.z[-1], res.zd[-1]]).tolist()))}
@@ -73,7 +75,8 @@ def format_text(r: dict) -> str:
     lines = [f"{r['system']} COM free vibration: {r['steps']} steps of {r['dt']} s "
              f"({r['scheme']}), {r['wall_time_s']:.2f} s wall, {r['newton_iterations']} Newton "
              f"iterations, {r['jacobian_evaluations']} Jacobians",
-             "perturbation: " + ", ".join(f"{k}={v:g}" for k, v in r["perturbation"].items())]
+             "perturbation: " + ", ".join(f"{k}={v:g}" for k, v in r["perturbation"].items()),
+             f"smallest tendon force {r['min_tendon_force_N']:.4g} N ({r['min_tendon_force_tendon']})"]
     for i, w in enumerate(r["w_max_abs_m"]):
         lines.append(f"max |w_{i + 1}| = {1e3 * w:.4f} mm")
     for k, v in r["node_range_m"].items():

@@ -144,7 +144,8 @@ class ControlOrientedModel:
         zc = self._zeta_closed_form_sx(zs[: self.nq])
         w = ca.mtimes(ca.DM(self._Wout[:, 1:]), ca.vertcat(zc[: self.layout.n_delta], zs[self.nq:]))
         from tmfem.reduced.kinematics import nodes_sx
-        self._outfn = ca.Function("com_out", [zs], [ca.vertcat(w, ca.vec(nodes_sx(system, zs[: self.nq])))])
+        self._outfn = ca.Function("com_out", [zs], [ca.vertcat(w, tendon_lengths_sx(system, zs[: self.nq]),
+                                                              ca.vec(nodes_sx(system, zs[: self.nq])))])
 
     def _check_membrane_stretched(self):
         """The design must pull every corner outward (eqs. 3.21, 3.36): radial corner
@@ -564,11 +565,13 @@ class ControlOrientedModel:
                                f"iterations, |F_hat + B_hat u| = {np.linalg.norm(r):.3e}")
 
     # ------------------------------------------------------------------ outputs
-    def fast_outputs(self, z):
-        """(w at the output points, node coordinates (3, n_nodes)) for configuration z."""
+    def fast_outputs(self, z, with_lengths: bool = False):
+        """(w at the output points, node coordinates (3, n_nodes)[, tendon lengths]) for z."""
         v = self._outfn(self.P @ np.asarray(z, dtype=float)).full().ravel()
         nw = len(self.output_points)
-        return v[:nw], v[nw:].reshape(3, -1, order="F")
+        L = v[nw:nw + self.n_t]
+        X = v[nw + self.n_t:].reshape(3, -1, order="F")
+        return (v[:nw], X, L) if with_lengths else (v[:nw], X)
 
     def membrane_positions(self, z):
         """Membrane FE node positions (3, n_nodes) in the inertial frame (eqs. 5.1, 5.3) and

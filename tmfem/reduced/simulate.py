@@ -113,8 +113,14 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
         series = SeriesWriter(vtk_dir, name=f"com_{system.name}".replace("(", "").replace(")", ""))
     count = [0]
 
+    Tmin = [np.inf, 0.0, ""]          # smallest tendon force, its time and tendon
+
     def record(t, z, zd, a):
-        w, X = model.fast_outputs(z)
+        w, X, L = model.fast_outputs(z, with_lengths=True)
+        force = model.k * (L - model.u0)      # eq. 3.8 with the model's spring constants
+        k = int(np.argmin(force))
+        if force[k] < Tmin[0]:
+            Tmin[:] = [float(force[k]), float(t), system.tendons[k].name]
         pos = X[:, idx]
         if series is not None and count[0] % vtk_every == 0:
             from tmfem.io.vtk import MembraneField
@@ -144,7 +150,14 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
     Xa = np.array(XS)
     nodes = {n: Xa[:, :, k] for k, n in enumerate(labels)}
     stats = {"steps": res.steps, "newton_iterations": res.newton_iterations,
-             "jacobian_evaluations": res.jacobian_evaluations}
+             "jacobian_evaluations": res.jacobian_evaluations,
+             "min_tendon_force": Tmin[0], "min_tendon_force_time": Tmin[1],
+             "min_tendon_force_tendon": Tmin[2]}
+    if Tmin[0] <= 0:
+        # the COM's tendons are bilateral springs (docs/com.md): a compressed tendon means the
+        # motion left the model's range of validity
+        print(f"warning: tendon {Tmin[2]} goes slack (force {Tmin[0]:.4g} N at t = {Tmin[1]:.4g} s); "
+              "the COM treats tendons as two-sided springs", file=sys.stderr)
     if series is not None:
         stats["pvd"] = str(series.pvd)
     return FreeVibration(t=np.array(T), z=np.array(Z), zd=np.array(ZD), w=np.array(W), nodes=nodes,
