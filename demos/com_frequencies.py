@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
 from tmfem.errors import TmfemError
 from tmfem.reduced.modal import (DISSERTATION_HIGHEST, default_membrane_modes,
                                  dissertation_com_frequencies, frequency_study, modal_summary)

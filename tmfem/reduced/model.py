@@ -27,9 +27,9 @@ import casadi as ca
 import numpy as np
 
 from tmfem.errors import InfeasibleDesign, InputError, SlackTendon
-from tmfem.reduced.constraints import ConstraintSolver, ZetaLayout, phi_sx, zeta_closed_form
-from tmfem.reduced.kinematics import (bar_kinetic_energy_sx, bars_sx, euler_from_rotation,
-                                      rotation_ef_sx, tendon_lengths_sx)
+from tmfem.reduced.constraints import ConstraintSolver, ZetaLayout, phi_sx
+from tmfem.reduced.kinematics import (bar_kinetic_energy_sx, bars_sx, rotation_ef_sx,
+                                      tendon_lengths_sx)
 from tmfem.reduced.membrane_modes import build_membrane_basis
 
 # Monitored membrane points of 6.5 (eqs. 5.36 and 5.38), (x_f, y_f) in m.
