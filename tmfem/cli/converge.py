@@ -32,16 +32,18 @@ def configure(parser) -> None:
     parser.add_argument("--attachment", choices=("point", "distributed"), default="point")
     parser.add_argument("--patch", type=float, default=None,
                         help="patch radius of the distributed attachment [m] (default 0.1 r_mb)")
-    parser.add_argument("--rest-lengths", choices=("system", "design", "mtc"), default=None,
-                        help="fixed rest lengths (system/design, evaluated once) or the "
-                             "design-consistent ones recomputed on each mesh (mtc)")
+    parser.add_argument("--rest-lengths", default=None,
+                        help="fixed rest lengths (system/design, evaluated once, or GROUP=VALUE "
+                             "pairs such as S1=1.5025) or the design-consistent ones recomputed "
+                             "on each mesh (mtc)")
     parser.add_argument("--csv", help="write one row per run, as it finishes")
     parser.add_argument("--plot", help="PNG: frequencies and peak stresses against h")
 
 
 def run(args) -> dict:
     from tmfem.fem.mtc_study import ROW_KEYS, convergence_rows, fit_convergence
-    system = system_from_args(args)
+    from tmfem.cli.static import apply_rest_lengths
+    system, rest = apply_rest_lengths(system_from_args(args), args.rest_lengths)
     meshes = _ints(args.mesh, "--mesh")
     tendons = _ints(args.tendon_elements, "--tendon-elements")
     rows = []
@@ -50,7 +52,7 @@ def run(args) -> dict:
         if args.csv:
             fh = open(args.csv, "w", newline="")
         for row in convergence_rows(system, meshes=meshes, tendon_elements=tendons,
-                                    attachment=args.attachment, rest_lengths=args.rest_lengths,
+                                    attachment=args.attachment, rest_lengths=rest,
                                     modes=args.modes, patch=args.patch):
             rows.append(row)
             if fh is not None:

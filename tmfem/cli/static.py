@@ -21,10 +21,10 @@ def add_model_args(parser) -> None:
     parser.add_argument("--attachment", choices=("point", "distributed"), default="point",
                         help="membrane corners pinned to the bar tops (point) or spread over a "
                              "small corner patch (distributed)")
-    parser.add_argument("--rest-lengths", choices=("system", "design", "mtc"), default=None,
-                        help="tendon rest lengths: the system's (default when it has them), the "
-                             "equilibrium design (eq. 3.8), or those that make the design an exact "
-                             "equilibrium of this model (mtc)")
+    parser.add_argument("--rest-lengths", default=None,
+                        help="tendon rest lengths: 'system' (default when it has them), 'design' "
+                             "(eq. 3.8), 'mtc' (those that make the design an exact equilibrium "
+                             "of this model) or values per group/tendon, e.g. 'S1=1.5025'")
     parser.add_argument("--start", choices=("undeformed", "design"), default="undeformed",
                         help="start of the static iteration (default: the undeformed membrane)")
     parser.add_argument("--sequence", type=int, default=None,
@@ -46,8 +46,26 @@ def build_model(args):
     if getattr(args, "model", "mtc") != "mtc":
         raise InputError(f"model: expected 'mtc', found {args.model!r}")
     system = system_from_args(args)
+    system, rest = apply_rest_lengths(system, args.rest_lengths)
     return MTCModel(system, mesh_n=args.mesh, tendon_elements=args.tendon_elements,
-                    attachment=args.attachment, rest_lengths=args.rest_lengths)
+                    attachment=args.attachment, rest_lengths=rest)
+
+
+def apply_rest_lengths(system, text):
+    """The system and the ``rest_lengths`` argument of MTCModel for ``--rest-lengths``."""
+    if text is None or text in ("system", "design", "mtc"):
+        return system, text
+    values = {}
+    for item in text.split(","):
+        key, sep, val = item.partition("=")
+        try:
+            values[key.strip()] = float(val)
+        except ValueError:
+            sep = ""
+        if not sep:
+            raise InputError(f"--rest-lengths: expected system, design, mtc or GROUP=VALUE[,...] "
+                             f"(e.g. S1=1.5025), found {text!r}")
+    return system.with_rest_lengths(values), "system"
 
 
 def configure(parser) -> None:
