@@ -217,6 +217,11 @@ def test_cli_static_and_modal_json(tmp_path, capsys):
     assert len(out["freq_hz"]) == 4 and out["dissertation"]["source"] == "dissertation Table 6.6"
     assert main(["static", "--preset", "1-4", "--mesh", "0", "--json"]) != 0
     assert "error" in capsys.readouterr().err
+    assert main(["static", "--preset", "1-4", "--mesh", "3", "--tendon-elements", "1",
+                 "--rest-lengths", "S1=1.5025", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["rest_lengths"]["S_13"] == 1.5025
+    assert main(["modal", "--preset", "1-4", "--rest-lengths", "S1=x"]) != 0
+    assert "GROUP=VALUE" in capsys.readouterr().err
 
 
 def test_2_3_printed_rest_lengths_do_not_fit_printed_geometry():
