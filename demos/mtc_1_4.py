@@ -41,6 +41,9 @@ def run_case(label, system, *, out=None):
         plot_histories(out / f"history_B14_{label}.png", np.arange(len(h)),
                        {"x": h[:, 0], "y": h[:, 1], "z": h[:, 2]}, ylabel="B_14 [m]",
                        title=f"1-4 MTC: iteration history of B_14 ({label}; Fig. 6.1)")
+        from tmfem.fem.mtc_post import plot_membrane_stress
+        plot_membrane_stress(out / f"membrane_stress_{label}.png", m, res.x,
+                             title=f"1-4 MTC membrane stresses, {label} (Figs. 6.3-6.4)")
         from tmfem.io.vtk import write_modes
         write_modes(out / f"modes_{label}.vtu", res.x, model_cells(m),
                     m.topology.T @ modes.shapes, modes.freq_hz)

@@ -79,6 +79,8 @@ def configure(parser) -> None:
     parser.add_argument("--vtk", help="write the equilibrium (bars, tendons with forces, membrane "
                                       "with displacement and stresses) to this .vtu file")
     parser.add_argument("--png", help="render the equilibrium to this PNG")
+    parser.add_argument("--stress-plot", help="PNG maps of the membrane stresses in the floating "
+                                              "frame (Figs. 6.3-6.4)")
     parser.add_argument("--progress", action="store_true", help="iteration progress on stderr")
 
 
@@ -101,6 +103,10 @@ def solve(args, model):
 
 def write_outputs(args, model, x, summary) -> None:
     from tmfem.fem.mtc_post import membrane_field, member_state, q_from_positions
+    if getattr(args, "stress_plot", None):
+        from tmfem.fem.mtc_post import plot_membrane_stress
+        summary["stress_plot"] = str(plot_membrane_stress(
+            args.stress_plot, model, x, title=f"{model.system.name} MTC membrane stresses (O_f frame)"))
     if not (getattr(args, "vtk", None) or getattr(args, "png", None)):
         return
     system = model.system
@@ -170,7 +176,7 @@ def format_text(r: dict) -> str:
     for c in r["checks"]:
         lines.append(f"check {c['check']:36s} {'ok' if c['ok'] else 'VIOLATED'}  "
                      f"({c['value']:.4g} vs {c['limit']:.4g}, eq. {c['equation']})")
-    for k in ("vtk", "png"):
+    for k in ("vtk", "png", "stress_plot"):
         if k in r:
             lines.append(f"wrote {r[k]}")
     return "\n".join(lines)

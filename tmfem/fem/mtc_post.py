@@ -198,3 +198,35 @@ def model_cells(model) -> list:
 def frame_of(x: np.ndarray, model) -> tuple[np.ndarray, np.ndarray]:
     """Floating frame (origin, R) of the current membrane corners of positions x."""
     return floating_frame(x[:, model.topology.mesh.corners])
+
+
+def plot_membrane_stress(png, model, x: np.ndarray, *, title: str | None = None):
+    """Maps of sigma_p1, sigma_p2 and the von Mises stress over the membrane in the floating
+    frame O_f-x_f y_f (element means; Figures 6.3-6.4, 6.9-6.10)."""
+    from matplotlib.collections import PolyCollection
+
+    from tmfem.io.vtk import check_path
+    from tmfem.post.plots import _plt, _save
+    png = check_path(png, suffixes=(".png",))
+    topo = model.topology
+    xm = x[:, :topo.n_mesh]
+    xf = to_floating(xm, xm[:, topo.mesh.corners])
+    st = model.membrane.stresses(xm)
+    fields = [("sigma_p1", st.principal_elem[0]),
+              ("sigma_p2 (in-plane minor)", st.principal_elem[1] + st.principal_elem[2]),
+              ("von Mises", st.von_mises_elem)]
+    plt = _plt()
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    verts = np.stack([xf[0, topo.mesh.t].T, xf[1, topo.mesh.t].T], axis=-1)    # (ne, 4, 2)
+    for ax, (name, v) in zip(axes, fields):
+        pc = PolyCollection(verts, array=v / 1e6, cmap="viridis", edgecolors="none")
+        ax.add_collection(pc)
+        ax.autoscale_view()
+        ax.set_aspect("equal")
+        ax.set_xlabel("x_f [m]")
+        ax.set_ylabel("y_f [m]")
+        ax.set_title(f"{name}: max {v.max() / 1e6:.3f} MPa")
+        fig.colorbar(pc, ax=ax, label="MPa", shrink=0.8)
+    if title:
+        fig.suptitle(title)
+    return _save(fig, png)
