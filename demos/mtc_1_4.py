@@ -38,8 +38,10 @@ def run_case(label, system, *, out=None):
         np.savetxt(out / f"history_B14_{label}.csv", np.column_stack([np.arange(len(h)), h]),
                    delimiter=",", header="iteration,x,y,z", comments="")
         from tmfem.post.plots import plot_histories
+        d = 1e3 * (h - system.nodes()[:, system.node_index("B_14")])
         plot_histories(out / f"history_B14_{label}.png", np.arange(len(h)),
-                       {"x": h[:, 0], "y": h[:, 1], "z": h[:, 2]}, ylabel="B_14 [m]",
+                       {"x - x_design": d[:, 0], "y - y_design": d[:, 1], "z - z_design": d[:, 2]},
+                       ylabel="B_14 - design [mm]", xlabel="iteration", subplots=True,
                        title=f"1-4 MTC: iteration history of B_14 ({label}; Fig. 6.1)")
         from tmfem.fem.mtc_post import plot_membrane_stress
         plot_membrane_stress(out / f"membrane_stress_{label}.png", m, res.x,
