@@ -39,6 +39,32 @@ def parse_perturbation(items, names) -> dict:
     return out
 
 
+class _Driven:
+    """The model with prescribed rest lengths u(t), as a residual for park_integrate."""
+
+    def __init__(self, model, u):
+        self.model = model
+        if callable(u):
+            self._u = u
+        else:
+            arr = np.asarray(u, dtype=float)
+            if arr.shape != (model.n_t,):
+                raise InputError(f"rest lengths: expected {model.n_t} values, found shape {arr.shape}")
+            self._u = lambda t: arr
+
+    def rest_lengths(self, t):
+        return np.asarray(self._u(t), dtype=float)
+
+    def residual(self, x, v, a, t):
+        return self.model.residual(x, v, a, t, u=self.rest_lengths(t))
+
+    def jacobians(self, x, v, a, t):
+        return self.model.jacobians(x, v, a, t, u=self.rest_lengths(t))
+
+    def newton_matrix(self, x, v, a, t, cv, ca):
+        return self.model.newton_matrix(x, v, a, t, cv, ca, u=self.rest_lengths(t))
+
+
 @dataclass
 class FreeVibration:
     """Result of :func:`free_vibration`."""
@@ -56,7 +82,7 @@ class FreeVibration:
 def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | None = None,
                    csv_path=None, scheme: str = "park", jacobian: str = "step",
                    monitor_nodes=None, progress: bool = False, vtk_dir=None,
-                   vtk_every: int = 10) -> FreeVibration:
+                   vtk_every: int = 10, u=None) -> FreeVibration:
     """Free vibration from the equilibrium with an initial perturbation (6.5).
 
     Parameters
@@ -72,6 +98,10 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
         Passed to :func:`park_integrate` (``jacobian="step"``: modified Newton).
     monitor_nodes : list of str, optional
         Node labels whose positions are recorded (default per preset, see MONITOR_NODES).
+    u : array or callable, optional
+        Tendon rest lengths during the run: an array, or ``u(t) -> array`` (e.g. a step of
+        one rest length); default the model's nominal ``u0`` (free vibration). The run
+        always starts from the equilibrium for ``u0``.
     vtk_dir : path, optional
         Write every ``vtk_every``-th step as a ParaView frame (bars, tendons with forces,
         deformed membrane with its deflection in O_f) and a ``.pvd`` collection, as the run
@@ -117,7 +147,7 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
 
     def record(t, z, zd, a):
         w, X, L = model.fast_outputs(z, with_lengths=True)
-        force = model.k * (L - model.u0)      # eq. 3.8 with the model's spring constants
+        force = model.k * (L - (model.u0 if u is None else driven.rest_lengths(t)))  # eq. 3.8
         k = int(np.argmin(force))
         if force[k] < Tmin[0]:
             Tmin[:] = [float(force[k]), float(t), system.tendons[k].name]
@@ -139,9 +169,10 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
         if progress and (k % 100 == 0 or k == n):
             print(f"vibrate {system.name}: t = {k * dt:.2f} / {t_end:g} s", file=sys.stderr, flush=True)
 
+    driven = model if u is None else _Driven(model, u)
     t0 = time.perf_counter()
     try:
-        res = park_integrate(model, x0=z0, v0=zd0, dt=dt, n_steps=n_steps, scheme=scheme,
+        res = park_integrate(driven, x0=z0, v0=zd0, dt=dt, n_steps=n_steps, scheme=scheme,
                              jacobian=jacobian, callback=record, store=False, progress=prog)
     finally:
         if fh:
