@@ -18,7 +18,27 @@ from tmfem.reduced.modal import (DISSERTATION_HIGHEST, default_membrane_modes,
 from tmfem.system import load_preset
 
 
-def table(name: str, k_study) -> None:
+def plot_study(rows, path, *, title: str, reference=None) -> str:
+    """Frequencies vs K (one marker column per K, one panel per prestress factor)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    scales = sorted({r["prestress_scale"] for r in rows})
+    fig, axes = plt.subplots(1, len(scales), figsize=(5 * len(scales), 4), sharey=True, squeeze=False)
+    for ax, sc in zip(axes[0], scales):
+        for r in (r for r in rows if r["prestress_scale"] == sc):
+            ax.plot([r["K"]] * len(r["freq_hz"]), r["freq_hz"], "o", ms=4, color="C0")
+        if reference:
+            for f in reference:
+                ax.axhline(f, color="C3", lw=0.6, alpha=0.6)
+        ax.set_xlabel("membrane modes K"); ax.set_title(f"prestress x{sc:.4f}")
+    axes[0][0].set_ylabel("frequency [Hz] (first 12)")
+    fig.suptitle(title + (" (red: printed COM column)" if reference else ""))
+    fig.tight_layout(); fig.savefig(path, dpi=110); plt.close(fig)
+    return str(path)
+
+
+def table(name: str, k_study, plot_dir=None) -> None:
     system = load_preset(name)
     K = default_membrane_modes(system)
     r1 = modal_summary(system, modes=12, membrane_modes=K)
@@ -48,20 +68,27 @@ def table(name: str, k_study) -> None:
           + (f", printed-stress {r2['highest_hz']:.4f}" if r2 else ""))
     if k_study:
         print(f"\nfrequencies [Hz] vs K ({name})")
-        for row in frequency_study(system, K_values=k_study, prestress_scales=[1.0] + ([s] if s else []),
-                                   progress=False):
+        rows = frequency_study(system, K_values=k_study, prestress_scales=[1.0] + ([s] if s else []),
+                               progress=False)
+        for row in rows:
             print(f"  x{row['prestress_scale']:.4f} K={row['K']:2d}: "
                   + " ".join(f"{f:.4f}" for f in row["freq_hz"]) + f"  (highest {row['highest_hz']:.4f})")
+        if plot_dir:
+            from pathlib import Path
+            Path(plot_dir).mkdir(parents=True, exist_ok=True)
+            print("plot:", plot_study(rows, Path(plot_dir) / f"com_frequencies_vs_K_{name}.png",
+                                      title=f"{name} COM", reference=com))
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--systems", nargs="+", default=["1-4", "2-3"])
     ap.add_argument("--k-study", nargs="*", type=int, default=[1, 2, 3, 4, 5, 6, 8])
+    ap.add_argument("--plot-dir", default=None, help="write PNG plots of the K study here")
     a = ap.parse_args()
     for name in a.systems:
         try:
-            table(name, a.k_study)
+            table(name, a.k_study, a.plot_dir)
         except TmfemError as exc:
             print(f"\n{name}: cannot build the COM: {exc}")
 
