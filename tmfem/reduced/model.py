@@ -95,6 +95,8 @@ class ControlOrientedModel:
             raise InputError(f"formulation: expected 'partitioned' or 'substituted', found {formulation!r}")
         if not (np.isfinite(damping) and damping >= 0):
             raise InputError(f"damping c_m: expected >= 0, found {damping!r}")
+        if not (np.isfinite(prestress_scale) and prestress_scale > 0):
+            raise InputError(f"prestress_scale: expected > 0, found {prestress_scale!r}")
         self.system = system
         self.formulation = formulation
         self.layout = ZetaLayout.for_polygon(system.N)
