@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 
-import numpy as np
 import pytest
 
 from tmfem.fem.mtc_study import convergence_rows, fit_convergence

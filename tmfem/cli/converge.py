@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import csv
-import sys
 
 from tmfem.cli.common import add_system_args, system_from_args
 from tmfem.errors import InputError

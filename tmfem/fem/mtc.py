@@ -35,8 +35,7 @@ import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.membrane import MembraneTL
-from tmfem.fem.mtc_topology import (MTCTopology, build_topology, floating_frame,
-                                    membrane_placement, to_floating)
+from tmfem.fem.mtc_topology import MTCTopology, build_topology, membrane_placement
 from tmfem.fem.truss import TrussSet, truss_internal, truss_mass
 from tmfem.system.topology import label
 
