@@ -282,10 +282,11 @@ def run(args) -> dict:
 
 
 def format_text(r: dict) -> str:
-    lines = [f"{'quantity':<36}{'unit':>6}{'ours':>14}{'printed':>14}{'rel. diff':>11}"]
+    w = max(len("quantity"), *(len(row["quantity"]) for row in r["table"])) + 2
+    lines = [f"{'quantity':<{w}}{'unit':>6}{'ours':>14}{'printed':>14}{'rel. diff':>11}"]
     for row in r["table"]:
         rd = "" if row["rel_diff"] is None else f"{100 * row['rel_diff']:+.2f}%"
-        lines.append(f"{row['quantity']:<36}{row['unit']:>6}{_fmt(row['ours']):>14}"
+        lines.append(f"{row['quantity']:<{w}}{row['unit']:>6}{_fmt(row['ours']):>14}"
                      f"{_fmt(row['printed']):>14}{rd:>11}")
     lines.append("")
     lines.append("checks: " + ("all passed" if r["ok"] else "FAILED: " + ", ".join(r["failed_checks"])))
