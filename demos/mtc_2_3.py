@@ -2,15 +2,14 @@
 
     .venv/bin/python demos/mtc_2_3.py
 
-1. Table 6.4 as printed: tendon lengths at the printed geometry against the printed rest
-   lengths (most tendons would be slack), and the MTC static solve with them (it stops with a
-   ConvergenceError naming the slack tendons).
-2. The design Tables 6.5 and 6.7 belong to: the final 2-3 configuration of Table 7.7 with the
-   materials of Table 6.1 (`tmfem.fem.mtc_designs`): the stage-2 base fitted to the Table 7.7
-   rest lengths, the prestress calibrated on the stage-1 bar load of Table 6.5 only; landing
-   from the undeformed membrane (Figs. 6.5-6.7 nodes), Table 6.5 and Table 6.7 beside ours.
-3. For contrast, a feasible 2-3 near Table 6.4 (`tmfem.reduced.examples.feasible_2_3`: stage 1,
-   bars and membrane of Table 6.4, stage-2 base from `symmetric_map.best_bases` at 63/20 deg).
+1. Table 6.4 as printed (`load_preset("2-3", as_printed=True)`): tendon lengths at the
+   printed geometry against the printed rest lengths (most tendons would be slack), and the
+   MTC static solve with them (it stops with a ConvergenceError naming the slack tendons).
+2. The design Tables 6.5 and 6.7 belong to, the default of the preset `2-3`: the final 2-3
+   configuration of Table 7.7 with the materials of Table 6.1 (stage-2 base checked against
+   the Table 7.7 rest lengths by `tmfem.fem.mtc_designs.fit_stage2_base`), the prestress
+   calibrated on the stage-1 bar load of Table 6.5 only; landing from the undeformed membrane
+   (Figs. 6.5-6.7 nodes), Table 6.5 and Table 6.7 beside ours.
 """
 from __future__ import annotations
 
@@ -42,17 +41,17 @@ def main() -> int:
     except ConvergenceError as exc:
         print(f"  {exc}")
     print()
-    from tmfem.fem.mtc_designs import chapter7_final_2_3, fit_stage2_base, scaled_consistent_rest_lengths
+    from tmfem.fem.mtc_designs import calibrate_on_bar_load, fit_stage2_base
     fit = fit_stage2_base()
-    print(f"Table 7.7 final configuration: stage-2 base r_2 = {fit['r2']:.5f} m, z_2 = {fit['z2']:.5f} m "
-          f"(sigma_2 = -34.86 deg, eq. 5.97), F_Delta = {fit['F_Delta']:.3f} N, Delta = "
-          f"{1e3 * fit['Delta']:.3f} mm; rest-length residuals {np.round(1e3 * fit['residual'], 3)} mm")
+    d = load_preset("2-3")
+    c = d.symmetric
+    print(f"Table 7.7 final configuration: stage-2 base fitted to its rest lengths r_2 = {fit['r2']:.5f} m, "
+          f"z_2 = {fit['z2']:.5f} m (sigma_2 = -34.86 deg, eq. 5.97), F_Delta = {fit['F_Delta']:.3f} N, "
+          f"Delta = {1e3 * fit['Delta']:.3f} mm; rest-length residuals {np.round(1e3 * fit['residual'], 3)} mm")
+    print(f"  preset 2-3 (rule of 2-3-deploy): r_2 = {c.r[1]:.6f} m, z_2 = {c.z[1]:.6f} m")
     pr = s.printed
-    c7 = chapter7_final_2_3()
-    m = MTCModel(c7, mesh_n=10, tendon_elements=3, rest_lengths="mtc")
-    st1 = static_summary(m, m.solve_static(start="design").x)
-    k = pr["bar_load_stage1"] / st1["bar_load_by_stage"][0]
-    m.set_rest_lengths(scaled_consistent_rest_lengths(m, k))
+    m = MTCModel(d, mesh_n=10, tendon_elements=3, rest_lengths="mtc")
+    k = calibrate_on_bar_load(m, pr["bar_load_stage1"])
     res = m.solve_static(start="undeformed", monitor=["B_11", "A_21", "B_21"])
     st = static_summary(m, res.x, result=res)
     md = m.modes(res.x, k=12)
@@ -72,29 +71,6 @@ def main() -> int:
     for i in range(12):
         print(f"  {i + 1:4d} {md.freq_hz[i]:10.4f} {ref['MTC'][i]:9.4f} {ref['SBC'][i]:9.4f} "
               f"{100 * (md.freq_hz[i] / ref['MTC'][i] - 1):+7.3f}%")
-    print()
-    from tmfem.reduced.examples import feasible_2_3
-    f = feasible_2_3()
-    ref = DISSERTATION_FREQUENCIES["2-3"]
-    pr = s.printed
-    for label, rest in (("design rest lengths (eq. 3.8)", "design"),
-                        ("MTC-consistent rest lengths", "mtc")):
-        m = MTCModel(f, mesh_n=10, tendon_elements=3, rest_lengths=rest)
-        res = m.solve_static(start="undeformed", monitor=["B_11", "A_21", "B_21"])
-        st = static_summary(m, res.x, result=res)
-        md = m.modes(res.x, k=12)
-        print(f"feasible 2-3 (theta 63, psi 20, r_2 0.364, z_2 0.551, sigma_2 162.6 deg), {label}:")
-        print(f"  {res.iterations} iterations from the undeformed membrane, lands "
-              f"{1e3 * st['max_deviation_from_design']:.3f} mm from the design, Delta "
-              f"{1e3 * np.mean(st['Delta']):.3f} mm")
-        print(f"  bar loads {st['bar_load_by_stage'][0]:.2f} / {st['bar_load_by_stage'][1]:.2f} N "
-              f"(Table 6.5: {pr['bar_load_stage1']} / {pr['bar_load_stage2']} N), tendon max "
-              f"{st['tendon_stress_max'] / 1e6:.2f} MPa ({pr['tendon_max_stress'] / 1e6} MPa), "
-              f"sigma_p1 {st['membrane_max_sigma_p1'] / 1e6:.3f} MPa "
-              f"({pr['membrane_max_sigma_p1'] / 1e6} MPa)")
-        print(f"  {'mode':>4s} {'ours':>8s} {'Table 6.7 MTC':>14s}")
-        for i in range(12):
-            print(f"  {i + 1:4d} {md.freq_hz[i]:8.4f} {ref['MTC'][i]:14.4f}")
     return 0
 
 

@@ -120,10 +120,10 @@ def test_study_writes_table_plots_and_vtk(tmp_path, capsys):
 
 def test_study_2_3_as_printed_allow_infeasible_writes_map(tmp_path, capsys):
     out = tmp_path / "s23"
-    rc, _, err = run(["study", "--preset", "2-3", "--out", str(out), "--mesh", "3",
+    rc, _, err = run(["study", "--preset", "2-3", "--as-printed", "--out", str(out), "--mesh", "3",
                       "--no-render", "--map-grid", "3"], capsys)
     assert rc == 1 and "membrane stretched" in one_error_line(err.splitlines()[-1])
-    rc, _, err = run(["study", "--preset", "2-3", "--out", str(out), "--mesh", "3",
+    rc, _, err = run(["study", "--preset", "2-3", "--as-printed", "--out", str(out), "--mesh", "3",
                       "--no-render", "--map-grid", "3", "--allow-infeasible"], capsys)
     assert rc == 0, err
     m = json.loads((out / "equilibrium_map.json").read_text())

@@ -66,7 +66,7 @@ def test_bar_load_is_axial_and_balances_the_bar_top():
 def test_2_3_design_agrees_with_reduced_null_vector_scaled_to_F_delta():
     # a 2-3 configuration with a positive null vector and Delta > 0 (found with the map of
     # tmfem.equilibrium.symmetric_map); tendon forces = null vector scaled to F_Delta (3.2)
-    s = load_preset("2-3")
+    s = load_preset("2-3", as_printed=True)      # Table 6.4: theta 63 deg, l 2.5 m, r_mb 1.87 m
     c = s.symmetric
     cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(157.84)],
                           sigma=[0, np.radians(145.67)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
@@ -90,7 +90,7 @@ def test_named_errors():
         design_equilibrium(one_stage(r_mb=2.0), mesh_n=MESH)
     # a 1-N system with cot psi_1 < tan(pi/N) also has Delta < 0 (eq. 3.36), so take a 2-3
     # configuration with Delta > 0 whose unique null vector (3.3.2) has negative entries
-    s = load_preset("2-3")
+    s = load_preset("2-3", as_printed=True)      # Table 6.4 dimensions
     c = s.symmetric
     cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(120)],
                           sigma=[0, np.radians(100)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
@@ -123,7 +123,7 @@ def test_equilibrium_map_agrees_with_pointwise_design():
     # the design's tendon forces / F_Delta (unique: A_T is square and regular for 2-3)
     from tmfem.equilibrium.symmetric_map import (configuration_5_97, equilibrium_map,
                                                  with_configuration)
-    s = load_preset("2-3")
+    s = load_preset("2-3", as_printed=True)      # Table 6.4 dimensions
     c = s.symmetric
     sg = np.radians(145.67)
     cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(12.17), np.radians(12.17) + sg],
@@ -207,7 +207,7 @@ def test_force_ratios_agree_with_mtc_nodal_balance():
     # directions. The membrane forces differ (nonlinear vs linear), so compare the tendon
     # forces relative to one of them: they must agree for a 2-3 design (3.3.2)
     from tmfem.fem.mtc import MTCModel
-    s = load_preset("2-3")
+    s = load_preset("2-3", as_printed=True)      # Table 6.4: theta 63 deg, l 2.5 m, r_mb 1.87 m
     c = s.symmetric
     cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(157.84)],
                           sigma=[0, np.radians(145.67)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)

@@ -244,8 +244,7 @@ def test_two_stage_system_lands_on_its_design():
     # (node balance of all 27 free-node equations, 6 bars + 21 tendons) the equilibrium
     # reached from the undeformed membrane is the design; and tmfem.equilibrium's linear
     # design (independent formulation, eq. 3.16) lands within 0.1 mm of it.
-    from tmfem.reduced.examples import feasible_2_3
-    s = feasible_2_3()
+    s = load_preset("2-3")      # the final 2-3 configuration of Table 7.7 (docs/errata.md)
     m = MTCModel(s, mesh_n=4, tendon_elements=1, rest_lengths="mtc")
     res = m.solve_static(start="undeformed")
     st = static_summary(m, res.x)
