@@ -5,11 +5,11 @@ import pytest
 
 from tmfem.errors import InputError
 from tmfem.reduced.constraints import ZetaLayout, zeta_closed_form
-from tmfem.reduced.kinematics import rotation_ef
 from tmfem.reduced.linearize import linearize, output_jacobian
 from tmfem.reduced.model import ControlOrientedModel
 from tmfem.solvers.park import park_integrate
 from tmfem.system import load_preset
+from tmfem.system.geometry import rotation_ef
 
 
 @pytest.fixture(scope="module")

@@ -3,12 +3,12 @@ import numpy as np
 import pytest
 
 from tmfem.equilibrium.general import (corner_state, delta_gradient, equilibrium_matrix,
-                                       euler_R, euler_R_derivatives, expand_symmetric_forces,
+                                       euler_R_derivatives, expand_symmetric_forces,
                                        node_jacobian, positive_null_vector, solve_corner_constraints,
                                        symmetric_matrix, tendon_length_gradient)
 from tmfem.errors import ConvergenceError
 from tmfem.system import load_preset
-from tmfem.system.geometry import SymmetricConfig
+from tmfem.system.geometry import SymmetricConfig, rotation_ef
 
 rng = np.random.default_rng(3)
 H = 1e-6
@@ -32,8 +32,8 @@ def test_euler_angles_3_2_1_and_derivatives():
     Rz = np.array([[c1, -s1, 0], [s1, c1, 0], [0, 0, 1]])
     Ry = np.array([[c2, 0, s2], [0, 1, 0], [-s2, 0, c2]])
     Rx = np.array([[1, 0, 0], [0, c3, -s3], [0, s3, c3]])
-    np.testing.assert_allclose(euler_R(g), Rz @ Ry @ Rx, atol=1e-15)   # eq. 3.3
-    dR = fd(euler_R, g)                                                 # (3, 3, 3) k first
+    np.testing.assert_allclose(rotation_ef(g), Rz @ Ry @ Rx, atol=1e-15)   # eq. 3.3
+    dR = fd(rotation_ef, g)                                                 # (3, 3, 3) k first
     np.testing.assert_allclose(np.moveaxis(dR, 0, -1), euler_R_derivatives(g), atol=1e-8)
 
 

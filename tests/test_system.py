@@ -5,7 +5,7 @@ import pytest
 from tmfem.errors import InputError
 from tmfem.system import (SymmetricConfig, System, dump_system, load_preset, load_system,
                           tendon_topology)
-from tmfem.system.geometry import beta
+from tmfem.system.geometry import beta, euler_angles_321, floating_frame, rotation_ef
 
 
 def test_frame_origin_and_x_axis_follow_section_2_2():
@@ -51,6 +51,64 @@ def test_membrane_corners_in_floating_frame():
     np.testing.assert_allclose(s.membrane_corners, [[2, 2, 0, 0], [0, 2, 2, 0]], atol=1e-4)
     b = beta(4)
     np.testing.assert_allclose(np.degrees(b), [-45, 45, 135, 225])  # eq. 3.21
+
+
+def test_floating_frame_of_the_1_4_design():
+    s = load_preset("1-4")
+    B = s.membrane_corners_inertial()
+    o, R = floating_frame(B)
+    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-14)
+    assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-14)          # right-handed (3.2)
+    np.testing.assert_array_equal(o, B[:, 3])                         # O_f = B_14
+    e14_11 = (B[:, 0] - B[:, 3]) / np.linalg.norm(B[:, 0] - B[:, 3])
+    np.testing.assert_allclose(R[:, 0], e14_11, atol=1e-14)           # x_f along B_14 -> B_11
+    # the design top is horizontal (symmetric, eq. 3.19), so z_f = +z and x_f, y_f horizontal
+    np.testing.assert_allclose(R[2, :2], 0, atol=1e-14)
+    np.testing.assert_allclose(R[:, 2], [0, 0, 1], atol=1e-14)
+    # the corners in O_f are the undeformed square stretched by Delta (eq. 3.22) along the
+    # radii: B_13 (corner N-1) lies on the +y_f side, all corners on z_f = 0
+    local = R.T @ (B - o[:, None])
+    np.testing.assert_allclose(local[2], 0, atol=1e-14)
+    assert local[1, 2] > 0 and abs(local[1, 0]) < 1e-14
+    d = s.symmetric.membrane_delta(s.N, s.r_mb)
+    np.testing.assert_allclose(local[:2], s.membrane_corners * (s.r_mb + d) / s.r_mb, atol=1e-12)
+
+
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_floating_frame_z_axis_is_the_polygon_normal(preset):
+    # y_f towards B_M,N-1 (eq. 3.5) and z_f along (B_M1 - B_MN) x (B_M2 - B_MN) agree for
+    # convex corner polygons (the rule of the former io.vtk copy)
+    s = load_preset(preset)
+    rng = np.random.default_rng(7)
+    for _ in range(5):
+        B = s.membrane_corners_inertial(s.q + 0.02 * rng.standard_normal(s.q.size))
+        o, R = floating_frame(B)
+        assert np.dot(np.cross(B[:, 0] - o, B[:, 1] - o), R[:, 2]) > 0
+
+
+def test_floating_frame_rejects_collinear_corners():
+    B = np.array([[1.0, 3.0, 2.0, 0.0], [1.0, 3.0, 2.0, 0.0], [0.5, 1.5, 1.0, 0.0]])
+    with pytest.raises(InputError, match="collinear"):       # B_M3 on the line B_M4 B_M1
+        floating_frame(B)
+    B[:, 0] = 0.0
+    with pytest.raises(InputError, match="collinear"):       # B_M1 = B_M4
+        floating_frame(B)
+    with pytest.raises(InputError, match=r"shape \(3, N >= 3\)"):
+        floating_frame(B[:, :2])
+
+
+def test_rotation_ef_numeric_matches_casadi_and_inverts():
+    import casadi as ca
+
+    from tmfem.reduced.kinematics import rotation_ef_sx
+    rng = np.random.default_rng(11)
+    g = ca.SX.sym("g", 3)
+    f = ca.Function("R", [g], [rotation_ef_sx(g)])
+    for gamma in rng.uniform([-np.pi, -1.5, -np.pi], [np.pi, 1.5, np.pi], (20, 3)):
+        R = rotation_ef(gamma)
+        np.testing.assert_allclose(f(gamma).full(), R, atol=1e-15)      # symbolic = numeric
+        np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-14)
+        np.testing.assert_allclose(euler_angles_321(R), gamma, atol=1e-12)  # |gamma_2| < pi/2
 
 
 def test_q_round_trip_and_symmetric_recovery():

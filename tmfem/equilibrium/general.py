@@ -24,7 +24,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.system.geometry import beta
+from tmfem.system.geometry import beta, euler_angles_321, floating_frame, rotation_ef
 from tmfem.system.topology import FAMILIES_MN
 
 
@@ -85,17 +85,9 @@ def tendon_length_gradient(system, q=None) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- corner constraints
-def euler_R(gamma) -> np.ndarray:
-    """R^ef of the 3-2-1 Euler angles (gamma_1, gamma_2, gamma_3) (eq. 3.3): O_f -> O-xyz."""
-    g1, g2, g3 = gamma
-    c1, s1, c2, s2, c3, s3 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2), np.cos(g3), np.sin(g3)
-    return np.array([[c1 * c2, c1 * s2 * s3 - c3 * s1, c1 * c3 * s2 + s1 * s3],
-                     [c2 * s1, c1 * c3 + s1 * s2 * s3, c3 * s1 * s2 - c1 * s3],
-                     [-s2, c2 * s3, c2 * c3]])
-
-
 def euler_R_derivatives(gamma) -> np.ndarray:
-    """dR^ef/dgamma_k, shape (3, 3, 3) with k last."""
+    """dR^ef/dgamma_k of :func:`tmfem.system.geometry.rotation_ef` (eq. 3.3), shape (3, 3, 3)
+    with k last."""
     g1, g2, g3 = gamma
     c1, s1, c2, s2, c3, s3 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2), np.cos(g3), np.sin(g3)
     Rz = np.array([[c1, -s1, 0], [s1, c1, 0], [0, 0, 1]])
@@ -105,12 +97,6 @@ def euler_R_derivatives(gamma) -> np.ndarray:
     dRy = np.array([[-s2, 0, c2], [0, 0, 0], [-c2, 0, -s2]])
     dRx = np.array([[0, 0, 0], [0, -s3, -c3], [0, c3, -s3]])
     return np.stack([dRz @ Ry @ Rx, Rz @ dRy @ Rx, Rz @ Ry @ dRx], axis=-1)
-
-
-def euler_angles(R: np.ndarray) -> np.ndarray:
-    """3-2-1 Euler angles of a rotation matrix R^ef (inverse of eq. 3.3)."""
-    return np.array([np.arctan2(R[1, 0], R[0, 0]), -np.arcsin(np.clip(R[2, 0], -1, 1)),
-                     np.arctan2(R[2, 1], R[2, 2])])
 
 
 def free_corner_components(N: int) -> list[tuple[int, int]]:
@@ -152,25 +138,25 @@ def _corner_data(system, q):
 
 
 def corner_state(system, q=None) -> CornerState:
-    """Solve eq. 3.5 in closed form: x_f along B_MN -> B_M1, z_f normal to the plane of
-    B_MN, B_M1, B_M,N-1; the corner displacements are then R^fe (B_Mi - B_MN) - P_i."""
+    """Solve eq. 3.5 in closed form with the floating frame of 3.2
+    (:func:`tmfem.system.geometry.floating_frame`: x_f along B_MN -> B_M1, z_f normal to the
+    plane of B_MN, B_M1, B_M,N-1); the corner displacements are then
+    R^fe (B_Mi - B_MN) - P_i.
+
+    Raises
+    ------
+    InputError
+        if B_MN, B_M1, B_M,N-1 are collinear.
+    """
     q = system.q if q is None else np.asarray(q, dtype=float)
     X, P = _corner_data(system, q)
     N = system.N
-    ex = X[:, 0] / np.linalg.norm(X[:, 0])
-    ez = np.cross(ex, X[:, N - 2])
-    nz = np.linalg.norm(ez)
-    if nz < 1e-12 * np.linalg.norm(X[:, N - 2]):
-        raise InputError("corners B_MN, B_M1, B_M,N-1 are collinear: the floating frame O_f "
-                         "of 3.2 is undefined")
-    ez /= nz
-    ey = np.cross(ez, ex)
-    R = np.column_stack([ex, ey, ez])
+    _, R = floating_frame(system.membrane_corners_inertial(q))
     delta = np.zeros((3, N))
     delta[:, :N - 1] = R.T @ X - P[:, :N - 1]
     comps = free_corner_components(N)
     free = np.array([delta[c, i] for i, c in comps])
-    return CornerState(R=R, gamma=euler_angles(R), delta=delta, free=free)
+    return CornerState(R=R, gamma=euler_angles_321(R), delta=delta, free=free)
 
 
 def _G(gamma, free, P, N):
@@ -178,7 +164,7 @@ def _G(gamma, free, P, N):
     D = np.zeros((3, N - 1))
     for k, (i, c) in enumerate(free_corner_components(N)):
         D[c, i] = free[k]
-    return euler_R(gamma) @ (P[:, :N - 1] + D)
+    return rotation_ef(gamma) @ (P[:, :N - 1] + D)
 
 
 def _G_jacobian(gamma, free, P, N) -> np.ndarray:
@@ -187,7 +173,7 @@ def _G_jacobian(gamma, free, P, N) -> np.ndarray:
     comps = free_corner_components(N)
     for k, (i, c) in enumerate(comps):
         D[c, i] = free[k]
-    R = euler_R(gamma)
+    R = rotation_ef(gamma)
     dR = euler_R_derivatives(gamma)
     Y = P[:, :N - 1] + D
     J = np.zeros((3, N - 1, 3 + len(comps)))
@@ -225,7 +211,7 @@ def solve_corner_constraints(system, q=None, *, gamma0=None, free0=None, tol: fl
         r = _G(y[:3], y[3:], P, N).T.ravel() - x
         res = np.abs(r).max()
         if res < tol * scale:
-            R = euler_R(y[:3])
+            R = rotation_ef(y[:3])
             delta = np.zeros((3, N))
             for k, (i, c) in enumerate(free_corner_components(N)):
                 delta[c, i] = y[3 + k]

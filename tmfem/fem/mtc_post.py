@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.fem.mtc_topology import floating_frame, to_floating
+from tmfem.fem.mtc_topology import to_floating
 from tmfem.fem.truss import truss_internal
-from tmfem.system.geometry import wrap_angle
+from tmfem.system.geometry import floating_frame, wrap_angle
 from tmfem.system.topology import label
 
 # Natural frequencies [Hz] printed in the dissertation, Tables 6.6 (1-4) and 6.7 (2-3):

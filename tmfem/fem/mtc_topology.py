@@ -24,6 +24,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import InputError
 from tmfem.mesh.polygon import MembraneMesh, polygon_quad_mesh
+from tmfem.system.geometry import floating_frame
 from tmfem.system.topology import label
 
 
@@ -191,33 +192,6 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
 
 
 # ---------------------------------------------------------------------------- frames
-def floating_frame(corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Origin and axes of the floating frame O_f-x_f y_f z_f of 3.2 from the corners B_Mj.
-
-    O_f = B_MN; x_f through B_M1; the x_f y_f plane through B_MN, B_M1, B_M,N-1 (y_f towards
-    B_M,N-1, so a counter-clockwise membrane has y_f >= 0); z_f = x_f x y_f.
-
-    Parameters
-    ----------
-    corners : ndarray (3, N)
-        Positions of B_M1 .. B_MN in the inertial frame.
-
-    Returns
-    -------
-    origin : ndarray (3,)
-    R : ndarray (3, 3)
-        Columns e_xf, e_yf, e_zf in inertial components (R = R^ef of eq. 3.3).
-    """
-    o = corners[:, -1]
-    ex = corners[:, 0] - o
-    ex = ex / np.linalg.norm(ex)
-    v = corners[:, -2] - o
-    ez = np.cross(ex, v)
-    ez = ez / np.linalg.norm(ez)
-    ey = np.cross(ez, ex)
-    return o, np.column_stack([ex, ey, ez])
-
-
 def to_floating(x: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """Coordinates (3, n) of points ``x`` in the floating frame of ``corners`` (eq. 3.3)."""
     o, R = floating_frame(corners)

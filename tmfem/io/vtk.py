@@ -28,6 +28,7 @@ import numpy as np
 
 from tmfem.errors import BackendUnavailable, InputError
 from tmfem.mesh.polygon import MembraneMesh
+from tmfem.system.geometry import floating_frame
 from tmfem.system.topology import label
 
 KIND_CODES = {"bar": 0, "tendon": 1, "membrane": 2}
@@ -383,26 +384,6 @@ def mean_value_coordinates(corners: np.ndarray, x: np.ndarray) -> np.ndarray:
     lam[:, hit[1]] = 0.0
     lam[hit[0], hit[1]] = 1.0
     return lam
-
-
-def floating_frame(corners_3d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Origin and rotation (3, 3) of the floating frame O_f from the corners B_Mj (3, N).
-
-    O_f is at corner N, x_f points to corner 1, z_f is normal to the plane of corners
-    N, 1 and N-1 (3.2); columns of the rotation are x_f, y_f, z_f in the inertial frame.
-    """
-    o = corners_3d[:, -1]
-    ex = corners_3d[:, 0] - o
-    ex /= np.linalg.norm(ex)
-    v = corners_3d[:, -2] - o
-    ez = np.cross(ex, v)
-    # corners run counter-clockwise seen from +z_f; orient z_f along the polygon normal
-    ez /= np.linalg.norm(ez)
-    ey = np.cross(ez, ex)
-    R = np.column_stack([ex, ey, ez])
-    if np.dot(np.cross(corners_3d[:, 0] - o, corners_3d[:, 1] - o), ez) < 0:
-        R = np.column_stack([ex, -ey, -ez])
-    return o, R
 
 
 def membrane_on_configuration(system, mesh: MembraneMesh, *, q=None,

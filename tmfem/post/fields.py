@@ -12,7 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import MembraneField, floating_frame
+from tmfem.io.vtk import MembraneField
+from tmfem.system.geometry import floating_frame
 
 
 def corner_displacements(system, q=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -21,7 +21,8 @@ import casadi as ca
 import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.reduced.kinematics import bars_sx, euler_from_rotation, rotation_ef_sx
+from tmfem.reduced.kinematics import bars_sx, rotation_ef_sx
+from tmfem.system.geometry import euler_angles_321, floating_frame
 
 
 @dataclass(frozen=True)
@@ -95,23 +96,17 @@ def phi_sx(system, layout: ZetaLayout, q, zeta):
 
 
 def zeta_closed_form(system, layout: ZetaLayout, q=None) -> np.ndarray:
-    """zeta(q) from the geometric definition of O_f (3.2): x_f along B_MN -> B_M1, z_f normal
-    to the plane (B_MN, B_M1, B_M,N-1); corner displacements Delta_i = R^T(B_Mi - B_MN) - c_i.
-    An exact solution of Phi = 0, used as the Newton starting point and as a test."""
+    """zeta(q) from the geometric definition of O_f (3.2,
+    :func:`tmfem.system.geometry.floating_frame`): x_f along B_MN -> B_M1, z_f normal to the
+    plane (B_MN, B_M1, B_M,N-1); corner displacements Delta_i = R^T(B_Mi - B_MN) - c_i. An exact solution of Phi = 0, used as the Newton starting point and as a test."""
     B = system.membrane_corners_inertial(q)
-    N = system.N
-    ex = B[:, 0] - B[:, -1]
-    ex /= np.linalg.norm(ex)
-    nz = np.cross(ex, B[:, N - 2] - B[:, -1])
-    ez = nz / np.linalg.norm(nz)
-    ey = np.cross(ez, ex)
-    R = np.column_stack([ex, ey, ez])
-    rel = R.T @ (B - B[:, [-1]])
+    o, R = floating_frame(B)
+    rel = R.T @ (B - o[:, None])
     rel[:2] -= system.membrane_corners
     zeta = np.empty(layout.n)
     for k, (i, c) in enumerate(layout.corner_components):
         zeta[k] = rel[c, i]
-    zeta[layout.n_delta:] = euler_from_rotation(R)
+    zeta[layout.n_delta:] = euler_angles_321(R)
     return zeta
 
 

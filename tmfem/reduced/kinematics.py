@@ -8,7 +8,6 @@ q follows :attr:`tmfem.system.System.q_names` (eqs. 3.1-3.2); node order follows
 from __future__ import annotations
 
 import casadi as ca
-import numpy as np
 
 
 def bar_direction_sx(theta, psi):
@@ -87,7 +86,8 @@ def bar_kinetic_energy_sx(system, q, qdot):
 
 def rotation_ef_sx(g):
     """Rotation matrix R^ef of the 3-2-1 Euler angles (gamma_1, gamma_2, gamma_3), eq. 3.3:
-    R^ef = Rz(gamma_1) Ry(gamma_2) Rx(gamma_3); columns are the O_f axes in O-xyz."""
+    R^ef = Rz(gamma_1) Ry(gamma_2) Rx(gamma_3); columns are the O_f axes in O-xyz. The numeric
+    counterpart is :func:`tmfem.system.geometry.rotation_ef`."""
     c1, s1 = ca.cos(g[0]), ca.sin(g[0])
     c2, s2 = ca.cos(g[1]), ca.sin(g[1])
     c3, s3 = ca.cos(g[2]), ca.sin(g[2])
@@ -95,19 +95,3 @@ def rotation_ef_sx(g):
         ca.horzcat(c1 * c2, c1 * s2 * s3 - c3 * s1, c1 * c3 * s2 + s1 * s3),
         ca.horzcat(c2 * s1, c1 * c3 + s1 * s2 * s3, c3 * s1 * s2 - c1 * s3),
         ca.horzcat(-s2, c2 * s3, c2 * c3))
-
-
-def rotation_ef(g) -> np.ndarray:
-    """Numeric R^ef (eq. 3.3)."""
-    c1, s1 = np.cos(g[0]), np.sin(g[0])
-    c2, s2 = np.cos(g[1]), np.sin(g[1])
-    c3, s3 = np.cos(g[2]), np.sin(g[2])
-    return np.array([[c1 * c2, c1 * s2 * s3 - c3 * s1, c1 * c3 * s2 + s1 * s3],
-                     [c2 * s1, c1 * c3 + s1 * s2 * s3, c3 * s1 * s2 - c1 * s3],
-                     [-s2, c2 * s3, c2 * c3]])
-
-
-def euler_from_rotation(R: np.ndarray) -> np.ndarray:
-    """3-2-1 Euler angles of a rotation matrix R^ef (inverse of eq. 3.3, |gamma_2| < pi/2)."""
-    g2 = -np.arcsin(np.clip(R[2, 0], -1.0, 1.0))
-    return np.array([np.arctan2(R[1, 0], R[0, 0]), g2, np.arctan2(R[2, 1], R[2, 2])])

@@ -31,6 +31,7 @@ from tmfem.reduced.constraints import ConstraintSolver, ZetaLayout, phi_sx
 from tmfem.reduced.kinematics import (bar_kinetic_energy_sx, bars_sx, rotation_ef_sx,
                                       tendon_lengths_sx)
 from tmfem.reduced.membrane_modes import build_membrane_basis
+from tmfem.system.geometry import rotation_ef
 
 # Monitored membrane points of 6.5 (eqs. 5.36 and 5.38), (x_f, y_f) in m.
 MONITOR_POINTS = {
@@ -242,6 +243,18 @@ class ControlOrientedModel:
         return L, 0.5 * ca.dot(ca.DM(self.k), L * L)
 
     # ------------------------------------------------------------------ build
+    def _lagrange_terms(self, T, U, kL, x, xd, etad):
+        """M, F, B of Lagrange's equations M x'' + F + B u = 0 in coordinates x = (q, eta, ...)
+        (eq. 5.19 without the constraint forces; eq. 5.27 when x = z): M = T_x'x',
+        F = T_x'x x' - T_x + U_x plus the modal damping on eta, B = -(k L)_x."""
+        M = ca.hessian(T, xd)[0]
+        F = ca.jtimes(ca.gradient(T, xd), x, xd) - ca.gradient(T, x) + ca.gradient(U, x)
+        K = etad.numel()
+        if K and self.damping:
+            rest = x.numel() - self.nq - K
+            F += ca.vertcat(ca.SX.zeros(self.nq), self.damping * etad, ca.SX.zeros(rest))
+        return M, F, -ca.jacobian(kL, x).T
+
     def _build(self):
         nq, K, nzeta = self.nq, self.K, self.layout.n
         q = ca.SX.sym("q", nq); qd = ca.SX.sym("qd", nq)
@@ -255,11 +268,7 @@ class ControlOrientedModel:
             T = bar_kinetic_energy_sx(self.system, q, qd) + \
                 self._membrane_kinetic_energy(q, zz, eta, lambda e: ca.jtimes(e, x, xd))
             U = U_td + self._membrane_potential(zz, eta)
-            M = ca.hessian(T, xd)[0]
-            F = ca.jtimes(ca.gradient(T, xd), x, xd) - ca.gradient(T, x) + ca.gradient(U, x)
-            if K and self.damping:
-                F += ca.vertcat(ca.SX.zeros(nq), self.damping * etad, ca.SX.zeros(nzeta))
-            B = -ca.jacobian(kL, x).T
+            M, F, B = self._lagrange_terms(T, U, kL, x, xd, etad)       # eq. 5.19
             # coordinate partitioning, eqs. 5.22-5.26
             phi = phi_sx(self.system, self.layout, q, zz)
             Pz, Pq = ca.jacobian(phi, zz), ca.jacobian(phi, q)
@@ -294,11 +303,7 @@ class ControlOrientedModel:
             T = bar_kinetic_energy_sx(self.system, q, qd) + \
                 self._membrane_kinetic_energy(q, zeta_q, eta, lambda e: ca.jtimes(e, z, zd))
             U = U_td + self._membrane_potential(zeta_q, eta)
-            Mh = ca.hessian(T, zd)[0]
-            Fh = ca.jtimes(ca.gradient(T, zd), z, zd) - ca.gradient(T, z) + ca.gradient(U, z)
-            if K and self.damping:
-                Fh += ca.vertcat(ca.SX.zeros(nq), self.damping * etad)
-            Bh = -ca.jacobian(kL, z).T
+            Mh, Fh, Bh = self._lagrange_terms(T, U, kL, z, zd, etad)
             dzeta_dz = None
             args = [z, zd, zz]       # zeta is ignored (kept for a common signature)
         self._terms = ca.Function("com_terms", args, [Mh, Fh, Bh],
@@ -578,7 +583,6 @@ class ControlOrientedModel:
     def membrane_positions(self, z):
         """Membrane FE node positions (3, n_nodes) in the inertial frame (eqs. 5.1, 5.3) and
         the deflections (3, n_nodes) in O_f, for configuration z."""
-        from tmfem.reduced.kinematics import rotation_ef
         zm = self.P @ np.asarray(z, dtype=float)
         q = zm[: self.nq]
         zeta = self.zeta(q)

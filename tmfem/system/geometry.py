@@ -59,6 +59,87 @@ def membrane_corners_regular(N: int, r_mb: float) -> np.ndarray:
     return xy - xy[:, [-1]]
 
 
+def floating_frame(corners_3d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Origin and axes of the floating frame O_f-x_f y_f z_f (3.2) from the corners B_Mj.
+
+    O_f = B_MN; x_f goes through B_M1; the plane x_f y_f is the plane of B_MN, B_M1 and
+    B_M,N-1, with y_f on the side of B_M,N-1 (so the undeformed corners P_i of a
+    counter-clockwise membrane have y_f >= 0, as eq. 3.5 assumes); z_f = x_f x y_f (right-hand
+    rule). The columns of R are the O_f axes in the inertial frame, R = R^ef of eq. 3.3.
+
+    Parameters
+    ----------
+    corners_3d : ndarray (3, N)
+        Positions of B_M1, ..., B_MN in the inertial frame, N >= 3.
+
+    Returns
+    -------
+    origin : ndarray (3,)
+        B_MN.
+    R : ndarray (3, 3)
+        Rotation O_f -> O-xyz (columns e_xf, e_yf, e_zf).
+
+    Raises
+    ------
+    InputError
+        if the array is not (3, N >= 3) or B_MN, B_M1, B_M,N-1 are collinear (the frame of
+        3.2 is then undefined).
+    """
+    c = np.asarray(corners_3d, dtype=float)
+    if c.ndim != 2 or c.shape[0] != 3 or c.shape[1] < 3:
+        raise InputError(f"floating frame: expected corners of shape (3, N >= 3), found {c.shape}")
+    o = c[:, -1]
+    x1, v = c[:, 0] - o, c[:, -2] - o
+    n1, nv = np.linalg.norm(x1), np.linalg.norm(v)
+    ex = x1 / n1 if n1 > 0 else x1
+    ez = np.cross(ex, v)
+    nz = np.linalg.norm(ez)
+    if n1 == 0 or nz == 0 or nz < 1e-12 * nv:
+        raise InputError("corners B_MN, B_M1, B_M,N-1 are collinear: the floating frame O_f "
+                         f"of 3.2 is undefined (|B_M1 - B_MN| = {n1:.3g} m, "
+                         f"|B_M,N-1 - B_MN| = {nv:.3g} m, sine of their angle {nz / max(nv, 1e-300):.3g})")
+    ez = ez / nz
+    return o, np.column_stack([ex, np.cross(ez, ex), ez])
+
+
+def rotation_ef(gamma) -> np.ndarray:
+    """Rotation matrix R^ef of the 3-2-1 Euler angles (gamma_1, gamma_2, gamma_3), eq. 3.3.
+
+    R^ef = Rz(gamma_1) Ry(gamma_2) Rx(gamma_3); its columns are the O_f axes in O-xyz. The
+    casadi version for automatic differentiation is
+    :func:`tmfem.reduced.kinematics.rotation_ef_sx`.
+
+    Parameters
+    ----------
+    gamma : array_like (3,)
+
+    Returns
+    -------
+    ndarray (3, 3)
+    """
+    g1, g2, g3 = gamma
+    c1, s1, c2, s2, c3, s3 = np.cos(g1), np.sin(g1), np.cos(g2), np.sin(g2), np.cos(g3), np.sin(g3)
+    return np.array([[c1 * c2, c1 * s2 * s3 - c3 * s1, c1 * c3 * s2 + s1 * s3],
+                     [c2 * s1, c1 * c3 + s1 * s2 * s3, c3 * s1 * s2 - c1 * s3],
+                     [-s2, c2 * s3, c2 * c3]])
+
+
+def euler_angles_321(R: np.ndarray) -> np.ndarray:
+    """3-2-1 Euler angles (gamma_1, gamma_2, gamma_3) of a rotation R^ef (inverse of eq. 3.3).
+
+    Parameters
+    ----------
+    R : ndarray (3, 3)
+
+    Returns
+    -------
+    ndarray (3,)
+        gamma_1, gamma_3 in (-pi, pi], gamma_2 in [-pi/2, pi/2] (unique for |gamma_2| < pi/2).
+    """
+    return np.array([np.arctan2(R[1, 0], R[0, 0]), -np.arcsin(np.clip(R[2, 0], -1.0, 1.0)),
+                     np.arctan2(R[2, 1], R[2, 2])])
+
+
 @dataclass(frozen=True)
 class SymmetricConfig:
     """Symmetric parametrisation of an M-N or 1-N(D) configuration (3.3.1, eqs. 3.19-3.20).
