@@ -3,8 +3,9 @@
 For each system: the COM linearised about its equilibrium (eq. 5.33) with the dissertation's
 number of membrane modes (K = 5 for 1-4, 4 for 2-3), once with the prestress designed from
 the geometry (eq. 3.22, linear plane-stress FE, 4 x 10 x 10 / 3 x 10 x 10 mesh) and once
-with the prestress implied by the printed maximum tendon stress (Tables 6.3 / 6.5); then
-the frequencies vs K.
+with the prestress implied by the printed maximum tendon stress (Tables 6.3 / 6.5) and once
+with the prestress implied by the printed stage-1 bar load (14.53 / 14.48 N, the calibration
+of the MTC comparison); then the frequencies vs K.
 
     .venv/bin/python demos/com_frequencies.py [--systems 1-4 2-3] [--k-study 1 2 3 4 5 6 8]
 """
@@ -44,15 +45,21 @@ def table(name: str, k_study, plot_dir=None) -> None:
     r1 = modal_summary(system, modes=12, membrane_modes=K)
     s = r1.get("printed_stress_prestress_scale")
     r2 = modal_summary(system, modes=12, membrane_modes=K, prestress_scale=s) if s else None
+    sb = r1.get("printed_bar_load_prestress_scale")
+    r3 = modal_summary(system, modes=12, membrane_modes=K, prestress_scale=sb) if sb else None
     ref = dissertation_com_frequencies(name)
     print(f"\n{name}: COM with K = {K} membrane modes, {r1['sizes']['n_z']} coordinates")
     forces = sorted({round(float(v), 4) for v in r1['design_tendon_forces'].values()})
     print(f"designed prestress: tendon forces {forces} N")
     if s:
         print(f"prestress implied by the printed tendon stress: x{s:.4f}")
+    if sb:
+        print(f"prestress implied by the printed stage-1 bar load: x{sb:.4f}")
     hdr = f"{'mode':>4} {'printed':>9} {'designed':>9} {'rel.':>7}"
     if r2:
         hdr += f" {'printed-stress':>14} {'rel.':>7}"
+    if r3:
+        hdr += f" {'printed-load':>12} {'rel.':>7}"
     print(hdr)
     com = ref[1] if ref else []
     for i in range(12):
@@ -62,10 +69,14 @@ def table(name: str, k_study, plot_dir=None) -> None:
         if r2:
             f2 = r2["freq_hz"][i]
             line += f" {f2:>14.4f} {f2 / p - 1:>+7.2%}"
+        if r3:
+            f3 = r3["freq_hz"][i]
+            line += f" {f3:>12.4f} {f3 / p - 1:>+7.2%}"
         print(line)
     hp = DISSERTATION_HIGHEST.get(name)
     print(f"highest COM frequency: printed {hp}, designed {r1['highest_hz']:.4f}"
-          + (f", printed-stress {r2['highest_hz']:.4f}" if r2 else ""))
+          + (f", printed-stress {r2['highest_hz']:.4f}" if r2 else "")
+          + (f", printed-load {r3['highest_hz']:.4f}" if r3 else ""))
     if k_study:
         print(f"\nfrequencies [Hz] vs K ({name})")
         rows = frequency_study(system, K_values=k_study, prestress_scales=[1.0] + ([s] if s else []),

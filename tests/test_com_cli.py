@@ -40,3 +40,17 @@ def test_vibrate_cli_errors(capsys):
     assert "unknown state 'theta_99_dot'" in err and len(err.strip().splitlines()) <= 2
     assert main(["vibrate", "--preset", "1-4", "--membrane-modes", "1", "--t-end", "0.1",
                  "--perturb", "theta_12_dot"]) == 2
+
+
+def test_vibrate_cli_2_3_preset(capsys):
+    # free vibration of 6.5.2 on the preset 2-3 (final 2-3 of Table 7.7, Table 6.1 materials):
+    # perturbation theta_11_dot = 0.01 rad/s, K = 4, membrane points of eq. 5.38, nodes of
+    # Figs. 6.25-6.27; the design's smallest tendon force is 1.112 N (P_2, tmfem.equilibrium's
+    # design_equilibrium) and stays positive under the small perturbation
+    code = main(["vibrate", "--model", "com", "--preset", "2-3", "--t-end", "0.2", "--dt", "0.01",
+                 "--perturb", "theta_11_dot=0.01", "--json"])
+    assert code == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["steps"] == 20 and r["membrane_modes"] == 4
+    assert len(r["w_max_abs_m"]) == 3 and sorted(r["node_range_m"]) == ["A_21", "B_11", "B_21"]
+    assert 0.0 < r["min_tendon_force_N"] < 1.12 and r["min_tendon_force_tendon"].startswith("P_2")

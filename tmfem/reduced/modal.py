@@ -43,6 +43,22 @@ def printed_prestress_scale(model) -> float | None:
                  np.max(model.design.tendon_forces) / model.prestress_scale)
 
 
+def printed_bar_load_prestress_scale(model, *, mesh_n: int = 10) -> float | None:
+    """Prestress factor implied by the printed stage-1 bar load (Table 6.3 ``bar_load``,
+    Table 6.5 ``bar_load_stage1``): s = F_printed / F_design, the one-number calibration of
+    the MTC comparison (:func:`tmfem.fem.mtc_designs.calibrate_on_bar_load`) applied to the
+    COM's design. F_design is the largest stage-1 bar compression of
+    :func:`tmfem.equilibrium.design.design_equilibrium`, whose tendon forces the COM's design
+    reproduces (tests/test_com_2_3.py); all design loads scale with the prestress (3.2)."""
+    pr = model.system.printed
+    p = pr.get("bar_load_stage1", pr.get("bar_load"))
+    if p is None or model.design is None:
+        return None
+    from tmfem.equilibrium.design import design_equilibrium
+    d = design_equilibrium(model.system, mesh_n=mesh_n)
+    return float(p / np.max(d.bar_loads[0]) / model.prestress_scale)
+
+
 def com_frequencies(system, *, membrane_modes: int, prestress_scale: float = 1.0,
                     mesh_n: int = 10, rest_lengths=None):
     """(frequencies in Hz, model) of the COM linearised about its equilibrium (eq. 5.33)."""
@@ -93,6 +109,9 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
     s_pr = printed_prestress_scale(m)
     if s_pr is not None:
         out["printed_stress_prestress_scale"] = s_pr
+    s_bar = printed_bar_load_prestress_scale(m, mesh_n=mesh_n)
+    if s_bar is not None:
+        out["printed_bar_load_prestress_scale"] = s_bar
     ref = dissertation_com_frequencies(system.name)
     if ref is not None and K == DISSERTATION_K.get(system.name):
         src, com = ref
@@ -114,6 +133,8 @@ def format_summary(r: dict) -> str:
     if "printed_stress_prestress_scale" in r:
         lines.append(f"prestress implied by the printed tendon stress: x{r['printed_stress_prestress_scale']:.4f}"
                      " (--prestress-scale in the Python API, docs/com.md)")
+    if "printed_bar_load_prestress_scale" in r:
+        lines.append(f"prestress implied by the printed stage-1 bar load: x{r['printed_bar_load_prestress_scale']:.4f}")
     ref = r.get("dissertation", {}).get("COM", [])
     lines.append(f"{'mode':>4} {'ours [Hz]':>10} {'printed':>10} {'rel.diff':>9}")
     for i, f in enumerate(r["freq_hz"]):
