@@ -438,6 +438,31 @@ def _normalise_cells(cells, n_points: int) -> list:
     return out
 
 
+def check_modes(points, shapes, freq_hz, *, points_name: str = "points"):
+    """Validated float arrays (X (3, n), S (3 n, k), f (k,)) of mode shapes about ``points``.
+
+    Raises
+    ------
+    InputError
+        if the shapes do not match (node-interleaved dofs, one frequency per mode) or an
+        entry of ``shapes`` or ``freq_hz`` is not finite.
+    """
+    X = np.asarray(points, dtype=float)
+    if X.ndim != 2 or X.shape[0] != 3:
+        raise InputError(f"{points_name}: expected shape (3, n), found {X.shape}")
+    n = X.shape[1]
+    S = np.asarray(shapes, dtype=float)
+    if S.ndim != 2 or S.shape[0] != 3 * n:
+        raise InputError(f"shapes: expected shape ({3 * n}, k) for {n} points, found {S.shape}")
+    f = np.atleast_1d(np.asarray(freq_hz, dtype=float))
+    if f.shape != (S.shape[1],):
+        raise InputError(f"freq_hz: expected {S.shape[1]} frequencies (one per mode), "
+                         f"found shape {f.shape}")
+    if not (np.all(np.isfinite(S)) and np.all(np.isfinite(f))):
+        raise InputError("shapes/freq_hz: non-finite entries")
+    return X, S, f
+
+
 def write_modes(path, base_points, cells, shapes, freq_hz, *, point_data=None,
                 cell_data=None) -> Path:
     """Write mode shapes into one ``.vtu``: point data ``mode_1`` .. ``mode_k`` (3-vectors).
@@ -458,21 +483,10 @@ def write_modes(path, base_points, cells, shapes, freq_hz, *, point_data=None,
     In ParaView: Warp By Vector with ``mode_k`` animates mode k.
     """
     path = check_path(path, suffixes=(".vtu",))
-    X = np.asarray(base_points, dtype=float)
-    if X.ndim != 2 or X.shape[0] != 3:
-        raise InputError(f"base_points: expected shape (3, n), found {X.shape}")
+    shapes = np.asarray(shapes, dtype=float)
+    X, S, f = check_modes(base_points, shapes[:, None] if shapes.ndim == 1 else shapes, freq_hz,
+                          points_name="base_points")
     n = X.shape[1]
-    S = np.asarray(shapes, dtype=float)
-    if S.ndim == 1:
-        S = S[:, None]
-    if S.ndim != 2 or S.shape[0] != 3 * n:
-        raise InputError(f"shapes: expected shape ({3 * n}, k) for {n} points, found {S.shape}")
-    f = np.atleast_1d(np.asarray(freq_hz, dtype=float))
-    if f.shape != (S.shape[1],):
-        raise InputError(f"freq_hz: expected {S.shape[1]} frequencies (one per mode), "
-                         f"found shape {f.shape}")
-    if not (np.all(np.isfinite(S)) and np.all(np.isfinite(f))):
-        raise InputError("shapes/freq_hz: non-finite entries")
     blocks = _normalise_cells(cells, n)
     pdata = {f"mode_{k + 1}": S[:, k].reshape(n, 3) for k in range(S.shape[1])}
     for k, v in (point_data or {}).items():

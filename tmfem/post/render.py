@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import (MembraneField, _normalise_cells, check_path, member_data,
+from tmfem.io.vtk import (MembraneField, _normalise_cells, check_modes, check_path, member_data,
                           membrane_corner_nodes)
 
 _VTK_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "polygon": 7}
@@ -230,16 +230,8 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
     """
     png_path = check_path(png_path, suffixes=(".png",))
     pv = _pv()
-    X = np.asarray(points, dtype=float)
-    if X.ndim != 2 or X.shape[0] != 3:
-        raise InputError(f"points: expected shape (3, n), found {X.shape}")
+    X, S, f = check_modes(points, shapes, freq_hz)
     n = X.shape[1]
-    S = np.asarray(shapes, dtype=float)
-    if S.ndim != 2 or S.shape[0] != 3 * n:
-        raise InputError(f"shapes: expected shape ({3 * n}, k) for {n} points, found {S.shape}")
-    f = np.atleast_1d(np.asarray(freq_hz, dtype=float))
-    if f.shape != (S.shape[1],):
-        raise InputError(f"freq_hz: expected {S.shape[1]} values, found shape {f.shape}")
     if not (isinstance(k, (int, np.integer)) and 1 <= k <= S.shape[1]):
         raise InputError(f"k: expected 1 <= k <= {S.shape[1]} modes, found {k!r}")
     blocks = _normalise_cells(cells, n)
