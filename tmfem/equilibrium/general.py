@@ -24,7 +24,8 @@ import numpy as np
 from scipy.optimize import linprog
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.system.geometry import beta, euler_angles_321, floating_frame, rotation_ef
+from tmfem.system.geometry import (beta, euler_angles_321, floating_frame, free_corner_components,
+                                  rotation_ef)
 from tmfem.system.topology import FAMILIES_MN
 
 
@@ -97,15 +98,6 @@ def euler_R_derivatives(gamma) -> np.ndarray:
     dRy = np.array([[-s2, 0, c2], [0, 0, 0], [-c2, 0, -s2]])
     dRx = np.array([[0, 0, 0], [0, -s3, -c3], [0, c3, -s3]])
     return np.stack([dRz @ Ry @ Rx, Rz @ dRy @ Rx, Rz @ Ry @ dRx], axis=-1)
-
-
-def free_corner_components(N: int) -> list[tuple[int, int]]:
-    """(corner index 0..N-1, component 0=u 1=v 2=w) of the free corner displacements (3.2)."""
-    out = [(0, 0)]
-    for i in range(1, N - 2):
-        out += [(i, 0), (i, 1), (i, 2)]
-    out += [(N - 2, 0), (N - 2, 1)]
-    return out
 
 
 def corner_force_names(N: int) -> list[str]:

@@ -22,7 +22,8 @@ import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.reduced.kinematics import bars_sx, rotation_ef_sx
-from tmfem.system.geometry import euler_angles_321, floating_frame
+from tmfem.equilibrium.general import corner_state
+from tmfem.system.geometry import free_corner_components
 
 
 @dataclass(frozen=True)
@@ -42,11 +43,8 @@ class ZetaLayout:
 
     @classmethod
     def for_polygon(cls, N: int) -> "ZetaLayout":
-        cc = [(0, 0)]
-        for i in range(1, N - 2):
-            cc += [(i, 0), (i, 1), (i, 2)]
-        cc += [(N - 2, 0), (N - 2, 1)]
-        return cls(N=N, corner_components=tuple(cc))
+        """The layout of eq. 5.14 (:func:`tmfem.system.geometry.free_corner_components`)."""
+        return cls(N=N, corner_components=tuple(free_corner_components(N)))
 
     @property
     def n_delta(self) -> int:
@@ -97,17 +95,11 @@ def phi_sx(system, layout: ZetaLayout, q, zeta):
 
 def zeta_closed_form(system, layout: ZetaLayout, q=None) -> np.ndarray:
     """zeta(q) from the geometric definition of O_f (3.2,
-    :func:`tmfem.system.geometry.floating_frame`): x_f along B_MN -> B_M1, z_f normal to the
-    plane (B_MN, B_M1, B_M,N-1); corner displacements Delta_i = R^T(B_Mi - B_MN) - c_i. An exact solution of Phi = 0, used as the Newton starting point and as a test."""
-    B = system.membrane_corners_inertial(q)
-    o, R = floating_frame(B)
-    rel = R.T @ (B - o[:, None])
-    rel[:2] -= system.membrane_corners
-    zeta = np.empty(layout.n)
-    for k, (i, c) in enumerate(layout.corner_components):
-        zeta[k] = rel[c, i]
-    zeta[layout.n_delta:] = euler_angles_321(R)
-    return zeta
+    :func:`tmfem.equilibrium.general.corner_state`): x_f along B_MN -> B_M1, z_f normal to the
+    plane (B_MN, B_M1, B_M,N-1); corner displacements Delta_i = R^T(B_Mi - B_MN) - c_i. An
+    exact solution of Phi = 0, used as the Newton starting point and as a test."""
+    st = corner_state(system, q)
+    return np.concatenate([[st.delta[c, i] for i, c in layout.corner_components], st.gamma])
 
 
 class ConstraintSolver:

@@ -102,6 +102,23 @@ def floating_frame(corners_3d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return o, np.column_stack([ex, np.cross(ez, ex), ez])
 
 
+def free_corner_components(N: int) -> list[tuple[int, int]]:
+    """The 3N-6 free corner displacements of eq. 3.5 in the order of eqs. 3.4 and 5.14.
+
+    Delta_u1; Delta_ui, Delta_vi, Delta_wi (2 <= i <= N-2); Delta_u,N-1, Delta_v,N-1 (corner
+    N is O_f, corner 1 lies on x_f and corner N-1 in the plane x_f y_f).
+
+    Returns
+    -------
+    list of (corner index 0..N-1, component 0=u 1=v 2=w)
+    """
+    out = [(0, 0)]
+    for i in range(1, N - 2):
+        out += [(i, 0), (i, 1), (i, 2)]
+    out += [(N - 2, 0), (N - 2, 1)]
+    return out
+
+
 def rotation_ef(gamma) -> np.ndarray:
     """Rotation matrix R^ef of the 3-2-1 Euler angles (gamma_1, gamma_2, gamma_3), eq. 3.3.
 
