@@ -38,13 +38,17 @@ def test_zeta_layout_counts():
 
 
 def test_rotation_is_3_2_1_sequence():
-    # eq. 3.3 equals Rz(g1) Ry(g2) Rx(g3); independent construction
+    # eq. 3.3 equals Rz(g1) Ry(g2) Rx(g3); independent construction, checked on the casadi
+    # R^ef of the model (the numeric one: tests/test_equilibrium_general.py, test_system.py)
+    import casadi as ca
+
+    from tmfem.reduced.kinematics import rotation_ef_sx
     g = np.array([0.3, -0.2, 0.7])
     c, s = np.cos, np.sin
     Rz = np.array([[c(g[0]), -s(g[0]), 0], [s(g[0]), c(g[0]), 0], [0, 0, 1]])
     Ry = np.array([[c(g[1]), 0, s(g[1])], [0, 1, 0], [-s(g[1]), 0, c(g[1])]])
     Rx = np.array([[1, 0, 0], [0, c(g[2]), -s(g[2])], [0, s(g[2]), c(g[2])]])
-    assert np.allclose(rotation_ef(g), Rz @ Ry @ Rx, atol=1e-15)
+    assert np.allclose(ca.evalf(rotation_ef_sx(ca.SX(g))).full(), Rz @ Ry @ Rx, atol=1e-15)
 
 
 def test_constraints_newton_and_jacobian(m14, sys14):
