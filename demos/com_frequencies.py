@@ -14,7 +14,8 @@ from __future__ import annotations
 import argparse
 
 from tmfem.errors import TmfemError
-from tmfem.reduced.modal import (DISSERTATION_HIGHEST, default_membrane_modes,
+from tmfem.tables import HIGHEST_COM_FREQUENCY
+from tmfem.reduced.modal import (default_membrane_modes,
                                  dissertation_com_frequencies, frequency_study, modal_summary)
 from tmfem.system import load_preset
 
@@ -73,7 +74,7 @@ def table(name: str, k_study, plot_dir=None) -> None:
             f3 = r3["freq_hz"][i]
             line += f" {f3:>12.4f} {f3 / p - 1:>+7.2%}"
         print(line)
-    hp = DISSERTATION_HIGHEST.get(name)
+    hp = HIGHEST_COM_FREQUENCY.get(name)
     print(f"highest COM frequency: printed {hp}, designed {r1['highest_hz']:.4f}"
           + (f", printed-stress {r2['highest_hz']:.4f}" if r2 else "")
           + (f", printed-load {r3['highest_hz']:.4f}" if r3 else ""))

@@ -23,7 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.fem.mtc import MTCModel
-from tmfem.fem.mtc_post import DISSERTATION_FREQUENCIES, model_cells, static_summary
+from tmfem.tables import FREQUENCIES
+from tmfem.fem.mtc_post import model_cells, static_summary
 from tmfem.system import load_preset
 
 
@@ -64,7 +65,7 @@ def main(argv=None) -> int:
     for title, label, s in cases:
         print(f"... {title}", file=sys.stderr)
         results.append((title,) + run_case(label, s, out=args.out))
-    ref = DISSERTATION_FREQUENCIES["1-4"]
+    ref = FREQUENCIES["1-4"]
     pr = printed.printed
     print("1-4 MTC statics (4 x 10 x 10 membrane, 3 elements per tendon), from the undeformed membrane")
     print(f"{'':30s}" + "".join(f"{t:>24s}" for t, *_ in results) + f"{'dissertation':>16s}")

@@ -7,7 +7,8 @@ import pytest
 
 from tmfem.fem.mtc import MTCModel
 from tmfem.fem.mtc_designs import calibrate_on_bar_load, fit_stage2_base
-from tmfem.fem.mtc_post import DISSERTATION_FREQUENCIES, static_summary
+from tmfem.tables import FREQUENCIES
+from tmfem.fem.mtc_post import static_summary
 from tmfem.system import load_preset
 
 
@@ -58,7 +59,7 @@ def test_frequencies_vs_table_6_7(table_6_7_state):
     m, res, st, modes, k = table_6_7_state
     assert 1.0 < k < 1.1
     assert st["bar_load_by_stage"][0] == pytest.approx(14.48, rel=1e-3)
-    assert modes.freq_hz == pytest.approx(DISSERTATION_FREQUENCIES["2-3"]["MTC"], rel=1e-3)
+    assert modes.freq_hz == pytest.approx(FREQUENCIES["2-3"]["MTC"], rel=1e-3)
 
 
 def test_static_vs_table_6_5(table_6_7_state):
@@ -83,4 +84,4 @@ def test_designed_rest_lengths_reproduce_tables_6_5_and_6_7_without_calibration(
     assert st["bar_load_by_stage"] == pytest.approx([14.48, 5.02], rel=2e-3)
     assert st["max_deviation_from_design"] < 5e-4 and not st["tendon_slack"]
     f = m.modes(res.x, k=12).freq_hz
-    assert f == pytest.approx(DISSERTATION_FREQUENCIES["2-3"]["MTC"], rel=5e-4)
+    assert f == pytest.approx(FREQUENCIES["2-3"]["MTC"], rel=5e-4)

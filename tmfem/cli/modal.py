@@ -38,7 +38,8 @@ def run(args) -> dict:
         from tmfem.reduced.modal import modal_summary
         system = system_from_args(args)
         return modal_summary(system, modes=args.modes, membrane_modes=args.membrane_modes)
-    from tmfem.fem.mtc_post import DISSERTATION_FREQUENCIES, model_cells, static_summary
+    from tmfem.tables import FREQUENCIES
+    from tmfem.fem.mtc_post import model_cells, static_summary
     model = build_model(args)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
@@ -51,7 +52,7 @@ def run(args) -> dict:
            "tendon_stress_max": st["tendon_stress_max"], "bar_load_max": st["bar_load_max"],
            "Delta_mean": float(np.mean(st["Delta"])),
            "freq_hz": modes.freq_hz.tolist()}
-    ref = DISSERTATION_FREQUENCIES.get(system_name)
+    ref = FREQUENCIES.get(system_name)
     if ref is not None:
         n = min(len(ref["MTC"]), args.modes)
         out["dissertation"] = {"source": ref["source"], "MTC": ref["MTC"][:n], "SBC": ref["SBC"][:n]}

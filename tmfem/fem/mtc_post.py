@@ -10,30 +10,6 @@ from tmfem.fem.truss import truss_internal
 from tmfem.system.geometry import floating_frame, wrap_angle
 from tmfem.system.topology import label
 
-# Natural frequencies [Hz] printed in the dissertation, Tables 6.6 (1-4) and 6.7 (2-3):
-# shell-beam-cable (SBC), membrane-truss-cable (MTC) and control-oriented (COM) models.
-DISSERTATION_FREQUENCIES = {
-    "1-4": {
-        "source": "dissertation Table 6.6",
-        "SBC": [0.1386, 0.3076, 0.3076, 1.5598, 1.8590, 2.0571, 2.0571, 2.0770, 2.1793, 2.2130,
-                2.2130, 2.2523],
-        "MTC": [0.1386, 0.3076, 0.3076, 1.5599, 1.8679, 2.0569, 2.0569, 2.0763, 2.1803, 2.2277,
-                2.2277, 2.2653],
-        "COM": [0.1367, 0.2997, 0.2997, 1.5401, 1.8552, 2.0288, 2.0289, 2.0471, 2.1507, 2.2062,
-                2.2119, 2.2479],
-    },
-    "2-3": {
-        "source": "dissertation Table 6.7",
-        "SBC": [0.2527, 0.4116, 0.4116, 1.0942, 1.3164, 1.3164, 1.5230, 1.5230, 1.7399, 1.8186,
-                1.9834, 1.9834],
-        "MTC": [0.2527, 0.4116, 0.4116, 1.0953, 1.3174, 1.3174, 1.5264, 1.5264, 1.7404, 1.8224,
-                1.9876, 1.9876],
-        "COM": [0.2503, 0.4076, 0.4076, 1.0843, 1.3020, 1.3020, 1.5110, 1.5121, 1.7258, 1.8053,
-                1.9712, 1.9720],
-    },
-}
-
-
 def q_from_positions(system, X: np.ndarray) -> np.ndarray:
     """Generalised coordinates q (eqs. 3.1-3.2) of labelled node positions X (3, n_labels).
 

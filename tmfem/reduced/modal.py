@@ -12,17 +12,15 @@ import sys
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.tables import FREQUENCIES, HIGHEST_COM_FREQUENCY
 
 # Numbers of membrane modes used by the dissertation (6.4.1, 6.4.2, 7.4).
 DISSERTATION_K = {"1-4": 5, "2-3": 4, "1-4D": 3, "1-6D": 5}
-# Highest COM frequency quoted in 6.5.1 / 6.5.2 (all coordinates of the COM).
-DISSERTATION_HIGHEST = {"1-4": 2.4322, "2-3": 4.4607}
 
 
 def dissertation_com_frequencies(name: str):
     """COM column of Table 6.6 (1-4) or 6.7 (2-3), or None."""
-    from tmfem.fem.mtc_post import DISSERTATION_FREQUENCIES
-    ref = DISSERTATION_FREQUENCIES.get(name)
+    ref = FREQUENCIES.get(name)
     return None if ref is None else (ref["source"], list(ref["COM"]))
 
 
@@ -117,7 +115,7 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
         src, com = ref
         k = min(n, len(com))
         out["dissertation"] = {"source": src, "COM": com[:k],
-                               "highest_hz": DISSERTATION_HIGHEST.get(system.name)}
+                               "highest_hz": HIGHEST_COM_FREQUENCY.get(system.name)}
         out["relative_difference"] = (f[:k] / np.array(com[:k]) - 1).tolist()
     return out
 
