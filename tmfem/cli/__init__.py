@@ -57,10 +57,27 @@ def main(argv=None) -> int:
         print(f"tmfem {args.command}: error: {exc}", file=sys.stderr)
         return exc.exit_code
     if args.json:
-        print(json.dumps(result, default=_json_default))
+        print(json.dumps(_finite(result), default=_json_default, allow_nan=False))
     else:
         print(getattr(mod, "format_text", _default_text)(result))
     return 0
+
+
+def _finite(obj):
+    """``obj`` with non-finite floats replaced by None: JSON has no NaN or infinity
+    (a tendon that would push has no rest length, a missing printed value is absent)."""
+    import math
+
+    import numpy as np
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _finite(obj.tolist())
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if math.isfinite(obj) else None
+    return obj
 
 
 def _json_default(obj):

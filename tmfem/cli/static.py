@@ -168,7 +168,8 @@ def format_text(r: dict) -> str:
         rows.append(("bar load [N]", r["bar_load_max"], pr.get("bar_load", np.nan)))
     rows.append(("bar critical load [N]", r["bar_critical_load"], pr.get("bar_critical_load", np.nan)))
     lines.append(f"{'':32s} {'MTC':>12s} {'dissertation':>12s}")
-    lines += [f"{a:32s} {b:12.4g} {c:12.4g}" for a, b, c in rows]
+    lines += [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
+              for a, b, c in rows]
     lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.3f}" for k, v in
                                                    list(r["tendon_force"].items())[:12]))
     if r["tendon_slack"]:

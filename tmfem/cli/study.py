@@ -52,9 +52,7 @@ def _progress(msg: str) -> None:
 
 
 def _rel(ours, printed):
-    if printed is None or ours is None:
-        return None
-    if printed == 0:
+    if printed is None or ours is None or printed == 0 or not np.isfinite(ours):
         return None
     return (ours - printed) / abs(printed)
 
@@ -113,7 +111,11 @@ def table_rows(d, system) -> list[dict]:
 
 
 def _fmt(v, nd=6):
-    return "" if v is None else f"{v:.{nd}g}"
+    """Number for the tables; ``n/a`` where there is none (a tendon that would push has no
+    rest length, eqs. 3.8-3.9)."""
+    if v is None:
+        return ""
+    return f"{v:.{nd}g}" if np.isfinite(v) else "n/a"
 
 
 def write_tables(out: Path, d, system) -> dict:
