@@ -1,4 +1,5 @@
-"""``tmfem vibrate``: free vibration of the control-oriented model (6.5, Park's method)."""
+"""``tmfem vibrate``: free vibration of the control-oriented model or of the membrane-truss-cable
+model (6.5, Park's method)."""
 from __future__ import annotations
 
 import sys
@@ -9,13 +10,14 @@ from tmfem.cli.common import add_system_args, system_from_args
 from tmfem.errors import InputError
 
 NAME = "vibrate"
-HELP = "free vibration after an initial perturbation (control-oriented model, Park's method)"
+HELP = "free vibration after an initial perturbation (COM or MTC model, Park's method)"
 
 
 def configure(parser) -> None:
     add_system_args(parser)
-    parser.add_argument("--model", choices=("com",), default="com",
-                        help="com: control-oriented model (ch. 5)")
+    parser.add_argument("--model", choices=("com", "mtc"), default="com",
+                        help="com: control-oriented model (ch. 5); mtc: membrane-truss-cable "
+                             "finite-element model (4.4) about its static equilibrium")
     parser.add_argument("--membrane-modes", type=int, default=None,
                         help="membrane modes K (default: the dissertation's, 5 for 1-4, 4 for 2-3)")
     parser.add_argument("--t-end", type=float, default=10.0, help="duration [s] (default 10)")
@@ -33,9 +35,20 @@ def configure(parser) -> None:
                         help="write a ParaView series (.pvd + .vtu frames) to this directory")
     parser.add_argument("--vtk-every", type=int, default=10,
                         help="steps between ParaView frames (default 10)")
+    mtc = parser.add_argument_group("membrane-truss-cable model (--model mtc)")
+    mtc.add_argument("--tendon-elements", type=int, default=3,
+                     help="truss elements per tendon (default 3, as in 6.5)")
+    mtc.add_argument("--rest-lengths", default=None,
+                     help="tendon rest lengths as for `tmfem static` (system, design, mtc, "
+                          "GROUP=VALUE,...)")
+    mtc.add_argument("--rayleigh", type=float, nargs=2, default=(0.0, 0.0),
+                     metavar=("ALPHA", "BETA"),
+                     help="Rayleigh damping C = ALPHA M + BETA K_0 (default none)")
 
 
 def run(args) -> dict:
+    if args.model == "mtc":
+        return run_mtc(args)
     from tmfem.reduced.modal import default_membrane_modes
     from tmfem.reduced.model import ControlOrientedModel
     from tmfem.reduced.simulate import free_vibration, parse_perturbation, plot_free_vibration
@@ -71,17 +84,81 @@ def run(args) -> dict:
     return out
 
 
+def run_mtc(args) -> dict:
+    """Free vibration of the MTC model (tmfem.fem.mtc_dynamics)."""
+    from tmfem.cli.static import apply_rest_lengths, sequence_of
+    from tmfem.fem.mtc import MTCModel
+    from tmfem.fem.mtc_dynamics import mtc_free_vibration, perturbation_names
+    from tmfem.reduced.simulate import parse_perturbation, plot_free_vibration
+
+    system = system_from_args(args)
+    if not (args.t_end > 0 and args.dt > 0):
+        raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
+    if args.damping or args.membrane_modes is not None or args.prestress_scale != 1.0:
+        raise InputError("--damping, --membrane-modes and --prestress-scale belong to --model com; "
+                         "the MTC model takes --rayleigh ALPHA BETA and --rest-lengths")
+    pert = parse_perturbation(args.perturb, perturbation_names(system))
+    system, rest = apply_rest_lengths(system, args.rest_lengths)
+    model = MTCModel(system, mesh_n=args.mesh, tendon_elements=args.tendon_elements,
+                     rest_lengths=rest)
+    print(f"tmfem vibrate: {system.name} MTC, mesh {system.N}x{args.mesh}x{args.mesh}, "
+          f"{model.ndof} DOFs, static equilibrium", file=sys.stderr)
+    st = model.solve_static(start="undeformed", sequence=sequence_of(args))
+    res = mtc_free_vibration(model, st.x, t_end=args.t_end, dt=args.dt, perturb=pert,
+                             csv_path=args.csv, scheme=args.scheme, alpha=args.rayleigh[0],
+                             beta=args.rayleigh[1], progress=True, vtk_dir=args.vtk,
+                             vtk_every=args.vtk_every)
+    out = {"system": system.name, "model": "mtc", "mesh": args.mesh, "ndof": model.ndof,
+           "tendon_elements": args.tendon_elements, "t_end": args.t_end, "dt": args.dt,
+           "perturbation": pert, "scheme": args.scheme, "rayleigh": list(args.rayleigh),
+           "static_time_s": st.time, "wall_time_s": res.wall_time, "steps": res.stats["steps"],
+           "newton_iterations": res.stats["newton_iterations"],
+           "jacobian_evaluations": res.stats["jacobian_evaluations"],
+           "min_tendon_force_N": res.stats["min_tendon_force"],
+           "min_tendon_force_tendon": res.stats["min_tendon_force_tendon"],
+           "max_tendon_deflection_m": res.stats["max_tendon_deflection"],
+           "max_tendon_deflection_tendon": res.stats["max_tendon_deflection_tendon"],
+           "energy_drift_J": float(np.max(np.abs(res.energy - res.energy[0]))),
+           "initial_kinetic_energy_J": float(res.kinetic[0]),
+           "w_max_abs_m": np.max(np.abs(res.w), axis=0).tolist() if res.w.size else [],
+           "node_range_m": {k: np.ptp(v, axis=0).tolist() for k, v in res.nodes.items()},
+           "q_range": dict(zip(system.q_names, np.ptp(res.q, axis=0).tolist()))}
+    if args.csv:
+        out["csv"] = args.csv
+    if "pvd" in res.stats:
+        out["pvd"] = res.stats["pvd"]
+    if args.plot:
+        out["plot"] = plot_free_vibration(res, args.plot,
+                                          title=f"{system.name} MTC free vibration, mesh {args.mesh}")
+    return out
+
+
 def format_text(r: dict) -> str:
+    if r.get("model") == "mtc":
+        return _format_mtc(r)
     lines = [f"{r['system']} COM free vibration: {r['steps']} steps of {r['dt']} s "
              f"({r['scheme']}), {r['wall_time_s']:.2f} s wall, {r['newton_iterations']} Newton "
              f"iterations, {r['jacobian_evaluations']} Jacobians",
              "perturbation: " + ", ".join(f"{k}={v:g}" for k, v in r["perturbation"].items()),
              f"smallest tendon force {r['min_tendon_force_N']:.4g} N ({r['min_tendon_force_tendon']})"]
-    for i, w in enumerate(r["w_max_abs_m"]):
-        lines.append(f"max |w_{i + 1}| = {1e3 * w:.4f} mm")
+    return "\n".join(lines + _format_outputs(r))
+
+
+def _format_mtc(r: dict) -> str:
+    lines = [f"{r['system']} MTC free vibration ({r['ndof']} DOFs): {r['steps']} steps of "
+             f"{r['dt']} s ({r['scheme']}), {r['wall_time_s']:.2f} s wall (static "
+             f"{r['static_time_s']:.2f} s), {r['newton_iterations']} Newton iterations, "
+             f"{r['jacobian_evaluations']} Jacobians",
+             "perturbation: " + ", ".join(f"{k}={v:g}" for k, v in r["perturbation"].items()),
+             f"smallest tendon force {r['min_tendon_force_N']:.4g} N ({r['min_tendon_force_tendon']})",
+             f"largest tendon transverse deflection {1e3 * r['max_tendon_deflection_m']:.3g} mm "
+             f"({r['max_tendon_deflection_tendon']})",
+             f"energy drift {r['energy_drift_J']:.3g} J (initial kinetic {r['initial_kinetic_energy_J']:.3g} J)"]
+    return "\n".join(lines + _format_outputs(r))
+
+
+def _format_outputs(r: dict) -> list:
+    lines = [f"max |w_{i + 1}| = {1e3 * w:.4f} mm" for i, w in enumerate(r["w_max_abs_m"])]
     for k, v in r["node_range_m"].items():
         lines.append(f"{k} peak-to-peak (x, y, z) = " + ", ".join(f"{1e3 * a:.3f}" for a in v) + " mm")
-    for k in ("csv", "plot", "pvd"):
-        if k in r:
-            lines.append(f"{k}: {r[k]}")
-    return "\n".join(lines)
+    return lines + [f"{k}: {r[k]}" for k in ("csv", "plot", "pvd") if k in r]

@@ -39,6 +39,22 @@ def parse_perturbation(items, names) -> dict:
     return out
 
 
+def open_outputs(csv_path, columns, vtk_dir, vtk_every, *, name: str):
+    """CSV file (header written), its writer and the ParaView series of a simulation; each
+    None when not asked."""
+    fh = open(csv_path, "w", newline="") if csv_path else None
+    writer = csv.writer(fh) if fh else None
+    if writer:
+        writer.writerow(columns)
+    series = None
+    if vtk_dir is not None:
+        from tmfem.io.vtk import SeriesWriter
+        if not (isinstance(vtk_every, int) and vtk_every >= 1):
+            raise InputError(f"vtk_every: expected an integer >= 1, found {vtk_every!r}")
+        series = SeriesWriter(vtk_dir, name=name.replace("(", "").replace(")", ""))
+    return fh, writer, series
+
+
 class _Driven:
     """The model with prescribed rest lengths u(t), as a residual for park_integrate."""
 
@@ -130,17 +146,8 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
                + [f"{n}_{c}" for n in labels for c in "xyz"])
     n_steps = int(round(t_end / dt))
     T, Z, ZD, W, XS = [], [], [], [], []
-    fh = open(csv_path, "w", newline="") if csv_path else None
-    writer = csv.writer(fh) if fh else None
-    if writer:
-        writer.writerow(columns)
-
-    series = None
-    if vtk_dir is not None:
-        from tmfem.io.vtk import SeriesWriter
-        if not (isinstance(vtk_every, int) and vtk_every >= 1):
-            raise InputError(f"vtk_every: expected an integer >= 1, found {vtk_every!r}")
-        series = SeriesWriter(vtk_dir, name=f"com_{system.name}".replace("(", "").replace(")", ""))
+    fh, writer, series = open_outputs(csv_path, columns, vtk_dir, vtk_every,
+                                      name=f"com_{system.name}")
     count = [0]
 
     Tmin = [np.inf, 0.0, ""]          # smallest tendon force, its time and tendon
