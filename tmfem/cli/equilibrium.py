@@ -23,17 +23,40 @@ def configure(parser) -> None:
                         help="membrane mesh n x n per quadrilateral patch (default 10, as in 6.2)")
     parser.add_argument("--allow-infeasible", action="store_true",
                         help="print the design even when an equilibrium condition is violated")
+    add_attachment_args(parser)
 
 
-def design_result(system, *, mesh_n: int, strict: bool) -> tuple[dict, object]:
+def add_attachment_args(parser) -> None:
+    """``--attachment`` / ``--patch``: membrane corner attachment of the plane-stress FE."""
+    parser.add_argument("--attachment", choices=("point", "distributed"), default="point",
+                        help="membrane corner attachment: 'point' (default, the dissertation's "
+                             "model; singular, F_Delta and the rest lengths drift like 1/log(n) "
+                             "with the mesh) or 'distributed' (corner spread over a patch by an "
+                             "RBE3-type affine coupling; converges under mesh refinement)")
+    parser.add_argument("--patch", type=float, default=None, metavar="R",
+                        help="patch radius [m] of --attachment distributed (default 10%% of "
+                             "r_mb). It must reach beyond the corner's two edge neighbours: "
+                             "with fewer than 3 nodes it is an error, with only those it "
+                             "reduces to the point attachment (1-4 at the default patch: "
+                             "--mesh 5 fails, --mesh 10 equals point; use --mesh >= 20)")
+
+
+def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point",
+                  patch: float | None = None) -> tuple[dict, object]:
     """Run the design and return (JSON-able result, EquilibriumDesign)."""
     from tmfem.equilibrium.design import design_equilibrium
 
     if mesh_n < 1:
         raise InputError(f"--mesh: expected n >= 1, found {mesh_n}")
-    d = design_equilibrium(system, mesh_n=mesh_n, strict=strict)
+    if patch is not None and attachment != "distributed":
+        raise InputError(f"--patch: expected only with --attachment distributed, found "
+                         f"--attachment {attachment}")
+    d = design_equilibrium(system, mesh_n=mesh_n, strict=strict, attachment=attachment,
+                           patch=patch)
     out = d.to_dict()
     out["mesh_n"] = mesh_n
+    out["attachment"] = attachment
+    out["patch"] = d.membrane_model.patch
     out["node_labels"] = list(system.node_labels)
     out["printed"] = dict(system.printed)
     if d.given_rest_lengths is not None:
@@ -49,7 +72,8 @@ def design_result(system, *, mesh_n: int, strict: bool) -> tuple[dict, object]:
 
 def run(args) -> dict:
     system = system_from_args(args)
-    out, _ = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible)
+    out, _ = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible,
+                           attachment=args.attachment, patch=args.patch)
     out["as_printed"] = bool(args.as_printed)
     return out
 
@@ -64,7 +88,9 @@ def _groups(r: dict) -> dict:
 
 def format_text(r: dict) -> str:
     L = [f"system {r['system']} ({r['M']}-{r['N']}{'(D)' if r['deployable'] else ''}), "
-         f"membrane mesh {r['mesh_n']}x{r['mesh_n']} per patch: "
+         f"membrane mesh {r['mesh_n']}x{r['mesh_n']} per patch"
+         + (f", distributed corners (patch radius {r['patch']:.4g} m)"
+            if r.get("attachment") == "distributed" else ", point corners") + ": "
          + ("all checks passed" if r["ok"] else "CHECKS FAILED")]
     L.append("")
     L.append("nodes [m]:")

@@ -45,6 +45,8 @@ def configure(parser) -> None:
                              "and 1-N(D) systems "
                              "(default 13; 0 = no map)")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render")
+    from tmfem.cli.equilibrium import add_attachment_args
+    add_attachment_args(parser)
 
 
 def _progress(msg: str) -> None:
@@ -144,7 +146,10 @@ def write_tables(out: Path, d, system) -> dict:
             w.writerow(row)
     md = [f"# Equilibrium study: {system.name}", "", system.description, "",
           f"Membrane mesh {d.membrane_model.mesh.n} x {d.membrane_model.mesh.n} per patch "
-          f"({d.membrane_model.mesh.t.shape[1]} quads). Printed values: "
+          f"({d.membrane_model.mesh.t.shape[1]} quads), "
+          + (f"distributed corners (patch radius {d.membrane_model.patch:.4g} m). "
+             if d.membrane_model.attachment == "distributed" else "point corners. ")
+          + f"Printed values: "
           f"{system.printed.get('source', 'none')}.", "",
           "| quantity | unit | ours | printed | rel. diff | source |",
           "|---|---|---|---|---|---|"]
@@ -239,7 +244,8 @@ def run(args) -> dict:
     except OSError as exc:
         raise InputError(f"--out: cannot create directory {out}: {exc}") from None
     _progress(f"equilibrium design of {system.name} (membrane mesh {args.mesh}x{args.mesh})")
-    result, d = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible)
+    result, d = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible,
+                              attachment=args.attachment, patch=args.patch)
     files = {}
     _progress("tables")
     tables = write_tables(out, d, system)
@@ -253,7 +259,8 @@ def run(args) -> dict:
     _progress("VTK file")
     from tmfem.io.vtk import write_configuration
     from tmfem.post.fields import membrane_design_field
-    membrane = membrane_design_field(system, n=args.mesh)
+    membrane = membrane_design_field(system, n=args.mesh, attachment=args.attachment,
+                                     patch=d.membrane_model.patch)
     files["configuration.vtu"] = str(write_configuration(
         out / "configuration.vtu", system, tendon_forces=d.tendon_forces,
         rest_lengths=d.rest_lengths if np.all(np.isfinite(d.rest_lengths)) else None,

@@ -30,6 +30,7 @@ from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix,
                                        symmetric_matrix)
 from tmfem.equilibrium.symmetric import closed_form_1N, closed_form_1ND
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
+from tmfem.fem.attachment import default_patch_radius
 from tmfem.fem.plane_stress import PlaneStressMembrane, PlaneStressSolution
 from tmfem.system.geometry import beta
 
@@ -161,8 +162,13 @@ def _finite(v):
 
 
 # ---------------------------------------------------------------------------- pieces
-def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembrane | None = None):
+def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembrane | None = None,
+                   attachment: str = "point", patch: float | None = None):
     """Corner displacements (eq. 3.5) and the plane-stress membrane solution for them.
+
+    ``attachment``/``patch``: corner attachment of :class:`PlaneStressMembrane` (``"point"``,
+    the dissertation's model, or ``"distributed"``; default patch radius 10 % of r_mb, as in
+    the MTC model). Ignored when ``model`` is given.
 
     Returns
     -------
@@ -171,8 +177,10 @@ def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembra
     q = system.q if q is None else np.asarray(q, dtype=float)
     E = equilibrium_matrix(system, q)
     if model is None:
+        if attachment == "distributed" and patch is None:
+            patch = default_patch_radius(system.membrane_corners, system.r_mb)
         model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane,
-                                    n=mesh_n)
+                                    n=mesh_n, attachment=attachment, patch=patch)
     sol = model.solve(E.state.delta[:2])
     return E, model, sol
 
@@ -242,7 +250,8 @@ def bar_axial_loads(system, q, tendon_forces: np.ndarray, corner_force_inertial:
 
 
 def forces_from_rest_lengths(system, rest_lengths=None, *, q=None, mesh_n: int = 10,
-                             membrane=None) -> dict:
+                             membrane=None, attachment: str = "point",
+                             patch: float | None = None) -> dict:
     """Tendon forces T = EA (|d| - r)/r (eqs. 3.8-3.9) implied by rest lengths at q.
 
     Parameters
@@ -251,6 +260,9 @@ def forces_from_rest_lengths(system, rest_lengths=None, *, q=None, mesh_n: int =
         Defaults to ``system.rest_lengths``.
     membrane : (EquilibriumMatrix, PlaneStressMembrane, PlaneStressSolution), optional
         A precomputed :func:`membrane_state` to reuse.
+    attachment, patch
+        Corner attachment of the membrane (see :func:`membrane_state`) when ``membrane`` is
+        not given.
 
     Returns
     -------
@@ -269,7 +281,8 @@ def forces_from_rest_lengths(system, rest_lengths=None, *, q=None, mesh_n: int =
     EA = system.tendon_EA
     strain = (L - r) / r
     T = EA * strain
-    E, _, sol = membrane_state(system, q, mesh_n=mesh_n) if membrane is None else membrane
+    E, _, sol = membrane_state(system, q, mesh_n=mesh_n, attachment=attachment,
+                               patch=patch) if membrane is None else membrane
     b = E.A_F @ free_forces(sol.corner_forces)
     residual = float(np.linalg.norm(E.A_T @ np.maximum(T, 0.0) + b) / max(np.linalg.norm(b), 1e-300))
     return {"rest_lengths": r, "lengths": L, "strain": strain, "forces": T,
@@ -304,7 +317,8 @@ def _radial_delta(system, delta: np.ndarray) -> float | None:
 
 
 def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
-                       residual_tol: float = 1e-3) -> EquilibriumDesign:
+                       residual_tol: float = 1e-3, attachment: str = "point",
+                       patch: float | None = None) -> EquilibriumDesign:
     """Design the prestress of ``system`` at configuration q (dissertation 3.2, 6.2).
 
     Parameters
@@ -321,9 +335,17 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
         Strength checks (yield, buckling) are reported in ``checks`` and never raise.
     residual_tol : float
         Largest accepted relative residual of eq. 3.16.
+    attachment : {"point", "distributed"}
+        Membrane corner attachment of the plane-stress FE. ``"point"`` (default, the
+        dissertation's model) is singular: F_Delta, hence every force and rest length,
+        falls like 1/log(n) under mesh refinement. ``"distributed"`` spreads each corner over
+        a patch (RBE3-type affine coupling, the MTC model's ``attachment="distributed"``)
+        and converges.
+    patch : float, optional
+        Patch radius [m] of the distributed attachment (default 10 % of r_mb).
     """
     q = system.q if q is None else np.asarray(q, dtype=float)
-    E, model, sol = membrane_state(system, q, mesh_n=mesh_n)
+    E, model, sol = membrane_state(system, q, mesh_n=mesh_n, attachment=attachment, patch=patch)
     st = E.state
     N = system.N
     checks: list[Check] = []

@@ -493,14 +493,17 @@ class MTCModel:
         B_ij) — a linear system for the member forces, solved by least squares; a residual
         above round-off means the design geometry is not an equilibrium; (3) the rest
         lengths follow from the truss law (:func:`green_rest_length`).
-        Only for ``attachment="point"``.
+        With ``attachment="distributed"`` step (1) holds the weighted patch centroids
+        sum_i w_i x_i (the attachment of :func:`tmfem.fem.attachment.attachment_weights`) at
+        the bar tops by Lagrange multipliers, which are the corner forces.
         """
-        if self.topology.attachment != "point":
-            raise InputError("consistent_rest_lengths: defined for attachment='point' only")
         topo, sysm = self.topology, self.system
         x = self.initial_positions("design")
         nm = topo.n_mesh
         corners = topo.mesh.corners
+        if topo.attachment == "distributed":
+            Fc = self._distributed_corner_forces(x[:, :nm].T.ravel().copy(), tol=tol)
+            return self._consistent_from_corner_forces(Fc)
         freem = np.ones(3 * nm, dtype=bool)
         for c in corners:
             freem[3 * c:3 * c + 3] = False
@@ -517,6 +520,35 @@ class MTCModel:
             raise ConvergenceError(f"membrane with prescribed corners: |r| = {fn:.3e} N after 50 "
                                    f"iterations")
         Fc = -f.reshape(-1, 3)[corners].T                  # force of the membrane on corner j (3, N)
+        return self._consistent_from_corner_forces(Fc)
+
+    def _distributed_corner_forces(self, xm: np.ndarray, *, tol: float) -> np.ndarray:
+        """Forces (3, N) of the membrane on the bar tops with the patch centroids held at
+        their design positions: Newton on the bordered system [[K, s C^T], [s C, 0]]
+        (C: the attachment coupling; the start ``xm`` satisfies C x = B_top already)."""
+        from tmfem.fem.attachment import coupling_matrix
+        nm = self.topology.n_mesh
+        C = coupling_matrix(self.topology.weights, nm, 3)
+        CCt = (C @ C.T).toarray()
+        for it in range(50):
+            f, K = self.membrane.internal(xm.reshape(-1, 3).T)
+            lam = -np.linalg.solve(CCt, C @ f)             # least-squares multipliers
+            fn = np.linalg.norm(f + C.T @ lam)
+            if fn <= tol * (np.linalg.norm(lam) + 1e-30):
+                break
+            s = float(np.abs(K.diagonal()).mean())
+            A = sp.bmat([[K, s * C.T], [s * C, None]], format="csc")
+            du = spla.spsolve(A, np.concatenate([-f, np.zeros(C.shape[0])]))[:3 * nm]
+            xm += du
+        else:
+            raise ConvergenceError(f"membrane with prescribed corner patches: |r| = {fn:.3e} N "
+                                   f"after 50 iterations")
+        # f_int = C^T mu with mu the force on the membrane; lam = -mu is the force on the bar
+        return lam.reshape(-1, 3).T
+
+    def _consistent_from_corner_forces(self, Fc: np.ndarray) -> dict:
+        """Steps (2)-(3) of :meth:`consistent_rest_lengths` for the corner forces Fc (3, N)."""
+        sysm = self.system
         X = sysm.nodes()
         labels = sysm.node_labels
         fixed = {sysm.node_index(label("A", 1, j)) for j in range(1, sysm.N + 1)}

@@ -23,6 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
+from tmfem.fem.attachment import attachment_weights, default_patch_radius  # noqa: F401 (re-export)
 from tmfem.mesh.polygon import MembraneMesh, polygon_quad_mesh
 from tmfem.system.geometry import floating_frame
 from tmfem.system.topology import label
@@ -80,49 +81,6 @@ class MTCTopology:
         return int(self.T.shape[1]) // 3
 
 
-def attachment_weights(mesh: MembraneMesh, *, attachment: str, patch: float) -> list:
-    """Nodes and weights of the membrane patch each corner load is spread over.
-
-    ``"point"``: the corner node alone (weight 1). ``"distributed"``: the membrane nodes
-    within ``patch`` [m] of the corner. The bar top is the value at the corner of the affine
-    map x(p) = a + B p fitted by weighted least squares to the patch nodes (weights omega_i =
-    lumped nodal area times the taper 1 - r / patch): x_top = sum_i w_i x_i with
-    w_i = omega_i [1, p_i] G^-1 [1, p_c], G = sum_i omega_i [1, p_i][1, p_i]^T. Hence
-    sum w_i = 1 and sum w_i p_i = p_c: the link is exact for rigid motions (objective) and
-    for any affine deformation of the patch, the attachment point stays at the design corner,
-    and the corner force is spread over the patch as a smooth body-force density
-    taper(r) (alpha + beta . p) that does not depend on the mesh. The stresses it causes stay
-    bounded under refinement, unlike a point load (log-singular displacement, 1/r stress).
-    """
-    if attachment == "point":
-        return [(np.array([c]), np.array([1.0])) for c in mesh.corners]
-    if attachment != "distributed":
-        raise InputError(f"attachment: expected 'point' or 'distributed', found {attachment!r}")
-    if not patch > 0:
-        raise InputError(f"attachment patch radius: expected > 0, found {patch!r}")
-    p, t = mesh.p, mesh.t
-    # lumped nodal areas (quarter of each quad's area to each of its nodes)
-    x, y = p[0, t], p[1, t]
-    area = 0.5 * np.abs(np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y, axis=0))
-    nodal = np.bincount(t.ravel(), weights=np.repeat(area[None] / 4.0, 4, axis=0).ravel(),
-                        minlength=p.shape[1])
-    out = []
-    for c in mesh.corners:
-        r = np.hypot(p[0] - p[0, c], p[1] - p[1, c])
-        nodes = np.flatnonzero(r < patch)
-        omega = nodal[nodes] * (1.0 - r[nodes] / patch)
-        P = np.vstack([np.ones(nodes.size), p[:, nodes]])          # (3, n)
-        G = (P * omega) @ P.T
-        if nodes.size < 3 or np.linalg.cond(G) > 1e12:
-            raise InputError(f"distributed attachment: the patch of radius {patch} m holds "
-                             f"{nodes.size} membrane nodes; expected >= 3 not on a line (refine "
-                             f"the mesh or enlarge the patch)")
-        # weighted least-squares affine fit of the patch, evaluated at the corner
-        w = omega * (P.T @ np.linalg.solve(G, np.array([1.0, p[0, c], p[1, c]])))
-        out.append((nodes, w))
-    return out
-
-
 def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str = "point",
                    patch: float | None = None) -> MTCTopology:
     """Number the nodes and members of the MTC model of ``system`` (4.4, 6.2).
@@ -164,9 +122,7 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
     n_nodes = nm + ns + n_t * (k - 1)
 
     if patch is None:
-        R = system.r_mb if system.r_mb else float(np.max(np.linalg.norm(
-            system.membrane_corners - system.membrane_corners.mean(axis=1, keepdims=True), axis=0)))
-        patch = 0.1 * R
+        patch = default_patch_radius(system.membrane_corners, system.r_mb)
     weights = attachment_weights(mesh, attachment=attachment, patch=patch)
 
     dependent = np.zeros(n_nodes, dtype=bool)

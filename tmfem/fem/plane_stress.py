@@ -23,6 +23,12 @@ displacement decreases slowly (about like 1 / log n) and the peak stresses next 
 corners grow without bound as the mesh is refined. The corner force F_Delta of eq. 3.21
 and the maximum stresses of Tables 6.3 and 6.5 are therefore properties of the mesh
 (4 x 10 x 10 in 6.2), not of the continuum; see tests/test_plane_stress.py.
+
+``attachment="distributed"`` removes the singularity: each corner displacement is imposed
+on a small patch around the corner through the kinematic (RBE3-type, affine-fit) coupling of
+:func:`tmfem.fem.attachment.attachment_weights` (the one of the MTC model), sum_i w_i u_i =
+delta_j, by Lagrange multipliers; the multiplier is the resultant corner force on the patch.
+F_Delta then converges under mesh refinement (for a fixed patch radius).
 """
 from __future__ import annotations
 
@@ -34,6 +40,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from tmfem.errors import InputError, SlackMembrane
+from tmfem.fem.attachment import (ATTACHMENTS, attachment_weights, coupling_matrix,
+                                  default_patch_radius)
 from tmfem.mesh import MembraneMesh, polygon_quad_mesh
 from tmfem.system.geometry import beta
 from tmfem.system.materials import MembraneMaterial
@@ -148,7 +156,7 @@ class PlaneStressSolution:
 
 
 class PlaneStressMembrane:
-    """Linear plane-stress model of the flat membrane with corner point attachments.
+    """Linear plane-stress model of the flat membrane loaded at its corners.
 
     Parameters
     ----------
@@ -158,13 +166,25 @@ class PlaneStressMembrane:
         E, nu, thickness h.
     n : int
         Elements per side of each of the N quadrilateral patches (6.2 uses 10).
+    attachment : {"point", "distributed"}
+        ``"point"`` (the dissertation's model): the corner node carries the prescribed
+        displacement (Dirichlet); singular, F_Delta falls like 1/log(n). ``"distributed"``:
+        the displacement is imposed on the patch of nodes within ``patch`` of the corner
+        through the affine-fit coupling sum_i w_i u_i = delta_j
+        (:func:`tmfem.fem.attachment.attachment_weights`); converges under refinement.
+    patch : float, optional
+        Patch radius [m] of the distributed attachment; default 10 % of the corner polygon's
+        circumradius (:func:`tmfem.fem.attachment.default_patch_radius`).
     """
 
-    def __init__(self, *, corners, material: MembraneMaterial, n: int = 10):
+    def __init__(self, *, corners, material: MembraneMaterial, n: int = 10,
+                 attachment: str = "point", patch: float | None = None):
         from skfem import Basis, ElementQuad1, ElementVector
 
         if not isinstance(material, MembraneMaterial):
             raise InputError(f"expected a MembraneMaterial, found {type(material).__name__}")
+        if attachment not in ATTACHMENTS:
+            raise InputError(f"attachment: expected one of {ATTACHMENTS}, found {attachment!r}")
         self.material = material
         self.mesh: MembraneMesh = polygon_quad_mesh(corners, n)
         self.corners = self.mesh.p[:, self.mesh.corners].copy()
@@ -176,6 +196,12 @@ class PlaneStressMembrane:
         mask = np.ones(self.basis.N, dtype=bool)
         mask[self.corner_dofs] = False
         self.interior_dofs = np.flatnonzero(mask)
+        self.attachment = attachment
+        self.patch = None
+        if attachment == "distributed":
+            self.patch = float(default_patch_radius(self.corners) if patch is None else patch)
+        self.weights = attachment_weights(self.mesh, attachment=attachment,
+                                          patch=self.patch if self.patch is not None else 1.0)
 
     # ------------------------------------------------------------------ assembly
     @cached_property
@@ -200,13 +226,45 @@ class PlaneStressMembrane:
         I = self.interior_dofs
         return spla.splu(self.K[I][:, I].tocsc())
 
-    def corner_stiffness(self) -> np.ndarray:
-        """Condensed in-plane corner stiffness S (2N, 2N), static condensation of all
-        non-corner DOFs: f_c = S delta, DOFs interleaved (u_1, v_1, ..., u_N, v_N), O_f frame.
+    @cached_property
+    def coupling(self) -> sp.csr_matrix:
+        """Coupling C (2N, n_dofs): corner displacements (u_1, v_1, ...) = C x (scikit-fem
+        DOF numbering); the corner rows of the identity for a point attachment."""
+        C = coupling_matrix(self.weights, self.mesh.p.shape[1], 2)
+        perm = self.basis.nodal_dofs.T.ravel()      # skfem dof of interleaved dof 2 node + a
+        return sp.csr_matrix((C.data, perm[C.indices], C.indptr), shape=(C.shape[0], self.basis.N))
 
-        S = K_cc - K_ci K_ii^{-1} K_ic; symmetric positive semidefinite with the three
-        in-plane rigid motions as its null space.
+    @cached_property
+    def _kkt(self):
+        """LU of the bordered system [[K, s C^T], [s C, 0]] (distributed attachment); s scales
+        the coupling rows to the stiffness."""
+        s = float(np.abs(self.K.diagonal()).mean())
+        C = self.coupling
+        A = sp.bmat([[self.K, s * C.T], [s * C, None]], format="csc")
+        return spla.splu(A), s
+
+    def _solve_distributed(self, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """DOF vectors x (n_dofs, k) and corner forces mu (2N, k) for corner displacements
+        rhs (2N, k): K x = C^T mu, C x = rhs."""
+        lu, s = self._kkt
+        nd = self.basis.N
+        b = np.zeros((nd + rhs.shape[0], rhs.shape[1]))
+        b[nd:] = s * rhs                      # s C x = s rhs
+        y = lu.solve(b)
+        return y[:nd], -s * y[nd:]              # K x + s C^T y = 0: K x = C^T mu, mu = -s y
+
+    def corner_stiffness(self) -> np.ndarray:
+        """Condensed in-plane corner stiffness S (2N, 2N): f_c = S delta, DOFs interleaved
+        (u_1, v_1, ..., u_N, v_N), O_f frame.
+
+        Point attachment: static condensation of all non-corner DOFs,
+        S = K_cc - K_ci K_ii^{-1} K_ic. Distributed: the corner forces (Lagrange multipliers)
+        for unit corner displacements imposed through the coupling C. Either way symmetric
+        positive semidefinite with the three in-plane rigid motions as its null space.
         """
+        if self.attachment == "distributed":
+            _, S = self._solve_distributed(np.eye(2 * self.N))
+            return 0.5 * (S + S.T)
         c, I = self.corner_dofs, self.interior_dofs
         K = self.K
         Kic = K[I][:, c].toarray()
@@ -216,15 +274,23 @@ class PlaneStressMembrane:
     # ------------------------------------------------------------------ solution
     def displacement(self, delta) -> np.ndarray:
         """Full DOF vector for prescribed corner displacements delta (2, N)."""
+        return self._displacement(delta)[0]
+
+    def _displacement(self, delta) -> tuple[np.ndarray, np.ndarray]:
+        """DOF vector and corner forces (2, N) on the membrane for corner displacements."""
         delta = np.asarray(delta, dtype=float)
         if delta.shape != (2, self.N) or not np.all(np.isfinite(delta)):
             raise InputError(f"expected corner displacements of shape (2, {self.N}) with finite "
                              f"entries, found shape {delta.shape}")
+        if self.attachment == "distributed":
+            x, mu = self._solve_distributed(delta.T.reshape(-1, 1))
+            return x[:, 0], mu[:, 0].reshape(self.N, 2).T
         x = np.zeros(self.basis.N)
         c, I = self.corner_dofs, self.interior_dofs
         x[c] = delta.T.ravel()
         x[I] = -self._interior_lu.solve(self.K[I][:, c] @ x[c])
-        return x
+        f = self.K @ x
+        return x, f[self.basis.nodal_dofs[:, self.mesh.corners]]
 
     def stresses(self, x: np.ndarray) -> np.ndarray:
         """(s_xx, s_yy, s_xy) at the quadrature points (3, n_el, n_qp) of DOF vector x."""
@@ -232,12 +298,11 @@ class PlaneStressMembrane:
 
     def solve(self, delta) -> PlaneStressSolution:
         """Plane-stress state for corner displacements delta (2, N) in O_f."""
-        x = self.displacement(delta)
-        f = self.K @ x
+        x, corner_forces = self._displacement(delta)
         nd = self.basis.nodal_dofs
         return PlaneStressSolution(
             delta=np.asarray(delta, dtype=float).copy(),
-            corner_forces=f[nd[:, self.mesh.corners]],
+            corner_forces=corner_forces,
             u=x[nd],
             sigma=self.stresses(x),
             qp=np.array(self.basis.global_coordinates()),
@@ -302,7 +367,8 @@ class SymmetricCornerResponse:
 
 
 def symmetric_corner_force(system, *, n: int = 10, Delta: float | None = None,
-                           allow_slack: bool = False, symmetry_tol: float = 1e-6) -> float:
+                           allow_slack: bool = False, symmetry_tol: float = 1e-6,
+                           attachment: str = "point", patch: float | None = None) -> float:
     """Membrane corner force F_Delta of a symmetric system (eqs. 3.21-3.22), linear FE.
 
     Parameters
@@ -318,6 +384,8 @@ def symmetric_corner_force(system, *, n: int = 10, Delta: float | None = None,
         (compressive, physically meaningless) force is returned.
     symmetry_tol : float
         Largest accepted asymmetry of the corner forces relative to F_Delta.
+    attachment, patch
+        Corner attachment of :class:`PlaneStressMembrane` (default patch 10 % of r_mb).
 
     Returns
     -------
@@ -338,7 +406,10 @@ def symmetric_corner_force(system, *, n: int = 10, Delta: float | None = None,
     if not np.allclose(e / np.linalg.norm(e, axis=0), [np.cos(b), np.sin(b)], atol=1e-9):
         raise InputError(f"system {system.name!r}: membrane corners are not a regular polygon "
                          "oriented as beta_j of eq. 3.21")
-    resp = PlaneStressMembrane(corners=corners, material=system.membrane, n=n).symmetric_response(Delta)
+    if attachment == "distributed" and patch is None:
+        patch = default_patch_radius(corners, system.r_mb)
+    resp = PlaneStressMembrane(corners=corners, material=system.membrane, n=n,
+                               attachment=attachment, patch=patch).symmetric_response(Delta)
     if resp.asymmetry > symmetry_tol:
         raise InputError(f"system {system.name!r}: corner forces not symmetric: expected "
                          f"asymmetry <= {symmetry_tol:g}, found {resp.asymmetry:.3g}")

@@ -44,7 +44,8 @@ def corner_radial_displacements(system, q=None) -> np.ndarray:
     return np.sum(d * e, axis=0)
 
 
-def membrane_design_field(system, *, q=None, n: int = 10) -> MembraneField:
+def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "point",
+                          patch: float | None = None) -> MembraneField:
     """The membrane of configuration q: linear plane-stress state for its corner positions.
 
     Parameters
@@ -54,6 +55,9 @@ def membrane_design_field(system, *, q=None, n: int = 10) -> MembraneField:
         Configuration; default ``system.q``.
     n : int
         Elements per side of each of the N quadrilateral patches (6.2 uses 10).
+    attachment, patch
+        Corner attachment of the plane-stress membrane (``"point"`` or ``"distributed"``,
+        default patch 10 % of r_mb; see :class:`tmfem.fem.plane_stress.PlaneStressMembrane`).
 
     Returns
     -------
@@ -66,7 +70,11 @@ def membrane_design_field(system, *, q=None, n: int = 10) -> MembraneField:
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise InputError(f"membrane mesh: expected n >= 1, found {n!r}")
     delta, o, R = corner_displacements(system, q)
-    model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane, n=n)
+    if attachment == "distributed" and patch is None:
+        from tmfem.fem.attachment import default_patch_radius
+        patch = default_patch_radius(system.membrane_corners, system.r_mb)
+    model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane, n=n,
+                                attachment=attachment, patch=patch)
     sol = model.solve(delta)
     mesh = model.mesh
     xf = np.vstack([mesh.p + sol.u, np.zeros(mesh.p.shape[1])])
