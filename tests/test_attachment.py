@@ -97,9 +97,10 @@ def test_patch_to_zero_approaches_point(s14):
     n = 40
     h = s14.r_mb * np.sin(np.pi / 4) / n            # element size: half edge / n (N = 4)
     Fp = symmetric_corner_force(s14, n=n)
-    # patch with only the corner and its two edge neighbours: exactly the point attachment
-    F3 = symmetric_corner_force(s14, n=n, attachment="distributed", patch=1.2 * h)
-    assert F3 == pytest.approx(Fp, rel=1e-9)
+    # a patch with only the corner and its two edge neighbours would be the point attachment
+    # in disguise (an affine fit through 3 nodes interpolates): it is refused, not used
+    with pytest.raises(InputError, match="holds 3 membrane nodes"):
+        symmetric_corner_force(s14, n=n, attachment="distributed", patch=1.2 * h)
     Fs = [symmetric_corner_force(s14, n=n, attachment="distributed", patch=f * s14.r_mb)
           for f in (0.4, 0.2, 0.1, 0.05)]
     assert np.all(np.diff(Fs) < 0) and Fs[-1] > Fp          # decreasing towards the point value

@@ -196,13 +196,20 @@ def test_tendon_subdivision_does_not_change_frequencies():
 
 
 def test_distributed_attachment_close_to_point():
-    # a small patch (radius 10 % of r_mb) changes the global modes little
+    # a small patch (radius 10 % of r_mb, 0.14 m) changes the four global modes little (they
+    # converge under refinement, docs/mtc.md); the membrane modes from mode 5 on are the
+    # corner-sensitive ones. At mesh 20 the patch holds 8-9 nodes per corner, so the two
+    # models really differ
     s = load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
     f = {}
     for att in ("point", "distributed"):
-        m = MTCModel(s, mesh_n=10, tendon_elements=1, attachment=att)
+        m = MTCModel(s, mesh_n=20, tendon_elements=1, attachment=att)
         f[att] = m.modes(m.solve_static(start="design").x, k=6).freq_hz
-    assert f["distributed"] == pytest.approx(f["point"], rel=3e-2)
+    assert min(nodes.size for nodes, _ in m.topology.weights) > 3
+    assert f["distributed"][:4] == pytest.approx(f["point"][:4], rel=1e-2)
+    assert np.max(np.abs(f["distributed"] / f["point"] - 1)) > 1e-3   # not the same model
+    with pytest.raises(InputError, match="holds 3 membrane nodes"):
+        MTCModel(s, mesh_n=10, tendon_elements=1, attachment="distributed")
 
 
 def test_cli_static_and_modal_json(tmp_path, capsys):

@@ -70,10 +70,13 @@ def attachment_weights(mesh: MembraneMesh, *, attachment: str, patch: float) -> 
         omega = nodal[nodes] * (1.0 - r[nodes] / patch)
         P = np.vstack([np.ones(nodes.size), p[:, nodes]])          # (3, n)
         G = (P * omega) @ P.T
-        if nodes.size < 3 or np.linalg.cond(G) > 1e12:
-            raise InputError(f"distributed attachment: the patch of radius {patch} m holds "
-                             f"{nodes.size} membrane nodes; expected >= 3 not on a line (refine "
-                             f"the mesh or enlarge the patch)")
+        # the affine fit has 3 parameters: through 3 nodes it interpolates, and its value at
+        # the corner node is that node alone, i.e. the point attachment in disguise
+        if nodes.size < 4 or np.linalg.cond(G) > 1e12:
+            raise InputError(f"distributed attachment: the patch of radius {patch:.4g} m holds "
+                             f"{nodes.size} membrane nodes at this mesh; expected >= 4 not on a "
+                             f"line (with 3 the affine fit is the point attachment): refine the "
+                             f"mesh or enlarge the patch")
         # weighted least-squares affine fit of the patch, evaluated at the corner
         w = omega * (P.T @ np.linalg.solve(G, np.array([1.0, p[0, c], p[1, c]])))
         out.append((nodes, w))
