@@ -2,10 +2,9 @@
 import json
 from pathlib import Path
 
+import meshio            # a declared dependency (pyproject.toml): a missing one must fail, not skip
 import numpy as np
 import pytest
-
-meshio = pytest.importorskip("meshio")
 
 from tmfem.cli import main
 from tmfem.errors import InputError
@@ -13,6 +12,13 @@ from tmfem.io.msh import read_membrane_mesh, write_membrane_mesh
 from tmfem.system import beta, load_preset
 
 MESHES = Path(__file__).resolve().parents[1] / "meshes"
+
+
+def _line_data(m):
+    """Line cells (bars, then tendons) and their cell data, concatenated over blocks."""
+    k = [i for i, b in enumerate(m.cells) if b.type == "line"]
+    return (np.concatenate([m.cells[i].data for i in k]),
+            {name: np.concatenate([v[i] for i in k]) for name, v in m.cell_data.items()})
 
 
 @pytest.mark.parametrize("name, args, N, r_mb", [
@@ -74,13 +80,14 @@ def test_export_cli(tmp_path, capsys):
     assert m.points.shape[0] == 12 + (3 * 16 + 3 * 4 + 1)             # nodes + 3x4x4 mesh
     assert sum(b.data.shape[0] for b in m.cells if b.type == "quad") == 48
     assert png.stat().st_size > 10_000
-    rest = [m.cell_data["rest_length"][k] for k, b in enumerate(m.cells) if b.type == "line"]
-    rest = np.concatenate(rest)[6:]
-    if r["forces_from"] == "none":      # the preset's own rest lengths, or none
-        if s.rest_lengths is None:
-            assert np.all(np.isnan(rest))
-        else:
-            np.testing.assert_allclose(rest, s.rest_lengths)
+    # the 2-3 preset is a feasible design (Delta = 1 mm, Table 7.7 rule): the file carries the
+    # design forces, and its rest lengths obey eqs. 3.8-3.9 with the file's own lengths
+    assert r["forces_from"] == "design_equilibrium" and r["warnings"] == []
+    _, d = _line_data(m)
+    T, L, rest = d["axial_force"][6:], d["length"][6:], d["rest_length"][6:]
+    np.testing.assert_allclose(T, list(r["tendon_forces"].values()))
+    assert np.all(T > 0)
+    np.testing.assert_allclose(rest, s.tendon_EA * L / (T + s.tendon_EA), rtol=1e-12)
     # --as-printed carries the rest lengths printed in Table 6.4
     assert main(["export", "--preset", "2-3", "--as-printed", str(tmp_path / "a.vtu"),
                  "--mesh", "0", "--no-equilibrium"]) == 0
@@ -120,14 +127,11 @@ def test_membrane_design_field_lands_on_the_bar_tops():
 
 
 def test_export_writes_the_equilibrium_design(tmp_path, capsys):
-    pytest.importorskip("tmfem.equilibrium.design")
     assert main(["export", "--preset", "1-4", str(tmp_path / "d.vtu"), "--mesh", "4",
                  "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     assert r["forces_from"] == "design_equilibrium" and r["warnings"] == []
-    m = meshio.read(tmp_path / "d.vtu")
-    k = [i for i, b in enumerate(m.cells) if b.type == "line"]
-    d = {name: np.concatenate([v[i] for i in k]) for name, v in m.cell_data.items()}
+    _, d = _line_data(meshio.read(tmp_path / "d.vtu"))
     T, L, r0 = d["axial_force"][4:], d["length"][4:], d["rest_length"][4:]
     np.testing.assert_allclose(T, list(r["tendon_forces"].values()))
     assert np.all(T > 0) and np.all(d["slack"][4:] == 0)
