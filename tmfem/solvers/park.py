@@ -107,9 +107,14 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         eq. 5.35 throughout (energy-conserving for linear systems, no numerical damping).
     tol : float
         Newton stops when |dx| <= tol (1 + |x|) (infinity norm).
-    jacobian : {"iteration", "step"}
-        Re-evaluate and factor the Newton matrix at every iteration (full Newton) or once
-        per step (modified Newton; cheaper when the Jacobian is costly).
+    jacobian : {"iteration", "step", "reuse"}
+        Re-evaluate and factor the Newton matrix at every iteration (full Newton), once
+        per step (modified Newton; cheaper when the Jacobian is costly), or keep it over
+        steps and refresh it when a step needs more than ``reuse_iter`` iterations. With
+        "step" and "reuse", a step whose Newton corrections grow restarts from the
+        predictor with full Newton, and one still unconverged after ``2 reuse_iter``
+        iterations continues with full Newton (a stale matrix can make modified Newton
+        diverge).
     callback : callable, optional
         ``callback(t, x, v, a)`` after the initial state and after every step (e.g. to
         write a CSV row); a true return value stops the integration.
@@ -169,16 +174,30 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         if jacobian != "reuse" or kept_coef != (cv, ca):
             solve = None
         fresh = False
+        full = jacobian == "iteration"
+        x_pred = xk.copy()
+        dx_prev = np.inf
         for it in range(1, max_iter + 1):
             vk, ak = kin(xk)
             r = system.residual(xk, vk, ak, t)
-            if (solve is None or jacobian == "iteration"
+            # a kept (modified-Newton) matrix that has not converged in 2 reuse_iter
+            # iterations gives way to full Newton for the step
+            full = full or it > 2 * reuse_iter
+            if (solve is None or full
                     or (jacobian == "reuse" and it > reuse_iter and not fresh)):
                 solve = _solver(_newton_matrix(system, xk, vk, ak, t, cv, ca))
                 kept_coef = (cv, ca)
                 fresh = True
                 res.jacobian_evaluations += 1
             dx = -solve(r)
+            dx_norm = np.max(np.abs(dx))
+            if dx_norm > dx_prev and not full and dx_norm > 1e3 * tol * (1.0 + np.max(np.abs(xk))):
+                # growing corrections of a kept matrix: restart the step from the predictor
+                # with full Newton
+                full = True
+                xk, dx_prev = x_pred.copy(), np.inf
+                continue
+            dx_prev = dx_norm
             xk = xk + dx
             res.newton_iterations += 1
             if not np.all(np.isfinite(xk)):
