@@ -1,8 +1,9 @@
 """VTK output (tmfem.io.vtk): files read back with meshio and with VTK itself (pyvista)."""
+import h5py  # noqa: F401  (XDMF); meshio, pyvista, h5py are declared dependencies (pyproject.toml):
+import meshio            # a broken install must fail here, not skip
 import numpy as np
 import pytest
-
-meshio = pytest.importorskip("meshio")
+import pyvista as pv
 
 from tmfem.errors import InputError
 from tmfem.io import (FAMILY_CODES, KIND_CODES, MembraneField, SeriesWriter, configuration_cells,
@@ -131,11 +132,13 @@ def test_membrane_placement_is_the_radial_stretch_of_eq_3_22(sys14):
 
 
 def test_mean_value_coordinates_reproduce_linear_functions():
+    # an irregular convex heptagon: vertices on a circle in angular order (always convex);
+    # random radii would not be (seed 3 gave a reflex vertex at P_0)
     rng = np.random.default_rng(3)
     ang = np.sort(rng.uniform(0, 2 * np.pi, 7))
-    P = np.array([np.cos(ang), np.sin(ang)]) * rng.uniform(0.8, 1.2, 7)
-    if np.any(np.diff(ang) > np.pi - 0.1):
-        pytest.skip("random polygon not convex")
+    P = 1.1 * np.array([np.cos(ang), np.sin(ang)])
+    e = np.roll(P, -1, axis=1) - P
+    assert np.all(e[0] * np.roll(e[1], -1) - e[1] * np.roll(e[0], -1) > 0)   # convex, CCW
     w = rng.uniform(0, 1, (7, 200))
     w /= w.sum(axis=0)
     X = P @ w                                                  # points inside the polygon
@@ -148,8 +151,6 @@ def test_mean_value_coordinates_reproduce_linear_functions():
 
 
 def test_xdmf_and_vtk_reader(tmp_path, sys14):
-    pytest.importorskip("h5py")
-    pv = pytest.importorskip("pyvista")
     s = sys14
     p = write_configuration(tmp_path / "c.xdmf", s, tendon_forces=np.full(4, 7.0))
     m = meshio.read(p)
@@ -168,7 +169,6 @@ def test_xdmf_and_vtk_reader(tmp_path, sys14):
 
 
 def test_modes_file(tmp_path, sys14):
-    pv = pytest.importorskip("pyvista")
     s = sys14
     X = s.nodes()
     n = X.shape[1]
@@ -207,7 +207,6 @@ def test_series_survives_an_interrupted_run(tmp_path, sys14):
     w.append_configuration(0.0, s)
     w.append_configuration(0.5, s, tendon_forces=np.ones(4))
     assert len(read_pvd(w.pvd)) == 2
-    pv = pytest.importorskip("pyvista")
     reader = pv.get_reader(str(w.pvd))          # VTK's own PVD reader accepts the collection
     assert reader.time_values == pytest.approx([0.0, 0.5])
     reader.set_active_time_value(0.5)

@@ -1,13 +1,12 @@
 """Pictures (tmfem.post): off-screen pyvista renders and matplotlib plots are real images."""
+import matplotlib.image as plt_image   # pyvista, matplotlib: declared dependencies
 import numpy as np
 import pytest
+import pyvista  # noqa: F401  (pyproject.toml): a broken install must fail, not skip
 
 from tmfem.errors import InputError
 from tmfem.io import configuration_cells
 from tmfem.system import load_preset
-
-pytest.importorskip("pyvista")
-plt_image = pytest.importorskip("matplotlib.image")
 
 
 def _rgb(path):
