@@ -139,14 +139,21 @@ def test_square_membrane_deflection_lines_converge():
 def test_prestressed_membrane_frequencies_converge_at_rate_two():
     # source: closed form f_mn = (1/2a) sqrt(N/(rho h)) sqrt(m^2+n^2) (benchmarks.json
     # rectangular_membrane_uniform_tension); bilinear elements + consistent mass: O(h^2)
+    # evaluated here for the function's defaults (side a = 1 m, strain 1e-3, Kapton of
+    # Table 6.1): S0 = E/(1 - nu) E_G, E_G = ((1 + strain)^2 - 1)/2; modes (1,1), (1,2), (2,1),
+    # (2,2), (1,3), (3,1)
+    E, nu, rho, strain = 1.65e8, 0.34, 1400.0, 1e-3
+    S0 = E / (1 - nu) * ((1 + strain) ** 2 - 1) / 2
+    f_exact = 0.5 * np.sqrt(S0 / rho) * np.sqrt([2.0, 5.0, 5.0, 8.0, 10.0, 10.0])
     ns = (2, 4, 8)
     err, hs = [], []
     for n in ns:
         d = prestressed_square_membrane_modes(n=n, k=6)
         assert d["residual_force"] < 1e-9       # the uniform prestress is an equilibrium
+        np.testing.assert_allclose(d["freq_exact"], f_exact, rtol=1e-12)
         # the (1,2)/(2,1) and (1,3)/(3,1) pairs come out repeated
         assert d["freq_fe"][1] == pytest.approx(d["freq_fe"][2], rel=1e-9)
-        err.append(np.max(np.abs(d["freq_fe"] / d["freq_exact"] - 1)))
+        err.append(np.max(np.abs(d["freq_fe"] / f_exact - 1)))
         hs.append(d["h"])
     rate = np.polyfit(np.log(hs), np.log(err), 1)[0]
     assert 1.8 < rate < 2.2
@@ -165,8 +172,10 @@ def test_taut_string_codeaster_frequency_and_rate(lumped):
         d = taut_string_modes(n_el=n_el, length=1.0, tension=F0, mu=F0 / (4 * f1**2), EA=1e7, k=4,
                               lumped=lumped)
         np.testing.assert_allclose(d["N"], F0, rtol=1e-12)
-        assert d["freq_exact"][0] == pytest.approx(f1, rel=1e-12)
-        e = d["freq_fe"] / d["freq_exact"] - 1
+        # f_n = n f1 (fundamental from the table), each twice (two transverse planes)
+        f_exact = f1 * np.array([1, 1, 2, 2])
+        np.testing.assert_allclose(d["freq_exact"], f_exact, rtol=1e-12)
+        e = d["freq_fe"] / f_exact - 1
         assert np.all(e > 0) if not lumped else np.all(e < 0)
         err.append(np.max(np.abs(e)))
         hs.append(d["h"])
@@ -179,7 +188,10 @@ def test_beaded_string_is_exact():
     # source: closed form omega_k = 2 sqrt(T/(m l)) sin(k pi / (2(N+1))) (benchmarks.json
     # beaded_string): the initial-stress stiffness N/l of the truss is exact for a beaded string
     d = beaded_string_modes(n_beads=7, spacing=0.2, tension=100.0, bead_mass=0.01, EA=1e6)
-    np.testing.assert_allclose(d["omega_fe"], d["omega_exact"], rtol=1e-10)
+    k = np.repeat(np.arange(1, 8), 2)                       # each twice: two transverse planes
+    omega = 2 * np.sqrt(100.0 / (0.01 * 0.2)) * np.sin(k * np.pi / (2 * (7 + 1)))
+    np.testing.assert_allclose(d["omega_fe"], omega, rtol=1e-10)
+    np.testing.assert_allclose(d["omega_exact"], omega, rtol=1e-12)
     V = d["modes"].shapes
     # each repeated pair: one mode in y, one in z (or a rotation of them), M-orthonormal
     M = 0.01 * np.eye(V.shape[0])
