@@ -115,7 +115,15 @@ def test_study_writes_table_plots_and_vtk(tmp_path, capsys):
     assert "| rest length S1 | m |" in md and "## Checks" in md
     import meshio
     m = meshio.read(out / "configuration.vtu")
-    assert m.points.shape[0] >= 8
+    # 8 system nodes + the 4 x 4 x 4 membrane mesh (N n^2 + N n + 1 nodes, 6.2), 4 bars +
+    # 4 tendons, 64 quads; the tendons carry the design forces
+    assert m.points.shape[0] == 8 + 4 * 16 + 4 * 4 + 1
+    cells = {b.type: b.data.shape[0] for b in m.cells}
+    assert cells == {"line": 8, "quad": 64}
+    line = [k for k, b in enumerate(m.cells) if b.type == "line"][0]
+    np.testing.assert_allclose(m.cell_data["axial_force"][line][4:], d.tendon_forces, rtol=1e-12)
+    tendons = list(csv.DictReader(open(out / "tendons.csv")))
+    np.testing.assert_allclose([float(t["force_N"]) for t in tendons], d.tendon_forces, rtol=1e-6)
 
 
 def test_study_2_3_as_printed_allow_infeasible_writes_map(tmp_path, capsys):
