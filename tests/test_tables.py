@@ -17,6 +17,15 @@ from tmfem.tables import (PRINTED, deployment_bases, fit_rest_lengths, rest_leng
 rad = np.radians
 
 
+def delta_from_corners(s):
+    """Delta of eq. 3.22 from the explicit bar-top geometry (independent formulation): the
+    circumradius of the corner polygon B_M1..B_MN minus r_mb."""
+    B = s.membrane_corners_inertial()
+    R = np.linalg.norm(B - B.mean(axis=1, keepdims=True), axis=0)
+    assert np.ptp(R) < 1e-12
+    return R.mean() - s.r_mb
+
+
 # ---------------------------------------------------------------- Tables 6.2 / 6.3 (1-4)
 def test_table_6_2_rest_length_contradicts_table_6_3_stress():
     P = PRINTED["6.2"]
@@ -64,6 +73,7 @@ def test_euler_loads_of_ch7_ch8_need_d_30mm(preset, printed):
 def test_table_7_3_final_configuration_as_printed_is_slack():
     s = load_preset("1-4D", as_printed=True)                     # psi = 30 deg as printed
     assert membrane_delta_system(s) == pytest.approx(-0.03678, abs=2e-5)   # eq. 3.22 < 0
+    assert delta_from_corners(s) == pytest.approx(membrane_delta_system(s), abs=1e-12)
     # eq. 3.41's membrane bound (eq. 3.36 form) is violated too: r_mb = 1.414 > 0.778
     th, ps = rad(75.0), rad(30.0)
     assert 2.2 * np.sin(th) * np.cos(np.pi / 4 + ps) / np.cos(np.pi / 4) == pytest.approx(0.7778, abs=1e-4)
@@ -106,6 +116,8 @@ def test_table_7_5_reconstruction_k_H():
     assert np.abs(misfit).max() < 7e-3
     assert membrane_delta_system(s0) == pytest.approx(2.480e-3, abs=2e-6)   # eq. 3.22 > 0
     assert membrane_delta_system(s1) == pytest.approx(1.458e-3, abs=2e-6)
+    for sx in (s0, s1):
+        assert delta_from_corners(sx) == pytest.approx(membrane_delta_system(sx), abs=1e-12)
 
 
 # ---------------------------------------------------------------- Table 7.7 (2-3 deploy)
@@ -118,6 +130,7 @@ def test_table_7_7_stage2_rule_reproduces_all_rest_lengths(preset, cfg):
     assert c.sigma[1] == pytest.approx(c.psi[1] - c.psi[0], abs=1e-9)
     assert c.z[1] == pytest.approx(0.7 * 1.8 * np.cos(th), abs=1e-6)
     assert membrane_delta_system(s) == pytest.approx(1e-3, abs=1e-6)
+    assert delta_from_corners(s) == pytest.approx(1e-3, abs=1e-6)
     p = symmetric_prestress(s)
     assert p.margin > 0                                   # all tendons taut (3.3.2)
     m = rest_length_misfit(s, PRINTED["7.7"][cfg]["rest"])
@@ -138,7 +151,8 @@ def test_table_7_7_free_fit_of_final_bases():
                                  bounds=([-60, 0.2, 0.3], [-10, 1.2, 0.8]))
     assert x[0] == pytest.approx(-34.86, abs=0.01)
     assert x[1] == pytest.approx(0.7 * 1.8 * np.cos(rad(55)), abs=2e-4)
-    assert x[2] == pytest.approx(0.52086, abs=2e-4)
+    assert x[2] == pytest.approx(c.r[1], abs=2e-4)          # the preset's r_2 (Delta = 1 mm)
+    assert c.r[1] == pytest.approx(0.52086, abs=1e-5)       # docs/errata.md (Table 7.7)
     assert np.abs(misfit).max() < 1e-4
 
 
@@ -146,6 +160,7 @@ def test_table_7_7_free_fit_of_final_bases():
 def test_table_6_4_as_printed_is_not_an_equilibrium():
     s = load_preset("2-3", as_printed=True)
     assert membrane_delta_system(s) == pytest.approx(-0.13564, abs=1e-5)   # eq. 3.22 < 0
+    assert delta_from_corners(s) == pytest.approx(membrane_delta_system(s), abs=1e-12)
     p = symmetric_prestress(s)
     assert p.margin < 0                                   # no positive null vector (3.3.2)
     neg = {g for g, v in zip(p.groups, p.per_F) if v < 0}
