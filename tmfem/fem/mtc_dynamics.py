@@ -110,6 +110,11 @@ class MTCDynamics:
             S = S + cv * self.C
         return S.tocsc()
 
+    def factorize(self, S):
+        """Solver of the Newton matrix: the default backend's symmetric-mode sparse LU."""
+        from tmfem.solvers.backends import get_backend
+        return get_backend().factorize(S)
+
     # energies
     def kinetic_energy(self, v) -> float:
         return 0.5 * float(v @ (self.M @ v))

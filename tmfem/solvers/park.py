@@ -23,7 +23,9 @@ The residual and its Jacobians come from a *system* object with two methods:
 ``jacobians(x, v, a, t) -> (K, C, M)``, each (n, n) dense ndarray or scipy sparse matrix.
 
 An optional ``newton_matrix(x, v, a, t, cv, ca)`` returning ``K + cv C + ca M`` directly
-(dense or sparse) is used when present (cheaper for models that assemble it at once).
+(dense or sparse) is used when present (cheaper for models that assemble it at once), and an
+optional ``factorize(S) -> solve`` replaces the default LU of the Newton matrix (e.g. a
+symmetric-mode sparse LU for finite-element tangents).
 """
 from __future__ import annotations
 
@@ -53,7 +55,9 @@ class ParkResult:
     stats: dict = field(default_factory=dict)
 
 
-def _solver(S):
+def _solver(S, system=None):
+    if system is not None and hasattr(system, "factorize"):
+        return system.factorize(S)
     if sp.issparse(S):
         lu = spla.splu(sp.csc_matrix(S))
         return lu.solve
@@ -185,7 +189,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
             full = full or it > 2 * reuse_iter
             if (solve is None or full
                     or (jacobian == "reuse" and it > reuse_iter and not fresh)):
-                solve = _solver(_newton_matrix(system, xk, vk, ak, t, cv, ca))
+                solve = _solver(_newton_matrix(system, xk, vk, ak, t, cv, ca), system)
                 kept_coef = (cv, ca)
                 fresh = True
                 res.jacobian_evaluations += 1
