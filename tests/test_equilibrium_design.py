@@ -240,6 +240,8 @@ def test_1ND_slack_tendon_names_the_r1_bounds():
     base = load_preset("1-4")
     cfg = SymmetricConfig(theta=[np.radians(50)], psi=[np.radians(15)], sigma=[0], z=[0],
                           r=[0.1], l=[2.2])                    # r_1 below k_H r* = 0.185 m
+    # eq. 3.41: r* = l_1 sin(theta_1) sin(psi_1) / cos(pi/N) = 2.2 sin 50 sin 15 / cos 45
+    # = 0.616862 m, k_H r* = 0.3 r* = 0.185059 m
     s = System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
                                 bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
                                 deployable=True, k_H=0.3)
