@@ -130,7 +130,11 @@ def test_design_prestress_agrees_with_linear_design():
     d = design_equilibrium(s, mesh_n=6)
     m = MTCModel(s, mesh_n=6, tendon_elements=1, rest_lengths="mtc")
     c = m.consistent_rest_lengths()
-    assert c["tendon_force"] == pytest.approx(d.tendon_forces, rel=1e-2)
+    # the two membranes differ at first order in the strain: the relative force difference is
+    # bounded by the peak membrane strain sigma_p1,max / E (0.6 % here; we find 0.4 %)
+    strain = d.membrane_max_principal / s.membrane.E
+    assert strain < 1e-2
+    assert c["tendon_force"] == pytest.approx(d.tendon_forces, rel=strain)
 
 
 @pytest.fixture(scope="module")
