@@ -136,4 +136,14 @@ def test_study_2_3_as_printed_allow_infeasible_writes_map(tmp_path, capsys):
     assert rc == 0, err
     m = json.loads((out / "equilibrium_map.json").read_text())
     assert np.array(m["feasible"]).shape == (3, 3)
+    np.testing.assert_array_equal(m["feasible"], np.array(m["positive"]) & (np.array(m["Delta"]) > 0))
+    # Delta of every grid point (eq. 5.97 configuration) against the bar-top geometry
+    # (independent of eq. 3.22): circumradius of the corner triangle minus r_mb
+    from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
+    s = load_preset("2-3", as_printed=True)
+    for a, th in enumerate(np.radians(m["theta_deg"])):
+        for b, ps in enumerate(np.radians(m["psi_deg"])):
+            B = with_configuration(s, configuration_5_97(s, th, ps)).membrane_corners_inertial()
+            R = np.linalg.norm(B - B.mean(axis=1, keepdims=True), axis=0)
+            assert m["Delta"][a][b] == pytest.approx(R.mean() - s.r_mb, abs=1e-12)
     assert (out / "equilibrium_map.png").stat().st_size > 0
