@@ -17,8 +17,10 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     assert code == 0
     r = json.loads(capsys.readouterr().out)
     assert r["steps"] == 30 and r["perturbation"] == {"theta_12_dot": 0.01}
-    # taut tendons throughout (design force 8.32 N, small perturbation)
-    assert 7.0 < r["min_tendon_force_N"] < 8.4
+    # taut tendons throughout (design force 8.3228 N of the COM design, tests/test_com.py
+    # checks it against eq. 3.34); the perturbed bar does unload a tendon (we find 8.17 N),
+    # so the minimum lies below the design value
+    assert 7.0 < r["min_tendon_force_N"] < 0.995 * 8.3228
     rows = list(csv.reader(open(out)))
     assert len(rows) == 32                       # header + t = 0 .. 0.3
     head = rows[0]
@@ -53,4 +55,6 @@ def test_vibrate_cli_2_3_preset(capsys):
     r = json.loads(capsys.readouterr().out)
     assert r["steps"] == 20 and r["membrane_modes"] == 4
     assert len(r["w_max_abs_m"]) == 3 and sorted(r["node_range_m"]) == ["A_21", "B_11", "B_21"]
-    assert 0.0 < r["min_tendon_force_N"] < 1.12 and r["min_tendon_force_tendon"].startswith("P_2")
+    # (we find 0.80 N: the minimum must lie below the design value, else nothing moved)
+    assert 0.0 < r["min_tendon_force_N"] < 0.99 * 1.1115
+    assert r["min_tendon_force_tendon"].startswith("P_2")
