@@ -178,10 +178,14 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
     from tmfem.cli import main
     out = tmp_path / "m.csv"
     code = main(["vibrate", "--model", "mtc", "--preset", "1-4", "--mesh", "4", "--t-end", "0.2",
-                 "--perturb", "theta_12_dot=0.01", "--csv", str(out), "--json"])
+                 "--perturb", "theta_12_dot=0.01", "--csv", str(out), "--json",
+                 "--plot", str(tmp_path / "m.png"), "--vtk", str(tmp_path / "vtk")])
     assert code == 0
     r = json.loads(capsys.readouterr().out)
     assert r["model"] == "mtc" and r["steps"] == 20 and r["ndof"] == 267
+    from tmfem.io.vtk import read_pvd
+    assert [round(t, 6) for t, _ in read_pvd(r["pvd"])] == [0.0, 0.1, 0.2]
+    assert (tmp_path / "m.png").stat().st_size > 1000
     rows = list(csv.reader(open(out)))
     assert len(rows) == 22                                 # header + t = 0 .. 0.2
     head = rows[0]
