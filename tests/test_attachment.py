@@ -160,3 +160,15 @@ def test_cli_attachment(s14, capsys):
         symmetric_corner_force(s14, n=20, attachment="distributed"), rel=1e-10)
     assert main(["equilibrium", "--preset", "1-4", "--patch", "0.2"]) != 0
     assert "--patch" in capsys.readouterr().err
+
+
+def test_mtc_default_rest_lengths_come_from_the_design_on_its_own_mesh_and_attachment(s14):
+    # the MTC model without given rest lengths takes those of the ch. 3 design (eqs. 3.8-3.9)
+    # computed with the same membrane mesh and corner attachment, so both see the same corner
+    # stiffness; the point design on mesh 10 would give 1.50891 m instead (docs/errata.md)
+    from tmfem.fem.mtc import MTCModel
+    m = MTCModel(s14, mesh_n=20, tendon_elements=1, attachment="distributed")
+    d = design_equilibrium(s14, mesh_n=20, attachment="distributed")
+    np.testing.assert_array_equal(m.rest_lengths, d.rest_lengths)
+    assert m.rest_lengths_source == "design"
+    assert abs(m.rest_lengths[0] - design_equilibrium(s14).rest_lengths[0]) > 1e-3

@@ -33,15 +33,12 @@ def configure(parser) -> None:
 def design_forces(system, *, mesh_n: int) -> dict:
     """Tendon forces, rest lengths and bar forces of the equilibrium design.
 
-    Uses ``tmfem.equilibrium.design_equilibrium`` (3.2, eqs. 3.8-3.9, 3.16); returns an
-    empty dict when that module is not available. Bar forces are axial forces, negative in
+    Uses ``tmfem.equilibrium.design_equilibrium`` (3.2, eqs. 3.8-3.9, 3.16). Bar forces are
+    axial forces, negative in
     compression, in stage-major order. Errors of the design itself (an infeasible
     system) propagate as the named tmfem errors.
     """
-    try:
-        from tmfem.equilibrium.design import design_equilibrium
-    except ImportError:
-        return {}
+    from tmfem.equilibrium.design import design_equilibrium
     d = design_equilibrium(system, mesh_n=mesh_n if mesh_n > 0 else 10)
     out = {"tendon_forces": np.asarray(d.tendon_forces, dtype=float),
            "rest_lengths": np.asarray(d.rest_lengths, dtype=float)}

@@ -120,6 +120,7 @@ class MTCModel:
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
                  lumped_tendon_mass: bool = False):
         self.system = system
+        self.mesh_n, self.patch = mesh_n, patch
         self.topology: MTCTopology = build_topology(system, mesh_n=mesh_n,
                                                     tendon_elements=tendon_elements,
                                                     attachment=attachment, patch=patch)
@@ -183,13 +184,11 @@ class MTCModel:
         self._M = None
 
     def _design_rest_lengths(self) -> np.ndarray:
-        try:
-            from tmfem.equilibrium.design import design_equilibrium
-        except ImportError as exc:  # the equilibrium package has not got it
-            raise InputError("the system has no rest lengths and tmfem.equilibrium."
-                             "design_equilibrium is unavailable; pass rest_lengths='mtc' or an "
-                             f"array ({exc})") from exc
-        d = design_equilibrium(self.system)
+        """Rest lengths of the ch. 3 design (eqs. 3.8-3.9) on this model's membrane mesh and
+        corner attachment, so that the design and the model see the same corner stiffness."""
+        from tmfem.equilibrium.design import design_equilibrium
+        d = design_equilibrium(self.system, mesh_n=self.mesh_n,
+                               attachment=self.topology.attachment, patch=self.patch)
         return np.asarray(d.rest_lengths, dtype=float)
 
     # ------------------------------------------------------------------ positions
