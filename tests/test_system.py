@@ -161,3 +161,65 @@ def test_negative_lengths_are_rejected():
         SymmetricConfig(theta=[1.0], psi=[0.1], sigma=[0], z=[0], r=[0.4], l=[-2.0])
     with pytest.raises(InputError, match="0 < theta < 90 deg"):
         SymmetricConfig(theta=[2.0], psi=[0.1], sigma=[0], z=[0], r=[0.4], l=[2.0])
+
+
+@pytest.mark.parametrize("as_printed", [False, True])
+def test_every_preset_file_round_trips(as_printed, tmp_path):
+    # every shipped preset (and its [as_printed] variant) passes the key checks and
+    # dump_system writes only keys that load_system accepts back
+    from tmfem.system import list_presets
+    for name in list_presets():
+        s = load_preset(name, as_printed=as_printed)
+        dump_system(s, tmp_path / f"{name}.toml")
+        t = load_system(tmp_path / f"{name}.toml")
+        np.testing.assert_allclose(t.nodes(), s.nodes(), atol=1e-14)
+        assert t.tendon_sections == s.tendon_sections
+        assert t.tendon_names() == s.tendon_names()
+
+
+def _general_dict():
+    from tmfem.system import system_to_dict
+    s = load_preset("2-3")
+    g = System(name="g", M=s.M, N=s.N, deployable=False, base=s.base, l=s.l, q=s.q,
+               membrane=s.membrane, membrane_corners=s.membrane_corners, bar=s.bar,
+               tendon_sections=s.tendon_sections)
+    return system_to_dict(g)
+
+
+def _preset_1_4_dict():
+    from tmfem.system import system_to_dict
+    return system_to_dict(load_preset("1-4"))
+
+
+@pytest.mark.parametrize("make, path, table, expected", [
+    (_preset_1_4_dict, ("symmetric",), r"\[symmetric\]", "psi_deg"),
+    (_preset_1_4_dict, ("membrane",), r"\[membrane\]", "r_mb"),
+    (_preset_1_4_dict, ("bar",), r"\[bar\]", "rho"),
+    (_preset_1_4_dict, ("tendons", "S"), r"\[tendons\.S\]", "yield_stress"),
+    (_general_dict, ("general",), r"\[general\]", "base"),
+    (_general_dict, ("tendon", 0), r"\[\[tendon\]\] entry 1", "family"),
+])
+def test_unknown_keys_in_sub_tables_are_rejected(make, path, table, expected, tmp_path):
+    import tomli_w
+    d = make()
+    t = d
+    for k in path:
+        t = t[k]
+    t["diameter"] = 1.0                       # misspelt key (e.g. for 'd')
+    p = tmp_path / "bad.toml"
+    p.write_bytes(tomli_w.dumps(d).encode())
+    with pytest.raises(InputError, match=table + r": unknown keys \['diameter'\]; expected some of") as e:
+        load_system(p)
+    assert repr(expected) in str(e.value)
+    del t["diameter"]                         # the same file without the typo loads
+    p.write_bytes(tomli_w.dumps(d).encode())
+    load_system(p)
+
+
+def test_as_printed_overrides_are_checked_after_merging():
+    from tmfem.system import system_from_dict
+    from tmfem.system.presets import preset_dict
+    d = preset_dict("2-3", as_printed=True)
+    d["symmetric"]["theta"] = [63.0, 63.0]    # 'theta' instead of 'theta_deg'
+    with pytest.raises(InputError, match=r"\[symmetric\]: unknown keys \['theta'\]"):
+        system_from_dict(d, where="preset 2-3")

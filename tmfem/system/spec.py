@@ -46,6 +46,16 @@ from tmfem.system.topology import Tendon
 
 _TOP_KEYS = {"name", "description", "N", "deployable", "k_H", "notes", "symmetric", "general",
              "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed"}
+# Keys accepted inside each sub-table ([printed] and [rest_lengths] are free-form;
+# [as_printed] is merged in before validation, see tmfem.system.presets.preset_dict).
+_TABLE_KEYS = {
+    "symmetric": {"theta_deg", "psi_deg", "sigma_deg", "z", "r", "l"},
+    "general": {"base", "l", "q"},
+    "membrane": {"E", "nu", "rho", "h", "yield_stress", "r_mb", "corners"},
+    "bar": {"E", "rho", "d"},
+    "tendons.*": {"E", "d", "rho", "yield_stress"},
+    "tendon": {"name", "family", "stage", "j", "ends"},
+}
 
 
 def deep_merge(base: dict, override: dict) -> dict:
@@ -59,11 +69,21 @@ def deep_merge(base: dict, override: dict) -> dict:
     return out
 
 
+def _check_keys(t: dict, kind: str, where: str) -> None:
+    """Reject keys of sub-table ``t`` (of kind ``kind``, see _TABLE_KEYS) that are not read."""
+    unknown = set(t) - _TABLE_KEYS[kind]
+    if unknown:
+        raise InputError(f"{where}: unknown keys {sorted(unknown)}; "
+                         f"expected some of {sorted(_TABLE_KEYS[kind])}")
+
+
 def _table(d: dict, key: str, where: str) -> dict:
     if key not in d:
         raise InputError(f"{where}: missing table [{key}]")
     if not isinstance(d[key], dict):
         raise InputError(f"{where}: expected [{key}] to be a table, found {type(d[key]).__name__}")
+    if key in _TABLE_KEYS:
+        _check_keys(d[key], key, f"{where} [{key}]")
     return d[key]
 
 
@@ -108,6 +128,7 @@ def _materials(d: dict, where: str):
         w = f"{where} [tendons.{key}]"
         if not isinstance(t, dict):
             raise InputError(f"{w}: expected a table, found {t!r}")
+        _check_keys(t, "tendons.*", w)
         sections[key] = TendonSection(E=_num(t, "E", w), d=_num(t, "d", w), rho=t.get("rho"),
                                       yield_stress=t.get("yield_stress"))
     return membrane, bar, sections
@@ -128,6 +149,14 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     rest = d.get("rest_lengths") or None
     common = dict(name=str(d.get("name", where)), description=str(d.get("description", "")),
                   notes=tuple(d.get("notes", ())), printed=dict(d.get("printed", {})))
+    for k, t in enumerate(d.get("tendon", ())):
+        wt = f"{where} [[tendon]] entry {k + 1}"
+        if not isinstance(t, dict):
+            raise InputError(f"{wt}: expected a table, found {t!r}")
+        _check_keys(t, "tendon", wt)
+        missing = {"name", "family", "ends"} - set(t)
+        if missing:
+            raise InputError(f"{wt}: missing keys {sorted(missing)}")
     if ("symmetric" in d) == ("general" in d):
         raise InputError(f"{where}: expected exactly one of [symmetric] or [general]")
     if "symmetric" in d:
