@@ -284,3 +284,38 @@ def test_equilibrium_map_of_a_1ND_system_matches_closed_form_bounds():
     expect = (lo < 0.5) & (0.5 < np.minimum(up, up_sl))
     np.testing.assert_array_equal(m.positive, expect)
     assert 5 < m.feasible.sum() < m.feasible.size
+
+
+def test_equilibrium_map_marks_points_without_a_stage_base_infeasible():
+    # preset 2-3 with the Table 7.7 base rule (tmfem.tables.deployment_bases): at
+    # psi = -10 deg, theta = 60-80 deg no r_2 satisfies eq. 3.22 (the rule itself raises
+    # there, checked directly below); the map must mark those points infeasible, keep
+    # the reason, and give every other point exactly as a map over feasible points only.
+    from tmfem.equilibrium.symmetric_map import equilibrium_map
+    from tmfem.errors import InputError
+    from tmfem.tables import deployment_bases
+    s = load_preset("2-3")
+    rule = deployment_bases(s)
+    th, ps = np.radians([55.0, 60.0, 70.0, 80.0]), np.radians([-10.0, 0.0, 10.0])
+    bad = [(a, 0) for a in (1, 2, 3)]
+    for a, b in bad:
+        with pytest.raises(InputError, match="eq. 3.22"):
+            rule(th[a], ps[b])
+    m = equilibrium_map(s, theta=th, psi=ps, bases=rule)
+    for a in range(th.size):
+        for b in range(ps.size):
+            if (a, b) in bad:
+                assert not m.feasible[a, b] and not m.positive[a, b]
+                assert "eq. 3.22" in m.reason[a, b] and np.isnan(m.Delta[a, b])
+                assert np.isnan(m.ratios[a, b]).all()
+            else:
+                assert m.reason[a, b] == ""
+    assert m.feasible[:, 2].all()       # psi = 10 deg: feasible (Delta = 1 mm by the rule)
+    # feasible points unchanged: theta = 55 deg over all psi, the rest over psi = 0, 10 deg
+    ref55 = equilibrium_map(s, theta=th[:1], psi=ps, bases=rule)
+    ref = equilibrium_map(s, theta=th[1:], psi=ps[1:], bases=rule)
+    for k in ("feasible", "positive", "margin", "Delta", "ratios"):
+        np.testing.assert_array_equal(getattr(m, k)[:1], getattr(ref55, k))
+        np.testing.assert_array_equal(getattr(m, k)[1:, 1:], getattr(ref, k))
+    d = m.to_dict()
+    assert d["Delta"][1][0] is None and d["reason"][1][0].startswith("bases rule: eq. 3.22")

@@ -64,10 +64,13 @@ class EquilibriumMap:
     positive : (n_theta, n_psi) bool: positive null vector of the reduced matrix.
     margin : (n_theta, n_psi) smallest entry of the null vector (LP of 3.2, entries
         normalised to sum 1; > 0 when positive).
-    Delta : (n_theta, n_psi) eq. 3.22 [m].
+    Delta : (n_theta, n_psi) eq. 3.22 [m] (NaN where the point could not be built).
     ratios : (n_theta, n_psi, 6M-4) null vector scaled to F_Delta = 1 (NaN where none).
     columns : names of the null-vector entries (eq. 3.26).
     fixed : the parameters the axes hold fixed.
+    reason : (n_theta, n_psi) str: why a point is infeasible without being evaluated (the
+        ``bases`` rule has no stage base there, e.g. no r_2 of eq. 3.22 reaches the
+        membrane); "" where the point was evaluated.
     """
 
     theta: np.ndarray
@@ -79,12 +82,18 @@ class EquilibriumMap:
     ratios: np.ndarray
     columns: list
     fixed: dict
+    reason: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.reason is None:
+            self.reason = np.full(self.feasible.shape, "", dtype=object)
 
     def to_dict(self) -> dict:
         return {"theta_deg": np.degrees(self.theta).tolist(), "psi_deg": np.degrees(self.psi).tolist(),
                 "feasible": self.feasible.tolist(), "positive": self.positive.tolist(),
                 "margin": np.where(np.isfinite(self.margin), self.margin, None).tolist(),
-                "Delta": self.Delta.tolist(), "columns": self.columns, "fixed": self.fixed}
+                "Delta": np.where(np.isfinite(self.Delta), self.Delta, None).tolist(),
+                "reason": self.reason.tolist(), "columns": self.columns, "fixed": self.fixed}
 
 
 def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -> EquilibriumMap:
@@ -98,7 +107,10 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
     bases : callable, optional
         ``bases(theta, psi) -> dict`` with any of ``r``, ``z``, ``sigma`` (arrays of length
         M) giving the stage bases along the family (e.g. a reconstructed deployment rule);
-        by default they are held at the values of ``system``.
+        by default they are held at the values of ``system``. Where the rule raises
+        :class:`~tmfem.errors.InputError` (no admissible base at that point, e.g.
+        :func:`tmfem.tables.deployment_bases` where no r_2 satisfies eq. 3.22) the point is
+        marked infeasible, its message kept in ``reason``, and the map goes on.
     """
     theta = np.atleast_1d(np.asarray(theta, dtype=float))
     psi = np.atleast_1d(np.asarray(psi, dtype=float))
@@ -109,16 +121,20 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
     positive = np.zeros(shape, dtype=bool)
     margin = np.full(shape, -np.inf)
     Delta = np.zeros(shape)
-    cols = None
-    ratios = None
+    reason = np.full(shape, "", dtype=object)
+    cols = symmetric_matrix(system).cols
+    ratios = np.full(shape + (len(cols),), np.nan)
     for a, th in enumerate(theta):
         for b, ps in enumerate(psi):
-            cfg = configuration_5_97(system, th, ps, **(bases(th, ps) if bases else {}))
+            try:
+                rule = bases(th, ps) if bases else {}
+            except InputError as exc:       # no stage base at this point: infeasible
+                reason[a, b] = f"bases rule: {exc}"
+                Delta[a, b] = np.nan
+                continue
+            cfg = configuration_5_97(system, th, ps, **rule)
             s = with_configuration(system, cfg)
             S = symmetric_matrix(s)
-            if ratios is None:
-                cols = S.cols
-                ratios = np.full(shape + (len(cols),), np.nan)
             nv = positive_null_vector(S.A)
             positive[a, b] = nv.exists
             margin[a, b] = nv.margin
@@ -134,7 +150,8 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
              "rule": "eq. 5.97: theta_i = theta, psi_i = psi + sigma_i"
                      + ("; bases from a user rule" if bases else "")}
     return EquilibriumMap(theta=theta, psi=psi, feasible=positive & (Delta > 0), positive=positive,
-                          margin=margin, Delta=Delta, ratios=ratios, columns=cols, fixed=fixed)
+                          margin=margin, Delta=Delta, ratios=ratios, columns=cols, fixed=fixed,
+                          reason=reason)
 
 
 def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
