@@ -29,7 +29,7 @@ symmetric-mode sparse LU for finite-element tangents).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -52,7 +52,7 @@ class ParkResult:
     newton_iterations: int = 0
     jacobian_evaluations: int = 0
     steps: int = 0
-    stats: dict = field(default_factory=dict)
+    restarts: int = 0
 
 
 def _solver(S, system=None):
@@ -200,6 +200,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                 # with full Newton
                 full = True
                 xk, dx_prev = x_pred.copy(), np.inf
+                res.restarts += 1
                 continue
             dx_prev = dx_norm
             xk = xk + dx
