@@ -24,3 +24,17 @@ def system_from_args(args: argparse.Namespace) -> System:
     if args.as_printed:
         raise InputError("--as-printed applies to presets only")
     return load_system(args.spec)
+
+
+def add_prestress_scale_arg(parser) -> None:
+    """Add ``--prestress-scale S`` (control-oriented model only, see
+    :class:`tmfem.reduced.model.ControlOrientedModel`); read it with :func:`prestress_scale_of`."""
+    parser.add_argument("--prestress-scale", type=float, default=None,
+                        help="--model com: factor on the designed membrane prestress (default 1 = "
+                             "designed; 1.2903 gives the printed 1-4 tendon stress and Table 6.6, "
+                             "docs/errata.md)")
+
+
+def prestress_scale_of(args: argparse.Namespace) -> float:
+    """The ``--prestress-scale`` factor (1 when not given)."""
+    return 1.0 if args.prestress_scale is None else args.prestress_scale

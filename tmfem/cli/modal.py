@@ -5,8 +5,10 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import (add_prestress_scale_arg, add_system_args, prestress_scale_of,
+                              system_from_args)
 from tmfem.cli.static import add_model_args, build_model, default_monitor, sequence_of
+from tmfem.errors import InputError
 
 NAME = "modal"
 HELP = "natural frequencies and mode shapes (MTC finite-element or control-oriented model)"
@@ -21,6 +23,7 @@ def configure(parser) -> None:
     parser.add_argument("--modes", type=int, default=12, help="number of modes (default 12)")
     parser.add_argument("--membrane-modes", type=int, default=None,
                         help="membrane modes of the control-oriented model (--model com)")
+    add_prestress_scale_arg(parser)
     parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu")
     parser.add_argument("--png", help="render the first six mode shapes to this PNG")
 
@@ -37,7 +40,11 @@ def run(args) -> dict:
     if args.model == "com":
         from tmfem.reduced.modal import modal_summary
         system = system_from_args(args)
-        return modal_summary(system, modes=args.modes, membrane_modes=args.membrane_modes)
+        return modal_summary(system, modes=args.modes, membrane_modes=args.membrane_modes,
+                             prestress_scale=prestress_scale_of(args))
+    if args.prestress_scale is not None:
+        raise InputError("--prestress-scale belongs to --model com; the MTC prestress follows "
+                         "from its rest lengths (--rest-lengths)")
     from tmfem.tables import FREQUENCIES
     from tmfem.fem.mtc_post import model_cells, static_summary
     model = build_model(args)

@@ -6,7 +6,8 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import (add_prestress_scale_arg, add_system_args, prestress_scale_of,
+                              system_from_args)
 from tmfem.errors import InputError
 
 NAME = "vibrate"
@@ -25,8 +26,7 @@ def configure(parser) -> None:
     parser.add_argument("--perturb", action="append", default=[], metavar="STATE=VALUE",
                         help="initial perturbation, e.g. theta_11_dot=0.01 (repeatable)")
     parser.add_argument("--damping", type=float, default=0.0, help="modal damping c_m [1/s] (eq. 5.13)")
-    parser.add_argument("--prestress-scale", type=float, default=1.0,
-                        help="factor on the designed membrane prestress (1 = designed)")
+    add_prestress_scale_arg(parser)
     parser.add_argument("--mesh", type=int, default=10, help="membrane mesh n per patch (default 10)")
     parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park")
     parser.add_argument("--csv", help="write the histories to this CSV file (row by row)")
@@ -59,7 +59,7 @@ def run(args) -> dict:
         raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
     print(f"tmfem vibrate: {system.name} COM, K = {K}, building the model", file=sys.stderr)
     model = ControlOrientedModel(system, membrane_modes=K, mesh_n=args.mesh, damping=args.damping,
-                                 prestress_scale=args.prestress_scale)
+                                 prestress_scale=prestress_scale_of(args))
     pert = parse_perturbation(args.perturb, model.state_names)
     res = free_vibration(model, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
                          scheme=args.scheme, jacobian="reuse", progress=True,
@@ -94,7 +94,7 @@ def run_mtc(args) -> dict:
     system = system_from_args(args)
     if not (args.t_end > 0 and args.dt > 0):
         raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
-    if args.damping or args.membrane_modes is not None or args.prestress_scale != 1.0:
+    if args.damping or args.membrane_modes is not None or args.prestress_scale is not None:
         raise InputError("--damping, --membrane-modes and --prestress-scale belong to --model com; "
                          "the MTC model takes --rayleigh ALPHA BETA and --rest-lengths")
     pert = parse_perturbation(args.perturb, perturbation_names(system))
