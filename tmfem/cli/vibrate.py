@@ -51,7 +51,7 @@ def run(args) -> dict:
         return run_mtc(args)
     from tmfem.reduced.modal import default_membrane_modes
     from tmfem.reduced.model import ControlOrientedModel
-    from tmfem.reduced.simulate import free_vibration, parse_perturbation, plot_free_vibration
+    from tmfem.reduced.simulate import free_vibration, parse_perturbation
 
     system = system_from_args(args)
     K = default_membrane_modes(system) if args.membrane_modes is None else args.membrane_modes
@@ -66,21 +66,29 @@ def run(args) -> dict:
                          vtk_dir=args.vtk, vtk_every=args.vtk_every)
     out = {"system": system.name, "model": "com", "membrane_modes": K, "t_end": args.t_end,
            "dt": args.dt, "perturbation": pert, "scheme": args.scheme,
-           "wall_time_s": res.wall_time, "steps": res.stats["steps"],
+           **_run_summary(res, args, title=f"{system.name} COM free vibration, K = {K}"),
+           "final": dict(zip(model.state_names, np.concatenate([res.z[-1], res.zd[-1]]).tolist()))}
+    return out
+
+
+def _run_summary(res, args, *, title: str) -> dict:
+    """What both models report of a free-vibration run: solver counts, the smallest tendon
+    force, monitored amplitudes, and the files written (CSV, ParaView series, plot)."""
+    from tmfem.reduced.simulate import plot_free_vibration
+
+    out = {"wall_time_s": res.wall_time, "steps": res.stats["steps"],
            "newton_iterations": res.stats["newton_iterations"],
            "jacobian_evaluations": res.stats["jacobian_evaluations"],
            "min_tendon_force_N": res.stats["min_tendon_force"],
            "min_tendon_force_tendon": res.stats["min_tendon_force_tendon"],
            "w_max_abs_m": np.max(np.abs(res.w), axis=0).tolist() if res.w.size else [],
-           "node_range_m": {k: np.ptp(v, axis=0).tolist() for k, v in res.nodes.items()},
-           "final": dict(zip(model.state_names, np.concatenate([res.z[-1], res.zd[-1]]).tolist()))}
+           "node_range_m": {k: np.ptp(v, axis=0).tolist() for k, v in res.nodes.items()}}
     if args.csv:
         out["csv"] = args.csv
     if "pvd" in res.stats:
         out["pvd"] = res.stats["pvd"]
     if args.plot:
-        out["plot"] = plot_free_vibration(res, args.plot,
-                                          title=f"{system.name} COM free vibration, K = {K}")
+        out["plot"] = plot_free_vibration(res, args.plot, title=title)
     return out
 
 
@@ -89,7 +97,7 @@ def run_mtc(args) -> dict:
     from tmfem.cli.static import apply_rest_lengths, sequence_of
     from tmfem.fem.mtc import MTCModel
     from tmfem.fem.mtc_dynamics import mtc_free_vibration, perturbation_names
-    from tmfem.reduced.simulate import parse_perturbation, plot_free_vibration
+    from tmfem.reduced.simulate import parse_perturbation
 
     system = system_from_args(args)
     if not (args.t_end > 0 and args.dt > 0):
@@ -111,25 +119,13 @@ def run_mtc(args) -> dict:
     out = {"system": system.name, "model": "mtc", "mesh": args.mesh, "ndof": model.ndof,
            "tendon_elements": args.tendon_elements, "t_end": args.t_end, "dt": args.dt,
            "perturbation": pert, "scheme": args.scheme, "rayleigh": list(args.rayleigh),
-           "static_time_s": st.time, "wall_time_s": res.wall_time, "steps": res.stats["steps"],
-           "newton_iterations": res.stats["newton_iterations"],
-           "jacobian_evaluations": res.stats["jacobian_evaluations"],
-           "min_tendon_force_N": res.stats["min_tendon_force"],
-           "min_tendon_force_tendon": res.stats["min_tendon_force_tendon"],
+           "static_time_s": st.time,
+           **_run_summary(res, args, title=f"{system.name} MTC free vibration, mesh {args.mesh}"),
            "max_tendon_deflection_m": res.stats["max_tendon_deflection"],
            "max_tendon_deflection_tendon": res.stats["max_tendon_deflection_tendon"],
            "energy_drift_J": float(np.max(np.abs(res.energy - res.energy[0]))),
            "initial_kinetic_energy_J": float(res.kinetic[0]),
-           "w_max_abs_m": np.max(np.abs(res.w), axis=0).tolist() if res.w.size else [],
-           "node_range_m": {k: np.ptp(v, axis=0).tolist() for k, v in res.nodes.items()},
            "q_range": dict(zip(system.q_names, np.ptp(res.q, axis=0).tolist()))}
-    if args.csv:
-        out["csv"] = args.csv
-    if "pvd" in res.stats:
-        out["pvd"] = res.stats["pvd"]
-    if args.plot:
-        out["plot"] = plot_free_vibration(res, args.plot,
-                                          title=f"{system.name} MTC free vibration, mesh {args.mesh}")
     return out
 
 
