@@ -38,7 +38,6 @@ local frame e_t1 (chord), e_t2 = e_t1 x e_z / |.|, e_t3 = e_t1 x e_t2 (eq. 5.37;
 from __future__ import annotations
 
 import sys
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -48,7 +47,6 @@ from tmfem.errors import InputError
 from tmfem.fem.mtc_post import q_from_positions
 from tmfem.fem.mtc_topology import to_floating
 from tmfem.fem.truss import truss_internal
-from tmfem.solvers.park import park_integrate
 
 
 class MTCDynamics:
@@ -284,7 +282,7 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
         Histories written row by row; ParaView frames every ``vtk_every`` steps.
     """
     from tmfem.reduced.model import MONITOR_POINTS
-    from tmfem.reduced.simulate import MONITOR_NODES, open_outputs
+    from tmfem.reduced.simulate import MONITOR_NODES, RunOutputs
     if not (t_end > 0 and dt > 0):
         raise InputError(f"expected t_end > 0 and dt > 0, found t_end={t_end!r}, dt={dt!r}")
     system, topo = model.system, model.topology
@@ -305,11 +303,11 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
                + ["tendon_deflection", "kinetic_energy", "strain_energy"])
     n_steps = int(round(t_end / dt))
     T, Q, W, XS, TD, KE, SE = [], [], [], [], [], [], []
-    fh, writer, series = open_outputs(csv_path, columns, vtk_dir, vtk_every,
-                                      name=f"mtc_{system.name}")
-    count = [0]
+    out = RunOutputs(csv_path=csv_path, columns=columns, vtk_dir=vtk_dir, vtk_every=vtk_every,
+                     name=f"mtc_{system.name}", label=f"vibrate {system.name} MTC", dt=dt,
+                     t_end=t_end, progress=progress)
+    element_tendon = [system.tendons[k].name for k in topo.tendon_of_element]
     worst = [0.0, ""]
-    Tmin = [np.inf, 0.0, ""]          # smallest tendon force, its time and tendon
 
     def record(t, u, v, a):
         x = dyn.positions(u)
@@ -328,51 +326,29 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
         else:
             td = 0.0
         ke, se = dyn.kinetic_energy(v), dyn.strain_energy(u)
-        tn = truss_internal(x, model.tendons, tangent=False).N
-        k = int(np.argmin(tn))
-        if tn[k] < Tmin[0]:
-            Tmin[:] = [float(tn[k]), float(t), system.tendons[topo.tendon_of_element[k]].name]
+        out.tendon_forces(t, truss_internal(x, model.tendons, tangent=False).N, element_tendon)
         pos = x[:, lab_nodes]
-        if series is not None and count[0] % vtk_every == 0:
+        if out.frame_due():
             from tmfem.fem.mtc_post import member_state, membrane_field
             ms = member_state(model, x)
-            series.append_configuration(t, system, q=q, tendon_forces=ms["tendon_force"],
-                                        rest_lengths=model.rest_lengths,
-                                        membrane=membrane_field(model, x),
-                                        bar_forces=ms["bar_force"])
-        count[0] += 1
+            out.series.append_configuration(t, system, q=q, tendon_forces=ms["tendon_force"],
+                                            rest_lengths=model.rest_lengths,
+                                            membrane=membrane_field(model, x),
+                                            bar_forces=ms["bar_force"])
         T.append(t); Q.append(q); W.append(w); XS.append(pos); TD.append(td); KE.append(ke)
         SE.append(se)
-        if writer:
-            writer.writerow([f"{t:.6g}"] + [f"{val:.10g}" for val in np.concatenate(
-                [q, w, pos.T.ravel(), [td, ke, se]])])
-            fh.flush()
+        out.row(t, np.concatenate([q, w, pos.T.ravel(), [td, ke, se]]))
 
-    def prog(k, n):
-        if progress and (k % 100 == 0 or k == n):
-            print(f"vibrate {system.name} MTC: t = {k * dt:.2f} / {t_end:g} s", file=sys.stderr,
-                  flush=True)
-
-    t0 = time.perf_counter()
-    try:
-        res = park_integrate(dyn, x0=u0, v0=v0, dt=dt, n_steps=n_steps, scheme=scheme,
-                             jacobian=jacobian, callback=record, store=False, progress=prog,
-                             tol=tol)
-    finally:
-        if fh:
-            fh.close()
-    wall = time.perf_counter() - t0
+    res, wall = out.integrate(dyn, x0=u0, v0=v0, n_steps=n_steps, scheme=scheme,
+                              jacobian=jacobian, callback=record, tol=tol)
     Xa = np.array(XS)
-    stats = {"steps": res.steps, "newton_iterations": res.newton_iterations,
-             "jacobian_evaluations": res.jacobian_evaluations, "ndof": int(dyn.free.sum()),
-             "max_tendon_deflection": worst[0], "max_tendon_deflection_tendon": worst[1],
-             "min_tendon_force": Tmin[0], "min_tendon_force_time": Tmin[1],
-             "min_tendon_force_tendon": Tmin[2]}
-    if Tmin[0] <= 0:
-        print(f"warning: tendon {Tmin[2]} went slack at t = {Tmin[1]:.4g} s (tension-only in "
-              "the MTC model)", file=sys.stderr)
-    if series is not None:
-        stats["pvd"] = str(series.pvd)
+    stats = out.stats(res)
+    stats.update({"ndof": int(dyn.free.sum()), "max_tendon_deflection": worst[0],
+                  "max_tendon_deflection_tendon": worst[1]})
+    if stats["min_tendon_force"] <= 0:
+        print(f"warning: tendon {stats['min_tendon_force_tendon']} went slack at t = "
+              f"{stats['min_tendon_force_time']:.4g} s (tension-only in the MTC model)",
+              file=sys.stderr)
     return MTCVibration(t=np.array(T), q=np.array(Q), w=np.array(W),
                         nodes={n: Xa[:, :, k] for k, n in enumerate(labels)},
                         tendon_deflection=np.array(TD), kinetic=np.array(KE), strain=np.array(SE),

@@ -39,20 +39,91 @@ def parse_perturbation(items, names) -> dict:
     return out
 
 
-def open_outputs(csv_path, columns, vtk_dir, vtk_every, *, name: str):
-    """CSV file (header written), its writer and the ParaView series of a simulation; each
-    None when not asked."""
-    fh = open(csv_path, "w", newline="") if csv_path else None
-    writer = csv.writer(fh) if fh else None
-    if writer:
-        writer.writerow(columns)
-    series = None
-    if vtk_dir is not None:
-        from tmfem.io.vtk import SeriesWriter
-        if not (isinstance(vtk_every, int) and vtk_every >= 1):
-            raise InputError(f"vtk_every: expected an integer >= 1, found {vtk_every!r}")
-        series = SeriesWriter(vtk_dir, name=name.replace("(", "").replace(")", ""))
-    return fh, writer, series
+class RunOutputs:
+    """Per-step outputs of a free-vibration run, shared by the COM and MTC drivers (6.5).
+
+    The CSV history (header ``columns``, one row per recorded step, flushed), the ParaView
+    series (a frame every ``vtk_every`` steps, :class:`tmfem.io.vtk.SeriesWriter`), the
+    smallest tendon force with its time and tendon, and the progress line on stderr.
+
+    Parameters
+    ----------
+    csv_path : path or None
+    columns : list of str
+    vtk_dir : path or None
+    vtk_every : int
+    name : str
+        Name of the ParaView series (parentheses dropped).
+    label : str
+        Progress label (``"vibrate 1-4"``).
+    dt, t_end : float
+        Time step and duration, for the progress line.
+    progress : bool
+        Print ``label: t = ... / ... s`` to stderr every 100 steps and at the end.
+    """
+
+    def __init__(self, *, csv_path, columns, vtk_dir, vtk_every, name: str, label: str,
+                 dt: float, t_end: float, progress: bool):
+        self.series = None
+        if vtk_dir is not None:
+            from tmfem.io.vtk import SeriesWriter
+            if not (isinstance(vtk_every, int) and vtk_every >= 1):
+                raise InputError(f"vtk_every: expected an integer >= 1, found {vtk_every!r}")
+            self.series = SeriesWriter(vtk_dir, name=name.replace("(", "").replace(")", ""))
+        self.fh = open(csv_path, "w", newline="") if csv_path else None
+        self.writer = csv.writer(self.fh) if self.fh else None
+        if self.writer:
+            self.writer.writerow(columns)
+        self.vtk_every = vtk_every
+        self.label, self.dt, self.t_end, self.show = label, dt, t_end, progress
+        self.count = 0
+        self.min_force = [np.inf, 0.0, ""]        # smallest tendon force, its time and tendon
+
+    def frame_due(self) -> bool:
+        """True when the current step is written as a ParaView frame."""
+        return self.series is not None and self.count % self.vtk_every == 0
+
+    def tendon_forces(self, t: float, force: np.ndarray, names) -> None:
+        """Keep the smallest of ``force`` (one per member, ``names[k]`` its tendon) over time."""
+        k = int(np.argmin(force))
+        if force[k] < self.min_force[0]:
+            self.min_force[:] = [float(force[k]), float(t), names[k]]
+
+    def row(self, t: float, values: np.ndarray) -> None:
+        """Write the CSV row of time t (when a CSV is asked) and count the step."""
+        self.count += 1
+        if self.writer:
+            self.writer.writerow([f"{t:.6g}"] + [f"{v:.10g}" for v in values])
+            self.fh.flush()
+
+    def progress(self, k: int, n: int) -> None:
+        if self.show and (k % 100 == 0 or k == n):
+            print(f"{self.label}: t = {k * self.dt:.2f} / {self.t_end:g} s", file=sys.stderr,
+                  flush=True)
+
+    def integrate(self, residual, *, x0, v0, n_steps: int, scheme: str, jacobian: str,
+                  callback, **kw):
+        """:func:`park_integrate` with this run's progress; the CSV is closed at the end
+        (also on an error). Returns the ParkResult and the wall time [s]."""
+        t0 = time.perf_counter()
+        try:
+            res = park_integrate(residual, x0=x0, v0=v0, dt=self.dt, n_steps=n_steps,
+                                 scheme=scheme, jacobian=jacobian, callback=callback, store=False,
+                                 progress=self.progress, **kw)
+        finally:
+            if self.fh:
+                self.fh.close()
+        return res, time.perf_counter() - t0
+
+    def stats(self, res) -> dict:
+        """Step and Newton counts of ``res``, the smallest tendon force, the .pvd path."""
+        out = {"steps": res.steps, "newton_iterations": res.newton_iterations,
+               "jacobian_evaluations": res.jacobian_evaluations,
+               "min_tendon_force": self.min_force[0], "min_tendon_force_time": self.min_force[1],
+               "min_tendon_force_tendon": self.min_force[2]}
+        if self.series is not None:
+            out["pvd"] = str(self.series.pvd)
+        return out
 
 
 class _Driven:
@@ -146,58 +217,38 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
                + [f"{n}_{c}" for n in labels for c in "xyz"])
     n_steps = int(round(t_end / dt))
     T, Z, ZD, W, XS = [], [], [], [], []
-    fh, writer, series = open_outputs(csv_path, columns, vtk_dir, vtk_every,
-                                      name=f"com_{system.name}")
-    count = [0]
-
-    Tmin = [np.inf, 0.0, ""]          # smallest tendon force, its time and tendon
+    out = RunOutputs(csv_path=csv_path, columns=columns, vtk_dir=vtk_dir, vtk_every=vtk_every,
+                     name=f"com_{system.name}", label=f"vibrate {system.name}", dt=dt,
+                     t_end=t_end, progress=progress)
+    tendon_names = [t.name for t in system.tendons]
 
     def record(t, z, zd, a):
         w, X, L = model.fast_outputs(z, with_lengths=True)
         force = model.k * (L - (model.u0 if u is None else driven.rest_lengths(t)))  # eq. 3.8
-        k = int(np.argmin(force))
-        if force[k] < Tmin[0]:
-            Tmin[:] = [float(force[k]), float(t), system.tendons[k].name]
+        out.tendon_forces(t, force, tendon_names)
         pos = X[:, idx]
-        if series is not None and count[0] % vtk_every == 0:
+        if out.frame_due():
             from tmfem.io.vtk import MembraneField
             xm, defl = model.membrane_positions(z)
-            series.append_configuration(
+            out.series.append_configuration(
                 t, system, q=(model.P @ z)[: model.nq], tendon_forces=model.tendon_forces(z),
                 membrane=MembraneField(mesh=model.membrane.mesh, x=xm,
                                        point_data={"deflection_Of": defl}))
-        count[0] += 1
         T.append(t); Z.append(z.copy()); ZD.append(zd.copy()); W.append(w); XS.append(pos)
-        if writer:
-            writer.writerow([f"{t:.6g}"] + [f"{v:.10g}" for v in np.concatenate([z, zd, w, pos.T.ravel()])])
-            fh.flush()
-
-    def prog(k, n):
-        if progress and (k % 100 == 0 or k == n):
-            print(f"vibrate {system.name}: t = {k * dt:.2f} / {t_end:g} s", file=sys.stderr, flush=True)
+        out.row(t, np.concatenate([z, zd, w, pos.T.ravel()]))
 
     driven = model if u is None else _Driven(model, u)
-    t0 = time.perf_counter()
-    try:
-        res = park_integrate(driven, x0=z0, v0=zd0, dt=dt, n_steps=n_steps, scheme=scheme,
-                             jacobian=jacobian, callback=record, store=False, progress=prog)
-    finally:
-        if fh:
-            fh.close()
-    wall = time.perf_counter() - t0
+    res, wall = out.integrate(driven, x0=z0, v0=zd0, n_steps=n_steps, scheme=scheme,
+                              jacobian=jacobian, callback=record)
     Xa = np.array(XS)
     nodes = {n: Xa[:, :, k] for k, n in enumerate(labels)}
-    stats = {"steps": res.steps, "newton_iterations": res.newton_iterations,
-             "jacobian_evaluations": res.jacobian_evaluations,
-             "min_tendon_force": Tmin[0], "min_tendon_force_time": Tmin[1],
-             "min_tendon_force_tendon": Tmin[2]}
-    if Tmin[0] <= 0:
+    stats = out.stats(res)
+    if stats["min_tendon_force"] <= 0:
         # the COM's tendons are bilateral springs (docs/com.md): a compressed tendon means the
         # motion left the model's range of validity
-        print(f"warning: tendon {Tmin[2]} goes slack (force {Tmin[0]:.4g} N at t = {Tmin[1]:.4g} s); "
+        print(f"warning: tendon {stats['min_tendon_force_tendon']} goes slack (force "
+              f"{stats['min_tendon_force']:.4g} N at t = {stats['min_tendon_force_time']:.4g} s); "
               "the COM treats tendons as two-sided springs", file=sys.stderr)
-    if series is not None:
-        stats["pvd"] = str(series.pvd)
     return FreeVibration(t=np.array(T), z=np.array(Z), zd=np.array(ZD), w=np.array(W), nodes=nodes,
                          columns=columns, wall_time=wall, stats=stats)
 
