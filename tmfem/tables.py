@@ -207,6 +207,7 @@ def with_symmetric(system, **changes):
     """A copy of a symmetric system with parameters of its SymmetricConfig changed
     (``theta``, ``psi``, ``sigma``, ``z``, ``r``, ``l``: arrays in radians / metres), and
     optionally ``r_mb`` or ``k_H``; rest lengths are dropped."""
+    from tmfem.equilibrium.symmetric_map import with_configuration
     from tmfem.system import SymmetricConfig
     from tmfem.system.geometry import membrane_corners_regular
 
@@ -221,9 +222,7 @@ def with_symmetric(system, **changes):
         extra["k_H"] = float(changes.pop("k_H"))
     if changes:
         raise InputError(f"with_symmetric: unknown parameters {sorted(changes)}")
-    N = system.N
-    return system.replace(q=cfg.to_q(N), symmetric=cfg, base=cfg.base_nodes(N)[:, 0, :],
-                          l=np.repeat(cfg.l[:, None], N, axis=1), rest_lengths=None, **extra)
+    return with_configuration(system.replace(**extra) if extra else system, cfg)
 
 
 def top_radius_for_delta(*, l_M: float, theta_M: float, psi_rel: float, r_mb: float,

@@ -46,11 +46,13 @@ def configuration_5_97(system, theta: float, psi: float, *, r=None, z=None,
 
 
 def with_configuration(system, cfg: SymmetricConfig):
-    """A copy of a symmetric system at another symmetric configuration (rest lengths dropped)."""
+    """A copy of a symmetric system at another symmetric configuration (eqs. 3.19-3.20):
+    q, base A_1j and bar lengths l_ij from ``cfg``; rest lengths dropped."""
     if system.M != cfg.M:
         raise InputError(f"expected a configuration with M = {system.M} stages, found {cfg.M}")
-    return system.replace(q=cfg.to_q(system.N), symmetric=cfg,
-                          base=cfg.base_nodes(system.N)[:, 0, :], rest_lengths=None)
+    N = system.N
+    return system.replace(q=cfg.to_q(N), symmetric=cfg, base=cfg.base_nodes(N)[:, 0, :],
+                          l=np.repeat(cfg.l[:, None], N, axis=1), rest_lengths=None)
 
 
 @dataclass
