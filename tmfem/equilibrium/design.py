@@ -25,9 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import linprog
 
-from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix,
-                                       free_corner_components, null_space, positive_null_vector,
-                                       symmetric_matrix)
+from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix, free_components,
+                                       null_space, positive_null_vector, symmetric_matrix)
 from tmfem.equilibrium.symmetric import closed_form_1N, closed_form_1ND
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.attachment import default_patch_radius
@@ -187,9 +186,7 @@ def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembra
 
 def free_forces(F: np.ndarray) -> np.ndarray:
     """The 3N-6 corner-force entries of T_q (eq. 3.17) from in-plane corner forces (2, N)."""
-    N = F.shape[1]
-    F3 = np.vstack([F, np.zeros((1, N))])
-    return np.array([F3[c, i] for i, c in free_corner_components(N)])
+    return free_components(F)
 
 
 def tendon_forces_for(E: EquilibriumMatrix, F: np.ndarray, *, rtol: float = 1e-9):

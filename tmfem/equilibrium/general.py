@@ -105,6 +105,24 @@ def corner_force_names(N: int) -> list[str]:
     return [f"F_{'uvw'[c]}{i + 1}" for i, c in free_corner_components(N)]
 
 
+def free_components(X) -> np.ndarray:
+    """The 3N-6 free entries of a corner array X (2 or 3, N), in the order of eq. 3.4
+    (:func:`tmfem.system.geometry.free_corner_components`); a missing w row counts as 0."""
+    X = np.asarray(X, dtype=float)
+    if X.shape[0] == 2:
+        X = np.vstack([X, np.zeros((1, X.shape[1]))])
+    return np.array([X[c, i] for i, c in free_corner_components(X.shape[1])])
+
+
+def corner_array(free, N: int) -> np.ndarray:
+    """The corner array (3, N) of eq. 3.4 with the 3N-6 free entries ``free`` and zeros
+    elsewhere (the inverse of :func:`free_components`)."""
+    D = np.zeros((3, N))
+    for k, (i, c) in enumerate(free_corner_components(N)):
+        D[c, i] = free[k]
+    return D
+
+
 @dataclass(frozen=True)
 class CornerState:
     """Solution of the corner constraints (eq. 3.5) for one q.
@@ -146,28 +164,20 @@ def corner_state(system, q=None) -> CornerState:
     _, R = floating_frame(system.membrane_corners_inertial(q))
     delta = np.zeros((3, N))
     delta[:, :N - 1] = R.T @ X - P[:, :N - 1]
-    comps = free_corner_components(N)
-    free = np.array([delta[c, i] for i, c in comps])
-    return CornerState(R=R, gamma=euler_angles_321(R), delta=delta, free=free)
+    return CornerState(R=R, gamma=euler_angles_321(R), delta=delta, free=free_components(delta))
 
 
 def _G(gamma, free, P, N):
     """Right-hand side R(gamma) (P_i + Delta_i) of eq. 3.5, shape (3, N-1)."""
-    D = np.zeros((3, N - 1))
-    for k, (i, c) in enumerate(free_corner_components(N)):
-        D[c, i] = free[k]
-    return rotation_ef(gamma) @ (P[:, :N - 1] + D)
+    return rotation_ef(gamma) @ (P + corner_array(free, N))[:, :N - 1]
 
 
 def _G_jacobian(gamma, free, P, N) -> np.ndarray:
     """d vec(G)/d(gamma, free), shape (3(N-1), 3N-3); vec is column-major over corners."""
-    D = np.zeros((3, N - 1))
     comps = free_corner_components(N)
-    for k, (i, c) in enumerate(comps):
-        D[c, i] = free[k]
     R = rotation_ef(gamma)
     dR = euler_R_derivatives(gamma)
-    Y = P[:, :N - 1] + D
+    Y = (P + corner_array(free, N))[:, :N - 1]
     J = np.zeros((3, N - 1, 3 + len(comps)))
     J[:, :, :3] = np.einsum("abk,bi->aik", dR, Y)
     for k, (i, c) in enumerate(comps):
@@ -203,11 +213,8 @@ def solve_corner_constraints(system, q=None, *, gamma0=None, free0=None, tol: fl
         r = _G(y[:3], y[3:], P, N).T.ravel() - x
         res = np.abs(r).max()
         if res < tol * scale:
-            R = rotation_ef(y[:3])
-            delta = np.zeros((3, N))
-            for k, (i, c) in enumerate(free_corner_components(N)):
-                delta[c, i] = y[3 + k]
-            return CornerState(R=R, gamma=y[:3].copy(), delta=delta, free=y[3:].copy(),
+            return CornerState(R=rotation_ef(y[:3]), gamma=y[:3].copy(),
+                               delta=corner_array(y[3:], N), free=y[3:].copy(),
                                iterations=it - 1)
         J = _G_jacobian(y[:3], y[3:], P, N)
         try:
@@ -280,8 +287,7 @@ def equilibrium_matrix(system, q=None) -> EquilibriumMatrix:
 def symmetric_corner_direction(N: int) -> np.ndarray:
     """Free corner-force components for F_Delta = 1 (eq. 3.21: F_ui = cos beta_i, F_vi = sin beta_i)."""
     b = beta(N)
-    f = np.vstack([np.cos(b), np.sin(b), np.zeros(N)])
-    return np.array([f[c, i] for i, c in free_corner_components(N)])
+    return free_components(np.vstack([np.cos(b), np.sin(b)]))
 
 
 def symmetric_groups(system) -> list[str]:
