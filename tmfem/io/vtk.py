@@ -438,6 +438,20 @@ def _normalise_cells(cells, n_points: int) -> list:
     return out
 
 
+def _block_data(point_data, cell_data, blocks, n_points: int) -> tuple[dict, dict]:
+    """Point data (n,) / (c, n) and cell data (a list with one array per cell block) in
+    meshio's layout, checked against ``n_points`` and the blocks' cell counts."""
+    pdata = {k: _check_data(f"point data {k!r}", v, n_points)
+             for k, v in (point_data or {}).items()}
+    cdata = {}
+    for k, v in (cell_data or {}).items():
+        if len(v) != len(blocks):
+            raise InputError(f"cell data {k!r}: expected one array per cell block "
+                             f"({len(blocks)}), found {len(v)}")
+        cdata[k] = [_check_data(f"cell data {k!r}", a, c.shape[1]) for a, (_, c) in zip(v, blocks)]
+    return pdata, cdata
+
+
 def check_modes(points, shapes, freq_hz, *, points_name: str = "points"):
     """Validated float arrays (X (3, n), S (3 n, k), f (k,)) of mode shapes about ``points``.
 
@@ -488,15 +502,9 @@ def write_modes(path, base_points, cells, shapes, freq_hz, *, point_data=None,
                           points_name="base_points")
     n = X.shape[1]
     blocks = _normalise_cells(cells, n)
+    extra, cdata = _block_data(point_data, cell_data, blocks, n)
     pdata = {f"mode_{k + 1}": S[:, k].reshape(n, 3) for k in range(S.shape[1])}
-    for k, v in (point_data or {}).items():
-        pdata[k] = _check_data(f"point data {k!r}", v, n)
-    cdata = {}
-    for k, v in (cell_data or {}).items():
-        if len(v) != len(blocks):
-            raise InputError(f"cell data {k!r}: expected one array per cell block "
-                             f"({len(blocks)}), found {len(v)}")
-        cdata[k] = [_check_data(f"cell data {k!r}", a, c.shape[1]) for a, (_, c) in zip(v, blocks)]
+    pdata.update(extra)
     fd = {"frequency_hz": f}
     fd.update({f"mode_{k + 1}_hz": f[k] for k in range(f.size)})
     return _write_mesh(path, X, blocks, point_data=pdata, cell_data=cdata, field_data=fd)
@@ -563,12 +571,7 @@ class SeriesWriter:
         if X.ndim != 2 or X.shape[0] != 3:
             raise InputError(f"points: expected shape (3, n), found {X.shape}")
         blocks = _normalise_cells(cells, X.shape[1])
-        pdata = {k: _check_data(f"point data {k!r}", v, X.shape[1])
-                 for k, v in (point_data or {}).items()}
-        cdata = {}
-        for k, v in (cell_data or {}).items():
-            cdata[k] = [_check_data(f"cell data {k!r}", a, c.shape[1])
-                        for a, (_, c) in zip(v, blocks)]
+        pdata, cdata = _block_data(point_data, cell_data, blocks, X.shape[1])
         path = _write_mesh(self._next(), X, blocks, point_data=pdata, cell_data=cdata)
         return self._commit(time, path)
 
