@@ -190,3 +190,19 @@ def test_consistent_mass(mem):
 def test_wrong_shape_is_an_input_error(mem):
     with pytest.raises(InputError, match=r"expected current positions of shape \(3,"):
         mem.internal(np.zeros((2, mem.nn)))
+
+
+def test_point_matrix_reproduces_bilinear_fields_and_rejects_outside_points(mem):
+    # a bilinear field a + b x + c y + d x y is reproduced exactly on parallelograms; on the
+    # distorted mesh the affine part a + b x + c y is (isoparametric Q1 completeness)
+    from tmfem.fem.membrane import point_matrix
+    pts = np.array([[0.3, 1.1, 1.9], [0.7, 1.6, 0.2]])
+    P = point_matrix(mem.skmesh, pts)
+    assert P.shape == (3, mem.nn)
+    x, y = mem.mesh.p
+    assert P @ (0.5 + 2.0 * x - 3.0 * y) == pytest.approx(0.5 + 2.0 * pts[0] - 3.0 * pts[1],
+                                                        abs=1e-12)
+    with pytest.raises(InputError, match="outside the undeformed membrane"):
+        point_matrix(mem.skmesh, [[5.0], [5.0]])
+    with pytest.raises(InputError, match=r"expected shape \(2, n\)"):
+        point_matrix(mem.skmesh, np.zeros((3, 2)))

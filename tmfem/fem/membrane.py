@@ -109,6 +109,29 @@ class MembraneStresses:
         return self.von_mises.mean(axis=-1)
 
 
+def point_matrix(skmesh, points) -> sp.csr_matrix:
+    """Interpolation matrix (n_points, n_nodes) of a nodal bilinear field on a quadrilateral
+    mesh at reference points: the bilinear interpolation of eqs. 4.25-4.26 (scikit-fem probes
+    of ``ElementQuad1``, whose dof k is node k).
+
+    Parameters
+    ----------
+    skmesh : skfem.MeshQuad
+    points : array_like (2, n_points)
+        Reference coordinates (x_f, y_f) [m].
+    """
+    from skfem import Basis, ElementQuad1
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    if pts.shape[0] != 2:
+        raise InputError(f"membrane points: expected shape (2, n) of (x_f, y_f), found {pts.shape}")
+    basis = Basis(skmesh, ElementQuad1(), intorder=1)
+    try:
+        return sp.csr_matrix(basis.probes(pts))
+    except ValueError as exc:
+        raise InputError(f"membrane points {pts.T.tolist()}: outside the undeformed membrane "
+                         f"({exc})") from None
+
+
 class MembraneTL:
     """Total-Lagrangian membrane on a flat reference mesh (eqs. 4.25-4.28).
 

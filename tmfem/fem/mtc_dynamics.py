@@ -44,6 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
+from tmfem.fem.membrane import point_matrix
 from tmfem.fem.mtc_post import q_from_positions
 from tmfem.fem.mtc_topology import to_floating
 from tmfem.fem.truss import truss_internal
@@ -228,15 +229,6 @@ class MTCVibration:
         return self.kinetic + self.strain
 
 
-def membrane_point_matrix(model, points) -> sp.csr_matrix:
-    """Interpolation matrix (n_points, n_mesh) of the bilinear membrane mesh at reference points
-    (x_f, y_f) (the skfem probes of the membrane's scalar Q1 basis)."""
-    from skfem import Basis, ElementQuad1
-    pts = np.asarray(points, dtype=float).reshape(-1, 2).T
-    basis = Basis(model.membrane.skmesh, ElementQuad1(), intorder=1)
-    return sp.csr_matrix(basis.probes(pts))
-
-
 def tendon_transverse(model, x) -> np.ndarray:
     """Transverse offsets (n_t, k - 1, 2) of every tendon's internal nodes from its chord, in
     the tendon frame e_t2, e_t3 of eq. 5.37."""
@@ -291,7 +283,7 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
     labels = MONITOR_NODES.get(system.name, []) if monitor_nodes is None else list(monitor_nodes)
     lab_nodes = [topo.system_node[system.node_index(n)] for n in labels]
     pts = MONITOR_POINTS.get(system.name, []) if output_points is None else list(output_points)
-    P = membrane_point_matrix(model, pts) if pts else None
+    P = point_matrix(model.membrane.skmesh, np.reshape(pts, (-1, 2)).T) if pts else None
     nm = topo.n_mesh
     corners = topo.mesh.corners
     x0 = dyn.positions(u0)

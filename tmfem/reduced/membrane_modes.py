@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError, SlackMembrane
+from tmfem.fem.membrane import point_matrix
 from tmfem.reduced.constraints import ZetaLayout
 
 
@@ -87,15 +88,7 @@ class MembraneBasis:
 
     def probe(self, points) -> np.ndarray:
         """Interpolation matrix (n_points, n_nodes) of the bilinear FE field at points (2, n)."""
-        pts = np.atleast_2d(np.asarray(points, dtype=float))
-        if pts.shape[0] != 2:
-            raise InputError(f"membrane points: expected shape (2, n) of (x_f, y_f), found {pts.shape}")
-        try:
-            P = self.scalar_basis.probes(pts)
-        except ValueError as exc:
-            raise InputError(f"membrane points {pts.T.tolist()}: outside the undeformed membrane "
-                             f"({exc})") from None
-        return np.asarray(P.todense())
+        return point_matrix(self.scalar_basis.mesh, points).toarray()
 
     def point_matrix(self, points, component: int = 2) -> np.ndarray:
         """Deflection component (0 u, 1 v, 2 w) at points as a linear map of
