@@ -29,7 +29,6 @@ from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix, fr
                                        null_space, positive_null_vector, symmetric_matrix)
 from tmfem.equilibrium.symmetric import closed_form_1N, closed_form_1ND
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
-from tmfem.fem.attachment import default_patch_radius
 from tmfem.fem.plane_stress import PlaneStressMembrane, PlaneStressSolution
 from tmfem.system.geometry import beta
 
@@ -166,8 +165,9 @@ def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembra
     """Corner displacements (eq. 3.5) and the plane-stress membrane solution for them.
 
     ``attachment``/``patch``: corner attachment of :class:`PlaneStressMembrane` (``"point"``,
-    the dissertation's model, or ``"distributed"``; default patch radius 10 % of r_mb, as in
-    the MTC model). Ignored when ``model`` is given.
+    the dissertation's model, or ``"distributed"``; default patch radius that of
+    :class:`PlaneStressMembrane`, 10 % of the membrane's circumradius r_mb, as in the MTC
+    model). Ignored when ``model`` is given.
 
     Returns
     -------
@@ -176,8 +176,6 @@ def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembra
     q = system.q if q is None else np.asarray(q, dtype=float)
     E = equilibrium_matrix(system, q)
     if model is None:
-        if attachment == "distributed" and patch is None:
-            patch = default_patch_radius(system.membrane_corners, system.r_mb)
         model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane,
                                     n=mesh_n, attachment=attachment, patch=patch)
     sol = model.solve(E.state.delta[:2])
@@ -353,10 +351,7 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
                         f"out-of-plane corner displacement max |Delta_w| = {dw:.3g} m; the "
                         f"plane-stress membrane needs coplanar corners (<= {1e-9 * scale:.1g} m)"))
     F = sol.corner_forces
-    centre = system.membrane_corners.mean(axis=1, keepdims=True)
-    e = system.membrane_corners - centre
-    e = e / np.linalg.norm(e, axis=0)
-    radial = np.sum(F * e, axis=0)
+    radial = np.sum(F * model.radial_directions(), axis=0)
     F_Delta = float(radial.mean())
     Delta = _radial_delta(system, st.delta)
     if Delta is not None:

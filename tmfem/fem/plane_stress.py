@@ -101,6 +101,14 @@ def von_mises(sigma: np.ndarray) -> np.ndarray:
     return np.sqrt(0.5 * ((p[0] - p[1])**2 + (p[1] - p[2])**2 + (p[2] - p[0])**2))
 
 
+def radial_directions(corners) -> np.ndarray:
+    """Unit vectors (2, N) from the centroid of a membrane polygon (2, N) to each corner:
+    (cos beta_i, sin beta_i) of eq. 3.21 for the regular polygon of 3.3.1."""
+    c = np.asarray(corners, dtype=float)
+    d = c - c.mean(axis=1, keepdims=True)
+    return d / np.linalg.norm(d, axis=0)
+
+
 @dataclass(frozen=True)
 class PlaneStressSolution:
     """Linear plane-stress state of the membrane for prescribed corner displacements.
@@ -312,9 +320,9 @@ class PlaneStressMembrane:
 
     # ------------------------------------------------------------------ symmetric load
     def radial_directions(self) -> np.ndarray:
-        """Unit vectors (2, N) from the membrane centroid to each corner."""
-        d = self.corners - self.corners.mean(axis=1, keepdims=True)
-        return d / np.linalg.norm(d, axis=0)
+        """Unit vectors (2, N) from the membrane centroid to each corner
+        (:func:`radial_directions`)."""
+        return radial_directions(self.corners)
 
     def symmetric_delta(self, Delta: float) -> np.ndarray:
         """Corner displacements of eq. 3.21: Delta (cos b_i - cos b_N, sin b_i - sin b_N).
@@ -401,13 +409,10 @@ def symmetric_corner_force(system, *, n: int = 10, Delta: float | None = None,
         raise SlackMembrane(f"system {system.name!r}: expected membrane corner displacement "
                             f"Delta > 0 (eq. 3.36), found Delta = {Delta:.6g} m")
     corners = np.asarray(system.membrane_corners, dtype=float)
-    e = corners - corners.mean(axis=1, keepdims=True)
     b = beta(system.N)
-    if not np.allclose(e / np.linalg.norm(e, axis=0), [np.cos(b), np.sin(b)], atol=1e-9):
+    if not np.allclose(radial_directions(corners), [np.cos(b), np.sin(b)], atol=1e-9):
         raise InputError(f"system {system.name!r}: membrane corners are not a regular polygon "
                          "oriented as beta_j of eq. 3.21")
-    if attachment == "distributed" and patch is None:
-        patch = default_patch_radius(corners, system.r_mb)
     resp = PlaneStressMembrane(corners=corners, material=system.membrane, n=n,
                                attachment=attachment, patch=patch).symmetric_response(Delta)
     if resp.asymmetry > symmetry_tol:

@@ -36,12 +36,11 @@ def corner_radial_displacements(system, q=None) -> np.ndarray:
     the undeformed corner. For a symmetric system every entry equals Delta of eq. 3.22;
     a membrane is stretched only if all are positive (eq. 3.36).
     """
+    from tmfem.fem.plane_stress import radial_directions
+
     delta, _, _ = corner_displacements(system, q)
-    ref = system.membrane_corners
-    e = ref - ref.mean(axis=1, keepdims=True)
-    e /= np.linalg.norm(e, axis=0)
     d = delta - delta.mean(axis=1, keepdims=True)
-    return np.sum(d * e, axis=0)
+    return np.sum(d * radial_directions(system.membrane_corners), axis=0)
 
 
 def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "point",
@@ -69,17 +68,34 @@ def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "poi
 
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise InputError(f"membrane mesh: expected n >= 1, found {n!r}")
-    delta, o, R = corner_displacements(system, q)
-    if attachment == "distributed" and patch is None:
-        from tmfem.fem.attachment import default_patch_radius
-        patch = default_patch_radius(system.membrane_corners, system.r_mb)
+    delta, _, _ = corner_displacements(system, q)
     model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane, n=n,
                                 attachment=attachment, patch=patch)
-    sol = model.solve(delta)
+    return placed_membrane_field(system, model, model.solve(delta), q=q)
+
+
+def placed_membrane_field(system, model, sol, *, q=None) -> MembraneField:
+    """A solved plane-stress membrane placed on the bar tops of configuration q.
+
+    Parameters
+    ----------
+    system : System
+    model : PlaneStressMembrane
+        The membrane model (its mesh is the one placed).
+    sol : PlaneStressSolution
+        Its solution for the corner displacements of q (eq. 5.8), e.g. the ``membrane`` of
+        an :class:`tmfem.equilibrium.design.EquilibriumDesign` at the same q.
+    q : ndarray, optional
+        Configuration; default ``system.q``.
+
+    Returns
+    -------
+    MembraneField as :func:`membrane_design_field`.
+    """
+    _, o, R = corner_displacements(system, q)
     mesh = model.mesh
-    xf = np.vstack([mesh.p + sol.u, np.zeros(mesh.p.shape[1])])
-    x = o[:, None] + R @ xf
-    u = x - (o[:, None] + R @ np.vstack([mesh.p, np.zeros(mesh.p.shape[1])]))
+    u = R[:, :2] @ sol.u                      # in-plane displacement in the inertial frame
+    x = o[:, None] + R[:, :2] @ mesh.p + u
     vm = sol.von_mises()
     pr = sol.principal()
     return MembraneField(mesh=mesh, x=x, point_data={"displacement": u},
