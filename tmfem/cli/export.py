@@ -30,44 +30,35 @@ def configure(parser) -> None:
                         help="geometry and rest lengths only, no equilibrium design")
 
 
-def design_forces(system, *, mesh_n: int) -> dict:
-    """Tendon forces, rest lengths and bar forces of the equilibrium design.
-
-    Uses ``tmfem.equilibrium.design_equilibrium`` (3.2, eqs. 3.8-3.9, 3.16). Bar forces are
-    axial forces, negative in
-    compression, in stage-major order. Errors of the design itself (an infeasible
-    system) propagate as the named tmfem errors.
-    """
-    from tmfem.equilibrium.design import design_equilibrium
-    d = design_equilibrium(system, mesh_n=mesh_n if mesh_n > 0 else 10)
-    out = {"tendon_forces": np.asarray(d.tendon_forces, dtype=float),
-           "rest_lengths": np.asarray(d.rest_lengths, dtype=float)}
-    if getattr(d, "bar_loads", None) is not None:
-        out["bar_forces"] = -np.asarray(d.bar_loads, dtype=float).ravel()
-    return out
+def design_forces(d) -> dict:
+    """Tendon forces, rest lengths and bar forces of an equilibrium design ``d``
+    (:func:`tmfem.equilibrium.design.design_equilibrium`, 3.2, eqs. 3.8-3.9, 3.16). Bar
+    forces are axial forces, negative in compression, in stage-major order."""
+    return {"tendon_forces": np.asarray(d.tendon_forces, dtype=float),
+            "rest_lengths": np.asarray(d.rest_lengths, dtype=float),
+            "bar_forces": -np.asarray(d.bar_loads, dtype=float).ravel()}
 
 
 def run(args) -> dict:
+    from tmfem.equilibrium.design import design_equilibrium
     from tmfem.io import write_configuration
-    from tmfem.post.fields import corner_radial_displacements, membrane_design_field
+    from tmfem.post.fields import (corner_radial_displacements, membrane_design_field,
+                                   placed_membrane_field)
 
     system = system_from_args(args)
     if args.mesh < 0:
         raise InputError(f"--mesh: expected n >= 0, found {args.mesh}")
     warnings = []
-    forces = {}
+    d = None
     if not args.no_equilibrium:
         try:
-            forces = design_forces(system, mesh_n=args.mesh)
+            d = design_equilibrium(system, mesh_n=args.mesh if args.mesh > 0 else 10)
         except InfeasibleDesign as exc:
             # the configuration is still worth looking at: write it without forces, say why
             warnings.append(f"no equilibrium design ({type(exc).__name__}: {exc}); "
                             "writing geometry and rest lengths only")
-        else:
-            if "tendon_forces" not in forces:
-                warnings.append("equilibrium design not available; writing geometry and rest "
-                                "lengths only")
-    source = "design_equilibrium" if "tendon_forces" in forces else "none"
+    forces = {} if d is None else design_forces(d)
+    source = "design_equilibrium" if d is not None else "none"
     radial = corner_radial_displacements(system)
     if np.any(radial <= 0):
         warnings.append("membrane not stretched (eq. 3.36): radial corner displacements "
@@ -75,7 +66,12 @@ def run(args) -> dict:
                         "field is compressive and only shows the misfit")
     for w in warnings:
         print(f"tmfem export: warning: {w}", file=sys.stderr)
-    membrane = membrane_design_field(system, n=args.mesh) if args.mesh > 0 else None
+    if args.mesh == 0:
+        membrane = None
+    elif d is not None:     # the design solved this membrane already (same mesh, same q)
+        membrane = placed_membrane_field(system, d.membrane_model, d.membrane)
+    else:
+        membrane = membrane_design_field(system, n=args.mesh)
     path = write_configuration(args.out, system, membrane=membrane,
                                tendon_forces=forces.get("tendon_forces"),
                                rest_lengths=forces.get("rest_lengths"),

@@ -258,9 +258,8 @@ def run(args) -> dict:
     files["membrane_stress.png"] = str(plot_membrane_stress(out / "membrane_stress.png", d))
     _progress("VTK file")
     from tmfem.io.vtk import write_configuration
-    from tmfem.post.fields import membrane_design_field
-    membrane = membrane_design_field(system, n=args.mesh, attachment=args.attachment,
-                                     patch=d.membrane_model.patch)
+    from tmfem.post.fields import placed_membrane_field
+    membrane = placed_membrane_field(system, d.membrane_model, d.membrane)
     files["configuration.vtu"] = str(write_configuration(
         out / "configuration.vtu", system, tendon_forces=d.tendon_forces,
         rest_lengths=d.rest_lengths if np.all(np.isfinite(d.rest_lengths)) else None,
