@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from tmfem.errors import InputError
-from tmfem.fem.mtc import MTCModel, green_rest_length, linear_rest_length
+from tmfem.fem.mtc import MTCModel
+from tmfem.fem.truss import green_rest_length, linear_rest_length
 from tmfem.tables import FREQUENCIES
 from tmfem.fem.mtc_post import static_summary
 from tmfem.system import System, SymmetricConfig, load_preset

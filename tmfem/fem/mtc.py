@@ -36,31 +36,9 @@ import scipy.sparse.linalg as spla
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.membrane import MembraneTL
 from tmfem.fem.mtc_topology import MTCTopology, build_topology, membrane_placement
-from tmfem.fem.truss import TrussSet, truss_internal, truss_mass
+from tmfem.fem.truss import (TrussSet, green_rest_length, linear_rest_length, truss_internal,
+                             truss_mass)
 from tmfem.system.topology import label
-
-
-def green_rest_length(length, tension, EA):
-    """Rest length r of a total-Lagrangian truss that carries ``tension`` at ``length``.
-
-    The truss of :mod:`tmfem.fem.truss` has N = EA E l / r with E = (l^2 - r^2) / (2 r^2);
-    with s = l / r this is the cubic s^3 - s - 2 N / EA = 0 (one positive root for N > -EA/3),
-    solved by Newton's method from the linear-spring value s = 1 + N / EA (eq. 3.8).
-    """
-    length = np.asarray(length, dtype=float)
-    c = 2.0 * np.asarray(tension, dtype=float) / np.asarray(EA, dtype=float)
-    s = 1.0 + 0.5 * c
-    for _ in range(50):
-        g = s**3 - s - c
-        s = s - g / (3 * s**2 - 1)
-        if np.all(np.abs(g) < 1e-15):
-            break
-    return length / s
-
-
-def linear_rest_length(length, tension, EA):
-    """Rest length of the linear spring of eqs. 3.8-3.9: T = EA (|d| - r) / r."""
-    return np.asarray(EA) * np.asarray(length) / (np.asarray(tension) + np.asarray(EA))
 
 
 @dataclass

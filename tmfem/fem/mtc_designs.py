@@ -75,7 +75,7 @@ def fit_stage2_base(*, starts: int = 5, seed: int = 0) -> dict:
 def scaled_consistent_rest_lengths(model, scale: float) -> np.ndarray:
     """Rest lengths that carry ``scale`` times the design-consistent forces of ``model``
     (:meth:`MTCModel.consistent_rest_lengths`) at the design lengths (Green-strain truss)."""
-    from tmfem.fem.mtc import green_rest_length
+    from tmfem.fem.truss import green_rest_length
     c = model.consistent_rest_lengths()
     return green_rest_length(c["tendon_length"], scale * c["tendon_force"], model.tendon_EA)
 

@@ -161,3 +161,26 @@ def truss_mass(trusses: TrussSet, nn: int, *, lumped: bool = False) -> sp.csr_ma
     else:
         pattern = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3)) / 6.0
     return asm.matrix(m[:, None, None] * pattern[None])
+
+
+def green_rest_length(length, tension, EA):
+    """Rest length r of a total-Lagrangian truss that carries ``tension`` at ``length``.
+
+    The truss of this module has N = EA E l / r with E = (l^2 - r^2) / (2 r^2);
+    with s = l / r this is the cubic s^3 - s - 2 N / EA = 0 (one positive root for N > -EA/3),
+    solved by Newton's method from the linear-spring value s = 1 + N / EA (eq. 3.8).
+    """
+    length = np.asarray(length, dtype=float)
+    c = 2.0 * np.asarray(tension, dtype=float) / np.asarray(EA, dtype=float)
+    s = 1.0 + 0.5 * c
+    for _ in range(50):
+        g = s**3 - s - c
+        s = s - g / (3 * s**2 - 1)
+        if np.all(np.abs(g) < 1e-15):
+            break
+    return length / s
+
+
+def linear_rest_length(length, tension, EA):
+    """Rest length of the linear spring of eqs. 3.8-3.9: T = EA (|d| - r) / r."""
+    return np.asarray(EA) * np.asarray(length) / (np.asarray(tension) + np.asarray(EA))

@@ -20,13 +20,13 @@ affinely (B(x) u, eq. 5.19) -- see docs/com.md.
 """
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 
 from tmfem.errors import InfeasibleDesign, InputError, SlackTendon
+from tmfem.fem.truss import linear_rest_length
 from tmfem.reduced.constraints import ConstraintSolver, ZetaLayout, phi_sx
 from tmfem.reduced.kinematics import (bar_kinetic_energy_sx, bars_sx, rotation_ef_sx,
                                       tendon_lengths_sx)
@@ -386,7 +386,7 @@ class ControlOrientedModel:
             bad = [f"{t.name}={f:.4g} N" for t, f in zip(self.system.tendons, T) if f <= 0]
             raise SlackTendon(f"system {self.system.name!r}: design tendon forces must be > 0 "
                               f"(eq. 3.16), found {', '.join(bad)}")
-        r = self.EA * L / (self.EA + T)
+        r = linear_rest_length(L, T, self.EA)
         return StaticDesign(tendon_forces=T, rest_lengths=r, residual=float(res))
 
     # ------------------------------------------------------------------ second coordinates
@@ -653,11 +653,3 @@ class ControlOrientedModel:
                 "membrane_mode_frequencies_hz": (self.membrane.omega / (2 * np.pi)).tolist(),
                 "membrane_mode_kinds": list(self.membrane.mode_kind),
                 "formulation": self.formulation}
-
-
-def progress_printer(label: str, every: int = 100):
-    """A progress callback printing ``label: step/n`` to stderr every ``every`` steps."""
-    def cb(k, n):
-        if k % every == 0 or k == n:
-            print(f"{label}: {k}/{n}", file=sys.stderr, flush=True)
-    return cb
