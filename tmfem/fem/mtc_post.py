@@ -7,7 +7,7 @@ import numpy as np
 
 from tmfem.fem.mtc_topology import to_floating
 from tmfem.fem.truss import truss_internal
-from tmfem.system.geometry import floating_frame, wrap_angle
+from tmfem.system.geometry import wrap_angle
 from tmfem.system.topology import label
 
 def q_from_positions(system, X: np.ndarray) -> np.ndarray:
@@ -169,11 +169,6 @@ def model_cells(model) -> list:
     """Cells of the full MTC mesh: bars, tendon elements (lines) and membrane quads."""
     return [("line", model.topology.bar_conn), ("line", model.topology.tendon_conn),
             ("quad", model.topology.mesh.t)]
-
-
-def frame_of(x: np.ndarray, model) -> tuple[np.ndarray, np.ndarray]:
-    """Floating frame (origin, R) of the current membrane corners of positions x."""
-    return floating_frame(x[:, model.topology.mesh.corners])
 
 
 def plot_membrane_stress(png, model, x: np.ndarray, *, title: str | None = None):
