@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
-from tmfem.equilibrium.symmetric import membrane_delta
+from tmfem.equilibrium.symmetric import membrane_delta_system
 from tmfem.errors import InputError
 from tmfem.system.geometry import SymmetricConfig, wrap_angle
 
@@ -142,9 +142,7 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
             margin[a, b] = nv.margin
             if nv.dim == 1 and abs(nv.x[-1]) > 1e-12 * np.abs(nv.x).max():
                 ratios[a, b] = nv.x / nv.x[-1]
-            Delta[a, b] = membrane_delta(l_M=cfg.l[-1], theta_M=th, psi_M=cfg.psi[-1],
-                                         sigma_M=cfg.sigma[-1], r_M=cfg.r[-1], r_mb=system.r_mb,
-                                         N=system.N)
+            Delta[a, b] = membrane_delta_system(s)
         if progress:
             print(f"equilibrium map: theta {a + 1}/{theta.size}", file=sys.stderr)
     fixed = {"l": c.l.tolist(), "r": c.r.tolist(), "z": c.z.tolist(),
@@ -161,10 +159,9 @@ def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
 
     ``mark`` = (theta, psi) [rad] of a point to mark (e.g. the design).
     """
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from tmfem.post.plots import _plt, _save
 
+    plt = _plt()
     th, ps = np.degrees(emap.theta), np.degrees(emap.psi)
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     ax.contourf(ps, th, emap.feasible.astype(float), levels=[0.5, 1.5], colors=["#9fd49f"])
@@ -179,10 +176,7 @@ def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
     ax.set_ylabel("theta [deg]")
     ax.set_title(title or "symmetric equilibria (green); blue: null vector positive "
                  "boundary, red dashed: Delta = 0", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(png, dpi=120)
-    plt.close(fig)
-    return png
+    return _save(fig, png)
 
 
 def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int = 0,
@@ -220,9 +214,7 @@ def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int =
         cfg = configuration_5_97(system, theta, psi, r=r, z=z, sigma=sg)
         s = with_configuration(system, cfg)
         nv = positive_null_vector(symmetric_matrix(s).A)
-        D = membrane_delta(l_M=cfg.l[-1], theta_M=theta, psi_M=cfg.psi[-1], sigma_M=sg[-1],
-                           r_M=r[-1], r_mb=system.r_mb, N=system.N)
-        return nv.margin, D
+        return nv.margin, membrane_delta_system(s)
 
     def objective(p):
         m, D = evaluate(p)
