@@ -36,7 +36,6 @@ def mtc_modes(model, *, k: int, start: str = "undeformed", sequence: int | None 
 
 
 def run(args) -> dict:
-    system_name = None
     if args.model == "com":
         from tmfem.reduced.modal import modal_summary
         system = system_from_args(args)

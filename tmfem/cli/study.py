@@ -175,10 +175,9 @@ def write_tables(out: Path, d, system) -> dict:
 
 def plot_configuration(png: Path, d, system) -> Path:
     """3-D line plot: bars black, tendons coloured by force, membrane polygon."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from tmfem.post.plots import _plt, _save
 
+    plt = _plt()
     X = d.nodes
     fig = plt.figure(figsize=(7, 6))
     ax = fig.add_subplot(projection="3d")
@@ -203,18 +202,16 @@ def plot_configuration(png: Path, d, system) -> Path:
     sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, tmax))
     fig.colorbar(sm, ax=ax, shrink=0.6, label="tendon force [N] (red: slack)")
     ax.set_title(f"{system.name}: design configuration")
-    fig.savefig(png, dpi=120)
-    plt.close(fig)
-    return png
+    return _save(fig, png)
 
 
 def plot_membrane_stress(png: Path, d) -> Path:
     """von Mises stress (element maximum, eq. 5.30) over the membrane mesh in O_f."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
+    from tmfem.post.plots import _plt, _save
+
+    plt = _plt()
     mesh = d.membrane_model.mesh
     vm = d.membrane.von_mises().max(axis=1) / 1e6
     verts = np.moveaxis(mesh.p[:, mesh.t], 0, -1).transpose(1, 0, 2)   # (ne, 4, 2)
@@ -228,10 +225,7 @@ def plot_membrane_stress(png: Path, d) -> Path:
     fig.colorbar(pc, ax=ax, label="von Mises stress [MPa] (element max)")
     ax.set_xlabel("x_f [m]"), ax.set_ylabel("y_f [m]")
     ax.set_title("membrane stress in the floating frame O_f (linear plane stress)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(png, dpi=120)
-    plt.close(fig)
-    return png
+    return _save(fig, png)
 
 
 def run(args) -> dict:

@@ -47,6 +47,8 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
+    if not (args.t_end > 0 and args.dt > 0):
+        raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
     if args.model == "mtc":
         return run_mtc(args)
     from tmfem.reduced.modal import default_membrane_modes
@@ -55,8 +57,6 @@ def run(args) -> dict:
 
     system = system_from_args(args)
     K = default_membrane_modes(system) if args.membrane_modes is None else args.membrane_modes
-    if not (args.t_end > 0 and args.dt > 0):
-        raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
     print(f"tmfem vibrate: {system.name} COM, K = {K}, building the model", file=sys.stderr)
     model = ControlOrientedModel(system, membrane_modes=K, mesh_n=args.mesh, damping=args.damping,
                                  prestress_scale=prestress_scale_of(args))
@@ -100,8 +100,6 @@ def run_mtc(args) -> dict:
     from tmfem.reduced.simulate import parse_perturbation
 
     system = system_from_args(args)
-    if not (args.t_end > 0 and args.dt > 0):
-        raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
     if args.damping or args.membrane_modes is not None or args.prestress_scale is not None:
         raise InputError("--damping, --membrane-modes and --prestress-scale belong to --model com; "
                          "the MTC model takes --rayleigh ALPHA BETA and --rest-lengths")
