@@ -118,6 +118,8 @@ class EquilibriumDesign:
 
     def to_dict(self) -> dict:
         s = self.system
+        L, T = self.group_values(self.tendon_lengths), self.group_values(self.tendon_forces)
+        fd, r = self.group_values(self.force_densities), self.group_values(self.rest_lengths)
         d = {
             "system": s.name, "M": s.M, "N": s.N, "deployable": s.deployable,
             "ok": self.ok,
@@ -134,10 +136,8 @@ class EquilibriumDesign:
                                                          self.tendon_lengths, self.tendon_forces,
                                                          self.force_densities, self.rest_lengths,
                                                          self.tendon_stress)],
-            "groups": {g: {"length": L, "force": self.group_values(self.tendon_forces)[g],
-                           "force_density": self.group_values(self.force_densities)[g],
-                           "rest_length": _finite(self.group_values(self.rest_lengths)[g])}
-                       for g, L in self.group_values(self.tendon_lengths).items()},
+            "groups": {g: {"length": L[g], "force": T[g], "force_density": fd[g],
+                           "rest_length": _finite(r[g])} for g in L},
             "bar_loads": self.bar_loads.tolist(), "bar_critical": self.bar_critical.tolist(),
             "membrane_max_principal": self.membrane_max_principal,
             "membrane_max_von_mises": self.membrane_max_von_mises,
