@@ -389,10 +389,7 @@ class MTCModel:
                 ok = False
             if not ok or mu > 1e12 * mu_scale:
                 # no step improves the state: accept it if we sit on the round-off floor
-                xf = self.full(xr)
-                scale = 1.0 + float(np.sum(np.abs(truss_internal(xf, self.tendons, tangent=False).N))
-                                    + np.sum(np.abs(truss_internal(xf, self.bars, tangent=False).N)))
-                if rn <= 1e3 * tol * scale:
+                if rn <= 1e3 * tol * self._force_scale(self.full(xr)):
                     converged = True
                     break
                 raise ConvergenceError(f"MTC static solve: no descent step at iteration {it} "
@@ -412,10 +409,8 @@ class MTCModel:
             if progress:
                 print(f"  static it {it:3d}  |r| = {rn:.3e} N  mu = {mu_used:.3g}  rho = {rho:.3g}",
                       file=sys.stderr)
-            scale = 1.0 + float(np.sum(np.abs(truss_internal(xf, self.tendons, tangent=False).N))
-                                + np.sum(np.abs(truss_internal(xf, self.bars, tangent=False).N)))
             step = float(np.abs(du).max())
-            if rn <= tol * scale and (mu_used == 0.0 or step < 1e-9):
+            if rn <= tol * self._force_scale(xf) and (mu_used == 0.0 or step < 1e-9):
                 converged = True
                 break
             if it >= 60 and min(res_hist[-40:]) > 0.1 * min(res_hist[:-40]):
@@ -427,6 +422,12 @@ class MTCModel:
         return StaticResult(x=self.full(xr), iterations=it, residual_history=res_hist,
                             monitor={k: np.array(v) for k, v in hist.items()},
                             dt2_history=mu_hist, time=time.perf_counter() - t0)
+
+    def _force_scale(self, x: np.ndarray) -> float:
+        """1 N + the sum of |member forces| at positions x: the scale of the convergence test
+        of :meth:`solve_static`."""
+        return 1.0 + float(np.sum(np.abs(truss_internal(x, self.tendons, tangent=False).N))
+                           + np.sum(np.abs(truss_internal(x, self.bars, tangent=False).N)))
 
     def _state_note(self, xr) -> str:
         """Slack tendons and stretch of the membrane at independent positions xr, for errors."""
@@ -543,13 +544,14 @@ class MTCModel:
                 A[3 * row_of[a]:3 * row_of[a] + 3, m] += e
             if b in row_of:
                 A[3 * row_of[b]:3 * row_of[b] + 3, m] -= e
+        top = [sysm.node_index(label("B", sysm.M, j)) for j in range(1, sysm.N + 1)]
+        Xtop = X[:, top]
         rhs = np.zeros(3 * len(rows))
-        for j in range(sysm.N):
-            n = sysm.node_index(label("B", sysm.M, j + 1))
+        for j, n in enumerate(top):
             rhs[3 * row_of[n]:3 * row_of[n] + 3] -= Fc[:, j]
         sol, *_ = np.linalg.lstsq(A, rhs, rcond=None)
         res = np.linalg.norm(A @ sol - rhs) / max(np.linalg.norm(rhs), 1e-30)
-        s, _ = np.linalg.svd(A, compute_uv=False), None
+        s = np.linalg.svd(A, compute_uv=False)
         bar_force, T = sol[:nb], sol[nb:]
         L = sysm.tendon_lengths()
         out = {"tendon_force": T, "bar_force": bar_force, "corner_force": Fc,
@@ -559,13 +561,12 @@ class MTCModel:
             bad = [sysm.tendons[i].name for i in np.flatnonzero(T <= 0)]
             raise SlackTendon(f"the design geometry needs non-positive tendon forces in {bad}: "
                               f"{T[T <= 0]} N (expected > 0)")
-        if np.any(np.einsum("ij,ij->j", Fc, X[:, [sysm.node_index(label('B', sysm.M, j))
-                                                   for j in range(1, sysm.N + 1)]]
-                                     - X[:, [sysm.node_index(label('B', sysm.M, j))
-                                             for j in range(1, sysm.N + 1)]].mean(axis=1,
-                                                                                   keepdims=True)) >= 0):
-            raise SlackMembrane("the membrane does not pull the corners inwards at the design "
-                                "(Delta <= 0, eq. 3.36)")
+        outward = Xtop - Xtop.mean(axis=1, keepdims=True)
+        pull = np.einsum("ij,ij->j", Fc, outward / np.linalg.norm(outward, axis=0))
+        if np.any(pull >= 0):
+            raise SlackMembrane(f"the membrane does not pull the corners inwards at the design "
+                                f"(Delta <= 0, eq. 3.36): outward corner force components "
+                                f"{np.round(pull, 6).tolist()} N, expected < 0")
         out["rest_lengths"] = green_rest_length(L, T, self.tendon_EA)
         out["rest_lengths_linear"] = linear_rest_length(L, T, self.tendon_EA)
         return out
