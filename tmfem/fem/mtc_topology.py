@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
-from tmfem.fem.attachment import attachment_weights, default_patch_radius  # noqa: F401 (re-export)
+from tmfem.fem.attachment import attachment_weights, default_patch_radius
 from tmfem.mesh.polygon import MembraneMesh, polygon_quad_mesh
 from tmfem.system.geometry import floating_frame
 from tmfem.system.topology import label
