@@ -24,7 +24,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.system.geometry import (beta, euler_angles_321, floating_frame, free_corner_components,
+from tmfem.system.geometry import (beta, euler_angles_321, free_corner_components,
                                   rotation_ef)
 from tmfem.system.topology import FAMILIES_MN
 
@@ -158,12 +158,8 @@ def corner_state(system, q=None) -> CornerState:
     InputError
         if B_MN, B_M1, B_M,N-1 are collinear.
     """
-    q = system.q if q is None else np.asarray(q, dtype=float)
-    X, P = _corner_data(system, q)
-    N = system.N
-    _, R = floating_frame(system.membrane_corners_inertial(q))
-    delta = np.zeros((3, N))
-    delta[:, :N - 1] = R.T @ X - P[:, :N - 1]
+    delta, _, R = system.corner_displacements(q)
+    delta[:, -1] = 0.0                  # corner N is the origin O_f (eq. 3.4)
     return CornerState(R=R, gamma=euler_angles_321(R), delta=delta, free=free_components(delta))
 
 

@@ -28,7 +28,6 @@ import numpy as np
 
 from tmfem.errors import BackendUnavailable, InputError
 from tmfem.mesh.polygon import MembraneMesh
-from tmfem.system.geometry import floating_frame
 from tmfem.system.topology import label
 
 KIND_CODES = {"bar": 0, "tendon": 1, "membrane": 2}
@@ -397,16 +396,14 @@ def membrane_on_configuration(system, mesh: MembraneMesh, *, q=None,
     (eq. 3.22). It is a picture, not a stress analysis: pass the FE displacements when
     you have them.
     """
-    corners3 = system.membrane_corners_inertial(q)
-    o, R = floating_frame(corners3)
-    local = R.T @ (corners3 - o[:, None])                   # (3, N) in O_f
     ref = system.membrane_corners
     if mesh.p.shape[0] != 2:
         raise InputError(f"membrane mesh: expected 2-D points, found shape {mesh.p.shape}")
     if len(mesh.corners) != system.N:
         raise InputError(f"membrane mesh has {len(mesh.corners)} corners, system has N={system.N}")
+    delta, o, R = system.corner_displacements(q)            # (3, N) in O_f, eq. 3.4
     lam = mean_value_coordinates(ref, mesh.p)              # (N, nn)
-    disp = (local - np.vstack([ref, np.zeros(system.N)])) @ lam
+    disp = delta @ lam
     xf = np.vstack([mesh.p, np.zeros(mesh.p.shape[1])]) + disp
     x = o[:, None] + R @ xf
     return MembraneField(mesh=mesh, x=x, point_data=dict(point_data or {}),

@@ -13,32 +13,20 @@ import numpy as np
 
 from tmfem.errors import InputError
 from tmfem.io.vtk import MembraneField
-from tmfem.system.geometry import floating_frame
-
-
-def corner_displacements(system, q=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """In-plane corner displacements delta (2, N) in O_f, with O_f's origin and rotation.
-
-    O_f is at B_MN with x_f toward B_M1 and z_f normal to the plane of B_MN, B_M1, B_M,N-1
-    (3.2); delta_j = (position of B_Mj in O_f) - (undeformed corner j).
-    """
-    corners3 = system.membrane_corners_inertial(q)
-    o, R = floating_frame(corners3)
-    local = R.T @ (corners3 - o[:, None])
-    return local[:2] - system.membrane_corners, o, R
 
 
 def corner_radial_displacements(system, q=None) -> np.ndarray:
     """Outward radial displacement (N,) of each membrane corner relative to the centroid.
 
-    The corner displacements of :func:`corner_displacements` with the rigid translation
+    The in-plane corner displacements (:meth:`tmfem.system.System.corner_displacements`,
+    eq. 3.4) with the rigid translation
     that keeps the centroid fixed removed, projected on the direction from the centroid to
     the undeformed corner. For a symmetric system every entry equals Delta of eq. 3.22;
     a membrane is stretched only if all are positive (eq. 3.36).
     """
     from tmfem.fem.plane_stress import radial_directions
 
-    delta, _, _ = corner_displacements(system, q)
+    delta = system.corner_displacements(q)[0][:2]
     d = delta - delta.mean(axis=1, keepdims=True)
     return np.sum(d * radial_directions(system.membrane_corners), axis=0)
 
@@ -68,10 +56,10 @@ def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "poi
 
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise InputError(f"membrane mesh: expected n >= 1, found {n!r}")
-    delta, _, _ = corner_displacements(system, q)
     model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane, n=n,
                                 attachment=attachment, patch=patch)
-    return placed_membrane_field(system, model, model.solve(delta), q=q)
+    return placed_membrane_field(system, model, model.solve(system.corner_displacements(q)[0][:2]),
+                                 q=q)
 
 
 def placed_membrane_field(system, model, sol, *, q=None) -> MembraneField:
@@ -92,7 +80,7 @@ def placed_membrane_field(system, model, sol, *, q=None) -> MembraneField:
     -------
     MembraneField as :func:`membrane_design_field`.
     """
-    _, o, R = corner_displacements(system, q)
+    _, o, R = system.corner_displacements(q)
     mesh = model.mesh
     u = R[:, :2] @ sol.u                      # in-plane displacement in the inertial frame
     x = o[:, None] + R[:, :2] @ mesh.p + u

@@ -14,7 +14,7 @@ import numpy as np
 
 from tmfem.errors import InputError
 from tmfem.system.geometry import (SymmetricConfig, bar_direction, base_centre, beta,
-                                   membrane_corners_regular, wrap_angle)
+                                   floating_frame, membrane_corners_regular, wrap_angle)
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
 from tmfem.system.topology import Tendon, label, node_labels, tendon_topology
 
@@ -250,6 +250,25 @@ class System:
     def membrane_corners_inertial(self, q=None) -> np.ndarray:
         """Positions (3, N) of the membrane corners B_Mj for configuration q."""
         return self.bar_ends(q)[1][:, -1, :]
+
+    def corner_displacements(self, q=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Corner displacements in the floating frame (eq. 3.4), with the frame.
+
+        Returns
+        -------
+        delta : ndarray (3, N)
+            R^fe (B_Mj - B_MN) - P_j: position of corner B_Mj in O_f minus the undeformed
+            corner P_j (``membrane_corners``, w = 0).
+        origin : ndarray (3,)
+            O_f = B_MN.
+        R : ndarray (3, 3)
+            R^ef (eq. 3.3), the axes of O_f of :func:`tmfem.system.geometry.floating_frame`.
+        """
+        corners = self.membrane_corners_inertial(q)
+        o, R = floating_frame(corners)
+        local = R.T @ (corners - o[:, None])
+        local[:2] -= self.membrane_corners
+        return local, o, R
 
     # ------------------------------------------------------------------ symmetry
     def symmetric_from_q(self, q=None, tol: float = 1e-9) -> SymmetricConfig:
