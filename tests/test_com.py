@@ -359,3 +359,24 @@ def test_rest_length_step_matches_linear_input_response(m14):
     amp = np.max(np.abs(X[:, :m14.nq]))
     assert amp > 1e-4                                  # the step does move the bars
     assert np.max(np.abs(dz[:, :m14.nq] - X[:, :m14.nq])) < 0.01 * amp
+
+
+def test_driven_run_frames_carry_the_driven_rest_lengths_and_forces(m14, tmp_path):
+    # the ParaView frames of a run with prescribed rest lengths u show T = k (|d| - u)
+    # (eq. 3.8) for that u, computed here independently by ControlOrientedModel.tendon_forces
+    import meshio
+    from tmfem.io.vtk import read_pvd
+    from tmfem.reduced.simulate import free_vibration
+    du = np.zeros(m14.n_t); du[1] = -1e-3
+    res = free_vibration(m14, t_end=0.02, dt=0.01, u=m14.u0 + du, vtk_dir=tmp_path, vtk_every=1)
+    frames = read_pvd(res.stats["pvd"])
+    assert len(frames) == 3
+    nb = m14.system.M * m14.system.N
+    last = meshio.read(frames[-1][1])
+    cd = {k: np.concatenate(v) for k, v in last.cell_data.items()}
+    T = m14.tendon_forces(res.z[-1], m14.u0 + du)
+    assert cd["axial_force"][nb:nb + m14.n_t] == pytest.approx(T, rel=1e-9)
+    assert cd["rest_length"][nb:nb + m14.n_t] == pytest.approx(m14.u0 + du, rel=1e-12)
+    # the driven tendon S_12 differs from the nominal-u force by k du
+    assert abs(T[1] - m14.tendon_forces(res.z[-1])[1]) == pytest.approx(
+        m14.k[1] * 1e-3, rel=1e-9)

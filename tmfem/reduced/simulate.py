@@ -224,14 +224,15 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
 
     def record(t, z, zd, a):
         w, X, L = model.fast_outputs(z, with_lengths=True)
-        force = model.k * (L - (model.u0 if u is None else driven.rest_lengths(t)))  # eq. 3.8
+        rest = model.u0 if u is None else driven.rest_lengths(t)
+        force = model.k * (L - rest)                                   # eq. 3.8
         out.tendon_forces(t, force, tendon_names)
         pos = X[:, idx]
         if out.frame_due():
             from tmfem.io.vtk import MembraneField
             xm, defl = model.membrane_positions(z)
             out.series.append_configuration(
-                t, system, q=(model.P @ z)[: model.nq], tendon_forces=model.tendon_forces(z),
+                t, system, q=(model.P @ z)[: model.nq], tendon_forces=force, rest_lengths=rest,
                 membrane=MembraneField(mesh=model.membrane.mesh, x=xm,
                                        point_data={"deflection_Of": defl}))
         T.append(t); Z.append(z.copy()); ZD.append(zd.copy()); W.append(w); XS.append(pos)
