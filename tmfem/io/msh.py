@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import check_path
+from tmfem.io.vtk import check_path, require_h5py
 from tmfem.mesh.polygon import MembraneMesh
 
 MEMBRANE_TAG = 1
@@ -41,11 +41,7 @@ def write_membrane_mesh(path, mesh: MembraneMesh) -> Path:
         meshio.write(path, m, file_format="gmsh22", binary=False)
     else:
         if path.suffix.lower() == ".xdmf":
-            try:
-                import h5py  # noqa: F401
-            except ImportError:
-                from tmfem.errors import BackendUnavailable
-                raise BackendUnavailable("writing .xdmf needs h5py: `pip install h5py`") from None
+            require_h5py()
         meshio.write(path, meshio.Mesh(pts, cells, cell_data={"group": phys}))
     return path
 

@@ -195,6 +195,15 @@ def member_data(system, *, q=None, tendon_forces=None, rest_lengths=None,
 
 
 # ---------------------------------------------------------------------------- writing
+def require_h5py() -> None:
+    """meshio writes ``.xdmf`` through h5py: raise BackendUnavailable when it is missing."""
+    try:
+        import h5py  # noqa: F401
+    except ImportError:
+        raise BackendUnavailable("writing .xdmf needs h5py: `pip install h5py`, "
+                                 "or write .vtu") from None
+
+
 def _write_mesh(path: Path, points: np.ndarray, cells: list, *, point_data: dict,
                 cell_data: dict, field_data: dict | None = None) -> Path:
     """Write with meshio; ``points`` (3, n), cells as (type, (nv, nc)) pairs."""
@@ -218,11 +227,7 @@ def _write_mesh(path: Path, points: np.ndarray, cells: list, *, point_data: dict
     mesh = meshio.Mesh(np.ascontiguousarray(np.asarray(points, dtype=float).T), blocks,
                        point_data=point_data, cell_data=cdata)
     if suffix == ".xdmf":
-        try:
-            import h5py  # noqa: F401
-        except ImportError:
-            raise BackendUnavailable("writing .xdmf needs h5py: `pip install h5py`, "
-                                     "or write .vtu") from None
+        require_h5py()
     meshio.write(path, mesh)
     if field_data:
         if suffix != ".vtu":
