@@ -7,7 +7,8 @@ r_1 that makes it singular, the null vector and the tension conditions.
 1-N(D) systems (eqs. 3.38-3.41): tendon lengths |SL|, |SU|, the 2 x 3 matrix A_1N^D, its
 null vector and the tension conditions.
 
-Delta of eq. 3.22 (any symmetric M-N system) is :func:`membrane_delta`.
+Delta of eq. 3.22 (any symmetric M-N system) is :func:`membrane_delta`
+(:func:`tmfem.system.geometry.membrane_delta`, also ``SymmetricConfig.membrane_delta``).
 
 All functions take plain numbers (radians); the ``*_system`` helpers read them from a
 symmetric :class:`tmfem.system.System`. The checks raise :class:`SlackMembrane`,
@@ -19,19 +20,10 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
+from tmfem.system.geometry import membrane_delta  # noqa: F401 (eq. 3.22, re-exported)
 
 
 # ---------------------------------------------------------------------------- any M-N
-def membrane_delta(*, l_M, theta_M, psi_M, sigma_M, r_M, r_mb, N):
-    """Radial membrane corner displacement Delta of a symmetric system (eq. 3.22).
-
-    Parameters are those of the top stage M (radians). Delta > 0 means a stretched
-    membrane.
-    """
-    L = l_M * np.sin(theta_M)
-    return -r_mb + np.sqrt(L**2 + r_M**2 - 2 * r_M * L * np.sin(psi_M - sigma_M + np.pi / N))
-
-
 def _sym(system):
     cfg = system.symmetric
     if cfg is None:
@@ -43,9 +35,7 @@ def _sym(system):
 
 def membrane_delta_system(system) -> float:
     """Delta of eq. 3.22 for a symmetric system."""
-    c = _sym(system)
-    return float(membrane_delta(l_M=c.l[-1], theta_M=c.theta[-1], psi_M=c.psi[-1],
-                                sigma_M=c.sigma[-1], r_M=c.r[-1], r_mb=system.r_mb, N=system.N))
+    return _sym(system).membrane_delta(system.N, system.r_mb)
 
 
 # ---------------------------------------------------------------------------- 1-N

@@ -224,7 +224,16 @@ class SymmetricConfig:
         return np.concatenate(parts)
 
     def membrane_delta(self, N: int, r_mb: float) -> float:
-        """Radial membrane corner displacement Delta of eq. 3.22."""
-        L = self.l[-1] * np.sin(self.theta[-1])
-        rM = self.r[-1]
-        return -r_mb + np.sqrt(L**2 + rM**2 - 2 * rM * L * np.sin(self.psi[-1] - self.sigma[-1] + np.pi / N))
+        """Radial membrane corner displacement Delta of eq. 3.22 (:func:`membrane_delta`)."""
+        return float(membrane_delta(l_M=self.l[-1], theta_M=self.theta[-1], psi_M=self.psi[-1],
+                                    sigma_M=self.sigma[-1], r_M=self.r[-1], r_mb=r_mb, N=N))
+
+
+def membrane_delta(*, l_M, theta_M, psi_M, sigma_M, r_M, r_mb, N):
+    """Radial membrane corner displacement Delta of a symmetric system (eq. 3.22).
+
+    Parameters are those of the top stage M (radians). Delta > 0 means a stretched
+    membrane.
+    """
+    L = l_M * np.sin(theta_M)
+    return -r_mb + np.sqrt(L**2 + r_M**2 - 2 * r_M * L * np.sin(psi_M - sigma_M + np.pi / N))
