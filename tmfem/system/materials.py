@@ -45,6 +45,7 @@ class BarSection:
 
     @property
     def area(self) -> float:
+        """Cross-section area pi d^2 / 4."""
         return math.pi * self.d**2 / 4.0
 
     @property
@@ -53,6 +54,7 @@ class BarSection:
         return math.pi * self.d**4 / 64.0
 
     def mass(self, length: float) -> float:
+        """Mass rho A l of a bar of the given length."""
         return self.rho * self.area * length
 
     def euler_critical_load(self, length: float, K: float = 1.0) -> float:
@@ -74,8 +76,10 @@ class TendonSection:
 
     @property
     def area(self) -> float:
+        """Cross-section area pi d^2 / 4."""
         return math.pi * self.d**2 / 4.0
 
     @property
     def EA(self) -> float:
+        """Axial stiffness E A (eqs. 3.8-3.9)."""
         return self.E * self.area

@@ -194,9 +194,11 @@ class System:
 
     @property
     def node_labels(self) -> list[str]:
+        """Node labels in global order: A_ij by stage, B_ij by stage, then H_1j (2.2)."""
         return node_labels(self.M, self.N, self.deployable)
 
     def node_index(self, name: str) -> int:
+        """Index of node ``name`` in :attr:`node_labels`; InputError naming the nodes if unknown."""
         try:
             return self.node_labels.index(name)
         except ValueError:
@@ -230,9 +232,11 @@ class System:
         return X[:, c[1]] - X[:, c[0]]
 
     def tendon_lengths(self, q=None) -> np.ndarray:
+        """Current tendon lengths |d_k| (n_tendons,) at configuration q (eq. 3.8)."""
         return np.linalg.norm(self.tendon_vectors(q), axis=0)
 
     def tendon_section(self, tendon: Tendon) -> TendonSection:
+        """Cross section of ``tendon``: the most specific of its group, family or ``"*"``."""
         for key in (tendon.group, tendon.family, "*"):
             if key in self.tendon_sections:
                 return self.tendon_sections[key]
@@ -242,9 +246,11 @@ class System:
 
     @property
     def tendon_EA(self) -> np.ndarray:
+        """Axial stiffness EA of every tendon (n_tendons,), as in eqs. 3.8-3.9."""
         return np.array([self.tendon_section(t).EA for t in self.tendons])
 
     def tendon_names(self) -> list[str]:
+        """Tendon names in :attr:`tendons` order."""
         return [t.name for t in self.tendons]
 
     def membrane_corners_inertial(self, q=None) -> np.ndarray:
