@@ -221,7 +221,8 @@ def with_symmetric(system, **changes):
     if "k_H" in changes:
         extra["k_H"] = float(changes.pop("k_H"))
     if changes:
-        raise InputError(f"with_symmetric: unknown parameters {sorted(changes)}")
+        raise InputError("with_symmetric: expected parameters among theta, psi, sigma, z, r, l, "
+                         f"r_mb, k_H, found {sorted(changes)}")
     return with_configuration(system.replace(**extra) if extra else system, cfg)
 
 
@@ -249,7 +250,9 @@ def deployment_bases(system, *, z_ratio: float = 0.7, Delta: float = 1e-3, sigma
     """
     c = system.symmetric
     if c is None or c.M != 2:
-        raise InputError(f"system {system.name!r}: deployment_bases needs a symmetric 2-stage system")
+        raise InputError(f"system {system.name!r}: deployment_bases expected a symmetric 2-stage "
+                         f"system, found " + ("no symmetric parametrisation" if c is None
+                                              else f"M = {c.M}"))
     sg2 = float(c.sigma[1]) if sigma2 is None else float(sigma2)
 
     def bases(theta, psi):

@@ -78,7 +78,8 @@ def tendon_length_gradient(system, q=None) -> np.ndarray:
     d = system.tendon_vectors(q)
     L = np.linalg.norm(d, axis=0)
     if np.any(L <= 0):
-        raise InputError(f"tendons of zero length: {np.flatnonzero(L <= 0)}")
+        raise InputError("expected tendons of positive length, found zero length for "
+                         f"{[system.tendons[k].name for k in np.flatnonzero(L <= 0)]}")
     n = d / L
     c = system.tendon_connectivity
     dJ = J[:, c[1], :] - J[:, c[0], :]                   # (3, n_t, n_q)
@@ -307,7 +308,8 @@ def symmetric_matrix(system, q=None) -> SymmetricMatrix:
     """Reduce A(q) by symmetry (3.3.2): rows of bar b_iN (eq. 3.24), columns summed per
     tendon group (eq. 3.23) and the membrane column for F_Delta (eq. 3.21)."""
     if system.symmetric is None:
-        raise InputError(f"system {system.name!r} is not symmetric (3.3.1)")
+        raise InputError(f"system {system.name!r}: expected a symmetric system (3.3.1), found "
+                         "no symmetric parametrisation")
     E = equilibrium_matrix(system, q)
     xyz, th, ps = _bar_q_index(system)
     rows = [th[0, -1], ps[0, -1]]

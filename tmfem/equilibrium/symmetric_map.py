@@ -38,7 +38,8 @@ def configuration_5_97(system, theta: float, psi: float, *, r=None, z=None,
     """
     c = system.symmetric
     if c is None:
-        raise InputError(f"system {system.name!r} is not symmetric (3.3.1)")
+        raise InputError(f"system {system.name!r}: expected a symmetric system (3.3.1), found "
+                         "no symmetric parametrisation")
     M = c.M
     sg = c.sigma if sigma is None else np.asarray(sigma, dtype=float)
     return SymmetricConfig(theta=np.full(M, theta), psi=psi + sg, sigma=sg,

@@ -104,7 +104,8 @@ class System:
         for t in tendons:
             for e in t.ends:
                 if e not in labels:
-                    raise InputError(f"tendon {t.name}: unknown end node {e!r}")
+                    raise InputError(f"tendon {t.name}: expected end nodes among the "
+                                     f"{len(labels)} nodes of a {M}-{N} system, found {e!r}")
         object.__setattr__(self, "base", base)
         object.__setattr__(self, "l", l)
         object.__setattr__(self, "q", q)
@@ -294,9 +295,11 @@ class System:
             checks = {"theta": np.ptp(theta[i]), "base radius": np.ptp(rad),
                       "base height": np.ptp(rel[2]), "base rotation": np.ptp(np.unwrap(sig)),
                       "azimuth": np.ptp(np.unwrap(psi0)), "bar length": np.ptp(self.l[i])}
-            bad = {k: v for k, v in checks.items() if v > tol * max(1.0, rad.max())}
+            limit = tol * max(1.0, rad.max())
+            bad = {k: v for k, v in checks.items() if v > limit}
             if bad:
-                raise InputError(f"stage {i + 1} is not symmetric (eqs. 3.19-3.20): spread of "
+                raise InputError(f"stage {i + 1} is not symmetric (eqs. 3.19-3.20): expected a "
+                                 f"spread <= {limit:.3g} over the bars, found "
                                  + ", ".join(f"{k} {v:.3g}" for k, v in bad.items()))
             th.append(theta[i, 0]); ps.append(psi0[-1]); sg.append(0.0 if i == 0 else sig[-1])
             zz.append(0.0 if i == 0 else rel[2, 0]); rr.append(rad[0])
