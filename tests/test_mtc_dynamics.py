@@ -8,6 +8,7 @@ import json
 import numpy as np
 import pytest
 
+from tmfem.errors import InputError
 from tmfem.fem.mtc import MTCModel
 from tmfem.fem.mtc_dynamics import (MTCDynamics, fit_frequency, initial_state,
                                     mtc_free_vibration)
@@ -203,3 +204,15 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
     assert main(["vibrate", "--model", "mtc", "--preset", "1-4", "--mesh", "4", "--t-end", "0.1",
                  "--perturb", "eta_1_dot=0.01"]) == 2
     assert "unknown state 'eta_1_dot'" in capsys.readouterr().err
+
+
+def test_split_perturbation_offsets_rates_and_unknown_names():
+    # the 6.5 perturbations: theta_12_dot = 0.01 rad/s (6.5.1), an offset theta_11 = 0.001 rad
+    from tmfem.reduced.simulate import split_perturbation
+    names = ["theta_11", "psi_11", "theta_12"]
+    d, dd = split_perturbation({"theta_12_dot": 0.01, "theta_11": 0.001}, names)
+    assert d.tolist() == [0.001, 0.0, 0.0]
+    assert dd.tolist() == [0.0, 0.0, 0.01]
+    assert [a.tolist() for a in split_perturbation(None, names)] == [[0.0] * 3, [0.0] * 3]
+    with pytest.raises(InputError, match=r"unknown state 'theta_13'; expected one of .*psi_11_dot"):
+        split_perturbation({"theta_13": 0.1}, names)

@@ -122,20 +122,6 @@ class MTCDynamics:
         return self.model.energy(self.reduced(x))
 
 
-def _split_perturbation(pert: dict, q_names) -> tuple[np.ndarray, np.ndarray]:
-    dq = np.zeros(len(q_names))
-    dqd = np.zeros(len(q_names))
-    for k, val in pert.items():
-        if k.endswith("_dot") and k[:-4] in q_names:
-            dqd[q_names.index(k[:-4])] += val
-        elif k in q_names:
-            dq[q_names.index(k)] += val
-        else:
-            raise InputError(f"perturbation: unknown state {k!r}; expected one of "
-                             f"{list(q_names) + [n + '_dot' for n in q_names]}")
-    return dq, dqd
-
-
 def perturbation_names(system) -> list:
     """Accepted perturbation names: the q of 3.2 and their rates (``theta_12_dot``)."""
     return list(system.q_names) + [n + "_dot" for n in system.q_names]
@@ -153,7 +139,8 @@ def initial_state(dyn: MTCDynamics, perturb: dict | None, *, h: float = 1e-6):
     u0 = dyn.state0()
     if not perturb:
         return u0, np.zeros_like(u0)
-    dq, dqd = _split_perturbation(perturb, system.q_names)
+    from tmfem.reduced.simulate import split_perturbation
+    dq, dqd = split_perturbation(perturb, system.q_names)
     x_eq = model.full(dyn.xr_eq)
     q_e = q_from_positions(system, x_eq[:, topo.system_node])
     X_e = system.nodes(q_e)

@@ -39,6 +39,36 @@ def parse_perturbation(items, names) -> dict:
     return out
 
 
+def split_perturbation(perturb: dict | None, names) -> tuple[np.ndarray, np.ndarray]:
+    """Initial offsets and rates of the coordinates ``names`` from a perturbation by name.
+
+    Parameters
+    ----------
+    perturb : dict or None
+        ``{"theta_11_dot": 0.01, "theta_12": 0.001}``: a coordinate name adds to its value,
+        ``<name>_dot`` to its rate (6.5.1-6.5.2).
+    names : list of str
+        The coordinates (``system.q_names`` for the MTC model, ``model.z_names`` for the COM).
+
+    Returns
+    -------
+    d, d_dot : ndarray (len(names),)
+    """
+    names = list(names)
+    accepted = names + [n + "_dot" for n in names]
+    d = np.zeros(len(names))
+    d_dot = np.zeros(len(names))
+    for k, val in (perturb or {}).items():
+        if k not in accepted:
+            raise InputError(f"perturbation: unknown state {k!r}; expected one of {accepted}")
+        i = accepted.index(k)
+        if i < len(names):
+            d[i] += val
+        else:
+            d_dot[i - len(names)] += val
+    return d, d_dot
+
+
 class RunOutputs:
     """Per-step outputs of a free-vibration run, shared by the COM and MTC drivers (6.5).
 
@@ -197,19 +227,9 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
     if not (t_end > 0 and dt > 0):
         raise InputError(f"expected t_end > 0 and dt > 0, found t_end={t_end!r}, dt={dt!r}")
     system = model.system
-    names = model.state_names
-    pert = dict(perturb or {})
-    for k in pert:
-        if k not in names:
-            raise InputError(f"perturbation: unknown state {k!r}; expected one of {names}")
-    z0 = model.equilibrium()
-    zd0 = np.zeros(model.nz)
-    for k, v in pert.items():
-        i = names.index(k)
-        if i < model.nz:
-            z0[i] += v
-        else:
-            zd0[i - model.nz] += v
+    dz, dzd = split_perturbation(perturb, model.z_names)
+    z0 = model.equilibrium() + dz
+    zd0 = dzd
     labels = MONITOR_NODES.get(system.name, []) if monitor_nodes is None else list(monitor_nodes)
     idx = [system.node_index(n) for n in labels]
     wnames = [f"w_{i + 1}" for i in range(len(model.output_points))]
