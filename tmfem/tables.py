@@ -18,6 +18,7 @@ them beside the printed tables.
 """
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -264,14 +265,21 @@ def deployment_bases(system, *, z_ratio: float = 0.7, Delta: float = 1e-3, sigma
     return bases
 
 
+def relative_difference(ours, printed) -> float | None:
+    """(ours - printed) / |printed|; None when either is not a number (None: not printed /
+    not computed, or a string), ``printed`` is 0 or ``ours`` is not finite."""
+    def number(v):
+        return isinstance(v, numbers.Real) and not isinstance(v, bool)
+    if number(printed) and number(ours) and printed != 0 and np.isfinite(ours):
+        return (ours - printed) / abs(printed)
+    return None
+
+
 def comparison_row(quantity: str, printed, ours, unit: str = "") -> tuple:
     """One row (quantity, printed, ours, relative difference) for :func:`format_comparison`;
     ``printed`` or ``ours`` may be None (not printed / not computed) or a string."""
-    rel = None
-    if isinstance(printed, (int, float)) and isinstance(ours, (int, float)) and printed != 0 \
-            and np.isfinite(ours):
-        rel = (ours - printed) / abs(printed)
-    return (quantity + (f" [{unit}]" if unit else ""), printed, ours, rel)
+    return (quantity + (f" [{unit}]" if unit else ""), printed, ours,
+            relative_difference(ours, printed))
 
 
 def format_comparison(rows, title: str = "") -> str:

@@ -53,14 +53,10 @@ def _progress(msg: str) -> None:
     print(f"tmfem study: {msg}", file=sys.stderr, flush=True)
 
 
-def _rel(ours, printed):
-    if printed is None or ours is None or printed == 0 or not np.isfinite(ours):
-        return None
-    return (ours - printed) / abs(printed)
-
-
 def table_rows(d, system) -> list[dict]:
     """Rows (quantity, unit, ours, printed, rel_diff, source) of the design table."""
+    from tmfem.tables import relative_difference
+
     p = dict(system.printed)
     prest = p.get("rest_lengths", {}) or {}
     rows = []
@@ -68,7 +64,7 @@ def table_rows(d, system) -> list[dict]:
     def add(q, unit, ours, printed=None, source=""):
         rows.append({"quantity": q, "unit": unit, "ours": None if ours is None else float(ours),
                      "printed": None if printed is None else float(printed),
-                     "rel_diff": _rel(ours, printed), "source": source})
+                     "rel_diff": relative_difference(ours, printed), "source": source})
 
     c = system.symmetric
     if c is not None:
