@@ -213,6 +213,14 @@ class MembraneTL:
         S[1, 1] += self.lam * tr
         return F, Eg, S
 
+    def strain_energy(self, x) -> float:
+        """Strain energy [J] at current positions x (3, nn): h int (lam tr(E)^2 / 2 + mu E:E) dA,
+        the potential of the plane-stress St.Venant-Kirchhoff law (eq. 4.9)."""
+        _, Eg, _ = self.kinematics(x)
+        tr = Eg[0, 0] + Eg[1, 1]
+        dens = 0.5 * self.lam * tr**2 + 0.5 * self.mu2 * np.einsum("ab...,ab...->...", Eg, Eg)
+        return self.material.h * float(np.sum(dens * np.asarray(self.basis.dx)))
+
     # ------------------------------------------------------------------ residual/tangent
     def internal(self, x, *, tangent: bool = True):
         """Internal nodal forces f (3 nn,) and tangent K (csr) at current positions x (3, nn).

@@ -36,8 +36,8 @@ import scipy.sparse.linalg as spla
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.membrane import MembraneTL
 from tmfem.fem.mtc_topology import MTCTopology, build_topology, membrane_placement
-from tmfem.fem.truss import (TrussSet, green_rest_length, linear_rest_length, truss_internal,
-                             truss_mass)
+from tmfem.fem.truss import (TrussSet, green_rest_length, linear_rest_length, truss_energy,
+                             truss_internal, truss_mass)
 from tmfem.system.topology import label
 
 
@@ -288,18 +288,8 @@ class MTCModel:
         + mu E:E) dA (plane-stress St.Venant-Kirchhoff, the potential of eq. 4.9).
         """
         x = self.full(xr)
-        W = 0.0
-        for ts in (self.bars, self.tendons):
-            d = x[:, ts.conn[1]] - x[:, ts.conn[0]]
-            E = (np.einsum("ie,ie->e", d, d) - ts.L**2) / (2 * ts.L**2)
-            E = np.where(ts.tension_only & (E <= 0), 0.0, E)
-            W += 0.5 * float(np.sum(ts.EA * ts.L * E**2))
-        _, Eg, _ = self.membrane.kinematics(x[:, :self.topology.n_mesh])
-        tr = Eg[0, 0] + Eg[1, 1]
-        dens = 0.5 * self.membrane.lam * tr**2 + 0.5 * self.membrane.mu2 * np.einsum(
-            "ab...,ab...->...", Eg, Eg)
-        W += self.system.membrane.h * float(np.sum(dens * np.asarray(self.membrane.basis.dx)))
-        return W
+        return (truss_energy(x, self.bars) + truss_energy(x, self.tendons)
+                + self.membrane.strain_energy(x[:, :self.topology.n_mesh]))
 
     # ------------------------------------------------------------------ statics
     def solve_static(self, *, start: str = "undeformed", x0: np.ndarray | None = None,
@@ -431,10 +421,9 @@ class MTCModel:
 
     def _state_note(self, xr) -> str:
         """Slack tendons and stretch of the membrane at independent positions xr, for errors."""
+        from tmfem.fem.mtc_post import member_state
         x = self.full(xr)
-        tt = truss_internal(x, self.tendons, tangent=False)
-        e = self.topology.tendon_of_element
-        slack = np.bincount(e, weights=tt.slack.astype(float), minlength=len(self.system.tendons)) > 0
+        slack = member_state(self, x)["tendon_slack"]
         names = [t.name for t, s_ in zip(self.system.tendons, slack) if s_]
         c = x[:, self.topology.mesh.corners]
         return (f"{len(names)} of {slack.size} tendons slack{': ' + ', '.join(names[:9]) if names else ''}"

@@ -148,6 +148,17 @@ def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True) ->
     return TrussResponse(f=f, K=K, N=N, strain=E, slack=slack, length=l)
 
 
+def truss_energy(x: np.ndarray, trusses: TrussSet) -> float:
+    """Strain energy W = sum EA L E^2 / 2 [J] of the truss elements at positions x (3, nn)
+    (St.Venant-Kirchhoff, eq. 4.9, on the reference volume A L); zero for slack
+    tension-only members."""
+    d = x[:, trusses.conn[1]] - x[:, trusses.conn[0]]
+    L = trusses.L
+    E = (np.einsum("ie,ie->e", d, d) - L**2) / (2 * L**2)
+    E = np.where(trusses.tension_only & (E <= 0), 0.0, E)
+    return 0.5 * float(np.sum(trusses.EA * L * E**2))
+
+
 def truss_mass(trusses: TrussSet, nn: int, *, lumped: bool = False) -> sp.csr_matrix:
     """Mass matrix of the truss elements, total mass rho A L per element.
 
