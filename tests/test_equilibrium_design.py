@@ -27,6 +27,27 @@ def _corners(r_mb):
     return membrane_corners_regular(4, r_mb)
 
 
+def one_stage_D(*, theta, psi, r1, l1=2.2):
+    """A symmetric 1-4(D) system (k_H = 0.3, r_mb = 1 m) with the 1-4 materials; angles [rad]."""
+    from tmfem.system import System, TendonSection
+    base = load_preset("1-4")
+    cfg = SymmetricConfig(theta=[theta], psi=[psi], sigma=[0], z=[0], r=[r1], l=[l1])
+    return System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
+                                   bar=base.bar,
+                                   tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
+                                   deployable=True, k_H=0.3)
+
+
+def two_stage(psi2_deg, sigma2_deg):
+    """2-3 with the Table 6.4 dimensions (theta 63 deg, l 2.5 m, r_mb 1.87 m), psi_1 = 20 deg,
+    z_2 = 0.6001 m, r_2 = 0.2798 m and the given psi_2, sigma_2."""
+    s = load_preset("2-3", as_printed=True)
+    c = s.symmetric
+    cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(psi2_deg)],
+                          sigma=[0, np.radians(sigma2_deg)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
+    return s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
+
+
 def test_1N_design_matches_closed_form_null_vector():
     s = one_stage()
     d = design_equilibrium(s, mesh_n=MESH)
@@ -66,11 +87,7 @@ def test_bar_load_is_axial_and_balances_the_bar_top():
 def test_2_3_design_agrees_with_reduced_null_vector_scaled_to_F_delta():
     # a 2-3 configuration with a positive null vector and Delta > 0 (found with the map of
     # tmfem.equilibrium.symmetric_map); tendon forces = null vector scaled to F_Delta (3.2)
-    s = load_preset("2-3", as_printed=True)      # Table 6.4: theta 63 deg, l 2.5 m, r_mb 1.87 m
-    c = s.symmetric
-    cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(157.84)],
-                          sigma=[0, np.radians(145.67)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
-    s = s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
+    s = two_stage(157.84, 145.67)
     nv = positive_null_vector(symmetric_matrix(s).A)
     assert nv.exists
     d = design_equilibrium(s, mesh_n=MESH)
@@ -90,11 +107,7 @@ def test_named_errors():
         design_equilibrium(one_stage(r_mb=2.0), mesh_n=MESH)
     # a 1-N system with cot psi_1 < tan(pi/N) also has Delta < 0 (eq. 3.36), so take a 2-3
     # configuration with Delta > 0 whose unique null vector (3.3.2) has negative entries
-    s = load_preset("2-3", as_printed=True)      # Table 6.4 dimensions
-    c = s.symmetric
-    cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(120)],
-                          sigma=[0, np.radians(100)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
-    s = s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
+    s = two_stage(120, 100)      # Table 6.4 dimensions
     with pytest.raises(SlackTendon, match=r"tendons taut.*= -\d.*slack\)"):
         design_equilibrium(s, mesh_n=MESH)
     with pytest.raises(InfeasibleDesign, match=r"eq. 3.33 requires r_1 = 0.42854"):
@@ -149,13 +162,7 @@ def test_1ND_design_matches_null_vector_of_eq_3_40():
     # 1-4(D) inside the bounds of eq. 3.41: forces = averaged null vector of 3.40 times
     # |SL|, |SU| and F_Delta / (Delta + r_mb) (eq. 3.39)
     from tmfem.equilibrium.symmetric import closed_form_1ND
-    from tmfem.system import System, TendonSection
-    base = load_preset("1-4")
-    cfg = SymmetricConfig(theta=[np.radians(50)], psi=[np.radians(15)], sigma=[0], z=[0],
-                          r=[0.5], l=[2.2])
-    s = System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
-                                bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
-                                deployable=True, k_H=0.3)
+    s = one_stage_D(theta=np.radians(50), psi=np.radians(15), r1=0.5)
     d = design_equilibrium(s, mesh_n=MESH)
     cf = closed_form_1ND(s)
     scale = d.F_Delta / (cf["delta"] + s.r_mb) / cf["null"][2]
@@ -207,11 +214,7 @@ def test_force_ratios_agree_with_mtc_nodal_balance():
     # directions. The membrane forces differ (nonlinear vs linear), so compare the tendon
     # forces relative to one of them: they must agree for a 2-3 design (3.3.2)
     from tmfem.fem.mtc import MTCModel
-    s = load_preset("2-3", as_printed=True)      # Table 6.4: theta 63 deg, l 2.5 m, r_mb 1.87 m
-    c = s.symmetric
-    cfg = SymmetricConfig(theta=c.theta, psi=[np.radians(20), np.radians(157.84)],
-                          sigma=[0, np.radians(145.67)], z=[0, 0.6001], r=[0.7, 0.2798], l=c.l)
-    s = s.replace(q=cfg.to_q(3), symmetric=cfg, rest_lengths=None)
+    s = two_stage(157.84, 145.67)
     d = design_equilibrium(s, mesh_n=MESH)
     m = MTCModel(s, mesh_n=MESH, rest_lengths=d.rest_lengths)
     T = m.consistent_rest_lengths()["tendon_force"]
@@ -236,15 +239,9 @@ def test_best_bases_reports_what_it_found():
 
 
 def test_1ND_slack_tendon_names_the_r1_bounds():
-    from tmfem.system import System, TendonSection
-    base = load_preset("1-4")
-    cfg = SymmetricConfig(theta=[np.radians(50)], psi=[np.radians(15)], sigma=[0], z=[0],
-                          r=[0.1], l=[2.2])                    # r_1 below k_H r* = 0.185 m
-    # eq. 3.41: r* = l_1 sin(theta_1) sin(psi_1) / cos(pi/N) = 2.2 sin 50 sin 15 / cos 45
-    # = 0.616862 m, k_H r* = 0.3 r* = 0.185059 m
-    s = System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
-                                bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
-                                deployable=True, k_H=0.3)
+    # r_1 below k_H r* = 0.185 m. eq. 3.41: r* = l_1 sin(theta_1) sin(psi_1) / cos(pi/N)
+    # = 2.2 sin 50 sin 15 / cos 45 = 0.616862 m, k_H r* = 0.3 r* = 0.185059 m
+    s = one_stage_D(theta=np.radians(50), psi=np.radians(15), r1=0.1)
     with pytest.raises(SlackTendon, match=r"0.185059 < r_1 < min\(0.616862"):
         design_equilibrium(s, mesh_n=MESH)
 
@@ -270,12 +267,7 @@ def test_equilibrium_map_of_a_1ND_system_matches_closed_form_bounds():
     # and Delta of eq. 3.22
     from tmfem.equilibrium.symmetric import r1_bounds_1ND
     from tmfem.equilibrium.symmetric_map import equilibrium_map
-    from tmfem.system import System, TendonSection
-    base = load_preset("1-4")
-    cfg = SymmetricConfig(theta=[1.0], psi=[0.3], sigma=[0], z=[0], r=[0.5], l=[2.2])
-    s = System.symmetric_system(name="d", N=4, config=cfg, r_mb=1.0, membrane=base.membrane,
-                                bar=base.bar, tendon_sections={"*": TendonSection(E=2e9, d=1e-3)},
-                                deployable=True, k_H=0.3)
+    s = one_stage_D(theta=1.0, psi=0.3, r1=0.5)
     th = np.radians(np.linspace(20, 85, 9))
     ps = np.radians(np.linspace(2, 70, 9))
     m = equilibrium_map(s, theta=th, psi=ps)
