@@ -39,7 +39,7 @@ import numpy as np
 import tomli_w
 
 from tmfem.errors import InputError
-from tmfem.system.geometry import SymmetricConfig
+from tmfem.system.geometry import SymmetricConfig, membrane_corners_regular
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
 from tmfem.system.system import System
 from tmfem.system.topology import Tendon
@@ -185,7 +185,6 @@ def system_from_dict(d: dict, where: str = "system") -> System:
         corners = _floats(mtab, "corners", f"{where} [membrane]").reshape(-1, 2).T
         r_mb = None
     else:
-        from tmfem.system.geometry import membrane_corners_regular
         r_mb = _num(mtab, "r_mb", f"{where} [membrane]")
         corners = membrane_corners_regular(N, r_mb)
     tendons = tuple(Tendon(name=t["name"], family=t["family"], stage=int(t.get("stage", 1)),
