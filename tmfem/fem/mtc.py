@@ -139,7 +139,6 @@ class MTCModel:
             elif rest == "design":
                 r = self._design_rest_lengths()
             elif rest == "mtc":
-                self._set_tendons(np.full(n_t, 1.0))   # placeholder lengths for the solve
                 r = self.consistent_rest_lengths()["rest_lengths"]
             else:
                 raise InputError(f"rest_lengths: expected an array or one of 'system', 'design', "
