@@ -38,3 +38,19 @@ def add_prestress_scale_arg(parser) -> None:
 def prestress_scale_of(args: argparse.Namespace) -> float:
     """The ``--prestress-scale`` factor (1 when not given)."""
     return 1.0 if args.prestress_scale is None else args.prestress_scale
+
+
+def add_attachment_args(parser) -> None:
+    """``--attachment`` / ``--patch``: membrane corner attachment of the plane-stress FE
+    (``equilibrium``, ``study``) and of the MTC model (``converge``)."""
+    parser.add_argument("--attachment", choices=("point", "distributed"), default="point",
+                        help="membrane corner attachment: 'point' (default, the dissertation's "
+                             "model; singular, F_Delta and the rest lengths drift like 1/log(n) "
+                             "with the mesh) or 'distributed' (corner spread over a patch by an "
+                             "RBE3-type affine coupling; converges under mesh refinement)")
+    parser.add_argument("--patch", type=float, default=None, metavar="R",
+                        help="patch radius [m] of --attachment distributed (default 10%% of "
+                             "r_mb). It must reach beyond the corner's two edge neighbours: "
+                             "with fewer than 3 nodes it is an error, with only those it "
+                             "reduces to the point attachment (1-4 at the default patch: "
+                             "--mesh 5 fails, --mesh 10 equals point; use --mesh >= 20)")

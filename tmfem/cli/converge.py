@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import csv
 
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
 from tmfem.errors import InputError
 
 NAME = "converge"
@@ -28,9 +28,7 @@ def configure(parser) -> None:
     parser.add_argument("--tendon-elements", default="3",
                         help="comma-separated numbers of truss elements per tendon")
     parser.add_argument("--modes", type=int, default=12)
-    parser.add_argument("--attachment", choices=("point", "distributed"), default="point")
-    parser.add_argument("--patch", type=float, default=None,
-                        help="patch radius of the distributed attachment [m] (default 0.1 r_mb)")
+    add_attachment_args(parser)
     parser.add_argument("--rest-lengths", default=None,
                         help="fixed rest lengths (system/design, evaluated once, or GROUP=VALUE "
                              "pairs such as S1=1.5025) or the design-consistent ones recomputed "

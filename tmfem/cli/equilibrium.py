@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
 from tmfem.errors import InputError
 
 NAME = "equilibrium"
@@ -24,21 +24,6 @@ def configure(parser) -> None:
     parser.add_argument("--allow-infeasible", action="store_true",
                         help="print the design even when an equilibrium condition is violated")
     add_attachment_args(parser)
-
-
-def add_attachment_args(parser) -> None:
-    """``--attachment`` / ``--patch``: membrane corner attachment of the plane-stress FE."""
-    parser.add_argument("--attachment", choices=("point", "distributed"), default="point",
-                        help="membrane corner attachment: 'point' (default, the dissertation's "
-                             "model; singular, F_Delta and the rest lengths drift like 1/log(n) "
-                             "with the mesh) or 'distributed' (corner spread over a patch by an "
-                             "RBE3-type affine coupling; converges under mesh refinement)")
-    parser.add_argument("--patch", type=float, default=None, metavar="R",
-                        help="patch radius [m] of --attachment distributed (default 10%% of "
-                             "r_mb). It must reach beyond the corner's two edge neighbours: "
-                             "with fewer than 3 nodes it is an error, with only those it "
-                             "reduces to the point attachment (1-4 at the default patch: "
-                             "--mesh 5 fails, --mesh 10 equals point; use --mesh >= 20)")
 
 
 def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point",

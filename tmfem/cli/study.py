@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.cli import _json_default
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
 from tmfem.errors import InputError
 
 NAME = "study"
@@ -45,7 +45,6 @@ def configure(parser) -> None:
                              "and 1-N(D) systems "
                              "(default 13; 0 = no map)")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render")
-    from tmfem.cli.equilibrium import add_attachment_args
     add_attachment_args(parser)
 
 
