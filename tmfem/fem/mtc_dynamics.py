@@ -77,9 +77,11 @@ class MTCDynamics:
 
     # state <-> positions
     def state0(self) -> np.ndarray:
+        """The equilibrium as a free-DOF state."""
         return self.xr_eq[self.free].copy()
 
     def reduced(self, u) -> np.ndarray:
+        """Independent positions (flat, 3 n_red) of the free-DOF state u (fixed DOFs at x_eq)."""
         xr = self.xr_eq.copy()
         xr[self.free] = u
         return xr
@@ -90,21 +92,27 @@ class MTCDynamics:
 
     # park_integrate protocol
     def residual(self, x, v, a, t):
+        """r = M a + C v + f_int(x) on the free DOFs (module docstring)."""
         r, _ = self.model.residual(self.reduced(x), tangent=False)
         out = r[self.free] + self.M @ a
         if self.C is not None:
             out = out + self.C @ v
         return out
 
-    def jacobians(self, x, v, a, t):
+    def _tangent(self, x):
+        """Tangent K_T (eqs. 4.4-4.6) on the free DOFs at the free-DOF state x."""
         _, K = self.model.residual(self.reduced(x))
-        K = K[self.free][:, self.free]
+        return K[self.free][:, self.free]
+
+    def jacobians(self, x, v, a, t):
+        """(dr/dx, dr/dv, dr/da) = (K_T, C, M)."""
+        K = self._tangent(x)
         C = self.C if self.C is not None else sp.csc_matrix(K.shape)
         return K, C, self.M
 
     def newton_matrix(self, x, v, a, t, cv, ca):
-        _, K = self.model.residual(self.reduced(x))
-        S = K[self.free][:, self.free] + ca * self.M
+        """K_T + cv C + ca M, the Newton matrix of Park's method (eq. 5.34)."""
+        S = self._tangent(x) + ca * self.M
         if self.C is not None:
             S = S + cv * self.C
         return S.tocsc()
@@ -116,9 +124,11 @@ class MTCDynamics:
 
     # energies
     def kinetic_energy(self, v) -> float:
+        """v^T M v / 2 [J] of the free-DOF velocities v."""
         return 0.5 * float(v @ (self.M @ v))
 
     def strain_energy(self, x) -> float:
+        """Strain energy [J] of membrane, bars and tendons (:meth:`MTCModel.energy`)."""
         return self.model.energy(self.reduced(x))
 
 

@@ -120,6 +120,7 @@ class ConstraintSolver:
         self._f = ca.Function("phi", [q, z], [phi, ca.jacobian(phi, z), ca.jacobian(phi, q)])
 
     def phi(self, q, zeta):
+        """Phi(q, zeta) of eq. 3.5 and its Jacobians d Phi / d zeta, d Phi / d q."""
         p, pz, pq = self._f(q, zeta)
         return np.asarray(p).ravel(), np.asarray(pz), np.asarray(pq)
 

@@ -121,6 +121,7 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
 
 
 def format_summary(r: dict) -> str:
+    """Text table of a :func:`modal_summary` result: ours beside the printed COM column."""
     lines = [f"COM of {r['system']}: {r['sizes']['n_z']} coordinates (nq = {r['sizes']['n_q']}, "
              f"K = {r['membrane_modes']}), prestress x{r['prestress_scale']:g}, rest lengths "
              f"from the {r.get('rest_lengths_source', 'design')}"]

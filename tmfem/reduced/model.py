@@ -529,6 +529,7 @@ class ControlOrientedModel:
         return self.P.T @ r
 
     def jacobians(self, z, zd, zdd, t=0.0, u=None):
+        """(dr/dz, dr/dz', dr/dz'') of the residual of eq. 5.27 (casadi AD), rest lengths u."""
         u = self.u0 if u is None else u
         zm, zdm = self._to_modal(z, zd)
         zeta = self.zeta(zm[: self.nq])
@@ -537,6 +538,7 @@ class ControlOrientedModel:
         return P.T @ K @ P, P.T @ C @ P, P.T @ M @ P
 
     def newton_matrix(self, z, zd, zdd, t, cv, cacc, u=None):
+        """K + cv C + cacc M of the residual of eq. 5.27, in one casadi call (eq. 5.34)."""
         u = self.u0 if u is None else u
         zm, zdm = self._to_modal(z, zd)
         zeta = self.zeta(zm[: self.nq])
@@ -607,6 +609,7 @@ class ControlOrientedModel:
 
 
     def kinetic_energy(self, z, zd) -> float:
+        """z'^T M_hat(z) z' / 2 [J] (eq. 5.27)."""
         M, _, _ = self.matrices(z, zd)
         return 0.5 * float(zd @ M @ zd)
 
@@ -647,6 +650,7 @@ class ControlOrientedModel:
         return np.concatenate([(self.P @ np.asarray(z, dtype=float))[: self.nq], w])
 
     def summary(self) -> dict:
+        """Sizes of the model (coordinates, states, inputs), membrane mass and modes."""
         return {"n_q": self.nq, "K": self.K, "n_z": self.nz, "n_states": 2 * self.nz,
                 "n_zeta": self.layout.n, "n_inputs": self.n_t,
                 "membrane_mass": self.membrane.mass,

@@ -28,6 +28,8 @@ PETSC_INSTALL = ("PETSC_CONFIGURE_OPTIONS=\"--with-fc=0 --with-cuda=0 --with-x=0
 
 
 class Backend(Protocol):
+    """What a solver asks of a linear-algebra backend (module docstring)."""
+
     name: str
 
     def factorize(self, A) -> Callable[[np.ndarray], np.ndarray]: ...
@@ -52,6 +54,9 @@ class ScipyBackend:
     _orderings: dict = {}
 
     def factorize(self, A):
+        """``solve(b)`` of the square matrix A (SuperLU, symmetric mode; nested dissection
+        from ``nd_threshold`` dofs); :class:`SingularMatrix` when A cannot be factorised or a
+        solution is not finite."""
         if not sp.issparse(A):
             A = np.asarray(A, dtype=float)
         A = sp.csc_matrix(A)
@@ -112,6 +117,9 @@ class ScipyBackend:
         return perm, Ap
 
     def eigsh(self, K, M, k, sigma):
+        """The k eigenpairs of K v = w M v nearest to ``sigma`` (eq. 5.32): dense ``eigh``
+        up to 600 dofs (or k >= n - 1), else ARPACK shift-invert with this backend's LU of
+        K - sigma M."""
         n = K.shape[0]
         if n <= 600 or k >= n - 1:
             import scipy.linalg as la
