@@ -58,6 +58,13 @@ def _screenshot(plotter, png_path: Path) -> Path:
     return png_path
 
 
+def _scalar_bar(title: str, *, position_x: float) -> dict:
+    """Arguments of a vertical colour bar at ``position_x`` (tendons right, membrane left)."""
+    return {"title": title, "color": "black", "fmt": "%.3g", "vertical": True,
+            "position_x": position_x, "position_y": 0.1, "width": 0.05, "height": 0.5,
+            "title_font_size": 14, "label_font_size": 12}
+
+
 def _robust_range(v: np.ndarray) -> list:
     """Colour range of a membrane field: [min, max], or [min, 98th percentile] when a few
     elements (the point-attached corners, where stresses are singular) exceed the
@@ -130,11 +137,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
             # colour scale from zero: nearly equal forces look equal, not noise-amplified
             p.add_mesh(merged, scalars="tendon force [N]", cmap=_tendon_cmap(),
                        clim=[0.0, fmax], smooth_shading=True,
-                       scalar_bar_args={"title": "tendon force [N]", "color": "black", "fmt": "%.3g",
-                                        "vertical": True, "position_x": 0.86,
-                                        "title_font_size": 14, "label_font_size": 12,
-                                        "position_y": 0.1, "width": 0.05,
-                                        "height": 0.5})
+                       scalar_bar_args=_scalar_bar("tendon force [N]", position_x=0.86))
         if np.any(~taut):
             p.add_mesh(_segments(pv, X, con[:, ~taut]).tube(radius=0.8 * r_ten, n_sides=8),
                        color="#e41a1c", ambient=0.6)
@@ -160,11 +163,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
                 bar_title = f"{name} (clipped)"
             p.add_mesh(grid, scalars=name, cmap="viridis", opacity=0.9, show_edges=True,
                        edge_color="#555555", line_width=0.5, clim=clim,
-                       scalar_bar_args={"title": bar_title, "color": "black", "vertical": True,
-                                        "fmt": "%.3g",
-                                        "position_x": 0.08, "position_y": 0.1,
-                                        "title_font_size": 14, "label_font_size": 12,
-                                        "width": 0.05, "height": 0.5})
+                       scalar_bar_args=_scalar_bar(bar_title, position_x=0.08))
         else:
             p.add_mesh(grid, color="#f4c27a", opacity=0.75, show_edges=True,
                        edge_color="#9a6a2a", line_width=0.5)
