@@ -12,8 +12,11 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import math
 import pkgutil
 import sys
+
+import numpy as np
 
 from tmfem.errors import TmfemError
 
@@ -66,9 +69,6 @@ def main(argv=None) -> int:
 def _finite(obj):
     """``obj`` with non-finite floats replaced by None: JSON has no NaN or infinity
     (a tendon that would push has no rest length, a missing printed value is absent)."""
-    import math
-
-    import numpy as np
     if isinstance(obj, dict):
         return {k: _finite(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -81,7 +81,6 @@ def _finite(obj):
 
 
 def _json_default(obj):
-    import numpy as np
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     if isinstance(obj, np.generic):
