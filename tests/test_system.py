@@ -134,11 +134,16 @@ def test_toml_round_trip(preset, tmp_path):
     assert t.tendon_names() == s.tendon_names()
 
 
-def test_general_system_file_round_trip(tmp_path):
+def _general_2_3():
+    """The 2-3 preset as a general (non-symmetric) system: base, l, q given explicitly."""
     s = load_preset("2-3")
-    g = System(name="g", M=s.M, N=s.N, deployable=False, base=s.base, l=s.l, q=s.q,
-               membrane=s.membrane, membrane_corners=s.membrane_corners, bar=s.bar,
-               tendon_sections=s.tendon_sections)
+    return s, System(name="g", M=s.M, N=s.N, deployable=False, base=s.base, l=s.l, q=s.q,
+                     membrane=s.membrane, membrane_corners=s.membrane_corners, bar=s.bar,
+                     tendon_sections=s.tendon_sections)
+
+
+def test_general_system_file_round_trip(tmp_path):
+    s, g = _general_2_3()
     dump_system(g, tmp_path / "g.toml")
     t = load_system(tmp_path / "g.toml")
     np.testing.assert_allclose(t.nodes(), s.nodes(), atol=1e-14)
@@ -179,11 +184,7 @@ def test_every_preset_file_round_trips(as_printed, tmp_path):
 
 def _general_dict():
     from tmfem.system import system_to_dict
-    s = load_preset("2-3")
-    g = System(name="g", M=s.M, N=s.N, deployable=False, base=s.base, l=s.l, q=s.q,
-               membrane=s.membrane, membrane_corners=s.membrane_corners, bar=s.bar,
-               tendon_sections=s.tendon_sections)
-    return system_to_dict(g)
+    return system_to_dict(_general_2_3()[1])
 
 
 def _preset_1_4_dict():
