@@ -206,3 +206,13 @@ def test_point_matrix_reproduces_bilinear_fields_and_rejects_outside_points(mem)
         point_matrix(mem.skmesh, [[5.0], [5.0]])
     with pytest.raises(InputError, match=r"expected shape \(2, n\)"):
         point_matrix(mem.skmesh, np.zeros((3, 2)))
+
+
+def test_zero_area_reference_element_is_rejected():
+    # an element whose four nodes coincide has zero area (shoelace formula): InputError with
+    # the count found, before scikit-fem fails on its zero Jacobian
+    m = square(2)
+    t = m.t.copy()
+    t[:, 0] = t[0, 0]
+    with pytest.raises(InputError, match=r"positive area, found 1 of zero area \(elements \[0\]\)"):
+        MembraneTL(mesh=MembraneMesh(p=m.p, t=t, corners=m.corners, n=m.n), material=KAPTON)

@@ -134,7 +134,8 @@ class MTCModel:
             source = rest
             if rest == "system":
                 if self.system.rest_lengths is None:
-                    raise InputError("rest_lengths='system': the system has no rest lengths")
+                    raise InputError(f"rest_lengths='system': expected rest lengths in system "
+                                     f"{self.system.name!r}, found none (use 'design' or 'mtc')")
                 r = self.system.rest_lengths
             elif rest == "design":
                 r = self._design_rest_lengths()

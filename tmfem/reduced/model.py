@@ -125,7 +125,8 @@ class ControlOrientedModel:
             self.u0 = self.design.rest_lengths
         elif isinstance(rest_lengths, str) and rest_lengths == "system":
             if system.rest_lengths is None:
-                raise InputError(f"system {system.name!r} has no rest lengths; use rest_lengths='design'")
+                raise InputError(f"rest_lengths='system': expected rest lengths in system "
+                                 f"{system.name!r}, found none (use rest_lengths='design')")
             self.u0 = np.asarray(system.rest_lengths, dtype=float)
         else:
             self.u0 = np.asarray(rest_lengths, dtype=float)
@@ -458,7 +459,8 @@ class ControlOrientedModel:
         M(x), F(x, x'), B(x), Phi_x, the velocity term gamma = (Phi_x x')_x x' of the
         constraint accelerations (Phi_x x'' + gamma = 0), and T_z of eq. 5.25."""
         if self.formulation != "partitioned":
-            raise InputError("dae_terms: available for formulation='partitioned'")
+            raise InputError(f"dae_terms: expected formulation='partitioned', found "
+                             f"{self.formulation!r}")
         nq, K = self.nq, self.K
         z = np.asarray(z, dtype=float); zd = np.asarray(zd, dtype=float)
         q, qd = z[:nq], zd[:nq]
