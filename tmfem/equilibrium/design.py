@@ -30,6 +30,7 @@ from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix, fr
 from tmfem.equilibrium.symmetric import closed_form_1N, closed_form_1ND
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.plane_stress import PlaneStressMembrane, PlaneStressSolution
+from tmfem.system.system import rest_length_array
 from tmfem.system.geometry import beta
 
 
@@ -267,11 +268,10 @@ def forces_from_rest_lengths(system, rest_lengths=None, *, q=None, mesh_n: int =
     |A_T T + A_F F| / |A_F F| (0 at an equilibrium).
     """
     q = system.q if q is None else np.asarray(q, dtype=float)
-    r = system.rest_lengths if rest_lengths is None else np.asarray(rest_lengths, dtype=float)
+    r = system.rest_lengths if rest_lengths is None else rest_length_array(rest_lengths,
+                                                                          len(system.tendons))
     if r is None:
-        raise InputError(f"system {system.name!r} has no rest lengths to evaluate")
-    if r.shape != (len(system.tendons),) or np.any(~np.isfinite(r)) or np.any(r <= 0):
-        raise InputError(f"expected {len(system.tendons)} positive rest lengths, found {r}")
+        raise InputError(f"system {system.name!r}: expected rest lengths to evaluate, found none")
     L = system.tendon_lengths(q)
     EA = system.tendon_EA
     strain = (L - r) / r

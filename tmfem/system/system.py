@@ -19,6 +19,15 @@ from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
 from tmfem.system.topology import Tendon, label, node_labels, tendon_topology
 
 
+def rest_length_array(values, n_tendons: int) -> np.ndarray:
+    """Rest lengths r (eqs. 3.8-3.9) as a float array, checked: ``n_tendons`` finite
+    positive values, else InputError."""
+    r = np.asarray(values, dtype=float)
+    if r.shape != (n_tendons,) or np.any(~np.isfinite(r)) or np.any(r <= 0):
+        raise InputError(f"expected {n_tendons} positive rest lengths, found {r}")
+    return r
+
+
 @dataclass(frozen=True)
 class System:
     """A tensegrity-membrane system and its design configuration.
@@ -114,10 +123,8 @@ class System:
         for t in tendons:
             self.tendon_section(t)
         if self.rest_lengths is not None:
-            r = np.asarray(self.rest_lengths, dtype=float)
-            if r.shape != (len(tendons),) or np.any(~np.isfinite(r)) or np.any(r <= 0):
-                raise InputError(f"expected {len(tendons)} positive rest lengths, found {r}")
-            object.__setattr__(self, "rest_lengths", r)
+            object.__setattr__(self, "rest_lengths", rest_length_array(self.rest_lengths,
+                                                                       len(tendons)))
 
     # ------------------------------------------------------------------ construction
     @classmethod
