@@ -46,3 +46,17 @@ def test_distributed_attachment_peak_stress_converges(system):
     s = [r["sigma_p1_max_MPa"] for r in rows]
     assert abs(s[-1] / s[-2] - 1) < 0.1
     assert max(fit["frequency_change_last"][:4]) < 5e-3
+
+
+def test_study_rest_lengths_are_the_6_2_design_once():
+    # a system without rest lengths: the study holds the ch. 3 design of 6.2 (point corners,
+    # mesh n = 10; r_1^S = 1.5089 m in docs/errata.md) on every mesh, not a design on some
+    # other mesh (a 2 x 2 one gave 1.4953 m)
+    from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.fem.mtc_study import resolve_rest_lengths
+    s = load_preset("1-4")
+    assert s.rest_lengths is None
+    r = resolve_rest_lengths(s, rest_lengths=None)
+    assert r == pytest.approx(design_equilibrium(s, mesh_n=10).rest_lengths, rel=1e-12)
+    assert r[0] == pytest.approx(1.5089, abs=1e-4)
+    assert resolve_rest_lengths(s, rest_lengths="mtc") == "mtc"

@@ -15,15 +15,22 @@ ROW_KEYS = ("mesh_n", "tendon_elements", "attachment", "elements", "h", "dofs", 
             "von_mises_elem_max_MPa")
 
 
-def resolve_rest_lengths(system, *, rest_lengths, attachment: str):
+def resolve_rest_lengths(system, *, rest_lengths):
     """Rest lengths held fixed over a study: an array, or ``"mtc"`` (recomputed per mesh).
 
     ``None``/``"system"``/``"design"`` are evaluated once, so every mesh analyses the same
-    physical structure.
+    physical structure; ``"design"`` (the default without system rest lengths) is the ch. 3
+    design of 6.2 (eqs. 3.8-3.9; point corners on the membrane mesh n = 10,
+    :func:`tmfem.equilibrium.design.design_equilibrium`).
     """
     if isinstance(rest_lengths, str) and rest_lengths == "mtc":
         return "mtc"
-    m = MTCModel(system, mesh_n=2, tendon_elements=1, rest_lengths=rest_lengths)
+    if rest_lengths is None:
+        rest_lengths = "system" if system.rest_lengths is not None else "design"
+    if isinstance(rest_lengths, str) and rest_lengths == "design":
+        from tmfem.equilibrium.design import design_equilibrium
+        return np.asarray(design_equilibrium(system).rest_lengths, dtype=float)
+    m = MTCModel(system, mesh_n=2, tendon_elements=1, rest_lengths=rest_lengths)   # checks
     return m.rest_lengths.copy()
 
 
@@ -36,7 +43,7 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
     (Gauss-point maxima and element-mean maxima), and the frequencies ``f1 .. f<modes>`` [Hz].
     ``h`` is the element size sqrt(area / elements).
     """
-    rest = resolve_rest_lengths(system, rest_lengths=rest_lengths, attachment=attachment)
+    rest = resolve_rest_lengths(system, rest_lengths=rest_lengths)
     for n in meshes:
         for k in tendon_elements:
             t0 = time.perf_counter()
