@@ -93,21 +93,21 @@ def default_monitor(system) -> list[str]:
 
 def solve(args, model):
     from tmfem.fem.mtc_post import static_summary
-    monitor = args.monitor.split(",") if getattr(args, "monitor", None) else default_monitor(model.system)
+    monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
     print(f"tmfem static: {model.system.name}, {model.ndof} free dofs, solving from the "
           f"{args.start} state", file=sys.stderr)
     res = model.solve_static(start=args.start, monitor=monitor,
-                             progress=getattr(args, "progress", False), sequence=sequence_of(args))
+                             progress=args.progress, sequence=sequence_of(args))
     return res, static_summary(model, res.x, result=res)
 
 
 def write_outputs(args, model, x, summary) -> None:
     from tmfem.fem.mtc_post import membrane_field, member_state, q_from_positions
-    if getattr(args, "stress_plot", None):
+    if args.stress_plot:
         from tmfem.fem.mtc_post import plot_membrane_stress
         summary["stress_plot"] = str(plot_membrane_stress(
             args.stress_plot, model, x, title=f"{model.system.name} MTC membrane stresses (O_f frame)"))
-    if not (getattr(args, "vtk", None) or getattr(args, "png", None)):
+    if not (args.vtk or args.png):
         return
     system = model.system
     X = x[:, model.topology.system_node]
