@@ -54,8 +54,7 @@ def membrane_corners_regular(N: int, r_mb: float) -> np.ndarray:
 
     O_f is at corner N and x_f runs from corner N through corner 1.
     """
-    b = beta(N)
-    xy = r_mb * np.array([np.cos(b), np.sin(b)])
+    xy = regular_polygon(N, r_mb, (0.0, 0.0, 0.0))[:2]
     return xy - xy[:, [-1]]
 
 
