@@ -203,17 +203,16 @@ def closed_form_1ND(system) -> dict:
     c = _sym(system)
     if not system.deployable:
         raise InputError(f"expected a 1-N(D) system, found {system.M}-{system.N}")
-    p = dict(l1=c.l[0], theta1=c.theta[0], psi1=c.psi[0], r1=c.r[0], k_H=system.k_H, N=system.N)
+    g = dict(l1=c.l[0], theta1=c.theta[0], psi1=c.psi[0], N=system.N)
+    p = dict(g, r1=c.r[0], k_H=system.k_H)
     SL, SU = sl_su_lengths(**p)
     A = A_1ND(**p)
     v = null_vector_1ND(A)
-    lo, up, up_sl = r1_bounds_1ND(l1=c.l[0], theta1=c.theta[0], psi1=c.psi[0], k_H=system.k_H,
-                                  N=system.N)
+    lo, up, up_sl = r1_bounds_1ND(k_H=system.k_H, **g)
     return {"SL": float(SL), "SU": float(SU), "A": A, "null": v,
             "r1_upper": float(up), "r1_lower": float(lo), "r1_upper_SL": float(up_sl),
             "delta": membrane_delta_system(system),
-            "delta_3_41": float(delta_1N(l1=c.l[0], theta1=c.theta[0], psi1=c.psi[0],
-                                         r_mb=system.r_mb, N=system.N)),
+            "delta_3_41": float(delta_1N(r_mb=system.r_mb, **g)),
             "r_mb": system.r_mb}
 
 
