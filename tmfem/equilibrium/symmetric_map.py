@@ -51,9 +51,7 @@ def with_configuration(system, cfg: SymmetricConfig):
     q, base A_1j and bar lengths l_ij from ``cfg``; rest lengths dropped."""
     if system.M != cfg.M:
         raise InputError(f"expected a configuration with M = {system.M} stages, found {cfg.M}")
-    N = system.N
-    return system.replace(q=cfg.to_q(N), symmetric=cfg, base=cfg.base_nodes(N)[:, 0, :],
-                          l=np.repeat(cfg.l[:, None], N, axis=1), rest_lengths=None)
+    return system.replace(symmetric=cfg, rest_lengths=None, **cfg.system_arrays(system.N))
 
 
 @dataclass

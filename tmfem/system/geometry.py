@@ -222,6 +222,12 @@ class SymmetricConfig:
             parts.append(np.column_stack([A[0, i], A[1, i], A[2, i], theta[i], psi[i]]).ravel())
         return np.concatenate(parts)
 
+    def system_arrays(self, N: int) -> dict:
+        """The :class:`tmfem.system.System` fields this configuration fixes: ``q`` (eqs.
+        3.1-3.2), ``base`` A_1j (3, N) and the bar lengths ``l`` (M, N)."""
+        return {"q": self.to_q(N), "base": self.base_nodes(N)[:, 0, :],
+                "l": np.repeat(self.l[:, None], N, axis=1)}
+
     def membrane_delta(self, N: int, r_mb: float) -> float:
         """Radial membrane corner displacement Delta of eq. 3.22 (:func:`membrane_delta`)."""
         return float(membrane_delta(l_M=self.l[-1], theta_M=self.theta[-1], psi_M=self.psi[-1],

@@ -139,11 +139,8 @@ class System:
         """
         if not (r_mb > 0):
             raise InputError(f"expected membrane radius r_mb > 0, found {r_mb!r}")
-        M = config.M
-        base = config.base_nodes(N)[:, 0, :]
-        sys = cls(name=name, M=M, N=N, deployable=deployable, base=base,
-                  l=np.repeat(config.l[:, None], N, axis=1), q=config.to_q(N), membrane=membrane,
-                  membrane_corners=membrane_corners_regular(N, r_mb), bar=bar,
+        sys = cls(name=name, M=config.M, N=N, deployable=deployable, **config.system_arrays(N),
+                  membrane=membrane, membrane_corners=membrane_corners_regular(N, r_mb), bar=bar,
                   tendon_sections=dict(tendon_sections), k_H=k_H, symmetric=config, r_mb=r_mb,
                   description=description, notes=tuple(notes), printed=dict(printed or {}))
         if rest_lengths:
