@@ -70,9 +70,9 @@ def main(argv=None) -> int:
     print("1-4 MTC statics (4 x 10 x 10 membrane, 3 elements per tendon), from the undeformed membrane")
     print(f"{'':30s}" + "".join(f"{t:>24s}" for t, *_ in results) + f"{'dissertation':>16s}")
     rows = [("rest length r_1^S [m]", lambda st: st["rest_lengths"]["S_11"], pr["rest_lengths"]["S1"]),
-            ("Newton iterations", lambda st: st["iterations"], np.nan),
-            ("max |node - design| [mm]", lambda st: 1e3 * st["max_deviation_from_design"], 0.0),
-            ("Delta [mm] (design 1.264)", lambda st: 1e3 * np.mean(st["Delta"]), np.nan),
+            ("Newton iterations", lambda st: st["iterations"], None),
+            ("max |node - design| [mm]", lambda st: 1e3 * st["max_deviation_from_design"], None),
+            ("Delta [mm] (design 1.264)", lambda st: 1e3 * np.mean(st["Delta"]), None),
             ("theta_1 [deg]", lambda st: st["theta_deg"][0], 60.0),
             ("psi_14 [deg]", lambda st: st["psi_deg"][3], 10.0),
             ("tendon stress [MPa]", lambda st: st["tendon_stress_max"] / 1e6, pr["tendon_max_stress"] / 1e6),
@@ -80,7 +80,8 @@ def main(argv=None) -> int:
             ("max sigma_p1 [MPa]", lambda st: st["membrane_max_sigma_p1"] / 1e6, pr["membrane_max_sigma_p1"] / 1e6),
             ("max von Mises [MPa]", lambda st: st["membrane_max_von_mises"] / 1e6, pr["membrane_max_von_mises"] / 1e6)]
     for name, f, p in rows:
-        print(f"{name:30s}" + "".join(f"{f(st):24.4f}" for _, _, _, st, _ in results) + f"{p:16.4f}")
+        printed_col = f"{'-':>16s}" if p is None else f"{p:16.4f}"      # '-': not printed
+        print(f"{name:30s}" + "".join(f"{f(st):24.4f}" for _, _, _, st, _ in results) + printed_col)
     print()
     print(f"1-4 natural frequencies [Hz] ({ref['source']})")
     print(f"{'mode':>4s}" + "".join(f"{t:>24s}" for t, *_ in results) + f"{'MTC paper':>11s}{'SBC paper':>11s}")
