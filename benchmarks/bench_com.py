@@ -13,10 +13,10 @@ import time
 import numpy as np
 
 from tmfem.errors import TmfemError
-from tmfem.reduced.linearize import linearize
-from tmfem.reduced.modal import default_membrane_modes
-from tmfem.reduced.model import ControlOrientedModel
-from tmfem.reduced.simulate import free_vibration
+from tmfem.models.com.linearize import linearize
+from tmfem.models.com.modal import default_membrane_modes
+from tmfem.models.com.model import ControlOrientedModel
+from tmfem.models.com.simulate import free_vibration
 from tmfem.system import load_preset
 
 PERTURB = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}

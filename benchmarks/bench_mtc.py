@@ -33,7 +33,7 @@ def main(argv=None) -> int:
     ap.add_argument("--rest-length", type=float, default=1.5025,
                     help="rest length of the S tendons [m] (default: the value Tables 6.3/6.6 imply)")
     args = ap.parse_args(argv)
-    from tmfem.fem.mtc import MTCModel, _solve_symmetric
+    from tmfem.models.mtc.model import MTCModel, _solve_symmetric
     from tmfem.system import load_preset
 
     system = load_preset("1-4", as_printed=True).with_rest_lengths({"S1": args.rest_length})

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import TmfemError
-from tmfem.reduced.modal import default_membrane_modes
-from tmfem.reduced.model import ControlOrientedModel
-from tmfem.reduced.simulate import free_vibration, plot_free_vibration
+from tmfem.models.com.modal import default_membrane_modes
+from tmfem.models.com.model import ControlOrientedModel
+from tmfem.models.com.simulate import free_vibration, plot_free_vibration
 from tmfem.system import load_preset
 
 CASES = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}

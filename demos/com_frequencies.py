@@ -14,8 +14,8 @@ from __future__ import annotations
 import argparse
 
 from tmfem.errors import TmfemError
-from tmfem.tables import HIGHEST_COM_FREQUENCY
-from tmfem.reduced.modal import (default_membrane_modes,
+from tmfem.reference.tables import HIGHEST_COM_FREQUENCY
+from tmfem.models.com.modal import (default_membrane_modes,
                                  dissertation_com_frequencies, frequency_study, modal_summary)
 from tmfem.system import load_preset
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.fem.element_benchmarks import (beaded_string_modes, prestressed_square_membrane_modes,
+from tmfem.reference.element_benchmarks import (beaded_string_modes, prestressed_square_membrane_modes,
                                           square_membrane, taut_string_modes, two_bar_arch)
 
 
@@ -43,7 +43,7 @@ def arch(out: Path, plt):
         print(f"{name:40s} {r.P_max_fe:13.6e} {L['P_green']:13.6e} {L['P_eng']:13.6e} {dev:14.2e} {r.steps}")
         rows.append([name, r.P_max_fe, L["P_green"], L["P_eng"], dev])
         vv = np.linspace(0, r.v.max(), 400)
-        from tmfem.fem.element_benchmarks import arch_load_engineering, arch_load_green
+        from tmfem.reference.element_benchmarks import arch_load_engineering, arch_load_green
         ax.plot(vv / kw["b"], arch_load_green(vv, **kw) / L["P_green"], "k-", lw=1, label="Green (closed form)")
         ax.plot(vv / kw["b"], arch_load_engineering(vv, **kw) / L["P_green"], "r--", lw=1, label="engineering strain")
         ax.plot(r.v / kw["b"], r.P / L["P_green"], "o", ms=2.5, label="truss FE, arc length")

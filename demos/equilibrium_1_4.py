@@ -8,7 +8,7 @@ import numpy as np
 from tmfem.equilibrium.design import design_equilibrium
 from tmfem.equilibrium.symmetric import r1_1N
 from tmfem.system import load_preset
-from tmfem.tables import PRINTED, comparison_row as row, format_comparison
+from tmfem.reference.tables import PRINTED, comparison_row as row, format_comparison
 
 
 def main():

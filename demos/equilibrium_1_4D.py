@@ -8,7 +8,7 @@ import numpy as np
 
 from tmfem.equilibrium.symmetric import membrane_delta_system
 from tmfem.system import load_preset
-from tmfem.tables import (PRINTED, comparison_row as row, fit_rest_lengths, format_comparison,
+from tmfem.reference.tables import (PRINTED, comparison_row as row, fit_rest_lengths, format_comparison,
                           symmetric_prestress, with_symmetric)
 
 

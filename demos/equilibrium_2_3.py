@@ -7,7 +7,7 @@ import numpy as np
 
 from tmfem.equilibrium.symmetric import s1_length
 from tmfem.system import load_preset
-from tmfem.tables import (PRINTED, comparison_row as row, format_comparison, symmetric_prestress,
+from tmfem.reference.tables import (PRINTED, comparison_row as row, format_comparison, symmetric_prestress,
                           top_radius_for_delta)
 
 

@@ -7,7 +7,7 @@ r_2, z_2, sigma_2 are not printed; the presets carry the reconstructed rule
 import numpy as np
 
 from tmfem.system import load_preset
-from tmfem.tables import PRINTED, comparison_row as row, format_comparison, symmetric_prestress
+from tmfem.reference.tables import PRINTED, comparison_row as row, format_comparison, symmetric_prestress
 
 
 def main():

@@ -9,7 +9,7 @@ import numpy as np
 from tmfem.equilibrium.design import design_equilibrium
 from tmfem.equilibrium.symmetric_map import equilibrium_map
 from tmfem.system import load_preset
-from tmfem.tables import PRINTED, comparison_row as row, deployment_bases, format_comparison
+from tmfem.reference.tables import PRINTED, comparison_row as row, deployment_bases, format_comparison
 
 
 def main():

@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.fem.mtc import MTCModel
-from tmfem.fem.mtc_dynamics import fit_frequency, mtc_free_vibration
-from tmfem.reduced.modal import default_membrane_modes
-from tmfem.reduced.model import ControlOrientedModel
-from tmfem.reduced.simulate import free_vibration
+from tmfem.models.mtc.model import MTCModel
+from tmfem.models.mtc.dynamics import fit_frequency, mtc_free_vibration
+from tmfem.models.com.modal import default_membrane_modes
+from tmfem.models.com.model import ControlOrientedModel
+from tmfem.models.com.simulate import free_vibration
 from tmfem.system import load_preset
 
 CASES = {"1-4": ("theta_12", {"theta_12_dot": 0.01}), "2-3": ("theta_11", {"theta_11_dot": 0.01})}

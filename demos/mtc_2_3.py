@@ -7,7 +7,7 @@
    MTC static solve with them (it stops with a ConvergenceError naming the slack tendons).
 2. The design Tables 6.5 and 6.7 belong to, the default of the preset `2-3`: the final 2-3
    configuration of Table 7.7 with the materials of Table 6.1 (stage-2 base checked against
-   the Table 7.7 rest lengths by `tmfem.fem.mtc_designs.fit_stage2_base`), the prestress
+   the Table 7.7 rest lengths by `tmfem.reference.designs.fit_stage2_base`), the prestress
    calibrated on the stage-1 bar load of Table 6.5 only; landing from the undeformed membrane
    (Figs. 6.5-6.7 nodes), Table 6.5 and Table 6.7 beside ours.
 """
@@ -18,9 +18,9 @@ import sys
 import numpy as np
 
 from tmfem.errors import ConvergenceError
-from tmfem.fem.mtc import MTCModel
-from tmfem.tables import FREQUENCIES
-from tmfem.fem.mtc_post import static_summary
+from tmfem.models.mtc.model import MTCModel
+from tmfem.reference.tables import FREQUENCIES
+from tmfem.models.mtc.post import static_summary
 from tmfem.system import load_preset
 
 
@@ -42,7 +42,7 @@ def main() -> int:
     except ConvergenceError as exc:
         print(f"  {exc}")
     print()
-    from tmfem.fem.mtc_designs import calibrate_on_bar_load, fit_stage2_base
+    from tmfem.reference.designs import calibrate_on_bar_load, fit_stage2_base
     fit = fit_stage2_base()
     d = load_preset("2-3")
     c = d.symmetric

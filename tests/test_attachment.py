@@ -108,7 +108,7 @@ def test_patch_to_zero_approaches_point(s14):
 
 
 def test_mtc_distributed_consistent_rest_lengths_agree_with_design(s14):
-    from tmfem.fem.mtc import MTCModel
+    from tmfem.models.mtc.model import MTCModel
     n, patch = 10, 0.3 * s14.r_mb
     d = design_equilibrium(s14, mesh_n=n, attachment="distributed", patch=patch)
     m = MTCModel(s14, mesh_n=n, tendon_elements=1, attachment="distributed", patch=patch,
@@ -129,7 +129,7 @@ def test_mtc_distributed_consistent_rest_lengths_agree_with_design(s14):
 
 
 def test_shared_weights_and_bad_input(s14):
-    from tmfem.fem.mtc_topology import build_topology
+    from tmfem.models.mtc.topology import build_topology
     topo = build_topology(s14, mesh_n=20, tendon_elements=1, attachment="distributed")
     w = attachment_weights(topo.mesh, attachment="distributed",
                            patch=default_patch_radius(s14.membrane_corners, s14.r_mb))
@@ -166,7 +166,7 @@ def test_mtc_default_rest_lengths_come_from_the_design_on_its_own_mesh_and_attac
     # the MTC model without given rest lengths takes those of the ch. 3 design (eqs. 3.8-3.9)
     # computed with the same membrane mesh and corner attachment, so both see the same corner
     # stiffness; the point design on mesh 10 would give 1.50891 m instead (docs/errata.md)
-    from tmfem.fem.mtc import MTCModel
+    from tmfem.models.mtc.model import MTCModel
     m = MTCModel(s14, mesh_n=20, tendon_elements=1, attachment="distributed")
     d = design_equilibrium(s14, mesh_n=20, attachment="distributed")
     np.testing.assert_array_equal(m.rest_lengths, d.rest_lengths)

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from tmfem.errors import InputError
-from tmfem.reduced.constraints import ZetaLayout, zeta_closed_form
-from tmfem.reduced.linearize import linearize, output_jacobian
-from tmfem.reduced.model import ControlOrientedModel
+from tmfem.models.com.constraints import ZetaLayout, zeta_closed_form
+from tmfem.models.com.linearize import linearize, output_jacobian
+from tmfem.models.com.model import ControlOrientedModel
 from tmfem.solvers.park import park_integrate
 from tmfem.system import load_preset
 from tmfem.system.geometry import rotation_ef
@@ -42,7 +42,7 @@ def test_rotation_is_3_2_1_sequence():
     # R^ef of the model (the numeric one: tests/test_equilibrium_general.py, test_system.py)
     import casadi as ca
 
-    from tmfem.reduced.kinematics import rotation_ef_sx
+    from tmfem.models.com.kinematics import rotation_ef_sx
     g = np.array([0.3, -0.2, 0.7])
     c, s = np.cos, np.sin
     Rz = np.array([[c(g[0]), -s(g[0]), 0], [s(g[0]), c(g[0]), 0], [0, 0, 1]])
@@ -126,7 +126,7 @@ def test_membrane_kinetic_energy_against_nodal_sum(m14, sys14):
 
     h = 1e-6
     V = (nodes(z + h * zd) - nodes(z - h * zd)) / (2 * h)
-    from tmfem.reduced.membrane_modes import _mass_matrix
+    from tmfem.models.com.membrane_modes import _mass_matrix
     Ms = _mass_matrix(mb.scalar_basis, sys14.membrane.rho * sys14.membrane.h)
     T_nodal = 0.5 * np.einsum("in,nm,im->", V, Ms.toarray(), V)
     # bar kinetic energy, eq. 5.9 (M = 1)
@@ -195,7 +195,7 @@ def test_frequencies_1_4_against_table_6_6(sys14):
     is the one implied by the printed tendon stress of Table 6.3 (37.98 MPa, i.e. x1.290 our
     designed prestress, see docs/errata.md); with the designed prestress the prestress-
     dominated modes are lower by up to 12 %."""
-    from tmfem.reduced.modal import modal_summary
+    from tmfem.models.com.modal import modal_summary
     r1 = modal_summary(sys14, modes=12, membrane_modes=5)
     s = r1["printed_stress_prestress_scale"]
     assert s == pytest.approx(37.98e6 * np.pi * 0.3e-3**2 / r1["design_tendon_forces"]["S_11"], rel=1e-9)
@@ -322,7 +322,7 @@ def test_free_vibration_matches_linear_response(m14):
     against the exact (matrix exponential) response of its linearisation (eq. 5.33) over
     3 s; the motion is small, so they agree to ~1 % of the amplitude."""
     from scipy.linalg import expm
-    from tmfem.reduced.simulate import free_vibration
+    from tmfem.models.com.simulate import free_vibration
     res = free_vibration(m14, t_end=3.0, dt=0.005, perturb={"theta_12_dot": 0.01}, jacobian="reuse")
     lin = linearize(m14)
     x0 = np.zeros(2 * m14.nz); x0[m14.nz + 2] = 0.01
@@ -343,7 +343,7 @@ def test_rest_length_step_matches_linear_input_response(m14):
     """A 1 mm step of the rest length of S_12 at t = 0 (input u, eq. 5.27): the nonlinear
     response against the exact zero-order-hold response of the linearisation (A, B of 5.33)."""
     from scipy.linalg import expm
-    from tmfem.reduced.simulate import free_vibration
+    from tmfem.models.com.simulate import free_vibration
     du = np.zeros(m14.n_t); du[1] = -1e-3
     dt = 0.005
     res = free_vibration(m14, t_end=2.0, dt=dt, u=m14.u0 + du, jacobian="reuse")
@@ -366,7 +366,7 @@ def test_driven_run_frames_carry_the_driven_rest_lengths_and_forces(m14, tmp_pat
     # (eq. 3.8) for that u, computed here independently by ControlOrientedModel.tendon_forces
     import meshio
     from tmfem.io.vtk import read_pvd
-    from tmfem.reduced.simulate import free_vibration
+    from tmfem.models.com.simulate import free_vibration
     du = np.zeros(m14.n_t); du[1] = -1e-3
     res = free_vibration(m14, t_end=0.02, dt=0.01, u=m14.u0 + du, vtk_dir=tmp_path, vtk_every=1)
     frames = read_pvd(res.stats["pvd"])

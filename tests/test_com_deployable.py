@@ -3,8 +3,8 @@ presets): design equilibrium, partitioning paths and the DAE with multipliers ag
 import numpy as np
 import pytest
 
-from tmfem.reduced.linearize import linearize
-from tmfem.reduced.model import ControlOrientedModel
+from tmfem.models.com.linearize import linearize
+from tmfem.models.com.model import ControlOrientedModel
 from tmfem.system import load_preset
 
 

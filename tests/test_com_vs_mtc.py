@@ -5,13 +5,13 @@ import os
 import numpy as np
 import pytest
 
-from tmfem.reduced.linearize import linearize
-from tmfem.reduced.model import ControlOrientedModel
+from tmfem.models.com.linearize import linearize
+from tmfem.models.com.model import ControlOrientedModel
 from tmfem.system import load_preset
 
 
 def test_com_frequencies_close_to_mtc_1_4():
-    from tmfem.fem.mtc import MTCModel
+    from tmfem.models.mtc.model import MTCModel
     n = 5 if os.environ.get("TMFEM_SLOW_SCALE") == "reduced" else 10
     s = load_preset("1-4")
     com = ControlOrientedModel(s, membrane_modes=5, mesh_n=n)
@@ -28,8 +28,8 @@ def test_com_frequencies_close_to_mtc_1_4():
 def test_printed_rest_length_1_529_gives_a_soft_system_in_both_models():
     # Table 6.2's r_1^S = 1.529 m (docs/errata.md): the COM and the MTC model both find a
     # nearly unstressed system whose first frequency is ~0.04 Hz instead of 0.1367 Hz
-    from tmfem.fem.mtc import MTCModel
-    from tmfem.reduced.modal import modal_summary
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.models.com.modal import modal_summary
     s = load_preset("1-4", as_printed=True)
     r = modal_summary(s, modes=3, membrane_modes=5)
     assert r["rest_lengths_source"] == "system"

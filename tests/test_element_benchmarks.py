@@ -1,5 +1,5 @@
 """Element benchmarks: dissertation 4.5.3 (two-bar arch), 4.5.4 (square membrane) and
-closed-form vibration problems (tmfem.fem.element_benchmarks)."""
+closed-form vibration problems (tmfem.reference.element_benchmarks)."""
 import json
 import os
 from pathlib import Path
@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tmfem.fem.element_benchmarks import (beaded_string_modes, prestressed_square_membrane_modes,
+from tmfem.reference.element_benchmarks import (beaded_string_modes, prestressed_square_membrane_modes,
                                           square_membrane, taut_string_modes, two_bar_arch)
 
 REF = Path(__file__).resolve().parents[2] / "shared" / "reference" / "benchmarks.json"

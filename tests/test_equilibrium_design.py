@@ -213,7 +213,7 @@ def test_force_ratios_agree_with_mtc_nodal_balance():
     # the design bar tops, then force balance at every free node along the member
     # directions. The membrane forces differ (nonlinear vs linear), so compare the tendon
     # forces relative to one of them: they must agree for a 2-3 design (3.3.2)
-    from tmfem.fem.mtc import MTCModel
+    from tmfem.models.mtc.model import MTCModel
     s = two_stage(157.84, 145.67)
     d = design_equilibrium(s, mesh_n=MESH)
     m = MTCModel(s, mesh_n=MESH, rest_lengths=d.rest_lengths)
@@ -279,13 +279,13 @@ def test_equilibrium_map_of_a_1ND_system_matches_closed_form_bounds():
 
 
 def test_equilibrium_map_marks_points_without_a_stage_base_infeasible():
-    # preset 2-3 with the Table 7.7 base rule (tmfem.tables.deployment_bases): at
+    # preset 2-3 with the Table 7.7 base rule (tmfem.reference.tables.deployment_bases): at
     # psi = -10 deg, theta = 60-80 deg no r_2 satisfies eq. 3.22 (the rule itself raises
     # there, checked directly below); the map must mark those points infeasible, keep
     # the reason, and give every other point exactly as a map over feasible points only.
     from tmfem.equilibrium.symmetric_map import equilibrium_map
     from tmfem.errors import InputError
-    from tmfem.tables import deployment_bases
+    from tmfem.reference.tables import deployment_bases
     s = load_preset("2-3")
     rule = deployment_bases(s)
     th, ps = np.radians([55.0, 60.0, 70.0, 80.0]), np.radians([-10.0, 0.0, 10.0])

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from tmfem.errors import InputError
-from tmfem.fem.mtc import MTCModel
+from tmfem.models.mtc.model import MTCModel
 from tmfem.fem.truss import green_rest_length, linear_rest_length
-from tmfem.tables import FREQUENCIES
-from tmfem.fem.mtc_post import static_summary
+from tmfem.reference.tables import FREQUENCIES
+from tmfem.models.mtc.post import static_summary
 from tmfem.system import System, SymmetricConfig, load_preset
 
 

@@ -11,7 +11,7 @@ import os
 
 import pytest
 
-from tmfem.fem.mtc_study import convergence_rows, fit_convergence
+from tmfem.reference.convergence import convergence_rows, fit_convergence
 from tmfem.system import load_preset
 
 REDUCED = os.environ.get("TMFEM_SLOW_SCALE", "") == "reduced"
@@ -53,7 +53,7 @@ def test_study_rest_lengths_are_the_6_2_design_once():
     # mesh n = 10; r_1^S = 1.5089 m in docs/errata.md) on every mesh, not a design on some
     # other mesh (a 2 x 2 one gave 1.4953 m)
     from tmfem.equilibrium.design import design_equilibrium
-    from tmfem.fem.mtc_study import resolve_rest_lengths
+    from tmfem.reference.convergence import resolve_rest_lengths
     s = load_preset("1-4")
     assert s.rest_lengths is None
     r = resolve_rest_lengths(s, rest_lengths=None)

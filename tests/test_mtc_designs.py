@@ -1,14 +1,14 @@
-"""The 2-3 design behind Tables 6.5 and 6.7: the preset ``2-3`` (tmfem.fem.mtc_designs;
+"""The 2-3 design behind Tables 6.5 and 6.7: the preset ``2-3`` (tmfem.reference.designs;
 docs/errata.md)."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tmfem.fem.mtc import MTCModel
-from tmfem.fem.mtc_designs import calibrate_on_bar_load, fit_stage2_base
-from tmfem.tables import FREQUENCIES
-from tmfem.fem.mtc_post import static_summary
+from tmfem.models.mtc.model import MTCModel
+from tmfem.reference.designs import calibrate_on_bar_load, fit_stage2_base
+from tmfem.reference.tables import FREQUENCIES
+from tmfem.models.mtc.post import static_summary
 from tmfem.system import load_preset
 
 

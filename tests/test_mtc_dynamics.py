@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from tmfem.errors import InputError
-from tmfem.fem.mtc import MTCModel
-from tmfem.fem.mtc_dynamics import (MTCDynamics, fit_frequency, initial_state,
+from tmfem.models.mtc.model import MTCModel
+from tmfem.models.mtc.dynamics import (MTCDynamics, fit_frequency, initial_state,
                                     mtc_free_vibration)
 from tmfem.solvers.park import park_integrate
 from tmfem.system import load_preset
@@ -112,7 +112,7 @@ def test_small_vibration_frequency_is_the_first_modal_frequency(mtc_1_4):
     assert f == pytest.approx(f1, rel=1e-4)
     # the bars' own coordinate shows the same frequency (the 11 % in higher modes blur it
     # slightly: measured 0.09 %)
-    from tmfem.fem.mtc_post import q_from_positions
+    from tmfem.models.mtc.post import q_from_positions
     psi = np.array([q_from_positions(m.system, dyn.positions(u)[:, m.topology.system_node])[1]
                     for u in r.x])
     assert fit_frequency(r.t, psi, f_min=0.5 * f1, f_max=1.5 * f1) == pytest.approx(f1, rel=3e-3)
@@ -125,8 +125,8 @@ def test_mtc_and_com_bar_responses_agree_1_4():
     # MTC's, so over 6 s (~2 periods of the 0.3 Hz bar mode) the histories drift apart slowly;
     # the peak-to-peak amplitudes must agree within 5 % (measured 2.5 %) and the fitted
     # frequencies within 3 %.
-    from tmfem.reduced.model import ControlOrientedModel
-    from tmfem.reduced.simulate import free_vibration
+    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.models.com.simulate import free_vibration
     s = load_preset("1-4")
     com = ControlOrientedModel(s, membrane_modes=5, mesh_n=4)
     rc = free_vibration(com, t_end=6.0, dt=0.01, perturb={"theta_12_dot": 0.01}, jacobian="reuse")
@@ -154,8 +154,8 @@ def test_mtc_and_com_bar_responses_agree_2_3():
     # of theta_11 and of the monitored nodes A_21, B_11, B_21 agree within 5 % (measured
     # <= 2.9 %) and the fitted frequencies within 3 % (measured 1.5 %); at the paper's mesh
     # (3 x 10 x 10, 10 s) demos/free_vibration_compare.py gives 0.9 % and 0.1 %.
-    from tmfem.reduced.model import ControlOrientedModel
-    from tmfem.reduced.simulate import free_vibration
+    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.models.com.simulate import free_vibration
     s = load_preset("2-3")
     pert = {"theta_11_dot": 0.01}
     com = ControlOrientedModel(s, membrane_modes=4, mesh_n=4)
@@ -197,7 +197,7 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
     assert float(rows[2][j]) - float(rows[1][j]) == pytest.approx(1e-4, rel=0.02)
     # taut tendons: the smallest tendon force lies below the same model's static value
     # (member_state at the equilibrium) and within 2 % of it (small perturbation)
-    from tmfem.fem.mtc_post import member_state
+    from tmfem.models.mtc.post import member_state
     m = MTCModel(load_preset("1-4"), mesh_n=4, tendon_elements=3)
     T_eq = member_state(m, m.solve_static(start="undeformed").x)["tendon_force"].min()
     assert 0.98 * T_eq < r["min_tendon_force_N"] < T_eq
@@ -208,7 +208,7 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
 
 def test_split_perturbation_offsets_rates_and_unknown_names():
     # the 6.5 perturbations: theta_12_dot = 0.01 rad/s (6.5.1), an offset theta_11 = 0.001 rad
-    from tmfem.reduced.simulate import split_perturbation
+    from tmfem.models.com.simulate import split_perturbation
     names = ["theta_11", "psi_11", "theta_12"]
     d, dd = split_perturbation({"theta_12_dot": 0.01, "theta_11": 0.001}, names)
     assert d.tolist() == [0.001, 0.0, 0.0]

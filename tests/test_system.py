@@ -100,7 +100,7 @@ def test_floating_frame_rejects_collinear_corners():
 def test_rotation_ef_numeric_matches_casadi_and_inverts():
     import casadi as ca
 
-    from tmfem.reduced.kinematics import rotation_ef_sx
+    from tmfem.models.com.kinematics import rotation_ef_sx
     rng = np.random.default_rng(11)
     g = ca.SX.sym("g", 3)
     f = ca.Function("R", [g], [rotation_ef_sx(g)])

@@ -11,7 +11,7 @@ import pytest
 from tmfem.equilibrium.symmetric import membrane_delta_system, r1_1N, s1_length, sl_su_lengths
 from tmfem.equilibrium.symmetric_map import equilibrium_map
 from tmfem.system import load_preset
-from tmfem.tables import (PRINTED, deployment_bases, fit_rest_lengths, rest_length_misfit,
+from tmfem.reference.tables import (PRINTED, deployment_bases, fit_rest_lengths, rest_length_misfit,
                           symmetric_prestress, top_radius_for_delta, with_symmetric)
 
 rad = np.radians
@@ -192,7 +192,7 @@ def test_ch8_grid_is_inside_the_equilibrium_region_of_the_reconstructed_design()
 
 def test_comparison_table_format():
     # rel. diff = (ours - printed) / |printed|; strings and None are shown as given / "-"
-    from tmfem.tables import comparison_row, format_comparison
+    from tmfem.reference.tables import comparison_row, format_comparison
     r = comparison_row("bar load", 14.53, 10.9531, "N")
     assert r[3] == pytest.approx((10.9531 - 14.53) / 14.53)
     text = format_comparison([r, comparison_row("k_H", "not printed", 0.25)], "t")

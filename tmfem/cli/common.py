@@ -28,7 +28,7 @@ def system_from_args(args: argparse.Namespace) -> System:
 
 def add_prestress_scale_arg(parser) -> None:
     """Add ``--prestress-scale S`` (control-oriented model only, see
-    :class:`tmfem.reduced.model.ControlOrientedModel`); read it with :func:`prestress_scale_of`."""
+    :class:`tmfem.models.com.model.ControlOrientedModel`); read it with :func:`prestress_scale_of`."""
     parser.add_argument("--prestress-scale", type=float, default=None,
                         help="--model com: factor on the designed membrane prestress (default 1 = "
                              "designed; 1.2903 gives the printed 1-4 tendon stress and Table 6.6, "

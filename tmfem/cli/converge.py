@@ -38,7 +38,7 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
-    from tmfem.fem.mtc_study import ROW_KEYS, convergence_rows, fit_convergence
+    from tmfem.reference.convergence import ROW_KEYS, convergence_rows, fit_convergence
     from tmfem.cli.static import apply_rest_lengths
     system, rest = apply_rest_lengths(system_from_args(args), args.rest_lengths)
     meshes = _ints(args.mesh, "--mesh")

@@ -37,15 +37,15 @@ def mtc_modes(model, *, k: int, start: str = "undeformed", sequence: int | None 
 
 def run(args) -> dict:
     if args.model == "com":
-        from tmfem.reduced.modal import modal_summary
+        from tmfem.models.com.modal import modal_summary
         system = system_from_args(args)
         return modal_summary(system, modes=args.modes, membrane_modes=args.membrane_modes,
                              prestress_scale=prestress_scale_of(args))
     if args.prestress_scale is not None:
         raise InputError("--prestress-scale belongs to --model com; the MTC prestress follows "
                          "from its rest lengths (--rest-lengths)")
-    from tmfem.tables import FREQUENCIES
-    from tmfem.fem.mtc_post import model_cells, static_summary
+    from tmfem.reference.tables import FREQUENCIES
+    from tmfem.models.mtc.post import model_cells, static_summary
     model = build_model(args)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
@@ -79,7 +79,7 @@ def run(args) -> dict:
 
 def format_text(r: dict) -> str:
     if r.get("model") != "mtc":
-        from tmfem.reduced.modal import format_summary
+        from tmfem.models.com.modal import format_summary
         return format_summary(r)
     lines = [f"MTC modes of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",

@@ -42,7 +42,7 @@ def sequence_of(args):
 
 def build_model(args):
     """The MTC model named by the command-line arguments."""
-    from tmfem.fem.mtc import MTCModel
+    from tmfem.models.mtc.model import MTCModel
     if getattr(args, "model", "mtc") != "mtc":
         raise InputError(f"model: expected 'mtc', found {args.model!r}")
     system = system_from_args(args)
@@ -92,7 +92,7 @@ def default_monitor(system) -> list[str]:
 
 
 def solve(args, model):
-    from tmfem.fem.mtc_post import static_summary
+    from tmfem.models.mtc.post import static_summary
     monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
     print(f"tmfem static: {model.system.name}, {model.ndof} free dofs, solving from the "
           f"{args.start} state", file=sys.stderr)
@@ -102,9 +102,9 @@ def solve(args, model):
 
 
 def write_outputs(args, model, x, summary) -> None:
-    from tmfem.fem.mtc_post import membrane_field, member_state, q_from_positions
+    from tmfem.models.mtc.post import membrane_field, member_state, q_from_positions
     if args.stress_plot:
-        from tmfem.fem.mtc_post import plot_membrane_stress
+        from tmfem.models.mtc.post import plot_membrane_stress
         summary["stress_plot"] = str(plot_membrane_stress(
             args.stress_plot, model, x, title=f"{model.system.name} MTC membrane stresses (O_f frame)"))
     if not (args.vtk or args.png):

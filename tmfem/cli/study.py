@@ -54,7 +54,7 @@ def _progress(msg: str) -> None:
 
 def table_rows(d, system) -> list[dict]:
     """Rows (quantity, unit, ours, printed, rel_diff, source) of the design table."""
-    from tmfem.tables import relative_difference
+    from tmfem.reference.tables import relative_difference
 
     p = dict(system.printed)
     prest = p.get("rest_lengths", {}) or {}

@@ -51,9 +51,9 @@ def run(args) -> dict:
         raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
     if args.model == "mtc":
         return run_mtc(args)
-    from tmfem.reduced.modal import default_membrane_modes
-    from tmfem.reduced.model import ControlOrientedModel
-    from tmfem.reduced.simulate import free_vibration, parse_perturbation
+    from tmfem.models.com.modal import default_membrane_modes
+    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.models.com.simulate import free_vibration, parse_perturbation
 
     system = system_from_args(args)
     K = default_membrane_modes(system) if args.membrane_modes is None else args.membrane_modes
@@ -74,7 +74,7 @@ def run(args) -> dict:
 def _run_summary(res, args, *, title: str) -> dict:
     """What both models report of a free-vibration run: solver counts, the smallest tendon
     force, monitored amplitudes, and the files written (CSV, ParaView series, plot)."""
-    from tmfem.reduced.simulate import plot_free_vibration
+    from tmfem.models.com.simulate import plot_free_vibration
 
     out = {"wall_time_s": res.wall_time, "steps": res.stats["steps"],
            "newton_iterations": res.stats["newton_iterations"],
@@ -93,11 +93,11 @@ def _run_summary(res, args, *, title: str) -> dict:
 
 
 def run_mtc(args) -> dict:
-    """Free vibration of the MTC model (tmfem.fem.mtc_dynamics)."""
+    """Free vibration of the MTC model (tmfem.models.mtc.dynamics)."""
     from tmfem.cli.static import apply_rest_lengths, sequence_of
-    from tmfem.fem.mtc import MTCModel
-    from tmfem.fem.mtc_dynamics import mtc_free_vibration, perturbation_names
-    from tmfem.reduced.simulate import parse_perturbation
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.models.mtc.dynamics import mtc_free_vibration, perturbation_names
+    from tmfem.models.com.simulate import parse_perturbation
 
     system = system_from_args(args)
     if args.damping or args.membrane_modes is not None or args.prestress_scale is not None:

@@ -110,7 +110,7 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
         M) giving the stage bases along the family (e.g. a reconstructed deployment rule);
         by default they are held at the values of ``system``. Where the rule raises
         :class:`~tmfem.errors.InputError` (no admissible base at that point, e.g.
-        :func:`tmfem.tables.deployment_bases` where no r_2 satisfies eq. 3.22) the point is
+        :func:`tmfem.reference.tables.deployment_bases` where no r_2 satisfies eq. 3.22) the point is
         marked infeasible, its message kept in ``reason``, and the map goes on.
     """
     theta = np.atleast_1d(np.asarray(theta, dtype=float))

@@ -123,7 +123,7 @@ def rotation_ef(gamma) -> np.ndarray:
 
     R^ef = Rz(gamma_1) Ry(gamma_2) Rx(gamma_3); its columns are the O_f axes in O-xyz. The
     casadi version for automatic differentiation is
-    :func:`tmfem.reduced.kinematics.rotation_ef_sx`.
+    :func:`tmfem.models.com.kinematics.rotation_ef_sx`.
 
     Parameters
     ----------

@@ -29,7 +29,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import InputError, SlackMembrane
 from tmfem.fem.membrane import point_matrix
-from tmfem.reduced.constraints import ZetaLayout
+from tmfem.models.com.constraints import ZetaLayout
 
 
 @dataclass

@@ -85,7 +85,7 @@ def calibrate_on_bar_load(model, bar_load: float) -> float:
     that its stage-1 bar load equals ``bar_load`` (the one printed number B2 calibrates on,
     e.g. 14.48 N of Table 6.5). Solves the design-consistent state, sets
     :func:`scaled_consistent_rest_lengths` with k = bar_load / bar load found, returns k."""
-    from tmfem.fem.mtc_post import static_summary
+    from tmfem.models.mtc.post import static_summary
     st = static_summary(model, model.solve_static(start="design").x)
     k = float(bar_load / st["bar_load_by_stage"][0])
     model.set_rest_lengths(scaled_consistent_rest_lengths(model, k))

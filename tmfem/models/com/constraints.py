@@ -21,7 +21,7 @@ import casadi as ca
 import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.reduced.kinematics import bars_sx, rotation_ef_sx
+from tmfem.models.com.kinematics import bars_sx, rotation_ef_sx
 from tmfem.equilibrium.general import corner_state
 from tmfem.system.geometry import free_corner_components
 

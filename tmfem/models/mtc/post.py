@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.fem.mtc_topology import to_floating
+from tmfem.models.mtc.topology import to_floating
 from tmfem.fem.truss import truss_internal
 from tmfem.system.geometry import wrap_angle
 from tmfem.system.topology import label

@@ -8,7 +8,7 @@ internal nodes carrying its mass, reference length = rest length / k. The bar ba
 pinned (their three translations fixed) and nothing else is constrained: the top membrane
 floats on the bar tops, which are the membrane corners (``attachment="point"``), or the
 weighted centroids of small corner patches (``attachment="distributed"``, see
-:mod:`tmfem.fem.mtc_topology`).
+:mod:`tmfem.models.mtc.topology`).
 
 Statics (6.2) start from the *undeformed* membrane (flat, unstressed, placed in the plane of
 the design bar tops) and let the rest lengths pull the system into equilibrium. That start is
@@ -35,7 +35,7 @@ import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.membrane import MembraneTL
-from tmfem.fem.mtc_topology import MTCTopology, build_topology, membrane_placement
+from tmfem.models.mtc.topology import MTCTopology, build_topology, membrane_placement
 from tmfem.fem.truss import (TrussSet, green_rest_length, linear_rest_length, truss_energy,
                              truss_internal, truss_mass)
 from tmfem.system.topology import label
@@ -421,7 +421,7 @@ class MTCModel:
 
     def _state_note(self, xr) -> str:
         """Slack tendons and stretch of the membrane at independent positions xr, for errors."""
-        from tmfem.fem.mtc_post import member_state
+        from tmfem.models.mtc.post import member_state
         x = self.full(xr)
         slack = member_state(self, x)["tendon_slack"]
         names = [t.name for t, s_ in zip(self.system.tendons, slack) if s_]

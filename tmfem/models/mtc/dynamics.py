@@ -1,6 +1,6 @@
 """Free vibration of the membrane-truss-cable model about its equilibrium (dissertation 6.5).
 
-The MTC model of :mod:`tmfem.fem.mtc` is integrated in time with Park's method started by the
+The MTC model of :mod:`tmfem.models.mtc.model` is integrated in time with Park's method started by the
 trapezoidal rule (eqs. 5.34-5.35, :func:`tmfem.solvers.park.park_integrate`). The equation of
 motion on the free reduced DOFs is
 
@@ -26,11 +26,11 @@ floating frame and corner-deformation fields (eqs. 5.1-5.3) and the membrane mod
 at zero. Giving the corner alone a velocity would instead excite the mesh-scale modes around it.
 
 **Outputs per step** (:class:`MTCVibration`, CSV row by row): theta and psi of every bar
-(recovered from the bar vectors, :func:`tmfem.fem.mtc_post.q_from_positions`), the monitored bar
+(recovered from the bar vectors, :func:`tmfem.models.mtc.post.q_from_positions`), the monitored bar
 ends (``MONITOR_NODES``: B_12, B_14 for 1-4; A_21, B_11, B_21 for 2-3; Figs. 6.21-6.22,
 6.25-6.27), the membrane transverse deflections w_1..w_3 at the material points of eqs.
 5.36 / 5.38 (the ``MONITOR_POINTS`` of the COM, reference coordinates in O_f) measured along z_f
-of the floating frame of the current corners (eq. 3.3, :func:`tmfem.fem.mtc_topology.to_floating`),
+of the floating frame of the current corners (eq. 3.3, :func:`tmfem.models.mtc.topology.to_floating`),
 and the largest tendon transverse deflection: the internal nodes' offset from the chord in the
 local frame e_t1 (chord), e_t2 = e_t1 x e_z / |.|, e_t3 = e_t1 x e_t2 (eq. 5.37; Figs. 6.24,
 6.29), relative to its value at the equilibrium.
@@ -45,8 +45,8 @@ import scipy.sparse as sp
 
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
-from tmfem.fem.mtc_post import q_from_positions
-from tmfem.fem.mtc_topology import to_floating
+from tmfem.models.mtc.post import q_from_positions
+from tmfem.models.mtc.topology import to_floating
 from tmfem.fem.truss import truss_internal
 
 
@@ -149,7 +149,7 @@ def initial_state(dyn: MTCDynamics, perturb: dict | None, *, h: float = 1e-6):
     u0 = dyn.state0()
     if not perturb:
         return u0, np.zeros_like(u0)
-    from tmfem.reduced.simulate import split_perturbation
+    from tmfem.models.com.simulate import split_perturbation
     dq, dqd = split_perturbation(perturb, system.q_names)
     x_eq = model.full(dyn.xr_eq)
     q_e = q_from_positions(system, x_eq[:, topo.system_node])
@@ -270,8 +270,8 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
     csv_path, vtk_dir, vtk_every :
         Histories written row by row; ParaView frames every ``vtk_every`` steps.
     """
-    from tmfem.reduced.model import MONITOR_POINTS
-    from tmfem.reduced.simulate import MONITOR_NODES, RunOutputs
+    from tmfem.models.com.model import MONITOR_POINTS
+    from tmfem.models.com.simulate import MONITOR_NODES, RunOutputs
     if not (t_end > 0 and dt > 0):
         raise InputError(f"expected t_end > 0 and dt > 0, found t_end={t_end!r}, dt={dt!r}")
     system, topo = model.system, model.topology
@@ -318,7 +318,7 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
         out.tendon_forces(t, truss_internal(x, model.tendons, tangent=False).N, element_tendon)
         pos = x[:, lab_nodes]
         if out.frame_due():
-            from tmfem.fem.mtc_post import member_state, membrane_field
+            from tmfem.models.mtc.post import member_state, membrane_field
             ms = member_state(model, x)
             out.series.append_configuration(t, system, q=q, tendon_forces=ms["tendon_force"],
                                             rest_lengths=model.rest_lengths,

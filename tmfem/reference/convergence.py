@@ -6,8 +6,8 @@ import time
 
 import numpy as np
 
-from tmfem.fem.mtc import MTCModel
-from tmfem.fem.mtc_post import static_summary
+from tmfem.models.mtc.model import MTCModel
+from tmfem.models.mtc.post import static_summary
 
 ROW_KEYS = ("mesh_n", "tendon_elements", "attachment", "elements", "h", "dofs", "iterations",
             "static_s", "modal_s", "Delta_mm", "tendon_stress_max_MPa", "bar_load_max_N",

@@ -12,7 +12,7 @@ import sys
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.tables import FREQUENCIES, HIGHEST_COM_FREQUENCY
+from tmfem.reference.tables import FREQUENCIES, HIGHEST_COM_FREQUENCY
 
 # Numbers of membrane modes used by the dissertation (6.4.1, 6.4.2, 7.4).
 DISSERTATION_K = {"1-4": 5, "2-3": 4, "1-4D": 3, "1-6D": 5}
@@ -44,7 +44,7 @@ def printed_prestress_scale(model) -> float | None:
 def printed_bar_load_prestress_scale(model, *, mesh_n: int = 10) -> float | None:
     """Prestress factor implied by the printed stage-1 bar load (Table 6.3 ``bar_load``,
     Table 6.5 ``bar_load_stage1``): s = F_printed / F_design, the one-number calibration of
-    the MTC comparison (:func:`tmfem.fem.mtc_designs.calibrate_on_bar_load`) applied to the
+    the MTC comparison (:func:`tmfem.reference.designs.calibrate_on_bar_load`) applied to the
     COM's design. F_design is the largest stage-1 bar compression of
     :func:`tmfem.equilibrium.design.design_equilibrium`, whose tendon forces the COM's design
     reproduces (tests/test_com_2_3.py); all design loads scale with the prestress (3.2)."""
@@ -60,8 +60,8 @@ def printed_bar_load_prestress_scale(model, *, mesh_n: int = 10) -> float | None
 def com_frequencies(system, *, membrane_modes: int, prestress_scale: float = 1.0,
                     mesh_n: int = 10, rest_lengths=None):
     """(frequencies in Hz, model) of the COM linearised about its equilibrium (eq. 5.33)."""
-    from tmfem.reduced.linearize import linearize
-    from tmfem.reduced.model import ControlOrientedModel
+    from tmfem.models.com.linearize import linearize
+    from tmfem.models.com.model import ControlOrientedModel
     if rest_lengths is None:       # the system's own (e.g. printed) if it has them
         rest_lengths = "design" if system.rest_lengths is None else "system"
     m = ControlOrientedModel(system, membrane_modes=membrane_modes, mesh_n=mesh_n,

@@ -27,10 +27,10 @@ import numpy as np
 
 from tmfem.errors import InfeasibleDesign, InputError, SlackTendon
 from tmfem.fem.truss import linear_rest_length
-from tmfem.reduced.constraints import ConstraintSolver, ZetaLayout, phi_sx
-from tmfem.reduced.kinematics import (bar_kinetic_energy_sx, bars_sx, rotation_ef_sx,
+from tmfem.models.com.constraints import ConstraintSolver, ZetaLayout, phi_sx
+from tmfem.models.com.kinematics import (bar_kinetic_energy_sx, bars_sx, rotation_ef_sx,
                                       tendon_lengths_sx)
-from tmfem.reduced.membrane_modes import build_membrane_basis
+from tmfem.models.com.membrane_modes import build_membrane_basis
 from tmfem.system.geometry import rotation_ef
 
 # Monitored membrane points of 6.5 (eqs. 5.36 and 5.38), (x_f, y_f) in m.
@@ -147,7 +147,7 @@ class ControlOrientedModel:
         zs = ca.SX.sym("z", self.nz)
         zc = self._zeta_closed_form_sx(zs[: self.nq])
         w = ca.mtimes(ca.DM(self._Wout[:, 1:]), ca.vertcat(zc[: self.layout.n_delta], zs[self.nq:]))
-        from tmfem.reduced.kinematics import nodes_sx
+        from tmfem.models.com.kinematics import nodes_sx
         self._outfn = ca.Function("com_out", [zs], [ca.vertcat(w, tendon_lengths_sx(system, zs[: self.nq]),
                                                               ca.vec(nodes_sx(system, zs[: self.nq])))])
 
@@ -632,7 +632,7 @@ class ControlOrientedModel:
         """The nonlinear model (eq. 5.27) as a python-control ``NonlinearIOSystem``.
 
         State x = [z, z'], input u = rest lengths (absolute, m), output y = [q, w at the
-        output points]; the same signal names as :func:`tmfem.reduced.linearize.linearize`.
+        output points]; the same signal names as :func:`tmfem.models.com.linearize.linearize`.
         """
         import control
         nz = self.nz
