@@ -37,6 +37,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
+from tmfem.fem.assembly import Assembler, element_dofs
 from tmfem.mesh.polygon import MembraneMesh
 from tmfem.system.materials import MembraneMaterial
 
@@ -184,7 +185,6 @@ class MembraneTL:
         sb = Basis(self.skmesh, ElementQuad1(), intorder=3)
         self._dN = np.stack([np.array(sb.basis[k][0].grad) for k in range(4)])  # (4, 2, ne, nqp)
         self._dx = np.array(sb.dx)                                              # (ne, nqp)
-        from tmfem.fem.assembly import Assembler, element_dofs
         self._asm = Assembler(element_dofs(self.skmesh.t, 3), self.ndof)
         if not np.array_equal(np.asarray(self.skmesh.t), np.asarray(mesh.t)):
             raise RuntimeError("scikit-fem reordered the quadrilateral connectivity")
@@ -227,18 +227,26 @@ class MembraneTL:
     def internal(self, x, *, tangent: bool = True):
         """Internal nodal forces f (3 nn,) and tangent K (csr) at current positions x (3, nn).
 
-        Eq. 4.4-4.6: f = F (element stresses), K = K_L + K_NL. Vectorised B-matrix kernel:
-        the variation of the Green-Lagrange strain of node k, component i is (Voigt)
-        B = [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1].
+        Eq. 4.4-4.6: f = F (element stresses), K = K_L + K_NL, assembled from
+        :meth:`element_arrays` on the membrane's own nodes (dof = 3 node + component).
+        """
+        fe, Ke = self.element_arrays(x, tangent=tangent)
+        return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
+
+    def element_arrays(self, x, *, tangent: bool = True):
+        """Element internal forces fe (ne, 12) and tangents Ke (ne, 12, 12) (or None) at
+        current positions x (3, nn), local dofs node-major (3 per node).
+
+        Vectorised B-matrix kernel of eqs. 4.4-4.6: the variation of the Green-Lagrange strain
+        of node k, component i is (Voigt) B = [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1].
         """
         F, _, S = self.kinematics(x)
         h = self.material.h
         dN, dx = self._dN, self._dx
         P = h * np.einsum("ia...,ab...->ib...", F, S)                 # (3, 2, ne, nqp)
         fe = np.einsum("ibeq,kbeq,eq->eki", P, dN, dx).reshape(-1, 12)
-        f = self._asm.vector(fe)
         if not tangent:
-            return f, None
+            return fe, None
         B = np.empty((4, 3, 3) + dx.shape)
         B[:, :, 0] = F[None, :, 0] * dN[:, None, 0]
         B[:, :, 1] = F[None, :, 1] * dN[:, None, 1]
@@ -251,8 +259,7 @@ class MembraneTL:
         # initial-stress part: delta_ij N_k,a S_ab N_l,b
         g = np.einsum("kaeq,abeq,lbeq,eq->ekl", dN, S, dN, hdx, optimize=True)
         Km += g[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
-        K = self._asm.matrix(Km.reshape(-1, 12, 12))
-        return f, K
+        return fe, Km.reshape(-1, 12, 12)
 
     def internal_forms(self, x, *, tangent: bool = True):
         """Same as :meth:`internal`, assembled with the scikit-fem forms (reference)."""
@@ -308,3 +315,36 @@ class MembraneTL:
         return MembraneStresses(S=np.stack([S[0, 0], S[1, 1], S[0, 1]]),
                                 cauchy=np.stack([s11, s22, s12]),
                                 principal=principal, von_mises=vm, points=points)
+
+
+class MembraneElement:
+    """A :class:`MembraneTL` behind the element interface of :mod:`tmfem.fem.element`: its
+    mesh nodes are the global nodes ``nodes`` of ``dofmap`` (their translations)."""
+
+    def __init__(self, membrane: MembraneTL, nodes, dofmap):
+        nodes = np.asarray(nodes, dtype=np.int64)
+        if nodes.shape != (membrane.nn,):
+            raise InputError(f"membrane element: expected {membrane.nn} global nodes, found "
+                             f"{nodes.shape}")
+        self.membrane, self.nodes, self.dofmap = membrane, nodes, dofmap
+        t = np.asarray(membrane.skmesh.t)
+        self._asm = Assembler(dofmap.element_dofs(nodes[t]), dofmap.ndof)
+        self._M = None
+
+    def internal(self, state, *, tangent: bool = True):
+        """Internal force and tangent of eqs. 4.4-4.6 in the global numbering."""
+        fe, Ke = self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent)
+        return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
+
+    def energy(self, state) -> float:
+        """Strain energy (:meth:`MembraneTL.strain_energy`)."""
+        return self.membrane.strain_energy(state.x[:, self.nodes])
+
+    def mass(self) -> sp.csr_matrix:
+        """Consistent mass (:meth:`MembraneTL.mass`) on the global dofs."""
+        if self._M is None:
+            g = self.dofmap.translation_dofs(self.nodes).ravel()
+            P = sp.csr_matrix((np.ones(g.size), (g, np.arange(g.size))),
+                              shape=(self.dofmap.ndof, g.size))
+            self._M = (P @ self.membrane.mass() @ P.T).tocsr()
+        return self._M

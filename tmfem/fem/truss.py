@@ -26,7 +26,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
-from tmfem.fem.assembly import Assembler, element_dofs
+from tmfem.fem.assembly import Assembler
+from tmfem.fem.dofmap import DofMap
 
 
 @dataclass
@@ -79,13 +80,17 @@ class TrussSet:
     def ne(self) -> int:
         return self.conn.shape[1]
 
-    def assembler(self, nn: int) -> Assembler:
-        """Cached sparse assembler for ``nn`` nodes (3 nn dofs)."""
-        a = self._assemblers.get(nn)
+    def assembler(self, dofmap: DofMap) -> Assembler:
+        """Sparse assembler on the translations of ``dofmap``, cached by dof layout."""
+        key = dofmap.counts.tobytes()
+        a = self._assemblers.get(key)
         if a is None:
-            if self.ne and self.conn.max() >= nn:
-                raise InputError(f"truss: expected node indices < {nn}, found {self.conn.max()}")
-            a = self._assemblers[nn] = Assembler(element_dofs(self.conn, 3), 3 * nn)
+            if self.ne and self.conn.max() >= dofmap.n_nodes:
+                raise InputError(f"truss: expected node indices < {dofmap.n_nodes}, found "
+                                 f"{self.conn.max()}")
+            if len(self._assemblers) >= 8:
+                self._assemblers.pop(next(iter(self._assemblers)))
+            a = self._assemblers[key] = Assembler(dofmap.element_dofs(self.conn), dofmap.ndof)
         return a
 
 
@@ -93,7 +98,7 @@ class TrussSet:
 class TrussResponse:
     """Internal force vector, tangent and member state of a :class:`TrussSet`.
 
-    f : (3 nn,) internal nodal forces; K : csr (3 nn, 3 nn) tangent; N : (ne,) true axial
+    f : (ndof,) internal nodal forces; K : csr (ndof, ndof) tangent; N : (ne,) true axial
     force (tension positive); strain : (ne,) Green-Lagrange strain w.r.t. L;
     slack : (ne,) True for tension-only members with strain <= 0; length : (ne,) current l.
     """
@@ -106,7 +111,8 @@ class TrussResponse:
     length: np.ndarray
 
 
-def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True) -> TrussResponse:
+def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True,
+                   dofmap: DofMap | None = None) -> TrussResponse:
     """Total-Lagrangian internal force and tangent of all truss elements (eqs. 4.4-4.7, 4.23-4.24).
 
     Parameters
@@ -116,12 +122,13 @@ def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True) ->
     trusses : TrussSet
     tangent : bool
         If False, ``K`` is None (residual only, e.g. inside a line search).
+    dofmap : DofMap, optional
+        Global dof numbering (default: three translations per node, dof = 3 node + component).
     """
     x = np.asarray(x, dtype=float)
     if x.ndim != 2 or x.shape[0] != 3:
         raise InputError(f"truss: expected positions of shape (3, nn), found {x.shape}")
-    nn = x.shape[1]
-    asm = trusses.assembler(nn)
+    asm = trusses.assembler(dofmap or DofMap.translations(x.shape[1]))
     d = x[:, trusses.conn[1]] - x[:, trusses.conn[0]]          # (3, ne)
     l2 = np.einsum("ie,ie->e", d, d)
     L = trusses.L
@@ -159,19 +166,45 @@ def truss_energy(x: np.ndarray, trusses: TrussSet) -> float:
     return 0.5 * float(np.sum(trusses.EA * L * E**2))
 
 
-def truss_mass(trusses: TrussSet, nn: int, *, lumped: bool = False) -> sp.csr_matrix:
-    """Mass matrix of the truss elements, total mass rho A L per element.
+def truss_mass(trusses: TrussSet, nn: int | DofMap, *, lumped: bool = False) -> sp.csr_matrix:
+    """Mass matrix of the truss elements, total mass rho A L per element, on ``nn``
+    translational nodes or on the translations of a :class:`DofMap`.
 
     Consistent (eq. 4.6 with the shape functions of eq. 4.24): (rho A L / 6) [[2I, I], [I, 2I]];
     lumped: (rho A L / 2) I at each end.
     """
-    asm = trusses.assembler(nn)
+    asm = trusses.assembler(nn if isinstance(nn, DofMap) else DofMap.translations(nn))
     m = trusses.rhoA * trusses.L
     if lumped:
         pattern = np.kron(np.eye(2), np.eye(3)) / 2.0
     else:
         pattern = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3)) / 6.0
     return asm.matrix(m[:, None, None] * pattern[None])
+
+
+class TrussElement:
+    """A :class:`TrussSet` behind the element interface of :mod:`tmfem.fem.element`, on the
+    translations of ``dofmap`` (its nodes may carry rotations too: a truss ignores them)."""
+
+    def __init__(self, trusses: TrussSet, dofmap: DofMap, *, lumped_mass: bool = False):
+        self.trusses, self.dofmap, self.lumped_mass = trusses, dofmap, lumped_mass
+
+    def response(self, state, *, tangent: bool = True) -> TrussResponse:
+        """Forces, tangent and member state (axial forces, strains, slack) at ``state``."""
+        return truss_internal(state.x, self.trusses, tangent=tangent, dofmap=self.dofmap)
+
+    def internal(self, state, *, tangent: bool = True):
+        """Internal force and tangent of eqs. 4.4-4.7 in the global numbering."""
+        r = self.response(state, tangent=tangent)
+        return r.f, r.K
+
+    def energy(self, state) -> float:
+        """Strain energy (:func:`truss_energy`)."""
+        return truss_energy(state.x, self.trusses)
+
+    def mass(self) -> sp.csr_matrix:
+        """Consistent or lumped mass (:func:`truss_mass`)."""
+        return truss_mass(self.trusses, self.dofmap, lumped=self.lumped_mass)
 
 
 def green_rest_length(length, tension, EA):

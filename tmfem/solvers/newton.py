@@ -40,6 +40,22 @@ def _sub(K, idx):
     return np.asarray(K)[np.ix_(idx, idx)]
 
 
+def _advance(u, idx, du, n: int, update):
+    """The iterate after the increment ``du`` on the free dofs ``idx``: ``u + du`` (additive
+    unknowns), or ``update(u, du_full)`` for unknowns that do not add (finite rotations)."""
+    if update is None:
+        ut = u.copy()
+        ut[idx] += du
+        return ut
+    full = np.zeros(n)
+    full[idx] = du
+    return update(u, full)
+
+
+def _copy(u, update):
+    return np.array(u, dtype=float, copy=True) if update is None else u
+
+
 def _fail(message, *, step=None, history=(), load_factor=None, u=None):
     err = ConvergenceError(message)
     err.step = step
@@ -66,7 +82,8 @@ class NewtonResult:
 def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float = 0.0,
            scale: float | None = None, max_iter: int = 50, line_search: bool = True,
            backend=None, callback: Callable | None = None, load_factor: float | None = None,
-           step: int | None = None, floor_factor: float = 100.0, max_stall: int = 5) -> NewtonResult:
+           step: int | None = None, floor_factor: float = 100.0, max_stall: int = 5,
+           update: Callable | None = None) -> NewtonResult:
     """Newton-Raphson iteration K du = -r on the free dofs, with backtracking line search.
 
     Parameters
@@ -93,6 +110,10 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         such iterations in a row raise ``ConvergenceError`` (stalled).
     load_factor, step : optional
         Only reported in a :class:`ConvergenceError`.
+    update : callable, optional
+        ``update(u, du) -> u_new`` for unknowns that are not a vector to add to: ``u`` is then
+        any object (e.g. a :class:`tmfem.fem.element.State` with finite rotations) and ``du``
+        the full increment (zero at fixed dofs). Default: ``u + du``.
 
     Raises
     ------
@@ -101,11 +122,11 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         when the residual is not finite, the tangent is singular or ``max_iter`` is exceeded.
     """
     be = get_backend(backend)
-    u = np.array(u0, dtype=float, copy=True)
-    n = u.size
-    idx = free_index(free, n)
+    u = _copy(u0, update)
     r, K = residual(u)
     r = np.asarray(r, dtype=float)
+    n = r.size
+    idx = free_index(free, n)
     rn = float(np.linalg.norm(r[idx]))
     history = [rn]
     where = (f" (load step {step}, load factor {load_factor:g})" if load_factor is not None
@@ -130,8 +151,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         du = -solve(r[idx])
         alpha, best = 1.0, None
         while True:
-            ut = u.copy()
-            ut[idx] += alpha * du
+            ut = _advance(u, idx, alpha * du, n, update)
             rt, Kt = residual(ut)
             rt = np.asarray(rt, dtype=float)
             rnt = float(np.linalg.norm(rt[idx]))
@@ -185,13 +205,14 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
                   dlam_min: float = 1e-4, tol: float = 1e-9, atol: float = 0.0,
                   scale: float | None = None, max_iter: int = 25, target_iter: int = 6,
                   line_search: bool = True, backend=None, store: bool = True,
-                  callback: Callable | None = None) -> LoadPath:
+                  callback: Callable | None = None, update: Callable | None = None) -> LoadPath:
     """Adaptive load stepping from load factor 0 to 1 with Newton at each step.
 
     ``residual_lam(u, lam) -> (r, K)``. A step whose Newton solve fails is retried with half the
     increment; an easy step (fewer than ``target_iter`` iterations) lets the next grow by 1.5.
     The Newton tolerance is relative to ``scale`` (default: the residual norm of the first
-    evaluation at lam = dlam0, i.e. of the first load increment).
+    evaluation at lam = dlam0, i.e. of the first load increment). ``update`` as in
+    :func:`newton` (then ``LoadPath.u`` is a list of the states).
 
     Raises
     ------
@@ -199,12 +220,12 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
         When the increment falls below ``dlam_min``; carries the step, the residual history
         of the last failure and the load factor that could not be reached.
     """
-    u = np.array(u0, dtype=float, copy=True)
-    idx = free_index(free, u.size)
+    u = _copy(u0, update)
     lam, dlam = 0.0, min(float(dlam0), 1.0)
-    lams, us, its = [0.0], [u.copy()] if store else [], []
+    lams, us, its = [0.0], [_copy(u, update)] if store else [], []
+    r1 = residual_lam(u, dlam)[0] if (scale is None or update is not None) else None
+    idx = free_index(free, u.size if update is None else np.asarray(r1).size)
     if scale is None:
-        r1, _ = residual_lam(u, dlam)
         r0, _ = residual_lam(u, 0.0)
         scale = max(float(np.linalg.norm(np.asarray(r1)[idx])), float(np.linalg.norm(np.asarray(r0)[idx])))
         if scale == 0.0:
@@ -217,7 +238,7 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
         try:
             res = newton(lambda v: residual_lam(v, target), u, free=idx, tol=tol, atol=atol,
                          scale=scale, max_iter=max_iter, line_search=line_search, backend=backend,
-                         load_factor=target, step=step)
+                         load_factor=target, step=step, update=update)
         except ConvergenceError as exc:
             rejected += 1
             dlam *= 0.5
@@ -230,11 +251,14 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
         lams.append(lam)
         its.append(res.iterations)
         if store:
-            us.append(u.copy())
+            us.append(_copy(u, update))
         if callback is not None:
             callback(lam, u)
         if res.iterations < target_iter:
             dlam *= 1.5
+    if update is not None:
+        return LoadPath(lam=np.array(lams), u=us if store else [u], iterations=its, last=last,
+                        rejected=rejected)
     return LoadPath(lam=np.array(lams), u=np.array(us) if store else u[None], iterations=its,
                     last=last, rejected=rejected)
 
@@ -242,7 +266,7 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
 def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: int = 100,
                lam_max: float | None = None, stop: Callable | None = None, tol: float = 1e-9,
                max_iter: int = 25, target_iter: int = 5, dl_min: float | None = None,
-               dl_max: float | None = None, backend=None) -> LoadPath:
+               dl_max: float | None = None, backend=None, update: Callable | None = None) -> LoadPath:
     """Crisfield's cylindrical arc-length method: f_int(u) = lam f_ext with ||Delta u|| = dl.
 
     Parameters
@@ -273,9 +297,10 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
     LoadPath with ``lam`` (m,) and ``u`` (m, n), the starting state included.
     """
     be = get_backend(backend)
-    u = np.array(u0, dtype=float, copy=True)
+    u = _copy(u0, update)
     f_ext = np.asarray(f_ext, dtype=float)
-    idx = free_index(free, u.size)
+    n = f_ext.size
+    idx = free_index(free, n)
     q = f_ext[idx]
     qn = float(np.linalg.norm(q))
     if qn == 0.0:
@@ -283,7 +308,7 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
     dl_min = dl * 1e-4 if dl_min is None else dl_min
     dl_max = dl * 10 if dl_max is None else dl_max
     lam = 0.0
-    lams, us, its = [lam], [u.copy()], []
+    lams, us, its = [lam], [_copy(u, update)], []
     fint, K = internal(u)
     prev = None            # previous converged increment (du, dlam)
     rejected = 0
@@ -301,8 +326,7 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
                 history = []
                 ok = False
                 for it in range(1, max_iter + 1):
-                    ut = u.copy()
-                    ut[idx] += Du
+                    ut = _advance(u, idx, Du, n, update)
                     fi, Kt = internal(ut)
                     r = fi[idx] - (lam + Dlam) * q
                     rn = float(np.linalg.norm(r))
@@ -342,9 +366,10 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
         K = Kt
         prev = (Du, Dlam)
         lams.append(lam)
-        us.append(u.copy())
+        us.append(_copy(u, update))
         its.append(it)
         dl = float(np.clip(dl * np.sqrt(target_iter / max(it, 1)), dl_min, dl_max))
         if (lam_max is not None and lam >= lam_max) or (stop is not None and stop(u, lam)):
             break
-    return LoadPath(lam=np.array(lams), u=np.array(us), iterations=its, rejected=rejected)
+    return LoadPath(lam=np.array(lams), u=np.array(us) if update is None else us, iterations=its,
+                    rejected=rejected)

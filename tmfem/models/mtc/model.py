@@ -34,10 +34,11 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
-from tmfem.fem.membrane import MembraneTL
+from tmfem.fem.element import State, assemble
+from tmfem.fem.membrane import MembraneElement, MembraneTL
 from tmfem.models.mtc.topology import MTCTopology, build_topology, membrane_placement
-from tmfem.fem.truss import (TrussSet, green_rest_length, linear_rest_length, truss_energy,
-                             truss_internal, truss_mass)
+from tmfem.fem.truss import (TrussElement, TrussSet, green_rest_length, linear_rest_length,
+                             truss_internal)
 from tmfem.system.topology import label
 
 
@@ -104,6 +105,7 @@ class MTCModel:
                                                     attachment=attachment, patch=patch)
         topo = self.topology
         self.membrane = MembraneTL(mesh=topo.mesh, material=system.membrane)
+        self.membrane_element = MembraneElement(self.membrane, np.arange(topo.n_mesh), topo.dofmap)
         bar = system.bar
         nb = system.M * system.N
         self.bars = TrussSet(conn=topo.bar_conn, L=system.l.ravel().copy(),
@@ -115,10 +117,8 @@ class MTCModel:
         self.tendon_rhoA = np.array([(s.rho or 0.0) * s.area for s in secs])
         self.tendon_yield = np.array([s.yield_stress if s.yield_stress else np.nan for s in secs])
         self.lumped_tendon_mass = lumped_tendon_mass
-        free = np.ones(3 * topo.n_red, dtype=bool)
-        for n in topo.fixed_nodes:
-            free[3 * topo.red_node[n]: 3 * topo.red_node[n] + 3] = False
-        self.free = free
+        self.bar_element = TrussElement(self.bars, topo.dofmap)
+        self.free = topo.constraints.free
         self._M = None
         self.rest_lengths_source = None
         if rest_lengths is None:
@@ -159,7 +159,14 @@ class MTCModel:
         e = self.topology.tendon_of_element
         self.tendons = TrussSet(conn=self.topology.tendon_conn, L=r[e] / k, EA=self.tendon_EA[e],
                                 rhoA=self.tendon_rhoA[e], tension_only=np.ones(e.size, dtype=bool))
+        self.tendon_element = TrussElement(self.tendons, self.topology.dofmap,
+                                           lumped_mass=self.lumped_tendon_mass)
         self._M = None
+
+    @property
+    def elements(self) -> list:
+        """The element sets of the model (membrane, bars, tendons) on ``topology.dofmap``."""
+        return [self.membrane_element, self.bar_element, self.tendon_element]
 
     def _design_rest_lengths(self) -> np.ndarray:
         """Rest lengths of the ch. 3 design (eqs. 3.8-3.9) on this model's membrane mesh and
@@ -248,37 +255,19 @@ class MTCModel:
     # ------------------------------------------------------------------ operators
     def internal_full(self, x: np.ndarray, *, tangent: bool = True):
         """Internal force (3 n_nodes,) and tangent of the full model at positions x (3, n_nodes)."""
-        nm = self.topology.n_mesh
-        fm, Km = self.membrane.internal(x[:, :nm], tangent=tangent)
-        tb = truss_internal(x, self.bars, tangent=tangent)
-        tt = truss_internal(x, self.tendons, tangent=tangent)
-        n = 3 * self.n_nodes
-        f = tb.f + tt.f
-        f[:3 * nm] += fm
-        K = None
-        if tangent:
-            K = _pad(Km, n) + tb.K + tt.K
-        return f, K
+        return assemble(self.elements, State(x=x), tangent=tangent)
 
     def residual(self, xr: np.ndarray, *, tangent: bool = True):
         """Reduced internal force T^T f and tangent T^T K T at independent positions xr."""
-        T = self.topology.T
+        c = self.topology.constraints
         f, K = self.internal_full(self.full(xr), tangent=tangent)
-        r = T.T @ f
-        if not tangent:
-            return r, None
-        return r, (T.T @ K @ T).tocsr()
+        return c.residual(f), (c.tangent(K) if tangent else None)
 
     def mass(self) -> sp.csr_matrix:
         """Reduced mass matrix T^T M T (membrane consistent, bars consistent, tendons
         consistent or lumped)."""
         if self._M is None:
-            n = 3 * self.n_nodes
-            Mm = _pad(self.membrane.mass(), n)
-            M = Mm + truss_mass(self.bars, self.n_nodes) \
-                + truss_mass(self.tendons, self.n_nodes, lumped=self.lumped_tendon_mass)
-            T = self.topology.T
-            self._M = (T.T @ M @ T).tocsr()
+            self._M = self.topology.constraints.tangent(sum(e.mass() for e in self.elements))
         return self._M
 
     def energy(self, xr: np.ndarray) -> float:
@@ -287,9 +276,8 @@ class MTCModel:
         Truss: EA L E^2 / 2 (zero when a tendon is slack); membrane: h int (lam tr(E)^2 / 2
         + mu E:E) dA (plane-stress St.Venant-Kirchhoff, the potential of eq. 4.9).
         """
-        x = self.full(xr)
-        return (truss_energy(x, self.bars) + truss_energy(x, self.tendons)
-                + self.membrane.strain_energy(x[:, :self.topology.n_mesh]))
+        state = State(x=self.full(xr))
+        return sum(e.energy(state) for e in self.elements)
 
     # ------------------------------------------------------------------ statics
     def solve_static(self, *, start: str = "undeformed", x0: np.ndarray | None = None,
@@ -569,11 +557,3 @@ def _solve_symmetric(A, b) -> np.ndarray:
         return get_backend().factorize(A)(b)
     except SingularMatrix:
         return np.full(b.shape, np.nan)
-
-
-def _pad(K: sp.csr_matrix, n: int) -> sp.csr_matrix:
-    """A square csr matrix K embedded in the top-left corner of an n x n one."""
-    K = K.tocsr()
-    m = K.shape[0]
-    indptr = np.concatenate([K.indptr, np.full(n - m, K.indptr[-1])])
-    return sp.csr_matrix((K.data, K.indices, indptr), shape=(n, n))

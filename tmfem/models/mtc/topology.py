@@ -23,6 +23,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
+from tmfem.fem.constraints import ConstraintMap
+from tmfem.fem.dofmap import DofMap
 from tmfem.fem.attachment import attachment_weights, default_patch_radius
 from tmfem.mesh.polygon import MembraneMesh, polygon_quad_mesh
 from tmfem.system.geometry import floating_frame
@@ -52,6 +54,10 @@ class MTCTopology:
         The bar bases A_1j (pinned).
     top_nodes : ndarray (N,)
         The dependent bar-top nodes B_Mj.
+    dofmap : DofMap
+        Three translational dofs per node (dof = 3 node + component).
+    constraints : ConstraintMap
+        The attachment (dependent B_Mj) and the pinned bases; ``T = constraints.T``.
     T : csr (3 n_nodes, 3 n_red)
         Full positions from independent ones, ``x_full = T x_red``.
     red_node : ndarray (n_nodes,)
@@ -70,6 +76,8 @@ class MTCTopology:
     tendon_internal: np.ndarray
     fixed_nodes: np.ndarray
     top_nodes: np.ndarray
+    dofmap: DofMap
+    constraints: ConstraintMap
     T: sp.csr_matrix
     red_node: np.ndarray
     weights: list
@@ -125,25 +133,19 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
         patch = default_patch_radius(system.membrane_corners, system.r_mb)
     weights = attachment_weights(mesh, attachment=attachment, patch=patch)
 
+    dofmap = DofMap.translations(n_nodes)
+    constraints = ConstraintMap.build(dofmap, dependent=[(top_nodes[j], nodes, w)
+                                                         for j, (nodes, w) in enumerate(weights)],
+                                      fixed_nodes=fixed_nodes)
     dependent = np.zeros(n_nodes, dtype=bool)
     dependent[top_nodes] = True
     red_node = np.full(n_nodes, -1, dtype=np.int64)
     red_node[~dependent] = np.arange(n_nodes - N)
-    # node-level map: rows = full nodes, cols = independent nodes
-    rows = [np.flatnonzero(~dependent)]
-    cols = [red_node[~dependent]]
-    vals = [np.ones(n_nodes - N)]
-    for j, (nodes, w) in enumerate(weights):
-        rows.append(np.full(nodes.size, top_nodes[j]))
-        cols.append(red_node[nodes])
-        vals.append(w)
-    Tn = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                       shape=(n_nodes, n_nodes - N))
-    T = sp.kron(Tn, sp.identity(3), format="csr")               # node-interleaved dofs
     return MTCTopology(mesh=mesh, n_mesh=nm, n_nodes=n_nodes, system_node=system_node,
                        bar_conn=bar_conn, tendon_conn=tendon_conn,
                        tendon_of_element=tendon_of_element, tendon_internal=internal,
-                       fixed_nodes=fixed_nodes, top_nodes=top_nodes, T=T, red_node=red_node,
+                       fixed_nodes=fixed_nodes, top_nodes=top_nodes, dofmap=dofmap,
+                       constraints=constraints, T=constraints.T, red_node=red_node,
                        weights=weights, tendon_elements=k, attachment=attachment)
 
 

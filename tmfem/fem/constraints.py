@@ -1,0 +1,108 @@
+"""Linear multi-point constraints on a dof map: dependent translations and fixed dofs.
+
+The independent (reduced) unknowns u_r map to all dofs by ``u = T u_r``. A *dependent* node
+has translations that are a fixed weighted average of other nodes' translations (a point
+attachment: one master of weight 1; a distributed one: the weights of an RBE3-type patch;
+a pinned connection between a shell corner and a bar top: the bar top's translations
+follow the corner, its rotations stay its own). Forces map back by ``T^T f`` and tangents by
+``T^T K T`` (the constraint adds no stiffness). Fixed dofs are removed by the ``free`` mask
+on the reduced dofs.
+"""
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.errors import InputError
+from tmfem.fem.dofmap import DofMap
+
+
+class ConstraintMap:
+    """``u = T u_r`` with dependent translations; fixed dofs in ``free`` (module docstring).
+
+    Build with :meth:`build`. Attributes: ``T`` (csr, ndof x n_red), ``free`` (bool, n_red),
+    ``reduced_of`` (int, ndof: the reduced dof of each independent dof, -1 at dependent ones).
+    """
+
+    def __init__(self, T: sp.csr_matrix, free: np.ndarray, reduced_of: np.ndarray):
+        self.T = T.tocsr()
+        self.free = np.asarray(free, dtype=bool)
+        self.reduced_of = reduced_of
+
+    @classmethod
+    def build(cls, dofmap: DofMap, *, dependent: Sequence[tuple[int, np.ndarray, np.ndarray]] = (),
+              fixed_nodes=(), fixed_dofs=()) -> "ConstraintMap":
+        """Constraint map of ``dofmap``.
+
+        Parameters
+        ----------
+        dependent : sequence of (node, masters, weights)
+            The translations of ``node`` are ``sum_i weights[i] x[masters[i]]``; weights
+            should sum to 1 for the map to carry positions as well as increments.
+        fixed_nodes : array_like of int
+            Nodes whose translations are fixed (pinned).
+        fixed_dofs : array_like of int
+            Further fixed dofs (full numbering).
+        """
+        n = dofmap.ndof
+        dep_nodes = np.array([d[0] for d in dependent], dtype=np.int64)
+        if np.unique(dep_nodes).size != dep_nodes.size:
+            raise InputError("constraints: expected each dependent node once, found repeats")
+        dep_dofs = dofmap.translation_dofs(dep_nodes).ravel() if dep_nodes.size else np.zeros(0, np.int64)
+        independent = np.ones(n, dtype=bool)
+        independent[dep_dofs] = False
+        reduced_of = np.full(n, -1, dtype=np.int64)
+        reduced_of[independent] = np.arange(int(independent.sum()))
+        rows = [np.flatnonzero(independent)]
+        cols = [reduced_of[independent]]
+        vals = [np.ones(int(independent.sum()))]
+        for node, masters, w in dependent:
+            masters = np.asarray(masters, dtype=np.int64)
+            w = np.asarray(w, dtype=float)
+            if masters.shape != w.shape or masters.size == 0:
+                raise InputError(f"constraints: node {node}: expected as many weights as masters "
+                                 f"(>= 1), found {masters.size} masters and {w.size} weights")
+            if np.isin(masters, dep_nodes).any():
+                raise InputError(f"constraints: node {node}: a master is itself dependent")
+            md = dofmap.translation_dofs(masters)                    # (m, 3)
+            nd = dofmap.translation_dofs([node])[0]                  # (3,)
+            rows.append(np.repeat(nd[None, :], masters.size, axis=0).ravel())
+            cols.append(reduced_of[md].ravel())
+            vals.append(np.repeat(w, 3))
+        T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(n, int(independent.sum())))
+        fixed = list(np.asarray(fixed_dofs, dtype=np.int64).ravel())
+        fn = np.asarray(fixed_nodes, dtype=np.int64).ravel()
+        if fn.size:
+            fixed += list(dofmap.translation_dofs(fn).ravel())
+        fixed = np.asarray(fixed, dtype=np.int64)
+        if fixed.size and np.any(reduced_of[fixed] < 0):
+            raise InputError("constraints: a fixed dof belongs to a dependent node (fix its masters)")
+        free = np.ones(T.shape[1], dtype=bool)
+        free[reduced_of[fixed]] = False
+        return cls(T, free, reduced_of)
+
+    @property
+    def n_reduced(self) -> int:
+        return int(self.T.shape[1])
+
+    def full(self, u_r: np.ndarray) -> np.ndarray:
+        """All dofs (ndof,) from the reduced ones."""
+        return self.T @ u_r
+
+    def reduce(self, u: np.ndarray) -> np.ndarray:
+        """Reduced dofs of a full vector that satisfies the constraints (its independent entries)."""
+        keep = self.reduced_of >= 0
+        out = np.empty(self.n_reduced)
+        out[self.reduced_of[keep]] = np.asarray(u)[keep]
+        return out
+
+    def residual(self, f: np.ndarray) -> np.ndarray:
+        """Reduced force T^T f."""
+        return self.T.T @ f
+
+    def tangent(self, K: sp.spmatrix) -> sp.csr_matrix:
+        """Reduced tangent T^T K T."""
+        return (self.T.T @ K @ self.T).tocsr()
