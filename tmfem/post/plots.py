@@ -167,3 +167,25 @@ def plot_table_comparison(png, names, computed, printed, *, ylabel: str,
     ax.legend(fontsize=8)
     ax.grid(True, axis="y", alpha=0.3)
     return _save(fig, png)
+
+
+def plot_xy(png, curves: dict, *, xlabel: str, ylabel: str, title: str | None = None) -> Path:
+    """Plot curves ``{label: (x, y)}`` on one axes with a legend (load-displacement paths,
+    benchmark results against their references)."""
+    png = check_path(png, suffixes=(".png",))
+    if not curves:
+        raise InputError("curves: expected at least one (x, y) curve")
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    styles = ["-", "--", ":", "-."]
+    for k, (label, (x, y)) in enumerate(curves.items()):
+        x = _finite_1d(f"{label!r} x", x)
+        ax.plot(x, _finite_1d(f"{label!r} y", y, x.size), styles[k % 4], lw=1.4, label=label,
+                marker="o" if x.size < 30 else None, ms=3)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title)
+    ax.legend(fontsize=8)
+    ax.grid(True, alpha=0.3)
+    return _save(fig, png)
