@@ -14,9 +14,9 @@ import numpy as np
 
 from tmfem.errors import TmfemError
 from tmfem.models.com.linearize import linearize
-from tmfem.models.com.modal import default_membrane_modes
+from tmfem.models.com.model import default_membrane_modes
 from tmfem.models.com.model import ControlOrientedModel
-from tmfem.models.com.simulate import free_vibration
+from tmfem.simulation.vibration import free_vibration
 from tmfem.system import load_preset
 
 PERTURB = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}

@@ -13,9 +13,10 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import TmfemError
-from tmfem.models.com.modal import default_membrane_modes
+from tmfem.models.com.model import default_membrane_modes
 from tmfem.models.com.model import ControlOrientedModel
-from tmfem.models.com.simulate import free_vibration, plot_free_vibration
+from tmfem.post.plots import plot_free_vibration
+from tmfem.simulation.vibration import free_vibration
 from tmfem.system import load_preset
 
 CASES = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}
@@ -37,7 +38,7 @@ def main():
             print(f"{name}: cannot build the COM: {exc}")
             continue
         res = free_vibration(m, t_end=a.t_end, dt=0.01, perturb=pert, csv_path=out / f"{name}.csv",
-                             jacobian="reuse", progress=True)
+                             jacobian="reuse")
         png = plot_free_vibration(res, out / f"{name}.png", title=f"{name} COM, K = {K}, {pert}")
         print(f"{name}: {res.stats['steps']} steps in {res.wall_time:.2f} s; max |w| = "
               + ", ".join(f"{1e3 * v:.3f}" for v in np.max(np.abs(res.w), axis=0)) + " mm; "

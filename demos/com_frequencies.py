@@ -15,8 +15,8 @@ import argparse
 
 from tmfem.errors import TmfemError
 from tmfem.reference.tables import HIGHEST_COM_FREQUENCY
-from tmfem.models.com.modal import (default_membrane_modes,
-                                 dissertation_com_frequencies, frequency_study, modal_summary)
+from tmfem.models.com.model import default_membrane_modes
+from tmfem.reference.com_modal import (                                 dissertation_com_frequencies, frequency_study, modal_summary)
 from tmfem.system import load_preset
 
 
@@ -80,8 +80,7 @@ def table(name: str, k_study, plot_dir=None) -> None:
           + (f", printed-load {r3['highest_hz']:.4f}" if r3 else ""))
     if k_study:
         print(f"\nfrequencies [Hz] vs K ({name})")
-        rows = frequency_study(system, K_values=k_study, prestress_scales=[1.0] + ([s] if s else []),
-                               progress=False)
+        rows = frequency_study(system, K_values=k_study, prestress_scales=[1.0] + ([s] if s else []))
         for row in rows:
             print(f"  x{row['prestress_scale']:.4f} K={row['K']:2d}: "
                   + " ".join(f"{f:.4f}" for f in row["freq_hz"]) + f"  (highest {row['highest_hz']:.4f})")

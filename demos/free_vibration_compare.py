@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.models.mtc.model import MTCModel
-from tmfem.models.mtc.dynamics import fit_frequency, mtc_free_vibration
-from tmfem.models.com.modal import default_membrane_modes
+from tmfem.models.mtc.dynamics import fit_frequency
+from tmfem.simulation.vibration import free_vibration, mtc_free_vibration
+from tmfem.models.com.model import default_membrane_modes
 from tmfem.models.com.model import ControlOrientedModel
-from tmfem.models.com.simulate import free_vibration
 from tmfem.system import load_preset
 
 CASES = {"1-4": ("theta_12", {"theta_12_dot": 0.01}), "2-3": ("theta_11", {"theta_11_dot": 0.01})}
@@ -79,14 +79,14 @@ def main():
         t0 = time.perf_counter()
         com = ControlOrientedModel(system, membrane_modes=K, mesh_n=a.mesh)
         rc = free_vibration(com, t_end=a.t_end, dt=0.01, perturb=pert, jacobian="reuse",
-                            csv_path=out / f"com_{name}.csv", progress=True)
+                            csv_path=out / f"com_{name}.csv")
         t_com = time.perf_counter() - t0
         t0 = time.perf_counter()
         m = MTCModel(system.with_rest_lengths(com.u0), mesh_n=a.mesh, tendon_elements=3)
         st = m.solve_static(start="undeformed")
         t_static = time.perf_counter() - t0
         rm = mtc_free_vibration(m, st.x, t_end=a.t_end, dt=0.01, perturb=pert,
-                                csv_path=out / f"mtc_{name}.csv", progress=True)
+                                csv_path=out / f"mtc_{name}.csv")
         f_modes = m.modes(st.x, k=4).freq_hz
         i = system.q_names.index(qname)
         yc, ym = rc.z[:, i] - rc.z[0, i], rm.q[:, i] - rm.q[0, i]

@@ -195,7 +195,7 @@ def test_frequencies_1_4_against_table_6_6(sys14):
     is the one implied by the printed tendon stress of Table 6.3 (37.98 MPa, i.e. x1.290 our
     designed prestress, see docs/errata.md); with the designed prestress the prestress-
     dominated modes are lower by up to 12 %."""
-    from tmfem.models.com.modal import modal_summary
+    from tmfem.reference.com_modal import modal_summary
     r1 = modal_summary(sys14, modes=12, membrane_modes=5)
     s = r1["printed_stress_prestress_scale"]
     assert s == pytest.approx(37.98e6 * np.pi * 0.3e-3**2 / r1["design_tendon_forces"]["S_11"], rel=1e-9)
@@ -322,7 +322,7 @@ def test_free_vibration_matches_linear_response(m14):
     against the exact (matrix exponential) response of its linearisation (eq. 5.33) over
     3 s; the motion is small, so they agree to ~1 % of the amplitude."""
     from scipy.linalg import expm
-    from tmfem.models.com.simulate import free_vibration
+    from tmfem.simulation.vibration import free_vibration
     res = free_vibration(m14, t_end=3.0, dt=0.005, perturb={"theta_12_dot": 0.01}, jacobian="reuse")
     lin = linearize(m14)
     x0 = np.zeros(2 * m14.nz); x0[m14.nz + 2] = 0.01
@@ -343,7 +343,7 @@ def test_rest_length_step_matches_linear_input_response(m14):
     """A 1 mm step of the rest length of S_12 at t = 0 (input u, eq. 5.27): the nonlinear
     response against the exact zero-order-hold response of the linearisation (A, B of 5.33)."""
     from scipy.linalg import expm
-    from tmfem.models.com.simulate import free_vibration
+    from tmfem.simulation.vibration import free_vibration
     du = np.zeros(m14.n_t); du[1] = -1e-3
     dt = 0.005
     res = free_vibration(m14, t_end=2.0, dt=dt, u=m14.u0 + du, jacobian="reuse")
@@ -366,7 +366,7 @@ def test_driven_run_frames_carry_the_driven_rest_lengths_and_forces(m14, tmp_pat
     # (eq. 3.8) for that u, computed here independently by ControlOrientedModel.tendon_forces
     import meshio
     from tmfem.io.vtk import read_pvd
-    from tmfem.models.com.simulate import free_vibration
+    from tmfem.simulation.vibration import free_vibration
     du = np.zeros(m14.n_t); du[1] = -1e-3
     res = free_vibration(m14, t_end=0.02, dt=0.01, u=m14.u0 + du, vtk_dir=tmp_path, vtk_every=1)
     frames = read_pvd(res.stats["pvd"])

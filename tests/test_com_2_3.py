@@ -93,7 +93,7 @@ def test_frequencies_2_3_against_table_6_7(s23):
     load (14.48 N, on which the MTC comparison is calibrated) implies x1.018, which moves the
     prestress-sensitive modes 1 and 9 by 0.4 % and 0.8 % away from the printed column."""
     from tmfem.reference.tables import FREQUENCIES
-    from tmfem.models.com.modal import modal_summary
+    from tmfem.reference.com_modal import modal_summary
     com = np.array(FREQUENCIES["2-3"]["COM"])
     r = modal_summary(s23, modes=12, membrane_modes=4)
     assert r["sizes"]["n_z"] == 25 and r["dissertation"]["COM"] == com.tolist()
@@ -113,7 +113,6 @@ def test_eq_5_38_points_fit_the_preset_membrane(s23):
     # eq. 5.38: w_1 at (0.86, 0.50) m is the centroid of the r_mb = 1 m triangle of the preset
     # (sqrt(3)/2, 1/2) in the floating frame (corner N at the origin, x_f through corner 1);
     # Table 6.4's r_mb = 1.87 m would put the centroid at (1.62, 0.935) m
-    from tmfem.models.com.model import MONITOR_POINTS
     c = s23.membrane_corners.mean(axis=1)
     assert np.allclose(c, [np.sqrt(3) / 2, 0.5], atol=1e-12)
-    assert np.allclose(MONITOR_POINTS["2-3"][0], c, atol=0.01)
+    assert np.allclose(load_preset("2-3").monitor_points[:, 0], c, atol=0.01)

@@ -10,8 +10,8 @@ import pytest
 
 from tmfem.errors import InputError
 from tmfem.models.mtc.model import MTCModel
-from tmfem.models.mtc.dynamics import (MTCDynamics, fit_frequency, initial_state,
-                                    mtc_free_vibration)
+from tmfem.models.mtc.dynamics import MTCDynamics, fit_frequency, initial_state
+from tmfem.simulation.vibration import mtc_free_vibration
 from tmfem.solvers.park import park_integrate
 from tmfem.system import load_preset
 
@@ -126,7 +126,7 @@ def test_mtc_and_com_bar_responses_agree_1_4():
     # the peak-to-peak amplitudes must agree within 5 % (measured 2.5 %) and the fitted
     # frequencies within 3 %.
     from tmfem.models.com.model import ControlOrientedModel
-    from tmfem.models.com.simulate import free_vibration
+    from tmfem.simulation.vibration import free_vibration
     s = load_preset("1-4")
     com = ControlOrientedModel(s, membrane_modes=5, mesh_n=4)
     rc = free_vibration(com, t_end=6.0, dt=0.01, perturb={"theta_12_dot": 0.01}, jacobian="reuse")
@@ -155,7 +155,7 @@ def test_mtc_and_com_bar_responses_agree_2_3():
     # <= 2.9 %) and the fitted frequencies within 3 % (measured 1.5 %); at the paper's mesh
     # (3 x 10 x 10, 10 s) demos/free_vibration_compare.py gives 0.9 % and 0.1 %.
     from tmfem.models.com.model import ControlOrientedModel
-    from tmfem.models.com.simulate import free_vibration
+    from tmfem.simulation.vibration import free_vibration
     s = load_preset("2-3")
     pert = {"theta_11_dot": 0.01}
     com = ControlOrientedModel(s, membrane_modes=4, mesh_n=4)
@@ -208,7 +208,7 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
 
 def test_split_perturbation_offsets_rates_and_unknown_names():
     # the 6.5 perturbations: theta_12_dot = 0.01 rad/s (6.5.1), an offset theta_11 = 0.001 rad
-    from tmfem.models.com.simulate import split_perturbation
+    from tmfem.models.base import split_perturbation
     names = ["theta_11", "psi_11", "theta_12"]
     d, dd = split_perturbation({"theta_12_dot": 0.01, "theta_11": 0.001}, names)
     assert d.tolist() == [0.001, 0.0, 0.0]

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+from contextlib import contextmanager
 
 from tmfem.errors import InputError
 from tmfem.system import System, load_preset, load_system
@@ -26,18 +27,53 @@ def system_from_args(args: argparse.Namespace) -> System:
     return load_system(args.spec)
 
 
-def add_prestress_scale_arg(parser) -> None:
-    """Add ``--prestress-scale S`` (control-oriented model only, see
-    :class:`tmfem.models.com.model.ControlOrientedModel`); read it with :func:`prestress_scale_of`."""
-    parser.add_argument("--prestress-scale", type=float, default=None,
-                        help="--model com: factor on the designed membrane prestress (default 1 = "
-                             "designed; 1.2903 gives the printed 1-4 tendon stress and Table 6.6, "
-                             "docs/errata.md)")
+def add_model_args(parser, command: str, *, default: str) -> None:
+    """``--model`` (the registry's models that serve ``command``), ``--backend`` and every
+    model option of ``command``, each saying which models take it; read them with
+    :func:`model_from_args`, which refuses an option the chosen model does not take."""
+    from tmfem.models.base import model_options, models_for
+    from tmfem.solvers.backends import backend_names
+    specs = models_for(command)
+    parser.add_argument("--model", choices=sorted(specs), default=default,
+                        help="; ".join(f"{n}: {s.help}" for n, s in specs.items())
+                        + f" (default {default})")
+    parser.add_argument("--backend", choices=backend_names(), default=None,
+                        help="linear-algebra backend of the finite-element models (default scipy; "
+                             "petsc: docs/backends.md)")
+    options, owners = {}, {}
+    for name in specs:
+        for o in model_options(name, command):
+            options.setdefault(o.dest, o)
+            owners.setdefault(o.dest, []).append(name)
+    group = parser.add_argument_group("model options (refused for a model that does not take them)")
+    for dest, o in options.items():
+        default_text = "" if o.default is None else f"; default {o.default}"
+        group.add_argument(o.flag, **{**o.kwargs, "default": None,
+                                      "help": f"{o.kwargs.get('help', '')} [--model "
+                                              f"{', '.join(owners[dest])}{default_text}]"})
+    parser.set_defaults(_model_option_dests=tuple(options))
 
 
-def prestress_scale_of(args: argparse.Namespace) -> float:
-    """The ``--prestress-scale`` factor (1 when not given)."""
-    return 1.0 if args.prestress_scale is None else args.prestress_scale
+def model_options_from_args(args, command: str):
+    """(system, options): the system and the chosen model's option values
+    (:func:`tmfem.models.base.resolve_options`: an option the model does not take is refused)."""
+    from tmfem.models.base import get_spec, resolve_options
+    spec = get_spec(args.model)
+    given = {d: getattr(args, d) for d in args._model_option_dests}
+    options = resolve_options(args.model, command, given)
+    if args.backend is not None and not spec.uses_backend:
+        raise InputError(f"{command} --model {args.model}: option does not apply: --backend "
+                         f"(the {args.model} model solves small dense systems; --backend is for "
+                         "the finite-element models)")
+    return system_from_args(args), options
+
+
+def model_from_args(args, command: str):
+    """(model, options): the model chosen by ``--model``, built from the system and its
+    options (:func:`model_options_from_args`)."""
+    from tmfem.models.base import get_spec
+    system, options = model_options_from_args(args, command)
+    return get_spec(args.model).build(system, options, args.backend or "scipy"), options
 
 
 def add_attachment_args(parser) -> None:
@@ -54,3 +90,36 @@ def add_attachment_args(parser) -> None:
                              "with fewer than 3 nodes it is an error, with only those it "
                              "reduces to the point attachment (1-4 at the default patch: "
                              "--mesh 5 fails, --mesh 10 equals point; use --mesh >= 20)")
+
+
+def parse_perturbation(items, names) -> dict:
+    """``["theta_11_dot=0.01", ...]`` -> {name: value}; names must be states of the model."""
+    out = {}
+    for it in items or []:
+        if "=" not in it:
+            raise InputError(f"perturbation: expected NAME=VALUE, found {it!r}")
+        k, v = it.split("=", 1)
+        k = k.strip()
+        if k not in names:
+            raise InputError(f"perturbation: unknown state {k!r}; expected one of {names}")
+        try:
+            out[k] = float(v)
+        except ValueError:
+            raise InputError(f"perturbation {k}: expected a number, found {v!r}") from None
+    return out
+
+
+@contextmanager
+def progress_bar(t_end: float, dt: float, label: str):
+    """A tqdm progress bar over the steps of a time run, as a ``progress(step, n_steps)``
+    callback (on stderr; closed on exit, also on an error)."""
+    from tqdm import tqdm
+    bar = tqdm(total=int(round(t_end / dt)), desc=label, unit="step", leave=False,
+               mininterval=0.5)
+
+    def update(k, n):
+        bar.update(k - bar.n)
+    try:
+        yield update
+    finally:
+        bar.close()

@@ -5,6 +5,8 @@ import csv
 
 from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
 from tmfem.errors import InputError
+from tmfem.models.mtc.spec import apply_rest_lengths
+from tmfem.solvers.backends import backend_names
 
 NAME = "converge"
 HELP = "mesh / tendon-subdivision convergence of frequencies and stresses (dissertation 6.3)"
@@ -22,7 +24,10 @@ def _ints(text: str, what: str) -> list[int]:
 
 def configure(parser) -> None:
     add_system_args(parser)
-    parser.add_argument("--model", choices=("mtc",), default="mtc")
+    parser.add_argument("--model", choices=("mtc",), default="mtc",
+                        help="finite-element model (mtc: membrane-truss-cable, 4.4)")
+    parser.add_argument("--backend", choices=backend_names(), default="scipy",
+                        help="linear-algebra backend (default scipy; docs/backends.md)")
     parser.add_argument("--mesh", default="10",
                         help="comma-separated membrane subdivisions n (N quads of n x n each)")
     parser.add_argument("--tendon-elements", default="3",
@@ -39,7 +44,6 @@ def configure(parser) -> None:
 
 def run(args) -> dict:
     from tmfem.reference.convergence import ROW_KEYS, convergence_rows, fit_convergence
-    from tmfem.cli.static import apply_rest_lengths
     system, rest = apply_rest_lengths(system_from_args(args), args.rest_lengths)
     meshes = _ints(args.mesh, "--mesh")
     tendons = _ints(args.tendon_elements, "--tendon-elements")
@@ -50,7 +54,7 @@ def run(args) -> dict:
             fh = open(args.csv, "w", newline="")
         for row in convergence_rows(system, meshes=meshes, tendon_elements=tendons,
                                     attachment=args.attachment, rest_lengths=rest,
-                                    modes=args.modes, patch=args.patch):
+                                    modes=args.modes, patch=args.patch, backend=args.backend):
             rows.append(row)
             if fh is not None:
                 if writer is None:

@@ -5,10 +5,11 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_prestress_scale_arg, add_system_args, prestress_scale_of,
-                              system_from_args)
-from tmfem.cli.static import add_model_args, build_model, default_monitor, sequence_of
+from tmfem.cli.common import (add_model_args, add_system_args, model_from_args,
+                              model_options_from_args)
+from tmfem.cli.static import default_monitor
 from tmfem.errors import InputError
+from tmfem.models.mtc.spec import sequence_of
 
 NAME = "modal"
 HELP = "natural frequencies and mode shapes (MTC finite-element or control-oriented model)"
@@ -16,16 +17,12 @@ HELP = "natural frequencies and mode shapes (MTC finite-element or control-orien
 
 def configure(parser) -> None:
     add_system_args(parser)
-    parser.add_argument("--model", choices=("mtc", "com"), default="mtc",
-                        help="mtc: membrane-truss-cable FE model (4.4); com: control-oriented "
-                             "model (ch. 5)")
-    add_model_args(parser)
+    add_model_args(parser, NAME, default="mtc")
     parser.add_argument("--modes", type=int, default=12, help="number of modes (default 12)")
-    parser.add_argument("--membrane-modes", type=int, default=None,
-                        help="membrane modes of the control-oriented model (--model com)")
-    add_prestress_scale_arg(parser)
-    parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu")
-    parser.add_argument("--png", help="render the first six mode shapes to this PNG")
+    parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu "
+                                      "[finite-element models]")
+    parser.add_argument("--png", help="render the first six mode shapes to this PNG "
+                                      "[finite-element models]")
 
 
 def mtc_modes(model, *, k: int, start: str = "undeformed", sequence: int | None = None):
@@ -36,23 +33,26 @@ def mtc_modes(model, *, k: int, start: str = "undeformed", sequence: int | None 
 
 
 def run(args) -> dict:
+    if not (isinstance(args.modes, int) and args.modes >= 1):
+        raise InputError(f"--modes: expected an integer >= 1, found {args.modes!r}")
     if args.model == "com":
-        from tmfem.models.com.modal import modal_summary
-        system = system_from_args(args)
-        return modal_summary(system, modes=args.modes, membrane_modes=args.membrane_modes,
-                             prestress_scale=prestress_scale_of(args))
-    if args.prestress_scale is not None:
-        raise InputError("--prestress-scale belongs to --model com; the MTC prestress follows "
-                         "from its rest lengths (--rest-lengths)")
+        if args.vtk or args.png:
+            raise InputError("modal --model com: option does not apply: --vtk/--png write "
+                             "finite-element mode shapes (use --model mtc)")
+        from tmfem.reference.com_modal import modal_summary
+        system, options = model_options_from_args(args, NAME)
+        return modal_summary(system, modes=args.modes, membrane_modes=options["membrane_modes"],
+                             prestress_scale=options["prestress_scale"], mesh_n=options["mesh"])
     from tmfem.reference.tables import FREQUENCIES
     from tmfem.models.mtc.post import model_cells, static_summary
-    model = build_model(args)
+    model, options = model_from_args(args, NAME)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
-    res, modes = mtc_modes(model, k=args.modes, start=args.start, sequence=sequence_of(args))
+    res, modes = mtc_modes(model, k=args.modes, start=options["start"],
+                           sequence=sequence_of(options["mesh"], options["sequence"]))
     st = static_summary(model, res.x, result=res)
-    out = {"system": system_name, "model": "mtc", "dofs": model.ndof, "mesh_n": args.mesh,
-           "tendon_elements": args.tendon_elements, "attachment": args.attachment,
+    out = {"system": system_name, "model": "mtc", "dofs": model.ndof, "mesh_n": options["mesh"],
+           "tendon_elements": options["tendon_elements"], "attachment": options["attachment"],
            "rest_lengths_source": model.rest_lengths_source,
            "rest_lengths": st["rest_lengths"], "static_iterations": res.iterations,
            "tendon_stress_max": st["tendon_stress_max"], "bar_load_max": st["bar_load_max"],
@@ -79,7 +79,7 @@ def run(args) -> dict:
 
 def format_text(r: dict) -> str:
     if r.get("model") != "mtc":
-        from tmfem.models.com.modal import format_summary
+        from tmfem.reference.com_modal import format_summary
         return format_summary(r)
     lines = [f"MTC modes of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",

@@ -5,74 +5,16 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import add_system_args, system_from_args
-from tmfem.errors import InputError
+from tmfem.cli.common import add_model_args, add_system_args, model_from_args
+from tmfem.models.mtc.spec import sequence_of
 
 NAME = "static"
 HELP = "static equilibrium of the membrane-truss-cable model (dissertation 6.2)"
 
 
-def add_model_args(parser) -> None:
-    """Options shared by ``static``, ``modal`` and ``converge`` for the MTC model."""
-    parser.add_argument("--mesh", type=int, default=10,
-                        help="membrane elements per side of each of the N quadrilaterals (default 10)")
-    parser.add_argument("--tendon-elements", type=int, default=3,
-                        help="truss elements per tendon (default 3, as in 6.2)")
-    parser.add_argument("--attachment", choices=("point", "distributed"), default="point",
-                        help="membrane corners pinned to the bar tops (point) or spread over a "
-                             "small corner patch (distributed)")
-    parser.add_argument("--rest-lengths", default=None,
-                        help="tendon rest lengths: 'system' (default when it has them), 'design' "
-                             "(eq. 3.8), 'mtc' (those that make the design an exact equilibrium "
-                             "of this model) or values per group/tendon, e.g. 'S1=1.5025'")
-    parser.add_argument("--start", choices=("undeformed", "design"), default="undeformed",
-                        help="start of the static iteration (default: the undeformed membrane)")
-    parser.add_argument("--sequence", type=int, default=None,
-                        help="mesh sequencing of the static solve from this coarse n, halving "
-                             "(default: 10 when --mesh > 20, else none; 0 disables)")
-
-
-def sequence_of(args):
-    """Coarsest mesh of the static mesh sequencing chosen by ``--sequence``."""
-    seq = getattr(args, "sequence", None)
-    if seq is None:
-        return 10 if args.mesh > 20 else None
-    return seq or None
-
-
-def build_model(args):
-    """The MTC model named by the command-line arguments."""
-    from tmfem.models.mtc.model import MTCModel
-    if getattr(args, "model", "mtc") != "mtc":
-        raise InputError(f"model: expected 'mtc', found {args.model!r}")
-    system = system_from_args(args)
-    system, rest = apply_rest_lengths(system, args.rest_lengths)
-    return MTCModel(system, mesh_n=args.mesh, tendon_elements=args.tendon_elements,
-                    attachment=args.attachment, rest_lengths=rest)
-
-
-def apply_rest_lengths(system, text):
-    """The system and the ``rest_lengths`` argument of MTCModel for ``--rest-lengths``."""
-    if text is None or text in ("system", "design", "mtc"):
-        return system, text
-    values = {}
-    for item in text.split(","):
-        key, sep, val = item.partition("=")
-        try:
-            values[key.strip()] = float(val)
-        except ValueError:
-            sep = ""
-        if not sep:
-            raise InputError(f"--rest-lengths: expected system, design, mtc or GROUP=VALUE[,...] "
-                             f"(e.g. S1=1.5025), found {text!r}")
-    return system.with_rest_lengths(values), "system"
-
-
 def configure(parser) -> None:
     add_system_args(parser)
-    parser.add_argument("--model", choices=("mtc",), default="mtc",
-                        help="finite-element model (mtc: membrane-truss-cable, 4.4)")
-    add_model_args(parser)
+    add_model_args(parser, NAME, default="mtc")
     parser.add_argument("--monitor", default=None,
                         help="comma-separated node labels whose iteration history is reported "
                              "(default B_M1 and, for 1-4, B_14 as in Fig. 6.1)")
@@ -91,13 +33,26 @@ def default_monitor(system) -> list[str]:
     return ["B_11", "A_21", "B_21"]
 
 
-def solve(args, model):
+def static_progress(enabled: bool):
+    """A ``progress(iteration, rnorm, mu, rho)`` callback of the static solve that prints one
+    line per iteration on stderr (``--progress``), or None."""
+    if not enabled:
+        return None
+
+    def show(it, rn, mu, rho):
+        print(f"  static it {it:3d}  |r| = {rn:.3e} N  mu = {mu:.3g}  rho = {rho:.3g}",
+              file=sys.stderr)
+    return show
+
+
+def solve(args, model, options):
     from tmfem.models.mtc.post import static_summary
     monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
     print(f"tmfem static: {model.system.name}, {model.ndof} free dofs, solving from the "
-          f"{args.start} state", file=sys.stderr)
-    res = model.solve_static(start=args.start, monitor=monitor,
-                             progress=args.progress, sequence=sequence_of(args))
+          f"{options['start']} state", file=sys.stderr)
+    res = model.solve_static(start=options["start"], monitor=monitor,
+                             progress=static_progress(args.progress),
+                             sequence=sequence_of(options["mesh"], options["sequence"]))
     return res, static_summary(model, res.x, result=res)
 
 
@@ -129,8 +84,8 @@ def write_outputs(args, model, x, summary) -> None:
 
 
 def run(args) -> dict:
-    model = build_model(args)
-    res, summary = solve(args, model)
+    model, options = model_from_args(args, NAME)
+    res, summary = solve(args, model, options)
     write_outputs(args, model, res.x, summary)
     return summary
 

@@ -6,9 +6,10 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_prestress_scale_arg, add_system_args, prestress_scale_of,
-                              system_from_args)
-from tmfem.errors import InputError
+from tmfem.cli.common import (add_model_args, add_system_args, model_from_args,
+                              parse_perturbation, progress_bar)
+from tmfem.models.mtc.spec import sequence_of
+from tmfem.simulation.driver import check_time_grid
 
 NAME = "vibrate"
 HELP = "free vibration after an initial perturbation (COM or MTC model, Park's method)"
@@ -16,18 +17,11 @@ HELP = "free vibration after an initial perturbation (COM or MTC model, Park's m
 
 def configure(parser) -> None:
     add_system_args(parser)
-    parser.add_argument("--model", choices=("com", "mtc"), default="com",
-                        help="com: control-oriented model (ch. 5); mtc: membrane-truss-cable "
-                             "finite-element model (4.4) about its static equilibrium")
-    parser.add_argument("--membrane-modes", type=int, default=None,
-                        help="membrane modes K (default: the dissertation's, 5 for 1-4, 4 for 2-3)")
+    add_model_args(parser, NAME, default="com")
     parser.add_argument("--t-end", type=float, default=10.0, help="duration [s] (default 10)")
     parser.add_argument("--dt", type=float, default=0.01, help="time step [s] (6.5: 0.01)")
     parser.add_argument("--perturb", action="append", default=[], metavar="STATE=VALUE",
                         help="initial perturbation, e.g. theta_11_dot=0.01 (repeatable)")
-    parser.add_argument("--damping", type=float, default=0.0, help="modal damping c_m [1/s] (eq. 5.13)")
-    add_prestress_scale_arg(parser)
-    parser.add_argument("--mesh", type=int, default=10, help="membrane mesh n per patch (default 10)")
     parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park")
     parser.add_argument("--csv", help="write the histories to this CSV file (row by row)")
     parser.add_argument("--plot", help="write a plot of the monitored histories (PNG)")
@@ -35,38 +29,25 @@ def configure(parser) -> None:
                         help="write a ParaView series (.pvd + .vtu frames) to this directory")
     parser.add_argument("--vtk-every", type=int, default=10,
                         help="steps between ParaView frames (default 10)")
-    mtc = parser.add_argument_group("membrane-truss-cable model (--model mtc)")
-    mtc.add_argument("--tendon-elements", type=int, default=3,
-                     help="truss elements per tendon (default 3, as in 6.5)")
-    mtc.add_argument("--rest-lengths", default=None,
-                     help="tendon rest lengths as for `tmfem static` (system, design, mtc, "
-                          "GROUP=VALUE,...)")
-    mtc.add_argument("--rayleigh", type=float, nargs=2, default=(0.0, 0.0),
-                     metavar=("ALPHA", "BETA"),
-                     help="Rayleigh damping C = ALPHA M + BETA K_0 (default none)")
 
 
 def run(args) -> dict:
-    if not (args.t_end > 0 and args.dt > 0):
-        raise InputError(f"expected --t-end > 0 and --dt > 0, found {args.t_end}, {args.dt}")
+    check_time_grid(args.t_end, args.dt)
+    model, options = model_from_args(args, NAME)
     if args.model == "mtc":
-        return run_mtc(args)
-    from tmfem.models.com.modal import default_membrane_modes
-    from tmfem.models.com.model import ControlOrientedModel
-    from tmfem.models.com.simulate import free_vibration, parse_perturbation
+        return run_mtc(args, model, options)
+    from tmfem.simulation.vibration import free_vibration
 
-    system = system_from_args(args)
-    K = default_membrane_modes(system) if args.membrane_modes is None else args.membrane_modes
-    print(f"tmfem vibrate: {system.name} COM, K = {K}, building the model", file=sys.stderr)
-    model = ControlOrientedModel(system, membrane_modes=K, mesh_n=args.mesh, damping=args.damping,
-                                 prestress_scale=prestress_scale_of(args))
+    system = model.system
+    print(f"tmfem vibrate: {system.name} COM, K = {model.K}", file=sys.stderr)
     pert = parse_perturbation(args.perturb, model.state_names)
-    res = free_vibration(model, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
-                         scheme=args.scheme, jacobian="reuse", progress=True,
-                         vtk_dir=args.vtk, vtk_every=args.vtk_every)
-    out = {"system": system.name, "model": "com", "membrane_modes": K, "t_end": args.t_end,
+    with progress_bar(args.t_end, args.dt, f"vibrate {system.name}") as bar:
+        res = free_vibration(model, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
+                             scheme=args.scheme, jacobian="reuse", progress=bar,
+                             vtk_dir=args.vtk, vtk_every=args.vtk_every)
+    out = {"system": system.name, "model": "com", "membrane_modes": model.K, "t_end": args.t_end,
            "dt": args.dt, "perturbation": pert, "scheme": args.scheme,
-           **_run_summary(res, args, title=f"{system.name} COM free vibration, K = {K}"),
+           **_run_summary(res, args, title=f"{system.name} COM free vibration, K = {model.K}"),
            "final": dict(zip(model.state_names, np.concatenate([res.z[-1], res.zd[-1]]).tolist()))}
     return out
 
@@ -74,7 +55,7 @@ def run(args) -> dict:
 def _run_summary(res, args, *, title: str) -> dict:
     """What both models report of a free-vibration run: solver counts, the smallest tendon
     force, monitored amplitudes, and the files written (CSV, ParaView series, plot)."""
-    from tmfem.models.com.simulate import plot_free_vibration
+    from tmfem.post.plots import plot_free_vibration
 
     out = {"wall_time_s": res.wall_time, "steps": res.stats["steps"],
            "newton_iterations": res.stats["newton_iterations"],
@@ -92,33 +73,27 @@ def _run_summary(res, args, *, title: str) -> dict:
     return out
 
 
-def run_mtc(args) -> dict:
-    """Free vibration of the MTC model (tmfem.models.mtc.dynamics)."""
-    from tmfem.cli.static import apply_rest_lengths, sequence_of
-    from tmfem.models.mtc.model import MTCModel
-    from tmfem.models.mtc.dynamics import mtc_free_vibration, perturbation_names
-    from tmfem.models.com.simulate import parse_perturbation
+def run_mtc(args, model, options) -> dict:
+    """Free vibration of the MTC model about its static equilibrium."""
+    from tmfem.models.mtc.dynamics import perturbation_names
+    from tmfem.simulation.vibration import mtc_free_vibration
 
-    system = system_from_args(args)
-    if args.damping or args.membrane_modes is not None or args.prestress_scale is not None:
-        raise InputError("--damping, --membrane-modes and --prestress-scale belong to --model com; "
-                         "the MTC model takes --rayleigh ALPHA BETA and --rest-lengths")
+    system = model.system
     pert = parse_perturbation(args.perturb, perturbation_names(system))
-    system, rest = apply_rest_lengths(system, args.rest_lengths)
-    model = MTCModel(system, mesh_n=args.mesh, tendon_elements=args.tendon_elements,
-                     rest_lengths=rest)
-    print(f"tmfem vibrate: {system.name} MTC, mesh {system.N}x{args.mesh}x{args.mesh}, "
+    rayleigh = options["rayleigh"] or (0.0, 0.0)
+    print(f"tmfem vibrate: {system.name} MTC, mesh {system.N}x{options['mesh']}x{options['mesh']}, "
           f"{model.ndof} DOFs, static equilibrium", file=sys.stderr)
-    st = model.solve_static(start="undeformed", sequence=sequence_of(args))
-    res = mtc_free_vibration(model, st.x, t_end=args.t_end, dt=args.dt, perturb=pert,
-                             csv_path=args.csv, scheme=args.scheme, alpha=args.rayleigh[0],
-                             beta=args.rayleigh[1], progress=True, vtk_dir=args.vtk,
-                             vtk_every=args.vtk_every)
-    out = {"system": system.name, "model": "mtc", "mesh": args.mesh, "ndof": model.ndof,
-           "tendon_elements": args.tendon_elements, "t_end": args.t_end, "dt": args.dt,
-           "perturbation": pert, "scheme": args.scheme, "rayleigh": list(args.rayleigh),
+    st = model.solve_static(start="undeformed", sequence=sequence_of(options["mesh"], options["sequence"]))
+    with progress_bar(args.t_end, args.dt, f"vibrate {system.name} MTC") as bar:
+        res = mtc_free_vibration(model, st.x, t_end=args.t_end, dt=args.dt, perturb=pert,
+                                 csv_path=args.csv, scheme=args.scheme, alpha=rayleigh[0],
+                                 beta=rayleigh[1], progress=bar, vtk_dir=args.vtk,
+                                 vtk_every=args.vtk_every)
+    out = {"system": system.name, "model": "mtc", "mesh": options["mesh"], "ndof": model.ndof,
+           "tendon_elements": options["tendon_elements"], "t_end": args.t_end, "dt": args.dt,
+           "perturbation": pert, "scheme": args.scheme, "rayleigh": list(rayleigh),
            "static_time_s": st.time,
-           **_run_summary(res, args, title=f"{system.name} MTC free vibration, mesh {args.mesh}"),
+           **_run_summary(res, args, title=f"{system.name} MTC free vibration, mesh {options['mesh']}"),
            "max_tendon_deflection_m": res.stats["max_tendon_deflection"],
            "max_tendon_deflection_tendon": res.stats["max_tendon_deflection_tendon"],
            "energy_drift_J": float(np.max(np.abs(res.energy - res.energy[0]))),

@@ -189,3 +189,26 @@ def plot_xy(png, curves: dict, *, xlabel: str, ylabel: str, title: str | None = 
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
     return _save(fig, png)
+
+
+def plot_free_vibration(result, path, *, title: str = "") -> str:
+    """Monitored node coordinates and membrane deflections vs time (Figs. 6.21-6.28) of a
+    free-vibration result (``nodes``: label -> (nt, 3), ``w`` (nt, k), ``t``)."""
+    plt = _plt()
+    nn = len(result.nodes)
+    fig, axes = plt.subplots(nn + 1, 1, figsize=(8, 2.4 * (nn + 1)), sharex=True)
+    axes = np.atleast_1d(axes)
+    for ax, (name, X) in zip(axes, result.nodes.items()):
+        for c, lab in enumerate("xyz"):
+            ax.plot(result.t, 1e3 * (X[:, c] - X[0, c]), label=f"{lab} - {lab}(0)")
+        ax.set_ylabel(f"{name} [mm]"); ax.legend(loc="upper right", fontsize=7)
+    ax = axes[-1]
+    for k in range(result.w.shape[1]):
+        ax.plot(result.t, 1e3 * result.w[:, k], label=f"w_{k + 1}")
+    ax.set_ylabel("w [mm]"); ax.set_xlabel("t [s]"); ax.legend(loc="upper right", fontsize=7)
+    if title:
+        axes[0].set_title(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return str(path)

@@ -36,7 +36,7 @@ def resolve_rest_lengths(system, *, rest_lengths):
 
 def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "point",
                      rest_lengths=None, modes: int = 12, patch: float | None = None,
-                     progress: bool = True):
+                     progress: bool = True, backend="scipy"):
     """Yield one result row (dict) per (mesh n, tendon elements k) pair, as it is computed.
 
     Each row: mesh size, DOFs, static iterations and time, landing (Delta), peak stresses
@@ -48,7 +48,7 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
         for k in tendon_elements:
             t0 = time.perf_counter()
             m = MTCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
-                         patch=patch, rest_lengths=rest)
+                         patch=patch, rest_lengths=rest, backend=backend)
             res = m.solve_static(start="design")
             t1 = time.perf_counter()
             md = m.modes(res.x, k=modes)

@@ -230,6 +230,11 @@ class PetscBackend:   # pragma: no cover - exercised only where petsc4py is inst
 _BACKENDS = {"scipy": ScipyBackend, "petsc": PetscBackend}
 
 
+def backend_names() -> list[str]:
+    """Names accepted by :func:`get_backend`."""
+    return sorted(_BACKENDS)
+
+
 def get_backend(name: str | Backend | None = None) -> Backend:
     """Return a backend by name ('scipy' default, 'petsc'), or pass an object through."""
     if name is None:

@@ -74,10 +74,10 @@ def _newton_matrix(system, x, v, a, t, cv, ca):
     return K + cv * C + ca * M
 
 
-def initial_acceleration(system, x0, v0, t0=0.0, *, tol=1e-12, max_iter=20) -> np.ndarray:
-    """Solve r(x0, v0, a, t0) = 0 for the initial acceleration a (Newton on a)."""
+def initial_acceleration(system, x0, v0, t0=0.0, *, a0=None, tol=1e-12, max_iter=20) -> np.ndarray:
+    """Solve r(x0, v0, a, t0) = 0 for the acceleration a (Newton on a, from ``a0`` or 0)."""
     x0 = np.asarray(x0, dtype=float)
-    a = np.zeros_like(x0)
+    a = np.zeros_like(x0) if a0 is None else np.array(a0, dtype=float)
     for it in range(max_iter):
         r = system.residual(x0, v0, a, t0)
         _, _, M = system.jacobians(x0, v0, a, t0)
@@ -93,7 +93,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                    a0=None, scheme: str = "park", tol: float = 1e-10,
                    max_iter: int = 25, jacobian: str = "iteration", reuse_iter: int = 4,
                    callback: Callable | None = None, store: bool = True,
-                   progress: Callable | None = None) -> ParkResult:
+                   progress: Callable | None = None, sampled: bool = False) -> ParkResult:
     """Integrate r(x, v, a, t) = 0 with Park's method started by the trapezoidal rule.
 
     Parameters
@@ -126,6 +126,12 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         Keep the histories in the result (else only the last state).
     progress : callable, optional
         ``progress(step, n_steps)`` called every step (e.g. to print to stderr).
+    sampled : bool
+        The callback may change the system's inputs (a zero-order-hold controller): after
+        each callback the acceleration is re-solved from r(x, v, a, t) = 0 with the new
+        inputs, so that the trapezoidal rule integrates every sample interval as a smooth
+        problem (second order). Park's multistep formula sees the input steps through its
+        history and is first order across them.
 
     Returns
     -------
@@ -152,6 +158,8 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
     res = ParkResult(t=T, x=None, v=None, a=None)
     if callback is not None and callback(t0, x, v, a):
         n_steps = 0
+    elif sampled:
+        a = initial_acceleration(system, x, v, t0, a0=a)
     hx = [x.copy()]       # most recent last: x_n, x_{n-1}, x_{n-2}
     hv = [v.copy()]
     c_park = 10.0 / (6.0 * dt)
@@ -227,6 +235,8 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
             progress(k, n_steps)
         if callback is not None and callback(t, x, v, a):
             break
+        if sampled:
+            a = initial_acceleration(system, x, v, t, a0=a)
     if store:
         res.x, res.v, res.a = X[: last + 1], V[: last + 1], A[: last + 1]
         res.t = T[: last + 1]

@@ -45,7 +45,8 @@ from tmfem.system.system import System
 from tmfem.system.topology import Tendon
 
 _TOP_KEYS = {"name", "description", "N", "deployable", "k_H", "notes", "symmetric", "general",
-             "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed"}
+             "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed",
+             "monitor", "models"}
 # Keys accepted inside each sub-table ([printed] and [rest_lengths] are free-form;
 # [as_printed] is merged in before validation, see tmfem.system.presets.preset_dict).
 _TABLE_KEYS = {
@@ -55,6 +56,8 @@ _TABLE_KEYS = {
     "bar": {"E", "rho", "d"},
     "tendons.*": {"E", "d", "rho", "yield_stress"},
     "tendon": {"name", "family", "stage", "j", "ends"},
+    "monitor": {"nodes", "points"},
+    "models.com": {"membrane_modes"},
 }
 
 
@@ -134,6 +137,41 @@ def _materials(d: dict, where: str):
     return membrane, bar, sections
 
 
+def _monitor(d: dict, where: str) -> dict:
+    """``monitor_nodes`` and ``monitor_points`` of the optional table ``[monitor]``."""
+    if "monitor" not in d:
+        return {}
+    t = _table(d, "monitor", where)
+    nodes = t.get("nodes", [])
+    if not (isinstance(nodes, list) and all(isinstance(n, str) for n in nodes)):
+        raise InputError(f"{where} [monitor]: expected 'nodes' as a list of node labels, found {nodes!r}")
+    pts = _floats(t, "points", f"{where} [monitor]", default=np.zeros(0))
+    if pts.size % 2:
+        raise InputError(f"{where} [monitor]: expected 'points' as rows [x_f, y_f], found {t['points']!r}")
+    return {"monitor_nodes": tuple(nodes), "monitor_points": pts.reshape(-1, 2).T}
+
+
+def _model_defaults(d: dict, where: str) -> dict:
+    """Default model options of the optional tables ``[models.<name>]``."""
+    t = d.get("models", {})
+    if not isinstance(t, dict):
+        raise InputError(f"{where}: expected [models] to be a table, found {type(t).__name__}")
+    out = {}
+    for name, opts in t.items():
+        kind = f"models.{name}"
+        if kind not in _TABLE_KEYS or not isinstance(opts, dict):
+            known = sorted(k.split(".", 1)[1] for k in _TABLE_KEYS if k.startswith("models."))
+            raise InputError(f"{where}: [models.{name}]: expected a table for one of the models "
+                             f"{known}")
+        _check_keys(opts, kind, f"{where} [models.{name}]")
+        K = opts.get("membrane_modes")
+        if K is not None and not (isinstance(K, int) and not isinstance(K, bool) and K >= 0):
+            raise InputError(f"{where} [models.{name}]: expected membrane_modes as an integer >= 0, "
+                             f"found {K!r}")
+        out[name] = dict(opts)
+    return out
+
+
 def system_from_dict(d: dict, where: str = "system") -> System:
     """Build a :class:`System` from the parsed contents of a system file."""
     unknown = set(d) - _TOP_KEYS
@@ -148,7 +186,8 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     mtab = d["membrane"]
     rest = d.get("rest_lengths") or None
     common = dict(name=str(d.get("name", where)), description=str(d.get("description", "")),
-                  notes=tuple(d.get("notes", ())), printed=dict(d.get("printed", {})))
+                  notes=tuple(d.get("notes", ())), printed=dict(d.get("printed", {})),
+                  **_monitor(d, where), model_defaults=_model_defaults(d, where))
     for k, t in enumerate(d.get("tendon", ())):
         wt = f"{where} [[tendon]] entry {k + 1}"
         if not isinstance(t, dict):
@@ -246,6 +285,11 @@ def system_to_dict(system: System) -> dict:
         d["rest_lengths"] = dict(zip(system.tendon_names(), system.rest_lengths.tolist()))
     if system.printed:
         d["printed"] = system.printed
+    if system.model_defaults:
+        d["models"] = {k: dict(v) for k, v in system.model_defaults.items()}
+    if system.monitor_nodes or system.monitor_points.size:
+        d["monitor"] = {k: v for k, v in (("nodes", list(system.monitor_nodes)),
+                                          ("points", system.monitor_points.T.tolist())) if v}
     return d
 
 

@@ -62,6 +62,16 @@ class System:
         The symmetric parametrisation of ``q`` when the system is symmetric.
     r_mb : float, optional
         Circumradius of a regular membrane.
+    monitor_nodes : tuple of str
+        Node labels whose motion studies record by default (the dissertation's Figs.
+        6.21-6.27 for its presets; file table ``[monitor] nodes``).
+    monitor_points : ndarray (2, n_points)
+        Membrane points (x_f, y_f) [m] whose transverse deflections w_k are outputs by
+        default (eqs. 5.36, 5.38 for the presets; file table ``[monitor] points``).
+    model_defaults : dict
+        Default options of the models for this system, ``{model: {option: value}}`` (file
+        table ``[models.<name>]``; the presets carry the dissertation's membrane modes K of
+        the control-oriented model).
     """
 
     name: str
@@ -83,6 +93,9 @@ class System:
     description: str = ""
     notes: tuple = ()
     printed: dict = field(default_factory=dict)
+    monitor_nodes: tuple = ()
+    monitor_points: np.ndarray = field(default_factory=lambda: np.zeros((2, 0)))
+    model_defaults: dict = field(default_factory=dict)
 
     def __post_init__(self):
         M, N = self.M, self.N
@@ -120,6 +133,16 @@ class System:
         object.__setattr__(self, "q", q)
         object.__setattr__(self, "membrane_corners", corners)
         object.__setattr__(self, "tendons", tendons)
+        pts = np.asarray(self.monitor_points, dtype=float).reshape(2, -1) \
+            if np.size(self.monitor_points) else np.zeros((2, 0))
+        if not np.all(np.isfinite(pts)):
+            raise InputError(f"expected finite monitored membrane points, found {pts.T.tolist()}")
+        object.__setattr__(self, "monitor_points", pts)
+        for n in self.monitor_nodes:
+            if n not in labels:
+                raise InputError(f"monitored node: expected one of the nodes of a {M}-{N} system, "
+                                 f"found {n!r}")
+        object.__setattr__(self, "monitor_nodes", tuple(self.monitor_nodes))
         for t in tendons:
             self.tendon_section(t)
         if self.rest_lengths is not None:
@@ -132,7 +155,8 @@ class System:
                          membrane: MembraneMaterial, bar: BarSection, tendon_sections: dict,
                          deployable: bool = False, k_H: float | None = None,
                          rest_lengths: dict | None = None, description: str = "",
-                         notes=(), printed: dict | None = None) -> "System":
+                         notes=(), printed: dict | None = None, monitor_nodes=(),
+                         monitor_points=None, model_defaults: dict | None = None) -> "System":
         """Build a symmetric system (3.3.1) from its parametrisation.
 
         ``rest_lengths`` may be given per group (``{"S1": 1.5}``) or per tendon name.
@@ -142,7 +166,9 @@ class System:
         sys = cls(name=name, M=config.M, N=N, deployable=deployable, **config.system_arrays(N),
                   membrane=membrane, membrane_corners=membrane_corners_regular(N, r_mb), bar=bar,
                   tendon_sections=dict(tendon_sections), k_H=k_H, symmetric=config, r_mb=r_mb,
-                  description=description, notes=tuple(notes), printed=dict(printed or {}))
+                  description=description, notes=tuple(notes), printed=dict(printed or {}),
+                  monitor_nodes=tuple(monitor_nodes), model_defaults=dict(model_defaults or {}),
+                  monitor_points=np.zeros((2, 0)) if monitor_points is None else monitor_points)
         if rest_lengths:
             sys = sys.with_rest_lengths(rest_lengths)
         return sys

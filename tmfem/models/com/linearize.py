@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.models.base import LinearPlant
 
 
 @dataclass
@@ -42,6 +43,13 @@ class Linearization:
         lam = sla.eigvals(self.K, self.M)
         lam = np.sort(lam.real)
         return np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
+
+    def plant(self, *, x0=None, v0=None):
+        """The linearised model as a simulation plant (:class:`tmfem.models.base.LinearPlant`)
+        in the same coordinates: M a + C v + K (z - z_e) + B_hat (u - u_e) = 0."""
+        return LinearPlant(M=self.M, C=self.C, K=self.K, B=self.B_hat, Cy=self.Cy, x_e=self.z_e,
+                           u_e=self.u_e, y_e=self.y_e, input_names=self.input_names,
+                           output_names=self.output_names, x0=x0, v0=v0)
 
     def to_ss(self, name: str = "com"):
         """python-control ``StateSpace`` with named states, inputs and outputs."""

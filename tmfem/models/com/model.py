@@ -33,11 +33,10 @@ from tmfem.models.com.kinematics import (bar_kinetic_energy_sx, bars_sx, rotatio
 from tmfem.models.com.membrane_modes import build_membrane_basis
 from tmfem.system.geometry import rotation_ef
 
-# Monitored membrane points of 6.5 (eqs. 5.36 and 5.38), (x_f, y_f) in m.
-MONITOR_POINTS = {
-    "1-4": [(0.6, 1.6), (0.5, 0.4), (1.5, 0.3)],
-    "2-3": [(0.86, 0.50), (0.86, 0.98), (0.45, 0.26)],
-}
+def default_membrane_modes(system) -> int:
+    """K of the system's ``[models.com] membrane_modes`` (the presets carry the
+    dissertation's: 5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6D), else 4."""
+    return int(system.model_defaults.get("com", {}).get("membrane_modes", 4))
 
 
 def _sq(v):
@@ -85,8 +84,8 @@ class ControlOrientedModel:
         zeta(q) written in closed form from the definition of O_f and substituted into the
         Lagrangian before differentiation (an independent formulation, used as a check).
     output_points : list of (x_f, y_f), optional
-        Membrane points whose transverse deflection w is an output; default: the monitored
-        points of eqs. 5.36/5.38 for the presets ``1-4`` and ``2-3``.
+        Membrane points whose transverse deflection w is an output; default:
+        ``system.monitor_points`` (eqs. 5.36/5.38 for the presets ``1-4`` and ``2-3``).
     """
 
     def __init__(self, system, *, membrane_modes: int = 4, mesh_n: int = 10,
@@ -139,7 +138,7 @@ class ControlOrientedModel:
         self.P = np.eye(self.nz)
         if membrane_points is not None:
             self._set_point_coordinates(membrane_points)
-        pts = output_points if output_points is not None else MONITOR_POINTS.get(system.name, [])
+        pts = output_points if output_points is not None else system.monitor_points.T
         self.output_points = [tuple(map(float, p)) for p in pts]
         self._Wout = self.membrane.point_matrix(np.array(self.output_points).T, 2) \
             if self.output_points else np.zeros((0, 1 + self.layout.n_delta + self.K))

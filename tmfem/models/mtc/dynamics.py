@@ -37,21 +37,24 @@ local frame e_t1 (chord), e_t2 = e_t1 x e_z / |.|, e_t3 = e_t1 x e_t2 (eq. 5.37;
 """
 from __future__ import annotations
 
-import sys
-from dataclasses import dataclass, field
-
 import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
+from tmfem.models.base import split_perturbation
 from tmfem.models.mtc.post import q_from_positions
 from tmfem.models.mtc.topology import to_floating
-from tmfem.fem.truss import truss_internal
 
 
 class MTCDynamics:
-    """The MTC equation of motion on the free DOFs, as a residual for ``park_integrate``.
+    """The MTC equation of motion on the free DOFs as a :class:`tmfem.models.base.Plant`.
+
+    Inputs u: the tendon rest lengths ``r_<tendon>`` (each tendon's k elements get u / k);
+    outputs y: the bar coordinates q recovered from the bar nodes (eqs. 3.1-3.2) and the
+    transverse deflections w_k in the floating frame at ``output_points`` (eqs. 5.36-5.38),
+    as a sensor would measure them. The start state ``x0, v0`` is the equilibrium with the
+    perturbation of :func:`initial_state`.
 
     Parameters
     ----------
@@ -60,9 +63,14 @@ class MTCDynamics:
         The static equilibrium (``model.solve_static().x``); the fixed DOFs stay there.
     alpha, beta : float
         Rayleigh damping C = alpha M + beta K_0 [1/s, s] (default: undamped).
+    perturb : dict, optional
+        Initial perturbation by coordinate name (``theta_12_dot=0.01``).
+    output_points : array (2, n) or list of (x_f, y_f), optional
+        Default ``system.monitor_points``.
     """
 
-    def __init__(self, model, x_eq, *, alpha: float = 0.0, beta: float = 0.0):
+    def __init__(self, model, x_eq, *, alpha: float = 0.0, beta: float = 0.0,
+                 perturb: dict | None = None, output_points=None):
         if not (np.isfinite(alpha) and np.isfinite(beta) and alpha >= 0 and beta >= 0):
             raise InputError(f"Rayleigh damping: expected alpha, beta >= 0, found {alpha}, {beta}")
         self.model = model
@@ -74,6 +82,15 @@ class MTCDynamics:
         self.K0 = K0[f][:, f].tocsc()
         self.alpha, self.beta = float(alpha), float(beta)
         self.C = (self.alpha * self.M + self.beta * self.K0).tocsc() if (alpha or beta) else None
+        system = model.system
+        pts = system.monitor_points.T if output_points is None else np.reshape(output_points, (-1, 2))
+        self.output_points = [tuple(map(float, p)) for p in pts]
+        self._P = point_matrix(model.membrane.skmesh, np.asarray(self.output_points).T) \
+            if self.output_points else None
+        self.u0 = np.asarray(model.rest_lengths, dtype=float)
+        self.input_names = [f"r_{t.name}" for t in system.tendons]
+        self.output_names = list(system.q_names) + [f"w_{i + 1}" for i in range(len(self.output_points))]
+        self.x0, self.v0 = initial_state(self, perturb)
 
     # state <-> positions
     def state0(self) -> np.ndarray:
@@ -90,9 +107,15 @@ class MTCDynamics:
         """Full node positions (3, n_nodes) of the free-DOF state u."""
         return self.model.full(self.reduced(u))
 
-    # park_integrate protocol
-    def residual(self, x, v, a, t):
-        """r = M a + C v + f_int(x) on the free DOFs (module docstring)."""
+    # Plant protocol (tmfem.models.base)
+    def _inputs(self, u) -> None:
+        # the plant drives its model: the tendon rest lengths are the inputs of this call
+        # (the nominal u0 when none are given), so the model is left at the last u
+        self.model.set_tendon_lengths(self.u0 if u is None else u)
+
+    def residual(self, x, v, a, t, u=None):
+        """r = M a + C v + f_int(x; u) on the free DOFs (module docstring)."""
+        self._inputs(u)
         r, _ = self.model.residual(self.reduced(x), tangent=False)
         out = r[self.free] + self.M @ a
         if self.C is not None:
@@ -104,23 +127,36 @@ class MTCDynamics:
         _, K = self.model.residual(self.reduced(x))
         return K[self.free][:, self.free]
 
-    def jacobians(self, x, v, a, t):
+    def jacobians(self, x, v, a, t, u=None):
         """(dr/dx, dr/dv, dr/da) = (K_T, C, M)."""
+        self._inputs(u)
         K = self._tangent(x)
         C = self.C if self.C is not None else sp.csc_matrix(K.shape)
         return K, C, self.M
 
-    def newton_matrix(self, x, v, a, t, cv, ca):
+    def newton_matrix(self, x, v, a, t, cv, ca, u=None):
         """K_T + cv C + ca M, the Newton matrix of Park's method (eq. 5.34)."""
+        self._inputs(u)
         S = self._tangent(x) + ca * self.M
         if self.C is not None:
             S = S + cv * self.C
         return S.tocsc()
 
     def factorize(self, S):
-        """Solver of the Newton matrix: the default backend's symmetric-mode sparse LU."""
-        from tmfem.solvers.backends import get_backend
-        return get_backend().factorize(S)
+        """Solver of the Newton matrix: the model's backend (symmetric-mode sparse LU)."""
+        return self.model.backend.factorize(S)
+
+    def outputs(self, x, v=None, u=None) -> np.ndarray:
+        """y = [q, w_k]: bar coordinates from the bar nodes (eqs. 3.1-3.2) and membrane
+        deflections along z_f of the floating frame at the output points (eqs. 5.36-5.38)."""
+        xf = self.positions(x)
+        topo = self.model.topology
+        q = q_from_positions(self.model.system, xf[:, topo.system_node])
+        if self._P is None:
+            return q
+        xm = xf[:, :topo.n_mesh]
+        w = to_floating((self._P @ xm.T).T, xm[:, topo.mesh.corners])[2]
+        return np.concatenate([q, w])
 
     # energies
     def kinetic_energy(self, v) -> float:
@@ -149,7 +185,6 @@ def initial_state(dyn: MTCDynamics, perturb: dict | None, *, h: float = 1e-6):
     u0 = dyn.state0()
     if not perturb:
         return u0, np.zeros_like(u0)
-    from tmfem.models.com.simulate import split_perturbation
     dq, dqd = split_perturbation(perturb, system.q_names)
     x_eq = model.full(dyn.xr_eq)
     q_e = q_from_positions(system, x_eq[:, topo.system_node])
@@ -190,8 +225,7 @@ def initial_state(dyn: MTCDynamics, perturb: dict | None, *, h: float = 1e-6):
     o = ~pf
     Koo = K[o][:, o].tocsc()
     Kop = K[o][:, pf]
-    from tmfem.solvers.backends import get_backend
-    solve = get_backend().factorize(Koo)
+    solve = model.backend.factorize(Koo)
 
     def condense(p):
         out = np.zeros(free.sum())
@@ -204,26 +238,6 @@ def initial_state(dyn: MTCDynamics, perturb: dict | None, *, h: float = 1e-6):
     if np.any(dpf):
         u0 = u0 + condense(dpf)
     return u0, v0
-
-
-@dataclass
-class MTCVibration:
-    """Result of :func:`mtc_free_vibration` (histories as arrays, one row per time)."""
-
-    t: np.ndarray
-    q: np.ndarray                 # (nt, nq) generalised coordinates recovered from the bars
-    w: np.ndarray                 # (nt, n_points) transverse deflections in O_f [m]
-    nodes: dict                   # label -> (nt, 3)
-    tendon_deflection: np.ndarray  # (nt,) largest tendon transverse deflection [m]
-    kinetic: np.ndarray
-    strain: np.ndarray
-    columns: list
-    wall_time: float
-    stats: dict = field(default_factory=dict)
-
-    @property
-    def energy(self) -> np.ndarray:
-        return self.kinetic + self.strain
 
 
 def tendon_transverse(model, x) -> np.ndarray:
@@ -239,109 +253,6 @@ def tendon_transverse(model, x) -> np.ndarray:
     e3 = np.cross(e1.T, e2.T).T
     d = x[:, topo.tendon_internal] - a[:, :, None]           # (3, n_t, k-1)
     return np.stack([np.einsum("it,itk->tk", e2, d), np.einsum("it,itk->tk", e3, d)], axis=-1)
-
-
-def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: dict | None = None,
-                       csv_path=None, scheme: str = "park", jacobian: str = "step",
-                       alpha: float = 0.0, beta: float = 0.0, monitor_nodes=None,
-                       output_points=None, progress: bool = False, vtk_dir=None,
-                       vtk_every: int = 10, tol: float = 1e-10) -> MTCVibration:
-    """Free vibration of an MTC model from its equilibrium ``x_eq`` (6.5, eqs. 5.34-5.35).
-
-    Parameters
-    ----------
-    model : MTCModel
-    x_eq : ndarray (3, n_nodes)
-        Static equilibrium of ``model``.
-    t_end, dt : float
-        Duration and time step (6.5: dt = 0.01 s).
-    perturb : dict
-        ``{"theta_12_dot": 0.01}`` etc. (see :func:`initial_state`).
-    scheme, jacobian, tol :
-        Passed to :func:`park_integrate` (default ``"step"``: one factorisation per step,
-        modified Newton; measured on 2-3 at n = 10 it needs half the factorisations of
-        ``"reuse"``, whose stale matrices diverge at times and restart with full Newton).
-    alpha, beta : float
-        Rayleigh damping (default none).
-    monitor_nodes : list of str, optional
-        Labelled nodes recorded (default ``MONITOR_NODES`` of the preset).
-    output_points : list of (x_f, y_f), optional
-        Membrane points for w (default ``MONITOR_POINTS`` of the preset, eqs. 5.36, 5.38).
-    csv_path, vtk_dir, vtk_every :
-        Histories written row by row; ParaView frames every ``vtk_every`` steps.
-    """
-    from tmfem.models.com.model import MONITOR_POINTS
-    from tmfem.models.com.simulate import MONITOR_NODES, RunOutputs
-    if not (t_end > 0 and dt > 0):
-        raise InputError(f"expected t_end > 0 and dt > 0, found t_end={t_end!r}, dt={dt!r}")
-    system, topo = model.system, model.topology
-    dyn = MTCDynamics(model, x_eq, alpha=alpha, beta=beta)
-    u0, v0 = initial_state(dyn, perturb)
-    labels = MONITOR_NODES.get(system.name, []) if monitor_nodes is None else list(monitor_nodes)
-    lab_nodes = [topo.system_node[system.node_index(n)] for n in labels]
-    pts = MONITOR_POINTS.get(system.name, []) if output_points is None else list(output_points)
-    P = point_matrix(model.membrane.skmesh, np.reshape(pts, (-1, 2)).T) if pts else None
-    nm = topo.n_mesh
-    corners = topo.mesh.corners
-    x0 = dyn.positions(u0)
-    has_int = topo.tendon_internal.size > 0
-    td0 = tendon_transverse(model, model.full(dyn.xr_eq)) if has_int else None
-    qn = list(system.q_names)
-    wn = [f"w_{i + 1}" for i in range(len(pts))]
-    columns = (["t"] + qn + wn + [f"{n}_{c}" for n in labels for c in "xyz"]
-               + ["tendon_deflection", "kinetic_energy", "strain_energy"])
-    n_steps = int(round(t_end / dt))
-    T, Q, W, XS, TD, KE, SE = [], [], [], [], [], [], []
-    out = RunOutputs(csv_path=csv_path, columns=columns, vtk_dir=vtk_dir, vtk_every=vtk_every,
-                     name=f"mtc_{system.name}", label=f"vibrate {system.name} MTC", dt=dt,
-                     t_end=t_end, progress=progress)
-    element_tendon = [system.tendons[k].name for k in topo.tendon_of_element]
-    worst = [0.0, ""]
-
-    def record(t, u, v, a):
-        x = dyn.positions(u)
-        q = q_from_positions(system, x[:, topo.system_node])
-        if P is not None:
-            xm = x[:, :nm]
-            w = to_floating((P @ xm.T).T, xm[:, corners])[2]
-        else:
-            w = np.zeros(0)
-        if has_int:
-            d = np.linalg.norm(tendon_transverse(model, x) - td0, axis=-1)      # (n_t, k-1)
-            k = int(np.argmax(d.max(axis=1)))
-            td = float(d[k].max())
-            if td > worst[0]:
-                worst[:] = [td, system.tendons[k].name]
-        else:
-            td = 0.0
-        ke, se = dyn.kinetic_energy(v), dyn.strain_energy(u)
-        out.tendon_forces(t, truss_internal(x, model.tendons, tangent=False).N, element_tendon)
-        pos = x[:, lab_nodes]
-        if out.frame_due():
-            from tmfem.models.mtc.post import member_state, membrane_field
-            ms = member_state(model, x)
-            out.series.append_configuration(t, system, q=q, tendon_forces=ms["tendon_force"],
-                                            rest_lengths=model.rest_lengths,
-                                            membrane=membrane_field(model, x),
-                                            bar_forces=ms["bar_force"])
-        T.append(t); Q.append(q); W.append(w); XS.append(pos); TD.append(td); KE.append(ke)
-        SE.append(se)
-        out.row(t, np.concatenate([q, w, pos.T.ravel(), [td, ke, se]]))
-
-    res, wall = out.integrate(dyn, x0=u0, v0=v0, n_steps=n_steps, scheme=scheme,
-                              jacobian=jacobian, callback=record, tol=tol)
-    Xa = np.array(XS)
-    stats = out.stats(res)
-    stats.update({"ndof": int(dyn.free.sum()), "max_tendon_deflection": worst[0],
-                  "max_tendon_deflection_tendon": worst[1]})
-    if stats["min_tendon_force"] <= 0:
-        print(f"warning: tendon {stats['min_tendon_force_tendon']} went slack at t = "
-              f"{stats['min_tendon_force_time']:.4g} s (tension-only in the MTC model)",
-              file=sys.stderr)
-    return MTCVibration(t=np.array(T), q=np.array(Q), w=np.array(W),
-                        nodes={n: Xa[:, :, k] for k, n in enumerate(labels)},
-                        tendon_deflection=np.array(TD), kinetic=np.array(KE), strain=np.array(SE),
-                        columns=columns, wall_time=wall, stats=stats)
 
 
 def fit_frequency(t, y, *, f_min: float, f_max: float, n_grid: int = 2000) -> float:

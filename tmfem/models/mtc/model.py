@@ -25,18 +25,20 @@ converged state (eq. 5.32).
 """
 from __future__ import annotations
 
-import sys
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.element import State, assemble
 from tmfem.fem.membrane import MembraneElement, MembraneTL
 from tmfem.models.mtc.topology import MTCTopology, build_topology, membrane_placement
+from tmfem.solvers.backends import get_backend
+from tmfem.solvers.eigen import lowest_modes
+from tmfem.solvers.newton import newton
+from tmfem.solvers.trust_region import trust_region_newton
 from tmfem.fem.truss import (TrussElement, TrussSet, green_rest_length, linear_rest_length,
                              truss_internal)
 from tmfem.system.topology import label
@@ -93,12 +95,16 @@ class MTCModel:
     lumped_tendon_mass : bool
         Lumped instead of consistent truss mass for the tendons (bars always consistent: it
         gives a pinned rigid bar its exact rotary inertia m l^2 / 3).
+    backend : str or Backend
+        Linear-algebra backend of every factorisation and eigen solve (``"scipy"`` default;
+        :func:`tmfem.solvers.get_backend`).
     """
 
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
-                 lumped_tendon_mass: bool = False):
+                 lumped_tendon_mass: bool = False, backend="scipy"):
         self.system = system
+        self.backend = get_backend(backend)
         self.mesh_n, self.patch = mesh_n, patch
         self.topology: MTCTopology = build_topology(system, mesh_n=mesh_n,
                                                     tendon_elements=tendon_elements,
@@ -162,6 +168,18 @@ class MTCModel:
         self.tendon_element = TrussElement(self.tendons, self.topology.dofmap,
                                            lumped_mass=self.lumped_tendon_mass)
         self._M = None
+
+    def set_tendon_lengths(self, u) -> None:
+        """Tendon rest lengths as time-varying inputs (a plant's u): the reference lengths of
+        the tendon elements become u / k in place (no re-assembly of patterns)."""
+        u = np.asarray(u, dtype=float)
+        if u.shape != self.rest_lengths.shape or not np.all(u > 0):
+            raise InputError(f"expected {self.rest_lengths.size} positive tendon rest lengths, "
+                             f"found {u}")
+        if np.array_equal(u, self.rest_lengths):
+            return
+        self.rest_lengths = u.copy()
+        self.tendons.L = u[self.topology.tendon_of_element] / self.topology.tendon_elements
 
     @property
     def elements(self) -> list:
@@ -281,7 +299,7 @@ class MTCModel:
 
     # ------------------------------------------------------------------ statics
     def solve_static(self, *, start: str = "undeformed", x0: np.ndarray | None = None,
-                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress: bool = False,
+                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress=None,
                      sequence: int | None = None) -> StaticResult:
         """Equilibrium reached from ``start`` (6.2): Newton regularised by a mass-scaled
         Levenberg-Marquardt trust region on the strain energy (module docstring).
@@ -296,6 +314,9 @@ class MTCModel:
             Newton step (mu = 0) or a step shorter than 1 nm.
         monitor : sequence of str
             Node labels (``"B_14"``) whose positions are recorded at every iteration.
+        progress : callable, optional
+            ``progress(iteration, rnorm, mu, rho)`` after every accepted step (the CLI's
+            progress display); iterations are logged at DEBUG level in any case.
         sequence : int, optional
             Mesh sequencing (nested iteration): first solve the same system on the membrane
             mesh max(sequence, n // 2) (recursively, down to n = ``sequence``, from the same
@@ -309,7 +330,7 @@ class MTCModel:
             coarse = MTCModel(self.system, mesh_n=n_coarse,
                               tendon_elements=self.topology.tendon_elements,
                               attachment=self.topology.attachment, rest_lengths=self.rest_lengths,
-                              lumped_tendon_mass=self.lumped_tendon_mass)
+                              lumped_tendon_mass=self.lumped_tendon_mass, backend=self.backend)
             rc = coarse.solve_static(start=start, tol=tol, max_iter=max_iter, monitor=monitor,
                                      progress=progress, sequence=sequence)
             fine = self.solve_static(x0=self.interpolate_from(coarse, rc.x), tol=tol,
@@ -322,84 +343,29 @@ class MTCModel:
                 newton_iterations_tangent=(rc.newton_iterations_tangent or [rc.iterations])
                 + [fine.iterations])
         x = self.initial_positions(start) if x0 is None else np.asarray(x0, dtype=float)
-        xr = self.reduce(x)
         free = self.free
         idx = {lab: self.topology.system_node[self.system.node_index(lab)] for lab in monitor}
         hist = {lab: [x[:, n].copy()] for lab, n in idx.items()}
         Md = np.asarray(self.mass().diagonal())[free]
-        Md = np.maximum(Md, 1e-9 * Md.max())
-        Dm = sp.diags(Md)
-        r, K = self.residual(xr)
-        rn = np.linalg.norm(r[free])
-        W = self.energy(xr)
-        res_hist, mu_hist = [rn], []
-        Kd = np.abs(K.diagonal()[free])
-        mu_scale = float(np.median(Kd[Kd > 0]) / np.median(Md)) if np.any(Kd > 0) else 1.0
-        # from the design the tangent is already positive definite: try Newton first
-        mu = 0.0 if (x0 is not None or start == "design") else 1e-3 * mu_scale
-        it = 0
-        converged = False
-        for it in range(1, max_iter + 1):
-            Kf = K[free][:, free]
-            g = r[free]
-            for _attempt in range(40):
-                A = (Kf + mu * Dm) if mu > 0 else Kf
-                du = _solve_symmetric(A, -g)
-                ok = np.all(np.isfinite(du)) and float(g @ du) < 0
-                if ok:
-                    xt = xr.copy()
-                    xt[free] += du
-                    Wt = self.energy(xt)
-                    pred = -(float(g @ du) + 0.5 * float(du @ (Kf @ du)))
-                    actual = W - Wt
-                    rt, Kt = self.residual(xt)
-                    rtn = np.linalg.norm(rt[free])
-                    # near the solution energy differences drown in round-off: accept a
-                    # step that reduces the residual there
-                    tiny = abs(pred) < 1e-11 * max(abs(W), 1e-30)
-                    if np.isfinite(Wt) and (actual > 0 or (tiny and rtn < rn)):
-                        rho = actual / pred if pred > 0 and not tiny else 1.0
-                        break
-                mu = max(4.0 * mu, 1e-8 * mu_scale)
-                if mu > 1e12 * mu_scale:
-                    break
-            else:
-                ok = False
-            if not ok or mu > 1e12 * mu_scale:
-                # no step improves the state: accept it if we sit on the round-off floor
-                if rn <= 1e3 * tol * self._force_scale(self.full(xr)):
-                    converged = True
-                    break
-                raise ConvergenceError(f"MTC static solve: no descent step at iteration {it} "
-                                       f"(|r| = {rn:.3e} N, mu = {mu:.3e}); residual history "
-                                       f"{np.array(res_hist[-6:])} N")
-            mu_used = mu
-            xr, r, K, W, rn = xt, rt, Kt, Wt, rtn
-            if rho > 0.75:
-                mu = 0.0 if mu < 1e-10 * mu_scale else mu / 8.0
-            elif rho < 0.25:
-                mu = max(4.0 * mu, 1e-8 * mu_scale)
-            res_hist.append(rn)
-            mu_hist.append(mu_used)
+
+        def record(it, xr, rn, mu, rho):
             xf = self.full(xr)
             for lab, n in idx.items():
                 hist[lab].append(xf[:, n].copy())
-            if progress:
-                print(f"  static it {it:3d}  |r| = {rn:.3e} N  mu = {mu_used:.3g}  rho = {rho:.3g}",
-                      file=sys.stderr)
-            step = float(np.abs(du).max())
-            if rn <= tol * self._force_scale(xf) and (mu_used == 0.0 or step < 1e-9):
-                converged = True
-                break
-            if it >= 60 and min(res_hist[-40:]) > 0.1 * min(res_hist[:-40]):
-                break          # stagnation: no tenfold progress in 40 iterations
-        if not converged:
-            raise ConvergenceError(f"MTC static solve: no equilibrium after {it} iterations "
-                                   f"({self._state_note(xr)}); residual history "
-                                   f"{np.array(res_hist[-6:])} N, mu = {mu:.3g}")
-        return StaticResult(x=self.full(xr), iterations=it, residual_history=res_hist,
+            if callable(progress):
+                progress(it, rn, mu, rho)
+
+        res = trust_region_newton(
+            self.residual, self.energy, self.reduce(x), free=free,
+            scale=np.maximum(Md, 1e-9 * Md.max()), force_scale=lambda xr: self._force_scale(self.full(xr)),
+            tol=tol, max_iter=max_iter, backend=self.backend, callback=record,
+            # from the design the tangent is already positive definite: try Newton first
+            newton_first=(x0 is not None or start == "design"),
+            describe=self._state_note, what="MTC static solve")
+        return StaticResult(x=self.full(res.u), iterations=res.iterations,
+                            residual_history=res.residual_history,
                             monitor={k: np.array(v) for k, v in hist.items()},
-                            dt2_history=mu_hist, time=time.perf_counter() - t0)
+                            dt2_history=res.mu_history, time=time.perf_counter() - t0)
 
     def _force_scale(self, x: np.ndarray) -> float:
         """1 N + the sum of |member forces| at positions x: the scale of the convergence test
@@ -428,9 +394,8 @@ class MTCModel:
         Returns a ``Modes`` of :func:`tmfem.solvers.lowest_modes` whose ``shapes`` are the
         reduced vectors; :meth:`full_shapes` maps them to all nodes.
         """
-        from tmfem.solvers import lowest_modes
         _, K = self.residual(self.reduce(x))
-        return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma)
+        return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma, backend=self.backend)
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
         """Mode shapes (3, n_nodes, k) from reduced vectors (3 n_red, k)."""
@@ -463,43 +428,43 @@ class MTCModel:
         for c in corners:
             freem[3 * c:3 * c + 3] = False
         xm = x[:, :nm].T.ravel().copy()
-        for it in range(50):
-            f, K = self.membrane.internal(xm.reshape(-1, 3).T)
-            fn = np.linalg.norm(f[freem])
-            scale = np.linalg.norm(f[~freem]) + 1e-30
-            if fn <= tol * scale:
-                break
-            du = spla.spsolve(K[freem][:, freem].tocsc(), -f[freem])
-            xm[freem] += du
-        else:
-            raise ConvergenceError(f"membrane with prescribed corners: |r| = {fn:.3e} N after 50 "
-                                   f"iterations")
+
+        def residual(u):
+            return self.membrane.internal(u.reshape(-1, 3).T)
+        # converged when the free residual is tol times the corner reactions (at the start,
+        # the affine stretch onto the design corners, which they hardly change)
+        f0, _ = residual(xm)
+        res = newton(residual, xm, free=freem, tol=tol, scale=np.linalg.norm(f0[~freem]) + 1e-30,
+                     max_iter=50, line_search=False, backend=self.backend)
+        f, _ = residual(res.u)
         Fc = -f.reshape(-1, 3)[corners].T                  # force of the membrane on corner j (3, N)
         return self._consistent_from_corner_forces(Fc)
 
     def _distributed_corner_forces(self, xm: np.ndarray, *, tol: float) -> np.ndarray:
         """Forces (3, N) of the membrane on the bar tops with the patch centroids held at
-        their design positions: Newton on the bordered system [[K, s C^T], [s C, 0]]
-        (C: the attachment coupling; the start ``xm`` satisfies C x = B_top already)."""
+        their design positions: Newton on the bordered system of (x, mu),
+        [f(x) + s C^T mu, s (C x - C x_0)] = 0 with tangent [[K, s C^T], [s C, 0]]
+        (C: the attachment coupling; the start ``xm`` satisfies C x = B_top already; s scales
+        the multiplier to the stiffness). The force on bar top j is s mu_j."""
         from tmfem.fem.attachment import coupling_matrix
         nm = self.topology.n_mesh
         C = coupling_matrix(self.topology.weights, nm, 3)
-        CCt = (C @ C.T).toarray()
-        for it in range(50):
-            f, K = self.membrane.internal(xm.reshape(-1, 3).T)
-            lam = -np.linalg.solve(CCt, C @ f)             # least-squares multipliers
-            fn = np.linalg.norm(f + C.T @ lam)
-            if fn <= tol * (np.linalg.norm(lam) + 1e-30):
-                break
-            s = float(np.abs(K.diagonal()).mean())
-            A = sp.bmat([[K, s * C.T], [s * C, None]], format="csc")
-            du = spla.spsolve(A, np.concatenate([-f, np.zeros(C.shape[0])]))[:3 * nm]
-            xm += du
-        else:
-            raise ConvergenceError(f"membrane with prescribed corner patches: |r| = {fn:.3e} N "
-                                   f"after 50 iterations")
-        # f_int = C^T mu with mu the force on the membrane; lam = -mu is the force on the bar
-        return lam.reshape(-1, 3).T
+        b = C @ xm
+        f0, K0 = self.membrane.internal(xm.reshape(-1, 3).T)
+        s = float(np.abs(K0.diagonal()).mean())
+        lam0 = -np.linalg.solve((C @ C.T).toarray(), C @ f0)      # least-squares multipliers
+
+        def residual(w):
+            f, K = self.membrane.internal(w[:3 * nm].reshape(-1, 3).T)
+            mu = w[3 * nm:]
+            r = np.concatenate([f + s * (C.T @ mu), s * (C @ w[:3 * nm] - b)])
+            return r, sp.bmat([[K, s * C.T], [s * C, None]], format="csr")
+
+        w0 = np.concatenate([xm, lam0 / s])
+        res = newton(residual, w0, tol=tol, scale=np.linalg.norm(lam0) + 1e-30, max_iter=50,
+                     line_search=False, backend=self.backend)
+        # f_int = -s C^T mu at the solution: s mu is the force of the membrane on the bar tops
+        return (s * res.u[3 * nm:]).reshape(-1, 3).T
 
     def _consistent_from_corner_forces(self, Fc: np.ndarray) -> dict:
         """Steps (2)-(3) of :meth:`consistent_rest_lengths` for the corner forces Fc (3, N)."""
@@ -547,13 +512,3 @@ class MTCModel:
         out["rest_lengths"] = green_rest_length(L, T, self.tendon_EA)
         out["rest_lengths_linear"] = linear_rest_length(L, T, self.tendon_EA)
         return out
-
-
-def _solve_symmetric(A, b) -> np.ndarray:
-    """Solve A x = b with the default backend's factorisation (symmetric-mode SuperLU);
-    NaN when the matrix is singular (the trust region then regularises harder)."""
-    from tmfem.solvers.backends import SingularMatrix, get_backend
-    try:
-        return get_backend().factorize(A)(b)
-    except SingularMatrix:
-        return np.full(b.shape, np.nan)

@@ -32,7 +32,7 @@ def member_state(model, x: np.ndarray) -> dict:
     """Bar and tendon forces at positions x (3, n_nodes).
 
     Tendon force = mean axial force of its k elements (equal in statics: no gravity);
-    slack = any element slack.
+    slack = any element slack; ``element_force`` the axial force of every tendon element.
     """
     tb = truss_internal(x, model.bars, tangent=False)
     tt = truss_internal(x, model.tendons, tangent=False)
@@ -41,7 +41,7 @@ def member_state(model, x: np.ndarray) -> dict:
     T = np.bincount(e, weights=tt.N, minlength=nt) / np.bincount(e, minlength=nt)
     slack = np.bincount(e, weights=tt.slack.astype(float), minlength=nt) > 0
     return {"bar_force": tb.N, "tendon_force": T, "tendon_slack": slack,
-            "tendon_stress": T / model.tendon_area}
+            "tendon_stress": T / model.tendon_area, "element_force": tt.N}
 
 
 def membrane_stress_summary(model, x: np.ndarray) -> dict:

@@ -7,27 +7,21 @@ for 2-3) are printed beside ours.
 """
 from __future__ import annotations
 
-import sys
+import logging
 
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.models.com.linearize import linearize
+from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.reference.tables import FREQUENCIES, HIGHEST_COM_FREQUENCY
 
-# Numbers of membrane modes used by the dissertation (6.4.1, 6.4.2, 7.4).
-DISSERTATION_K = {"1-4": 5, "2-3": 4, "1-4D": 3, "1-6D": 5}
-
+log = logging.getLogger(__name__)
 
 def dissertation_com_frequencies(name: str):
     """COM column of Table 6.6 (1-4) or 6.7 (2-3), or None."""
     ref = FREQUENCIES.get(name)
     return None if ref is None else (ref["source"], list(ref["COM"]))
-
-
-def default_membrane_modes(system) -> int:
-    """K of the dissertation for its systems (5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6(D))."""
-    base = system.name.split("-initial")[0].replace("(D)", "D")
-    return DISSERTATION_K.get(base, 4)
 
 
 def printed_prestress_scale(model) -> float | None:
@@ -60,8 +54,6 @@ def printed_bar_load_prestress_scale(model, *, mesh_n: int = 10) -> float | None
 def com_frequencies(system, *, membrane_modes: int, prestress_scale: float = 1.0,
                     mesh_n: int = 10, rest_lengths=None):
     """(frequencies in Hz, model) of the COM linearised about its equilibrium (eq. 5.33)."""
-    from tmfem.models.com.linearize import linearize
-    from tmfem.models.com.model import ControlOrientedModel
     if rest_lengths is None:       # the system's own (e.g. printed) if it has them
         rest_lengths = "design" if system.rest_lengths is None else "system"
     m = ControlOrientedModel(system, membrane_modes=membrane_modes, mesh_n=mesh_n,
@@ -87,7 +79,7 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
     K = default_membrane_modes(system) if membrane_modes is None else int(membrane_modes)
     if not (isinstance(modes, int) and modes >= 1):
         raise InputError(f"--modes: expected an integer >= 1, found {modes!r}")
-    print(f"tmfem modal: {system.name} COM, K = {K} membrane modes", file=sys.stderr)
+    log.info("%s COM, K = %d membrane modes", system.name, K)
     f, m = com_frequencies(system, membrane_modes=K, prestress_scale=prestress_scale,
                            mesh_n=mesh_n)
     n = min(modes, len(f))
@@ -111,7 +103,7 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
     if s_bar is not None:
         out["printed_bar_load_prestress_scale"] = s_bar
     ref = dissertation_com_frequencies(system.name)
-    if ref is not None and K == DISSERTATION_K.get(system.name):
+    if ref is not None and K == default_membrane_modes(system):
         src, com = ref
         k = min(n, len(com))
         out["dissertation"] = {"source": src, "COM": com[:k],
@@ -145,13 +137,12 @@ def format_summary(r: dict) -> str:
 
 
 def frequency_study(system, *, K_values, prestress_scales=(1.0,), modes: int = 12,
-                    mesh_n: int = 10, progress=True) -> list[dict]:
+                    mesh_n: int = 10) -> list[dict]:
     """Frequencies vs number of membrane modes K and prestress factor (rows of dicts)."""
     rows = []
     for s in prestress_scales:
         for K in K_values:
-            if progress:
-                print(f"frequency study {system.name}: prestress x{s:g}, K = {K}", file=sys.stderr)
+            log.info("frequency study %s: prestress x%g, K = %d", system.name, s, K)
             f, m = com_frequencies(system, membrane_modes=K, prestress_scale=s, mesh_n=mesh_n)
             rows.append({"prestress_scale": s, "K": K, "freq_hz": f[:modes].tolist(),
                          "highest_hz": float(f[-1])})

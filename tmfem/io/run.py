@@ -1,0 +1,73 @@
+"""Outputs of a time run written as it goes: CSV history, ParaView series, smallest tendon force.
+
+Every row is flushed and every ParaView frame committed when it is computed, so a run that
+stops early (an error, Ctrl-C) leaves everything computed so far on disk.
+"""
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.io.vtk import SeriesWriter
+
+
+class RunOutputs:
+    """Per-step outputs of a simulation run, shared by every model's runs (6.5, 7.4).
+
+    Parameters
+    ----------
+    csv_path : path or None
+        CSV history: header ``columns``, one row per recorded step, flushed.
+    columns : list of str
+    vtk_dir : path or None
+        ParaView series (:class:`tmfem.io.vtk.SeriesWriter`), a frame every ``vtk_every`` steps.
+    vtk_every : int
+    name : str
+        Name of the ParaView series (parentheses dropped).
+    """
+
+    def __init__(self, *, csv_path, columns, vtk_dir, vtk_every, name: str):
+        self.series = None
+        if vtk_dir is not None:
+            if not (isinstance(vtk_every, int) and vtk_every >= 1):
+                raise InputError(f"vtk_every: expected an integer >= 1, found {vtk_every!r}")
+            self.series = SeriesWriter(vtk_dir, name=name.replace("(", "").replace(")", ""))
+        self.fh = open(csv_path, "w", newline="") if csv_path else None
+        self.writer = csv.writer(self.fh, lineterminator="\n") if self.fh else None
+        if self.writer:
+            self.writer.writerow(columns)
+        self.vtk_every = vtk_every
+        self.count = 0
+        self.min_force = [np.inf, 0.0, ""]        # smallest tendon force, its time and tendon
+
+    def frame_due(self) -> bool:
+        """True when the current step is written as a ParaView frame."""
+        return self.series is not None and self.count % self.vtk_every == 0
+
+    def tendon_forces(self, t: float, force: np.ndarray, names) -> None:
+        """Keep the smallest of ``force`` (one per member, ``names[k]`` its tendon) over time."""
+        k = int(np.argmin(force))
+        if force[k] < self.min_force[0]:
+            self.min_force[:] = [float(force[k]), float(t), names[k]]
+
+    def row(self, t: float, values: np.ndarray) -> None:
+        """Write the CSV row of time t (when a CSV is asked) and count the step."""
+        self.count += 1
+        if self.writer:
+            self.writer.writerow([f"{t:.6g}"] + [f"{v:.10g}" for v in values])
+            self.fh.flush()
+
+    def close(self) -> None:
+        if self.fh:
+            self.fh.close()
+
+    def stats(self, sim) -> dict:
+        """Step and Newton counts of the simulation ``sim``, the smallest tendon force, the .pvd."""
+        out = {**sim.stats, "min_tendon_force": self.min_force[0],
+               "min_tendon_force_time": self.min_force[1],
+               "min_tendon_force_tendon": self.min_force[2]}
+        if self.series is not None:
+            out["pvd"] = str(self.series.pvd)
+        return out
