@@ -24,7 +24,8 @@ import numpy as np
 
 from tmfem.models.mtc.model import MTCModel
 from tmfem.reference.tables import FREQUENCIES
-from tmfem.models.mtc.post import model_cells, static_summary
+from tmfem.models.mtc.post import static_summary
+from tmfem.post.mtc import model_cells
 from tmfem.system import load_preset
 
 
@@ -44,7 +45,7 @@ def run_case(label, system, *, out=None):
                        {"x - x_design": d[:, 0], "y - y_design": d[:, 1], "z - z_design": d[:, 2]},
                        ylabel="B_14 - design [mm]", xlabel="iteration", subplots=True,
                        title=f"1-4 MTC: iteration history of B_14 ({label}; Fig. 6.1)")
-        from tmfem.models.mtc.post import plot_membrane_stress
+        from tmfem.post.mtc import plot_membrane_stress
         plot_membrane_stress(out / f"membrane_stress_{label}.png", m, res.x,
                              title=f"1-4 MTC membrane stresses, {label} (Figs. 6.3-6.4)")
         from tmfem.io.vtk import write_modes

@@ -44,7 +44,8 @@ def run(args) -> dict:
         return modal_summary(system, modes=args.modes, membrane_modes=options["membrane_modes"],
                              prestress_scale=options["prestress_scale"], mesh_n=options["mesh"])
     from tmfem.reference.tables import FREQUENCIES
-    from tmfem.models.mtc.post import model_cells, static_summary
+    from tmfem.models.mtc.post import static_summary
+    from tmfem.post.mtc import model_cells
     model, options = model_from_args(args, NAME)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)

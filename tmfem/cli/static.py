@@ -57,9 +57,10 @@ def solve(args, model, options):
 
 
 def write_outputs(args, model, x, summary) -> None:
-    from tmfem.models.mtc.post import membrane_field, member_state, q_from_positions
+    from tmfem.models.mtc.post import member_state, q_from_positions
+    from tmfem.post.mtc import membrane_field
     if args.stress_plot:
-        from tmfem.models.mtc.post import plot_membrane_stress
+        from tmfem.post.mtc import plot_membrane_stress
         summary["stress_plot"] = str(plot_membrane_stress(
             args.stress_plot, model, x, title=f"{model.system.name} MTC membrane stresses (O_f frame)"))
     if not (args.vtk or args.png):

@@ -261,7 +261,8 @@ def run(args) -> dict:
                                                        membrane=membrane, title=system.name))
     if system.symmetric is not None and (system.M >= 2 or system.deployable) \
             and args.map_grid > 0:
-        from tmfem.equilibrium.symmetric_map import equilibrium_map, plot_equilibrium_map
+        from tmfem.equilibrium.symmetric_map import equilibrium_map
+        from tmfem.post.equilibrium_map import plot_equilibrium_map
         k = args.map_grid
         c = system.symmetric
         _progress(f"equilibrium map {k}x{k} over (theta, psi) (eq. 5.97)")

@@ -6,8 +6,7 @@
 """
 from tmfem.equilibrium.design import EquilibriumDesign, design_equilibrium, forces_from_rest_lengths
 from tmfem.equilibrium.general import equilibrium_matrix, positive_null_vector, symmetric_matrix
-from tmfem.equilibrium.symmetric_map import equilibrium_map, plot_equilibrium_map
+from tmfem.equilibrium.symmetric_map import equilibrium_map
 
 __all__ = ["EquilibriumDesign", "design_equilibrium", "forces_from_rest_lengths",
-           "equilibrium_matrix", "positive_null_vector", "symmetric_matrix", "equilibrium_map",
-           "plot_equilibrium_map"]
+           "equilibrium_matrix", "positive_null_vector", "symmetric_matrix", "equilibrium_map"]

@@ -24,6 +24,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from tmfem.errors import ConvergenceError, InputError
+from tmfem.solvers.newton import newton
 from tmfem.system.geometry import (beta, euler_angles_321, free_corner_components,
                                   rotation_ef)
 from tmfem.system.topology import FAMILIES_MN
@@ -205,21 +206,17 @@ def solve_corner_constraints(system, q=None, *, gamma0=None, free0=None, tol: fl
         y[3:] = free0
     scale = max(np.abs(P).max(), 1.0)
     x = X.T.ravel()
-    res = np.inf
-    for it in range(1, maxiter + 1):
-        r = _G(y[:3], y[3:], P, N).T.ravel() - x
-        res = np.abs(r).max()
-        if res < tol * scale:
-            return CornerState(R=rotation_ef(y[:3]), gamma=y[:3].copy(),
-                               delta=corner_array(y[3:], N), free=y[3:].copy(),
-                               iterations=it - 1)
-        J = _G_jacobian(y[:3], y[3:], P, N)
-        try:
-            y = y - np.linalg.solve(J, r)
-        except np.linalg.LinAlgError:
-            break
-    raise ConvergenceError(f"corner constraints (eq. 3.5): expected residual < {tol * scale:.3g} m "
-                           f"within {maxiter} Newton iterations, found {res:.3g} m")
+
+    def residual(yy):
+        return _G(yy[:3], yy[3:], P, N).T.ravel() - x, _G_jacobian(yy[:3], yy[3:], P, N)
+    try:
+        res = newton(residual, y, tol=tol, scale=scale, max_iter=maxiter, line_search=False)
+    except ConvergenceError as exc:
+        raise ConvergenceError(f"corner constraints (eq. 3.5): expected residual < "
+                               f"{tol * scale:.3g} m within {maxiter} Newton iterations: {exc}") from None
+    y = res.u
+    return CornerState(R=rotation_ef(y[:3]), gamma=y[:3].copy(), delta=corner_array(y[3:], N),
+                       free=y[3:].copy(), iterations=res.iterations)
 
 
 def delta_gradient(system, q=None, state: CornerState | None = None) -> np.ndarray:

@@ -153,31 +153,6 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
                           reason=reason)
 
 
-def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
-    """Plot the map: feasible region shaded, Delta = 0 and margin = 0 contours.
-
-    ``mark`` = (theta, psi) [rad] of a point to mark (e.g. the design).
-    """
-    from tmfem.post.plots import _plt, _save
-
-    plt = _plt()
-    th, ps = np.degrees(emap.theta), np.degrees(emap.psi)
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
-    ax.contourf(ps, th, emap.feasible.astype(float), levels=[0.5, 1.5], colors=["#9fd49f"])
-    if emap.theta.size > 1 and emap.psi.size > 1:
-        m = np.where(np.isfinite(emap.margin), emap.margin, -1.0)
-        ax.contour(ps, th, m, levels=[0.0], colors="C0", linewidths=1.2)
-        ax.contour(ps, th, emap.Delta, levels=[0.0], colors="C3", linewidths=1.2, linestyles="--")
-    if mark is not None:
-        ax.plot(np.degrees(mark[1]), np.degrees(mark[0]), "k*", ms=12, label="design")
-        ax.legend(loc="best")
-    ax.set_xlabel("psi [deg] (azimuth relative to the stage base, eq. 5.97)")
-    ax.set_ylabel("theta [deg]")
-    ax.set_title(title or "symmetric equilibria (green); blue: null vector positive "
-                 "boundary, red dashed: Delta = 0", fontsize=9)
-    return _save(fig, png)
-
-
 def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int = 0,
                r_bounds=(0.05, 2.0), z_bounds=(0.05, 2.5), maxiter: int = 300) -> dict:
     """Stage bases (r_i, z_i, sigma_i, i >= 2) that maximise the null-vector margin at

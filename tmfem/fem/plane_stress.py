@@ -37,13 +37,13 @@ from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from tmfem.errors import InputError, SlackMembrane
 from tmfem.fem.attachment import (ATTACHMENTS, attachment_weights, coupling_matrix,
                                   default_patch_radius)
 from tmfem.mesh import MembraneMesh, polygon_quad_mesh
 from tmfem.system.geometry import beta
+from tmfem.solvers.backends import get_backend
 from tmfem.system.materials import MembraneMaterial
 
 
@@ -186,7 +186,7 @@ class PlaneStressMembrane:
     """
 
     def __init__(self, *, corners, material: MembraneMaterial, n: int = 10,
-                 attachment: str = "point", patch: float | None = None):
+                 attachment: str = "point", patch: float | None = None, backend="scipy"):
         from skfem import Basis, ElementQuad1, ElementVector
 
         if not isinstance(material, MembraneMaterial):
@@ -194,6 +194,7 @@ class PlaneStressMembrane:
         if attachment not in ATTACHMENTS:
             raise InputError(f"attachment: expected one of {ATTACHMENTS}, found {attachment!r}")
         self.material = material
+        self.backend = get_backend(backend)
         self.mesh: MembraneMesh = polygon_quad_mesh(corners, n)
         self.corners = self.mesh.p[:, self.mesh.corners].copy()
         self.N = self.corners.shape[1]
@@ -230,9 +231,10 @@ class PlaneStressMembrane:
         return asm(stiffness, self.basis).tocsr()
 
     @cached_property
-    def _interior_lu(self):
+    def _interior_solve(self):
+        """``solve(b)`` with the interior block K_II (the backend's factorisation)."""
         I = self.interior_dofs
-        return spla.splu(self.K[I][:, I].tocsc())
+        return self.backend.factorize(self.K[I][:, I].tocsc())
 
     @cached_property
     def coupling(self) -> sp.csr_matrix:
@@ -244,21 +246,21 @@ class PlaneStressMembrane:
 
     @cached_property
     def _kkt(self):
-        """LU of the bordered system [[K, s C^T], [s C, 0]] (distributed attachment); s scales
-        the coupling rows to the stiffness."""
+        """Solver of the bordered system [[K, s C^T], [s C, 0]] (distributed attachment; the
+        backend's factorisation); s scales the coupling rows to the stiffness."""
         s = float(np.abs(self.K.diagonal()).mean())
         C = self.coupling
         A = sp.bmat([[self.K, s * C.T], [s * C, None]], format="csc")
-        return spla.splu(A), s
+        return self.backend.factorize(A), s
 
     def _solve_distributed(self, rhs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """DOF vectors x (n_dofs, k) and corner forces mu (2N, k) for corner displacements
         rhs (2N, k): K x = C^T mu, C x = rhs."""
-        lu, s = self._kkt
+        solve, s = self._kkt
         nd = self.basis.N
         b = np.zeros((nd + rhs.shape[0], rhs.shape[1]))
         b[nd:] = s * rhs                      # s C x = s rhs
-        y = lu.solve(b)
+        y = solve(b)
         return y[:nd], -s * y[nd:]              # K x + s C^T y = 0: K x = C^T mu, mu = -s y
 
     def corner_stiffness(self) -> np.ndarray:
@@ -276,7 +278,7 @@ class PlaneStressMembrane:
         c, I = self.corner_dofs, self.interior_dofs
         K = self.K
         Kic = K[I][:, c].toarray()
-        S = K[c][:, c].toarray() - Kic.T @ self._interior_lu.solve(Kic)
+        S = K[c][:, c].toarray() - Kic.T @ self._interior_solve(Kic)
         return 0.5 * (S + S.T)
 
     # ------------------------------------------------------------------ solution
@@ -296,7 +298,7 @@ class PlaneStressMembrane:
         x = np.zeros(self.basis.N)
         c, I = self.corner_dofs, self.interior_dofs
         x[c] = delta.T.ravel()
-        x[I] = -self._interior_lu.solve(self.K[I][:, c] @ x[c])
+        x[I] = -self._interior_solve(self.K[I][:, c] @ x[c])
         f = self.K @ x
         return x, f[self.basis.nodal_dofs[:, self.mesh.corners]]
 

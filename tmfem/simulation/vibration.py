@@ -19,7 +19,8 @@ from tmfem.io.run import RunOutputs
 from tmfem.io.vtk import MembraneField
 from tmfem.models.com.plant import COMPlant
 from tmfem.models.mtc.dynamics import MTCDynamics, tendon_transverse
-from tmfem.models.mtc.post import member_state, membrane_field
+from tmfem.models.mtc.post import member_state
+from tmfem.post.mtc import membrane_field
 from tmfem.simulation.controllers import OpenLoop
 from tmfem.simulation.driver import check_time_grid, simulate
 

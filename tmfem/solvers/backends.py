@@ -5,7 +5,9 @@ added beside the embedded scipy default without touching elements or models. A b
 provides
 
 ``factorize(A) -> solve``     solve(b) for a square sparse matrix A (b may be (n,) or (n, m));
-``eigsh(K, M, k, sigma) -> (w, V)``   the k eigenpairs of K v = w M v nearest to ``sigma``.
+``eigsh(K, M, k, sigma, v0=None) -> (w, V)``   the k eigenpairs of K v = w M v nearest to
+                              ``sigma``; ``v0`` a start vector (Krylov methods) that makes
+                              the basis of a repeated eigenvalue reproducible.
 
 ``get_backend("scipy")`` is always available (SuperLU + ARPACK shift-invert). The name
 ``"petsc"`` is reserved for a PETSc/SLEPc backend (KSP/EPS through petsc4py/slepc4py); while
@@ -34,7 +36,7 @@ class Backend(Protocol):
 
     def factorize(self, A) -> Callable[[np.ndarray], np.ndarray]: ...
 
-    def eigsh(self, K, M, k: int, sigma: float) -> tuple[np.ndarray, np.ndarray]: ...
+    def eigsh(self, K, M, k: int, sigma: float, v0=None) -> tuple[np.ndarray, np.ndarray]: ...
 
 
 class SingularMatrix(ConvergenceError):
@@ -116,12 +118,12 @@ class ScipyBackend:
         Ap = sp.csc_matrix((A.data[where], indices, indptr), shape=A.shape)
         return perm, Ap
 
-    def eigsh(self, K, M, k, sigma):
+    def eigsh(self, K, M, k, sigma, v0=None):
         """The k eigenpairs of K v = w M v nearest to ``sigma`` (eq. 5.32): dense ``eigh``
-        up to 600 dofs (or k >= n - 1), else ARPACK shift-invert with this backend's LU of
-        K - sigma M."""
+        up to 600 dofs (or k >= n - 1) unless a start vector ``v0`` is given, else ARPACK
+        shift-invert with this backend's LU of K - sigma M (from ``v0`` when given)."""
         n = K.shape[0]
-        if n <= 600 or k >= n - 1:
+        if k >= n - 1 or (n <= 600 and v0 is None):
             import scipy.linalg as la
             Kd = K.toarray() if sp.issparse(K) else np.asarray(K)
             Md = M.toarray() if sp.issparse(M) else np.asarray(M)
@@ -136,7 +138,7 @@ class ScipyBackend:
         op = spla.LinearOperator(A.shape, matvec=lu, dtype=float)
         try:
             w, V = spla.eigsh(sp.csr_matrix(K), k=k, M=sp.csr_matrix(M), sigma=sigma, which="LM",
-                              OPinv=op, tol=1e-10)
+                              OPinv=op, tol=1e-10, v0=v0)
         except spla.ArpackNoConvergence as exc:
             raise ConvergenceError(f"eigen: ARPACK did not converge for k={k} modes near sigma={sigma:g} "
                                    f"({len(exc.eigenvalues)} converged)") from None

@@ -12,10 +12,11 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.solvers.backends import get_backend
+from tmfem.solvers.backends import SingularMatrix, get_backend
 
 
 def free_index(free, n: int) -> np.ndarray:
@@ -38,6 +39,20 @@ def _sub(K, idx):
         K = sp.csr_matrix(K)
         return K[idx][:, idx]
     return np.asarray(K)[np.ix_(idx, idx)]
+
+
+def factorize(A, backend):
+    """``solve(b)`` of a tangent: a small dense one by LU in place (LAPACK), a sparse one by the
+    backend; a singular matrix raises :class:`~tmfem.solvers.backends.SingularMatrix`."""
+    if sp.issparse(A):
+        return backend.factorize(A)
+    A = np.asarray(A, dtype=float)
+    lu, piv = sla.lu_factor(A, check_finite=False)
+    d = np.abs(np.diag(lu))
+    if A.size and (not np.all(np.isfinite(d)) or d.min() <= 1e-14 * max(d.max(), 1e-300)):
+        raise SingularMatrix(f"linear solve: expected a non-singular {A.shape[0]}x{A.shape[0]} "
+                             f"matrix, found a singular one (smallest LU pivot {d.min():.3e})")
+    return lambda b: sla.lu_solve((lu, piv), b, check_finite=False)
 
 
 def _advance(u, idx, du, n: int, update):
@@ -143,7 +158,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         if rn <= target:
             return NewtonResult(u=u, iterations=it - 1, residual_history=history, converged=True, r=r, K=K)
         try:
-            solve = be.factorize(_sub(K, idx))
+            solve = factorize(_sub(K, idx), be)
         except ConvergenceError as exc:
             raise _fail(f"newton{where}: iteration {it}: {exc}; residual history "
                         f"{[f'{h:.3e}' for h in history]}", step=step, history=history,
@@ -315,7 +330,7 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
     for step in range(1, n_steps + 1):
         while True:
             try:
-                solve = be.factorize(_sub(K, idx))
+                solve = factorize(_sub(K, idx), be)
                 dut = solve(q)
                 if prev is None:
                     sign = 1.0
@@ -336,7 +351,7 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
                     if rn <= tol * qn:
                         ok = True
                         break
-                    solve = be.factorize(_sub(Kt, idx))
+                    solve = factorize(_sub(Kt, idx), be)
                     dur = -solve(r)
                     dut = solve(q)
                     a = dut @ dut

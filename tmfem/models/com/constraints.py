@@ -21,6 +21,7 @@ import casadi as ca
 import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
+from tmfem.solvers.newton import newton
 from tmfem.models.com.kinematics import bars_sx, rotation_ef_sx
 from tmfem.equilibrium.general import corner_state
 from tmfem.system.geometry import free_corner_components
@@ -129,19 +130,15 @@ class ConstraintSolver:
         q = np.asarray(q, dtype=float)
         z = zeta_closed_form(self.system, self.layout, q) if zeta0 is None else np.array(zeta0, float)
         scale = max(1.0, float(np.max(np.abs(self.system.membrane_corners))))
-        for it in range(max_iter):
-            p, pz, _ = self.phi(q, z)
-            if np.max(np.abs(p)) <= tol * scale:
-                return z
-            try:
-                dz = np.linalg.solve(pz, -p)
-            except np.linalg.LinAlgError:
-                raise ConvergenceError("corner constraints (eq. 3.5): dPhi/dzeta is singular at "
-                                       f"iteration {it}; |Phi| = {np.max(np.abs(p)):.3e}") from None
-            z = z + dz
-        raise ConvergenceError(f"corner constraints (eq. 3.5): Newton did not converge in {max_iter} "
-                               f"iterations, |Phi| = {np.max(np.abs(p)):.3e} m "
-                               f"(expected <= {tol * scale:.1e})")
+
+        def residual(zeta):
+            p, pz, _ = self.phi(q, zeta)
+            return p, pz
+        try:
+            return newton(residual, z, tol=tol, scale=scale, max_iter=max_iter,
+                          line_search=False).u
+        except ConvergenceError as exc:
+            raise ConvergenceError(f"corner constraints (eq. 3.5): {exc}") from None
 
     def dzeta_dq(self, q, zeta) -> np.ndarray:
         """d zeta / d q = -(dPhi/dzeta)^-1 dPhi/dq (eq. 5.23)."""

@@ -171,9 +171,9 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
             P[:2] = x[nd]
         else:
             if lu_w is None:
-                lu_w = sp.linalg.splu(KG[free_w][:, free_w].tocsc())
+                lu_w = ps.backend.factorize(KG[free_w][:, free_w].tocsc())
             w = np.zeros(nn); w[corners[i]] = 1.0
-            w[free_w] = -lu_w.solve(KG[free_w][:, corners] @ w[corners])
+            w[free_w] = -lu_w(KG[free_w][:, corners] @ w[corners])
             P[2] = w
         shapes.append(P)
     shapes = np.array(shapes)
@@ -191,14 +191,15 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
     if n_modes > 0:
         Kw = KG[free_w][:, free_w]; Mw = Ms[free_w][:, free_w]
         kw = min(n_modes, len(free_w) - 2)
-        lw, vw = _lowest_modes(Kw, Mw, kw)
+        lw, vw = _lowest_modes(Kw, Mw, kw, ps.backend)
         if lw[0] <= 0:
             raise SlackMembrane(f"membrane prestress: expected a positive transverse stiffness "
                                 f"with the corners held, found the eigenvalue {lw[0]:.4g} "
                                 "(compressive prestress; is Delta > 0, eq. 3.36?)")
         Iuv = ps.interior_dofs
         Muv = _vector_mass(Ms, nd)
-        lp, vp = _lowest_modes(Kuv[Iuv][:, Iuv], Muv[Iuv][:, Iuv], min(n_modes, len(Iuv) - 2))
+        lp, vp = _lowest_modes(Kuv[Iuv][:, Iuv], Muv[Iuv][:, Iuv], min(n_modes, len(Iuv) - 2),
+                               ps.backend)
         cand = [(lw[k], "w", k) for k in range(kw)] + [(lp[k], "uv", k) for k in range(len(lp))]
         cand.sort(key=lambda t: t[0])
         for lam, kd, k in cand[:n_modes]:
@@ -229,13 +230,11 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
                          n_in_plane_candidates=n_modes)
 
 
-def _lowest_modes(K, M, k):
+def _lowest_modes(K, M, k, backend):
     """k lowest eigenpairs of K phi = lambda M phi (shift-invert about 0), M-normalised."""
-    import scipy.sparse.linalg as spla
     # fixed start vector: degenerate pairs (e.g. 1.787 Hz of the square) come out the same
     # every time, so two models built from one system share their modal coordinates
-    lam, vec = spla.eigsh(K.tocsc(), k=k, M=M.tocsc(), sigma=0.0, which="LM",
-                          v0=np.ones(K.shape[0]))
+    lam, vec = backend.eigsh(K.tocsc(), M.tocsc(), k, 0.0, v0=np.ones(K.shape[0]))
     order = np.argsort(lam)
     lam, vec = lam[order], vec[:, order]
     vec = vec / np.sqrt(np.einsum("ik,ik->k", vec, M @ vec))

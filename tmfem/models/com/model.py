@@ -25,12 +25,13 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from tmfem.errors import InfeasibleDesign, InputError, SlackTendon
+from tmfem.errors import ConvergenceError, InfeasibleDesign, InputError, SlackTendon
 from tmfem.fem.truss import linear_rest_length
 from tmfem.models.com.constraints import ConstraintSolver, ZetaLayout, phi_sx
 from tmfem.models.com.kinematics import (bar_kinetic_energy_sx, bars_sx, rotation_ef_sx,
                                       tendon_lengths_sx)
 from tmfem.models.com.membrane_modes import build_membrane_basis
+from tmfem.solvers.newton import newton
 from tmfem.system.geometry import rotation_ef
 
 def default_membrane_modes(system) -> int:
@@ -556,23 +557,20 @@ class ControlOrientedModel:
         return self.residual(z, np.zeros(self.nz), np.zeros(self.nz), 0.0, u)
 
     def equilibrium(self, u=None, z0=None, *, tol: float = 1e-11, max_iter: int = 50) -> np.ndarray:
-        """Static equilibrium z for rest lengths u by Newton on F_hat(z, 0) + B_hat u = 0."""
-        from tmfem.errors import ConvergenceError
+        """Static equilibrium z for rest lengths u by Newton on F_hat(z, 0) + B_hat u = 0
+        (with line search), converged when |F_hat + B_hat u| <= tol |B_hat u| (the tendon
+        forces' generalised load at the start)."""
+        u = self.u0 if u is None else np.asarray(u, dtype=float)
         z = self.z0 if z0 is None else np.array(z0, dtype=float)
         zero = np.zeros(self.nz)
-        for it in range(max_iter):
-            r = self.static_residual(z, u)
-            K, _, _ = self.jacobians(z, zero, zero, 0.0, u)
-            dz = np.linalg.lstsq(K, -r, rcond=None)[0]
-            step = 1.0
-            r0 = np.linalg.norm(r)
-            while step > 1e-4 and np.linalg.norm(self.static_residual(z + step * dz, u)) > r0 and r0 > 0:
-                step *= 0.5
-            z = z + step * dz
-            if np.max(np.abs(dz)) < tol * (1 + np.max(np.abs(z))):
-                return z
-        raise ConvergenceError(f"COM static equilibrium: Newton did not converge in {max_iter} "
-                               f"iterations, |F_hat + B_hat u| = {np.linalg.norm(r):.3e}")
+
+        def residual(zz):
+            return self.static_residual(zz, u), self.jacobians(zz, zero, zero, 0.0, u)[0]
+        scale = float(np.linalg.norm(self.input_matrix(z) @ u))
+        try:
+            return newton(residual, z, tol=tol, scale=scale, max_iter=max_iter).u
+        except ConvergenceError as exc:
+            raise ConvergenceError(f"COM static equilibrium: {exc}") from None
 
     # ------------------------------------------------------------------ outputs
     def fast_outputs(self, z, with_lengths: bool = False):
