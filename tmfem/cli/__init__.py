@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import logging
 import math
 import pkgutil
 import sys
@@ -49,8 +50,19 @@ def _default_text(result) -> str:
     return json.dumps(result, indent=2, default=str)
 
 
+def _log_to_stderr() -> None:
+    """Library progress (``logging`` INFO of the ``tmfem`` loggers) as lines on stderr."""
+    log = logging.getLogger("tmfem")
+    if not log.handlers:
+        handler = logging.StreamHandler(sys.stderr)
+        handler.setFormatter(logging.Formatter("tmfem: %(message)s"))
+        log.addHandler(handler)
+        log.setLevel(logging.INFO)
+
+
 def main(argv=None) -> int:
     """Entry point of the ``tmfem`` console script; returns the exit code."""
+    _log_to_stderr()
     parser = build_parser()
     args = parser.parse_args(argv)
     mod = args._module

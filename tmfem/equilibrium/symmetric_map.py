@@ -18,7 +18,8 @@ of the given system: these are what the axes fix.
 """
 from __future__ import annotations
 
-import sys
+import logging
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,8 @@ from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
 from tmfem.equilibrium.symmetric import membrane_delta_system
 from tmfem.errors import InputError
 from tmfem.system.geometry import SymmetricConfig, wrap_angle
+
+log = logging.getLogger(__name__)
 
 
 def configuration_5_97(system, theta: float, psi: float, *, r=None, z=None,
@@ -143,7 +146,7 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
                 ratios[a, b] = nv.x / nv.x[-1]
             Delta[a, b] = membrane_delta_system(s)
         if progress:
-            print(f"equilibrium map: theta {a + 1}/{theta.size}", file=sys.stderr)
+            log.info("equilibrium map: theta %d/%d", a + 1, theta.size)
     fixed = {"l": c.l.tolist(), "r": c.r.tolist(), "z": c.z.tolist(),
              "sigma_deg": np.degrees(c.sigma).tolist(), "r_mb": system.r_mb,
              "rule": "eq. 5.97: theta_i = theta, psi_i = psi + sigma_i"

@@ -1,13 +1,15 @@
 """Mesh and tendon-subdivision convergence of the MTC model (dissertation 6.3, Figs. 6.11-6.14)."""
 from __future__ import annotations
 
-import sys
+import logging
 import time
 
 import numpy as np
 
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.mtc.post import static_summary
+
+log = logging.getLogger(__name__)
 
 ROW_KEYS = ("mesh_n", "tendon_elements", "attachment", "elements", "h", "dofs", "iterations",
             "static_s", "modal_s", "Delta_mm", "tendon_stress_max_MPa", "bar_load_max_N",
@@ -68,9 +70,9 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
             for i, f in enumerate(md.freq_hz):
                 row[f"f{i + 1}"] = float(f)
             if progress:
-                print(f"  converge: n={n:3d} k={k} {attachment}: {m.ndof} dofs, f1 = {md.freq_hz[0]:.5f} Hz, "
-                      f"max sigma_p1 = {row['sigma_p1_max_MPa']:.3f} MPa ({t2 - t0:.1f} s)",
-                      file=sys.stderr)
+                log.info("converge: n=%3d k=%d %s: %d dofs, f1 = %.5f Hz, max sigma_p1 = %.3f MPa "
+                         "(%.1f s)", n, k, attachment, m.ndof, md.freq_hz[0],
+                         row["sigma_p1_max_MPa"], t2 - t0)
             yield row
 
 
