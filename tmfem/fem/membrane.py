@@ -38,6 +38,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler, element_dofs
+from tmfem.fem.plane_stress import principal_stresses, von_mises
 from tmfem.mesh.polygon import MembraneMesh
 from tmfem.system.materials import MembraneMaterial
 
@@ -304,17 +305,11 @@ class MembraneTL:
         U[1, 1] += j
         U /= np.sqrt(C[0, 0] + C[1, 1] + 2.0 * j)
         sig = np.einsum("ab...,bc...,cd...->ad...", U, S, U) / J
-        s11, s22, s12 = sig[0, 0], sig[1, 1], sig[0, 1]
-        c = 0.5 * (s11 + s22)
-        r = np.sqrt((0.5 * (s11 - s22)) ** 2 + s12**2)
-        three = np.stack([c + r, c - r, np.zeros_like(c)])
-        principal = -np.sort(-three, axis=0)
-        p1, p2, p3 = principal
-        vm = np.sqrt(((p1 - p2) ** 2 + (p2 - p3) ** 2 + (p3 - p1) ** 2) / 2.0)
+        cauchy = np.stack([sig[0, 0], sig[1, 1], sig[0, 1]])
         points = np.array(self.basis.mapping.F(self.basis.X))
         return MembraneStresses(S=np.stack([S[0, 0], S[1, 1], S[0, 1]]),
-                                cauchy=np.stack([s11, s22, s12]),
-                                principal=principal, von_mises=vm, points=points)
+                                cauchy=cauchy, principal=principal_stresses(cauchy),
+                                von_mises=von_mises(cauchy), points=points)
 
 
 class MembraneElement:

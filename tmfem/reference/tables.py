@@ -25,6 +25,7 @@ from functools import lru_cache
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.fem.truss import linear_rest_length
 
 #: Values exactly as printed in the dissertation (SI units, angles in degrees).
 PRINTED = {
@@ -162,7 +163,7 @@ def symmetric_prestress(system, *, mesh_n: int = 10) -> SymmetricPrestress:
     F = corner_force_per_Delta(system, mesh_n=mesh_n) * Delta
     T = per_F * F
     with np.errstate(invalid="ignore", divide="ignore"):
-        rest = np.where(T + EAg > 0, EAg * length / (T + EAg), np.nan)
+        rest = np.where(T + EAg > 0, linear_rest_length(length, T, EAg), np.nan)
     return SymmetricPrestress(groups=list(groups), per_F=per_F, length=length, force=T,
                               rest=rest, Delta=float(Delta), F_Delta=float(F), margin=float(margin))
 
