@@ -116,7 +116,6 @@ class ControlOrientedModel:
         self.n_t = len(system.tendons)
         self.damping = float(damping)
         self.EA = system.tendon_EA
-        self._zeta_cache = self.zeta0.copy()
         # nominal rest lengths and spring constants (eq. 3.9)
         self.design: StaticDesign | None = None
         self._build_static()
@@ -418,11 +417,10 @@ class ControlOrientedModel:
         self.P = P
 
     # ------------------------------------------------------------------ evaluation
-    def zeta(self, q, warm: bool = True) -> np.ndarray:
-        """zeta(q) by Newton on Phi (eq. 3.5), warm-started from the last solution."""
-        z = self.constraints.solve(q, self._zeta_cache if warm else None)
-        self._zeta_cache = z
-        return z
+    def zeta(self, q) -> np.ndarray:
+        """zeta(q) by Newton on Phi (eq. 3.5) from its closed form (a pure function of q: the
+        closed form is a root already, Newton only polishes it)."""
+        return self.constraints.solve(q)
 
     def _to_modal(self, z, zd=None):
         z = self.P @ np.asarray(z, dtype=float)
