@@ -34,9 +34,9 @@ from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError
+from tmfem.solvers.backends import get_backend
 
 _SCHEMES = ("park", "trapezoidal")
 
@@ -59,8 +59,7 @@ def _solver(S, system=None):
     if system is not None and hasattr(system, "factorize"):
         return system.factorize(S)
     if sp.issparse(S):
-        lu = spla.splu(sp.csc_matrix(S))
-        return lu.solve
+        return get_backend().factorize(S)
     S = np.asarray(S, dtype=float)
     import scipy.linalg as sla
     lu = sla.lu_factor(S, check_finite=False)

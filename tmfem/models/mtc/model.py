@@ -191,7 +191,8 @@ class MTCModel:
         corner attachment, so that the design and the model see the same corner stiffness."""
         from tmfem.equilibrium.design import design_equilibrium
         d = design_equilibrium(self.system, mesh_n=self.mesh_n,
-                               attachment=self.topology.attachment, patch=self.patch)
+                               attachment=self.topology.attachment, patch=self.patch,
+                               backend=self.backend)
         return np.asarray(d.rest_lengths, dtype=float)
 
     # ------------------------------------------------------------------ positions
