@@ -27,32 +27,18 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.newton import newton
 from tmfem.system.geometry import (beta, euler_angles_321, free_corner_components,
                                   rotation_ef)
+from tmfem.system.coordinates import q_index
 from tmfem.system.topology import FAMILIES_MN
 
 
 # ---------------------------------------------------------------------------- kinematics
-def _bar_q_index(system) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Indices into q of (x, y, z) (-1 for stage 1), theta and psi of each bar, (M, N) each."""
-    M, N = system.M, system.N
-    xyz = -np.ones((3, M, N), dtype=int)
-    th = np.empty((M, N), dtype=int)
-    ps = np.empty((M, N), dtype=int)
-    j = np.arange(N)
-    th[0], ps[0] = 2 * j, 2 * j + 1
-    for i in range(1, M):
-        off = 2 * N + 5 * N * (i - 1) + 5 * j
-        xyz[:, i, :] = off[None, :] + np.arange(3)[:, None]
-        th[i], ps[i] = off + 3, off + 4
-    return xyz, th, ps
-
-
 def node_jacobian(system, q=None) -> np.ndarray:
     """Derivatives dX/dq of all node coordinates, shape (3, n_nodes, n_q) (eqs. 3.1-3.2)."""
     q = system.q if q is None else np.asarray(q, dtype=float)
     M, N = system.M, system.N
     _, theta, psi = system.split_q(q)
     l = system.l
-    xyz, th, ps = _bar_q_index(system)
+    xyz, th, ps = q_index(system.M, system.N)
     nq = q.size
     st, ct, sp, cp = np.sin(theta), np.cos(theta), np.sin(psi), np.cos(psi)
     du_dth = np.array([ct * cp, ct * sp, -st])        # (3, M, N)
@@ -308,7 +294,7 @@ def symmetric_matrix(system, q=None) -> SymmetricMatrix:
         raise InputError(f"system {system.name!r}: expected a symmetric system (3.3.1), found "
                          "no symmetric parametrisation")
     E = equilibrium_matrix(system, q)
-    xyz, th, ps = _bar_q_index(system)
+    xyz, th, ps = q_index(system.M, system.N)
     rows = [th[0, -1], ps[0, -1]]
     for i in range(1, system.M):
         rows += [xyz[0, i, -1], xyz[1, i, -1], xyz[2, i, -1], th[i, -1], ps[i, -1]]

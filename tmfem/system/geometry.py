@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.system.coordinates import join_q
 
 
 def beta(N: int) -> np.ndarray:
@@ -216,11 +217,7 @@ class SymmetricConfig:
     def to_q(self, N: int) -> np.ndarray:
         """Generalised coordinates q of eqs. 3.1-3.2."""
         theta, psi = self.angles(N)
-        A = self.base_nodes(N)
-        parts = [np.column_stack([theta[0], psi[0]]).ravel()]
-        for i in range(1, self.M):
-            parts.append(np.column_stack([A[0, i], A[1, i], A[2, i], theta[i], psi[i]]).ravel())
-        return np.concatenate(parts)
+        return join_q(self.base_nodes(N), theta, psi)
 
     def system_arrays(self, N: int) -> dict:
         """The :class:`tmfem.system.System` fields this configuration fixes: ``q`` (eqs.

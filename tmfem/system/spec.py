@@ -39,6 +39,7 @@ import numpy as np
 import tomli_w
 
 from tmfem.errors import InputError
+from tmfem.system.coordinates import q_stages
 from tmfem.system.geometry import SymmetricConfig, membrane_corners_regular
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
 from tmfem.system.system import System
@@ -217,7 +218,7 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     if base is None or base.shape != (3, N):
         raise InputError(f"{w}: expected 'base' as {N} rows [x, y, z], found {g.get('base')!r}")
     q = _floats(g, "q", w)
-    M = 1 + (q.size - 2 * N) // (5 * N)
+    M = q_stages(q.size, N)
     l = _floats(g, "l", w)
     l = np.broadcast_to(l.reshape(M, -1) if l.size == M * N else l.reshape(-1)[0], (M, N))
     if "corners" in mtab:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.system.coordinates import q_index, q_size, split_q
 from tmfem.system.geometry import (SymmetricConfig, bar_direction, base_centre, beta,
                                    floating_frame, membrane_corners_regular, wrap_angle)
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
@@ -115,7 +116,7 @@ class System:
             raise InputError(f"expected base A_1j of shape (3, {N}), found {base.shape}")
         if np.any(~np.isfinite(l)) or np.any(l <= 0):
             raise InputError(f"expected bar lengths l > 0, found {l.ravel()}")
-        nq = 2 * N + 5 * N * (M - 1)
+        nq = q_size(M, N)
         if q.shape != (nq,) or not np.all(np.isfinite(q)):
             raise InputError(f"expected q of length {nq} (eqs. 3.1-3.2) with finite entries, "
                              f"found shape {q.shape}")
@@ -194,29 +195,18 @@ class System:
     @property
     def q_names(self) -> list[str]:
         """Names of the generalised coordinates, e.g. ``theta_11``, ``psi_11``, ``x_21``."""
-        names = []
-        for j in range(1, self.N + 1):
-            names += [label("theta", 1, j), label("psi", 1, j)]
-        for i in range(2, self.M + 1):
-            for j in range(1, self.N + 1):
-                names += [label(c, i, j) for c in ("x", "y", "z", "theta", "psi")]
+        xyz, th, ps = q_index(self.M, self.N)
+        names = [""] * q_size(self.M, self.N)
+        for (i, j), k in np.ndenumerate(th):
+            names[k], names[ps[i, j]] = label("theta", i + 1, j + 1), label("psi", i + 1, j + 1)
+            for c, comp in enumerate("xyz"):
+                if xyz[c, i, j] >= 0:
+                    names[xyz[c, i, j]] = label(comp, i + 1, j + 1)
         return names
 
     def split_q(self, q=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Lower ends A (3, M, N), declinations theta (M, N) and azimuths psi (M, N) from q."""
-        q = self.q if q is None else np.asarray(q, dtype=float)
-        M, N = self.M, self.N
-        A = np.empty((3, M, N))
-        theta = np.empty((M, N))
-        psi = np.empty((M, N))
-        A[:, 0, :] = self.base
-        s1 = q[: 2 * N].reshape(N, 2)
-        theta[0], psi[0] = s1[:, 0], s1[:, 1]
-        if M > 1:
-            rest = q[2 * N:].reshape(M - 1, N, 5)
-            A[:, 1:, :] = np.moveaxis(rest[..., :3], -1, 0)
-            theta[1:], psi[1:] = rest[..., 3], rest[..., 4]
-        return A, theta, psi
+        return split_q(self.q if q is None else q, self.base)
 
     def bar_ends(self, q=None) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper bar ends A_ij, B_ij, each (3, M, N)."""

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import casadi as ca
 
+from tmfem.system.coordinates import q_index
+
 
 def bar_direction_sx(theta, psi):
     """Unit vector (3,) of a bar with declination theta and azimuth psi (Fig. 3.1)."""
@@ -29,16 +31,15 @@ def bars_sx(system, q):
     A, e, B : list of SX (3,)
     """
     M, N = system.M, system.N
+    xyz, ith, ips = q_index(M, N)
     A, e, B = [], [], []
     for i in range(M):
         for j in range(N):
             if i == 0:
                 a = ca.SX(ca.DM(system.base[:, j]))
-                th, ps = q[2 * j], q[2 * j + 1]
             else:
-                k = 2 * N + 5 * ((i - 1) * N + j)
-                a = q[k:k + 3]
-                th, ps = q[k + 3], q[k + 4]
+                a = ca.vertcat(*[q[int(k)] for k in xyz[:, i, j]])
+            th, ps = q[int(ith[i, j])], q[int(ips[i, j])]
             d = bar_direction_sx(th, ps)
             A.append(a); e.append(d); B.append(a + float(system.l[i, j]) * d)
     return A, e, B

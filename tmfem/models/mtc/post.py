@@ -7,6 +7,7 @@ import numpy as np
 
 from tmfem.models.mtc.topology import to_floating
 from tmfem.fem.truss import truss_internal
+from tmfem.system.coordinates import join_q
 from tmfem.system.geometry import wrap_angle
 from tmfem.system.topology import label
 
@@ -22,10 +23,7 @@ def q_from_positions(system, X: np.ndarray) -> np.ndarray:
     d = X[:, n:2 * n].reshape(3, M, N) - A
     theta = np.arccos(d[2] / np.linalg.norm(d, axis=0))
     psi = wrap_angle(np.arctan2(d[1], d[0]))
-    parts = [np.column_stack([theta[0], psi[0]]).ravel()]
-    for i in range(1, M):
-        parts.append(np.column_stack([A[0, i], A[1, i], A[2, i], theta[i], psi[i]]).ravel())
-    return np.concatenate(parts)
+    return join_q(A, theta, psi)
 
 
 def member_state(model, x: np.ndarray) -> dict:
