@@ -24,7 +24,7 @@ from tmfem.fem.membrane import MembraneTL
 from tmfem.fem.truss import TrussSet, truss_internal, truss_mass
 from tmfem.mesh.polygon import polygon_quad_mesh
 from tmfem.solvers import arc_length, load_stepping, lowest_modes
-from tmfem.solvers.newton import _sub, free_index
+from tmfem.solvers.newton import submatrix
 from tmfem.solvers.backends import get_backend
 from tmfem.system.materials import MembraneMaterial
 
@@ -175,7 +175,7 @@ def square_membrane(*, n: int = 10, a: float = 2.0, F: float = 2.749, Fw: float 
     _, K1 = mem.internal(X + u1.reshape(-1, 3).T)
     zfree = np.flatnonzero((~fixed[:, 2]))
     zdofs = 3 * zfree + 2
-    solve = get_backend().factorize(_sub(K1, zdofs))
+    solve = get_backend().factorize(submatrix(K1, zdofs))
     w_lin = np.zeros(nn)
     w_lin[zfree] = solve(fz.ravel()[zdofs])
     st2 = load_stepping(lambda u, mu: residual(u, 1.0, mu), u1, free=(~fixed).ravel(), dlam0=0.25,

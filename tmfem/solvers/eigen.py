@@ -18,7 +18,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import InputError
 from tmfem.solvers.backends import get_backend
-from tmfem.solvers.newton import _sub, free_index
+from tmfem.solvers.newton import submatrix, free_index
 
 
 @dataclass
@@ -60,7 +60,7 @@ def lowest_modes(K, M, *, k: int, free=None, sigma: float | None = None, backend
     nf = idx.size
     if not (isinstance(k, (int, np.integer)) and 1 <= k <= nf):
         raise InputError(f"eigen: expected 1 <= k <= {nf} (free dofs), found k={k!r}")
-    Kf, Mf = _sub(K, idx), _sub(M, idx)
+    Kf, Mf = submatrix(K, idx), submatrix(M, idx)
     if sp.issparse(Kf):
         Kf, Mf = sp.csr_matrix(Kf), sp.csr_matrix(Mf)
     dK = Kf.diagonal() if sp.issparse(Kf) else np.diag(Kf)

@@ -34,7 +34,8 @@ def free_index(free, n: int) -> np.ndarray:
     return idx
 
 
-def _sub(K, idx):
+def submatrix(K, idx):
+    """The square block K[idx][:, idx] of a sparse or dense matrix (the free dofs)."""
     if sp.issparse(K):
         K = sp.csr_matrix(K)
         return K[idx][:, idx]
@@ -158,7 +159,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         if rn <= target:
             return NewtonResult(u=u, iterations=it - 1, residual_history=history, converged=True, r=r, K=K)
         try:
-            solve = factorize(_sub(K, idx), be)
+            solve = factorize(submatrix(K, idx), be)
         except ConvergenceError as exc:
             raise _fail(f"newton{where}: iteration {it}: {exc}; residual history "
                         f"{[f'{h:.3e}' for h in history]}", step=step, history=history,
@@ -330,7 +331,7 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
     for step in range(1, n_steps + 1):
         while True:
             try:
-                solve = factorize(_sub(K, idx), be)
+                solve = factorize(submatrix(K, idx), be)
                 dut = solve(q)
                 if prev is None:
                     sign = 1.0
@@ -351,7 +352,7 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
                     if rn <= tol * qn:
                         ok = True
                         break
-                    solve = factorize(_sub(Kt, idx), be)
+                    solve = factorize(submatrix(Kt, idx), be)
                     dur = -solve(r)
                     dut = solve(q)
                     a = dut @ dut

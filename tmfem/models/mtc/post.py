@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.models.mtc.topology import to_floating
 from tmfem.fem.truss import truss_internal
 from tmfem.system.coordinates import join_q
 from tmfem.system.geometry import wrap_angle
