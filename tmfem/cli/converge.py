@@ -6,6 +6,7 @@ import csv
 from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
 from tmfem.errors import InputError
 from tmfem.models.mtc.spec import apply_rest_lengths
+from tmfem.post.convergence import plot_convergence_study
 from tmfem.solvers.backends import backend_names
 
 NAME = "converge"
@@ -74,39 +75,12 @@ def run(args) -> dict:
         out["max_relative_change_over_tendon_elements"] = max(
             abs(r[f"f{i + 1}"] / f0[i] - 1) for r in rows for i in range(args.modes))
     if args.plot:
-        out["plot"] = str(_plot(args.plot, rows, args.modes, system.name, args.attachment,
-                                by_tendons=len(meshes) == 1 and len(tendons) > 1))
+        out["plot"] = str(plot_convergence_study(args.plot, rows, args.modes, system.name,
+                                                 args.attachment,
+                                                 by_tendons=len(meshes) == 1 and len(tendons) > 1))
     if args.csv:
         out["csv"] = args.csv
     return out
-
-
-def _plot(path, rows, modes, name, attachment, *, by_tendons: bool):
-    import numpy as np
-    from tmfem.io.vtk import check_path
-    from tmfem.post.plots import _plt, _save
-    path = check_path(path, suffixes=(".png",))
-    plt = _plt()
-    x = np.array([r["tendon_elements"] if by_tendons else r["elements"] for r in rows], float)
-    F = np.array([[r[f"f{i + 1}"] for i in range(modes)] for r in rows])
-    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
-    for i in range(modes):
-        ax[0].plot(x, F[:, i], "o-", ms=3, label=f"mode {i + 1}")
-    ax[0].set_xlabel("elements per tendon" if by_tendons else "membrane elements")
-    ax[0].set_ylabel("frequency [Hz]")
-    ax[0].set_title(f"{name} MTC, {attachment} attachment")
-    ax[0].legend(fontsize=6, ncol=2)
-    for key, lab in (("sigma_p1_max_MPa", "max sigma_p1 (Gauss pt)"),
-                     ("von_mises_max_MPa", "max von Mises (Gauss pt)"),
-                     ("sigma_p1_elem_max_MPa", "max sigma_p1 (element mean)")):
-        ax[1].plot(x, [r[key] for r in rows], "o-", label=lab)
-    ax[1].set_xlabel(ax[0].get_xlabel())
-    ax[1].set_ylabel("stress [MPa]")
-    if not by_tendons:
-        ax[0].set_xscale("log")
-        ax[1].set_xscale("log")
-    ax[1].legend(fontsize=8)
-    return _save(fig, path)
 
 
 def format_text(r: dict) -> str:
