@@ -40,6 +40,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from tmfem.equilibrium.general import node_jacobian
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
 from tmfem.models.base import split_perturbation
@@ -173,12 +174,12 @@ def perturbation_names(system) -> list:
     return list(system.q_names) + [n + "_dot" for n in system.q_names]
 
 
-def initial_state(dyn: MTCDynamics, perturb: dict | None, *, h: float = 1e-6):
+def initial_state(dyn: MTCDynamics, perturb: dict | None):
     """Free-DOF positions and velocities (u0, v0) of the perturbed equilibrium (module docstring).
 
-    The labelled-node field dX/dq is the central difference (step h) of ``system.nodes(q)``
-    at the q recovered from the equilibrium; the other free DOFs follow by static condensation
-    of the equilibrium tangent.
+    The labelled-node field dX/dq (exact, :func:`tmfem.equilibrium.general.node_jacobian`) is
+    taken at the q recovered from the equilibrium; the other free DOFs follow by static
+    condensation of the equilibrium tangent.
     """
     model = dyn.model
     system, topo = model.system, model.topology
@@ -190,11 +191,7 @@ def initial_state(dyn: MTCDynamics, perturb: dict | None, *, h: float = 1e-6):
     q_e = q_from_positions(system, x_eq[:, topo.system_node])
     X_e = system.nodes(q_e)
     dX_pos = system.nodes(q_e + dq) - X_e if np.any(dq) else np.zeros_like(X_e)
-    J = np.zeros_like(X_e)
-    for k in np.flatnonzero(dqd):
-        e = np.zeros_like(q_e)
-        e[k] = h
-        J += (system.nodes(q_e + e) - system.nodes(q_e - e)) / (2 * h) * dqd[k]
+    J = node_jacobian(system, q_e) @ dqd                       # dX/dq q' (eqs. 3.1-3.2)
     # reduced node carrying each labelled node (point attachment: B_Mj is the corner node)
     red_of = np.full(len(system.node_labels), -1)
     for i, n in enumerate(topo.system_node):
