@@ -154,7 +154,14 @@ def nodal_normals(X: np.ndarray, conn: np.ndarray) -> np.ndarray:
     for i in range(3):
         acc[i] = np.bincount(conn.ravel(), weights=n[..., i].T.ravel(), minlength=X.shape[1])
     nrm = np.linalg.norm(acc, axis=0)
-    used = nrm > 0
+    count = np.bincount(conn.ravel(), minlength=X.shape[1])
+    used = count > 0
+    coherence = np.where(used, nrm / np.maximum(count, 1), 1.0)
+    if np.any(coherence < 0.5):
+        k = int(np.argmin(coherence))
+        raise InputError(f"shell mesh: expected consistently oriented elements (corner normals at a node "
+                         f"within 60 deg), found node {k} where |sum of {count[k]} unit normals| / {count[k]} "
+                         f"= {coherence[k]:.3f}; reorder element nodes or pass normals")
     acc[:, used] /= nrm[used]
     dots = np.einsum("eci,ice->ce", n, acc[:, conn])
     if np.any(dots <= 0.0):
@@ -169,7 +176,7 @@ class _Points:
     """Reference quantities of the MITC4 element set at a tensor grid of points: in-plane
     points xi (2, nq) with weights wq, thickness coordinates r3 (nz,) with weights wz."""
 
-    def __init__(self, shell, xi, wq, r3, wz):
+    def __init__(self, shell, xi, wq, r3, wz, *, output_frame: bool = False):
         self.xi, self.r3 = np.asarray(xi, float), np.asarray(r3, float)
         self.h, self.dh = _quad_shape(self.xi)                       # (4, nq), (4, 2, nq)
         # MITC tying weights (eq. 4.17): eps_13 = xi_2 A + (1 - xi_2) C; eps_23 = xi_1 D + (1 - xi_1) B
@@ -194,7 +201,14 @@ class _Points:
         self.Ga, self.Gb, self.G3 = Ga, Gb, G3
         # local Cartesian frame (eq. 4.11) and the strain transformation Q (eq. 4.10)
         e3 = G3z / np.linalg.norm(G3z, axis=-1, keepdims=True)
-        e1 = np.cross(G[:, :, :, 1], e3)
+        if output_frame:
+            # results frame: eq. 4.16 at the point (e_1 = e_y x e_3 normalised, e_z if parallel)
+            e1 = np.cross(np.array([0.0, 1.0, 0.0]), e3)
+            par = np.linalg.norm(e1, axis=-1) < 1e-8
+            e1[par] = np.array([0.0, 0.0, 1.0])
+            e1 -= np.einsum("...i,...i->...", e1, e3)[..., None] * e3
+        else:
+            e1 = np.cross(G[:, :, :, 1], e3)
         e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
         e2 = np.cross(e3, e1)
         Ev = np.stack([e1, e2, e3], axis=-2)                         # rows e_m
@@ -453,8 +467,12 @@ class MITC4Shell:
     def stresses(self, state, *, xi=(0.5, 0.5)):
         """Local 2nd Piola-Kirchhoff stresses at one in-plane point of every element.
 
-        Returns ``dict`` with ``sigma`` (ne, 3, 5): [s11, s22, s12, s13, s23] in the local
-        Cartesian frame of eq. 4.11 at r_3 = -1, 0, 1 (bottom, mid, top), ``von_mises``
+        The results frame is that of eq. 4.16 at the point (e_3 along G_3, e_1 = e_y x e_3
+        normalised, e_z where e_3 is parallel to e_y; the same on every element of a flat
+        mesh), the stresses D Q_out c of the isotropic lamina law in that frame.
+
+        Returns ``dict`` with ``sigma`` (ne, 3, 5): [s11, s22, s12, s13, s23] in that frame
+        at r_3 = -1, 0, 1 (bottom, mid, top), ``von_mises``
         (ne, 3) of those (with the transverse shear), ``N`` (ne, 3) membrane forces
         [N11, N22, N12] and ``M`` (ne, 3) bending moments [M11, M22, M12] per unit length
         (2-point Gauss through the thickness) and ``Qs`` (ne, 2) transverse shear forces.
@@ -465,7 +483,7 @@ class MITC4Shell:
         out = {}
         for key, r3, wz in (("surf", np.array([-1.0, 0.0, 1.0]), np.ones(3)),
                             ("gauss", *np.polynomial.legendre.leggauss(2))):
-            pts = _Points(self, xi, np.ones(1), r3, wz)
+            pts = _Points(self, xi, np.ones(1), r3, wz, output_frame=True)
             c = self._strains(pts, u, d, w)[0][:, 0]                          # (ne, nz, 5)
             out[key] = np.einsum("ab,ezbc,ezc->eza", D, pts.Q[:, 0], c)
         sig = out["surf"]
@@ -524,6 +542,12 @@ class ShellPressure:
         K = (np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 1], skew(g[:, :, 0]))
              - np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 0], skew(g[:, :, 1])))
         return f, self._asm.matrix(K.reshape(-1, 12, 12))
+
+    def nodal_areas(self) -> np.ndarray:
+        """Consistent nodal areas int h_k |G_1 x G_2| dxi (4, ne) of the reference surface."""
+        g = np.einsum("kaq,ike->eqai", self._dh, self.X[:, self.conn])
+        a = np.linalg.norm(np.cross(g[:, :, 0], g[:, :, 1]), axis=-1)
+        return np.einsum("q,kq,eq->ke", self._wq, self._h, a)
 
     def internal(self, state, *, tangent: bool = True):
         """The load as an element set: internal force -F and tangent -dF/du."""

@@ -128,6 +128,8 @@ class Structure:
         self._prescribed = np.zeros(self.dofmap.ndof)
         self._force = np.zeros(self.dofmap.ndof)
         self._pressures: list[ShellPressure] = []
+        self._base_force = np.zeros(self.dofmap.ndof)
+        self._base_pressures: list[ShellPressure] = []
         self._dependent: list = []
         self._cm = None
 
@@ -268,6 +270,20 @@ class Structure:
                     self._force[o:o + 3] += m
         self._cm = None
 
+    def surface_load(self, q, *, elements=None, shell: int = 0) -> None:
+        """Dead distributed load q [N/m^2] (3,) per unit reference mid-surface area (e.g. self
+        weight), as consistent nodal forces f_k = int h_k q dA."""
+        if not self.shells:
+            raise InputError("surface load: expected a shell element set, found none")
+        q = np.asarray(q, dtype=float)
+        if q.shape != (3,):
+            raise InputError(f"surface load: expected a load of 3 components, found {q.shape}")
+        sh = self.shells[shell]
+        conn = sh.conn if elements is None else sh.conn[:, np.asarray(elements)]
+        dA = ShellPressure(X=self.X, conn=conn, dofmap=self.dofmap, p=1.0, follower=False).nodal_areas()
+        np.add.at(self._force, self.dofmap.translation_dofs(conn.ravel()), dA.ravel()[:, None] * q[None, :])
+        self._cm = None
+
     def pressure(self, p, *, elements=None, shell: int = 0, follower: bool = True) -> ShellPressure:
         """Pressure p [Pa] on the elements of a shell set (all by default), along the element
         normal (the directors' side); ``follower`` acts on the current surface."""
@@ -278,6 +294,16 @@ class Structure:
         pl = ShellPressure(X=self.X, conn=conn, dofmap=self.dofmap, p=p, follower=follower)
         self._pressures.append(pl)
         return pl
+
+    def freeze_loads(self) -> None:
+        """Make the loads defined so far a constant base load (no longer scaled by the load
+        factor) and the prescribed displacements reached so far permanent: the loads defined
+        next are the live load of the following :meth:`solve` (prestress, then load)."""
+        self._base_force = self._base_force + self._force
+        self._force = np.zeros(self.dofmap.ndof)
+        self._base_pressures += self._pressures
+        self._pressures = []
+        self._prescribed = np.zeros(self.dofmap.ndof)
 
     # ------------------------------------------------------------------ equations
     @property
@@ -293,14 +319,15 @@ class Structure:
         return State.reference(self.X, self.dofmap, frames=self.frames)
 
     def external(self, state: State, lam: float, *, tangent: bool = True):
-        """External force lam (F_point + F_pressure(state)) and its load stiffness."""
-        f = lam * self._force
+        """External force F_base + lam (F_point + F_pressure(state)) and its load stiffness
+        (base loads: :meth:`freeze_loads`)."""
+        f = self._base_force + lam * self._force
         K = None
-        for pl in self._pressures:
+        for pl, c in [(p, 1.0) for p in self._base_pressures] + [(p, lam) for p in self._pressures]:
             fp, Kp = pl.load(state, tangent=tangent)
-            f = f + lam * fp
+            f = f + c * fp
             if Kp is not None:
-                K = lam * Kp if K is None else K + lam * Kp
+                K = c * Kp if K is None else K + c * Kp
         return f, K
 
     def residual(self, state: State, lam: float):
@@ -324,7 +351,8 @@ class Structure:
 
     def _scale(self) -> float:
         f0, _ = self.external(self.reference_state(), 1.0, tangent=False)
-        sc = float(np.linalg.norm(self.constraints.residual(f0)[self.constraints.free]))
+        fb, _ = self.external(self.reference_state(), 0.0, tangent=False)
+        sc = float(np.linalg.norm(self.constraints.residual(f0 - fb)[self.constraints.free]))
         if np.any(self._prescribed):
             r, _ = self.residual(self._with_prescribed(self.reference_state(), 1.0), 0.0)
             sc = max(sc, float(np.linalg.norm(r[self.constraints.free])))
@@ -394,21 +422,26 @@ class Structure:
         return out
 
     def solve_arc_length(self, *, dl: float, n_steps: int = 50, lam_max: float | None = None,
-                         tol: float = 1e-8, stop=None) -> list[StructureState]:
+                         tol: float = 1e-8, stop=None, start: StructureState | None = None
+                         ) -> list[StructureState]:
         """Arc-length continuation (Crisfield, :func:`tmfem.solvers.arc_length`) for point
         loads and dead pressure (a follower pressure or prescribed displacements are refused:
-        the solver takes a fixed reference load)."""
+        the solver takes a fixed reference load). Starts from ``start`` (an equilibrium under
+        the base loads of :meth:`freeze_loads`; default the reference state)."""
         if any(p.follower for p in self._pressures) or np.any(self._prescribed):
             raise InputError("arc length: expected dead loads only, found a follower pressure or "
                              "prescribed displacements (use solve())")
         cm = self.constraints
-        f0, _ = self.external(self.reference_state(), 1.0, tangent=False)
-        q = cm.residual(f0)
+        f1, _ = self.external(self.reference_state(), 1.0, tangent=False)
+        f0, _ = self.external(self.reference_state(), 0.0, tangent=False)
+        q = cm.residual(f1 - f0)
 
         def internal(s):
             f, K = assemble(self.elements, s)
-            return cm.residual(f), cm.tangent(K)
-        path = arc_length(internal, q, self.reference_state(), free=cm.free, dl=dl, n_steps=n_steps,
+            fb, Kb = self.external(s, 0.0)
+            return cm.residual(f - fb), cm.tangent(K if Kb is None else K - Kb)
+        s0 = self.reference_state() if start is None else start.state
+        path = arc_length(internal, q, s0, free=cm.free, dl=dl, n_steps=n_steps,
                           lam_max=lam_max, tol=tol, update=self._update,
                           stop=None if stop is None else (lambda s, lam: stop(StructureState(s, lam))))
         its = [0] + list(path.iterations)
