@@ -242,7 +242,8 @@ class MITC4Shell:
         The shell's nodes must have 5 dofs (translations, rotations about V_1 and V_2).
     normals : ndarray (3, n_nodes), optional
         Reference directors V_n^0 (default: :func:`nodal_normals` of the mesh). Pass the exact
-        surface normals of a curved shell where known.
+        surface normals of a curved shell where known; each is turned to the side of the
+        element normals g_1 x g_2 (the mesh orientation decides the side).
 
     Attributes
     ----------
@@ -275,6 +276,9 @@ class MITC4Shell:
             Vn = np.asarray(normals, dtype=float)
             if Vn.shape != (3, dofmap.n_nodes):
                 raise InputError(f"MITC4: expected normals of shape (3, {dofmap.n_nodes}), found {Vn.shape}")
+            # orient the given directors to the side of the element normals g_1 x g_2
+            side = np.einsum("in,in->n", Vn, nodal_normals(X, conn))
+            Vn = Vn * np.where(side < 0, -1.0, 1.0)
         frames = np.broadcast_to(np.eye(3), (dofmap.n_nodes, 3, 3)).copy()
         frames[nodes] = director_frames(Vn[:, nodes])
         self.frames = frames

@@ -19,15 +19,13 @@ def model(*, n: int):
     at x = 0 (u_y = u_z = 0), symmetry planes x = L/2 and y = 0, exact radial directors.
     Returns (structure, node B at the middle of the free edge)."""
     from skfem import MeshQuad
-    from tmfem.fem.mitc4 import ShellSection, nodal_normals
-    from tmfem.fem.structure import Structure, read_quad_mesh
+    from tmfem.fem.mitc4 import ShellSection
+    from tmfem.fem.structure import Structure
     m = MeshQuad.init_tensor(np.linspace(0.0, LENGTH / 2, n + 1), np.linspace(0.0, PHI, n + 1))
     x, phi = m.p
-    p = np.vstack([x, R * np.sin(phi), R * np.cos(phi)])
-    _, t = read_quad_mesh((p, m.t))
+    p, t = np.vstack([x, R * np.sin(phi), R * np.cos(phi)]), m.t
     radial = np.vstack([np.zeros_like(x), np.sin(phi), np.cos(phi)])
-    sign = np.sign(np.einsum("in,in->n", nodal_normals(p, t), radial))
-    s = Structure.shell((p, t), section=ShellSection(E=E_MOD, nu=0.0, thickness=T), normals=sign * radial)
+    s = Structure.shell((p, t), section=ShellSection(E=E_MOD, nu=0.0, thickness=T), normals=radial)
     s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0.0)), ["uy", "uz"])
     s.symmetry(s.nodes_where(lambda x, y, z: np.isclose(x, LENGTH / 2)), normal="x")
     s.symmetry(s.nodes_where(lambda x, y, z: np.isclose(y, 0.0)), normal="y")

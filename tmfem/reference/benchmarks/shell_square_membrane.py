@@ -12,17 +12,18 @@ COLUMNS = {"y": "m", "x": "m", "w_membrane": "m", "w_shell": "m"}
 
 
 def shell_square_membrane(*, n: int = 10, a: float = 2.0, F: float = 2.749, Fw: float = 0.1,
-                          steps: int = 4):
+                          steps: int = 4, thickness: float = 51e-6):
     """The 4.5.4 problem with MITC4 shells on the membrane's mesh (4 n x n quads), the same
     supports and loads as :func:`tmfem.reference.element_benchmarks.square_membrane`
     ("diagonal" corner forces): stage 1 the in-plane corner forces (frozen as a base load,
     :meth:`Structure.freeze_loads`), stage 2 Fw at B in ``steps`` load steps.
-    Returns (structure, final state, stage-1 state, path of stage 2)."""
+    Returns (structure, final state, stage-1 state, path of stage 2, mesh)."""
     from tmfem.fem.mitc4 import ShellSection
     from tmfem.fem.structure import Structure
     from tmfem.mesh.polygon import polygon_quad_mesh
     mesh = polygon_quad_mesh(np.array([[0, a, a, 0], [0, 0, a, a]], float), n)
-    s = Structure.shell((mesh.p, mesh.t), section=ShellSection(E=1.65e8, nu=0.34, thickness=51e-6, rho=1400.0))
+    s = Structure.shell((mesh.p, mesh.t), section=ShellSection(E=1.65e8, nu=0.34, thickness=thickness,
+                                                                  rho=1400.0))
     O, A, B, C = mesh.corners
     s.fix([O], ["ux", "uy", "uz"])
     s.fix([A], ["uy", "uz"])
