@@ -135,3 +135,35 @@ def test_structure_refusals():
     with pytest.raises(InputError, match="quad cells"):
         Structure.shell(meshio.Mesh(np.zeros((3, 3)), [("triangle", np.array([[0, 1, 2]]))]),
                         section=ShellSection(E=1, nu=0, thickness=0.1))
+
+
+def test_gmsh_model_and_meshio_file_give_the_same_structure(tmp_path):
+    """A transfinite recombined gmsh rectangle read from the live model and from its .msh file:
+    same nodes and quads, and the same linear tip deflection P L^3/(3 EI) of a clamped strip."""
+    gmsh = pytest.importorskip("gmsh")
+    from tmfem.fem.structure import gmsh_quad_mesh
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("strip")
+        gmsh.model.occ.addRectangle(0, 0, 0, 4.0, 0.5)
+        gmsh.model.occ.synchronize()
+        for c in gmsh.model.getEntities(1):
+            gmsh.model.mesh.setTransfiniteCurve(c[1], 9 if c[1] in (1, 3) else 2)
+        gmsh.model.mesh.setTransfiniteSurface(1)
+        gmsh.model.mesh.setRecombine(2, 1)
+        gmsh.model.mesh.generate(2)
+        live = gmsh_quad_mesh()
+        gmsh.write(str(tmp_path / "strip.msh"))
+    finally:
+        gmsh.finalize()
+    tips = []
+    for mesh in (live, tmp_path / "strip.msh"):
+        s = Structure.shell(mesh, section=ShellSection(E=1e7, nu=0.0, thickness=0.05))
+        s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0)))
+        tip = s.nodes_where(lambda x, y, z: np.isclose(x, 4.0))
+        s.point_load(tip, force=(0, 0, 1e-3 / tip.size))
+        tips.append(s.displacements(s.solve_linear())[2, tip].mean())
+    EI = 1e7 * 0.5 * 0.05**3 / 12
+    assert tips[0] == pytest.approx(tips[1], rel=1e-12)
+    assert abs(tips[0]) == pytest.approx(1e-3 * 4.0**3 / (3 * EI), rel=0.01)

@@ -179,10 +179,7 @@ class _Points:
     def __init__(self, shell, xi, wq, r3, wz, *, output_frame: bool = False):
         self.xi, self.r3 = np.asarray(xi, float), np.asarray(r3, float)
         self.h, self.dh = _quad_shape(self.xi)                       # (4, nq), (4, 2, nq)
-        # MITC tying weights (eq. 4.17): eps_13 = xi_2 A + (1 - xi_2) C; eps_23 = xi_1 D + (1 - xi_1) B
-        x1, x2 = self.xi
-        self.wt13 = np.stack([x2, 1.0 - x2])                         # (2 [A, C], nq)
-        self.wt23 = np.stack([x1, 1.0 - x1])                         # (2 [D, B], nq)
+        self.wt13, self.wt23 = shell._tie_weights(self.xi)           # (nt, nq) each
         Xe, De = shell._Xe, shell._De                                # (ne, 4, 3)
         Ga = np.einsum("kaq,eki->eqai", self.dh, Xe)                 # (ne, nq, 2, 3)
         Gb = np.einsum("kaq,eki->eqai", self.dh, De)
@@ -252,7 +249,8 @@ class MITC4Shell:
         ``frames`` of :meth:`tmfem.fem.element.State.reference`.
     """
 
-    def __init__(self, *, X, conn, section: ShellSection, dofmap: DofMap, normals=None):
+    def __init__(self, *, X, conn, section: ShellSection, dofmap: DofMap, normals=None,
+                 shear: str = "mitc"):
         X = np.asarray(X, dtype=float)
         conn = np.asarray(conn, dtype=np.int64)
         if X.shape != (3, dofmap.n_nodes):
@@ -289,18 +287,42 @@ class MITC4Shell:
         from skfem.quadrature import get_quadrature
         from skfem.refdom import RefQuad
         xq, wq = get_quadrature(RefQuad, 3)
+        if shear not in ("mitc", "direct"):
+            raise InputError(f"MITC4: expected shear 'mitc' or 'direct', found {shear!r}")
+        self.shear = shear
+        if shear == "mitc":
+            # tying points (eqs. 4.17-4.18): A, C for eps_13; D, B for eps_23
+            self._tie_xi = np.array([[0.5, 0.5, 1.0, 0.0], [1.0, 0.0, 0.5, 0.5]])
+        else:
+            # displacement-based shear at the 2 x 2 Gauss points (locks in the thin limit)
+            self._tie_xi = np.concatenate([xq, xq], axis=1)
+        self._gxi = xq
+        nt = self._tie_xi.shape[1] // 2
+        self._nt = nt
+        self._tie_h, self._tie_dh = _quad_shape(self._tie_xi)
+        Gt = np.einsum("kat,eki->etai", self._tie_dh, self._Xe)              # (ne, 2 nt, 2, 3)
+        self._tie_G = np.stack([Gt[:, :nt, 0], Gt[:, nt:, 1]], axis=1)      # (ne, 2 comp, nt, 3)
+        self._tie_G3 = np.einsum("kt,eki->eti", self._tie_h, self._De).reshape(self.ne, 2, nt, 3)
         rz, wz = np.polynomial.legendre.leggauss(2)
         self._gauss = _Points(self, xq, wq, rz, wz)
-        # tying points (eq. 4.18): A, C for eps_13; D, B for eps_23
-        self._tie_xi = np.array([[0.5, 0.5, 1.0, 0.0], [1.0, 0.0, 0.5, 0.5]])
-        self._tie_h, self._tie_dh = _quad_shape(self._tie_xi)
-        Gt = np.einsum("kat,eki->etai", self._tie_dh, self._Xe)              # (ne, 4 tie, 2, 3)
-        self._tie_G = np.stack([Gt[:, 0:2, 0], Gt[:, 2:4, 1]], axis=1)      # (ne, 2 comp, 2 pt, 3)
-        self._tie_G3 = np.einsum("kt,eki->eti", self._tie_h, self._De).reshape(self.ne, 2, 2, 3)
         self._asm = Assembler(dofmap.element_dofs(conn, rotations=True), dofmap.ndof)
         self._M = None
 
     # ------------------------------------------------------------------ kinematics
+    def _tie_weights(self, xi):
+        """Weights (nt, m) of the tying-point values at points xi (2, m): eq. 4.17,
+        eps_13 = xi_2 A + (1 - xi_2) C, eps_23 = xi_1 D + (1 - xi_1) B (``shear="mitc"``), or the
+        bilinear interpolation of the Gauss-point values (``shear="direct"``)."""
+        x1, x2 = np.asarray(xi, float)
+        if self.shear == "mitc":
+            return np.stack([x2, 1.0 - x2]), np.stack([x1, 1.0 - x1])
+        g = self._gxi
+        lo, hi = g.min(axis=1), g.max(axis=1)
+        t1, t2 = (x1[None] - lo[0]) / (hi[0] - lo[0]), (x2[None] - lo[1]) / (hi[1] - lo[1])
+        a1 = np.where(np.isclose(g[0], lo[0])[:, None], 1 - t1, t1)
+        a2 = np.where(np.isclose(g[1], lo[1])[:, None], 1 - t2, t2)
+        return a1 * a2, a1 * a2
+
     def _nodal(self, state):
         """Element nodal displacements u (ne, 4, 3), directors d = (a/2) V_n (ne, 4, 3),
         director changes w = d - D and the rotating triads (ne, 4, 3, 3) at ``state``."""
@@ -332,8 +354,9 @@ class MITC4Shell:
                + np.einsum("...i,...i->...", Ux[..., 0, :], Ux[..., 1, :]))
         # tying points at r3 = 0: gamma_a3 = u_a.G_3 + G_a.u_3 + u_a.u_3 (A, C for a = 1; D, B for a = 2)
         ut = np.einsum("kat,eki->etai", self._tie_dh, u)
-        ut = np.stack([ut[:, 0:2, 0], ut[:, 2:4, 1]], axis=1)                # (ne, 2, 2, 3)
-        u3 = np.einsum("kt,eki->eti", self._tie_h, w).reshape(self.ne, 2, 2, 3)
+        nt = self._nt
+        ut = np.stack([ut[:, :nt, 0], ut[:, nt:, 1]], axis=1)                # (ne, 2, nt, 3)
+        u3 = np.einsum("kt,eki->eti", self._tie_h, w).reshape(self.ne, 2, nt, 3)
         gam_t = (np.einsum("ecti,ecti->ect", ut, self._tie_G3) + np.einsum("ecti,ecti->ect", self._tie_G, u3)
                  + np.einsum("ecti,ecti->ect", ut, u3))                       # (ne, 2, 2)
         g13 = np.einsum("tq,et->eq", pts.wt13, gam_t[:, 0])
@@ -368,9 +391,10 @@ class MITC4Shell:
         Bm[:, :, :, 2, :, 0] = h1 * g2 + h2 * g1
         Bm[:, :, :, :, :, 1] = r3[None, None, :, None, None, None] * Bm[:, :, :, :, :, 0]
         # shear rows at the tying points: d gamma_a3 / d x_k = h_k,a g_3, / d d_k = h_k g_a
-        Bt = np.empty((ne, 2, 2, 4, 2, 3))                                   # (ne, comp, pt, k, x/d, 3)
-        tdh = self._tie_dh.reshape(4, 2, 2, 2)                               # (k, a, comp, pt)
-        th = self._tie_h.reshape(4, 2, 2)                                    # (k, comp, pt)
+        nt = self._nt
+        Bt = np.empty((ne, 2, nt, 4, 2, 3))                                  # (ne, comp, pt, k, x/d, 3)
+        tdh = self._tie_dh.reshape(4, 2, 2, nt)                              # (k, a, comp, pt)
+        th = self._tie_h.reshape(4, 2, nt)                                   # (k, comp, pt)
         for comp in range(2):
             Bt[:, comp, :, :, 0] = np.transpose(tdh[:, comp, comp, :])[None, :, :, None] * g3t[:, comp, :, None, :]
             Bt[:, comp, :, :, 1] = np.transpose(th[:, comp, :])[None, :, :, None] * gt[:, comp, :, None, :]

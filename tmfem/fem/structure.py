@@ -135,22 +135,24 @@ class Structure:
 
     # ------------------------------------------------------------------ building
     @classmethod
-    def shell(cls, mesh, *, section: ShellSection, normals=None) -> "Structure":
+    def shell(cls, mesh, *, section: ShellSection, normals=None, shear: str = "mitc") -> "Structure":
         """A shell structure from a quad mesh (scikit-fem ``MeshQuad``, ``meshio.Mesh``,
         meshio-readable path or ``(points, quads)``; flat or curved in 3-D): every node a 5-dof
-        shell node, one MITC4 element set. ``normals`` (3, n): reference directors."""
+        shell node, one MITC4 element set. ``normals`` (3, n): reference directors; ``shear``:
+        see :class:`MITC4Shell`."""
         p, t = read_quad_mesh(mesh)
         s = cls(points=p, dofs=5)
-        s.add_shell(t, section=section, normals=normals)
+        s.add_shell(t, section=section, normals=normals, shear=shear)
         return s
 
     @property
     def n_nodes(self) -> int:
         return self.X.shape[1]
 
-    def add_shell(self, quads, *, section: ShellSection, normals=None) -> MITC4Shell:
+    def add_shell(self, quads, *, section: ShellSection, normals=None, shear: str = "mitc") -> MITC4Shell:
         """Add MITC4 elements on the 5-dof nodes ``quads`` (4, ne)."""
-        sh = MITC4Shell(X=self.X, conn=quads, section=section, dofmap=self.dofmap, normals=normals)
+        sh = MITC4Shell(X=self.X, conn=quads, section=section, dofmap=self.dofmap, normals=normals,
+                        shear=shear)
         self.frames[sh.nodes] = sh.frames[sh.nodes]
         self.shells.append(sh)
         self.elements.append(sh)
