@@ -566,9 +566,8 @@ class ShellPressure:
         f = self._asm.vector(fe)
         if not (tangent and self.follower):
             return f, None
-        skew = _skew
-        K = (np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 1], skew(g[:, :, 0]))
-             - np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 0], skew(g[:, :, 1])))
+        K = (np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 1], _skew(g[:, :, 0]))
+             - np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 0], _skew(g[:, :, 1])))
         return f, self._asm.matrix(K.reshape(-1, 12, 12))
 
     def nodal_areas(self) -> np.ndarray:
