@@ -167,3 +167,20 @@ def test_gmsh_model_and_meshio_file_give_the_same_structure(tmp_path):
     EI = 1e7 * 0.5 * 0.05**3 / 12
     assert tips[0] == pytest.approx(tips[1], rel=1e-12)
     assert abs(tips[0]) == pytest.approx(1e-3 * 4.0**3 / (3 * EI), rel=0.01)
+
+
+def test_shell_started_from_the_membrane_equilibrium_converges_at_once():
+    """4.5.4 at 51 um: the membrane element's equilibrium, turned into a shell state
+    (positions, directors along the deformed normals), is within the shell's bending effect of
+    the shell equilibrium: Newton from it converges in at most 3 iterations to the shell solution
+    of the load-stepped run."""
+    from tmfem.reference.benchmarks.shell_square_membrane import shell_square_membrane
+    from tmfem.reference.element_benchmarks import square_membrane
+    from tmfem.solvers import newton
+    s, st, _, _, mesh = shell_square_membrane(n=5)
+    mem = square_membrane(n=5)
+    start = s.state_from_positions(s.X + mem.u)
+    r = newton(lambda q: s.residual(q, 1.0), start.state, free=s.constraints.free, tol=1e-8, scale=0.1,
+               line_search=False, update=s.advance)
+    assert r.iterations <= 3
+    assert np.abs(r.u.x - st.x).max() <= 1e-6 * np.abs(mem.u[2]).max()

@@ -320,6 +320,28 @@ class Structure:
         """The undeformed state."""
         return State.reference(self.X, self.dofmap, frames=self.frames)
 
+    def state_from_positions(self, x, *, lam: float = 0.0) -> StructureState:
+        """A state at nodal positions x (3, n_nodes) (e.g. the equilibrium of a membrane model
+        of the same mesh): every shell node's director is turned by the smallest rotation onto
+        the normal of the surface through x (averaged element normals), other nodes keep their
+        orientation. A start for Newton, not an equilibrium."""
+        from scipy.spatial.transform import Rotation
+        from tmfem.fem.mitc4 import nodal_normals
+        x = np.asarray(x, dtype=float)
+        if x.shape != self.X.shape:
+            raise InputError(f"state from positions: expected shape {self.X.shape}, found {x.shape}")
+        st = self.reference_state()
+        R = st.R
+        for sh in self.shells:
+            n = nodal_normals(x, sh.conn)[:, sh.nodes]
+            V0 = self.frames[sh.nodes][:, :, 2].T
+            axis = np.cross(V0, n, axis=0)
+            ang = np.arctan2(np.linalg.norm(axis, axis=0), np.einsum("in,in->n", V0, n))
+            nrm = np.linalg.norm(axis, axis=0)
+            rv = np.where(nrm > 0, axis / np.where(nrm > 0, nrm, 1.0) * ang, 0.0)
+            R[sh.nodes] = Rotation.from_rotvec(rv.T).as_matrix()
+        return StructureState(state=State(x=x.copy(), R=R, frames=self.frames), lam=lam)
+
     def external(self, state: State, lam: float, *, tangent: bool = True):
         """External force F_base + lam (F_point + F_pressure(state)) and its load stiffness
         (base loads: :meth:`freeze_loads`)."""
@@ -343,7 +365,9 @@ class Structure:
             K = K - Ke
         return cm.residual(f - fe), cm.tangent(K)
 
-    def _update(self, s: State, du) -> State:
+    def advance(self, s: State, du) -> State:
+        """The state after the reduced increment du (translations added, rotations by the
+        exponential map): the ``update=`` of the solvers of :mod:`tmfem.solvers.newton`."""
         return s.advanced(self.constraints.full(du), self.dofmap)
 
     def _with_prescribed(self, s: State, dlam: float) -> State:
@@ -406,7 +430,7 @@ class Structure:
             try:
                 res = newton(lambda s: self.residual(s, target), s_try, free=self.constraints.free,
                              tol=tol, scale=scale, max_iter=max_iter, line_search=line_search,
-                             load_factor=target, update=self._update)
+                             load_factor=target, update=self.advance)
             except ConvergenceError as exc:
                 dlam = 0.5 * d
                 log.info("structure: step to lam = %g failed (%s); halving", target, exc)
@@ -444,7 +468,7 @@ class Structure:
             return cm.residual(f - fb), cm.tangent(K if Kb is None else K - Kb)
         s0 = self.reference_state() if start is None else start.state
         path = arc_length(internal, q, s0, free=cm.free, dl=dl, n_steps=n_steps,
-                          lam_max=lam_max, tol=tol, update=self._update,
+                          lam_max=lam_max, tol=tol, update=self.advance,
                           stop=None if stop is None else (lambda s, lam: stop(StructureState(s, lam))))
         its = [0] + list(path.iterations)
         return [StructureState(state=s, lam=float(lam), iterations=i) for s, lam, i in zip(path.u, path.lam, its)]
@@ -460,9 +484,11 @@ class Structure:
 
     def modes(self, *, k: int = 6, at: StructureState | None = None):
         """Lowest k modes about ``at`` (default: the reference state) with the tangent there
-        (prestress and load stiffness included, eq. 5.32); shapes in full dofs."""
+        (prestress and load stiffness included, eq. 5.32; the symmetric part where a follower
+        pressure makes it non-symmetric); shapes in full dofs."""
         st = at or StructureState(state=self.reference_state(), lam=0.0)
         _, K = self.residual(st.state, st.lam)
+        K = 0.5 * (K + K.T).tocsr()
         cm = self.constraints
         M = cm.tangent(self.mass(st.state))
         m = lowest_modes(K, M, k=k, free=cm.free)
