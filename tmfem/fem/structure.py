@@ -130,6 +130,7 @@ class Structure:
         self._pressures: list[ShellPressure] = []
         self._base_force = np.zeros(self.dofmap.ndof)
         self._base_pressures: list[ShellPressure] = []
+        self._moments: list = []
         self._dependent: list = []
         self._cm = None
 
@@ -261,16 +262,24 @@ class Structure:
             m = np.asarray(moment, dtype=float)
             if m.shape != (3,):
                 raise InputError(f"point load: expected a moment of 3 components, found {m.shape}")
-            for n in nodes:
-                c = int(self.dofmap.counts[n])
-                if c == 3:
-                    raise InputError(f"point load: node {n} has no rotations; a moment needs 5 or 6 dofs")
-                o = self.dofmap.offset[n] + 3
-                if c == 5:
-                    self._force[o:o + 2] += self.frames[n][:, :2].T @ m
-                else:
-                    self._force[o:o + 3] += m
+            bad = nodes[self.dofmap.counts[nodes] == 3]
+            if bad.size:
+                raise InputError(f"point load: nodes {bad[:5].tolist()} have no rotations; a moment needs "
+                                 f"5 or 6 dofs")
+            self._moments += [(int(n), m) for n in nodes]
         self._cm = None
+
+    def _moment_vector(self) -> np.ndarray:
+        """Generalised forces of the point moments: m . V_1, m . V_2 of the reference triads
+        at 5-dof nodes (read when solving, so later symmetry() triads count), m at 6-dof nodes."""
+        f = np.zeros(self.dofmap.ndof)
+        for n, m in self._moments:
+            o = self.dofmap.offset[n] + 3
+            if self.dofmap.counts[n] == 5:
+                f[o:o + 2] += self.frames[n][:, :2].T @ m
+            else:
+                f[o:o + 3] += m
+        return f
 
     def surface_load(self, q, *, elements=None, shell: int = 0) -> None:
         """Dead distributed load q [N/m^2] (3,) per unit reference mid-surface area (e.g. self
@@ -301,8 +310,9 @@ class Structure:
         """Make the loads defined so far a constant base load (no longer scaled by the load
         factor) and the prescribed displacements reached so far permanent: the loads defined
         next are the live load of the following :meth:`solve` (prestress, then load)."""
-        self._base_force = self._base_force + self._force
+        self._base_force = self._base_force + self._force + self._moment_vector()
         self._force = np.zeros(self.dofmap.ndof)
+        self._moments = []
         self._base_pressures += self._pressures
         self._pressures = []
         self._prescribed = np.zeros(self.dofmap.ndof)
@@ -345,7 +355,7 @@ class Structure:
     def external(self, state: State, lam: float, *, tangent: bool = True):
         """External force F_base + lam (F_point + F_pressure(state)) and its load stiffness
         (base loads: :meth:`freeze_loads`)."""
-        f = self._base_force + lam * self._force
+        f = self._base_force + lam * (self._force + self._moment_vector())
         K = None
         for pl, c in [(p, 1.0) for p in self._base_pressures] + [(p, lam) for p in self._pressures]:
             fp, Kp = pl.load(state, tangent=tangent)
