@@ -184,3 +184,26 @@ def test_shell_started_from_the_membrane_equilibrium_converges_at_once():
                line_search=False, update=s.advance)
     assert r.iterations <= 3
     assert np.abs(r.u.x - st.x).max() <= 1e-6 * np.abs(mem.u[2]).max()
+
+
+def test_point_moment_does_not_depend_on_the_order_of_symmetry_and_load():
+    """Half of a clamped strip (symmetry plane y = 0 turns the triads of its nodes) under an end
+    moment about y: the same tip rotation M L/(EI) whether the moment is given before or after
+    the symmetry plane (beam closed form, nu = 0, linear)."""
+    tips = []
+    for order in ("load first", "symmetry first"):
+        m = MeshQuad.init_tensor(np.linspace(0, 2.0, 5), np.linspace(0, 0.5, 2))
+        s = Structure.shell(m, section=ShellSection(E=1e4, nu=0.0, thickness=0.02))
+        tip = s.nodes_where(lambda x, y, z: np.isclose(x, 2.0))
+        sym = s.nodes_where(lambda x, y, z: np.isclose(y, 0.0))
+        s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0.0)))
+        if order == "load first":
+            s.point_load(tip, moment=(0, 1e-4 / 2, 0))
+            s.symmetry(sym, normal="y")
+        else:
+            s.symmetry(sym, normal="y")
+            s.point_load(tip, moment=(0, 1e-4 / 2, 0))
+        tips.append(s.rotation_vectors(s.solve_linear())[1, tip])
+    EI = 1e4 * 0.5 * 0.02**3 / 12
+    np.testing.assert_allclose(tips[0], tips[1], rtol=1e-12)
+    np.testing.assert_allclose(np.abs(tips[0]), 1e-4 * 2.0 / EI, rtol=1e-8)
