@@ -1,0 +1,545 @@
+"""A general structural problem: shells (MITC4) and any other element set on one dof map.
+
+:class:`Structure` holds nodes with 3, 5 or 6 dofs, element sets that implement the
+:class:`tmfem.fem.element.Element` protocol (MITC4 shells, trusses, membranes, beams, ...),
+boundary conditions on node sets, loads, and solves
+
+- linear statics about the reference state (:meth:`Structure.solve_linear`),
+- nonlinear statics by load/displacement stepping (:meth:`Structure.solve`: the load factor
+  lam scales point loads, pressures and prescribed displacements together; Newton at every
+  step, adaptive step halving) or by arc length (:meth:`Structure.solve_arc_length`),
+- modes about any state, prestressed or loaded (:meth:`Structure.modes`, eq. 5.32),
+
+and returns :class:`StructureState` objects that turn into a ``meshio.Mesh``
+(:meth:`Structure.to_meshio`) with displacements, rotations, membrane forces, bending
+moments and von Mises stresses at the bottom, middle and top surfaces for ParaView.
+
+Rotations at 5-dof (shell) nodes are the two director rotations about the node's V_1, V_2
+(eq. 4.16); the solvers update them by the exponential map (finite rotations). Shell nodes
+on a symmetry plane get a reference triad whose V_1 is the plane normal, so that the
+symmetry condition is "translation along the normal fixed, rotation about V_2 fixed".
+See docs/shells.md for a worked example.
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.errors import ConvergenceError, InputError
+from tmfem.fem.constraints import ConstraintMap
+from tmfem.fem.dofmap import DofMap
+from tmfem.fem.element import State, assemble
+from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
+from tmfem.solvers import arc_length, lowest_modes, newton
+from tmfem.solvers.backends import get_backend
+
+log = logging.getLogger(__name__)
+
+#: dof names of a node: translations, then the rotations of a 5-dof (about V_1, V_2) or a
+#: 6-dof node (about x, y, z)
+DOF_NAMES = {3: ("ux", "uy", "uz"), 5: ("ux", "uy", "uz", "r1", "r2"),
+             6: ("ux", "uy", "uz", "rx", "ry", "rz")}
+_AXES = {"x": 0, "y": 1, "z": 2}
+
+
+def read_quad_mesh(mesh):
+    """Points (3, n) and quadrilaterals (4, ne) of a scikit-fem ``MeshQuad`` (2-D or 3-D
+    points), a ``meshio.Mesh``, a path readable by meshio, or a ``(points, quads)`` pair."""
+    if isinstance(mesh, tuple) and len(mesh) == 2:
+        p, t = np.asarray(mesh[0], float), np.asarray(mesh[1], np.int64)
+    elif hasattr(mesh, "p") and hasattr(mesh, "t"):
+        p, t = np.asarray(mesh.p, float), np.asarray(mesh.t, np.int64)
+    else:
+        import meshio
+        if not isinstance(mesh, meshio.Mesh):
+            mesh = meshio.read(str(mesh))
+        quads = [c.data for c in mesh.cells if c.type == "quad"]
+        if not quads:
+            raise InputError(f"shell mesh: expected quad cells, found {[c.type for c in mesh.cells]}")
+        p, t = np.asarray(mesh.points, float).T, np.concatenate(quads).T.astype(np.int64)
+    if p.ndim != 2 or p.shape[0] not in (2, 3):
+        raise InputError(f"shell mesh: expected points of shape (2 or 3, n), found {p.shape}")
+    if p.shape[0] == 2:
+        p = np.vstack([p, np.zeros(p.shape[1])])
+    if t.ndim != 2 or t.shape[0] != 4:
+        raise InputError(f"shell mesh: expected quadrilaterals of shape (4, ne), found {t.shape}")
+    used = np.unique(t)
+    if used.size != p.shape[1]:
+        # drop unused points (a gmsh file carries geometry points without elements)
+        new = np.full(p.shape[1], -1, np.int64)
+        new[used] = np.arange(used.size)
+        p, t = p[:, used], new[t]
+    return p, t
+
+
+def gmsh_quad_mesh():
+    """Points (3, n) and 4-node quadrilaterals (4, ne) of the current gmsh model
+    (``gmsh.model.mesh``, element type 3), for :meth:`Structure.shell`."""
+    import gmsh
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    _, etags, enodes = gmsh.model.mesh.getElements(dim=2)
+    types = gmsh.model.mesh.getElementTypes(dim=2)
+    if 3 not in list(types):
+        raise InputError(f"gmsh: expected 4-node quadrilaterals (type 3), found element types {list(types)}")
+    nodes = np.asarray(gmsh.model.mesh.getElementsByType(3)[1], np.int64).reshape(-1, 4).T
+    index = np.full(int(tags.max()) + 1, -1, np.int64)
+    index[np.asarray(tags, np.int64)] = np.arange(tags.size)
+    return read_quad_mesh((np.asarray(coords).reshape(-1, 3).T, index[nodes]))
+
+
+@dataclass
+class StructureState:
+    """A solution: the nodal :class:`State`, its load factor and Newton iterations."""
+
+    state: State
+    lam: float = 1.0
+    iterations: int = 0
+    residual_history: list = field(default_factory=list)
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.state.x
+
+
+class Structure:
+    """Nodes, element sets, supports and loads of one structural model (module docstring).
+
+    Parameters
+    ----------
+    points : ndarray (3, n_nodes)
+        Reference positions [m].
+    dofs : int or array_like (n_nodes,)
+        Dofs per node: 3 (translations), 5 (shell) or 6 (beam).
+    """
+
+    def __init__(self, *, points, dofs):
+        self.X = np.asarray(points, dtype=float)
+        if self.X.ndim != 2 or self.X.shape[0] != 3:
+            raise InputError(f"structure: expected points of shape (3, n), found {self.X.shape}")
+        counts = np.broadcast_to(np.asarray(dofs, dtype=np.int64), (self.X.shape[1],))
+        self.dofmap = DofMap(counts.copy())
+        self.elements: list = []
+        self.shells: list[MITC4Shell] = []
+        self.frames = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
+        self._fixed = np.zeros(self.dofmap.ndof, bool)
+        self._prescribed = np.zeros(self.dofmap.ndof)
+        self._force = np.zeros(self.dofmap.ndof)
+        self._pressures: list[ShellPressure] = []
+        self._base_force = np.zeros(self.dofmap.ndof)
+        self._base_pressures: list[ShellPressure] = []
+        self._moments: list = []
+        self._dependent: list = []
+        self._cm = None
+
+    # ------------------------------------------------------------------ building
+    @classmethod
+    def shell(cls, mesh, *, section: ShellSection, normals=None, shear: str = "mitc") -> "Structure":
+        """A shell structure from a quad mesh (scikit-fem ``MeshQuad``, ``meshio.Mesh``,
+        meshio-readable path or ``(points, quads)``; flat or curved in 3-D): every node a 5-dof
+        shell node, one MITC4 element set. ``normals`` (3, n): reference directors; ``shear``:
+        see :class:`MITC4Shell`."""
+        p, t = read_quad_mesh(mesh)
+        s = cls(points=p, dofs=5)
+        s.add_shell(t, section=section, normals=normals, shear=shear)
+        return s
+
+    @property
+    def n_nodes(self) -> int:
+        return self.X.shape[1]
+
+    def add_shell(self, quads, *, section: ShellSection, normals=None, shear: str = "mitc") -> MITC4Shell:
+        """Add MITC4 elements on the 5-dof nodes ``quads`` (4, ne)."""
+        sh = MITC4Shell(X=self.X, conn=quads, section=section, dofmap=self.dofmap, normals=normals,
+                        shear=shear)
+        self.frames[sh.nodes] = sh.frames[sh.nodes]
+        self.shells.append(sh)
+        self.elements.append(sh)
+        self._cm = None
+        return sh
+
+    def add(self, element) -> None:
+        """Add an element set built on :attr:`dofmap` (truss, membrane, beam, ...)."""
+        if getattr(element, "dofmap", None) is None or element.dofmap.ndof != self.dofmap.ndof:
+            raise InputError(f"structure: expected an element set on this structure's dof map "
+                             f"({self.dofmap.ndof} dofs), found {getattr(element, 'dofmap', None)}")
+        self.elements.append(element)
+
+    def _nodes(self, nodes) -> np.ndarray:
+        nodes = np.asarray(nodes)
+        if nodes.dtype == bool:
+            if nodes.shape != (self.n_nodes,):
+                raise InputError(f"structure: expected a node mask of shape ({self.n_nodes},), found {nodes.shape}")
+            nodes = np.flatnonzero(nodes)
+        return self.dofmap._nodes(nodes)
+
+    def nodes_where(self, predicate) -> np.ndarray:
+        """Nodes whose reference position satisfies ``predicate(x, y, z)`` (arrays -> bool)."""
+        sel = np.asarray(predicate(*self.X), dtype=bool)
+        nodes = np.flatnonzero(sel)
+        if nodes.size == 0:
+            raise InputError("structure: expected at least one node to satisfy the predicate, found none")
+        return nodes
+
+    def _dof_index(self, nodes, dofs) -> np.ndarray:
+        nodes = self._nodes(nodes)
+        out = []
+        for n in nodes:
+            names = DOF_NAMES[int(self.dofmap.counts[n])]
+            want = names if dofs == "all" else ((dofs,) if isinstance(dofs, str) else tuple(dofs))
+            bad = [d for d in want if d not in names]
+            if bad:
+                raise InputError(f"structure: node {n} has dofs {names}, expected names from them, found {bad}")
+            out += [self.dofmap.offset[n] + names.index(d) for d in want]
+        return np.asarray(out, dtype=np.int64)
+
+    def fix(self, nodes, dofs="all") -> None:
+        """Fix dofs of ``nodes``: "all", a name (``ux uy uz`` translations, ``r1 r2`` shell
+        rotations about V_1, V_2, ``rx ry rz`` beam rotations) or a list of names."""
+        self._fixed[self._dof_index(nodes, dofs)] = True
+        self._cm = None
+
+    def symmetry(self, nodes, *, normal: str) -> None:
+        """Symmetry plane with normal along a global axis ("x", "y" or "z") through ``nodes``:
+        the normal translation is fixed and the rotation may only be about the normal (shell
+        nodes get V_1 along the normal's projection on their tangent plane, r2 fixed; beam
+        nodes keep the rotation about the normal only)."""
+        if normal not in _AXES:
+            raise InputError(f"symmetry: expected normal 'x', 'y' or 'z', found {normal!r}")
+        ax = _AXES[normal]
+        nodes = self._nodes(nodes)
+        e = np.zeros(3)
+        e[ax] = 1.0
+        for n in nodes:
+            c = int(self.dofmap.counts[n])
+            self._fixed[self.dofmap.offset[n] + ax] = True
+            if c == 5:
+                Vn = self.frames[n][:, 2]
+                v1 = e - (e @ Vn) * Vn
+                if np.linalg.norm(v1) < 1e-8:
+                    raise InputError(f"symmetry: node {n}: the plane normal {normal} is parallel to the "
+                                     f"director; expected a plane that cuts the shell")
+                v1 /= np.linalg.norm(v1)
+                self._set_frame(n, np.column_stack([v1, np.cross(Vn, v1), Vn]))
+                self._fixed[self.dofmap.offset[n] + 4] = True
+            elif c == 6:
+                for k in range(3):
+                    if k != ax:
+                        self._fixed[self.dofmap.offset[n] + 3 + k] = True
+        self._cm = None
+
+    def _set_frame(self, n: int, frame: np.ndarray) -> None:
+        self.frames[n] = frame
+        for sh in self.shells:
+            sh.frames[n] = frame
+
+    def pin(self, node: int, *, to: int) -> None:
+        """Translation-only connection: the translations of ``node`` follow those of ``to``
+        (its rotations, if any, stay free: a pin)."""
+        self._dependent.append((int(node), np.array([int(to)]), np.array([1.0])))
+        self._cm = None
+
+    def prescribe(self, nodes, dof: str, value: float) -> None:
+        """Prescribed displacement ``value`` [m] (or rotation [rad]) of dof ``dof`` at
+        ``nodes``, reached at load factor 1 (displacement control)."""
+        idx = self._dof_index(nodes, dof)
+        self._fixed[idx] = True
+        self._prescribed[idx] = float(value)
+        self._cm = None
+
+    def point_load(self, nodes, *, force=(0.0, 0.0, 0.0), moment=None) -> None:
+        """Point force [N] (3,) on each of ``nodes`` and optional moment [N m] (3,): on a 5-dof
+        node its components along the node's reference V_1, V_2 (the moment follows the node's
+        triad), on a 6-dof node about x, y, z."""
+        nodes = self._nodes(nodes)
+        force = np.asarray(force, dtype=float)
+        if force.shape != (3,):
+            raise InputError(f"point load: expected a force of 3 components, found {force.shape}")
+        self._force[self.dofmap.translation_dofs(nodes)] += force
+        if moment is not None:
+            m = np.asarray(moment, dtype=float)
+            if m.shape != (3,):
+                raise InputError(f"point load: expected a moment of 3 components, found {m.shape}")
+            bad = nodes[self.dofmap.counts[nodes] == 3]
+            if bad.size:
+                raise InputError(f"point load: nodes {bad[:5].tolist()} have no rotations; a moment needs "
+                                 f"5 or 6 dofs")
+            self._moments += [(int(n), m) for n in nodes]
+        self._cm = None
+
+    def _moment_vector(self) -> np.ndarray:
+        """Generalised forces of the point moments: m . V_1, m . V_2 of the reference triads
+        at 5-dof nodes (read when solving, so later symmetry() triads count), m at 6-dof nodes."""
+        f = np.zeros(self.dofmap.ndof)
+        for n, m in self._moments:
+            o = self.dofmap.offset[n] + 3
+            if self.dofmap.counts[n] == 5:
+                f[o:o + 2] += self.frames[n][:, :2].T @ m
+            else:
+                f[o:o + 3] += m
+        return f
+
+    def surface_load(self, q, *, elements=None, shell: int = 0) -> None:
+        """Dead distributed load q [N/m^2] (3,) per unit reference mid-surface area (e.g. self
+        weight), as consistent nodal forces f_k = int h_k q dA."""
+        if not self.shells:
+            raise InputError("surface load: expected a shell element set, found none")
+        q = np.asarray(q, dtype=float)
+        if q.shape != (3,):
+            raise InputError(f"surface load: expected a load of 3 components, found {q.shape}")
+        sh = self.shells[shell]
+        conn = sh.conn if elements is None else sh.conn[:, np.asarray(elements)]
+        dA = ShellPressure(X=self.X, conn=conn, dofmap=self.dofmap, p=1.0, follower=False).nodal_areas()
+        np.add.at(self._force, self.dofmap.translation_dofs(conn.ravel()), dA.ravel()[:, None] * q[None, :])
+        self._cm = None
+
+    def pressure(self, p, *, elements=None, shell: int = 0, follower: bool = True) -> ShellPressure:
+        """Pressure p [Pa] on the elements of a shell set (all by default), along the element
+        normal (the directors' side); ``follower`` acts on the current surface."""
+        if not self.shells:
+            raise InputError("pressure: expected a shell element set, found none")
+        sh = self.shells[shell]
+        conn = sh.conn if elements is None else sh.conn[:, np.asarray(elements)]
+        pl = ShellPressure(X=self.X, conn=conn, dofmap=self.dofmap, p=p, follower=follower)
+        self._pressures.append(pl)
+        return pl
+
+    def freeze_loads(self) -> None:
+        """Make the loads defined so far a constant base load (no longer scaled by the load
+        factor) and the prescribed displacements reached so far permanent: the loads defined
+        next are the live load of the following :meth:`solve` (prestress, then load)."""
+        self._base_force = self._base_force + self._force + self._moment_vector()
+        self._force = np.zeros(self.dofmap.ndof)
+        self._moments = []
+        self._base_pressures += self._pressures
+        self._pressures = []
+        self._prescribed = np.zeros(self.dofmap.ndof)
+
+    # ------------------------------------------------------------------ equations
+    @property
+    def constraints(self) -> ConstraintMap:
+        """The constraint map (dependent nodes, fixed and prescribed dofs)."""
+        if self._cm is None:
+            self._cm = ConstraintMap.build(self.dofmap, dependent=self._dependent,
+                                           fixed_dofs=np.flatnonzero(self._fixed))
+        return self._cm
+
+    def reference_state(self) -> State:
+        """The undeformed state."""
+        return State.reference(self.X, self.dofmap, frames=self.frames)
+
+    def state_from_positions(self, x, *, lam: float = 0.0) -> StructureState:
+        """A state at nodal positions x (3, n_nodes) (e.g. the equilibrium of a membrane model
+        of the same mesh): every shell node's director is turned by the smallest rotation onto
+        the normal of the surface through x (averaged element normals), other nodes keep their
+        orientation. A start for Newton, not an equilibrium."""
+        from scipy.spatial.transform import Rotation
+        from tmfem.fem.mitc4 import nodal_normals
+        x = np.asarray(x, dtype=float)
+        if x.shape != self.X.shape:
+            raise InputError(f"state from positions: expected shape {self.X.shape}, found {x.shape}")
+        st = self.reference_state()
+        R = st.R
+        for sh in self.shells:
+            n = nodal_normals(x, sh.conn)[:, sh.nodes]
+            V0 = self.frames[sh.nodes][:, :, 2].T
+            axis = np.cross(V0, n, axis=0)
+            ang = np.arctan2(np.linalg.norm(axis, axis=0), np.einsum("in,in->n", V0, n))
+            nrm = np.linalg.norm(axis, axis=0)
+            rv = np.where(nrm > 0, axis / np.where(nrm > 0, nrm, 1.0) * ang, 0.0)
+            R[sh.nodes] = Rotation.from_rotvec(rv.T).as_matrix()
+        return StructureState(state=State(x=x.copy(), R=R, frames=self.frames), lam=lam)
+
+    def external(self, state: State, lam: float, *, tangent: bool = True):
+        """External force F_base + lam (F_point + F_pressure(state)) and its load stiffness
+        (base loads: :meth:`freeze_loads`)."""
+        f = self._base_force + lam * (self._force + self._moment_vector())
+        K = None
+        for pl, c in [(p, 1.0) for p in self._base_pressures] + [(p, lam) for p in self._pressures]:
+            fp, Kp = pl.load(state, tangent=tangent)
+            f = f + c * fp
+            if Kp is not None:
+                K = c * Kp if K is None else K + c * Kp
+        return f, K
+
+    def residual(self, state: State, lam: float):
+        """Reduced residual T^T (f_int - f_ext) and tangent T^T (K - K_load) T."""
+        if not self.elements:
+            raise InputError("structure: expected at least one element set, found none")
+        cm = self.constraints
+        f, K = assemble(self.elements, state)
+        fe, Ke = self.external(state, lam)
+        if Ke is not None:
+            K = K - Ke
+        return cm.residual(f - fe), cm.tangent(K)
+
+    def advance(self, s: State, du) -> State:
+        """The state after the reduced increment du (translations added, rotations by the
+        exponential map): the ``update=`` of the solvers of :mod:`tmfem.solvers.newton`."""
+        return s.advanced(self.constraints.full(du), self.dofmap)
+
+    def _with_prescribed(self, s: State, dlam: float) -> State:
+        if dlam == 0.0 or not np.any(self._prescribed):
+            return s
+        return s.advanced(dlam * self._prescribed, self.dofmap)
+
+    def _scale(self) -> float:
+        f0, _ = self.external(self.reference_state(), 1.0, tangent=False)
+        fb, _ = self.external(self.reference_state(), 0.0, tangent=False)
+        sc = float(np.linalg.norm(self.constraints.residual(f0 - fb)[self.constraints.free]))
+        if np.any(self._prescribed):
+            r, _ = self.residual(self._with_prescribed(self.reference_state(), 1.0), 0.0)
+            sc = max(sc, float(np.linalg.norm(r[self.constraints.free])))
+        if sc == 0.0:
+            raise InputError("structure: expected loads or prescribed displacements, found none")
+        return sc
+
+    # ------------------------------------------------------------------ solvers
+    def solve_linear(self) -> StructureState:
+        """Linear statics about the reference state: K0 u = F (pressure on the reference
+        surface, prescribed displacements at their values). Rotations are applied as finite
+        rotations of the small solution (for output)."""
+        cm = self.constraints
+        s0 = self.reference_state()
+        r, K = self.residual(self._with_prescribed(s0, 0.0), 0.0)
+        idx = np.flatnonzero(cm.free)
+        f0, _ = self.external(s0, 1.0, tangent=False)
+        rhs = cm.residual(f0)
+        up = cm.reduce(self._prescribed) if np.any(self._prescribed) else np.zeros(cm.n_reduced)
+        rhs = rhs - K @ up
+        u = up.copy()
+        u[idx] = get_backend().factorize(K[idx][:, idx])(rhs[idx])
+        return StructureState(state=s0.advanced(cm.full(u), self.dofmap), lam=1.0, iterations=1)
+
+    def solve(self, *, steps: int = 10, lam_end: float = 1.0, tol: float = 1e-8, max_iter: int = 30,
+              line_search: bool = False, min_step: float = 1e-4, start: StructureState | None = None,
+              callback=None) -> list[StructureState]:
+        """Nonlinear statics by load (and displacement) control from ``start`` (default the
+        reference state at lam = 0) to ``lam_end`` in ``steps`` equal increments; a step whose
+        Newton iteration fails is retried in halves down to ``min_step``.
+
+        Newton (eq. 4.6) converges when ||r|| <= tol * scale, scale = ||F(lam = 1)|| (or the
+        reaction of the prescribed displacements). ``line_search`` is off by default: the
+        residual norm is a poor merit function for bending-dominated shells (a linear
+        predictor stretches the mid-surface), and the full Newton step converges.
+        Returns the converged states, the start included.
+        """
+        if not (isinstance(steps, (int, np.integer)) and steps >= 1):
+            raise InputError(f"solve: expected steps >= 1, found {steps!r}")
+        scale = self._scale()
+        cur = start or StructureState(state=self.reference_state(), lam=0.0)
+        out = [cur]
+        dlam = (lam_end - cur.lam) / steps
+        lam = cur.lam
+        while (lam_end - lam) * np.sign(dlam) > 1e-12 * abs(lam_end):
+            d = dlam if abs(dlam) <= abs(lam_end - lam) else lam_end - lam
+            target = lam + d
+            s_try = self._with_prescribed(cur.state, d)
+            try:
+                res = newton(lambda s: self.residual(s, target), s_try, free=self.constraints.free,
+                             tol=tol, scale=scale, max_iter=max_iter, line_search=line_search,
+                             load_factor=target, update=self.advance)
+            except ConvergenceError as exc:
+                dlam = 0.5 * d
+                log.info("structure: step to lam = %g failed (%s); halving", target, exc)
+                if abs(dlam) < min_step:
+                    raise ConvergenceError(f"structure: expected to reach load factor {lam_end:g}, stuck at "
+                                           f"{lam:g} (increment {abs(d):.2e} failed, below min_step "
+                                           f"{min_step:g} after halving): {exc}") from None
+                continue
+            lam = target
+            cur = StructureState(state=res.u, lam=lam, iterations=res.iterations,
+                                 residual_history=res.residual_history)
+            out.append(cur)
+            if callback is not None:
+                callback(cur)
+        return out
+
+    def solve_arc_length(self, *, dl: float, n_steps: int = 50, lam_max: float | None = None,
+                         tol: float = 1e-8, stop=None, start: StructureState | None = None
+                         ) -> list[StructureState]:
+        """Arc-length continuation (Crisfield, :func:`tmfem.solvers.arc_length`) for point
+        loads and dead pressure (a follower pressure or prescribed displacements are refused:
+        the solver takes a fixed reference load). Starts from ``start`` (an equilibrium under
+        the base loads of :meth:`freeze_loads`; default the reference state)."""
+        if any(p.follower for p in self._pressures) or np.any(self._prescribed):
+            raise InputError("arc length: expected dead loads only, found a follower pressure or "
+                             "prescribed displacements (use solve())")
+        cm = self.constraints
+        f1, _ = self.external(self.reference_state(), 1.0, tangent=False)
+        f0, _ = self.external(self.reference_state(), 0.0, tangent=False)
+        q = cm.residual(f1 - f0)
+
+        def internal(s):
+            f, K = assemble(self.elements, s)
+            fb, Kb = self.external(s, 0.0)
+            return cm.residual(f - fb), cm.tangent(K if Kb is None else K - Kb)
+        s0 = self.reference_state() if start is None else start.state
+        path = arc_length(internal, q, s0, free=cm.free, dl=dl, n_steps=n_steps,
+                          lam_max=lam_max, tol=tol, update=self.advance,
+                          stop=None if stop is None else (lambda s, lam: stop(StructureState(s, lam))))
+        its = [0] + list(path.iterations)
+        return [StructureState(state=s, lam=float(lam), iterations=i) for s, lam, i in zip(path.u, path.lam, its)]
+
+    def mass(self, state: State | None = None) -> sp.csr_matrix:
+        """Mass matrix (ndof, ndof): sum of the element sets' masses (shell rotary inertia
+        mapped with the triads of ``state``)."""
+        M = None
+        for e in self.elements:
+            Me = e.mass(state) if (state is not None and isinstance(e, MITC4Shell)) else e.mass()
+            M = Me if M is None else M + Me
+        return M
+
+    def modes(self, *, k: int = 6, at: StructureState | None = None):
+        """Lowest k modes about ``at`` (default: the reference state) with the tangent there
+        (prestress and load stiffness included, eq. 5.32; the symmetric part where a follower
+        pressure makes it non-symmetric); shapes in full dofs."""
+        st = at or StructureState(state=self.reference_state(), lam=0.0)
+        _, K = self.residual(st.state, st.lam)
+        K = 0.5 * (K + K.T).tocsr()
+        cm = self.constraints
+        M = cm.tangent(self.mass(st.state))
+        m = lowest_modes(K, M, k=k, free=cm.free)
+        m.shapes = np.asarray(cm.T @ m.shapes)
+        return m
+
+    # ------------------------------------------------------------------ results
+    def displacements(self, st: StructureState) -> np.ndarray:
+        """Nodal displacements (3, n_nodes)."""
+        return st.state.x - self.X
+
+    def rotation_vectors(self, st: StructureState) -> np.ndarray:
+        """Nodal rotation vectors (3, n_nodes) [rad] of R (axis times angle; zero at 3-dof nodes)."""
+        from scipy.spatial.transform import Rotation
+        if st.state.R is None:
+            return np.zeros((3, self.n_nodes))
+        return Rotation.from_matrix(st.state.R).as_rotvec().T
+
+    def to_meshio(self, st: StructureState, *, deformed: bool = False):
+        """A ``meshio.Mesh`` of the shells' quads (reference or deformed points) with point data
+        ``displacement``, ``rotation`` and ``director`` and cell data per element ``N`` (membrane
+        forces N11 N22 N12 [N/m]), ``M`` (bending moments M11 M22 M12 [N m/m]), ``Q`` (shear
+        forces [N/m]) and ``von_mises_bottom/mid/top`` [Pa] (local 2nd Piola-Kirchhoff
+        stresses at the element centre, frame of eq. 4.11)."""
+        import meshio
+        if not self.shells:
+            raise InputError("to_meshio: expected a shell element set, found none")
+        pts = (st.state.x if deformed else self.X).T
+        u = self.displacements(st).T
+        Vn = np.einsum("nij,nj->ni", st.state.R, self.frames[:, :, 2]) if st.state.R is not None else None
+        cells, cd = [], {k: [] for k in ("N", "M", "Q", "von_mises_bottom", "von_mises_mid", "von_mises_top")}
+        for sh in self.shells:
+            cells.append(("quad", sh.conn.T))
+            r = sh.stresses(st.state)
+            cd["N"].append(r["N"])
+            cd["M"].append(r["M"])
+            cd["Q"].append(r["Qs"])
+            for j, name in enumerate(("bottom", "mid", "top")):
+                cd[f"von_mises_{name}"].append(r["von_mises"][:, j])
+        point_data = {"displacement": u, "rotation": self.rotation_vectors(st).T}
+        if Vn is not None:
+            point_data["director"] = Vn
+        return meshio.Mesh(points=pts, cells=cells, point_data=point_data, cell_data=cd)
+
