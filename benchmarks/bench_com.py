@@ -40,14 +40,14 @@ class Timed:
         self.n[key] += 1
         return r
 
-    def residual(self, *a):
-        return self._timed("residual", self.model.residual, *a)
+    def residual(self, *a, **kw):
+        return self._timed("residual", self.model.residual, *a, **kw)
 
-    def newton_matrix(self, *a):
-        return self._timed("newton_matrix", self.model.newton_matrix, *a)
+    def newton_matrix(self, *a, **kw):
+        return self._timed("newton_matrix", self.model.newton_matrix, *a, **kw)
 
-    def jacobians(self, *a):
-        return self.model.jacobians(*a)
+    def jacobians(self, *a, **kw):
+        return self.model.jacobians(*a, **kw)
 
     def fast_outputs(self, *a, with_lengths: bool = False):
         return self._timed("outputs", self.model.fast_outputs, *a, with_lengths=with_lengths)

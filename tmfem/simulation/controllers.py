@@ -9,7 +9,9 @@ and advances its own states x_c. The protocol:
 ``output(t, y, x_c) -> u``             the input, ordered as the plant's ``input_names``;
 ``update(t, y, x_c) -> x_c``           the controller state at t + dt;
 ``name``                               which controller acts (recorded per step; a switching
-                                       controller reports the active one).
+                                       controller reports the active one);
+``reads_outputs`` (optional, True)     False for a controller that ignores y (an open loop):
+                                       the driver may then skip evaluating the outputs.
 """
 from __future__ import annotations
 
@@ -36,6 +38,7 @@ class OpenLoop:
     """Prescribed inputs: a constant array or a schedule ``u(t)`` (no controller states)."""
 
     name = "open-loop"
+    reads_outputs = False
 
     def __init__(self, u):
         self._u = u if callable(u) else np.asarray(u, dtype=float)

@@ -73,7 +73,8 @@ def check_time_grid(t_end: float, dt: float) -> int:
 
 def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=None,
              scheme: str = "park", jacobian: str = "step", tol: float = 1e-10,
-             record: Callable | None = None, progress: Callable | None = None) -> Simulation:
+             record: Callable | None = None, progress: Callable | None = None,
+             outputs: bool = True) -> Simulation:
     """Integrate ``plant`` over [0, t_end] with inputs from ``controller`` (module docstring).
 
     Parameters
@@ -97,6 +98,11 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
         value stops the run.
     progress : callable, optional
         ``progress(step, n_steps)``.
+    outputs : bool
+        Evaluate the plant outputs y at every step for the record and the result even when
+        the controller does not read them (an open loop); False skips them there (``record``
+        then gets ``y = None`` and ``Simulation.y`` is empty) -- a free vibration that
+        records its own quantities.
     """
     n_steps = check_time_grid(t_end, dt)
     ctrl = as_controller(controller, plant.u0)
@@ -104,20 +110,23 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
     x0 = np.asarray(plant.x0 if x0 is None else x0, dtype=float)
     v0 = np.asarray(plant.v0 if v0 is None else v0, dtype=float)
     nu = len(plant.input_names)
-    y0 = np.asarray(plant.outputs(x0, v0, loop.u), dtype=float)
+    measure = outputs or getattr(ctrl, "reads_outputs", True)
+    y0 = np.asarray(plant.outputs(x0, v0, loop.u), dtype=float) if measure else None
     xc = ctrl.reset(0.0, y0, dt)
     T, Y, U, C = [], [], [], []
     state = {"xc": xc}
 
     def step(t, x, v, a):
-        y = np.asarray(plant.outputs(x, v, loop.u), dtype=float)
+        y = np.asarray(plant.outputs(x, v, loop.u), dtype=float) if measure else None
         u = np.asarray(ctrl.output(t, y, state["xc"]), dtype=float)
         if u.shape != (nu,) or not np.all(np.isfinite(u)):
             raise InputError(f"controller {ctrl.name}: expected {nu} finite inputs at t = {t:.6g} s, "
                              f"found {u}")
         state["xc"] = ctrl.update(t, y, state["xc"])
         loop.u = u
-        T.append(t); Y.append(y); U.append(u); C.append(ctrl.name)
+        T.append(t); U.append(u); C.append(ctrl.name)
+        if outputs:
+            Y.append(y)
         return bool(record(t, x, v, a, u, y)) if record is not None else False
 
     t0 = time.perf_counter()

@@ -100,7 +100,8 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
 
     try:
         sim = simulate(plant, t_end=t_end, dt=dt, controller=None if u is None else OpenLoop(u),
-                       scheme=scheme, jacobian=jacobian, record=record, progress=progress)
+                       scheme=scheme, jacobian=jacobian, record=record, progress=progress,
+                       outputs=False)
     finally:
         out.close()
     Xa = np.array(XS)
