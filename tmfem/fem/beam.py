@@ -279,6 +279,13 @@ def reference_directors(X: np.ndarray, conn: np.ndarray, v1=None) -> np.ndarray:
         raise InputError(f"beam: element {e} has a degenerate axis (nodes {conn[:, e].tolist()} "
                          f"coincide or fold back)")
     t = t / nt[..., None]
+    chord = (Xe[:, 3] - Xe[:, 0]).T                                  # (ne, 3)
+    fold = np.einsum("eki,ei->ek", t, chord) <= 0.0
+    if np.any(fold):
+        e, k = (int(i) for i in np.argwhere(fold)[0])
+        raise InputError(f"beam: element {e}: expected the axis to run from node 1 to node 4 "
+                         f"(dx/dr1 along the chord), found it folding back at its node {k + 1} "
+                         f"(interior nodes too far from r1 = -1/3, 1/3: nodes {conn[:, e].tolist()})")
     ne = conn.shape[1]
     if v1 is None:
         ey, ez = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0])
