@@ -478,28 +478,30 @@ class BeamElement:
         Kg[:, :, 3:, :, 3:] = tt
         return Ke + Kg.reshape(ne, 24, 24)
 
-    def mass(self) -> sp.csr_matrix:
+    def mass(self, state=None) -> sp.csr_matrix:
         """Consistent mass (eq. 4.6): the kinetic energy of eq. 4.19's velocity field,
         rho int (|sum h xdot|^2 A + |sum h V1dot|^2 I_t + |sum h V2dot|^2 I_s) J dr1 / 2 with
-        Vdot = omega x V at the reference directors (translational and rotary inertia;
-        4-point Gauss)."""
-        if self._M is None:
-            b, sec = self.beams, self.beams.section
-            r, w = _gauss(4)
-            h, dh = shape_functions(r)
-            conn = b.conn
-            x = self._X[:, conn].transpose(2, 1, 0)
-            J = np.linalg.norm(np.einsum("kg,eki->egi", dh, x), axis=-1)   # (ne, 4)
-            c = b.rho * w[None, :] * J                                     # (ne, ngp)
-            hh = np.einsum("eg,kg,lg->ekl", c, h, h)
-            ne = b.ne
-            T = -_skew(np.stack([self.triads[..., 1], self.triads[..., 2]], axis=2))
-            Me = np.zeros((ne, 4, 6, 4, 6))
-            Me[:, :, :3, :, :3] = sec.A * np.einsum("ekl,ij->ekilj", hh, np.eye(3))
-            Me[:, :, 3:, :, 3:] = np.einsum("ekl,ekji,eljm->ekilm", hh, sec.I_t * T[:, :, 0], T[:, :, 0]) \
-                + np.einsum("ekl,ekji,eljm->ekilm", hh, sec.I_s * T[:, :, 1], T[:, :, 1])
-            self._M = self._asm.matrix(Me.reshape(ne, 24, 24))
-        return self._M
+        Vdot = omega x V (translational and rotary inertia; 4-point Gauss), at the reference
+        directors, or at the current directors of ``state`` (modes about a rotated state:
+        the rotary inertia turns with the section)."""
+        if state is None and self._M is not None:
+            return self._M
+        b, sec = self.beams, self.beams.section
+        r, w = _gauss(4)
+        h, dh = shape_functions(r)
+        x = self._X[:, b.conn].transpose(2, 1, 0)
+        J = np.linalg.norm(np.einsum("kg,eki->egi", dh, x), axis=-1)        # (ne, 4)
+        hh = np.einsum("eg,kg,lg->ekl", b.rho * w[None, :] * J, h, h)
+        V = (self.triads[..., 1], self.triads[..., 2]) if state is None else self.directors(state)
+        T = -_skew(np.stack(V, axis=2))                                      # (ne, 4, 2, 3, 3)
+        Me = np.zeros((b.ne, 4, 6, 4, 6))
+        Me[:, :, :3, :, :3] = sec.A * np.einsum("ekl,ij->ekilj", hh, np.eye(3))
+        Me[:, :, 3:, :, 3:] = np.einsum("ekl,ekji,eljm->ekilm", hh, sec.I_t * T[:, :, 0], T[:, :, 0]) \
+            + np.einsum("ekl,ekji,eljm->ekilm", hh, sec.I_s * T[:, :, 1], T[:, :, 1])
+        M = self._asm.matrix(Me.reshape(b.ne, 24, 24))
+        if state is None:
+            self._M = M
+        return M
 
     # -- post ------------------------------------------------------------------------------
     def gauss_points(self) -> np.ndarray:
@@ -544,3 +546,67 @@ def line_mesh(start, end, *, n_elements: int) -> tuple[np.ndarray, np.ndarray]:
     X = a[:, None] + (b - a)[:, None] * s[None, :]
     conn = 3 * np.arange(n_elements)[None, :] + np.arange(4)[:, None]
     return X, conn
+
+
+def spin_constraint(beam: BeamElement, *, nodes, state=None) -> tuple[int, np.ndarray, np.ndarray]:
+    """The constraint that removes the rigid spin of a bar whose ends are pinned.
+
+    A bar connected only through translations (pinned to the base, to tendons, to membrane
+    corners) can spin about its own axis at no energy: its tangent is singular and its
+    spectrum has a zero. The spin phi_s (rotation about the bar axis a at every node of the
+    bar, ``nodes`` from end to end; a = the unit chord of the end nodes at ``state``) is
+    removed by the mass-orthogonality constraint
+
+        c^T u = 0,    c = M phi_s    (rotation dofs of the bar),
+
+    which every elastic mode of the free bar satisfies already (modes are M-orthogonal), so
+    the elastic frequencies are unchanged and only the zero-frequency spin goes. In statics
+    the energy and loads do not depend on the spin, so the constrained equilibrium is an
+    equilibrium of the unconstrained problem (the constraint force is zero). Exact for a
+    straight bar (its nodes on the axis); the constraint is linear in the increments and
+    stays valid while the axis turns by less than 90 degrees from ``a``.
+
+    Returns
+    -------
+    (dof, master_dofs, weights) for ``ConstraintMap.build(dependent_dofs=[...])``: the bar's
+    rotation dof with the largest |c| expressed by the others, u_d = -sum c_j u_j / c_d.
+    """
+    nodes = np.asarray(nodes, dtype=np.int64)
+    if nodes.ndim != 1 or nodes.size < 2 or not np.isin(nodes, beam.beams.conn).all():
+        raise InputError(f"spin constraint: expected >= 2 nodes of the beam set, found {nodes.tolist()}")
+    dm = beam.dofmap
+    x = beam._X if state is None else state.x
+    a = x[:, nodes[-1]] - x[:, nodes[0]]
+    if not np.linalg.norm(a) > 0:
+        raise InputError("spin constraint: expected distinct end nodes, found coincident ones")
+    a = a / np.linalg.norm(a)
+    rot = dm.rotation_dofs(nodes)                                            # (n, 3)
+    phi = np.zeros(dm.ndof)
+    phi[rot] = a
+    c = (beam.mass(state) @ phi)[rot.ravel()]
+    if not np.abs(c).max() > 0:
+        raise InputError("spin constraint: expected a bar with rotary inertia (rho > 0), found none")
+    k = int(np.argmax(np.abs(c)))
+    others = np.flatnonzero((np.arange(c.size) != k) & (c != 0.0))
+    return int(rot.ravel()[k]), rot.ravel()[others], -c[others] / c[k]
+
+
+def point_on_bar(beam: BeamElement, *, element: int, r1: float) -> tuple[np.ndarray, np.ndarray]:
+    """Masters and weights of a point of the beam axis at natural coordinate r1 of
+    ``element``: x = sum_k h_k(r1) x_k (eq. 4.19 at r2 = r3 = 0; eq. 4.20 weights sum to
+    one). A tendon end pinned there is a ``ConstraintMap`` dependent node
+    ``(node, masters, weights)``; a point that is a node of the mesh is that node."""
+    if not (0 <= element < beam.beams.ne and -1.0 <= r1 <= 1.0):
+        raise InputError(f"point on bar: expected element in [0, {beam.beams.ne}) and -1 <= r1 <= 1, "
+                         f"found element {element}, r1 {r1}")
+    h, _ = shape_functions([r1])
+    return beam.beams.conn[:, element].copy(), h[:, 0]
+
+
+def locate_on_line(k: float, *, n_elements: int) -> tuple[int, float]:
+    """Element and r1 of the point at the fraction ``k`` (0..1) of the length of a straight
+    bar of :func:`line_mesh` (equally spaced nodes: x is linear in r1), e.g. H_1j at k_H."""
+    if not (0.0 <= k <= 1.0):
+        raise InputError(f"locate on line: expected 0 <= k <= 1, found {k!r}")
+    e = min(int(np.floor(k * n_elements)), n_elements - 1)
+    return e, 2.0 * (k * n_elements - e) - 1.0
