@@ -368,6 +368,12 @@ class BeamElement:
         self._cA = beams.E * w[None, :] / J**3
         self._cS = beams.G * w[None, :] / J
         self._asm = Assembler(dofmap.element_dofs(conn, rotations=True), dofmap.ndof)
+        # Pm[g, p, (b, k)]: field p at Gauss point g from block b (x, V1, V2) of node k
+        N = np.stack([self.dh, self.dh, self.dh, self.h, self.h])            # (5, 4, ngp)
+        self._Pm = np.zeros((r.size, 5, 3, 4))
+        for p, b in enumerate((0, 1, 2, 1, 2)):
+            self._Pm[:, p, b] = N[p].T
+        self._Pm = self._Pm.reshape(r.size, 5, 12)
         self._X = X
         self._M = None
 
@@ -449,17 +455,12 @@ class BeamElement:
         BV2 = np.einsum("kg,egci->egcki", dh, B[:, :, :, 2]) + np.einsum("kg,egci->egcki", h, B[:, :, :, 4])
         Bt = np.cross(V1[:, None, None], BV1) + np.cross(V2[:, None, None], BV2)
         BL = np.concatenate([Bx, Bt], axis=-1).reshape(ne, ngp, 12, 24)
-        DBL = self._cA[..., None, None] * np.einsum("cd,egdm->egcm", self._Da, BL) \
-            + (self._cS[..., None] * self._Ds)[..., None] * BL
-        Ke = np.einsum("egcm,egcn->emn", BL, DBL)
-        # initial stress: Z[p, q, k, l] = sum_g S_pq N_pk N_ql, N = dh for a0, a1, a2, h for d1, d2
-        N = np.stack([dh, dh, dh, h, h])                             # (5, 4, ngp)
-        Z = np.einsum("egpq,pkg,qlg->epqkl", S, N, N)
-        blk = np.array([0, 1, 2, 1, 2])                              # field -> block (x, V1, V2)
-        Zb = np.zeros((ne, 3, 3, 4, 4))
-        for p in range(5):
-            for q in range(5):
-                Zb[:, blk[p], blk[q]] += Z[:, p, q]
+        DBL = self._cA[..., None, None] * (self._Da @ BL) + (self._cS[..., None] * self._Ds)[..., None] * BL
+        Ke = np.matmul(BL.reshape(ne, ngp * 12, 24).transpose(0, 2, 1), DBL.reshape(ne, ngp * 12, 24))
+        # initial stress: Zb[(b, k), (b', l)] = sum_g sum_{p in b, q in b'} S_pq N_pk N_ql with the
+        # constant map Pm_g (5 fields -> 3 blocks (x, V1, V2) x 4 nodes)
+        Zb = np.einsum("gpm,egpn->emn", self._Pm, S @ self._Pm[None], optimize=True)
+        Zb = Zb.reshape(ne, 3, 4, 3, 4).transpose(0, 1, 3, 2, 4)           # (ne, b, b', k, l)
         T = -_skew(np.stack([V1, V2], axis=2))                       # dV = T theta, (ne, 4, 2, 3, 3)
         Kg = np.zeros((ne, 4, 6, 4, 6))
         Kg[:, :, :3, :, :3] = np.einsum("ekl,ij->ekilj", Zb[:, 0, 0], np.eye(3))
@@ -470,7 +471,8 @@ class BeamElement:
         tt = np.zeros((ne, 4, 3, 4, 3))
         for a in range(2):
             for b in range(2):
-                tt += np.einsum("ekl,ekji,eljm->ekilm", Zb[:, 1 + a, 1 + b], T[:, :, a], T[:, :, b])
+                tt += np.einsum("ekl,ekji,eljm->ekilm", Zb[:, 1 + a, 1 + b], T[:, :, a], T[:, :, b],
+                                optimize=True)
         # finite-rotation term on each node's own rotational block
         G = np.einsum("ekij,ekjl->ekil", _skew(gV1), _skew(V1)) + np.einsum("ekij,ekjl->ekil", _skew(gV2), _skew(V2))
         k = np.arange(4)
