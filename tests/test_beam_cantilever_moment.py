@@ -1,31 +1,16 @@
 """``tmfem benchmark beam-cantilever-moment`` (dissertation 4.5.2, 5 four-node beams).
 
-Sources: the elastica (benchmarks.json ``elastica_end_moment_closed_form``), itself checked
-against the 'exact' columns read from Sze et al. 2004 (``sze32_cantilever_end_moment``).
+Sources: the elastica (benchmarks.json ``elastica_end_moment_closed_form``; its function is
+checked against the 'exact' columns of Sze et al. 2004 in tests/test_shell_benchmarks.py).
 """
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from tmfem.cli import main
-from tmfem.reference.beam_benchmarks import cantilever_end_moment, elastica_end_moment
-
-REF = Path("/work/shared/reference/benchmarks.json")
-
-
-def _entry(entry_id):
-    return next(e for e in json.loads(REF.read_text())["benchmarks"] if e["id"] == entry_id)
-
-
-@pytest.mark.skipif(not REF.exists(), reason="shared reference values not available")
-def test_elastica_reproduces_the_published_exact_columns():
-    rows = np.array(_entry("sze32_cantilever_end_moment")["data"]["rows"])
-    u, w = elastica_end_moment(rows[:, 0], L=12.0)
-    np.testing.assert_allclose(-u, rows[:, 2], atol=6e-4)
-    np.testing.assert_allclose(w, rows[:, 4], atol=6e-4)
-
+from tmfem.reference.beam_benchmarks import cantilever_end_moment
+from tmfem.reference.benchmarks.shell_cantilever_moment import elastica
 
 @pytest.mark.parametrize("integration", ["reduced", "full"])
 def test_roll_up_follows_the_elastica_within_one_percent(integration):
@@ -46,7 +31,7 @@ def test_cli_rows_and_plot(tmp_path, capsys):
     assert r["units"]["u_tip"] == "m" and r["load_steps"] == 10
     lam = np.array([row["lambda"] for row in r["rows"]])
     np.testing.assert_allclose(lam, np.linspace(0, 1, 11), atol=1e-12)
-    u, w = elastica_end_moment(lam, L=12.0)
+    u, w = elastica(lam, 12.0)
     assert np.allclose([row["u_tip"] for row in r["rows"]], u, atol=0.01 * 12.0)
     assert np.allclose([row["w_tip"] for row in r["rows"]], w, atol=0.01 * 12.0)
     assert all(row["newton_iterations"] > 0 for row in r["rows"][1:])

@@ -62,7 +62,7 @@ finite-rotation update is). Everything is vectorised over elements and Gauss poi
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
@@ -71,6 +71,7 @@ from numpy.polynomial import Polynomial
 from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler
 from tmfem.fem.dofmap import DofMap
+from tmfem.fem.element import skew
 
 #: Gauss points along the axis for the stiffness, by integration rule (4.3.2)
 INTEGRATION = {"reduced": 3, "full": 4}
@@ -102,15 +103,6 @@ def shape_functions(r) -> tuple[np.ndarray, np.ndarray]:
     of shape (4, len(r))."""
     r = np.atleast_1d(np.asarray(r, dtype=float))
     return np.array([h(r) for h in _H]), np.array([d(r) for d in _DH])
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    """skew(v) w = v x w for v (..., 3) -> (..., 3, 3)."""
-    S = np.zeros(v.shape + (3,))
-    S[..., 0, 1], S[..., 0, 2] = -v[..., 2], v[..., 1]
-    S[..., 1, 0], S[..., 1, 2] = v[..., 2], -v[..., 0]
-    S[..., 2, 0], S[..., 2, 1] = -v[..., 1], v[..., 0]
-    return S
 
 
 def rectangle_torsion_constant(a: float, b: float, *, terms: int = 50) -> float:
@@ -313,8 +305,8 @@ def reference_directors(X: np.ndarray, conn: np.ndarray, v1=None) -> np.ndarray:
 class BeamResponse:
     """Internal force, tangent and section state of a :class:`BeamElement` at a state.
 
-    f : (ndof,); K : csr or None; e : (ne, ngp, 12) generalised strains; energy : float;
-    forces : dict of section resultants at the Gauss points (:meth:`BeamElement.section_forces`).
+    f : (ndof,); K : csr or None; e : (ne, ngp, 12) generalised strains; energy : float
+    (section resultants: :meth:`BeamElement.section_forces`).
     """
 
     f: np.ndarray
@@ -461,7 +453,7 @@ class BeamElement:
         # constant map Pm_g (5 fields -> 3 blocks (x, V1, V2) x 4 nodes)
         Zb = np.einsum("gpm,egpn->emn", self._Pm, S @ self._Pm[None], optimize=True)
         Zb = Zb.reshape(ne, 3, 4, 3, 4).transpose(0, 1, 3, 2, 4)           # (ne, b, b', k, l)
-        T = -_skew(np.stack([V1, V2], axis=2))                       # dV = T theta, (ne, 4, 2, 3, 3)
+        T = -skew(np.stack([V1, V2], axis=2))                       # dV = T theta, (ne, 4, 2, 3, 3)
         Kg = np.zeros((ne, 4, 6, 4, 6))
         Kg[:, :, :3, :, :3] = np.einsum("ekl,ij->ekilj", Zb[:, 0, 0], np.eye(3))
         xt = np.einsum("ekl,elij->ekilj", Zb[:, 0, 1], T[:, :, 0]) \
@@ -474,7 +466,7 @@ class BeamElement:
                 tt += np.einsum("ekl,ekji,eljm->ekilm", Zb[:, 1 + a, 1 + b], T[:, :, a], T[:, :, b],
                                 optimize=True)
         # finite-rotation term on each node's own rotational block
-        G = np.einsum("ekij,ekjl->ekil", _skew(gV1), _skew(V1)) + np.einsum("ekij,ekjl->ekil", _skew(gV2), _skew(V2))
+        G = np.einsum("ekij,ekjl->ekil", skew(gV1), skew(V1)) + np.einsum("ekij,ekjl->ekil", skew(gV2), skew(V2))
         k = np.arange(4)
         tt[:, k, :, k, :] += G.transpose(1, 0, 2, 3)
         Kg[:, :, 3:, :, 3:] = tt
@@ -495,7 +487,7 @@ class BeamElement:
         J = np.linalg.norm(np.einsum("kg,eki->egi", dh, x), axis=-1)        # (ne, 4)
         hh = np.einsum("eg,kg,lg->ekl", b.rho * w[None, :] * J, h, h)
         V = (self.triads[..., 1], self.triads[..., 2]) if state is None else self.directors(state)
-        T = -_skew(np.stack(V, axis=2))                                      # (ne, 4, 2, 3, 3)
+        T = -skew(np.stack(V, axis=2))                                      # (ne, 4, 2, 3, 3)
         Me = np.zeros((b.ne, 4, 6, 4, 6))
         Me[:, :, :3, :, :3] = sec.A * np.einsum("ekl,ij->ekilj", hh, np.eye(3))
         Me[:, :, 3:, :, 3:] = np.einsum("ekl,ekji,eljm->ekilm", hh, sec.I_t * T[:, :, 0], T[:, :, 0]) \

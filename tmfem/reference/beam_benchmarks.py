@@ -1,8 +1,9 @@
 """Beam benchmarks: the cantilever rolled up by an end moment (dissertation 4.5.2).
 
 :func:`cantilever_end_moment` builds the problem of 4.5.2 from the four-node beam element
-(:mod:`tmfem.fem.beam`) and the solver layer's load stepping; :func:`elastica_end_moment` is
-its closed form (benchmarks.json ``elastica_end_moment_closed_form``).
+(:mod:`tmfem.fem.beam`) and the solver layer's load stepping; the elastica is
+its closed form (benchmarks.json ``elastica_end_moment_closed_form``; the function
+``elastica`` of the shell benchmark of the same problem).
 """
 from __future__ import annotations
 
@@ -15,22 +16,8 @@ from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, line_mesh
 from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State
+from tmfem.reference.benchmarks.shell_cantilever_moment import elastica
 from tmfem.solvers import load_stepping
-
-
-def elastica_end_moment(lam, *, L: float) -> tuple[np.ndarray, np.ndarray]:
-    """Tip displacements (u along, w across the initial axis) [m] of an inextensible,
-    unshearable cantilever of length L under the end moment M = 2 pi lam EI / L: the axis
-    bends into a circular arc of curvature M / EI, tip rotation theta = 2 pi lam,
-    u = L (sin theta / theta - 1), w = L (1 - cos theta) / theta (benchmarks.json
-    ``elastica_end_moment_closed_form``)."""
-    lam = np.asarray(lam, dtype=float)
-    th = 2.0 * np.pi * lam
-    small = np.abs(th) < 1e-8
-    ths = np.where(small, 1.0, th)
-    u = np.where(small, -L * th**2 / 6.0, L * (np.sin(ths) / ths - 1.0))
-    w = np.where(small, L * th / 2.0, L * (1.0 - np.cos(ths)) / ths)
-    return u, w
 
 
 @dataclass
@@ -87,7 +74,7 @@ def cantilever_end_moment(*, n_elements: int = 5, n_steps: int = 20, E: float = 
                          update=lambda s, du: s.advanced(cm.full(du), dm))
     u_tip = np.array([s.x[0, -1] - L for s in path.u])
     w_tip = np.array([s.x[2, -1] for s in path.u])
-    ue, we = elastica_end_moment(path.lam, L=L)
+    ue, we = elastica(path.lam, L)
     return CantileverRollUp(lam=path.lam, u_tip=u_tip, w_tip=w_tip, u_elastica=ue, w_elastica=we,
                             iterations=list(path.iterations), rejected=path.rejected,
                             shapes=[beam.centreline(s) for s in path.u], L=L, EI=EI,
