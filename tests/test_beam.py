@@ -150,6 +150,14 @@ def test_cantilever_closed_forms(section, n_elements, integration):
     assert w == pytest.approx(L**3 / (3 * E * section.I_s) + L / (kap * G * section.A), rel=1e-10)
     assert u[tip[3:]] @ T[:, 0] == pytest.approx(3.0 * L / (G * section.J), rel=1e-10)
     assert u[tip[:3]] @ T[:, 0] == pytest.approx(2.0 * L / (E * section.A), rel=1e-10)
+    # section resultants at the Gauss points (a 1e-3 fraction of the load: linear range)
+    st = State.reference(X, dm).advanced(1e-3 * u, dm)
+    sf = be.section_forces(st)
+    xi = np.einsum("ieg,i->eg", be.gauss_points(), t)                # arc length of the points
+    np.testing.assert_allclose(sf["M1"], -1e-3 * (L - xi), rtol=1e-5, atol=1e-9)
+    np.testing.assert_allclose(sf["T"], 3e-3, rtol=1e-5)
+    np.testing.assert_allclose(sf["N"], 2e-3, rtol=1e-3)                  # + EA w'^2/2: 3e-4
+    np.testing.assert_allclose(sf["Q2"], 1e-3, rtol=1e-5)
 
 
 def test_large_stretch_follows_the_total_lagrangian_bar():
