@@ -33,7 +33,8 @@ class ConstraintMap:
 
     @classmethod
     def build(cls, dofmap: DofMap, *, dependent: Sequence[tuple[int, np.ndarray, np.ndarray]] = (),
-              fixed_nodes=(), fixed_dofs=()) -> "ConstraintMap":
+              fixed_nodes=(), fixed_dofs=(),
+              dependent_dofs: Sequence[tuple[int, np.ndarray, np.ndarray]] = ()) -> "ConstraintMap":
         """Constraint map of ``dofmap``.
 
         Parameters
@@ -45,14 +46,24 @@ class ConstraintMap:
             Nodes whose translations are fixed (pinned).
         fixed_dofs : array_like of int
             Further fixed dofs (full numbering).
+        dependent_dofs : sequence of (dof, master_dofs, weights)
+            Single dofs (full numbering, any field) that are ``sum_i weights[i] u[master_dofs[i]]``
+            of independent dofs: a linear multi-point constraint (e.g. the spin constraint
+            of a pinned bar, :func:`tmfem.fem.beam.spin_constraint`).
         """
         n = dofmap.ndof
         dep_nodes = np.array([d[0] for d in dependent], dtype=np.int64)
         if np.unique(dep_nodes).size != dep_nodes.size:
             raise InputError("constraints: expected each dependent node once, found repeats")
         dep_dofs = dofmap.translation_dofs(dep_nodes).ravel() if dep_nodes.size else np.zeros(0, np.int64)
+        extra = np.array([int(d[0]) for d in dependent_dofs], dtype=np.int64)
+        if extra.size and (np.unique(extra).size != extra.size or np.isin(extra, dep_dofs).any()
+                           or extra.min() < 0 or extra.max() >= n):
+            raise InputError(f"constraints: expected distinct dependent dofs in [0, {n}) outside the "
+                             f"dependent nodes, found {extra.tolist()}")
         independent = np.ones(n, dtype=bool)
         independent[dep_dofs] = False
+        independent[extra] = False
         reduced_of = np.full(n, -1, dtype=np.int64)
         reduced_of[independent] = np.arange(int(independent.sum()))
         rows = [np.flatnonzero(independent)]
@@ -71,6 +82,16 @@ class ConstraintMap:
             rows.append(np.repeat(nd[None, :], masters.size, axis=0).ravel())
             cols.append(reduced_of[md].ravel())
             vals.append(np.repeat(w, 3))
+        for dof, masters, w in dependent_dofs:
+            masters = np.asarray(masters, dtype=np.int64)
+            w = np.asarray(w, dtype=float)
+            if masters.shape != w.shape or masters.size == 0 or not independent[masters].all():
+                raise InputError(f"constraints: dof {dof}: expected as many weights as independent "
+                                 f"master dofs (>= 1), found {masters.size} masters "
+                                 f"({int(np.sum(~independent[masters]))} dependent) and {w.size} weights")
+            rows.append(np.full(masters.size, int(dof)))
+            cols.append(reduced_of[masters])
+            vals.append(w)
         T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                           shape=(n, int(independent.sum())))
         fixed = list(np.asarray(fixed_dofs, dtype=np.int64).ravel())

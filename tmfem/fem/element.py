@@ -87,6 +87,17 @@ class State:
         return State(x=x, R=R, frames=self.frames)
 
 
+def skew(v: np.ndarray) -> np.ndarray:
+    """Cross-product matrices: ``skew(v) @ w = v x w`` for v (..., 3) -> (..., 3, 3) (the
+    spin of a rotation increment, eqs. 4.16 and 4.22)."""
+    v = np.asarray(v, dtype=float)
+    S = np.zeros(v.shape + (3,))
+    S[..., 0, 1], S[..., 0, 2] = -v[..., 2], v[..., 1]
+    S[..., 1, 0], S[..., 1, 2] = v[..., 2], -v[..., 0]
+    S[..., 2, 0], S[..., 2, 1] = -v[..., 1], v[..., 0]
+    return S
+
+
 class Element(Protocol):
     """A set of elements of one kind on the global dofs of a :class:`DofMap` (module docstring)."""
 

@@ -59,6 +59,7 @@ import scipy.sparse as sp
 from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler
 from tmfem.fem.dofmap import DofMap
+from tmfem.fem.element import skew
 
 #: transverse shear correction factor of the plane-stress lamina law
 SHEAR_FACTOR = 5.0 / 6.0
@@ -566,8 +567,8 @@ class ShellPressure:
         f = self._asm.vector(fe)
         if not (tangent and self.follower):
             return f, None
-        K = (np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 1], _skew(g[:, :, 0]))
-             - np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 0], _skew(g[:, :, 1])))
+        K = (np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 1], skew(g[:, :, 0]))
+             - np.einsum("eq,kq,lq,eqij->ekilj", pw, self._h, self._dh[:, 0], skew(g[:, :, 1])))
         return f, self._asm.matrix(K.reshape(-1, 12, 12))
 
     def nodal_areas(self) -> np.ndarray:
@@ -597,12 +598,3 @@ class ShellPressure:
     def mass(self):
         """A load carries no mass."""
         return sp.csr_matrix((self.dofmap.ndof,) * 2)
-
-
-def _skew(v):
-    """Cross-product matrices [v]x (..., 3, 3)."""
-    S = np.zeros(v.shape + (3,))
-    S[..., 0, 1], S[..., 0, 2] = -v[..., 2], v[..., 1]
-    S[..., 1, 0], S[..., 1, 2] = v[..., 2], -v[..., 0]
-    S[..., 2, 0], S[..., 2, 1] = -v[..., 1], v[..., 0]
-    return S

@@ -29,6 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
+from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State, assemble
@@ -484,11 +485,11 @@ class Structure:
         return [StructureState(state=s, lam=float(lam), iterations=i) for s, lam, i in zip(path.u, path.lam, its)]
 
     def mass(self, state: State | None = None) -> sp.csr_matrix:
-        """Mass matrix (ndof, ndof): sum of the element sets' masses (shell rotary inertia
-        mapped with the triads of ``state``)."""
+        """Mass matrix (ndof, ndof): sum of the element sets' masses (shell and beam rotary
+        inertia mapped with the triads of ``state``)."""
         M = None
         for e in self.elements:
-            Me = e.mass(state) if (state is not None and isinstance(e, MITC4Shell)) else e.mass()
+            Me = e.mass(state) if (state is not None and isinstance(e, (MITC4Shell, BeamElement))) else e.mass()
             M = Me if M is None else M + Me
         return M
 
