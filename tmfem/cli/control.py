@@ -14,7 +14,7 @@ from tmfem.errors import InputError
 NAME = "control"
 HELP = "linear control at a deployed configuration: PBH tests, H-infinity LMI synthesis (7.3-7.4)"
 
-_HINF_ONLY = ("alpha", "u_m", "save", "plot", "solver")
+_HINF_ONLY = ("alpha", "u_m", "save", "plot", "solver", "method")
 
 
 def configure(parser) -> None:
@@ -30,6 +30,10 @@ def configure(parser) -> None:
                         help="u_m [m] of W_u = I/u_m (default 7.4's: 0.01, 0.02 for 1-6D)")
     parser.add_argument("--solver", choices=("CLARABEL", "SCS"), default=None,
                         help="SDP solver (default CLARABEL)")
+    parser.add_argument("--method", choices=("lmi", "riccati"), default=None,
+                        help="lmi (default): eliminated LMIs of eq. 5.65 (Clarabel); riccati: "
+                             "hinfsyn on the alpha-shifted plant (needed for 2-3-deploy, whose "
+                             "50-state LMI fails in Clarabel; docs/control.md)")
     parser.add_argument("--pbh-tol", type=float, default=None,
                         help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
     parser.add_argument("--save", help="write plant and controller to this .npz")
@@ -56,7 +60,7 @@ def run(args) -> dict:
     print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
                         solver=args.solver or "CLARABEL", synthesize=args.action == "hinf",
-                        pbh_tol=args.pbh_tol)
+                        pbh_tol=args.pbh_tol, method=args.method or "lmi")
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
         from tmfem.control.analysis import damping_table
@@ -88,7 +92,8 @@ def format_text(r: dict) -> str:
         s = r["solver"]
         lines += [f"gamma = {r['gamma']:.6g} (||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}), "
                   f"alpha_1 = {r['alpha']:g}, max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g}",
-                  f"controller order {r['controller_order']}, cond(I - RS) = {r['cond_I_minus_RS']:.3g}",
+                  f"{r['method']}, controller order {r['controller_order']}, cond(I - RS) = "
+                  f"{r['cond_I_minus_RS'] if r['cond_I_minus_RS'] is None else format(r['cond_I_minus_RS'], '.3g')}",
                   f"solver {s['solver']}: {s['status']}, {s['solve_time_s']:.1f} s, "
                   f"{s['n_variables']} variables, LMI sizes {s['lmi_sizes']}"]
         if "saved" in r:

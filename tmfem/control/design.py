@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.hinf import GeneralizedPlant, HinfDesign, hinf_lmi, verify
+from tmfem.control.hinf import GeneralizedPlant, HinfDesign, hinf_lmi, hinf_riccati, verify
 from tmfem.control.pbh import PBHResult, pbh_ss
 from tmfem.control.plant import DEPLOYED, DeployedPlant, deployed_plant, generalized_plant
 from tmfem.errors import InputError
@@ -44,14 +44,15 @@ class DeployedDesign:
             out.update({"gamma": d["gamma"], "alpha": d["alpha"],
                         "closed_loop_max_real_part": d["closed_loop_max_real_part"],
                         "closed_loop_hinf_norm": d["closed_loop_hinf_norm"],
-                        "controller_order": d["controller_order"],
+                        "controller_order": d["controller_order"], "method": d["kind"],
                         "cond_I_minus_RS": d["cond_I_minus_RS"], "solver": d["solver"]})
         return out
 
 
 def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = None,
                   membrane_modes: int | None = None, solver: str = "CLARABEL",
-                  synthesize: bool = True, pbh_tol: float | None = None) -> DeployedDesign:
+                  synthesize: bool = True, pbh_tol: float | None = None,
+                  method: str = "lmi") -> DeployedDesign:
     """Plant, PBH and H-infinity controller of a deployed system (7.3-7.4).
 
     Parameters
@@ -61,7 +62,12 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         (:data:`tmfem.control.plant.DEPLOYED`), required for other systems.
     synthesize : bool
         False: plant and PBH only (``tmfem control pbh``).
+    method : {"lmi", "riccati"}
+        Eliminated LMIs (:func:`~tmfem.control.hinf.hinf_lmi`) or the Riccati route on the
+        alpha-shifted plant (:func:`~tmfem.control.hinf.hinf_riccati`).
     """
+    if method not in ("lmi", "riccati"):
+        raise InputError(f"method: expected 'lmi' or 'riccati', found {method!r}")
     d = DEPLOYED.get(system.name, {})
     alpha = d.get("alpha") if alpha is None else alpha
     u_m = d.get("u_m") if u_m is None else u_m
@@ -74,7 +80,10 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     gen = generalized_plant(plant, u_m=u_m if u_m is not None else 1.0)
     design = None
     if synthesize:
-        design = hinf_lmi(gen, alpha=alpha, solver=solver, operating_point=plant.operating_point)
+        if method == "lmi":
+            design = hinf_lmi(gen, alpha=alpha, solver=solver, operating_point=plant.operating_point)
+        else:
+            design = hinf_riccati(gen, alpha=alpha, operating_point=plant.operating_point)
     return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design,
                           u_m=float(u_m) if u_m is not None else None)
 

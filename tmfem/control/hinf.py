@@ -143,6 +143,9 @@ class GeneralizedPlant:
 class HinfDesign:
     """An H-infinity controller and its certificate.
 
+    ``gamma`` is the level the controller is certified for (the LMI optimum ``gamma_lmi``
+    relaxed by ``gamma_relax``); ``closed_loop_norm`` the measured ||T_pw||_inf <= gamma.
+
     ``controller`` is a python-control ``StateSpace`` from the measured outputs y (inputs,
     named as the plant's y) to the control inputs u (outputs, named as the plant's u).
     ``operating_point`` holds what the design is linearised about (e.g. q_e, u_e): the
@@ -162,9 +165,10 @@ class HinfDesign:
     S: np.ndarray | None = None
     cond_I_minus_RS: float | None = None
     operating_point: dict = field(default_factory=dict)
+    gamma_lmi: float | None = None
 
     def summary(self) -> dict:
-        return {"kind": self.kind, "gamma": self.gamma, "alpha": self.alpha,
+        return {"kind": self.kind, "gamma": self.gamma, "gamma_lmi": self.gamma_lmi, "alpha": self.alpha,
                 "closed_loop_hinf_norm": self.closed_loop_norm,
                 "closed_loop_max_real_part": self.closed_loop_max_real_part,
                 "controller_order": int(self.controller.nstates),
@@ -173,7 +177,7 @@ class HinfDesign:
 
 # ---------------------------------------------------------------------------- LMIs
 def _elimination_problem(P: GeneralizedPlant, alpha: float, eps: float, *, gamma_fixed=None,
-                         bound=None, regularization: float = 0.0):
+                         bound=None, regularization: float = 0.0, coupling_weight: float = 1.0):
     """cvxpy problem of the eliminated H-infinity LMIs in (R, S, gamma) for A + alpha I."""
     import cvxpy as cp
     n, nw, nu, np_, ny = (P.sizes[k] for k in ("n", "nw", "nu", "np", "ny"))
@@ -215,7 +219,7 @@ def _elimination_problem(P: GeneralizedPlant, alpha: float, eps: float, *, gamma
         k = NS.shape[1] + rp
         cons.append(sym(L2) << -marg * np.eye(k))
         sizes["dual (N_S)"] = k
-    cons.append(sym(cp.bmat([[R, np.eye(n)], [np.eye(n), S]])) >> marg * np.eye(2 * n))
+    cons.append(sym(cp.bmat([[R, np.eye(n)], [np.eye(n), S]])) >> coupling_weight * marg * np.eye(2 * n))
     if t is not None:
         cons.append(cp.trace(R) + cp.trace(S) <= bound)
     sizes["coupling [R I; I S]"] = 2 * n
@@ -224,6 +228,24 @@ def _elimination_problem(P: GeneralizedPlant, alpha: float, eps: float, *, gamma
     obj = (cp.Minimize(g + regularization * (cp.trace(R) + cp.trace(S)) / (2 * n))
            if gamma_fixed is None else cp.Maximize(t))
     return cp.Problem(obj, cons), R, S, g, sizes, (NR, NS)
+
+
+def _balance_RS(P: GeneralizedPlant, R, S):
+    """Plant in coordinates x = T x_b with T^-1 R T^-T = T^T S T = Sigma (diagonal), and
+    the transformed R, S. Returns (P unchanged, R, S) when R or S is not positive definite."""
+    try:
+        Lr = np.linalg.cholesky((R + R.T) / 2)
+        Ls = np.linalg.cholesky((S + S.T) / 2)
+    except np.linalg.LinAlgError:
+        return P, R, S
+    U, sig, Vt = np.linalg.svd(Ls.T @ Lr)
+    T = Lr @ Vt.T / np.sqrt(sig)[None, :]
+    Ti = (np.sqrt(sig)[:, None] * Vt) @ np.linalg.inv(Lr)
+    Pb = GeneralizedPlant(A=Ti @ P.A @ T, B1=Ti @ P.B1, B2=Ti @ P.B2, C1=P.C1 @ T, C2=P.C2 @ T,
+                          D11=P.D11, D12=P.D12, D21=P.D21, D22=P.D22, state_names=P.state_names,
+                          w_names=P.w_names, u_names=P.u_names, p_names=P.p_names,
+                          y_names=P.y_names)
+    return Pb, np.diag(sig), np.diag(sig)
 
 
 def _range_basis(M: np.ndarray, *, rtol: float = 1e-12) -> np.ndarray:
@@ -379,6 +401,40 @@ def verify(plant: GeneralizedPlant, controller, *, gamma: float, alpha: float,
     return T, nrm, re
 
 
+def _minimise_gamma(plant, *, alpha, solver, eps, regularization, scale, residual_tol):
+    """Stage 1 of :func:`hinf_lmi`: minimise gamma over the eliminated LMIs (eq. 5.65 form)."""
+    Ps, t = plant.scaled() if scale else (plant, np.ones(plant.A.shape[0]))
+    prob, R, S, g, sizes, (NR, NS) = _elimination_problem(Ps, alpha, eps, regularization=regularization)
+    rep = solve(prob, solver=solver, what="H-infinity LMIs (eliminated, eq. 5.65)",
+                lmi_sizes=sizes, accept_inaccurate=True)
+    g_opt = float(g.value)
+    Rv, Sv = R.value, S.value
+    rep.residuals = _lmi_residuals(Ps, alpha, Rv, Sv, g_opt, eps, NR, NS)
+    scale_RS = max(1.0, g_opt, np.abs(Rv).max(), np.abs(Sv).max())
+    if max(rep.residuals.values()) > residual_tol * scale_RS:
+        raise InfeasibleController(f"H-infinity LMIs: expected every LMI satisfied at the "
+                                   f"returned point (largest eigenvalue <= {residual_tol:g} x "
+                                   f"{scale_RS:.3g}), found residuals {rep.residuals} "
+                                   f"(solver status {rep.status!r})")
+    return g_opt, rep, (Ps, Rv, Sv, sizes, NR, NS, scale_RS)
+
+
+def hinf_gamma(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLARABEL",
+               eps: float = 1e-7, regularization: float = 0.0, scale: bool = True,
+               residual_tol: float = 1e-6) -> tuple:
+    """The optimal H-infinity level of the eliminated LMIs (no controller): (gamma, SolverReport).
+
+    Same LMIs as :func:`hinf_lmi` (default without the trace penalty, so gamma is the LMI
+    optimum itself); a lower bound for every alpha-stabilising controller of the shifted
+    problem and, with alpha = 0, the H-infinity optimum.
+    """
+    if not (np.isfinite(alpha) and alpha >= 0):
+        raise InputError(f"alpha_1: expected a finite value >= 0, found {alpha!r}")
+    g, rep, _ = _minimise_gamma(plant, alpha=alpha, solver=solver, eps=eps,
+                                regularization=regularization, scale=scale, residual_tol=residual_tol)
+    return g, rep
+
+
 def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLARABEL",
              eps: float = 1e-7, gamma_relax: float = 1e-2, max_cond: float = 1e6,
              scale: bool = True, verify_rtol: float = 1e-3, residual_tol: float = 1e-6,
@@ -422,26 +478,20 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
     if np.any(plant.D22 != 0):
         raise InputError(f"generalised plant: expected D22 = 0 (7.3), found max |D22| = "
                          f"{np.max(np.abs(plant.D22)):.3g}")
-    Ps, t = plant.scaled() if scale else (plant, np.ones(plant.A.shape[0]))
-    prob, R, S, g, sizes, (NR, NS) = _elimination_problem(Ps, alpha, eps, regularization=regularization)
-    rep = solve(prob, solver=solver, what="H-infinity LMIs (eliminated, eq. 5.65)",
-                lmi_sizes=sizes, accept_inaccurate=True)
-    g_opt = float(g.value)
-    Rv, Sv = R.value, S.value
-    rep.residuals = _lmi_residuals(Ps, alpha, Rv, Sv, g_opt, eps, NR, NS)
-    scale_RS = max(1.0, g_opt, np.abs(Rv).max(), np.abs(Sv).max())
-    if max(rep.residuals.values()) > residual_tol * scale_RS:
-        raise InfeasibleController(f"H-infinity LMIs: expected every LMI satisfied at the "
-                                   f"returned point (largest eigenvalue <= {residual_tol:g} x "
-                                   f"{scale_RS:.3g}), found residuals {rep.residuals} "
-                                   f"(solver status {rep.status!r})")
+    g_opt, rep, (Ps, Rv, Sv, sizes, NR, NS, scale_RS) = _minimise_gamma(
+        plant, alpha=alpha, solver=solver, eps=eps, regularization=regularization, scale=scale,
+        residual_tol=residual_tol)
     gamma = g_opt * (1 + gamma_relax)
     (Ak, Bk, Ck, Dk), cond, lam = _controller_from_RS(Ps, alpha, Rv, Sv, gamma)
     if not (np.isfinite(cond) and cond <= max_cond and lam < 0):
         log.info("status %s, cond(I - RS) = %.3g, BRL residual %.3g: re-solving at gamma = "
                  "%.6g for a strictly feasible, better-conditioned R, S", rep.status, cond, lam, gamma)
-        bound = trace_budget * (np.trace(Rv) + np.trace(Sv))
-        prob2, R2, S2, _, _, _ = _elimination_problem(Ps, alpha, eps, gamma_fixed=gamma, bound=bound)
+        # state coordinates in which R and S are equal and diagonal (the balancing of
+        # balanced truncation, R and S in the roles of the Gramians): a well-scaled re-solve
+        Ps, Rb, Sb = _balance_RS(Ps, Rv, Sv)
+        bound = trace_budget * (np.trace(Rb) + np.trace(Sb))
+        prob2, R2, S2, _, _, (NR, NS) = _elimination_problem(Ps, alpha, eps, gamma_fixed=gamma,
+                                                              bound=bound)
         rep2 = solve(prob2, solver=solver, what="H-infinity LMIs (conditioning re-solve)",
                      lmi_sizes=sizes, accept_inaccurate=True)
         rep.status = f"{rep.status}; re-solve at gamma (1 + {gamma_relax:g}): {rep2.status}"
@@ -463,7 +513,8 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
     return HinfDesign(controller=K, gamma=gamma, alpha=float(alpha), closed_loop=T,
                       closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep,
                       plant=plant, kind="output feedback (eliminated LMIs)", R=Rv, S=Sv,
-                      cond_I_minus_RS=cond, operating_point=dict(operating_point or {}))
+                      cond_I_minus_RS=cond, operating_point=dict(operating_point or {}),
+                      gamma_lmi=g_opt)
 
 
 def _controller_ss(plant, Ak, Bk, Ck, Dk):
@@ -504,6 +555,11 @@ def hinf_state_feedback(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: 
     sizes = {"bounded real lemma": n + nw + np_, "Y > 0": n}
     rep = solve(prob, solver=solver, what="H-infinity state-feedback LMI", lmi_sizes=sizes)
     g_opt = float(g.value)
+    Yv, Wv = Y.value, W.value
+    AYv, CYv = Aa @ Yv + Ps.B2 @ Wv, Ps.C1 @ Yv + Ps.D12 @ Wv
+    lam1 = max_eig(np.block([[AYv + AYv.T, Ps.B1, CYv.T], [Ps.B1.T, -g_opt * np.eye(nw), Ps.D11.T],
+                             [CYv, Ps.D11, -g_opt * np.eye(np_)]]))
+    log.info("state feedback: gamma %.6g, LMI max eigenvalue %.3g", g_opt, lam1)
     # re-solve at a relaxed gamma for an interior point (the optimum is on the boundary)
     gamma = g_opt * (1 + gamma_relax)
     s = cp.Variable()
@@ -535,4 +591,42 @@ def hinf_state_feedback(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: 
                                    f"found {nrm:.6g}")
     return HinfDesign(controller=Kss, gamma=gamma, alpha=float(alpha), closed_loop=T,
                       closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep, plant=plant,
-                      kind="state feedback", operating_point=dict(operating_point or {}))
+                      kind="state feedback", operating_point=dict(operating_point or {}),
+                      gamma_lmi=g_opt)
+
+
+def hinf_riccati(plant: GeneralizedPlant, *, alpha: float = 0.0, verify_rtol: float = 1e-3,
+                 operating_point=None) -> HinfDesign:
+    """Riccati route (Glover-Doyle, python-control ``hinfsyn`` / SLICOT SB10AD) on the
+    alpha-shifted plant A + alpha_1 I, shifted back (A_k - alpha_1 I) as in :func:`hinf_lmi`.
+
+    For regular problems (D12 full column rank, D21 full row rank) only; used where the
+    LMI solver fails numerically (the 50-state 2-3 plant, docs/control.md). hinfsyn's own
+    gamma is not trusted: the returned ``gamma`` is the verified closed-loop norm.
+    """
+    import control
+    if not (np.isfinite(alpha) and alpha >= 0):
+        raise InputError(f"alpha_1: expected a finite value >= 0, found {alpha!r}")
+    n = plant.A.shape[0]
+    Pa = GeneralizedPlant(**{**plant.__dict__, "A": plant.A + alpha * np.eye(n)})
+    import time
+    t0 = time.perf_counter()
+    try:
+        K, _, g, _ = control.hinfsyn(Pa.to_ss(), len(plant.y_names), len(plant.u_names))
+    except Exception as exc:    # slycot raises its own error types
+        raise InfeasibleController(f"hinfsyn (Riccati) on the alpha-shifted plant: expected a "
+                                   f"controller, found the error: {exc}") from None
+    dt = time.perf_counter() - t0
+    Kss = _controller_ss(plant, np.asarray(K.A) - alpha * np.eye(K.nstates), K.B, K.C, K.D)
+    T = closed_loop(plant, Kss)
+    re = float(np.max(np.real(T.poles())))
+    if not re < -alpha + verify_rtol * max(alpha, 1e-6) + 1e-9:
+        raise InfeasibleController(f"closed loop (Riccati): expected all poles with Re < "
+                                   f"{-alpha:g}, found max Re = {re:.6g}")
+    nrm = float(control.norm(T, p="inf"))
+    rep = SolverReport(solver="hinfsyn (SLICOT SB10AD)", status=f"gamma reported {float(g):.6g}",
+                       solve_time_s=dt, n_variables=0, lmi_sizes={})
+    return HinfDesign(controller=Kss, gamma=nrm, alpha=float(alpha), closed_loop=T,
+                      closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep, plant=plant,
+                      kind="output feedback (Riccati, shifted plant)",
+                      operating_point=dict(operating_point or {}))
