@@ -36,3 +36,8 @@ class ConvergenceError(TmfemError):
 
 class BackendUnavailable(TmfemError):
     """An optional backend (PETSc/SLEPc) that is not installed."""
+
+
+class InfeasibleController(TmfemError):
+    """A controller synthesis whose LMIs are infeasible, whose solver did not reach an
+    optimal status, or whose recovered controller fails its closed-loop checks (eqs. 5.63-5.67)."""

@@ -1,0 +1,103 @@
+"""``tmfem control``: linear control at a deployed configuration (7.3-7.4).
+
+``tmfem control hinf --preset 1-4D [--alpha 0.5] [--save k.npz] [--plot out.png] [--json]``:
+H-infinity output feedback by LMIs with alpha-stability; ``tmfem control pbh --preset ...``:
+the PBH tests alone; ``tmfem control recheck k.npz``: re-verify a saved design.
+"""
+from __future__ import annotations
+
+import sys
+
+from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.errors import InputError
+
+NAME = "control"
+HELP = "linear control at a deployed configuration: PBH tests, H-infinity LMI synthesis (7.3-7.4)"
+
+_HINF_ONLY = ("alpha", "u_m", "save", "plot", "solver", "method")
+
+
+def configure(parser) -> None:
+    parser.add_argument("action", choices=("hinf", "pbh", "recheck"),
+                        help="hinf: synthesis; pbh: controllability/observability only; "
+                             "recheck FILE.npz: re-verify a saved design")
+    add_system_args(parser)
+    parser.add_argument("--membrane-modes", type=int, default=None,
+                        help="K (default 7.4's: 3 for 1-4D, 5 for 1-6D, 4 for 2-3-deploy)")
+    parser.add_argument("--alpha", type=float, default=None,
+                        help="alpha_1: closed-loop poles with Re < -alpha_1 (default 7.4's)")
+    parser.add_argument("--u-m", type=float, default=None,
+                        help="u_m [m] of W_u = I/u_m (default 7.4's: 0.01, 0.02 for 1-6D)")
+    parser.add_argument("--solver", choices=("CLARABEL", "SCS"), default=None,
+                        help="SDP solver (default CLARABEL)")
+    parser.add_argument("--method", choices=("lmi", "riccati"), default=None,
+                        help="lmi (default): eliminated LMIs of eq. 5.65 (Clarabel); riccati: "
+                             "hinfsyn on the alpha-shifted plant (needed for 2-3-deploy, whose "
+                             "50-state LMI fails in Clarabel; docs/control.md)")
+    parser.add_argument("--pbh-tol", type=float, default=None,
+                        help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
+    parser.add_argument("--save", help="write plant and controller to this .npz")
+    parser.add_argument("--plot", help="write the closed-loop analysis figure (PNG)")
+
+
+def run(args) -> dict:
+    if args.action == "recheck":
+        from tmfem.control.design import recheck
+        if args.spec is None or args.preset is not None:
+            raise InputError("recheck: expected one design file (.npz), found "
+                             f"spec={args.spec!r}, --preset={args.preset!r}")
+        given = [k for k in _HINF_ONLY + ("membrane_modes", "pbh_tol") if getattr(args, k) is not None]
+        if given:
+            raise InputError(f"recheck: options {given} do not apply")
+        return {"action": "recheck", "file": args.spec, **recheck(args.spec)}
+    from tmfem.control.design import deployed_hinf, save_design
+    if args.action == "pbh":
+        given = [k for k in _HINF_ONLY if getattr(args, k) is not None]
+        if given:
+            raise InputError(f"pbh: options {['--' + k.replace('_', '-') for k in given]} apply to "
+                             "`tmfem control hinf` only")
+    system = system_from_args(args)
+    print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
+    res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
+                        solver=args.solver or "CLARABEL", synthesize=args.action == "hinf",
+                        pbh_tol=args.pbh_tol, method=args.method or "lmi")
+    out = {"action": args.action, **res.summary()}
+    if args.action == "hinf":
+        from tmfem.control.analysis import damping_table
+        out["closed_loop_slowest"] = [list(r) for r in
+                                      sorted(damping_table(res.design.closed_loop), key=lambda r: -r[2])[:3]]
+        if args.save:
+            save_design(res.design, args.save)
+            out["saved"] = args.save
+        if args.plot:
+            from tmfem.control.analysis import plot_design
+            plot_design(res.design, open_loop=res.generalized, path=args.plot,
+                        title=f"{system.name}: H-infinity design, gamma = {res.design.gamma:.4g}, "
+                              f"alpha_1 = {res.design.alpha:g}")
+            out["plot"] = args.plot
+    return out
+
+
+def format_text(r: dict) -> str:
+    if r["action"] == "recheck":
+        return (f"{r['file']}: gamma = {r['gamma']:.6g}, ||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}, "
+                f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} (alpha_1 = {r['alpha']:g}): ok")
+    p = r["pbh"]
+    lines = [f"system {r['system']}: {r['n_states']} states, {r['n_inputs']} inputs",
+             f"open-loop f_max = {r['open_loop_f_max_hz']:.4f} Hz (printed {r['open_loop_f_max_printed_hz']})",
+             f"PBH (tol {p['tol']:g}): controllable {p['controllable']} (least margin "
+             f"{p['least_controllable']['margin']:.3g} at {p['least_controllable']['frequency_hz']:.3f} Hz), "
+             f"observable {p['observable']} (least margin {p['least_observable']['margin']:.3g})"]
+    if r["action"] == "hinf":
+        s = r["solver"]
+        lines += [f"gamma = {r['gamma']:.6g} (||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}), "
+                  f"alpha_1 = {r['alpha']:g}, max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g}",
+                  f"{r['method']}, controller order {r['controller_order']}, cond(I - RS) = "
+                  f"{r['cond_I_minus_RS'] if r['cond_I_minus_RS'] is None else format(r['cond_I_minus_RS'], '.3g')}",
+                  f"solver {s['solver']}: {s['status']}, {s['solve_time_s']:.1f} s, "
+                  f"{s['n_variables']} variables, LMI sizes {s['lmi_sizes']}"]
+        if "saved" in r:
+            lines.append(f"saved {r['saved']}")
+        if "plot" in r:
+            lines.append(f"plot {r['plot']}")
+    return "\n".join(lines)
