@@ -94,7 +94,8 @@ def run(args) -> dict:
 def format_text(r: dict) -> str:
     pr = r.get("printed", {})
     lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
-             f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",
+             f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
+             f"membrane, {r['dofs']} free dofs",
              f"rest lengths ({r['rest_lengths_source']}): "
              + ", ".join(f"{k}={v:.5f}" for k, v in list(r["rest_lengths"].items())[:8])
              + (" ..." if len(r["rest_lengths"]) > 8 else ""),

@@ -11,7 +11,9 @@ from tmfem.post.plots import _plt, _save
 def membrane_field(model, x: np.ndarray):
     """The membrane of positions x as a :class:`tmfem.io.vtk.MembraneField` with displacement
     in the floating frame (point data) and sigma_p1, sigma_p2, von Mises and the floating-frame
-    Cauchy components (cell data, element means)."""
+    Cauchy components (cell data, element means), the membrane state ``membrane_state``
+    (0 taut, 1 wrinkled, 2 slack) and the tension (wrinkle-crest) direction
+    ``wrinkle_direction`` in the reference plane (:meth:`MembraneTL.wrinkling`)."""
     topo = model.topology
     nm = topo.n_mesh
     xm = x[:, :nm]
@@ -23,6 +25,9 @@ def membrane_field(model, x: np.ndarray):
           "von_mises": st.von_mises_elem,
           "sigma_xf": st.cauchy[0].mean(axis=-1), "sigma_yf": st.cauchy[1].mean(axis=-1),
           "tau_xfyf": st.cauchy[2].mean(axis=-1)}
+    wr = model.membrane.wrinkling(xm)
+    cd["membrane_state"] = wr["state"].astype(np.int32)
+    cd["wrinkle_direction"] = wr["direction"]
     return MembraneField(mesh=topo.mesh, x=xm, point_data={"displacement_floating": xf - ref},
                          cell_data=cd)
 
