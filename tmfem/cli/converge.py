@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import csv
 
-from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
+from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
+                              system_from_args)
 from tmfem.errors import InputError
-from tmfem.fem.tension_field import MEMBRANE_LAWS
 from tmfem.models.mtc.spec import apply_rest_lengths
 from tmfem.post.convergence import plot_convergence_study
 from tmfem.solvers.backends import backend_names
@@ -36,9 +36,7 @@ def configure(parser) -> None:
                         help="comma-separated numbers of truss elements per tendon")
     parser.add_argument("--modes", type=int, default=12)
     add_attachment_args(parser)
-    parser.add_argument("--membrane-law", choices=MEMBRANE_LAWS, default="svk",
-                        help="membrane law: St.Venant-Kirchhoff (svk, eq. 4.9) or tension-field "
-                             "(wrinkling, docs/wrinkling.md)")
+    add_membrane_law_arg(parser)
     parser.add_argument("--rest-lengths", default=None,
                         help="fixed rest lengths (system/design, evaluated once, or GROUP=VALUE "
                              "pairs such as S1=1.5025) or the design-consistent ones recomputed "
