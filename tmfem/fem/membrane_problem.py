@@ -46,8 +46,8 @@ class MembraneSolution:
     u : ndarray (3, nn)
         Displacements x - X [m].
     reactions : ndarray (3, nn)
-        f_int - f_ext at the prescribed dofs (the force the membrane exerts on its supports;
-        the supports exert the opposite), zero at the free dofs [N].
+        f_int - f_ext at the prescribed dofs: the force the supports exert on the membrane
+        (the membrane pulls on them with the opposite), zero at the free dofs [N].
     steps : int
         Load steps taken.
     """
