@@ -116,3 +116,29 @@ def test_mtc_tension_field_prestress_and_cli(capsys):
     assert svk["membrane_law"] == "svk" and svk["membrane_min_minor_principal"] < 0
     with pytest.raises(SystemExit):
         main(["modal", "--preset", "1-4", "--membrane-law", "wrinkly"])
+
+
+def test_com_basis_about_the_tension_field_prestress():
+    from tmfem.models.com.membrane_modes import build_membrane_basis
+    from tmfem.models.com.model import ControlOrientedModel
+    s = load_preset("1-4")
+    com = ControlOrientedModel(s, membrane_modes=5, membrane_law="tension-field")
+    mb = com.membrane
+    d0 = mb.delta0
+    comps = mb.layout.corner_components
+    inplane = [k for k, (i, c) in enumerate(comps) if c < 2]
+    dvec = np.array([d0[c, i] for (i, c) in comps])
+    # Euler's theorem for the positively homogeneous law: K_t(Delta_0) Delta_0 = f(Delta_0),
+    # so the condensed tangent S reproduces the tension-field corner forces at the design
+    F = mb.plane.solve(d0[:2]).corner_forces
+    f_expected = np.array([F[c, i] for k, (i, c) in enumerate(comps) if k in inplane])
+    f_S = (mb.S @ dvec)[inplane]
+    assert np.allclose(f_S, f_expected, rtol=1e-6, atol=1e-6 * np.abs(f_expected).max())
+    # the prestress of the basis is tension-only (eta of SVK at most) ...
+    tau = mb.tau
+    minor = 0.5 * (tau[0] + tau[1]) - np.hypot(0.5 * (tau[0] - tau[1]), tau[2])
+    assert minor.min() >= -1e-5 * np.abs(tau).max()
+    # ... and the SVK basis (the dissertation's) keeps compression at the free edges
+    svk = build_membrane_basis(s, delta0=d0, n_modes=5)
+    t2 = svk.tau
+    assert (0.5 * (t2[0] + t2[1]) - np.hypot(0.5 * (t2[0] - t2[1]), t2[2])).min() < 0

@@ -357,6 +357,15 @@ class PlaneStressMembrane:
 
         return f, asm(stiffness, self.basis, D=np.ascontiguousarray(D)).tocsr()
 
+    def tangent(self, x: np.ndarray) -> sp.csr_matrix:
+        """Stiffness (thickness included) of the law at the DOF vector x: ``K`` for the linear
+        law, the consistent tangent of the tension-field law otherwise. By the positive
+        homogeneity of the small-strain tension-field law (Euler: D(eps) eps = sigma(eps)),
+        K_t(x) x equals the internal force at x."""
+        if self.law.name == "svk":
+            return self.K
+        return self._internal(np.asarray(x, dtype=float))[1]
+
     def _nonlinear_distributed(self, x, mu, delta):
         """Newton on the bordered system [f(x) - C^T mu, s (C x - delta)] = 0 from the linear
         solution (x, mu) (nonlinear law, distributed attachment)."""
