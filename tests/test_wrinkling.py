@@ -142,3 +142,19 @@ def test_com_basis_about_the_tension_field_prestress():
     svk = build_membrane_basis(s, delta0=d0, n_modes=5)
     t2 = svk.tau
     assert (0.5 * (t2[0] + t2[1]) - np.hypot(0.5 * (t2[0] - t2[1]), t2[2])).min() < 0
+
+
+def test_design_field_carries_membrane_states():
+    from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.post.fields import placed_membrane_field
+    s = load_preset("1-4")
+    d = design_equilibrium(s, membrane_law="tension-field")
+    mf = placed_membrane_field(s, d.membrane_model, d.membrane)
+    st, dr = mf.cell_data["membrane_state"], mf.cell_data["wrinkle_direction"]
+    w = st == 1
+    assert w.any() and (st == 0).any()
+    nrm = np.linalg.norm(dr, axis=1)
+    # unit where any Gauss point is wrinkled (always in a wrinkled element), zero elsewhere
+    assert np.allclose(nrm[w], 1.0) and np.all((nrm == 0.0) | np.isclose(nrm, 1.0))
+    # the direction lies in the membrane plane (normal to the inertial z of a level membrane)
+    assert np.abs(dr[w, 2]).max() < 1e-9

@@ -41,7 +41,7 @@ import scipy.sparse as sp
 from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler, element_dofs
 from tmfem.fem.plane_stress import principal_stresses, von_mises
-from tmfem.fem.tension_field import STATE_NAMES, WRINKLED, membrane_law
+from tmfem.fem.tension_field import element_wrinkling, membrane_law
 from tmfem.mesh.polygon import MembraneMesh
 from tmfem.system.materials import MembraneMaterial
 
@@ -240,20 +240,7 @@ class MembraneTL:
         With the SVK law these are the states the membrane would take if it could wrinkle.
         """
         _, Eg = self.strain(x)
-        sq = self.law.state(Eg)
-        counts = np.stack([(sq == k).sum(axis=1) for k in range(3)])       # (3, ne)
-        state = (2 - np.argmax(counts[::-1], axis=0)).astype(np.int8)
-        n = self.law.tension_direction(Eg)
-        w = sq == WRINKLED
-        c2 = np.sum(np.where(w, n[0]**2 - n[1]**2, 0.0), axis=1)
-        s2 = np.sum(np.where(w, 2 * n[0] * n[1], 0.0), axis=1)
-        th = 0.5 * np.arctan2(s2, c2)
-        any_w = w.any(axis=1)
-        direction = np.stack([np.where(any_w, np.cos(th), 0.0), np.where(any_w, np.sin(th), 0.0),
-                              np.zeros_like(th)])
-        fractions = counts.sum(axis=1) / sq.size
-        return {"state": state, "direction": direction, "state_qp": sq,
-                "fractions": dict(zip(STATE_NAMES, fractions.tolist()))}
+        return element_wrinkling(self.law, Eg)
 
     # ------------------------------------------------------------------ residual/tangent
     def internal(self, x, *, tangent: bool = True):

@@ -44,7 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError, SlackMembrane
-from tmfem.fem.tension_field import membrane_law
+from tmfem.fem.tension_field import element_wrinkling, membrane_law
 from tmfem.fem.attachment import (ATTACHMENTS, attachment_weights, coupling_matrix,
                                   default_patch_radius)
 from tmfem.mesh import MembraneMesh, polygon_quad_mesh
@@ -356,6 +356,13 @@ class PlaneStressMembrane:
             return h * np.einsum("v...,vw...,w...->...", vv, w["D"], vu)
 
         return f, asm(stiffness, self.basis, D=np.ascontiguousarray(D)).tocsr()
+
+    def wrinkling(self, x: np.ndarray) -> dict:
+        """Element states (taut / wrinkled / slack) and tension directions of the law's
+        criterion on the small strain of DOF vector x
+        (:func:`tmfem.fem.tension_field.element_wrinkling`)."""
+        g = np.array(self.basis.interpolate(x).grad)
+        return element_wrinkling(self.law, 0.5 * (g + np.swapaxes(g, 0, 1)))
 
     def tangent(self, x: np.ndarray) -> sp.csr_matrix:
         """Stiffness (thickness included) of the law at the DOF vector x: ``K`` for the linear

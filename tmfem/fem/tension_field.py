@@ -222,3 +222,25 @@ def check_law_name(law) -> str:
     if law not in MEMBRANE_LAWS:
         raise InputError(f"membrane law: expected one of {MEMBRANE_LAWS}, found {law!r}")
     return law
+
+
+def element_wrinkling(law: MembraneLaw, E: np.ndarray) -> dict:
+    """Element states and tension directions from the strain E (2, 2, ne, nqp) at the Gauss
+    points: ``state`` (ne,) int8, the state of most of the element's points (ties to the more
+    relaxed state); ``direction`` (3, ne), the tension (wrinkle-crest) direction in the
+    reference plane, the mean of the doubled angles over the element's wrinkled points, zero
+    where none is wrinkled; ``state_qp`` (ne, nqp); ``fractions`` of points per state."""
+    sq = law.state(E)
+    counts = np.stack([(sq == k).sum(axis=1) for k in range(3)])       # (3, ne)
+    state = (2 - np.argmax(counts[::-1], axis=0)).astype(np.int8)
+    n = law.tension_direction(E)
+    w = sq == WRINKLED
+    c2 = np.sum(np.where(w, n[0]**2 - n[1]**2, 0.0), axis=1)
+    s2 = np.sum(np.where(w, 2 * n[0] * n[1], 0.0), axis=1)
+    th = 0.5 * np.arctan2(s2, c2)
+    any_w = w.any(axis=1)
+    direction = np.stack([np.where(any_w, np.cos(th), 0.0), np.where(any_w, np.sin(th), 0.0),
+                          np.zeros_like(th)])
+    fractions = counts.sum(axis=1) / sq.size
+    return {"state": state, "direction": direction, "state_qp": sq,
+            "fractions": dict(zip(STATE_NAMES, fractions.tolist()))}
