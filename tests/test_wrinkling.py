@@ -158,3 +158,10 @@ def test_design_field_carries_membrane_states():
     assert np.allclose(nrm[w], 1.0) and np.all((nrm == 0.0) | np.isclose(nrm, 1.0))
     # the direction lies in the membrane plane (normal to the inertial z of a level membrane)
     assert np.abs(dr[w, 2]).max() < 1e-9
+
+
+def test_com_cli_takes_the_membrane_law(capsys):
+    rc = main(["modal", "--model", "com", "--preset", "1-4", "--membrane-law", "tension-field",
+               "--modes", "3", "--json"])
+    doc = json.loads(capsys.readouterr().out)
+    assert rc == 0 and doc["membrane_law"] == "tension-field" and len(doc["freq_hz"]) == 3

@@ -42,7 +42,8 @@ def run(args) -> dict:
         from tmfem.reference.com_modal import modal_summary
         system, options = model_options_from_args(args, NAME)
         return modal_summary(system, modes=args.modes, membrane_modes=options["membrane_modes"],
-                             prestress_scale=options["prestress_scale"], mesh_n=options["mesh"])
+                             prestress_scale=options["prestress_scale"], mesh_n=options["mesh"],
+                             membrane_law=options["membrane_law"])
     from tmfem.reference.tables import FREQUENCIES
     from tmfem.models.mtc.post import static_summary
     from tmfem.post.mtc import model_cells
