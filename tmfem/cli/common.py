@@ -92,6 +92,15 @@ def add_attachment_args(parser) -> None:
                              "--mesh 5 fails, --mesh 10 equals point; use --mesh >= 20)")
 
 
+def add_membrane_law_arg(parser) -> None:
+    """``--membrane-law``: membrane law of the plane-stress FE (``equilibrium``, ``study``) and
+    of the MTC model (``converge``; the registry's option for ``static``/``modal``/``vibrate``)."""
+    from tmfem.fem.tension_field import MEMBRANE_LAWS
+    parser.add_argument("--membrane-law", choices=MEMBRANE_LAWS, default="svk",
+                        help="membrane law: St.Venant-Kirchhoff (svk, default, eq. 4.9/5.8) or "
+                             "tension-field (wrinkling; docs/wrinkling.md)")
+
+
 def parse_perturbation(items, names) -> dict:
     """``["theta_11_dot=0.01", ...]`` -> {name: value}; names must be states of the model."""
     out = {}

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import csv
 
-from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
+from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
+                              system_from_args)
 from tmfem.errors import InputError
 from tmfem.models.mtc.spec import apply_rest_lengths
 from tmfem.post.convergence import plot_convergence_study
@@ -35,6 +36,7 @@ def configure(parser) -> None:
                         help="comma-separated numbers of truss elements per tendon")
     parser.add_argument("--modes", type=int, default=12)
     add_attachment_args(parser)
+    add_membrane_law_arg(parser)
     parser.add_argument("--rest-lengths", default=None,
                         help="fixed rest lengths (system/design, evaluated once, or GROUP=VALUE "
                              "pairs such as S1=1.5025) or the design-consistent ones recomputed "
@@ -55,7 +57,8 @@ def run(args) -> dict:
             fh = open(args.csv, "w", newline="")
         for row in convergence_rows(system, meshes=meshes, tendon_elements=tendons,
                                     attachment=args.attachment, rest_lengths=rest,
-                                    modes=args.modes, patch=args.patch, backend=args.backend):
+                                    modes=args.modes, patch=args.patch, backend=args.backend,
+                                    membrane_law=args.membrane_law):
             rows.append(row)
             if fh is not None:
                 if writer is None:
@@ -67,7 +70,8 @@ def run(args) -> dict:
     finally:
         if fh is not None:
             fh.close()
-    out = {"system": system.name, "attachment": args.attachment, "rows": rows}
+    out = {"system": system.name, "attachment": args.attachment,
+           "membrane_law": args.membrane_law, "rows": rows}
     if len(meshes) >= 3 and len(tendons) == 1:
         out["fit"] = fit_convergence(rows, modes=args.modes)
     elif len(tendons) >= 2 and len(meshes) == 1:
@@ -90,7 +94,8 @@ def format_text(r: dict) -> str:
     nf = sum(1 for k in rows[0] if k.startswith("f") and k[1:].isdigit())
     head = f"{'n':>3s} {'k':>2s} {'elem':>6s} {'dofs':>7s} {'Delta mm':>9s} {'sp1 MPa':>8s} {'vm MPa':>8s} " \
            + " ".join(f"{'f' + str(i + 1):>7s}" for i in range(nf))
-    lines = [f"{r['system']} MTC convergence, {r['attachment']} attachment", head]
+    lines = [f"{r['system']} MTC convergence, {r['attachment']} attachment, "
+             f"{r.get('membrane_law', 'svk')} membrane", head]
     for w in rows:
         lines.append(f"{w['mesh_n']:3d} {w['tendon_elements']:2d} {w['elements']:6d} {w['dofs']:7d} "
                      f"{w['Delta_mm']:9.4f} {w['sigma_p1_max_MPa']:8.3f} {w['von_mises_max_MPa']:8.3f} "

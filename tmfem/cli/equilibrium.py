@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
+from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
+                              system_from_args)
 from tmfem.errors import InputError
 
 NAME = "equilibrium"
@@ -24,10 +25,11 @@ def configure(parser) -> None:
     parser.add_argument("--allow-infeasible", action="store_true",
                         help="print the design even when an equilibrium condition is violated")
     add_attachment_args(parser)
+    add_membrane_law_arg(parser)
 
 
 def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point",
-                  patch: float | None = None) -> tuple[dict, object]:
+                  patch: float | None = None, membrane_law: str = "svk") -> tuple[dict, object]:
     """Run the design and return (JSON-able result, EquilibriumDesign)."""
     from tmfem.equilibrium.design import design_equilibrium
 
@@ -37,10 +39,11 @@ def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point
         raise InputError(f"--patch: expected only with --attachment distributed, found "
                          f"--attachment {attachment}")
     d = design_equilibrium(system, mesh_n=mesh_n, strict=strict, attachment=attachment,
-                           patch=patch)
+                           patch=patch, membrane_law=membrane_law)
     out = d.to_dict()
     out["mesh_n"] = mesh_n
     out["attachment"] = attachment
+    out["membrane_law"] = membrane_law
     out["patch"] = d.membrane_model.patch
     out["node_labels"] = list(system.node_labels)
     out["printed"] = dict(system.printed)
@@ -58,7 +61,8 @@ def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point
 def run(args) -> dict:
     system = system_from_args(args)
     out, _ = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible,
-                           attachment=args.attachment, patch=args.patch)
+                           attachment=args.attachment, patch=args.patch,
+                              membrane_law=args.membrane_law)
     out["as_printed"] = bool(args.as_printed)
     return out
 
@@ -75,7 +79,9 @@ def format_text(r: dict) -> str:
     L = [f"system {r['system']} ({r['M']}-{r['N']}{'(D)' if r['deployable'] else ''}), "
          f"membrane mesh {r['mesh_n']}x{r['mesh_n']} per patch"
          + (f", distributed corners (patch radius {r['patch']:.4g} m)"
-            if r.get("attachment") == "distributed" else ", point corners") + ": "
+            if r.get("attachment") == "distributed" else ", point corners")
+         + (f", {r['membrane_law']} membrane law" if r.get("membrane_law", "svk") != "svk" else "")
+         + ": "
          + ("all checks passed" if r["ok"] else "CHECKS FAILED")]
     L.append("")
     L.append("nodes [m]:")

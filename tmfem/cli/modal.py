@@ -42,7 +42,8 @@ def run(args) -> dict:
         from tmfem.reference.com_modal import modal_summary
         system, options = model_options_from_args(args, NAME)
         return modal_summary(system, modes=args.modes, membrane_modes=options["membrane_modes"],
-                             prestress_scale=options["prestress_scale"], mesh_n=options["mesh"])
+                             prestress_scale=options["prestress_scale"], mesh_n=options["mesh"],
+                             membrane_law=options["membrane_law"])
     from tmfem.reference.tables import FREQUENCIES
     from tmfem.models.mtc.post import static_summary
     from tmfem.post.mtc import model_cells
@@ -54,7 +55,7 @@ def run(args) -> dict:
     st = static_summary(model, res.x, result=res)
     out = {"system": system_name, "model": "mtc", "dofs": model.ndof, "mesh_n": options["mesh"],
            "tendon_elements": options["tendon_elements"], "attachment": options["attachment"],
-           "rest_lengths_source": model.rest_lengths_source,
+           "membrane_law": model.membrane_law, "rest_lengths_source": model.rest_lengths_source,
            "rest_lengths": st["rest_lengths"], "static_iterations": res.iterations,
            "tendon_stress_max": st["tendon_stress_max"], "bar_load_max": st["bar_load_max"],
            "Delta_mean": float(np.mean(st["Delta"])),
@@ -83,7 +84,8 @@ def format_text(r: dict) -> str:
         from tmfem.reference.com_modal import format_summary
         return format_summary(r)
     lines = [f"MTC modes of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
-             f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",
+             f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
+             f"membrane, {r['dofs']} free dofs",
              f"prestress: rest lengths ({r['rest_lengths_source']}) "
              + ", ".join(f"{k}={v:.5f}" for k, v in list(r["rest_lengths"].items())[:4])
              + f"; max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, bar load "

@@ -23,6 +23,8 @@ def configure(parser) -> None:
     parser.add_argument("--png", help="render the equilibrium to this PNG")
     parser.add_argument("--stress-plot", help="PNG maps of the membrane stresses in the floating "
                                               "frame (Figs. 6.3-6.4)")
+    parser.add_argument("--wrinkle-plot", help="PNG map of the membrane states (taut / wrinkled / "
+                                               "slack) and tension directions (docs/wrinkling.md)")
     parser.add_argument("--progress", action="store_true", help="iteration progress on stderr")
 
 
@@ -63,6 +65,9 @@ def write_outputs(args, model, x, summary) -> None:
         from tmfem.post.mtc import plot_membrane_stress
         summary["stress_plot"] = str(plot_membrane_stress(
             args.stress_plot, model, x, title=f"{model.system.name} MTC membrane stresses (O_f frame)"))
+    if args.wrinkle_plot:
+        from tmfem.post.mtc import plot_wrinkling
+        summary["wrinkle_plot"] = str(plot_wrinkling(args.wrinkle_plot, model, x))
     if not (args.vtk or args.png):
         return
     system = model.system
@@ -94,7 +99,8 @@ def run(args) -> dict:
 def format_text(r: dict) -> str:
     pr = r.get("printed", {})
     lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
-             f"elements/tendon, {r['attachment']} attachment, {r['dofs']} free dofs",
+             f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
+             f"membrane, {r['dofs']} free dofs",
              f"rest lengths ({r['rest_lengths_source']}): "
              + ", ".join(f"{k}={v:.5f}" for k, v in list(r["rest_lengths"].items())[:8])
              + (" ..." if len(r["rest_lengths"]) > 8 else ""),
@@ -133,7 +139,7 @@ def format_text(r: dict) -> str:
     for c in r["checks"]:
         lines.append(f"check {c['check']:36s} {'ok' if c['ok'] else 'VIOLATED'}  "
                      f"({c['value']:.4g} vs {c['limit']:.4g}, eq. {c['equation']})")
-    for k in ("vtk", "png", "stress_plot"):
+    for k in ("vtk", "png", "stress_plot", "wrinkle_plot"):
         if k in r:
             lines.append(f"wrote {r[k]}")
     return "\n".join(lines)

@@ -26,7 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.cli import _json_default
-from tmfem.cli.common import add_attachment_args, add_system_args, system_from_args
+from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
+                              system_from_args)
 from tmfem.errors import InputError
 
 NAME = "study"
@@ -46,6 +47,7 @@ def configure(parser) -> None:
                              "(default 13; 0 = no map)")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render")
     add_attachment_args(parser)
+    add_membrane_law_arg(parser)
 
 
 def _progress(msg: str) -> None:
@@ -234,7 +236,8 @@ def run(args) -> dict:
         raise InputError(f"--out: cannot create directory {out}: {exc}") from None
     _progress(f"equilibrium design of {system.name} (membrane mesh {args.mesh}x{args.mesh})")
     result, d = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible,
-                              attachment=args.attachment, patch=args.patch)
+                              attachment=args.attachment, patch=args.patch,
+                              membrane_law=args.membrane_law)
     files = {}
     _progress("tables")
     tables = write_tables(out, d, system)

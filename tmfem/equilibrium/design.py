@@ -162,14 +162,16 @@ def _finite(v):
 
 # ---------------------------------------------------------------------------- pieces
 def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembrane | None = None,
-                   attachment: str = "point", patch: float | None = None, backend="scipy"):
+                   attachment: str = "point", patch: float | None = None, backend="scipy",
+                   membrane_law: str = "svk"):
     """Corner displacements (eq. 3.5) and the plane-stress membrane solution for them.
 
     ``attachment``/``patch``: corner attachment of :class:`PlaneStressMembrane` (``"point"``,
     the dissertation's model, or ``"distributed"``; default patch radius that of
     :class:`PlaneStressMembrane`, 10 % of the membrane's circumradius r_mb, as in the MTC
-    model). ``backend``: the linear-algebra backend of its solves. The three are those of
-    ``model`` when it is given.
+    model). ``backend``: the linear-algebra backend of its solves. ``membrane_law``:
+    plane-stress law (``"svk"``, eq. 5.8, or ``"tension-field"``, :mod:`tmfem.fem.tension_field`).
+    These are those of ``model`` when it is given.
 
     Returns
     -------
@@ -179,7 +181,8 @@ def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembra
     E = equilibrium_matrix(system, q)
     if model is None:
         model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane,
-                                    n=mesh_n, attachment=attachment, patch=patch, backend=backend)
+                                    n=mesh_n, attachment=attachment, patch=patch, backend=backend,
+                                    law=membrane_law)
     sol = model.solve(E.state.delta[:2])
     return E, model, sol
 
@@ -314,7 +317,8 @@ def _radial_delta(system, delta: np.ndarray) -> float | None:
 
 def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
                        residual_tol: float = 1e-3, attachment: str = "point",
-                       patch: float | None = None, backend="scipy") -> EquilibriumDesign:
+                       patch: float | None = None, backend="scipy",
+                       membrane_law: str = "svk") -> EquilibriumDesign:
     """Design the prestress of ``system`` at configuration q (dissertation 3.2, 6.2).
 
     Parameters
@@ -341,10 +345,13 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
         Patch radius [m] of the distributed attachment (default 10 % of r_mb).
     backend : str or Backend
         Linear-algebra backend of the plane-stress solves (:func:`tmfem.solvers.get_backend`).
+    membrane_law : {"svk", "tension-field"}
+        Plane-stress law of the membrane (eq. 5.8 or the tension-field law of
+        :mod:`tmfem.fem.tension_field`; docs/wrinkling.md).
     """
     q = system.q if q is None else np.asarray(q, dtype=float)
     E, model, sol = membrane_state(system, q, mesh_n=mesh_n, attachment=attachment, patch=patch,
-                                   backend=backend)
+                                   backend=backend, membrane_law=membrane_law)
     st = E.state
     N = system.N
     checks: list[Check] = []

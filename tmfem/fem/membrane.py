@@ -8,15 +8,17 @@ eq. 4.8 are its columns. The in-plane Green-Lagrange strain (eq. 4.7) is
 
     E = (F^T F - I) / 2                          (2 x 2),
 
-the plane-stress St.Venant-Kirchhoff law (eq. 4.9 with the isotropic plane-stress
-constitutive tensor) gives the second Piola-Kirchhoff stress
+a membrane law (:mod:`tmfem.fem.tension_field`) gives the second Piola-Kirchhoff stress S(E)
+and its material tangent D = dS/dE: by default the plane-stress St.Venant-Kirchhoff law
+(eq. 4.9 with the isotropic plane-stress constitutive tensor),
 
     S = lam tr(E) I + 2 mu E,   lam = E_mod nu / (1 - nu^2),   mu = E_mod / (2 (1 + nu)),
 
-and the linearised virtual work of eq. 4.4 gives the internal force and tangent
+or, with ``law="tension-field"``, the relaxed (wrinkling) law of that module. The linearised
+virtual work of eq. 4.4 gives the internal force and tangent
 
     f(v)      = h int  (F S) : grad v  dA,
-    K(du, v)  = h int  sym(F^T grad du) : C : sym(F^T grad v)      (material, K_L)
+    K(du, v)  = h int  sym(F^T grad du) : D : sym(F^T grad v)      (material, K_L)
               + h int  S : (grad du^T grad v)  dA                  (initial stress, K_NL).
 
 There is no bending or transverse-shear stiffness (assumption a of 4.4). Both forms are
@@ -39,6 +41,7 @@ import scipy.sparse as sp
 from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler, element_dofs
 from tmfem.fem.plane_stress import principal_stresses, von_mises
+from tmfem.fem.tension_field import element_wrinkling, membrane_law
 from tmfem.mesh.polygon import MembraneMesh
 from tmfem.system.materials import MembraneMaterial
 
@@ -55,15 +58,14 @@ def _forms():
 
     @BilinearForm
     def tangent(du, v, w):
-        F, S, lam, mu2, h = w["F"], w["S"], w["lam"], w["mu2"], w["h"]
+        F, S, D, h = w["F"], w["S"], w["D"], w["h"]
         gu, gv = grad(du), grad(v)
         au = np.einsum("ia...,ib...->ab...", F, gu)
         av = np.einsum("ia...,ib...->ab...", F, gv)
-        eu = 0.5 * (au + np.swapaxes(au, 0, 1))
-        ev = 0.5 * (av + np.swapaxes(av, 0, 1))
-        tru = eu[0, 0] + eu[1, 1]
-        trv = ev[0, 0] + ev[1, 1]
-        material = lam * tru * trv + mu2 * np.einsum("ab...,ab...->...", eu, ev)
+        # Voigt strain variations [dE11, dE22, 2 dE12]
+        eu = np.stack([au[0, 0], au[1, 1], au[0, 1] + au[1, 0]])
+        ev = np.stack([av[0, 0], av[1, 1], av[0, 1] + av[1, 0]])
+        material = np.einsum("v...,vw...,w...->...", ev, D, eu)
         geometric = np.einsum("ab...,ib...,ia...->...", S, gu, gv)
         return h * (material + geometric)
 
@@ -143,6 +145,8 @@ class MembraneTL:
         Flat reference mesh; ``mesh.p`` (2, nn) are the reference coordinates.
     material : MembraneMaterial
         E, nu, rho, h.
+    law : {"svk", "tension-field"} or MembraneLaw
+        Membrane law S(E), D = dS/dE (:mod:`tmfem.fem.tension_field`; default "svk", eq. 4.9).
 
     Attributes
     ----------
@@ -153,7 +157,7 @@ class MembraneTL:
         node-interleaved (dof = 3 node + component), as everywhere in tmfem.
     """
 
-    def __init__(self, *, mesh: MembraneMesh, material: MembraneMaterial):
+    def __init__(self, *, mesh: MembraneMesh, material: MembraneMaterial, law="svk"):
         from skfem import Basis, ElementQuad1, ElementVector
 
         p = np.asarray(mesh.p, dtype=float)
@@ -178,9 +182,7 @@ class MembraneTL:
         self.nn = p.shape[1]
         self.ndof = 3 * self.nn
         self.X = np.vstack([p, np.zeros((1, self.nn))])
-        E, nu = material.E, material.nu
-        self.lam = E * nu / (1.0 - nu**2)       # plane-stress Lame constant
-        self.mu2 = E / (1.0 + nu)               # 2 mu
+        self.law = membrane_law(law, material)
         self._residual, self._tangent, self._mass = _forms()
         self._M = None
         sb = Basis(self.skmesh, ElementQuad1(), intorder=3)
@@ -198,9 +200,9 @@ class MembraneTL:
                              f"found {x.shape}")
         return x
 
-    def kinematics(self, x):
-        """Deformation gradient F (3, 2, ne, nqp), Green-Lagrange E (2, 2, ...) and 2nd PK S
-        (2, 2, ...) at the Gauss points (eqs. 4.7, 4.9)."""
+    def strain(self, x):
+        """Deformation gradient F (3, 2, ne, nqp) and Green-Lagrange strain E (2, 2, ...) at
+        the Gauss points (eq. 4.7)."""
         x = self._check_x(x)
         u = (x - self.X).T.ravel()
         F = np.array(self.basis.interpolate(u).grad)
@@ -210,19 +212,35 @@ class MembraneTL:
         Eg = 0.5 * C
         Eg[0, 0] -= 0.5
         Eg[1, 1] -= 0.5
-        tr = Eg[0, 0] + Eg[1, 1]
-        S = 0.5 * self.mu2 * 2.0 * Eg
-        S[0, 0] += self.lam * tr
-        S[1, 1] += self.lam * tr
+        return F, Eg
+
+    def kinematics(self, x):
+        """Deformation gradient F (3, 2, ne, nqp), Green-Lagrange E (2, 2, ...) and 2nd PK S
+        (2, 2, ...) of the membrane law at the Gauss points (eqs. 4.7, 4.9)."""
+        F, Eg = self.strain(x)
+        S, _ = self.law.stress(Eg, tangent=False)
         return F, Eg, S
 
     def strain_energy(self, x) -> float:
-        """Strain energy [J] at current positions x (3, nn): h int (lam tr(E)^2 / 2 + mu E:E) dA,
-        the potential of the plane-stress St.Venant-Kirchhoff law (eq. 4.9)."""
-        _, Eg, _ = self.kinematics(x)
-        tr = Eg[0, 0] + Eg[1, 1]
-        dens = 0.5 * self.lam * tr**2 + 0.5 * self.mu2 * np.einsum("ab...,ab...->...", Eg, Eg)
+        """Strain energy [J] at current positions x (3, nn): h int W(E) dA with the law's
+        energy density (SVK: lam tr(E)^2 / 2 + mu E:E, the potential of eq. 4.9)."""
+        _, Eg = self.strain(x)
+        dens = self.law.energy_density(Eg)
         return self.material.h * float(np.sum(dens * np.asarray(self.basis.dx)))
+
+    def wrinkling(self, x) -> dict:
+        """State of each element under the mixed criterion of the law
+        (:meth:`tmfem.fem.tension_field.MembraneLaw.state`) at current positions x (3, nn).
+
+        Returns ``state`` (ne,) int8: the state (0 taut, 1 wrinkled, 2 slack) of most of the
+        element's Gauss points (ties to the more relaxed state); ``fractions`` (3,) of Gauss
+        points taut/wrinkled/slack; ``direction`` (3, ne): the tension (wrinkle-crest)
+        direction in the reference plane (x_f, y_f, 0), the mean of the doubled angles over the
+        element's wrinkled Gauss points, zero where none is wrinkled; ``state_qp`` (ne, nqp).
+        With the SVK law these are the states the membrane would take if it could wrinkle.
+        """
+        _, Eg = self.strain(x)
+        return element_wrinkling(self.law, Eg)
 
     # ------------------------------------------------------------------ residual/tangent
     def internal(self, x, *, tangent: bool = True):
@@ -241,7 +259,8 @@ class MembraneTL:
         Vectorised B-matrix kernel of eqs. 4.4-4.6: the variation of the Green-Lagrange strain
         of node k, component i is (Voigt) B = [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1].
         """
-        F, _, S = self.kinematics(x)
+        F, Eg = self.strain(x)
+        S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
         dN, dx = self._dN, self._dx
         P = h * np.einsum("ia...,ab...->ib...", F, S)                 # (3, 2, ne, nqp)
@@ -252,10 +271,8 @@ class MembraneTL:
         B[:, :, 0] = F[None, :, 0] * dN[:, None, 0]
         B[:, :, 1] = F[None, :, 1] * dN[:, None, 1]
         B[:, :, 2] = F[None, :, 0] * dN[:, None, 1] + F[None, :, 1] * dN[:, None, 0]
-        lam, mu = self.lam, 0.5 * self.mu2
-        D = np.array([[lam + 2 * mu, lam, 0.0], [lam, lam + 2 * mu, 0.0], [0.0, 0.0, mu]])
         hdx = h * dx
-        DB = np.einsum("vw,kiweq->kiveq", D, B)
+        DB = np.einsum("vweq,kiweq->kiveq", D, B)
         Km = np.einsum("kiveq,ljveq,eq->ekilj", B, DB, hdx, optimize=True)
         # initial-stress part: delta_ij N_k,a S_ab N_l,b
         g = np.einsum("kaeq,abeq,lbeq,eq->ekl", dN, S, dN, hdx, optimize=True)
@@ -264,13 +281,14 @@ class MembraneTL:
 
     def internal_forms(self, x, *, tangent: bool = True):
         """Same as :meth:`internal`, assembled with the scikit-fem forms (reference)."""
-        F, _, S = self.kinematics(x)
+        F, Eg = self.strain(x)
+        S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
         P = h * np.einsum("ia...,ab...->ib...", F, S)
         f = self._residual.assemble(self.basis, P=P)
         if not tangent:
             return f, None
-        K = self._tangent.assemble(self.basis, F=F, S=S, lam=self.lam, mu2=self.mu2, h=h)
+        K = self._tangent.assemble(self.basis, F=F, S=S, D=np.ascontiguousarray(D), h=h)
         return f, K.tocsr()
 
     def mass(self) -> sp.csr_matrix:
@@ -289,7 +307,8 @@ class MembraneTL:
 
         The Cauchy stress is sigma = F S F^T / J with J = j lambda_3, j = sqrt(det F^T F) the
         area ratio and lambda_3 = sqrt(1 + 2 E_33), E_33 = -nu/(1-nu) (E_11 + E_22) the
-        thickness stretch of plane-stress SVK. It is reported in the reference axes rotated with
+        thickness stretch of plane-stress SVK (used with either law: with the tension-field law
+        it differs from the wrinkled state's by a relative O(strain)). It is reported in the reference axes rotated with
         the material, R^T sigma R = U S U / J with U = sqrt(F^T F).
         """
         F, Eg, S = self.kinematics(x)

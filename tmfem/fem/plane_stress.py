@@ -24,6 +24,11 @@ corners grow without bound as the mesh is refined. The corner force F_Delta of e
 and the maximum stresses of Tables 6.3 and 6.5 are therefore properties of the mesh
 (4 x 10 x 10 in 6.2), not of the continuum; see tests/test_plane_stress.py.
 
+``law="tension-field"`` replaces eq. 5.8 by the tension-field (wrinkling) law of
+:mod:`tmfem.fem.tension_field` applied to the small strain eps: the problem is then
+nonlinear (piecewise linear, positively homogeneous in the corner displacements) and is solved
+by Newton's method (:func:`tmfem.solvers.newton.newton`) from the linear solution.
+
 ``attachment="distributed"`` removes the singularity: each corner displacement is imposed
 on a small patch around the corner through the kinematic (RBE3-type, affine-fit) coupling of
 :func:`tmfem.fem.attachment.attachment_weights` (the one of the MTC model), sum_i w_i u_i =
@@ -39,11 +44,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError, SlackMembrane
+from tmfem.fem.tension_field import element_wrinkling, membrane_law
 from tmfem.fem.attachment import (ATTACHMENTS, attachment_weights, coupling_matrix,
                                   default_patch_radius)
 from tmfem.mesh import MembraneMesh, polygon_quad_mesh
 from tmfem.system.geometry import beta
 from tmfem.solvers.backends import get_backend
+from tmfem.solvers.newton import newton
 from tmfem.system.materials import MembraneMaterial
 
 
@@ -183,10 +190,14 @@ class PlaneStressMembrane:
     patch : float, optional
         Patch radius [m] of the distributed attachment; default 10 % of the corner polygon's
         circumradius (:func:`tmfem.fem.attachment.default_patch_radius`).
+    law : {"svk", "tension-field"}
+        Plane-stress law: linear elastic (eq. 5.8, default) or the tension-field law of
+        :mod:`tmfem.fem.tension_field` on the small strain (nonlinear solve).
     """
 
     def __init__(self, *, corners, material: MembraneMaterial, n: int = 10,
-                 attachment: str = "point", patch: float | None = None, backend="scipy"):
+                 attachment: str = "point", patch: float | None = None, backend="scipy",
+                 law: str = "svk"):
         from skfem import Basis, ElementQuad1, ElementVector
 
         if not isinstance(material, MembraneMaterial):
@@ -195,6 +206,7 @@ class PlaneStressMembrane:
             raise InputError(f"attachment: expected one of {ATTACHMENTS}, found {attachment!r}")
         self.material = material
         self.backend = get_backend(backend)
+        self.law = membrane_law(law, material)
         self.mesh: MembraneMesh = polygon_quad_mesh(corners, n)
         self.corners = self.mesh.p[:, self.mesh.corners].copy()
         self.N = self.corners.shape[1]
@@ -271,7 +283,12 @@ class PlaneStressMembrane:
         S = K_cc - K_ci K_ii^{-1} K_ic. Distributed: the corner forces (Lagrange multipliers)
         for unit corner displacements imposed through the coupling C. Either way symmetric
         positive semidefinite with the three in-plane rigid motions as its null space.
+        Linear law only (the tension-field law has no constant corner stiffness).
         """
+        if self.law.name != "svk":
+            raise InputError(f"corner_stiffness: expected the linear law 'svk', found "
+                             f"{self.law.name!r} (its corner forces are nonlinear in the corner "
+                             "displacements; use solve())")
         if self.attachment == "distributed":
             _, S = self._solve_distributed(np.eye(2 * self.N))
             return 0.5 * (S + S.T)
@@ -294,17 +311,93 @@ class PlaneStressMembrane:
                              f"entries, found shape {delta.shape}")
         if self.attachment == "distributed":
             x, mu = self._solve_distributed(delta.T.reshape(-1, 1))
-            return x[:, 0], mu[:, 0].reshape(self.N, 2).T
+            x, mu = x[:, 0], mu[:, 0]
+            if self.law.name != "svk":
+                x, mu = self._nonlinear_distributed(x, mu, delta)
+            return x, mu.reshape(self.N, 2).T
         x = np.zeros(self.basis.N)
         c, I = self.corner_dofs, self.interior_dofs
         x[c] = delta.T.ravel()
         x[I] = -self._interior_solve(self.K[I][:, c] @ x[c])
-        f = self.K @ x
+        if self.law.name != "svk":
+            free = np.zeros(self.basis.N, dtype=bool)
+            free[I] = True
+            f0 = self.K @ x
+            x = newton(lambda u: self._internal(u), x, free=free, tol=1e-10,
+                       scale=float(np.linalg.norm(f0[c])) + 1e-300, max_iter=100,
+                       backend=self.backend).u
+        f = self.K @ x if self.law.name == "svk" else self._internal(x, tangent=False)[0]
         return x, f[self.basis.nodal_dofs[:, self.mesh.corners]]
 
+    def _internal(self, x: np.ndarray, *, tangent: bool = True):
+        """Internal force h int sigma(eps(u)) : eps(v) dA and its tangent for the law (small
+        strain eps = sym grad u; eq. 5.8 for SVK)."""
+        from skfem import BilinearForm, LinearForm, asm
+        from skfem.helpers import sym_grad
+
+        g = np.array(self.basis.interpolate(x).grad)
+        eps = 0.5 * (g + np.swapaxes(g, 0, 1))
+        sig, D = self.law.stress(eps, tangent=tangent)
+        h = self.material.h
+
+        @LinearForm
+        def residual(v, w):
+            return h * np.einsum("ab...,ab...->...", w["sig"], sym_grad(v))
+
+        f = asm(residual, self.basis, sig=sig)
+        if not tangent:
+            return f, None
+
+        @BilinearForm
+        def stiffness(u, v, w):
+            eu, ev = sym_grad(u), sym_grad(v)
+            vu = np.stack([eu[0, 0], eu[1, 1], 2 * eu[0, 1]])
+            vv = np.stack([ev[0, 0], ev[1, 1], 2 * ev[0, 1]])
+            return h * np.einsum("v...,vw...,w...->...", vv, w["D"], vu)
+
+        return f, asm(stiffness, self.basis, D=np.ascontiguousarray(D)).tocsr()
+
+    def wrinkling(self, x: np.ndarray) -> dict:
+        """Element states (taut / wrinkled / slack) and tension directions of the law's
+        criterion on the small strain of DOF vector x
+        (:func:`tmfem.fem.tension_field.element_wrinkling`)."""
+        g = np.array(self.basis.interpolate(x).grad)
+        return element_wrinkling(self.law, 0.5 * (g + np.swapaxes(g, 0, 1)))
+
+    def tangent(self, x: np.ndarray) -> sp.csr_matrix:
+        """Stiffness (thickness included) of the law at the DOF vector x: ``K`` for the linear
+        law, the consistent tangent of the tension-field law otherwise. By the positive
+        homogeneity of the small-strain tension-field law (Euler: D(eps) eps = sigma(eps)),
+        K_t(x) x equals the internal force at x."""
+        if self.law.name == "svk":
+            return self.K
+        return self._internal(np.asarray(x, dtype=float))[1]
+
+    def _nonlinear_distributed(self, x, mu, delta):
+        """Newton on the bordered system [f(x) - C^T mu, s (C x - delta)] = 0 from the linear
+        solution (x, mu) (nonlinear law, distributed attachment)."""
+        _, s = self._kkt
+        C = self.coupling
+        nd = self.basis.N
+        rhs = delta.T.ravel()
+
+        def residual(w):
+            f, K = self._internal(w[:nd])
+            r = np.concatenate([f + s * (C.T @ w[nd:]), s * (C @ w[:nd] - rhs)])
+            return r, sp.bmat([[K, s * C.T], [s * C, None]], format="csr")
+
+        res = newton(residual, np.concatenate([x, -mu / s]), tol=1e-10,
+                     scale=float(np.linalg.norm(mu)) + 1e-300, max_iter=100, backend=self.backend)
+        return res.u[:nd], -s * res.u[nd:]
+
     def stresses(self, x: np.ndarray) -> np.ndarray:
-        """(s_xx, s_yy, s_xy) at the quadrature points (3, n_el, n_qp) of DOF vector x."""
-        return stress_from_grad(self.basis.interpolate(x).grad, self.material)
+        """(s_xx, s_yy, s_xy) at the quadrature points (3, n_el, n_qp) of DOF vector x (eq. 5.8,
+        or the tension-field law on the small strain)."""
+        g = np.array(self.basis.interpolate(x).grad)
+        if self.law.name == "svk":
+            return stress_from_grad(g, self.material)
+        sig, _ = self.law.stress(0.5 * (g + np.swapaxes(g, 0, 1)), tangent=False)
+        return np.stack([sig[0, 0], sig[1, 1], sig[0, 1]])
 
     def solve(self, delta) -> PlaneStressSolution:
         """Plane-stress state for corner displacements delta (2, N) in O_f."""

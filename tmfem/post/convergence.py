@@ -20,7 +20,8 @@ def plot_convergence_study(path, rows, modes, name, attachment, *, by_tendons: b
         ax[0].plot(x, F[:, i], "o-", ms=3, label=f"mode {i + 1}")
     ax[0].set_xlabel("elements per tendon" if by_tendons else "membrane elements")
     ax[0].set_ylabel("frequency [Hz]")
-    ax[0].set_title(f"{name} MTC, {attachment} attachment")
+    law = rows[0].get("membrane_law", "svk") if rows else "svk"
+    ax[0].set_title(f"{name} MTC, {attachment} attachment, {law} membrane")
     ax[0].legend(fontsize=6, ncol=2)
     for key, lab in (("sigma_p1_max_MPa", "max sigma_p1 (Gauss pt)"),
                      ("von_mises_max_MPa", "max von Mises (Gauss pt)"),

@@ -50,7 +50,9 @@ def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "poi
     -------
     MembraneField with point data ``displacement`` (inertial frame) and cell data
     ``von_mises`` and ``sigma_p1`` (element maxima over the quadrature points, as the maxima
-    of Tables 6.3 / 6.5 are taken), ``sigma_p2`` (element minimum) and ``von_mises_mean``.
+    of Tables 6.3 / 6.5 are taken), ``sigma_p2`` (element minimum), ``von_mises_mean``,
+    ``membrane_state`` (0 taut, 1 wrinkled, 2 slack) and ``wrinkle_direction`` (inertial
+    frame) of the membrane law's criterion (docs/wrinkling.md).
     """
     from tmfem.fem.plane_stress import PlaneStressMembrane
 
@@ -86,7 +88,12 @@ def placed_membrane_field(system, model, sol, *, q=None) -> MembraneField:
     x = o[:, None] + R[:, :2] @ mesh.p + u
     vm = sol.von_mises()
     pr = sol.principal()
+    dofs = np.zeros(model.basis.N)
+    dofs[model.basis.nodal_dofs] = sol.u
+    wr = model.wrinkling(dofs)
     return MembraneField(mesh=mesh, x=x, point_data={"displacement": u},
                          cell_data={"von_mises": vm.max(axis=1), "sigma_p1": pr[0].max(axis=1),
                                     "sigma_p2": pr[1].min(axis=1),
-                                    "von_mises_mean": vm.mean(axis=1)})
+                                    "von_mises_mean": vm.mean(axis=1),
+                                    "membrane_state": wr["state"].astype(np.int32),
+                                    "wrinkle_direction": R @ wr["direction"]})

@@ -52,18 +52,19 @@ def printed_bar_load_prestress_scale(model, *, mesh_n: int = 10) -> float | None
 
 
 def com_frequencies(system, *, membrane_modes: int, prestress_scale: float = 1.0,
-                    mesh_n: int = 10, rest_lengths=None):
+                    mesh_n: int = 10, rest_lengths=None, membrane_law: str = "svk"):
     """(frequencies in Hz, model) of the COM linearised about its equilibrium (eq. 5.33)."""
     if rest_lengths is None:       # the system's own (e.g. printed) if it has them
         rest_lengths = "design" if system.rest_lengths is None else "system"
     m = ControlOrientedModel(system, membrane_modes=membrane_modes, mesh_n=mesh_n,
-                             prestress_scale=prestress_scale, rest_lengths=rest_lengths)
+                             prestress_scale=prestress_scale, rest_lengths=rest_lengths,
+                             membrane_law=membrane_law)
     lin = linearize(m)
     return lin.frequencies_hz(), m
 
 
 def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
-                  prestress_scale: float = 1.0, mesh_n: int = 10) -> dict:
+                  prestress_scale: float = 1.0, mesh_n: int = 10, membrane_law: str = "svk") -> dict:
     """Natural frequencies of the COM beside Tables 6.6/6.7 (JSON-able dict).
 
     Parameters
@@ -75,17 +76,20 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
         K; default the dissertation's (5 for 1-4, 4 for 2-3).
     prestress_scale : float
         Factor on the designed membrane prestress (1 = designed, see ControlOrientedModel).
+    membrane_law : {"svk", "tension-field"}
+        Membrane basis about the linear or the tension-field prestress (docs/wrinkling.md).
     """
     K = default_membrane_modes(system) if membrane_modes is None else int(membrane_modes)
     if not (isinstance(modes, int) and modes >= 1):
         raise InputError(f"--modes: expected an integer >= 1, found {modes!r}")
     log.info("%s COM, K = %d membrane modes", system.name, K)
     f, m = com_frequencies(system, membrane_modes=K, prestress_scale=prestress_scale,
+                           membrane_law=membrane_law,
                            mesh_n=mesh_n)
     n = min(modes, len(f))
     names = system.tendon_names()
     out = {"system": system.name, "model": "com", "membrane_modes": K, "mesh_n": mesh_n,
-           "prestress_scale": prestress_scale, "sizes": m.summary(),
+           "prestress_scale": prestress_scale, "membrane_law": membrane_law, "sizes": m.summary(),
            "freq_hz": f[:n].tolist(), "highest_hz": float(f[-1]),
            "rest_lengths_source": "design" if m.design is not None else "system",
            "rest_lengths": dict(zip(names, m.u0.tolist()))}

@@ -14,7 +14,7 @@ log = logging.getLogger(__name__)
 ROW_KEYS = ("mesh_n", "tendon_elements", "attachment", "elements", "h", "dofs", "iterations",
             "static_s", "modal_s", "Delta_mm", "tendon_stress_max_MPa", "bar_load_max_N",
             "sigma_p1_max_MPa", "von_mises_max_MPa", "sigma_p1_elem_max_MPa",
-            "von_mises_elem_max_MPa")
+            "von_mises_elem_max_MPa", "membrane_law", "wrinkled_fraction", "slack_fraction")
 
 
 def resolve_rest_lengths(system, *, rest_lengths):
@@ -38,19 +38,21 @@ def resolve_rest_lengths(system, *, rest_lengths):
 
 def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "point",
                      rest_lengths=None, modes: int = 12, patch: float | None = None,
-                     progress: bool = True, backend="scipy"):
+                     progress: bool = True, backend="scipy", membrane_law: str = "svk"):
     """Yield one result row (dict) per (mesh n, tendon elements k) pair, as it is computed.
 
     Each row: mesh size, DOFs, static iterations and time, landing (Delta), peak stresses
     (Gauss-point maxima and element-mean maxima), and the frequencies ``f1 .. f<modes>`` [Hz].
-    ``h`` is the element size sqrt(area / elements).
+    ``h`` is the element size sqrt(area / elements). ``membrane_law`` selects the membrane
+    law of :class:`MTCModel`; the rows carry the fractions of wrinkled and slack Gauss points
+    (criterion of :mod:`tmfem.fem.tension_field`).
     """
     rest = resolve_rest_lengths(system, rest_lengths=rest_lengths)
     for n in meshes:
         for k in tendon_elements:
             t0 = time.perf_counter()
             m = MTCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
-                         patch=patch, rest_lengths=rest, backend=backend)
+                         patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
             res = m.solve_static(start="design")
             t1 = time.perf_counter()
             md = m.modes(res.x, k=modes)
@@ -66,7 +68,10 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
                    "sigma_p1_max_MPa": st["membrane_max_sigma_p1"] / 1e6,
                    "von_mises_max_MPa": st["membrane_max_von_mises"] / 1e6,
                    "sigma_p1_elem_max_MPa": st["membrane_max_sigma_p1_element_mean"] / 1e6,
-                   "von_mises_elem_max_MPa": st["membrane_max_von_mises_element_mean"] / 1e6}
+                   "von_mises_elem_max_MPa": st["membrane_max_von_mises_element_mean"] / 1e6,
+                   "membrane_law": m.membrane_law,
+                   "wrinkled_fraction": st["membrane_state_fractions"]["wrinkled"],
+                   "slack_fraction": st["membrane_state_fractions"]["slack"]}
             for i, f in enumerate(md.freq_hz):
                 row[f"f{i + 1}"] = float(f)
             if progress:

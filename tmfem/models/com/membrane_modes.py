@@ -121,7 +121,7 @@ def _geometric_stiffness(basis, tau: np.ndarray, h: float):
 
 
 def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
-                         prestress_scale: float = 1.0) -> MembraneBasis:
+                         prestress_scale: float = 1.0, membrane_law: str = "svk") -> MembraneBasis:
     """Static shapes, fixed-corner modes and mass invariants of the membrane (eqs. 5.1-5.8).
 
     Parameters
@@ -137,6 +137,12 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
     prestress_scale : float
         Factor on tau^s in the transverse stiffness only (for studies of the prestress the
         dissertation's printed numbers imply; 1 = designed prestress).
+    membrane_law : {"svk", "tension-field"}
+        ``"svk"``: linear plane stress (eq. 5.8), the dissertation's basis. ``"tension-field"``
+        (docs/wrinkling.md): tau^s is the tension-only prestress of the tension-field law at
+        Delta_0, and the in-plane stiffness (static shapes, S, in-plane modes) is the law's
+        consistent tangent about that state (a linearisation; S Delta_0 still equals the
+        corner forces at Delta_0 since the law is positively homogeneous).
     """
     from skfem import Basis, ElementQuad1
     from tmfem.fem.plane_stress import PlaneStressMembrane
@@ -146,7 +152,8 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
     N = system.N
     layout = ZetaLayout.for_polygon(N)
     mat = system.membrane
-    ps = PlaneStressMembrane(corners=system.membrane_corners, material=mat, n=mesh_n)
+    ps = PlaneStressMembrane(corners=system.membrane_corners, material=mat, n=mesh_n,
+                             law=membrane_law)
     nn = ps.mesh.p.shape[1]
     corners = ps.mesh.corners
     nd = ps.basis.nodal_dofs                     # (2, nn)
@@ -158,7 +165,18 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
     tau = sol0.sigma * float(prestress_scale)
     Ms = _mass_matrix(sb, mat.rho * mat.h)
     KG = _geometric_stiffness(sb, tau, mat.h)
-    Kuv = ps.K
+    Kuv = ps.tangent(ps.displacement(delta0[:2]))
+    if membrane_law == "svk":
+        inplane_shape = ps.displacement
+    else:
+        lu_uv = ps.backend.factorize(Kuv[ps.interior_dofs][:, ps.interior_dofs].tocsc())
+
+        def inplane_shape(d):
+            """Response of the tangent K_t to corner displacements d (2, N)."""
+            x = np.zeros(Kuv.shape[0])
+            x[ps.corner_dofs] = d.T.ravel()
+            x[ps.interior_dofs] = -lu_uv(Kuv[ps.interior_dofs][:, ps.corner_dofs] @ x[ps.corner_dofs])
+            return x
     # ---------------------------------------------------------------- static shapes
     free_w = np.setdiff1d(np.arange(nn), corners)
     lu_w = None
@@ -167,7 +185,7 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
         P = np.zeros((3, nn))
         if c < 2:
             d = np.zeros((2, N)); d[c, i] = 1.0
-            x = ps.displacement(d)
+            x = inplane_shape(d)
             P[:2] = x[nd]
         else:
             if lu_w is None:

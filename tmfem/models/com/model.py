@@ -87,11 +87,15 @@ class ControlOrientedModel:
     output_points : list of (x_f, y_f), optional
         Membrane points whose transverse deflection w is an output; default:
         ``system.monitor_points`` (eqs. 5.36/5.38 for the presets ``1-4`` and ``2-3``).
+    membrane_law : {"svk", "tension-field"}
+        Membrane basis about the linear (eq. 5.8) or the tension-field prestress
+        (:func:`tmfem.models.com.membrane_modes.build_membrane_basis`, docs/wrinkling.md).
     """
 
     def __init__(self, system, *, membrane_modes: int = 4, mesh_n: int = 10,
                  rest_lengths="design", damping: float = 0.0, prestress_scale: float = 1.0,
-                 membrane_points=None, formulation: str = "partitioned", output_points=None):
+                 membrane_points=None, formulation: str = "partitioned", output_points=None,
+                 membrane_law: str = "svk"):
         if formulation not in ("partitioned", "substituted"):
             raise InputError(f"formulation: expected 'partitioned' or 'substituted', found {formulation!r}")
         if not (np.isfinite(damping) and damping >= 0):
@@ -107,7 +111,8 @@ class ControlOrientedModel:
         self._check_membrane_stretched()
         self.membrane = build_membrane_basis(system, delta0=self.layout.delta_array(self.zeta0),
                                              n_modes=membrane_modes, mesh_n=mesh_n,
-                                             prestress_scale=prestress_scale)
+                                             prestress_scale=prestress_scale,
+                                             membrane_law=membrane_law)
         self.K = self.membrane.K
         self.prestress_scale = float(prestress_scale)
         self._delta0_vec = self.zeta0[: self.layout.n_delta].copy()

@@ -1,6 +1,7 @@
 """The control-oriented model in the model registry: its options and how they build it."""
 from __future__ import annotations
 
+from tmfem.fem.tension_field import MEMBRANE_LAWS
 from tmfem.models.base import ModelSpec, Option, register
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 
@@ -11,7 +12,8 @@ def build(system, options: dict, backend) -> ControlOrientedModel:
     K = options["membrane_modes"]
     return ControlOrientedModel(system, membrane_modes=default_membrane_modes(system) if K is None else K,
                                 mesh_n=options["mesh"], damping=options.get("damping", 0.0),
-                                prestress_scale=options["prestress_scale"])
+                                prestress_scale=options["prestress_scale"],
+                                membrane_law=options["membrane_law"])
 
 
 SPEC = register(ModelSpec(
@@ -24,5 +26,8 @@ SPEC = register(ModelSpec(
         Option("--prestress-scale", 1.0, None, dict(type=float, help=(
             "factor on the designed membrane prestress (1 = designed; 1.2903 gives the printed "
             "1-4 tendon stress and Table 6.6, docs/errata.md)"))),
+        Option("--membrane-law", "svk", None, dict(choices=MEMBRANE_LAWS, help=(
+            "membrane basis about the linear (svk) or the tension-field prestress "
+            "(docs/wrinkling.md)"))),
         Option("--damping", 0.0, ("vibrate",), dict(type=float, help="modal damping c_m [1/s] (eq. 5.13)")),
     )))

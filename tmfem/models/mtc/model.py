@@ -36,6 +36,7 @@ from tmfem.fem.element import State, assemble
 from tmfem.fem.membrane import MembraneElement, MembraneTL
 from tmfem.fem.truss import TrussElement, TrussSet, truss_internal
 from tmfem.models.mtc.design import consistent_rest_lengths
+from tmfem.fem.tension_field import check_law_name
 from tmfem.models.mtc.topology import MTCTopology, build_topology, membrane_placement
 from tmfem.solvers.backends import get_backend
 from tmfem.solvers.eigen import lowest_modes
@@ -97,19 +98,24 @@ class MTCModel:
     backend : str or Backend
         Linear-algebra backend of every factorisation and eigen solve (``"scipy"`` default;
         :func:`tmfem.solvers.get_backend`).
+    membrane_law : {"svk", "tension-field"}
+        Membrane law (:mod:`tmfem.fem.tension_field`): St.Venant-Kirchhoff (eq. 4.9, default)
+        or the tension-field (wrinkling) law. The prestress is the static equilibrium of this
+        model, so it passes through the same law.
     """
 
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
-                 lumped_tendon_mass: bool = False, backend="scipy"):
+                 lumped_tendon_mass: bool = False, backend="scipy", membrane_law: str = "svk"):
         self.system = system
+        self.membrane_law = check_law_name(membrane_law)
         self.backend = get_backend(backend)
         self.mesh_n, self.patch = mesh_n, patch
         self.topology: MTCTopology = build_topology(system, mesh_n=mesh_n,
                                                     tendon_elements=tendon_elements,
                                                     attachment=attachment, patch=patch)
         topo = self.topology
-        self.membrane = MembraneTL(mesh=topo.mesh, material=system.membrane)
+        self.membrane = MembraneTL(mesh=topo.mesh, material=system.membrane, law=self.membrane_law)
         self.membrane_element = MembraneElement(self.membrane, np.arange(topo.n_mesh), topo.dofmap)
         bar = system.bar
         nb = system.M * system.N
@@ -330,7 +336,8 @@ class MTCModel:
             coarse = MTCModel(self.system, mesh_n=n_coarse,
                               tendon_elements=self.topology.tendon_elements,
                               attachment=self.topology.attachment, rest_lengths=self.rest_lengths,
-                              lumped_tendon_mass=self.lumped_tendon_mass, backend=self.backend)
+                              lumped_tendon_mass=self.lumped_tendon_mass, backend=self.backend,
+                              membrane_law=self.membrane_law)
             rc = coarse.solve_static(start=start, tol=tol, max_iter=max_iter, monitor=monitor,
                                      progress=progress, sequence=sequence)
             fine = self.solve_static(x0=self.interpolate_from(coarse, rc.x), tol=tol,

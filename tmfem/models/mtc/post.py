@@ -44,10 +44,13 @@ def member_state(model, x: np.ndarray) -> dict:
 def membrane_stress_summary(model, x: np.ndarray) -> dict:
     """Membrane stresses (Cauchy, in the floating frame: reference axes rotated with the
     material) and their maxima at the Gauss points (eqs. 5.29-5.30, Tables 6.3, 6.5)."""
-    st = model.membrane.stresses(x[:, :model.topology.n_mesh])
+    xm = x[:, :model.topology.n_mesh]
+    st = model.membrane.stresses(xm)
     p1 = st.principal[0]
     vm = st.von_mises
-    return {"stresses": st,
+    wr = model.membrane.wrinkling(xm)
+    return {"stresses": st, "membrane_law": model.membrane.law.name,
+            "state_fractions": wr["fractions"],
             "max_sigma_p1": float(p1.max()), "max_von_mises": float(vm.max()),
             "min_minor_principal": float((st.principal[1] + st.principal[2]).min()),
             "wrinkled_fraction": float(np.mean(st.principal[1] + st.principal[2] < 0)),
@@ -129,6 +132,7 @@ def static_summary(model, x: np.ndarray, *, result=None) -> dict:
         "membrane_max_sigma_p1_element_mean": ss["max_sigma_p1_element_mean"],
         "membrane_min_minor_principal": ss["min_minor_principal"],
         "membrane_wrinkled_fraction": ss["wrinkled_fraction"],
+        "membrane_law": ss["membrane_law"], "membrane_state_fractions": ss["state_fractions"],
         "membrane_max_von_mises_element_mean": ss["max_von_mises_element_mean"],
         "checks": checks, "printed": dict(sysm.printed),
     }

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from tmfem.errors import InputError
+from tmfem.fem.tension_field import MEMBRANE_LAWS
 from tmfem.models.base import ModelSpec, Option, register
 from tmfem.models.mtc.model import MTCModel
 
@@ -39,7 +40,7 @@ def build(system, options: dict, backend) -> MTCModel:
     system, rest = apply_rest_lengths(system, options["rest_lengths"])
     return MTCModel(system, mesh_n=options["mesh"], tendon_elements=options["tendon_elements"],
                     attachment=options["attachment"], patch=options["patch"], rest_lengths=rest,
-                    backend=backend)
+                    backend=backend, membrane_law=options["membrane_law"])
 
 
 SPEC = register(ModelSpec(
@@ -57,6 +58,9 @@ SPEC = register(ModelSpec(
             "tendon rest lengths: 'system' (default when the system has them), 'design' (eq. 3.8), "
             "'mtc' (those that make the design an exact equilibrium of this model) or values per "
             "group/tendon, e.g. 'S1=1.5025'"))),
+        Option("--membrane-law", "svk", None, dict(choices=MEMBRANE_LAWS, help=(
+            "membrane law: St.Venant-Kirchhoff (svk, eq. 4.9) or tension-field (wrinkling, "
+            "docs/wrinkling.md)"))),
         Option("--start", "undeformed", ("static", "modal"), dict(
             choices=("undeformed", "design"),
             help="start of the static iteration (the undeformed membrane, as in 6.2)")),
