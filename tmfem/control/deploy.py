@@ -170,10 +170,12 @@ class DeploymentResult:
 
 def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float = 0.01,
                    r_min: float = 1e-3, stress_every: int = 10, progress=None,
-                   mesh_n: int = 10) -> DeploymentResult:
+                   mesh_n: int = 10, jacobian: str = "reuse") -> DeploymentResult:
     """Deploy: the COM plant (:class:`StatePlant`) from z0 under ``controller`` (reading
     y = [z, z']) saturated by :class:`RestLengthLimits`, integrated by Park's method
-    (eqs. 5.34-5.35) at step dt, with the recovery of the module docstring."""
+    (eqs. 5.34-5.35) at step dt, with the recovery of the module docstring. ``jacobian``:
+    the Newton-matrix policy of :func:`tmfem.solvers.park.park_integrate` (``"reuse"`` keeps
+    the matrix over steps while Newton converges within a few iterations)."""
     if stress_every < 1:
         raise InputError(f"stress_every: expected >= 1, found {stress_every}")
     plant = StatePlant(model, z0=z0)
@@ -209,7 +211,7 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
 
     t0 = time.perf_counter()
     sim = simulate(plant, t_end=t_end, dt=dt, controller=lim, record=record, progress=progress,
-                   outputs=False)
+                   outputs=False, jacobian=jacobian)
     wall = time.perf_counter() - t0
     act = np.array([a for _, a in lim.active])
     inner = controller

@@ -86,6 +86,7 @@ class DeploymentReference:
         self._angles = _angle_mask(self.q_names)
         self.q_0 = self.initial.to_q(self.N)
         self.q_e = self._continuous(self.final.to_q(self.N))
+        self._last = (None, None)
 
     def _continuous(self, q):
         d = q - self.q_0
@@ -111,13 +112,17 @@ class DeploymentReference:
         return (th - th0) * k, thd * k, thdd * k
 
     def __call__(self, t: float):
-        """q_d, q_d', q_d'' at time t."""
+        """q_d, q_d', q_d'' at time t (the last evaluation is cached)."""
+        if self._last[0] == t:
+            return self._last[1]
         s, sd, sdd = (float(v) for v in self.progress(t))
         h = 1e-5
         qp, q0, qm = self.q_of_s(s + h), self.q_of_s(s), self.q_of_s(s - h)
         dq = (qp - qm) / (2 * h)
         d2q = (qp - 2 * q0 + qm) / h**2
-        return q0, dq * sd, d2q * sd**2 + dq * sdd
+        out = (q0, dq * sd, d2q * sd**2 + dq * sdd)
+        self._last = (t, out)
+        return out
 
     def check_equilibria(self, *, checker, n: int = 21) -> np.ndarray:
         """Run ``checker(config)`` (raising an InfeasibleDesign where the configuration is not
