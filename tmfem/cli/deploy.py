@@ -28,7 +28,8 @@ DEPLOYMENTS = {
     "2-3-deploy": {"omega_r": 0.5, "table_7_1": (1.0, 24.0, 5.0, 0.9), "uncertainty": "no-MG",
                    "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01},
 }
-CONTROLLERS = {"adaptive-hinf": "hinf", "adaptive-lqr": "lqr", "adaptive": "none"}
+CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
+               "adaptive": "none"}
 
 
 def inside_points(system, points, *, inset: float = 1e-3):
@@ -42,7 +43,7 @@ def inside_points(system, points, *, inset: float = 1e-3):
     return out
 
 
-def setup(preset: str, *, controller: str = "adaptive-lqr", uncertainty: str | None = None):
+def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None):
     """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`)."""
     from tmfem.control.adaptive import Gains
     from tmfem.control.deploy import build_deployment
@@ -63,10 +64,11 @@ def setup(preset: str, *, controller: str = "adaptive-lqr", uncertainty: str | N
 
 def configure(parser) -> None:
     parser.add_argument("--preset", required=True, choices=sorted(DEPLOYMENTS))
-    parser.add_argument("--controller", default="adaptive-lqr", choices=sorted(CONTROLLERS),
+    parser.add_argument("--controller", default="adaptive-hinf", choices=sorted(CONTROLLERS),
                         help="adaptive PFL then a linear controller about the final equilibrium: "
-                             "adaptive-hinf (python-control hinfsyn stand-in for issue 12), "
-                             "adaptive-lqr (LQR state feedback) or adaptive (no switch)")
+                             "adaptive-hinf (the LMI H-infinity controller of 7.3, tmfem control), "
+                             "adaptive-hinf-riccati (python-control hinfsyn), adaptive-lqr (LQR "
+                             "state feedback) or adaptive (no switch)")
     parser.add_argument("--uncertainty", choices=["initial", "no-MG", "exact"],
                         help="controller model error (default: the 7.4 choice of the preset)")
     parser.add_argument("--t-end", type=float, default=20.0)

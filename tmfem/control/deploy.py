@@ -127,6 +127,31 @@ def hinf_output_feedback(model, *, u_e, z_e=None, w_e: float = 0.5, w_n: float =
     return LinearController(Kc, u_e=lin.u_e, y_e=lin.y_e, name="hinf-riccati"), lin, float(gam)
 
 
+def lmi_hinf_controller(system, *, membrane_modes: int):
+    """The H-infinity controller of 7.3 (eqs. 5.62-5.67, :func:`tmfem.control.design.
+    deployed_hinf`: eliminated LMIs with the 7.4 weights and alpha_1) as a
+    :class:`LinearController`, with ``measure`` mapping the modal state y = [z, z'] of
+    :class:`StatePlant` onto the design's measured signals [q, v, q', v'] (membrane point
+    coordinates of eq. 5.18: z_points = P^-1 z_modal, the same linear map for the rates).
+
+    Returns
+    -------
+    controller, measure, gamma
+    """
+    from tmfem.control.design import deployed_hinf
+    d = deployed_hinf(system, membrane_modes=membrane_modes)
+    pl = d.plant
+    P = pl.model.P
+    y_e = np.concatenate([pl.z_e, np.zeros(pl.z_e.size)])
+    ctrl = LinearController(d.design.controller, u_e=pl.u_e, y_e=y_e, name="hinf-lmi")
+    nz = P.shape[0]
+
+    def measure(y):
+        y = np.asarray(y)
+        return np.linalg.solve(P, np.column_stack([y[:nz], y[nz:2 * nz]])).T.ravel()
+    return ctrl, measure, float(d.design.gamma)
+
+
 @dataclass
 class DeploymentResult:
     """Signals and figures of a deployment run (see :func:`run_deployment`)."""
@@ -261,15 +286,17 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     """The model (built at the final configuration with its printed rest lengths), the
     reference from ``initial`` to ``final`` (:class:`DeploymentReference`), the adaptive PFL
     (eq. 5.58) and, unless ``linear="none"``, the switch (eq. 5.70) to a linear controller
-    about the final equilibrium: ``"lqr"`` (:func:`lqr_state_feedback`) or ``"hinf"``
-    (:func:`hinf_output_feedback`), both stand-ins for issue 12's LMI controller."""
+    about the final equilibrium: ``"lmi"`` (issue 12's H-infinity output feedback by LMIs
+    with alpha-stability, :func:`lmi_hinf_controller`), ``"lqr"`` (:func:`lqr_state_feedback`)
+    or ``"hinf"`` (:func:`hinf_output_feedback`, python-control Riccati)."""
     from tmfem.control.adaptive import AdaptivePFL, reference_centres
     from tmfem.control.reference_trajectory import DeploymentReference
     from tmfem.control.rbf import GaussianRBF
     from tmfem.control.switching import SwitchingController
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
-    if linear not in ("lqr", "hinf", "none"):
-        raise InputError(f"linear controller: expected 'lqr', 'hinf' or 'none', found {linear!r}")
+    if linear not in ("lmi", "lqr", "hinf", "none"):
+        raise InputError(f"linear controller: expected 'lmi', 'lqr', 'hinf' or 'none', found "
+                         f"{linear!r}")
     K = default_membrane_modes(final) if membrane_modes is None else membrane_modes
     model = ControlOrientedModel(final, membrane_modes=K, rest_lengths="system",
                                  output_points=output_points)
@@ -287,7 +314,10 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     lin_ctrl = None
     ctrl = ad
     if linear != "none":
-        if linear == "lqr":
+        if linear == "lmi":
+            lin_ctrl, measure, g = lmi_hinf_controller(final, membrane_modes=K)
+            info["hinf_gamma"] = g
+        elif linear == "lqr":
             lin_ctrl, _ = lqr_state_feedback(model, u_e=model.u0, z_e=z_e, u_m=u_m)
             measure = lambda y: np.asarray(y)                               # noqa: E731
         else:
