@@ -56,7 +56,8 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
 
 
 def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
-    """GIF of the bars (thick) and tendons (thin) over the run (Figures 7.5, 7.9, 7.14),
+    """GIF of the bars (thick), tendons (thin) and the membrane polygon (flat, its corners)
+    over the run (Figures 7.5, 7.9, 7.14),
     with matplotlib's pillow writer."""
     plt = _plt()
     from matplotlib.animation import FuncAnimation, PillowWriter
@@ -64,6 +65,7 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     nq = len(r.names["q"])
     idx = np.linspace(0, r.t.size - 1, frames).astype(int)
     Xs = [system.nodes(r.z[k, :nq]) for k in idx]
+    Cs = [system.membrane_corners_inertial(r.z[k, :nq]) for k in idx]
     allX = np.concatenate(Xs, axis=1)
     lo, hi = allX.min(axis=1), allX.max(axis=1)
     fig = plt.figure(figsize=(5, 5))
@@ -77,7 +79,11 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
             ax.plot(*X[:, [a, b]], color="saddlebrown", lw=3)
         for a, b in tends.T:
             ax.plot(*X[:, [a, b]], color="tab:blue", lw=0.8)
+        C = Cs[i]
+        ax.plot_trisurf(C[0], C[1], C[2], color="gold", alpha=0.4)
         ax.set_xlim(lo[0], hi[0]); ax.set_ylim(lo[1], hi[1]); ax.set_zlim(lo[2], hi[2])
+        ax.set_box_aspect(hi - lo)
+        ax.locator_params(axis="z", nbins=3)
         ax.set_xlabel("x [m]"); ax.set_ylabel("y [m]"); ax.set_zlabel("z [m]")
         ax.set_title(f"t = {r.t[idx[i]]:.2f} s ({r.controller[min(idx[i], len(r.controller) - 1)]})")
     anim = FuncAnimation(fig, draw, frames=len(idx))
