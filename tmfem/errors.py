@@ -41,3 +41,9 @@ class BackendUnavailable(TmfemError):
 class InfeasibleController(TmfemError):
     """A controller synthesis whose LMIs are infeasible, whose solver did not reach an
     optimal status, or whose recovered controller fails its closed-loop checks (eqs. 5.63-5.67)."""
+
+
+class SingularInputMatrix(TmfemError):
+    """The actuated input matrix B_q of the collocated partial feedback linearisation (eq.
+    5.46) is not square or not invertible at a configuration (its condition number exceeds
+    the limit)."""

@@ -1,0 +1,134 @@
+"""``tmfem deploy``: closed-loop deployment of a 1-N(D) or 2-3 system (dissertation 7.4).
+
+The dissertation's parameters per deployment (7.4): omega_r of eq. 5.68, the gains of
+Table 7.1 (eq. 5.69), the uncertainty model of the controller (eq. 5.72 for 1-4(D), M G
+ignored for 1-6(D) and 2-3) and the monitored membrane points of eqs. 5.73-5.75. The
+printed points lie on the membrane edges (mid-edge points of the polygon); they are moved
+1 mm toward the centroid so that they fall inside the mesh (docs/errata.md).
+"""
+from __future__ import annotations
+
+import csv
+import time
+
+import numpy as np
+
+from tmfem.cli.common import progress_bar
+from tmfem.errors import InputError
+
+NAME = "deploy"
+HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
+
+#: 7.4: omega_r (eq. 5.68), Table 7.1 (omega_0, omega_e, tau, d_c), uncertainty, points (5.73-5.75)
+DEPLOYMENTS = {
+    "1-4D": {"omega_r": 0.7, "table_7_1": (15.0, 150.0, 20.0, 1.5), "uncertainty": "initial",
+             "points": [(1.0, 1.0), (2.0, 1.0), (1.0, 2.0)], "u_m": 0.01},
+    "1-6D": {"omega_r": 0.35, "table_7_1": (4.0, 10.0, 20.0, 0.7), "uncertainty": "no-MG",
+             "points": [(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], "u_m": 0.02},
+    "2-3-deploy": {"omega_r": 0.5, "table_7_1": (1.0, 24.0, 5.0, 0.9), "uncertainty": "no-MG",
+                   "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01},
+}
+CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
+               "adaptive": "none"}
+
+
+def inside_points(system, points, *, inset: float = 1e-3):
+    """The points moved ``inset`` metres toward the membrane centroid (see module docstring)."""
+    c = system.membrane_corners.mean(axis=1)
+    out = []
+    for p in points:
+        p = np.asarray(p, dtype=float)
+        d = c - p
+        out.append(tuple(p + inset * d / np.linalg.norm(d)))
+    return out
+
+
+def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None):
+    """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`)."""
+    from tmfem.control.adaptive import Gains
+    from tmfem.control.deploy import build_deployment
+    from tmfem.system.presets import load_preset
+    if preset not in DEPLOYMENTS:
+        raise InputError(f"deploy: expected a preset among {sorted(DEPLOYMENTS)}, found {preset!r}")
+    if controller not in CONTROLLERS:
+        raise InputError(f"--controller: expected one of {sorted(CONTROLLERS)}, found {controller!r}")
+    p = DEPLOYMENTS[preset]
+    final, initial = load_preset(preset), load_preset(preset + "-initial")
+    w0, we, tau, dc = p["table_7_1"]
+    return build_deployment(final=final, initial=initial, omega_r=p["omega_r"],
+                            gains=Gains(omega_0=w0, omega_e=we, tau=tau, d_c=dc),
+                            uncertainty=uncertainty or p["uncertainty"],
+                            output_points=inside_points(final, p["points"]),
+                            linear=CONTROLLERS[controller], u_m=p["u_m"])
+
+
+def configure(parser) -> None:
+    parser.add_argument("--preset", required=True, choices=sorted(DEPLOYMENTS))
+    parser.add_argument("--controller", default="adaptive-hinf", choices=sorted(CONTROLLERS),
+                        help="adaptive PFL then a linear controller about the final equilibrium: "
+                             "adaptive-hinf (the LMI H-infinity controller of 7.3, tmfem control), "
+                             "adaptive-hinf-riccati (python-control hinfsyn), adaptive-lqr (LQR "
+                             "state feedback) or adaptive (no switch)")
+    parser.add_argument("--uncertainty", choices=["initial", "no-MG", "exact"],
+                        help="controller model error (default: the 7.4 choice of the preset)")
+    parser.add_argument("--t-end", type=float, default=20.0)
+    parser.add_argument("--dt", type=float, default=0.01)
+    parser.add_argument("--csv", help="write every named signal (one column each)")
+    parser.add_argument("--plot", help="PNG as Figures 7.2-7.4")
+    parser.add_argument("--gif", help="animation of the deployment (GIF)")
+    parser.add_argument("--vtk", metavar="DIR", help="ParaView series of the configuration")
+
+
+def run(args) -> dict:
+    t0 = time.perf_counter()
+    s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty)
+    from tmfem.control.deploy import run_deployment
+    with progress_bar(args.t_end, args.dt, f"deploy {args.preset}") as bar:
+        r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
+                           z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar)
+    out = {"preset": args.preset, "controller": args.controller,
+           "uncertainty": s.adaptive.uncertainty, **r.summary(), **s.info,
+           "total_wall_time_s": time.perf_counter() - t0}
+    if args.csv:
+        out["csv"] = write_csv(args.csv, r)
+    if args.plot:
+        from tmfem.post.deploy_plots import plot_deployment
+        out["plot"] = str(plot_deployment(args.plot, r, title=f"{args.preset} ({args.controller})"))
+    if args.gif:
+        from tmfem.post.deploy_plots import animate_deployment
+        out["gif"] = str(animate_deployment(args.gif, s.model.system, r))
+    if args.vtk:
+        from tmfem.io.vtk import configuration_cells, write_series
+        sysm = s.model.system
+        cells = configuration_cells(sysm)
+        idx = range(0, r.t.size, 10)
+        out["pvd"] = str(write_series(args.vtk, ((float(r.t[k]), sysm.nodes(r.z[k, :s.model.nq]),
+                                                  cells) for k in idx), name=args.preset))
+    return out
+
+
+def write_csv(path, r) -> str:
+    """One column per named signal: time, q, q_d, w, rest lengths, tendon lengths, controller."""
+    n = r.names
+    head = (["t"] + n["q"] + [f"{q}_d" for q in n["q"]] + n["w"] + n["u"]
+            + [f"L_{t}" for t in n["tendons"]] + ["eta_energy", "controller"])
+    nq = len(n["q"])
+    with open(path, "w", newline="") as fh:
+        wr = csv.writer(fh)
+        wr.writerow(head)
+        for k in range(r.t.size):
+            wr.writerow([f"{r.t[k]:.6g}"] + [f"{v:.10g}" for v in r.z[k, :nq]]
+                        + [f"{v:.10g}" for v in r.q_d[k]] + [f"{v:.10g}" for v in r.w[k]]
+                        + [f"{v:.10g}" for v in r.u[k]] + [f"{v:.10g}" for v in r.lengths[k]]
+                        + [f"{r.eta_energy[k]:.6g}", r.controller[min(k, len(r.controller) - 1)]])
+    return str(path)
+
+
+def format_text(r: dict) -> str:
+    keys = ["switch_time_s", "t_end_s", "max_membrane_deflection_m", "peak_bar_compression_N",
+            "bar_critical_load_N", "max_von_mises_Pa", "max_tendon_stress_Pa",
+            "min_rest_length_margin_m", "final_tracking_error", "limits_active_s",
+            "max_eta_energy_J", "B_q_condition_max", "wall_time_s"]
+    lines = [f"deployment {r['preset']} ({r['controller']}, uncertainty {r['uncertainty']})"]
+    lines += [f"  {k}: {r[k]:.6g}" if isinstance(r[k], float) else f"  {k}: {r[k]}" for k in keys]
+    return "\n".join(lines + [f"{k}: {r[k]}" for k in ("csv", "plot", "gif", "pvd") if k in r])

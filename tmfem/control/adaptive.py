@@ -1,0 +1,160 @@
+"""The adaptive collocated-PFL deployment controller (dissertation eqs. 5.42-5.58, 5.69, 5.72).
+
+Control law (eq. 5.58), sampled every dt with a zero-order hold:
+
+    u = B_q^-1 (-F_q - W_F^T Phi_F - q_d'' + D_q (q' - q_d') + K_q (q - q_d)),
+    W_F' = Proj(W_F, -Gamma Phi_F (e^T P_2 + e'^T P_3)),   e = q - q_d,
+
+with P_2 = alpha I, P_3 = beta I (eq. 5.50), D_q = d_q(t) I, K_q = k_q(t) I and (eq. 5.69)
+
+    omega(t) = omega_0 + omega_e (1 - exp(-t / tau)),  d_q = 2 d_c omega,  k_q = omega^2.
+
+B_q is exact (eq. 5.42); F_q is the controller's nominal model of F_q* (eq. 5.41), with the
+uncertainty models of 7.4:
+
+``"initial"``   F_q = F_q* at the initial configuration (q_0, q' = 0, eta = 0), eq. 5.72 (1-4(D));
+``"no-MG"``     F_q from F_hat without the term M(x) G of eq. 5.28 (1-6(D), 2-3);
+``"exact"``     F_q = F_q* (no model error; a check).
+
+The controller reads the full state: the plant outputs are y = [z, z'] (the dissertation
+assumes full-state measurement in 7.2; :class:`tmfem.control.deploy.StatePlant`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tmfem.control.pfl import check_input_matrix, partition
+from tmfem.control.rbf import GaussianRBF, euler_step
+from tmfem.errors import InputError
+
+UNCERTAINTY = ("initial", "no-MG", "exact")
+
+
+@dataclass
+class Gains:
+    """Time-varying gains of eq. 5.69 (Table 7.1)."""
+
+    omega_0: float
+    omega_e: float
+    tau: float
+    d_c: float
+
+    def __call__(self, t: float) -> tuple[float, float]:
+        """(d_q, k_q) at time t (eqs. 5.47, 5.69)."""
+        w = self.omega_0 + self.omega_e * (1 - np.exp(-t / self.tau))
+        return 2 * self.d_c * w, w * w
+
+
+class AdaptivePFL:
+    """Controller hook (``tmfem.simulation.controllers``) of eq. 5.58.
+
+    Parameters
+    ----------
+    model : ControlOrientedModel
+        The controller's model (modal coordinates: z = [q, eta]).
+    reference : callable
+        ``reference(t) -> (q_d, q_d', q_d'')``.
+    gains : Gains
+    rbf : GaussianRBF
+        Network on v_q = [q; q'] (eq. 5.44).
+    w_bar : float
+        Column bound of the projection (eqs. 5.51-5.52).
+    gamma, alpha, beta : float
+        Adaptation gain Gamma and the weights of eq. 5.50 (7.4: 0.01, 1, 1).
+    uncertainty : {"initial", "no-MG", "exact"}
+    z_initial : array, optional
+        Configuration at which ``"initial"`` evaluates F_q* (default: q_d(0), eta = 0).
+    """
+
+    name = "adaptive-pfl"
+
+    def __init__(self, *, model, reference, gains: Gains, rbf: GaussianRBF, w_bar: float,
+                 gamma: float = 0.01, alpha: float = 1.0, beta: float = 1.0,
+                 uncertainty: str = "initial", z_initial=None):
+        if uncertainty not in UNCERTAINTY:
+            raise InputError(f"uncertainty: expected one of {UNCERTAINTY}, found {uncertainty!r}")
+        if model.membrane_points is not None:
+            raise InputError("adaptive PFL: expected a model in modal coordinates "
+                             "(membrane_points=None), found point coordinates")
+        if rbf.centres.shape[1] != 2 * model.nq:
+            raise InputError(f"RBF centres: expected {2 * model.nq} columns (v_q = [q; q']), "
+                             f"found {rbf.centres.shape[1]}")
+        if not (gamma > 0 and alpha > 0 and beta > 0):
+            raise InputError(f"expected Gamma, alpha, beta > 0, found {gamma}, {alpha}, {beta}")
+        self.model, self.reference, self.gains, self.rbf = model, reference, gains, rbf
+        self.w_bar, self.gamma, self.alpha, self.beta = float(w_bar), gamma, alpha, beta
+        self.uncertainty = uncertainty
+        nq, nz = model.nq, model.nz
+        self.nq, self.nz = nq, nz
+        self._F_initial = None
+        if uncertainty == "initial":
+            z0 = np.concatenate([reference(0.0)[0], np.zeros(model.K)]) if z_initial is None \
+                else np.asarray(z_initial, dtype=float)
+            M, F, B = model.matrices(z0, np.zeros(nz))
+            self._F_initial = partition(M, F, B, nq=nq).F_q
+        self._cache = (None, None)
+        self.condition_numbers: list = []
+        self.dt = None
+
+    def reset(self, t0, y0, dt):
+        """W_F(0) = 0 (7.4); the controller state is vec(W_F) (m x n_q, column-major)."""
+        self.dt = dt
+        self.condition_numbers = []
+        self._cache = (None, None)
+        return np.zeros(self.rbf.m * self.nq)
+
+    def _terms(self, t, y, xc):
+        key = (t, xc.tobytes(), np.asarray(y).tobytes())
+        if self._cache[0] == key:
+            return self._cache[1]
+        nq, nz = self.nq, self.nz
+        y = np.asarray(y, dtype=float)
+        z, zd = y[:nz], y[nz:2 * nz]
+        q, qd = z[:nq], zd[:nq]
+        M, F, B = self.model.matrices(z, zd)
+        exact = partition(M, F, B, nq=nq)
+        if self.uncertainty == "exact":
+            F_q = exact.F_q
+        elif self.uncertainty == "initial":
+            F_q = self._F_initial
+        else:
+            d = self.model.dae_terms(z, zd)
+            F_q = partition(M, d["T_z"].T @ d["F"], B, nq=nq).F_q
+        self.condition_numbers.append(check_input_matrix(exact.B_q, where=f" at t = {t:.4g} s"))
+        q_d, qd_d, qdd_d = self.reference(t)
+        e, ed = q - q_d, qd - qd_d
+        d_q, k_q = self.gains(t)
+        W = xc.reshape(self.rbf.m, nq, order="F")
+        phi = self.rbf(np.concatenate([q, qd]))
+        v = -F_q - W.T @ phi - qdd_d + d_q * ed + k_q * e
+        u = np.linalg.solve(exact.B_q, v)
+        Y = -self.gamma * np.outer(phi, self.alpha * e + self.beta * ed)        # eq. 5.51
+        out = (u, Y, W, e)
+        self._cache = (key, out)
+        return out
+
+    def output(self, t, y, xc):
+        return self._terms(t, y, xc)[0]
+
+    def update(self, t, y, xc):
+        _, Y, W, _ = self._terms(t, y, xc)
+        return euler_step(W, Y, dt=self.dt, bound=self.w_bar).ravel(order="F")
+
+    def tracking_error(self, t, y) -> np.ndarray:
+        """e = q - q_d at t."""
+        return np.asarray(y)[: self.nq] - self.reference(t)[0]
+
+
+def reference_centres(reference, *, t_end: float, m: int) -> tuple[np.ndarray, float]:
+    """RBF centres on the reference: v_c,i = [q_d(t_i); q_d'(t_i)] at m times evenly spaced
+    over [0, t_end], and the width sigma_q = the largest distance between consecutive
+    centres (neighbouring Gaussians overlap at exp(-1/2)). Our choice: 7.4 does not print
+    its centres or widths."""
+    if m < 1:
+        raise InputError(f"RBF: expected m >= 1 centres, found {m}")
+    ts = np.linspace(0.0, t_end, m)
+    C = np.array([np.concatenate(reference(t)[:2]) for t in ts])
+    sig = float(np.max(np.linalg.norm(np.diff(C, axis=0), axis=1))) if m > 1 else 1.0
+    return C, max(sig, 1e-3)

@@ -1,0 +1,73 @@
+"""Collocated partial feedback linearisation of the control-oriented model (eqs. 5.39-5.41).
+
+With z = [q; eta] (q actuated, eta the unactuated membrane coordinates) eq. 5.27 in block
+form is (eq. 5.39)
+
+    [M11 M12; M12^T M22] [q''; eta''] + [F1; F2] + [B1; 0] u = 0,
+
+and eliminating eta'' gives (eqs. 5.40-5.41)
+
+    q'' + F_q* + B_q* u = 0,     M22 eta'' + F2 + M12^T q'' = 0,
+    M_q = M11 - M12 M22^-1 M12^T,  F_q* = M_q^-1 (F1 - M12 M22^-1 F2),  B_q* = M_q^-1 B1.
+
+The control law of eq. 5.46 inverts B_q: it must be square and invertible
+(:func:`check_input_matrix`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tmfem.errors import SingularInputMatrix
+
+#: condition number of B_q above which eq. 5.46 is refused
+COND_LIMIT = 1e10
+
+
+@dataclass
+class PFLTerms:
+    """M_q, F_q*, B_q* of eq. 5.41 and the membrane blocks M12, M22, F2 of eq. 5.39."""
+
+    M_q: np.ndarray
+    F_q: np.ndarray
+    B_q: np.ndarray
+    M12: np.ndarray
+    M22: np.ndarray
+    F2: np.ndarray
+
+
+def partition(M_hat, F_hat, B_hat, *, nq: int) -> PFLTerms:
+    """Eqs. 5.39-5.41 from M_hat, F_hat, B_hat (eq. 5.28) with the first nq coordinates
+    actuated. B_hat's eta rows are zero for the COM (eq. 5.39); they are not used."""
+    M11, M12, M22 = M_hat[:nq, :nq], M_hat[:nq, nq:], M_hat[nq:, nq:]
+    F1, F2 = F_hat[:nq], F_hat[nq:]
+    if M22.size:
+        X = np.linalg.solve(M22, np.column_stack([M12.T, F2]))
+        Mq = M11 - M12 @ X[:, :nq]
+        rhs = np.column_stack([F1 - M12 @ X[:, nq], B_hat[:nq]])
+    else:
+        Mq = M11
+        rhs = np.column_stack([F1, B_hat[:nq]])
+    sol = np.linalg.solve(Mq, rhs)
+    return PFLTerms(M_q=Mq, F_q=sol[:, 0], B_q=sol[:, 1:], M12=M12, M22=M22, F2=F2)
+
+
+def check_input_matrix(B_q, *, where: str = "", cond_limit: float = COND_LIMIT) -> float:
+    """Condition number of B_q (eq. 5.46 needs B_q^-1).
+
+    Raises
+    ------
+    SingularInputMatrix
+        B_q is not square (as many rest lengths as bar coordinates) or its 2-norm condition
+        number exceeds ``cond_limit``.
+    """
+    B_q = np.asarray(B_q)
+    if B_q.ndim != 2 or B_q.shape[0] != B_q.shape[1]:
+        raise SingularInputMatrix(f"eq. 5.46{where}: expected a square B_q (as many actuated "
+                                  f"tendons as bar coordinates), found shape {B_q.shape}")
+    c = float(np.linalg.cond(B_q))
+    if not np.isfinite(c) or c > cond_limit:
+        raise SingularInputMatrix(f"eq. 5.46{where}: expected an invertible B_q (condition number "
+                                  f"<= {cond_limit:g}), found {c:.3g}")
+    return c

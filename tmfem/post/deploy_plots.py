@@ -1,0 +1,92 @@
+"""Plots and animation of a deployment run (dissertation Figures 7.2-7.5).
+
+``result`` is a :class:`tmfem.control.deploy.DeploymentResult` (read by attribute: t, z, q_d,
+w, u, lengths, switch_time, names).
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tmfem.post.plots import _plt, _save
+
+
+def plot_deployment(png, result, *, title: str = "") -> Path:
+    """Three panels: bar attitudes theta_1j, psi_1j against their references (Fig. 7.2), the
+    membrane deflections w_1..w_3 (Fig. 7.3), rest lengths against their limits (the tendon
+    lengths, Fig. 7.4); the switching time as a dashed line."""
+    plt = _plt()
+    r = result
+    fig, ax = plt.subplots(3, 1, figsize=(8, 10), sharex=True)
+    names = r.names["q"]
+    sel = [k for k, n in enumerate(names) if n.startswith(("theta_1", "psi_1"))][:4]
+    for k in sel:
+        ln, = ax[0].plot(r.t, np.degrees(r.z[:, k]), label=names[k])
+        ax[0].plot(r.t, np.degrees(r.q_d[:, k]), "--", color=ln.get_color(), lw=1,
+                   label=f"{names[k]} reference")
+    ax[0].set_ylabel("bar attitude [deg]")
+    ax[0].legend(fontsize=7, ncol=2)
+    for k, n in enumerate(r.names["w"]):
+        ax[1].plot(r.t, 1e3 * r.w[:, k], label=n)
+    ax[1].set_ylabel("membrane deflection w [mm]")
+    ax[1].legend(fontsize=8)
+    tn = r.names["tendons"]
+    seen = set()
+    for k, n in enumerate(tn):
+        fam = n.rsplit("_", 1)[0]
+        if fam in seen:
+            continue
+        seen.add(fam)
+        ln, = ax[2].plot(r.t, r.u[:, k], label=f"rest length {n}")
+        ax[2].plot(r.t, r.lengths[:, k], ":", color=ln.get_color(), label=f"limit |{n}|")
+    ax[2].set_ylabel("length [m]")
+    ax[2].set_xlabel("time [s]")
+    ax[2].legend(fontsize=7, ncol=2)
+    if r.switch_time is not None:
+        for a in ax:
+            a.axvline(r.switch_time, color="k", ls="--", lw=0.8)
+        ax[0].annotate(f"switch {r.switch_time:.2f} s", (r.switch_time, ax[0].get_ylim()[1]),
+                       fontsize=8, va="top")
+    for a in ax:
+        a.grid(alpha=0.3)
+    if title:
+        ax[0].set_title(title)
+    return _save(fig, Path(png))
+
+
+def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
+    """GIF of the bars (thick), tendons (thin) and the membrane polygon (flat, its corners)
+    over the run (Figures 7.5, 7.9, 7.14),
+    with matplotlib's pillow writer."""
+    plt = _plt()
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    r = result
+    nq = len(r.names["q"])
+    idx = np.linspace(0, r.t.size - 1, frames).astype(int)
+    Xs = [system.nodes(r.z[k, :nq]) for k in idx]
+    Cs = [system.membrane_corners_inertial(r.z[k, :nq]) for k in idx]
+    allX = np.concatenate(Xs, axis=1)
+    lo, hi = allX.min(axis=1), allX.max(axis=1)
+    fig = plt.figure(figsize=(5, 5))
+    ax = fig.add_subplot(projection="3d")
+    bars, tends = system.bar_connectivity, system.tendon_connectivity
+
+    def draw(i):
+        ax.cla()
+        X = Xs[i]
+        for a, b in bars.T:
+            ax.plot(*X[:, [a, b]], color="saddlebrown", lw=3)
+        for a, b in tends.T:
+            ax.plot(*X[:, [a, b]], color="tab:blue", lw=0.8)
+        C = Cs[i]
+        ax.plot_trisurf(C[0], C[1], C[2], color="gold", alpha=0.4)
+        ax.set_xlim(lo[0], hi[0]); ax.set_ylim(lo[1], hi[1]); ax.set_zlim(lo[2], hi[2])
+        ax.set_box_aspect(hi - lo)
+        ax.locator_params(axis="z", nbins=3)
+        ax.set_xlabel("x [m]"); ax.set_ylabel("y [m]"); ax.set_zlabel("z [m]")
+        ax.set_title(f"t = {r.t[idx[i]]:.2f} s ({r.controller[min(idx[i], len(r.controller) - 1)]})")
+    anim = FuncAnimation(fig, draw, frames=len(idx))
+    anim.save(str(gif), writer=PillowWriter(fps=8))
+    plt.close(fig)
+    return Path(gif)
