@@ -3,9 +3,14 @@
 Every module of this package that defines ``NAME``, ``HELP``, ``configure(parser)`` and
 ``run(args) -> dict`` is a subcommand. ``run`` returns a JSON-serialisable result; with
 ``--json`` it is printed as one JSON document on stdout, otherwise the module's
-``format_text(result) -> str`` (or a default rendering) is printed. A
-:class:`tmfem.errors.TmfemError` becomes a one-line message on stderr and a non-zero
-exit code, never a traceback.
+``format_text(result) -> str`` (or a default rendering) is printed.
+
+Exit codes (docs/cli.md): a :class:`tmfem.errors.TmfemError` becomes one line on stderr
+and its ``exit_code`` (1 the analysis says no, 2 bad input, 3 too large for this machine,
+4 missing backend); a result whose ``ok`` is false or whose ``checks`` failed is printed
+and exits 1 unless the command was given ``--allow-infeasible``; an output path that
+cannot be written is exit 2; Ctrl-C prints one line and exits 130. Never a traceback for
+any of these.
 """
 from __future__ import annotations
 
@@ -50,31 +55,75 @@ def _default_text(result) -> str:
     return json.dumps(result, indent=2, default=str)
 
 
-def _log_to_stderr() -> None:
-    """Library progress (``logging`` INFO of the ``tmfem`` loggers) as lines on stderr."""
-    log = logging.getLogger("tmfem")
-    if not log.handlers:
-        handler = logging.StreamHandler(sys.stderr)
-        handler.setFormatter(logging.Formatter("tmfem: %(message)s"))
-        log.addHandler(handler)
+def _one_line(text: str) -> str:
+    """A message on one line (numpy arrays in messages print over several)."""
+    return " ".join(str(text).split())
+
+
+def failed_checks(result) -> list[str]:
+    """Names of the failed checks of a command's result: ``result["failed_checks"]``, the
+    entries of ``result["checks"]`` whose ``ok`` is false, or ``["ok"]`` when only
+    ``result["ok"]`` is false."""
+    if not isinstance(result, dict):
+        return []
+    names = list(result.get("failed_checks") or [])
+    for c in result.get("checks") or []:
+        if isinstance(c, dict) and c.get("ok") is False:
+            n = c.get("name", c.get("check", "check"))
+            if n not in names:
+                names.append(n)
+    if not names and result.get("ok") is False:
+        names = ["ok"]
+    return names
+
+
+def _setup_logging() -> None:
+    """Library progress (``logging`` INFO of the ``tmfem`` loggers), warnings and log
+    records on stderr, one line each, prefixed ``tmfem:``."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("tmfem: %(message)s"))
+    for name in ("tmfem", "py.warnings"):
+        log = logging.getLogger(name)
+        if not log.handlers:
+            log.addHandler(handler)
+            log.propagate = False
         log.setLevel(logging.INFO)
+    logging.captureWarnings(True)
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``tmfem`` console script; returns the exit code."""
-    _log_to_stderr()
+    """Entry point of the ``tmfem`` console script; returns the exit code (docs/cli.md)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     mod = args._module
+    _setup_logging()
     try:
         result = mod.run(args)
+        if args.json:
+            text = json.dumps(_finite(result), default=json_default, allow_nan=False)
+        else:
+            text = getattr(mod, "format_text", _default_text)(result)
+        print(text)
     except TmfemError as exc:
-        print(f"tmfem {args.command}: error: {exc}", file=sys.stderr)
+        print(f"tmfem {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
-    if args.json:
-        print(json.dumps(_finite(result), default=_json_default, allow_nan=False))
-    else:
-        print(getattr(mod, "format_text", _default_text)(result))
+    except KeyboardInterrupt:
+        print(f"tmfem {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except OSError as exc:                     # an output that cannot be written
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"tmfem {args.command}: error: cannot write{where}: "
+              f"{exc.strerror or _one_line(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"tmfem {args.command}: error: out of memory; use a coarser mesh or fewer "
+              "modes/steps", file=sys.stderr)
+        return 3
+    failed = failed_checks(result)
+    if failed and not getattr(args, "allow_infeasible", False):
+        print(f"tmfem {args.command}: failed checks: {', '.join(map(str, failed))} "
+              "(exit 1; see docs/cli.md)", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -92,7 +141,8 @@ def _finite(obj):
     return obj
 
 
-def _json_default(obj):
+def json_default(obj):
+    """``default`` of :func:`json.dumps` for numpy arrays and scalars."""
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     if isinstance(obj, np.generic):

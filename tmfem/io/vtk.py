@@ -107,6 +107,21 @@ def check_path(path, *, suffixes=SUFFIXES) -> Path:
     return path
 
 
+def check_dir(path) -> Path:
+    """Validate an output directory before any work: not a file, creatable, writable."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"output directory {str(path)!r} is a file")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"output directory {str(path)!r}: cannot create it "
+                         f"({exc.strerror})") from None
+    if not os.access(path, os.W_OK):
+        raise InputError(f"output directory {str(path)!r} is not writable")
+    return path
+
+
 # ---------------------------------------------------------------------------- labels
 _LABEL = re.compile(r"^([A-Z]+)_(\d)(\d)$|^([A-Z]+)_(\d+),(\d+)$")
 
