@@ -19,6 +19,7 @@ Progress goes to stderr.
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -63,7 +64,9 @@ def run(args) -> dict:
     check_patch(system, args.patch)
     out = output_dir(args.out, option="--out")
     with Progress(total=6, desc=f"study {system.name}") as bar:
-        return _study(args, system, out, bar)
+        result = _study(args, system, out, bar)
+    print(f"tmfem study: done: {out}", file=sys.stderr)     # also when the bar is off (no tty)
+    return result
 
 
 def _study(args, system, out: Path, bar: Progress) -> dict:

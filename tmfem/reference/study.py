@@ -76,12 +76,15 @@ def fmt(v, nd=6):
 
 
 def markdown_table(rows) -> str:
-    """The design table (rows of :func:`table_rows`) as a GitHub Markdown table (tabulate)."""
-    body = [[r["quantity"], r["unit"], fmt(r["ours"]), fmt(r["printed"]),
-             "" if r["rel_diff"] is None else f"{100 * r['rel_diff']:+.2f} %", r["source"]]
-            for r in rows]
-    return tabulate(body, headers=["quantity", "unit", "ours", "printed", "rel. diff", "source"],
-                    tablefmt="github", disable_numparse=True)
+    """The design table (rows of :func:`table_rows`) as a compact GitHub Markdown table
+    (unpadded cells, so that a row reads ``| rest length S1 | m | ...`` in the source too;
+    tabulate's Markdown formats pad every cell)."""
+    md = ["| quantity | unit | ours | printed | rel. diff | source |", "|---|---|---|---|---|---|"]
+    for r in rows:
+        rd = "" if r["rel_diff"] is None else f"{100 * r['rel_diff']:+.2f} %"
+        md.append(f"| {r['quantity']} | {r['unit']} | {fmt(r['ours'])} | {fmt(r['printed'])} | "
+                  f"{rd} | {r['source']} |")
+    return "\n".join(md)
 
 
 def text_table(rows) -> str:
