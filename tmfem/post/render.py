@@ -78,6 +78,18 @@ def _robust_range(v: np.ndarray) -> list:
     return [lo, top] if top > lo else [lo, lo + 1.0]
 
 
+_STRESS_NAMES = ("von_mises", "sigma_p1", "sigma_p2", "sigma_xf", "sigma_yf", "tau_xfyf")
+
+
+def _is_stress(name: str) -> bool:
+    """Membrane stress fields (Pa in the data, shown in MPa)."""
+    return name.startswith(_STRESS_NAMES)
+
+
+def _unit_of(name: str) -> str:
+    return "m" if "displacement" in name or "deflection" in name else ""
+
+
 def render_configuration(png_path, system, *, q=None, tendon_forces=None, membrane=None,
                          title=None, window_size=(1200, 900), membrane_field: str | None = None,
                          labels: bool | None = None) -> Path:
@@ -158,12 +170,16 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
                 raise InputError(f"membrane_field {name!r}: expected one of "
                                  f"{sorted(membrane.cell_data) + sorted(membrane.point_data)}")
             vals = np.asarray(grid[name], dtype=float).ravel()
-            clim, bar_title = _robust_range(vals), name
-            if clim[1] < np.nanmax(vals):
-                bar_title = f"{name} (clipped)"
+            scale, unit = (1e-6, "MPa") if _is_stress(name) else (1.0, _unit_of(name))
+            grid[name] = vals * scale
+            clim = _robust_range(vals * scale)
+            bar_title = f"{name} [{unit}]" if unit else name
+            if clim[1] < np.nanmax(vals * scale):
+                # a few corner elements (singular point attachment) lie above the range
+                bar_title += f"\n(max {np.nanmax(vals * scale):.3g} at corners)"
             p.add_mesh(grid, scalars=name, cmap="viridis", opacity=0.9, show_edges=True,
                        edge_color="#555555", line_width=0.5, clim=clim,
-                       scalar_bar_args=_scalar_bar(bar_title, position_x=0.08))
+                       scalar_bar_args=_scalar_bar(bar_title, position_x=0.04))
         else:
             p.add_mesh(grid, color="#f4c27a", opacity=0.75, show_edges=True,
                        edge_color="#9a6a2a", line_width=0.5)
@@ -178,13 +194,17 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
     if labels:
         # labels a little above their node, so the node marker does not hide them
         at = X + np.array([[0.0], [0.0], [0.025 * size]])
-        p.add_point_labels(np.ascontiguousarray(at.T), system.node_labels, font_size=12,
-                           point_size=1, shape_opacity=0.0, text_color="#222222",
-                           always_visible=True, show_points=False)
+        p.add_point_labels(np.ascontiguousarray(at.T), system.node_labels, font_size=11,
+                           point_size=1, shape="rounded_rect", shape_color="white",
+                           shape_opacity=0.7, text_color="#222222", always_visible=True,
+                           show_points=False)
     if title:
         p.add_text(title, position="upper_edge", font_size=12, color="black")
+    p.add_legend([["bar", "black"], ["tendon (taut)", "#2171b5"], ["tendon (slack)", "#e41a1c"],
+                  ["membrane", "#f4c27a"]], bcolor="white", border=True, size=(0.2, 0.14),
+                 loc="lower right", face="rectangle")
     _set_view(p, X)
-    p.camera.zoom(1.3)
+    p.camera.zoom(1.1)          # reset_camera frames the model; 1.3 cropped the 2-3's lowest node
     return _screenshot(p, png_path)
 
 
@@ -247,14 +267,22 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
         u = S[:, m].reshape(n, 3).T
         s = _mode_scale(X, S[:, m]) if scale is None else float(scale)
         g = _ugrid(pv, X + s * u, blocks)
-        g.point_data["|u|"] = np.linalg.norm(u, axis=0)
+        mag = np.linalg.norm(u, axis=0)
+        name = f"|u| / max |u|, mode {m + 1}"          # one array name per panel: own bar
+        g.point_data[name] = mag / (mag.max() or 1.0)
         p.add_mesh(base, color="#bbbbbb", style="wireframe", line_width=1)
-        p.add_mesh(g, scalars="|u|", cmap="plasma", show_scalar_bar=False, line_width=3,
-                   show_edges=False)
+        p.add_mesh(g, scalars=name, cmap="plasma", clim=[0.0, 1.0], line_width=3,
+                   show_edges=False,
+                   scalar_bar_args={"title": "|u| / max|u|", "color": "black", "fmt": "%.1f",
+                                    "vertical": True, "position_x": 0.86, "position_y": 0.15,
+                                    "width": 0.06, "height": 0.6, "n_labels": 3,
+                                    "title_font_size": 10, "label_font_size": 9})
         p.add_text(f"mode {m + 1}: {f[m]:.4g} Hz", position="upper_edge", font_size=10,
                    color="black")
         _set_view(p, X)
+        p.camera.zoom(1.25)
     if title:
-        p.subplot(0, 0)
-        p.add_text(title, position="lower_left", font_size=9, color="black")
+        p.subplot(rows - 1, 0)
+        p.add_text(title + " (grey: prestressed state; shapes scaled)", position="lower_left",
+                   font_size=8, color="black")
     return _screenshot(p, png_path)
