@@ -19,8 +19,11 @@ import importlib
 import json
 import logging
 import math
+import os
 import pkgutil
+import signal
 import sys
+import threading
 
 import numpy as np
 
@@ -91,12 +94,30 @@ def _setup_logging() -> None:
     logging.captureWarnings(True)
 
 
+def _install_interrupt_handler(command: str):
+    """Ctrl-C: one line and exit code 130, at once. A KeyboardInterrupt raised inside
+    compiled callbacks (CasADi functions of the control-oriented model) is swallowed there
+    and resurfaces as an unrelated error, so the handler ends the process itself; what was
+    written so far stays valid (CSV rows are flushed as they come, the .pvd collection is
+    rewritten atomically after each frame). Returns the previous handler (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def handler(signum, frame):
+        sys.stdout.flush()
+        print(f"tmfem {command}: interrupted", file=sys.stderr, flush=True)
+        os._exit(130)
+
+    return signal.signal(signal.SIGINT, handler)
+
+
 def main(argv=None) -> int:
     """Entry point of the ``tmfem`` console script; returns the exit code (docs/cli.md)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     mod = args._module
     _setup_logging()
+    previous = _install_interrupt_handler(args.command)
     try:
         result = mod.run(args)
         if args.json:
@@ -119,6 +140,9 @@ def main(argv=None) -> int:
         print(f"tmfem {args.command}: error: out of memory; use a coarser mesh or fewer "
               "modes/steps", file=sys.stderr)
         return 3
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
     failed = failed_checks(result)
     if failed and not getattr(args, "allow_infeasible", False):
         print(f"tmfem {args.command}: failed checks: {', '.join(map(str, failed))} "

@@ -75,7 +75,17 @@ def model_options_from_args(args, command: str):
         raise InputError(f"{command} --model {args.model}: option does not apply: --backend "
                          f"(the {args.model} model solves small dense systems; --backend is for "
                          "the finite-element models)")
-    return system_from_args(args), options
+    system = system_from_args(args)
+    if isinstance(options.get("mesh"), int):
+        check_mesh_budget(N=system.N, n=options["mesh"])
+    for dest, suffixes in (("vtk", (".vtu", ".vtk", ".xdmf")), ("png", (".png",)),
+                           ("stress_plot", (".png",)), ("csv", (".csv",)), ("plot", (".png",))):
+        if getattr(args, dest, None) is not None and not (command == "vibrate" and dest == "vtk"):
+            output_file(getattr(args, dest), option="--" + dest.replace("_", "-"),
+                        suffixes=suffixes)
+    if command == "vibrate":
+        output_dir(getattr(args, "vtk", None), option="--vtk")
+    return system, options
 
 
 def model_from_args(args, command: str):
@@ -83,7 +93,11 @@ def model_from_args(args, command: str):
     options (:func:`model_options_from_args`)."""
     from tmfem.models.base import get_spec
     system, options = model_options_from_args(args, command)
-    return get_spec(args.model).build(system, options, args.backend or "scipy"), options
+    model = get_spec(args.model).build(system, options, args.backend or "scipy")
+    rest = getattr(model, "rest_lengths", None)
+    if rest is not None and np.ndim(rest) == 1 and len(rest) == len(system.tendons):
+        warn_long_rest_lengths(system, rest)     # all slack: an error before the solve
+    return model, options
 
 
 def add_attachment_args(parser) -> None:
@@ -253,12 +267,9 @@ def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> i
     """Number of time steps of a run of ``t_end`` s in steps of ``dt`` s, refused when it
     is zero (dt > t_end), over ``MAX_STEPS`` or when the histories (``states`` values per
     step, 8 bytes each, position and velocity) would not fit in memory."""
-    if not (math.isfinite(t_end) and math.isfinite(dt) and t_end > 0 and dt > 0):
-        raise InputError(f"expected finite --t-end > 0 and --dt > 0, found {t_end}, {dt}")
-    steps = int(round(t_end / dt))
-    if steps < 1:
-        raise InputError(f"--dt {dt:g} s is longer than --t-end {t_end:g} s: the run would "
-                         "have no time step")
+    from tmfem.simulation.driver import check_time_grid
+
+    steps = check_time_grid(t_end, dt)
     if steps > MAX_STEPS:
         raise ResourceLimit(f"--t-end {t_end:g} s / --dt {dt:g} s = {steps:,} steps; the limit "
                             f"is {MAX_STEPS:,} (raise --dt or lower --t-end)")
@@ -284,11 +295,11 @@ def check_patch(system: System, patch) -> None:
                          f"membrane edge of {system.name}), found {patch!r}")
 
 
-def warn_long_rest_lengths(system: System) -> list[str]:
+def warn_long_rest_lengths(system: System, rest=None) -> list[str]:
     """Tendons whose rest length is at least their length in the design configuration
     (slack there: a tension-only member carries no force). Returns one message per tendon
     and logs each; all of them is an error (nothing prestresses the system)."""
-    r = system.rest_lengths
+    r = system.rest_lengths if rest is None else np.asarray(rest, dtype=float)
     if r is None:
         return []
     L = system.tendon_lengths()

@@ -1,7 +1,7 @@
 """``tmfem mesh``: the membrane mesh of a system (gmsh, N quadrilaterals of n x n, 6.2)."""
 from __future__ import annotations
 
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import add_system_args, check_mesh_budget, system_from_args
 from tmfem.errors import InputError
 
 NAME = "mesh"
@@ -41,6 +41,9 @@ def run(args) -> dict:
     from tmfem.mesh import polygon_quad_mesh
 
     corners, name = membrane_corners_from_args(args)
+    if args.n < 1:
+        raise InputError(f"--n: expected n >= 1, found {args.n}")
+    check_mesh_budget(N=corners.shape[1], n=args.n, option="--n", dofs_per_node=1)
     mesh = polygon_quad_mesh(corners, args.n)
     path = write_membrane_mesh(args.out, mesh)
     return {"file": str(path), "membrane": name, "N": int(corners.shape[1]), "n": args.n,
