@@ -105,7 +105,8 @@ def _install_interrupt_handler(command: str):
 
     def handler(signum, frame):
         sys.stdout.flush()
-        print(f"tmfem {command}: interrupted", file=sys.stderr, flush=True)
+        # on a line of its own: a progress bar may be half drawn
+        print(f"\ntmfem {command}: interrupted", file=sys.stderr, flush=True)
         os._exit(130)
 
     return signal.signal(signal.SIGINT, handler)

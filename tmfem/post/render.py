@@ -173,7 +173,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
             scale, unit = (1e-6, "MPa") if _is_stress(name) else (1.0, _unit_of(name))
             grid[name] = vals * scale
             clim = _robust_range(vals * scale)
-            bar_title = f"{name} [{unit}]" if unit else name
+            bar_title = (f"{name} [{unit}]" if unit else name) + "\nelement values"
             if clim[1] < np.nanmax(vals * scale):
                 # a few corner elements (singular point attachment) lie above the range
                 bar_title += f"\n(max {np.nanmax(vals * scale):.3g} at corners)"
@@ -202,7 +202,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
         p.add_text(title, position="upper_edge", font_size=12, color="black")
     p.add_legend([["bar", "black"], ["tendon (taut)", "#2171b5"], ["tendon (slack)", "#e41a1c"],
                   ["membrane", "#f4c27a"]], bcolor="white", border=True, size=(0.2, 0.14),
-                 loc="lower right", face="rectangle")
+                 loc="upper right", face="rectangle")
     _set_view(p, X)
     p.camera.zoom(1.1)          # reset_camera frames the model; 1.3 cropped the 2-3's lowest node
     return _screenshot(p, png_path)

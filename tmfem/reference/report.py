@@ -102,18 +102,17 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     """
     from tmfem.equilibrium.design import design_equilibrium
     from tmfem.io.vtk import write_configuration, write_modes
-    from tmfem.models.com.modal import (default_membrane_modes, modal_summary,
-                                        printed_prestress_scale)
-    from tmfem.models.com.model import ControlOrientedModel
-    from tmfem.models.com.simulate import free_vibration, plot_free_vibration
-    from tmfem.models.mtc.dynamics import mtc_free_vibration
+    from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
-    from tmfem.models.mtc.post import (member_state, membrane_field, model_cells,
-                                       plot_membrane_stress, q_from_positions, static_summary)
+    from tmfem.models.mtc.post import member_state, q_from_positions, static_summary
     from tmfem.post.fields import placed_membrane_field
+    from tmfem.post.mtc import membrane_field, model_cells, plot_membrane_stress
+    from tmfem.post.plots import plot_free_vibration
+    from tmfem.reference.com_modal import modal_summary
     from tmfem.reference.study import plot_configuration, plot_membrane_stress as plot_design_stress
     from tmfem.reference.study import write_tables
     from tmfem.reference.tables import FREQUENCIES
+    from tmfem.simulation.vibration import free_vibration, mtc_free_vibration
 
     out = Path(out)
     name = system.name
