@@ -30,7 +30,7 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     assert float(rows[1][i]) == pytest.approx(0.01)
     assert float(rows[3][j]) > float(rows[1][j])
     assert png.stat().st_size > 1000
-    from tmfem.io.vtk import read_pvd
+    from tmfem.io.series import read_pvd
     frames = read_pvd(r["pvd"])
     assert [round(t, 6) for t, _ in frames] == [0.0, 0.1, 0.2, 0.3]
 

@@ -184,7 +184,7 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
     assert code == 0
     r = json.loads(capsys.readouterr().out)
     assert r["model"] == "mtc" and r["steps"] == 20 and r["ndof"] == 267
-    from tmfem.io.vtk import read_pvd
+    from tmfem.io.series import read_pvd
     assert [round(t, 6) for t, _ in read_pvd(r["pvd"])] == [0.0, 0.1, 0.2]
     assert (tmp_path / "m.png").stat().st_size > 1000
     rows = list(csv.reader(open(out)))

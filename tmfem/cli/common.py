@@ -198,7 +198,7 @@ def positive_int(text: str) -> int:
 def output_file(path, *, option: str, suffixes) -> Path:
     """An output file checked before the work starts: known suffix, parent directory
     creatable and writable, not a directory (:func:`tmfem.io.paths.check_path`)."""
-    from tmfem.io.vtk import check_path
+    from tmfem.io.paths import check_path
 
     if path is None:
         return None
@@ -210,7 +210,7 @@ def output_file(path, *, option: str, suffixes) -> Path:
 
 def output_dir(path, *, option: str) -> Path:
     """An output directory, created now and checked writable, before the work starts."""
-    from tmfem.io.vtk import check_dir
+    from tmfem.io.paths import check_dir
 
     if path is None:
         return None

@@ -87,7 +87,7 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
     files["configuration.png"] = str(plot_configuration(out / "configuration.png", d, system))
     files["membrane_stress.png"] = str(plot_membrane_stress(out / "membrane_stress.png", d))
     bar.step("VTK file")
-    from tmfem.io.vtk import write_configuration
+    from tmfem.io.writer import write_configuration
     from tmfem.post.fields import placed_membrane_field
     membrane = placed_membrane_field(system, d.membrane_model, d.membrane)
     files["configuration.vtu"] = str(write_configuration(

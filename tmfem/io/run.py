@@ -10,7 +10,7 @@ import csv
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import SeriesWriter
+from tmfem.io.series import SeriesWriter
 
 
 class RunOutputs:
@@ -22,7 +22,7 @@ class RunOutputs:
         CSV history: header ``columns``, one row per recorded step, flushed.
     columns : list of str
     vtk_dir : path or None
-        ParaView series (:class:`tmfem.io.vtk.SeriesWriter`), a frame every ``vtk_every`` steps.
+        ParaView series (:class:`tmfem.io.series.SeriesWriter`), a frame every ``vtk_every`` steps.
     vtk_every : int
     name : str
         Name of the ParaView series (parentheses dropped).

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.io.vtk import check_path
+from tmfem.io.paths import check_path
 from tmfem.post.plots import new_figure, save_figure
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import MembraneField
+from tmfem.io.fields import MembraneField
 
 
 def corner_radial_displacements(system, q=None) -> np.ndarray:

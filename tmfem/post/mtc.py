@@ -3,13 +3,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.io.vtk import MembraneField, check_path
+from tmfem.io.fields import MembraneField
+
+from tmfem.io.paths import check_path
 from tmfem.models.mtc.topology import to_floating
 from tmfem.post.plots import new_figure, save_figure
 
 
 def membrane_field(model, x: np.ndarray):
-    """The membrane of positions x as a :class:`tmfem.io.vtk.MembraneField` with displacement
+    """The membrane of positions x as a :class:`tmfem.io.fields.MembraneField` with displacement
     in the floating frame (point data) and sigma_p1, sigma_p2, von Mises and the floating-frame
     Cauchy components (cell data, element means), the membrane state ``membrane_state``
     (0 taut, 1 wrinkled, 2 slack) and the tension (wrinkle-crest) direction

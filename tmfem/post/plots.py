@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import check_path
+from tmfem.io.paths import check_path
 
 
 def new_figure(*, figsize=(7.0, 4.5)):

@@ -101,7 +101,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     dict (JSON-able): ``files`` (name -> path), ``tables``, ``ok`` and the summaries.
     """
     from tmfem.equilibrium.design import design_equilibrium
-    from tmfem.io.vtk import write_configuration, write_modes
+    from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
     from tmfem.models.mtc.post import member_state, q_from_positions, static_summary
@@ -245,9 +245,9 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
 
 
 def _kind_cell_data(cells) -> dict:
-    """Cell data ``kind`` (0 bar, 1 tendon, 2 membrane; tmfem.io.vtk.KIND_CODES) for the
+    """Cell data ``kind`` (0 bar, 1 tendon, 2 membrane; tmfem.io.codes.KIND_CODES) for the
     three cell blocks of an MTC mesh, so ParaView can separate them (Threshold on kind)."""
-    from tmfem.io.vtk import KIND_CODES
+    from tmfem.io.codes import KIND_CODES
 
     codes = (KIND_CODES["bar"], KIND_CODES["tendon"], KIND_CODES["membrane"])
     return {"kind": [np.full(c.shape[1], k, dtype=np.int64) for (_, c), k in zip(cells, codes)]}

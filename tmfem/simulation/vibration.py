@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tmfem.io.run import RunOutputs
-from tmfem.io.vtk import MembraneField
+from tmfem.io.fields import MembraneField
 from tmfem.models.com.plant import COMPlant
 from tmfem.models.mtc.dynamics import MTCDynamics, tendon_transverse
 from tmfem.models.mtc.post import member_state

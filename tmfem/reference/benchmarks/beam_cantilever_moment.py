@@ -38,7 +38,7 @@ def plot(result: dict, png):
     from matplotlib import colormaps
 
     from tmfem.post.plots import new_figure, save_figure
-    from tmfem.io.vtk import check_path
+    from tmfem.io.paths import check_path
     png = check_path(png, suffixes=(".png",))
     fig = new_figure(figsize=(12, 4.8))
     ax, bx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.25, 1]})
