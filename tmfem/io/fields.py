@@ -9,6 +9,12 @@ from tmfem.errors import InputError
 from tmfem.mesh.polygon import MembraneMesh
 
 
+#: The one name of the membrane displacement field in every output (design, MTC statics,
+#: COM series): displacement [m] from the flat reference membrane, 3 components in the
+#: floating frame O_f of the current corners (eq. 3.4).
+DISPLACEMENT_FIELD = "displacement_Of"
+
+
 @dataclass(frozen=True)
 class MembraneField:
     """A membrane mesh placed in space, with data for the output files.

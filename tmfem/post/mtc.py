@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.io.fields import MembraneField
+from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 
 from tmfem.io.paths import check_path
 from tmfem.models.mtc.topology import to_floating
@@ -30,7 +30,7 @@ def membrane_field(model, x: np.ndarray):
     wr = model.membrane.wrinkling(xm)
     cd["membrane_state"] = wr["state"].astype(np.int32)
     cd["wrinkle_direction"] = wr["direction"]
-    return MembraneField(mesh=topo.mesh, x=xm, point_data={"displacement_floating": xf - ref},
+    return MembraneField(mesh=topo.mesh, x=xm, point_data={DISPLACEMENT_FIELD: xf - ref},
                          cell_data=cd)
 
 

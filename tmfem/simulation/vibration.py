@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 from tmfem.io.run import RunOutputs
-from tmfem.io.fields import MembraneField
 from tmfem.models.com.plant import COMPlant
 from tmfem.models.mtc.dynamics import MTCDynamics, tendon_transverse
 from tmfem.models.mtc.post import member_state
@@ -94,7 +94,7 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
             out.series.append_configuration(
                 t, system, q=(model.P @ z)[: model.nq], tendon_forces=force, rest_lengths=rest,
                 membrane=MembraneField(mesh=model.membrane.mesh, x=xm,
-                                       point_data={"deflection_Of": defl}))
+                                       point_data={DISPLACEMENT_FIELD: defl}))
         T.append(t); Z.append(z.copy()); ZD.append(zd.copy()); W.append(w); XS.append(pos)
         out.row(t, np.concatenate([z, zd, w, pos.T.ravel()]))
 
