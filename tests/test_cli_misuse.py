@@ -57,7 +57,7 @@ def string_rest(tmp_path):
      BAD_INPUT, "at most once"),
     (["modal", "--preset", "1-4", "--mesh", "2000"], TOO_LARGE, "GiB"),
     (["equilibrium", "--preset", "1-4", "--mesh", "5000"], TOO_LARGE, "GiB"),
-    (["mesh", "--preset", "1-4", "--n", "20000", "OUT.msh"], TOO_LARGE, "GiB"),
+    (["mesh", "--preset", "1-4", "--mesh", "20000", "OUT.msh"], TOO_LARGE, "GiB"),
     (["study", "--preset", "2-3", "--out", "OUT", "--map-grid", "1"], BAD_INPUT, "--map-grid"),
     (["study", "--preset", "1-4", "--out", "OUT", "--mesh", "3000"], TOO_LARGE, "GiB"),
     (["static", "--preset", "1-4", "--rest-lengths", "S1=2.0"], BAD_INPUT, "every tendon is slack"),

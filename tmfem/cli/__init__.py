@@ -41,13 +41,26 @@ def _subcommands() -> dict:
     return dict(sorted(mods.items()))
 
 
+class _HelpWithDefaults(argparse.HelpFormatter):
+    """Help text that states every option's default (unless its help already does)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        d = action.default
+        if (action.option_strings and d not in (None, False, argparse.SUPPRESS, [], ())
+                and "default" not in text):
+            text += f" (default {d})"
+        return text
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tmfem", description="Tensegrity-membrane systems: "
                                      "equilibrium, finite-element and control-oriented models, control.")
     sub = parser.add_subparsers(dest="command", metavar="<command>")
     sub.required = True
     for name, mod in _subcommands().items():
-        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
+        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP,
+                           formatter_class=_HelpWithDefaults)
         p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
         mod.configure(p)
         p.set_defaults(_module=mod)

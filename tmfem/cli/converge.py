@@ -34,7 +34,8 @@ def configure(parser) -> None:
                         help="comma-separated membrane subdivisions n (N quads of n x n each)")
     parser.add_argument("--tendon-elements", default="3",
                         help="comma-separated numbers of truss elements per tendon")
-    parser.add_argument("--modes", type=int, default=12)
+    parser.add_argument("--modes", type=int, default=12,
+                        help="number of modes per run (Table 6.6: 12)")
     add_attachment_args(parser)
     add_membrane_law_arg(parser)
     parser.add_argument("--rest-lengths", default=None,

@@ -22,7 +22,9 @@ def configure(parser) -> None:
                         help="time step [s] (default 0.01, as in 6.5)")
     parser.add_argument("--perturb", action="append", default=[], metavar="STATE=VALUE",
                         help="initial perturbation, e.g. theta_11_dot=0.01 (repeatable)")
-    parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park")
+    parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park",
+                        help="time integrator: Park's stiffly stable method (eqs. 5.34-5.35) or "
+                             "the trapezoidal rule")
     parser.add_argument("--csv", help="write the histories to this CSV file (row by row)")
     parser.add_argument("--plot", help="write a plot of the monitored histories (PNG)")
     parser.add_argument("--vtk", metavar="DIR",
