@@ -31,6 +31,11 @@ log = logging.getLogger(__name__)
 class FreeVibration:
     """Result of :func:`free_vibration` (control-oriented model)."""
 
+    def __repr__(self) -> str:
+        return (f"FreeVibration({self.t.size} times to t = {self.t[-1]:.4g} s, "
+                f"{self.z.shape[1]} coordinates, {self.wall_time:.2f} s wall)")
+
+
     t: np.ndarray
     z: np.ndarray
     zd: np.ndarray
@@ -120,6 +125,11 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
 @dataclass
 class MTCVibration:
     """Result of :func:`mtc_free_vibration` (histories as arrays, one row per time)."""
+
+    def __repr__(self) -> str:
+        return (f"MTCVibration({self.t.size} times to t = {self.t[-1]:.4g} s, "
+                f"{self.q.shape[1]} coordinates, {self.wall_time:.2f} s wall)")
+
 
     t: np.ndarray
     q: np.ndarray                 # (nt, nq) generalised coordinates recovered from the bars

@@ -150,6 +150,14 @@ class System:
             object.__setattr__(self, "rest_lengths", rest_length_array(self.rest_lengths,
                                                                        len(tendons)))
 
+    def __repr__(self) -> str:
+        """One line (the arrays are attributes; ``tmfem.system.system_to_dict`` shows all)."""
+        kind = f"{self.M}-{self.N}" + ("(D)" if self.deployable else "")
+        rest = "" if self.rest_lengths is None else ", rest lengths given"
+        return (f"System({self.name!r}, {kind}, {len(self.node_labels)} nodes, "
+                f"{self.M * self.N} bars, {len(self.tendons)} tendons"
+                + ("" if self.symmetric is None else ", symmetric") + rest + ")")
+
     # ------------------------------------------------------------------ construction
     @classmethod
     def symmetric_system(cls, *, name: str, N: int, config: SymmetricConfig, r_mb: float,
