@@ -23,7 +23,8 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     assert 7.0 < r["min_tendon_force_N"] < 0.995 * 8.3228
     rows = list(csv.reader(open(out)))
     assert len(rows) == 32                       # header + t = 0 .. 0.3
-    head = rows[0]
+    head = [h.split(" [")[0] for h in rows[0]]   # the header gained units ("t [s]")
+    assert "theta_12_dot [rad/s]" in rows[0] and "B_12_z [m]" in rows[0]
     assert head[:2] == ["t", "theta_11"] and "w_1" in head and "B_12_z" in head
     # the initial rate is the perturbation; the bar starts to turn (theta_12 grows)
     i = head.index("theta_12_dot"); j = head.index("theta_12")

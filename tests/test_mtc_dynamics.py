@@ -189,7 +189,8 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
     assert (tmp_path / "m.png").stat().st_size > 1000
     rows = list(csv.reader(open(out)))
     assert len(rows) == 22                                 # header + t = 0 .. 0.2
-    head = rows[0]
+    head = [h.split(" [")[0] for h in rows[0]]   # the header gained units ("t [s]")
+    assert rows[0][:2] == ["t [s]", "theta_11 [rad]"]
     assert head[:4] == ["t", "theta_11", "psi_11", "theta_12"]
     assert {"w_1", "w_3", "B_12_z", "B_14_x", "tendon_deflection"} <= set(head)
     # the bar starts to turn at the perturbation rate: theta_12(0.01) - theta_12(0) ~ 0.01 dt

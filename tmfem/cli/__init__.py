@@ -135,6 +135,9 @@ def main(argv=None) -> int:
     try:
         result = mod.run(args)
         if args.json:
+            if isinstance(result, dict) and "units" not in result:
+                from tmfem.cli.units import units_of
+                result = {**result, "units": units_of(result)}
             text = json.dumps(_finite(result), default=json_default, allow_nan=False)
         else:
             text = getattr(mod, "format_text", _default_text)(result)
