@@ -9,6 +9,7 @@ from ``index.md`` (:func:`tmfem.reference.report.write_report`). ``make demo`` r
 from __future__ import annotations
 
 import sys
+import textwrap
 
 from tmfem.cli.common import (Progress, add_system_args, check_mesh_budget, check_time_steps,
                               output_dir, positive_float, positive_int, system_from_args)
@@ -71,6 +72,9 @@ def format_text(r: dict) -> str:
              tabulate(srows, headers=["MTC statics", "tendon stress [MPa]", "bar load [N]",
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
-             f"index: {r['out']}/index.md ({len(r['files'])} files); why the numbers differ "
-             "from the printed ones: see its first section and docs/errata.md"]
+             f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+    if r.get("notes"):
+        lines += ["", "why ours and the printed values differ (docs/errata.md):"]
+        lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
+                  for n in r["notes"]]
     return "\n".join(lines)

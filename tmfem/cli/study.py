@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import sys
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +30,7 @@ from tmfem.cli.common import (Progress, add_attachment_args, add_membrane_law_ar
                               check_mesh_budget, check_patch, output_dir, positive_int,
                               system_from_args)
 from tmfem.errors import InputError
+from tmfem.reference.report import explanations
 from tmfem.reference.study import (plot_configuration, plot_membrane_stress, text_table,
                                    write_tables)
 
@@ -78,7 +80,7 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
                               membrane_law=args.membrane_law)
     files = {}
     bar.step("tables")
-    tables = write_tables(out, d, system)
+    tables = write_tables(out, d, system, notes=explanations(system.name, "design"))
     for f in ("equilibrium.csv", "tendons.csv", "equilibrium.md"):
         files[f] = str(out / f)
     (out / "design.json").write_text(json.dumps(result, default=json_default))
@@ -122,6 +124,11 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
 
 def format_text(r: dict) -> str:
     lines = [text_table(r["table"]), ""]
+    notes = explanations(r["system"], "design")
+    if notes:
+        lines += ["why ours and the printed values differ (docs/errata.md):"]
+        lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
+                  for n in notes] + [""]
     lines.append("checks: " + ("all passed" if r["ok"] else "FAILED: " + ", ".join(r["failed_checks"])))
     lines.append(f"written to {r['out']}/: " + ", ".join(Path(f).name for f in r["files"].values()))
     return "\n".join(lines)

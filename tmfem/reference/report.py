@@ -35,26 +35,33 @@ IMPLIED_PRESTRESS = {"1-4": {"rest_lengths": {"S1": 1.5025},
 #: Perturbation of the free-vibration runs of 6.5 (initial rate [rad/s] of one coordinate).
 VIBRATION_PERTURBATION = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}
 
-#: What the report says beside its tables (reasons documented in docs/errata.md).
+#: What the study and the report say beside their tables (reasons in docs/errata.md):
+#: ``design`` beside the equilibrium table, ``models`` beside the MTC/COM results.
 EXPLANATIONS = {
-    "1-4": [
+    "1-4": {"design": [
         "The tendon stress, bar load and membrane stresses of the design are 22-34 % below "
         "Tables 6.3: the design of ch. 3 on the 4 x 10 x 10 mesh gives r_1^S = 1.5089 m and "
         "less prestress than the dissertation's results imply. The printed r_1^S = 1.529 m "
         "contradicts the dissertation's other tables: Table 6.3's tendon stress (37.98 MPa) "
         "and bar load (14.53 N) and all 12 frequencies of Table 6.6 agree on r_1^S = "
-        "1.5025 m (docs/errata.md, '1-4 prestress'). The runs 'implied prestress' use it.",
+        "1.5025 m (docs/errata.md, '1-4 prestress'); `tmfem report` runs the models at it.",
         "Membrane peak stresses sit in the elements at the point-attached corners: they "
         "grow like 1/h under mesh refinement and are a property of the mesh, not of the "
         "membrane (docs/errata.md, 'F_Delta and the membrane peak stresses are properties "
         "of the mesh'); the renders show element values.",
+    ], "models": [
         "At the implied prestress the MTC frequencies match Table 6.6 to < 0.1 %; the COM "
         "matches the printed COM column at 1.29 x the designed prestress (docs/errata.md, "
         "'COM frequencies').",
         "The MTC tendon stress at the implied prestress is ~2.6 % above the printed 37.98 "
         "MPa: the total-Lagrangian truss uses Green strain, eq. 3.8 the linear strain.",
-    ],
+    ]},
 }
+
+
+def explanations(name: str, part: str) -> list[str]:
+    """The notes of :data:`EXPLANATIONS` for system ``name`` (``part``: design or models)."""
+    return list(EXPLANATIONS.get(name, {}).get(part, []))
 
 #: Steps of :func:`write_report`, for a progress bar.
 STEPS = ("equilibrium design", "MTC statics (designed)", "MTC statics (implied)",
@@ -118,7 +125,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     name = system.name
     step = progress or (lambda s: None)
     files: dict[str, str] = {}
-    notes = EXPLANATIONS.get(name, [])
+    notes = explanations(name, "design") + explanations(name, "models")
     implied = IMPLIED_PRESTRESS.get(name)
     perturb = VIBRATION_PERTURBATION.get(name, {"theta_11_dot": 0.01})
 
@@ -127,7 +134,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
 
     # 1. design (ch. 3) ------------------------------------------------------------------
     d = design_equilibrium(system, mesh_n=mesh_n)
-    tables = write_tables(out, d, system, notes=notes)
+    tables = write_tables(out, d, system, notes=explanations(name, "design"))
     for f in ("equilibrium.md", "equilibrium.csv", "tendons.csv"):
         add(f, out / f)
     add("configuration.png", plot_configuration(out / "configuration.png", d, system))
@@ -239,6 +246,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     add("index.md", out / "index.md")
     step(STEPS[7])
     summary["files"] = files
+    summary["notes"] = notes
     summary["out"] = str(out)
     summary["ok"] = bool(d.ok)
     return summary
