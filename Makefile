@@ -1,5 +1,5 @@
 # Two commands do all the set-up on a fresh Debian machine with Python >= 3.11:
-#   make demo   -- install, then run a complete equilibrium study of the 1-4 system
+#   make demo   -- install, then the complete analysis of the 1-4 system (out/1-4/index.md)
 #   make test   -- install, then run the test suite
 PYTHON ?= python3
 VENV   := .venv
@@ -24,7 +24,7 @@ $(STAMP): pyproject.toml $(VENV)/.syslibs
 	@touch $@
 
 demo: $(STAMP)
-	$(BIN)/tmfem study --preset 1-4 --out $(OUT)/1-4
+	$(BIN)/tmfem report --preset 1-4 --out $(OUT)/1-4
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -48,7 +48,7 @@ def run_case(label, system, *, out=None):
         from tmfem.post.mtc import plot_membrane_stress
         plot_membrane_stress(out / f"membrane_stress_{label}.png", m, res.x,
                              title=f"1-4 MTC membrane stresses, {label} (Figs. 6.3-6.4)")
-        from tmfem.io.vtk import write_modes
+        from tmfem.io.writer import write_modes
         write_modes(out / f"modes_{label}.vtu", res.x, model_cells(m),
                     m.topology.T @ modes.shapes, modes.freq_hz)
     return m, res, st, modes

@@ -365,7 +365,7 @@ def test_driven_run_frames_carry_the_driven_rest_lengths_and_forces(m14, tmp_pat
     # the ParaView frames of a run with prescribed rest lengths u show T = k (|d| - u)
     # (eq. 3.8) for that u, computed here independently by ControlOrientedModel.tendon_forces
     import meshio
-    from tmfem.io.vtk import read_pvd
+    from tmfem.io.series import read_pvd
     from tmfem.simulation.vibration import free_vibration
     du = np.zeros(m14.n_t); du[1] = -1e-3
     res = free_vibration(m14, t_end=0.02, dt=0.01, u=m14.u0 + du, vtk_dir=tmp_path, vtk_every=1)

@@ -23,14 +23,15 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     assert 7.0 < r["min_tendon_force_N"] < 0.995 * 8.3228
     rows = list(csv.reader(open(out)))
     assert len(rows) == 32                       # header + t = 0 .. 0.3
-    head = rows[0]
+    head = [h.split(" [")[0] for h in rows[0]]   # the header gained units ("t [s]")
+    assert "theta_12_dot [rad/s]" in rows[0] and "B_12_z [m]" in rows[0]
     assert head[:2] == ["t", "theta_11"] and "w_1" in head and "B_12_z" in head
     # the initial rate is the perturbation; the bar starts to turn (theta_12 grows)
     i = head.index("theta_12_dot"); j = head.index("theta_12")
     assert float(rows[1][i]) == pytest.approx(0.01)
     assert float(rows[3][j]) > float(rows[1][j])
     assert png.stat().st_size > 1000
-    from tmfem.io.vtk import read_pvd
+    from tmfem.io.series import read_pvd
     frames = read_pvd(r["pvd"])
     assert [round(t, 6) for t, _ in frames] == [0.0, 0.1, 0.2, 0.3]
 

@@ -115,7 +115,7 @@ def test_membrane_design_field_lands_on_the_bar_tops():
     np.testing.assert_allclose(mf.x[:, mf.mesh.corners], B, atol=1e-12)
     # displacement from the undeformed membrane placed in O_f (corner N fixed): corner j
     # moves by Delta (e_j - e_N), e_j = (cos beta_j, sin beta_j) (eqs. 3.21, 3.22)
-    u = mf.point_data["displacement"].T
+    u = mf.point_data["displacement_Of"].T     # one field name in every output (was "displacement")
     b = beta(s.N)
     e = np.array([np.cos(b), np.sin(b)])
     Delta = s.symmetric.membrane_delta(s.N, s.r_mb)

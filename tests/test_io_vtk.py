@@ -1,4 +1,4 @@
-"""VTK output (tmfem.io.vtk): files read back with meshio and with VTK itself (pyvista)."""
+"""VTK output (tmfem.io): files read back with meshio and with VTK itself (pyvista)."""
 import h5py  # noqa: F401  (XDMF); meshio, pyvista, h5py are declared dependencies (pyproject.toml):
 import meshio            # a broken install must fail here, not skip
 import numpy as np
@@ -7,10 +7,9 @@ import pyvista as pv
 
 from tmfem.errors import InputError
 from tmfem.io import (FAMILY_CODES, KIND_CODES, MembraneField, SeriesWriter, configuration_cells,
-                      membrane_on_configuration, read_pvd, write_configuration, write_modes,
-                      write_series)
-from tmfem.io.vtk import mean_value_coordinates
+                      read_pvd, write_configuration, write_modes, write_series)
 from tmfem.mesh import polygon_quad_mesh
+from tmfem.post.placement import mean_value_coordinates, membrane_on_configuration
 from tmfem.system import load_preset
 
 

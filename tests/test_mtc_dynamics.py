@@ -184,12 +184,13 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
     assert code == 0
     r = json.loads(capsys.readouterr().out)
     assert r["model"] == "mtc" and r["steps"] == 20 and r["ndof"] == 267
-    from tmfem.io.vtk import read_pvd
+    from tmfem.io.series import read_pvd
     assert [round(t, 6) for t, _ in read_pvd(r["pvd"])] == [0.0, 0.1, 0.2]
     assert (tmp_path / "m.png").stat().st_size > 1000
     rows = list(csv.reader(open(out)))
     assert len(rows) == 22                                 # header + t = 0 .. 0.2
-    head = rows[0]
+    head = [h.split(" [")[0] for h in rows[0]]   # the header gained units ("t [s]")
+    assert rows[0][:2] == ["t [s]", "theta_11 [rad]"]
     assert head[:4] == ["t", "theta_11", "psi_11", "theta_12"]
     assert {"w_1", "w_3", "B_12_z", "B_14_x", "tendon_deflection"} <= set(head)
     # the bar starts to turn at the perturbation rate: theta_12(0.01) - theta_12(0) ~ 0.01 dt

@@ -70,7 +70,7 @@ def test_render_modes_grid(tmp_path, sys14):
     with pytest.raises(InputError, match=r"k: expected 1 <= k <= 4"):
         render_modes(tmp_path / "m.png", points=X, cells=configuration_cells(s), shapes=S,
                      freq_hz=[1.0, 2.0, 3.0, 4.0], k=5)
-    S[0, 1] = np.nan                    # same checks as io.write_modes (io.vtk.check_modes)
+    S[0, 1] = np.nan                    # same checks as io.write_modes (io.meshes.check_modes)
     with pytest.raises(InputError, match="non-finite"):
         render_modes(tmp_path / "m.png", points=X, cells=configuration_cells(s), shapes=S,
                      freq_hz=[1.0, 2.0, 3.0, 4.0], k=4)

@@ -2,7 +2,17 @@
 
 Every message states what was expected and what was found, with numbers, so that a
 user can act on it without reading a traceback. The CLI prints ``str(exc)`` on one
-line and exits with :attr:`TmfemError.exit_code`.
+line and exits with :attr:`TmfemError.exit_code` (the contract is in docs/cli.md):
+
+====  ==========================================================================
+0     success (with ``--allow-infeasible``: also when checks failed; they are listed)
+1     the analysis says no: infeasible design, slack tendon or membrane, a failed
+      design check, no convergence
+2     bad input: malformed system file, option out of range, unwritable output path
+3     the job would not fit this machine (estimated memory/time over the limit)
+4     an optional backend or dependency is not installed
+130   interrupted (Ctrl-C)
+====  ==========================================================================
 """
 
 
@@ -47,3 +57,11 @@ class SingularInputMatrix(TmfemError):
     """The actuated input matrix B_q of the collocated partial feedback linearisation (eq.
     5.46) is not square or not invertible at a configuration (its condition number exceeds
     the limit)."""
+    exit_code = 4
+
+
+class ResourceLimit(InputError):
+    """A job whose estimated memory or run time exceeds what this machine can give; the
+    message states the estimate and the limit."""
+
+    exit_code = 3

@@ -3,9 +3,14 @@
 Every module of this package that defines ``NAME``, ``HELP``, ``configure(parser)`` and
 ``run(args) -> dict`` is a subcommand. ``run`` returns a JSON-serialisable result; with
 ``--json`` it is printed as one JSON document on stdout, otherwise the module's
-``format_text(result) -> str`` (or a default rendering) is printed. A
-:class:`tmfem.errors.TmfemError` becomes a one-line message on stderr and a non-zero
-exit code, never a traceback.
+``format_text(result) -> str`` (or a default rendering) is printed.
+
+Exit codes (docs/cli.md): a :class:`tmfem.errors.TmfemError` becomes one line on stderr
+and its ``exit_code`` (1 the analysis says no, 2 bad input, 3 too large for this machine,
+4 missing backend); a result whose ``ok`` is false or whose ``checks`` failed is printed
+and exits 1 unless the command was given ``--allow-infeasible``; an output path that
+cannot be written is exit 2; Ctrl-C prints one line and exits 130. Never a traceback for
+any of these.
 """
 from __future__ import annotations
 
@@ -14,8 +19,11 @@ import importlib
 import json
 import logging
 import math
+import os
 import pkgutil
+import signal
 import sys
+import threading
 
 import numpy as np
 
@@ -33,13 +41,26 @@ def _subcommands() -> dict:
     return dict(sorted(mods.items()))
 
 
+class _HelpWithDefaults(argparse.HelpFormatter):
+    """Help text that states every option's default (unless its help already does)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        d = action.default
+        if (action.option_strings and d not in (None, False, argparse.SUPPRESS, [], ())
+                and "default" not in text):
+            text += f" (default {d})"
+        return text
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tmfem", description="Tensegrity-membrane systems: "
                                      "equilibrium, finite-element and control-oriented models, control.")
     sub = parser.add_subparsers(dest="command", metavar="<command>")
     sub.required = True
     for name, mod in _subcommands().items():
-        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP)
+        p = sub.add_parser(name, help=mod.HELP, description=mod.HELP,
+                           formatter_class=_HelpWithDefaults)
         p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
         mod.configure(p)
         p.set_defaults(_module=mod)
@@ -50,31 +71,100 @@ def _default_text(result) -> str:
     return json.dumps(result, indent=2, default=str)
 
 
-def _log_to_stderr() -> None:
-    """Library progress (``logging`` INFO of the ``tmfem`` loggers) as lines on stderr."""
-    log = logging.getLogger("tmfem")
-    if not log.handlers:
-        handler = logging.StreamHandler(sys.stderr)
-        handler.setFormatter(logging.Formatter("tmfem: %(message)s"))
-        log.addHandler(handler)
+def _one_line(text: str) -> str:
+    """A message on one line (numpy arrays in messages print over several)."""
+    return " ".join(str(text).split())
+
+
+def failed_checks(result) -> list[str]:
+    """Names of the failed checks of a command's result: ``result["failed_checks"]``, the
+    entries of ``result["checks"]`` whose ``ok`` is false, or ``["ok"]`` when only
+    ``result["ok"]`` is false."""
+    if not isinstance(result, dict):
+        return []
+    names = list(result.get("failed_checks") or [])
+    for c in result.get("checks") or []:
+        if isinstance(c, dict) and c.get("ok") is False:
+            n = c.get("name", c.get("check", "check"))
+            if n not in names:
+                names.append(n)
+    if not names and result.get("ok") is False:
+        names = ["ok"]
+    return names
+
+
+def _setup_logging() -> None:
+    """Library progress (``logging`` INFO of the ``tmfem`` loggers), warnings and log
+    records on stderr, one line each, prefixed ``tmfem:``."""
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("tmfem: %(message)s"))
+    for name in ("tmfem", "py.warnings"):
+        log = logging.getLogger(name)
+        if not log.handlers:
+            log.addHandler(handler)
+            log.propagate = False
         log.setLevel(logging.INFO)
+    logging.captureWarnings(True)
+
+
+def _install_interrupt_handler(command: str):
+    """Ctrl-C: one line and exit code 130, at once. A KeyboardInterrupt raised inside
+    compiled callbacks (CasADi functions of the control-oriented model) is swallowed there
+    and resurfaces as an unrelated error, so the handler ends the process itself; what was
+    written so far stays valid (CSV rows are flushed as they come, the .pvd collection is
+    rewritten atomically after each frame). Returns the previous handler (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def handler(signum, frame):
+        sys.stdout.flush()
+        # on a line of its own: a progress bar may be half drawn
+        print(f"\ntmfem {command}: interrupted", file=sys.stderr, flush=True)
+        os._exit(130)
+
+    return signal.signal(signal.SIGINT, handler)
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``tmfem`` console script; returns the exit code."""
-    _log_to_stderr()
+    """Entry point of the ``tmfem`` console script; returns the exit code (docs/cli.md)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     mod = args._module
+    _setup_logging()
+    previous = _install_interrupt_handler(args.command)
     try:
         result = mod.run(args)
+        if args.json:
+            if isinstance(result, dict) and "units" not in result:
+                from tmfem.cli.units import units_of
+                result = {**result, "units": units_of(result)}
+            text = json.dumps(_finite(result), default=json_default, allow_nan=False)
+        else:
+            text = getattr(mod, "format_text", _default_text)(result)
+        print(text)
     except TmfemError as exc:
-        print(f"tmfem {args.command}: error: {exc}", file=sys.stderr)
+        print(f"tmfem {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
-    if args.json:
-        print(json.dumps(_finite(result), default=_json_default, allow_nan=False))
-    else:
-        print(getattr(mod, "format_text", _default_text)(result))
+    except KeyboardInterrupt:
+        print(f"tmfem {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except OSError as exc:                     # an output that cannot be written
+        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"tmfem {args.command}: error: cannot write{where}: "
+              f"{exc.strerror or _one_line(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print(f"tmfem {args.command}: error: out of memory; use a coarser mesh or fewer "
+              "modes/steps", file=sys.stderr)
+        return 3
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGINT, previous)
+    failed = failed_checks(result)
+    if failed and not getattr(args, "allow_infeasible", False):
+        print(f"tmfem {args.command}: failed checks: {', '.join(map(str, failed))} "
+              "(exit 1; see docs/cli.md)", file=sys.stderr)
+        return 1
     return 0
 
 
@@ -92,7 +182,8 @@ def _finite(obj):
     return obj
 
 
-def _json_default(obj):
+def json_default(obj):
+    """``default`` of :func:`json.dumps` for numpy arrays and scalars."""
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     if isinstance(obj, np.generic):

@@ -30,10 +30,10 @@ def run(args) -> dict:
     if args.plot and not hasattr(mod, "plot"):
         raise InputError(f"--plot: benchmark {args.name!r} has no figure")
     if args.plot:
-        from tmfem.io.vtk import check_path
+        from tmfem.io.paths import check_path
         check_path(args.plot, suffixes=(".png",))
     if args.csv:
-        from tmfem.io.vtk import check_path
+        from tmfem.io.paths import check_path
         check_path(args.csv, suffixes=(".csv",))
     out = {"benchmark": args.name, "units": dict(mod.COLUMNS), **mod.run(reduced=args.reduced)}
     if args.csv:

@@ -1,11 +1,21 @@
-"""Options shared by subcommands: which system to use."""
+"""Options shared by subcommands (which system to use) and the checks every command runs on
+its options before any expensive step (docs/cli.md)."""
 from __future__ import annotations
 
 import argparse
+import logging
+import math
+import os
+import sys
 from contextlib import contextmanager
+from pathlib import Path
 
-from tmfem.errors import InputError
+import numpy as np
+
+from tmfem.errors import InputError, ResourceLimit
 from tmfem.system import System, load_preset, load_system
+
+log = logging.getLogger(__name__)
 
 
 def add_system_args(parser: argparse.ArgumentParser) -> None:
@@ -65,7 +75,17 @@ def model_options_from_args(args, command: str):
         raise InputError(f"{command} --model {args.model}: option does not apply: --backend "
                          f"(the {args.model} model solves small dense systems; --backend is for "
                          "the finite-element models)")
-    return system_from_args(args), options
+    system = system_from_args(args)
+    if isinstance(options.get("mesh"), int):
+        check_mesh_budget(N=system.N, n=options["mesh"])
+    for dest, suffixes in (("vtk", (".vtu", ".vtk", ".xdmf")), ("png", (".png",)),
+                           ("stress_plot", (".png",)), ("csv", (".csv",)), ("plot", (".png",))):
+        if getattr(args, dest, None) is not None and not (command == "vibrate" and dest == "vtk"):
+            output_file(getattr(args, dest), option="--" + dest.replace("_", "-"),
+                        suffixes=suffixes)
+    if command == "vibrate":
+        output_dir(getattr(args, "vtk", None), option="--vtk")
+    return system, options
 
 
 def model_from_args(args, command: str):
@@ -73,7 +93,11 @@ def model_from_args(args, command: str):
     options (:func:`model_options_from_args`)."""
     from tmfem.models.base import get_spec
     system, options = model_options_from_args(args, command)
-    return get_spec(args.model).build(system, options, args.backend or "scipy"), options
+    model = get_spec(args.model).build(system, options, args.backend or "scipy")
+    rest = getattr(model, "rest_lengths", None)
+    if rest is not None and np.ndim(rest) == 1 and len(rest) == len(system.tendons):
+        warn_long_rest_lengths(system, rest)     # all slack: an error before the solve
+    return model, options
 
 
 def add_attachment_args(parser) -> None:
@@ -102,8 +126,9 @@ def add_membrane_law_arg(parser) -> None:
 
 
 def parse_perturbation(items, names) -> dict:
-    """``["theta_11_dot=0.01", ...]`` -> {name: value}; names must be states of the model."""
-    out = {}
+    """``["theta_11_dot=0.01", ...]`` -> {name: value}; names must be states of the model,
+    each at most once, values finite."""
+    out, seen = {}, set()
     for it in items or []:
         if "=" not in it:
             raise InputError(f"perturbation: expected NAME=VALUE, found {it!r}")
@@ -115,6 +140,11 @@ def parse_perturbation(items, names) -> dict:
             out[k] = float(v)
         except ValueError:
             raise InputError(f"perturbation {k}: expected a number, found {v!r}") from None
+        if not math.isfinite(out[k]):
+            raise InputError(f"perturbation {k}: expected a finite number, found {v!r}")
+        if k in seen:
+            raise InputError(f"--perturb: each state at most once, found {k} twice")
+        seen.add(k)
     return out
 
 
@@ -132,3 +162,203 @@ def progress_bar(t_end: float, dt: float, label: str):
         yield update
     finally:
         bar.close()
+# ---------------------------------------------------------------------------- validation
+# Checked before any expensive step, so that a bad option costs nothing (docs/cli.md).
+
+def finite_float(text: str) -> float:
+    """argparse ``type``: a finite float (``inf``, ``nan`` and ``1e999`` are refused)."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, found {text!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"expected a finite number, found {text!r}")
+    return v
+
+
+def positive_float(text: str) -> float:
+    """argparse ``type``: a finite float > 0."""
+    v = finite_float(text)
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"expected a number > 0, found {text!r}")
+    return v
+
+
+def positive_int(text: str) -> int:
+    """argparse ``type``: an integer >= 1."""
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, found {text!r}") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, found {text!r}")
+    return v
+
+
+def output_file(path, *, option: str, suffixes) -> Path:
+    """An output file checked before the work starts: known suffix, parent directory
+    creatable and writable, not a directory (:func:`tmfem.io.paths.check_path`)."""
+    from tmfem.io.paths import check_path
+
+    if path is None:
+        return None
+    try:
+        return check_path(path, suffixes=tuple(suffixes))
+    except InputError as exc:
+        raise InputError(f"{option}: {exc}") from None
+
+
+def output_dir(path, *, option: str) -> Path:
+    """An output directory, created now and checked writable, before the work starts."""
+    from tmfem.io.paths import check_dir
+
+    if path is None:
+        return None
+    try:
+        return check_dir(path)
+    except InputError as exc:
+        raise InputError(f"{option}: {exc}") from None
+
+
+def machine_memory() -> float:
+    """Physical memory of this machine in bytes (24 GiB on the project's machines)."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):     # pragma: no cover - non-POSIX
+        return 24.0 * 2**30
+
+
+# Measured on the 1-4 MTC model (modal, 12 modes): peak RSS grows by ~8-11 kB per free
+# DOF from n = 20 (5 067 DOFs, 0.17 GB) to n = 80 (78 000 DOFs, 0.81 GB); 16 kB leaves
+# room for the fill of larger factorisations. Base: the interpreter with numpy/scipy/VTK.
+BYTES_PER_DOF = 16e3
+BASE_BYTES = 0.3e9
+MEMORY_FRACTION = 0.6         # of the physical memory: the machine is shared
+
+
+def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3) -> int:
+    """Refuse a membrane mesh whose FE model would not fit this machine.
+
+    The N n x n quadrilateral patches have about N (n + 1)^2 nodes, hence
+    ``dofs_per_node`` N (n + 1)^2 unknowns; the estimated peak memory is
+    ``BASE_BYTES + BYTES_PER_DOF * dofs`` and must stay under ``MEMORY_FRACTION`` of the
+    physical memory. Returns the DOF estimate.
+
+    Raises
+    ------
+    ResourceLimit
+        with the estimate and the limit.
+    """
+    dofs = dofs_per_node * N * (n + 1) ** 2
+    need = BASE_BYTES + BYTES_PER_DOF * dofs
+    limit = MEMORY_FRACTION * machine_memory()
+    if need > limit:
+        raise ResourceLimit(f"{option} {n}: the membrane mesh {N} x {n} x {n} gives about "
+                            f"{dofs:,} DOFs and needs about {need / 2**30:.1f} GiB; the limit "
+                            f"is {limit / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this "
+                            f"machine's {machine_memory() / 2**30:.0f} GiB)")
+    return dofs
+
+
+MAX_STEPS = 200_000
+
+
+def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> int:
+    """Number of time steps of a run of ``t_end`` s in steps of ``dt`` s, refused when it
+    is zero (dt > t_end), over ``MAX_STEPS`` or when the histories (``states`` values per
+    step, 8 bytes each, position and velocity) would not fit in memory."""
+    from tmfem.simulation.driver import check_time_grid
+
+    steps = check_time_grid(t_end, dt)
+    if steps > MAX_STEPS:
+        raise ResourceLimit(f"--t-end {t_end:g} s / --dt {dt:g} s = {steps:,} steps; the limit "
+                            f"is {MAX_STEPS:,} (raise --dt or lower --t-end)")
+    if states is not None:
+        need = 2 * 8.0 * states * steps
+        limit = MEMORY_FRACTION * machine_memory()
+        if need > limit:
+            raise ResourceLimit(f"{steps:,} steps x {states:,} states need {need / 2**30:.1f} "
+                                f"GiB of history; the limit is {limit / 2**30:.1f} GiB")
+    return steps
+
+
+def check_patch(system: System, patch) -> None:
+    """``--patch R``: 0 < R < half the shortest membrane edge (the patches of neighbouring
+    corners would overlap)."""
+    if patch is None:
+        return
+
+    c = system.membrane_corners
+    edge = float(np.min(np.linalg.norm(np.roll(c, -1, axis=1) - c, axis=0)))
+    if not (math.isfinite(patch) and 0 < patch < edge / 2):
+        raise InputError(f"--patch: expected 0 < R < {edge / 2:.4g} m (half the shortest "
+                         f"membrane edge of {system.name}), found {patch!r}")
+
+
+def warn_long_rest_lengths(system: System, rest=None) -> list[str]:
+    """Tendons whose rest length is at least their length in the design configuration
+    (slack there: a tension-only member carries no force). Returns one message per tendon
+    and logs each; all of them is an error (nothing prestresses the system)."""
+    r = system.rest_lengths if rest is None else np.asarray(rest, dtype=float)
+    if r is None:
+        return []
+    L = system.tendon_lengths()
+    names = system.tendon_names()
+    msgs = [f"tendon {names[k]}: rest length {r[k]:.5g} m >= its length {L[k]:.5g} m in the "
+            "design configuration; it is slack there" for k in np.flatnonzero(r >= L)]
+    if msgs and len(msgs) == len(names):
+        raise InputError(f"every tendon is slack at the design configuration: rest lengths "
+                         f"{np.round(r, 5).tolist()} m >= lengths {np.round(L, 5).tolist()} m; "
+                         "nothing prestresses the system (expected rest lengths shorter than "
+                         "the tendons)")
+    for m in msgs:
+        log.warning(m)
+    return msgs
+
+
+# ---------------------------------------------------------------------------- progress
+class Progress:
+    """The CLI's progress bar (tqdm on stderr; silent when stderr is not a terminal).
+
+    ``step(label)`` advances one stage of a multi-stage job and names the next one;
+    ``callback(desc)`` returns a ``progress(done, total)`` function for library loops
+    (e.g. :func:`tmfem.equilibrium.symmetric_map.equilibrium_map`) drawn as a nested bar.
+    """
+
+    def __init__(self, *, total: int, desc: str):
+        from tqdm import tqdm
+
+        self._tqdm = tqdm
+        self.bar = tqdm(total=total, desc=desc, unit="step", file=sys.stderr, disable=None,
+                        leave=True, dynamic_ncols=True)
+
+    def step(self, label: str) -> None:
+        self.bar.set_postfix_str(label, refresh=False)
+        self.bar.update(1)
+
+    def note(self, label: str) -> None:
+        """Show what runs now without advancing."""
+        self.bar.set_postfix_str(label)
+
+    def callback(self, desc: str):
+        inner = {}
+
+        def progress(done: int, total: int) -> None:
+            if "bar" not in inner:
+                inner["bar"] = self._tqdm(total=total, desc=desc, file=sys.stderr, disable=None,
+                                          leave=False, position=1, dynamic_ncols=True)
+            inner["bar"].n = done
+            inner["bar"].refresh()
+            if done >= total:
+                inner["bar"].close()
+        return progress
+
+    def close(self) -> None:
+        self.bar.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False

@@ -4,7 +4,7 @@ from __future__ import annotations
 import csv
 
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
-                              system_from_args)
+                              check_mesh_budget, output_file, system_from_args)
 from tmfem.errors import InputError
 from tmfem.models.mtc.spec import apply_rest_lengths
 from tmfem.post.convergence import plot_convergence_study
@@ -34,7 +34,8 @@ def configure(parser) -> None:
                         help="comma-separated membrane subdivisions n (N quads of n x n each)")
     parser.add_argument("--tendon-elements", default="3",
                         help="comma-separated numbers of truss elements per tendon")
-    parser.add_argument("--modes", type=int, default=12)
+    parser.add_argument("--modes", type=int, default=12,
+                        help="number of modes per run (Table 6.6: 12)")
     add_attachment_args(parser)
     add_membrane_law_arg(parser)
     parser.add_argument("--rest-lengths", default=None,
@@ -50,6 +51,10 @@ def run(args) -> dict:
     system, rest = apply_rest_lengths(system_from_args(args), args.rest_lengths)
     meshes = _ints(args.mesh, "--mesh")
     tendons = _ints(args.tendon_elements, "--tendon-elements")
+    for n in meshes:
+        check_mesh_budget(N=system.N, n=n)
+    output_file(args.csv, option="--csv", suffixes=(".csv",))
+    output_file(args.plot, option="--plot", suffixes=(".png",))
     rows = []
     writer = fh = None
     try:

@@ -98,7 +98,8 @@ def run(args) -> dict:
         from tmfem.post.deploy_plots import animate_deployment
         out["gif"] = str(animate_deployment(args.gif, s.model.system, r))
     if args.vtk:
-        from tmfem.io.vtk import configuration_cells, write_series
+        from tmfem.io.codes import configuration_cells
+        from tmfem.io.series import write_series
         sysm = s.model.system
         cells = configuration_cells(sysm)
         idx = range(0, r.t.size, 10)

@@ -12,7 +12,7 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import add_system_args, check_mesh_budget, output_file, system_from_args
 from tmfem.errors import InfeasibleDesign, InputError
 
 NAME = "export"
@@ -48,6 +48,9 @@ def run(args) -> dict:
     system = system_from_args(args)
     if args.mesh < 0:
         raise InputError(f"--mesh: expected n >= 0, found {args.mesh}")
+    check_mesh_budget(N=system.N, n=max(args.mesh, 1), dofs_per_node=2)
+    output_file(args.out, option="out", suffixes=(".vtu", ".xdmf", ".vtk"))
+    output_file(args.png, option="--png", suffixes=(".png",))
     warnings = []
     d = None
     if not args.no_equilibrium:

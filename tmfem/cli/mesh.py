@@ -1,7 +1,7 @@
 """``tmfem mesh``: the membrane mesh of a system (gmsh, N quadrilaterals of n x n, 6.2)."""
 from __future__ import annotations
 
-from tmfem.cli.common import add_system_args, system_from_args
+from tmfem.cli.common import add_system_args, check_mesh_budget, system_from_args
 from tmfem.errors import InputError
 
 NAME = "mesh"
@@ -11,7 +11,7 @@ HELP = "write the membrane mesh of a system (N quadrilaterals of n x n elements)
 def configure(parser) -> None:
     add_system_args(parser)
     parser.add_argument("out", help="output mesh file (.msh gmsh 2.2 ASCII, .vtu or .xdmf)")
-    parser.add_argument("--n", type=int, default=10,
+    parser.add_argument("--mesh", "--n", dest="n", type=int, default=10, metavar="n",
                         help="elements per side of each quadrilateral patch (default 10, as in 6.2)")
     parser.add_argument("--polygon", type=int, metavar="N",
                         help="a regular N-gon instead of a system's membrane (needs --r-mb)")
@@ -41,6 +41,9 @@ def run(args) -> dict:
     from tmfem.mesh import polygon_quad_mesh
 
     corners, name = membrane_corners_from_args(args)
+    if args.n < 1:
+        raise InputError(f"--mesh: expected n >= 1, found {args.n}")
+    check_mesh_budget(N=corners.shape[1], n=args.n, option="--mesh", dofs_per_node=1)
     mesh = polygon_quad_mesh(corners, args.n)
     path = write_membrane_mesh(args.out, mesh)
     return {"file": str(path), "membrane": name, "N": int(corners.shape[1]), "n": args.n,

@@ -69,7 +69,7 @@ def run(args) -> dict:
         shapes = model.topology.T @ modes.shapes
         cells = model_cells(model)
         if args.vtk:
-            from tmfem.io.vtk import write_modes
+            from tmfem.io.writer import write_modes
             out["vtk"] = str(write_modes(args.vtk, res.x, cells, shapes, modes.freq_hz))
         if args.png:
             from tmfem.post.render import render_modes

@@ -76,7 +76,7 @@ def write_outputs(args, model, x, summary) -> None:
     ms = member_state(model, x)
     mf = membrane_field(model, x)
     if args.vtk:
-        from tmfem.io.vtk import write_configuration
+        from tmfem.io.writer import write_configuration
         p = write_configuration(args.vtk, system, q=q, tendon_forces=ms["tendon_force"],
                                 rest_lengths=model.rest_lengths, membrane=mf,
                                 bar_forces=ms["bar_force"])

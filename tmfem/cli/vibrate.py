@@ -6,10 +6,9 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_model_args, add_system_args, model_from_args,
-                              parse_perturbation, progress_bar)
+from tmfem.cli.common import (add_model_args, finite_float, add_system_args, model_from_args,
+                              check_time_steps, parse_perturbation, progress_bar)
 from tmfem.models.mtc.spec import sequence_of
-from tmfem.simulation.driver import check_time_grid
 
 NAME = "vibrate"
 HELP = "free vibration after an initial perturbation (COM or MTC model, Park's method)"
@@ -18,11 +17,14 @@ HELP = "free vibration after an initial perturbation (COM or MTC model, Park's m
 def configure(parser) -> None:
     add_system_args(parser)
     add_model_args(parser, NAME, default="com")
-    parser.add_argument("--t-end", type=float, default=10.0, help="duration [s] (default 10)")
-    parser.add_argument("--dt", type=float, default=0.01, help="time step [s] (6.5: 0.01)")
+    parser.add_argument("--t-end", type=finite_float, default=10.0, help="duration [s] (default 10)")
+    parser.add_argument("--dt", type=finite_float, default=0.01,
+                        help="time step [s] (default 0.01, as in 6.5)")
     parser.add_argument("--perturb", action="append", default=[], metavar="STATE=VALUE",
                         help="initial perturbation, e.g. theta_11_dot=0.01 (repeatable)")
-    parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park")
+    parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park",
+                        help="time integrator: Park's stiffly stable method (eqs. 5.34-5.35) or "
+                             "the trapezoidal rule")
     parser.add_argument("--csv", help="write the histories to this CSV file (row by row)")
     parser.add_argument("--plot", help="write a plot of the monitored histories (PNG)")
     parser.add_argument("--vtk", metavar="DIR",
@@ -32,7 +34,7 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
-    check_time_grid(args.t_end, args.dt)
+    check_time_steps(t_end=args.t_end, dt=args.dt)
     model, options = model_from_args(args, NAME)
     if args.model == "mtc":
         return run_mtc(args, model, options)

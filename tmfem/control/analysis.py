@@ -21,11 +21,10 @@ def damping_table(sys) -> list:
 def plot_design(design, *, open_loop=None, path, title: str = "") -> None:
     """Write the four-panel closed-loop analysis figure of ``design`` (HinfDesign) to ``path``."""
     import control
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from tmfem.post.plots import new_figure, save_figure
     T = design.closed_loop
-    fig, ax = plt.subplots(2, 2, figsize=(12, 9))
+    fig = new_figure(figsize=(12, 9))
+    ax = fig.subplots(2, 2)
     # poles
     a = ax[0, 0]
     if open_loop is not None:
@@ -70,6 +69,4 @@ def plot_design(design, *, open_loop=None, path, title: str = "") -> None:
         a.set_title(f"{kind} response from {wn[j]}")
         a.legend(loc="best", fontsize=7)
     fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -74,6 +74,15 @@ class EquilibriumDesign:
     checks : list of :class:`Check`.
     """
 
+    def __repr__(self) -> str:
+        """One line: the prestress and the checks (the arrays are attributes)."""
+        failed = [c.name for c in self.checks if not c.ok]
+        return (f"EquilibriumDesign({len(self.tendon_forces)} tendons, F_Delta={self.F_Delta:.4g} N, "
+                f"T=[{self.tendon_forces.min():.4g}, {self.tendon_forces.max():.4g}] N, "
+                f"residual={self.residual:.2g}, "
+                + (f"failed checks {failed})" if failed else "all checks passed)"))
+
+
     system: object
     q: np.ndarray
     nodes: np.ndarray

@@ -18,8 +18,6 @@ of the given system: these are what the axes fix.
 """
 from __future__ import annotations
 
-import logging
-
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,7 +27,6 @@ from tmfem.equilibrium.symmetric import membrane_delta_system
 from tmfem.errors import InputError
 from tmfem.system.geometry import SymmetricConfig, wrap_angle
 
-log = logging.getLogger(__name__)
 
 
 def configuration_5_97(system, theta: float, psi: float, *, r=None, z=None,
@@ -100,7 +97,7 @@ class EquilibriumMap:
                 "reason": self.reason.tolist(), "columns": self.columns, "fixed": self.fixed}
 
 
-def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -> EquilibriumMap:
+def equilibrium_map(system, *, theta, psi, bases=None, progress=None) -> EquilibriumMap:
     """Evaluate the family of eq. 5.97 on a (theta, psi) grid [rad].
 
     At each point: the reduced (5M-3) x (6M-4) matrix of 3.3.2, the LP search for a
@@ -115,6 +112,8 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
         :class:`~tmfem.errors.InputError` (no admissible base at that point, e.g.
         :func:`tmfem.reference.tables.deployment_bases` where no r_2 satisfies eq. 3.22) the point is
         marked infeasible, its message kept in ``reason``, and the map goes on.
+    progress : callable, optional
+        ``progress(done, total)`` after each row of theta (the CLI draws a bar with it).
     """
     theta = np.atleast_1d(np.asarray(theta, dtype=float))
     psi = np.atleast_1d(np.asarray(psi, dtype=float))
@@ -145,8 +144,8 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress: bool = False) -
             if nv.dim == 1 and abs(nv.x[-1]) > 1e-12 * np.abs(nv.x).max():
                 ratios[a, b] = nv.x / nv.x[-1]
             Delta[a, b] = membrane_delta_system(s)
-        if progress:
-            log.info("equilibrium map: theta %d/%d", a + 1, theta.size)
+        if progress is not None:
+            progress(a + 1, theta.size)
     fixed = {"l": c.l.tolist(), "r": c.r.tolist(), "z": c.z.tolist(),
              "sigma_deg": np.degrees(c.sigma).tolist(), "r_mb": system.r_mb,
              "rule": "eq. 5.97: theta_i = theta, psi_i = psi + sigma_i"

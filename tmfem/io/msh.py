@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import check_path, require_h5py
+from tmfem.io.paths import check_path
+from tmfem.io.writer import require_h5py
 from tmfem.mesh.polygon import MembraneMesh
 
 MEMBRANE_TAG = 1

@@ -6,11 +6,28 @@ stops early (an error, Ctrl-C) leaves everything computed so far on disk.
 from __future__ import annotations
 
 import csv
+import re
 
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import SeriesWriter
+from tmfem.io.series import SeriesWriter
+
+
+_UNITS = [(r"t", "s"), (r"(theta|psi|sigma)_\d+", "rad"), (r"w_\d+", "m"),
+          (r"[xyz]_\d+", "m"), (r"[A-Z]+_[\d,]+_[xyz]", "m"), (r"tendon_deflection", "m"),
+          (r"(kinetic|strain)_energy", "J"), (r"u_.+|r_.+", "m"), (r"T_.+|force_.+", "N")]
+
+
+def column_header(name: str) -> str:
+    """``name [unit]`` for the CSV header of a run history (``theta_11`` -> ``theta_11 [rad]``,
+    ``theta_11_dot`` -> ``theta_11_dot [rad/s]``, ``B_12_z`` -> ``B_12_z [m]``); names whose
+    unit depends on the model (the COM's membrane coordinates eta_k, docs/com.md) stay bare."""
+    base, rate = (name[:-4], True) if name.endswith("_dot") else (name, False)
+    for pattern, unit in _UNITS:
+        if re.fullmatch(pattern, base):
+            return f"{name} [{unit}/s]" if rate else f"{name} [{unit}]"
+    return name
 
 
 class RunOutputs:
@@ -19,10 +36,11 @@ class RunOutputs:
     Parameters
     ----------
     csv_path : path or None
-        CSV history: header ``columns``, one row per recorded step, flushed.
+        CSV history: header ``columns`` with their units (:func:`column_header`), one row
+        per recorded step, flushed; ``\n`` line endings.
     columns : list of str
     vtk_dir : path or None
-        ParaView series (:class:`tmfem.io.vtk.SeriesWriter`), a frame every ``vtk_every`` steps.
+        ParaView series (:class:`tmfem.io.series.SeriesWriter`), a frame every ``vtk_every`` steps.
     vtk_every : int
     name : str
         Name of the ParaView series (parentheses dropped).
@@ -37,7 +55,7 @@ class RunOutputs:
         self.fh = open(csv_path, "w", newline="") if csv_path else None
         self.writer = csv.writer(self.fh, lineterminator="\n") if self.fh else None
         if self.writer:
-            self.writer.writerow(columns)
+            self.writer.writerow([column_header(c) for c in columns])
         self.vtk_every = vtk_every
         self.count = 0
         self.min_force = [np.inf, 0.0, ""]        # smallest tendon force, its time and tendon

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.io.vtk import check_path
-from tmfem.post.plots import _plt, _save
+from tmfem.io.paths import check_path
+from tmfem.post.plots import new_figure, save_figure
 
 
 def plot_convergence_study(path, rows, modes, name, attachment, *, by_tendons: bool):
@@ -12,10 +12,10 @@ def plot_convergence_study(path, rows, modes, name, attachment, *, by_tendons: b
     study (6.3, Figs. 6.11-6.14) against the membrane elements (log axis) or the elements
     per tendon."""
     path = check_path(path, suffixes=(".png",))
-    plt = _plt()
     x = np.array([r["tendon_elements"] if by_tendons else r["elements"] for r in rows], float)
     F = np.array([[r[f"f{i + 1}"] for i in range(modes)] for r in rows])
-    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig = new_figure(figsize=(12, 4.5))
+    ax = fig.subplots(1, 2)
     for i in range(modes):
         ax[0].plot(x, F[:, i], "o-", ms=3, label=f"mode {i + 1}")
     ax[0].set_xlabel("elements per tendon" if by_tendons else "membrane elements")
@@ -33,4 +33,4 @@ def plot_convergence_study(path, rows, modes, name, attachment, *, by_tendons: b
         ax[0].set_xscale("log")
         ax[1].set_xscale("log")
     ax[1].legend(fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)

@@ -9,16 +9,16 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.post.plots import _plt, _save
+from tmfem.post.plots import new_figure, save_figure
 
 
 def plot_deployment(png, result, *, title: str = "") -> Path:
     """Three panels: bar attitudes theta_1j, psi_1j against their references (Fig. 7.2), the
     membrane deflections w_1..w_3 (Fig. 7.3), rest lengths against their limits (the tendon
     lengths, Fig. 7.4); the switching time as a dashed line."""
-    plt = _plt()
     r = result
-    fig, ax = plt.subplots(3, 1, figsize=(8, 10), sharex=True)
+    fig = new_figure(figsize=(8, 10))
+    ax = fig.subplots(3, 1, sharex=True)
     names = r.names["q"]
     sel = [k for k, n in enumerate(names) if n.startswith(("theta_1", "psi_1"))][:4]
     for k in sel:
@@ -52,14 +52,13 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
         a.grid(alpha=0.3)
     if title:
         ax[0].set_title(title)
-    return _save(fig, Path(png))
+    return save_figure(fig, Path(png))
 
 
 def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     """GIF of the bars (thick), tendons (thin) and the membrane polygon (flat, its corners)
     over the run (Figures 7.5, 7.9, 7.14),
     with matplotlib's pillow writer."""
-    plt = _plt()
     from matplotlib.animation import FuncAnimation, PillowWriter
     r = result
     nq = len(r.names["q"])
@@ -68,7 +67,7 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     Cs = [system.membrane_corners_inertial(r.z[k, :nq]) for k in idx]
     allX = np.concatenate(Xs, axis=1)
     lo, hi = allX.min(axis=1), allX.max(axis=1)
-    fig = plt.figure(figsize=(5, 5))
+    fig = new_figure(figsize=(5, 5))
     ax = fig.add_subplot(projection="3d")
     bars, tends = system.bar_connectivity, system.tendon_connectivity
 
@@ -88,5 +87,4 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
         ax.set_title(f"t = {r.t[idx[i]]:.2f} s ({r.controller[min(idx[i], len(r.controller) - 1)]})")
     anim = FuncAnimation(fig, draw, frames=len(idx))
     anim.save(str(gif), writer=PillowWriter(fps=8))
-    plt.close(fig)
     return Path(gif)

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.equilibrium.symmetric_map import EquilibriumMap
-from tmfem.post.plots import _plt, _save
+from tmfem.post.plots import new_figure, save_figure
 
 
 def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
@@ -12,9 +12,9 @@ def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
 
     ``mark`` = (theta, psi) [rad] of a point to mark (e.g. the design).
     """
-    plt = _plt()
     th, ps = np.degrees(emap.theta), np.degrees(emap.psi)
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    fig = new_figure(figsize=(6.4, 4.8))
+    ax = fig.subplots()
     ax.contourf(ps, th, emap.feasible.astype(float), levels=[0.5, 1.5], colors=["#9fd49f"])
     if emap.theta.size > 1 and emap.psi.size > 1:
         m = np.where(np.isfinite(emap.margin), emap.margin, -1.0)
@@ -27,4 +27,4 @@ def plot_equilibrium_map(png, emap: EquilibriumMap, *, mark=None, title=None):
     ax.set_ylabel("theta [deg]")
     ax.set_title(title or "symmetric equilibria (green); blue: null vector positive "
                  "boundary, red dashed: Delta = 0", fontsize=9)
-    return _save(fig, png)
+    return save_figure(fig, png)

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import MembraneField
+from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 
 
 def corner_radial_displacements(system, q=None) -> np.ndarray:
@@ -48,7 +48,8 @@ def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "poi
 
     Returns
     -------
-    MembraneField with point data ``displacement`` (inertial frame) and cell data
+    MembraneField with point data ``displacement_Of`` (floating frame O_f, the name used by
+    every output: :data:`tmfem.io.fields.DISPLACEMENT_FIELD`) and cell data
     ``von_mises`` and ``sigma_p1`` (element maxima over the quadrature points, as the maxima
     of Tables 6.3 / 6.5 are taken), ``sigma_p2`` (element minimum), ``von_mises_mean``,
     ``membrane_state`` (0 taut, 1 wrinkled, 2 slack) and ``wrinkle_direction`` (inertial
@@ -84,14 +85,14 @@ def placed_membrane_field(system, model, sol, *, q=None) -> MembraneField:
     """
     _, o, R = system.corner_displacements(q)
     mesh = model.mesh
-    u = R[:, :2] @ sol.u                      # in-plane displacement in the inertial frame
-    x = o[:, None] + R[:, :2] @ mesh.p + u
+    x = o[:, None] + R[:, :2] @ (mesh.p + sol.u)
+    u_f = np.vstack([sol.u, np.zeros(sol.u.shape[1])])      # in-plane: w = 0 in O_f
     vm = sol.von_mises()
     pr = sol.principal()
     dofs = np.zeros(model.basis.N)
     dofs[model.basis.nodal_dofs] = sol.u
     wr = model.wrinkling(dofs)
-    return MembraneField(mesh=mesh, x=x, point_data={"displacement": u},
+    return MembraneField(mesh=mesh, x=x, point_data={DISPLACEMENT_FIELD: u_f},
                          cell_data={"von_mises": vm.max(axis=1), "sigma_p1": pr[0].max(axis=1),
                                     "sigma_p2": pr[1].min(axis=1),
                                     "von_mises_mean": vm.mean(axis=1),

@@ -3,13 +3,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.io.vtk import MembraneField, check_path
+from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
+
+from tmfem.io.paths import check_path
 from tmfem.models.mtc.topology import to_floating
-from tmfem.post.plots import _plt, _save
+from tmfem.post.plots import new_figure, save_figure
 
 
 def membrane_field(model, x: np.ndarray):
-    """The membrane of positions x as a :class:`tmfem.io.vtk.MembraneField` with displacement
+    """The membrane of positions x as a :class:`tmfem.io.fields.MembraneField` with displacement
     in the floating frame (point data) and sigma_p1, sigma_p2, von Mises and the floating-frame
     Cauchy components (cell data, element means), the membrane state ``membrane_state``
     (0 taut, 1 wrinkled, 2 slack) and the tension (wrinkle-crest) direction
@@ -28,7 +30,7 @@ def membrane_field(model, x: np.ndarray):
     wr = model.membrane.wrinkling(xm)
     cd["membrane_state"] = wr["state"].astype(np.int32)
     cd["wrinkle_direction"] = wr["direction"]
-    return MembraneField(mesh=topo.mesh, x=xm, point_data={"displacement_floating": xf - ref},
+    return MembraneField(mesh=topo.mesh, x=xm, point_data={DISPLACEMENT_FIELD: xf - ref},
                          cell_data=cd)
 
 
@@ -50,8 +52,8 @@ def plot_membrane_stress(png, model, x: np.ndarray, *, title: str | None = None)
     fields = [("sigma_p1", st.principal_elem[0]),
               ("sigma_p2 (in-plane minor)", st.principal_elem[1] + st.principal_elem[2]),
               ("von Mises", st.von_mises_elem)]
-    plt = _plt()
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig = new_figure(figsize=(15, 4.6))
+    axes = fig.subplots(1, 3)
     verts = np.stack([xf[0, topo.mesh.t].T, xf[1, topo.mesh.t].T], axis=-1)    # (ne, 4, 2)
     for ax, (name, v) in zip(axes, fields):
         pc = PolyCollection(verts, array=v / 1e6, cmap="viridis", edgecolors="none")
@@ -60,11 +62,11 @@ def plot_membrane_stress(png, model, x: np.ndarray, *, title: str | None = None)
         ax.set_aspect("equal")
         ax.set_xlabel("x_f [m]")
         ax.set_ylabel("y_f [m]")
-        ax.set_title(f"{name}: max {v.max() / 1e6:.3f} MPa")
+        ax.set_title(f"{name} (element means): max {v.max() / 1e6:.3f} MPa")
         fig.colorbar(pc, ax=ax, label="MPa", shrink=0.8)
     if title:
         fig.suptitle(title)
-    return _save(fig, png)
+    return save_figure(fig, png)
 
 
 def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
@@ -73,6 +75,7 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
     the wrinkled elements; the legend gives the area fraction of each state (Gauss points)."""
     from matplotlib.collections import LineCollection, PolyCollection
     from matplotlib.colors import ListedColormap
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     from tmfem.fem.tension_field import STATE_NAMES, WRINKLED
@@ -85,8 +88,8 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
     t = topo.mesh.t
     verts = np.stack([xf[0, t].T, xf[1, t].T], axis=-1)
     colours = ["#d9d9d9", "#e6550d", "#3182bd"]
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(7.0, 7.6))
+    fig = new_figure(figsize=(7.0, 7.6))
+    ax = fig.subplots()
     pc = PolyCollection(verts, array=wr["state"].astype(float), cmap=ListedColormap(colours),
                         edgecolors="none")
     pc.set_clim(-0.5, 2.5)
@@ -106,8 +109,8 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
     fr = wr["fractions"]
     ax.legend(handles=[Patch(color=colours[i], label=f"{n} ({100 * fr[n]:.1f} % of Gauss points)")
                        for i, n in enumerate(STATE_NAMES)]
-              + ([plt.Line2D([], [], color="k", lw=0.8, label="tension (wrinkle) direction")]
+              + ([Line2D([], [], color="k", lw=0.8, label="tension (wrinkle) direction")]
                  if w.any() else []),
               loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2, fontsize=8)
     ax.set_title(title or f"{model.system.name} MTC membrane states ({model.membrane_law} law)")
-    return _save(fig, png)
+    return save_figure(fig, png)

@@ -1,4 +1,5 @@
-"""Line plots for studies (matplotlib, Agg backend: no display needed).
+"""Line plots for studies (matplotlib's object-oriented API: a ``Figure`` rendered by the Agg
+canvas; no pyplot state, no backend switch, no display needed).
 
 Small and generic: histories over time, convergence over mesh size, a computed-vs-printed
 comparison. Each function writes one PNG and returns its path.
@@ -10,21 +11,33 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import check_path
+from tmfem.io.paths import check_path
 
 
-def _plt():
-    import matplotlib
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-    return plt
+def new_figure(*, figsize=(7.0, 4.5)):
+    """A matplotlib ``Figure`` (object-oriented API; it is not registered with pyplot, so
+    nothing needs closing and the caller's backend is left alone)."""
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=figsize, layout="constrained")
 
 
-def _save(fig, png: Path) -> Path:
-    fig.tight_layout()
+def save_figure(fig, png) -> Path:
+    """Write ``fig`` to ``png`` (120 dpi) and return the path."""
     fig.savefig(png, dpi=120)
-    _plt().close(fig)
-    return png
+    return Path(png)
+
+
+def mode_styles(k: int) -> list[dict]:
+    """``k`` distinct line styles (colour x dash x marker) for mode-by-mode plots: 12 modes
+    get 12 different combinations (tab20 colours, four dash patterns, markers)."""
+    from matplotlib import colormaps
+
+    colours = colormaps["tab20"].colors
+    dashes = ["-", "--", "-.", ":"]
+    markers = ["o", "s", "^", "D", "v", "P"]
+    return [{"color": colours[(2 * i) % 20 + (i // 10) % 2], "linestyle": dashes[i % 4],
+             "marker": markers[i % 6]} for i in range(k)]
 
 
 def _finite_1d(name: str, v, n: int | None = None) -> np.ndarray:
@@ -47,10 +60,9 @@ def plot_histories(png, t, series: dict, *, ylabel: str, title: str | None = Non
     if not series:
         raise InputError("series: expected at least one history")
     data = {k: _finite_1d(f"series {k!r}", v, t.size) for k, v in series.items()}
-    plt = _plt()
     if subplots:
-        fig, axes = plt.subplots(len(data), 1, sharex=True,
-                                 figsize=(7, 1.8 * len(data) + 0.8), squeeze=False)
+        fig = new_figure(figsize=(7, 1.8 * len(data) + 0.8))
+        axes = fig.subplots(len(data), 1, sharex=True, squeeze=False)
         for ax, (k, v) in zip(axes[:, 0], data.items()):
             ax.plot(t, v, lw=1.2)
             ax.set_ylabel(k)
@@ -59,7 +71,8 @@ def plot_histories(png, t, series: dict, *, ylabel: str, title: str | None = Non
         axes[0, 0].set_title(title or "")
         fig.supylabel(ylabel)
     else:
-        fig, ax = plt.subplots(figsize=(7, 4.2))
+        fig = new_figure(figsize=(7, 4.2))
+        ax = fig.subplots()
         for k, v in data.items():
             ax.plot(t, v, lw=1.2, label=k)
         ax.set_xlabel(xlabel)
@@ -69,7 +82,7 @@ def plot_histories(png, t, series: dict, *, ylabel: str, title: str | None = Non
         ax.grid(True, alpha=0.3)
         if len(data) > 1:
             ax.legend(fontsize=8)
-    return _save(fig, png)
+    return save_figure(fig, png)
 
 
 def fit_rates(h, values, reference) -> np.ndarray:
@@ -113,19 +126,20 @@ def plot_convergence(png, h, values, *, labels, xlabel: str = "h", ylabel: str =
     labels = list(labels)
     if len(labels) != V.shape[1]:
         raise InputError(f"labels: expected {V.shape[1]} labels, found {len(labels)}")
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(7, 4.5))
+    fig = new_figure(figsize=(7, 4.5))
+    ax = fig.subplots()
+    styles = mode_styles(len(labels))
     if reference is not None:
         ref = _finite_1d("reference", reference, V.shape[1])
         err = np.abs(V - ref) / np.where(ref == 0, 1.0, np.abs(ref))
         rates = fit_rates(h, V, ref)
         for c, lab in enumerate(labels):
             ok = err[:, c] > 0
-            ax.loglog(h[ok], err[ok, c], "o-", label=f"{lab} (rate {rates[c]:.2f})")
+            ax.loglog(h[ok], err[ok, c], label=f"{lab} (rate {rates[c]:.2f})", **styles[c])
         ax.set_ylabel("relative error")
     else:
         for c, lab in enumerate(labels):
-            ax.plot(h, V[:, c], "o-", label=lab)
+            ax.plot(h, V[:, c], label=lab, **styles[c])
         if loglog:
             ax.set_xscale("log")
             ax.set_yscale("log")
@@ -135,7 +149,7 @@ def plot_convergence(png, h, values, *, labels, xlabel: str = "h", ylabel: str =
         ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8, ncol=2 if len(labels) > 6 else 1)
-    return _save(fig, png)
+    return save_figure(fig, png)
 
 
 def plot_table_comparison(png, names, computed, printed, *, ylabel: str,
@@ -148,8 +162,8 @@ def plot_table_comparison(png, names, computed, printed, *, ylabel: str,
     b = np.asarray(printed, dtype=float)
     if b.shape != a.shape:
         raise InputError(f"printed: expected shape {a.shape}, found {b.shape}")
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(max(6.0, 0.7 * len(names) + 2), 4.5))
+    fig = new_figure(figsize=(max(6.0, 0.7 * len(names) + 2), 4.5))
+    ax = fig.subplots()
     x = np.arange(len(names))
     ax.bar(x - 0.2, a, 0.4, label=labels[0], color="#2171b5")
     ax.bar(x + 0.2, np.nan_to_num(b), 0.4, label=labels[1], color="#bbbbbb")
@@ -166,7 +180,7 @@ def plot_table_comparison(png, names, computed, printed, *, ylabel: str,
         ax.set_title(title)
     ax.legend(fontsize=8)
     ax.grid(True, axis="y", alpha=0.3)
-    return _save(fig, png)
+    return save_figure(fig, png)
 
 
 def plot_xy(png, curves: dict, *, xlabel: str, ylabel: str, title: str | None = None) -> Path:
@@ -175,8 +189,8 @@ def plot_xy(png, curves: dict, *, xlabel: str, ylabel: str, title: str | None = 
     png = check_path(png, suffixes=(".png",))
     if not curves:
         raise InputError("curves: expected at least one (x, y) curve")
-    plt = _plt()
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    fig = new_figure(figsize=(6.5, 4.5))
+    ax = fig.subplots()
     styles = ["-", "--", ":", "-."]
     for k, (label, (x, y)) in enumerate(curves.items()):
         x = _finite_1d(f"{label!r} x", x)
@@ -188,15 +202,15 @@ def plot_xy(png, curves: dict, *, xlabel: str, ylabel: str, title: str | None = 
         ax.set_title(title)
     ax.legend(fontsize=8)
     ax.grid(True, alpha=0.3)
-    return _save(fig, png)
+    return save_figure(fig, png)
 
 
 def plot_free_vibration(result, path, *, title: str = "") -> str:
     """Monitored node coordinates and membrane deflections vs time (Figs. 6.21-6.28) of a
     free-vibration result (``nodes``: label -> (nt, 3), ``w`` (nt, k), ``t``)."""
-    plt = _plt()
     nn = len(result.nodes)
-    fig, axes = plt.subplots(nn + 1, 1, figsize=(8, 2.4 * (nn + 1)), sharex=True)
+    fig = new_figure(figsize=(8, 2.4 * (nn + 1)))
+    axes = fig.subplots(nn + 1, 1, sharex=True)
     axes = np.atleast_1d(axes)
     for ax, (name, X) in zip(axes, result.nodes.items()):
         for c, lab in enumerate("xyz"):
@@ -208,7 +222,4 @@ def plot_free_vibration(result, path, *, title: str = "") -> str:
     ax.set_ylabel("w [mm]"); ax.set_xlabel("t [s]"); ax.legend(loc="upper right", fontsize=7)
     if title:
         axes[0].set_title(title)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return str(path)
+    return str(save_figure(fig, path))

@@ -12,10 +12,11 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.vtk import (MembraneField, _normalise_cells, check_modes, check_path, member_data,
-                          membrane_corner_nodes)
+from tmfem.io.codes import KIND_CODES
+from tmfem.io.fields import MembraneField
+from tmfem.io.meshes import configuration_mesh, modes_mesh
+from tmfem.io.paths import check_path
 
-_VTK_TYPES = {"vertex": 1, "line": 3, "triangle": 5, "quad": 9, "polygon": 7}
 BACKGROUND = "white"
 
 
@@ -33,21 +34,11 @@ def _tendon_cmap():
     return LinearSegmentedColormap.from_list("tendon", ["#9ecae1", "#2171b5", "#08306b"])
 
 
-def _ugrid(pv, points: np.ndarray, blocks: list):
-    """A pyvista UnstructuredGrid from points (3, n) and (type, conn (nv, nc)) blocks."""
-    cells, types = [], []
-    for ctype, conn in blocks:
-        nv, nc = conn.shape
-        cells.append(np.vstack([np.full(nc, nv), conn]).T.ravel())
-        types.append(np.full(nc, _VTK_TYPES[ctype], dtype=np.uint8))
-    return pv.UnstructuredGrid(np.concatenate(cells).astype(np.int64), np.concatenate(types),
-                               np.ascontiguousarray(points.T, dtype=float))
-
-
-def _segments(pv, X: np.ndarray, conn: np.ndarray):
-    """PolyData with one line cell per column of conn (2, m)."""
-    lines = np.vstack([np.full(conn.shape[1], 2), conn]).T.ravel()
-    return pv.PolyData(np.ascontiguousarray(X.T, dtype=float), lines=lines)
+def _part(pv, grid, kind: str):
+    """The cells of ``grid`` (read from a configuration's meshio.Mesh) whose cell data
+    ``kind`` is ``kind`` (bar, tendon, membrane), as a grid of their own."""
+    ids = np.flatnonzero(np.asarray(grid.cell_data["kind"]) == KIND_CODES[kind])
+    return grid.extract_cells(ids)
 
 
 def _screenshot(plotter, png_path: Path) -> Path:
@@ -78,6 +69,18 @@ def _robust_range(v: np.ndarray) -> list:
     return [lo, top] if top > lo else [lo, lo + 1.0]
 
 
+_STRESS_NAMES = ("von_mises", "sigma_p1", "sigma_p2", "sigma_xf", "sigma_yf", "tau_xfyf")
+
+
+def _is_stress(name: str) -> bool:
+    """Membrane stress fields (Pa in the data, shown in MPa)."""
+    return name.startswith(_STRESS_NAMES)
+
+
+def _unit_of(name: str) -> str:
+    return "m" if "displacement" in name or "deflection" in name else ""
+
+
 def render_configuration(png_path, system, *, q=None, tendon_forces=None, membrane=None,
                          title=None, window_size=(1200, 900), membrane_field: str | None = None,
                          labels: bool | None = None) -> Path:
@@ -104,33 +107,36 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
         Draw node labels A_ij, B_ij, H_1j (default: when there are at most 40 nodes).
     """
     png_path = check_path(png_path, suffixes=(".png",))
+    if membrane is not None and not isinstance(membrane, MembraneField):
+        raise InputError(f"membrane: expected a MembraneField, found {type(membrane).__name__}")
     pv = _pv()
     X = system.nodes(q)
-    md = member_data(system, q=q, tendon_forces=tendon_forces)
-    nb = system.M * system.N
+    # the picture is drawn from the same meshio.Mesh that write_configuration writes
+    grid = pv.from_meshio(configuration_mesh(system, q=q, tendon_forces=tendon_forces,
+                                             membrane=membrane))
     size = float(np.ptp(X, axis=1).max()) or 1.0
     r_bar = 0.009 * size
     r_ten = 0.0035 * size
 
     p = pv.Plotter(off_screen=True, window_size=list(window_size))
     p.set_background(BACKGROUND)
-    p.add_mesh(_segments(pv, X, system.bar_connectivity).tube(radius=r_bar, n_sides=16),
+    p.add_mesh(_part(pv, grid, "bar").extract_surface(algorithm=None).tube(radius=r_bar, n_sides=16),
                color="black", smooth_shading=True)
 
-    con = system.tendon_connectivity
+    tendons = _part(pv, grid, "tendon")
     if tendon_forces is None:
-        p.add_mesh(_segments(pv, X, con).tube(radius=r_ten, n_sides=12), color="#2171b5",
+        p.add_mesh(tendons.extract_surface(algorithm=None).tube(radius=r_ten, n_sides=12), color="#2171b5",
                    smooth_shading=True)
     else:
-        f = md["axial_force"][nb:]
+        f = np.asarray(tendons.cell_data["axial_force"], dtype=float)
         taut = f > 0
         fmax = float(f[taut].max()) if np.any(taut) else 1.0
         if np.any(taut):
             # one tube per tendon so that the width follows its force (n_tendons is small)
             tubes = []
             for k in np.nonzero(taut)[0]:
-                seg = _segments(pv, X, con[:, [k]])
-                tube = seg.tube(radius=r_ten * (0.5 + 1.0 * f[k] / fmax), n_sides=12)
+                tube = tendons.extract_cells([k]).extract_surface(algorithm=None).tube(
+                    radius=r_ten * (0.5 + 1.0 * f[k] / fmax), n_sides=12)
                 tube.point_data["tendon force [N]"] = np.full(tube.n_points, f[k])
                 tubes.append(tube)
             merged = tubes[0].merge(tubes[1:]) if len(tubes) > 1 else tubes[0]
@@ -139,37 +145,39 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
                        clim=[0.0, fmax], smooth_shading=True,
                        scalar_bar_args=_scalar_bar("tendon force [N]", position_x=0.86))
         if np.any(~taut):
-            p.add_mesh(_segments(pv, X, con[:, ~taut]).tube(radius=0.8 * r_ten, n_sides=8),
-                       color="#e41a1c", ambient=0.6)
+            slack = tendons.extract_cells(np.flatnonzero(~taut)).extract_surface(algorithm=None)
+            p.add_mesh(slack.tube(radius=0.8 * r_ten, n_sides=8), color="#e41a1c", ambient=0.6)
 
+    mem = _part(pv, grid, "membrane")
     if membrane is not None:
-        if not isinstance(membrane, MembraneField):
-            raise InputError(f"membrane: expected a MembraneField, found {type(membrane).__name__}")
-        grid = _ugrid(pv, membrane.x, [("quad", membrane.mesh.t)])
         name = membrane_field
         if name is None and membrane.cell_data:
             name = next(iter(membrane.cell_data))
         if name is not None:
-            if name in membrane.cell_data:
-                grid.cell_data[name] = membrane.cell_data[name]
-            elif name in membrane.point_data:
-                grid.point_data[name] = membrane.point_data[name]
-            else:
+            if name not in membrane.cell_data and name not in membrane.point_data:
                 raise InputError(f"membrane_field {name!r}: expected one of "
                                  f"{sorted(membrane.cell_data) + sorted(membrane.point_data)}")
-            vals = np.asarray(grid[name], dtype=float).ravel()
-            clim, bar_title = _robust_range(vals), name
-            if clim[1] < np.nanmax(vals):
-                bar_title = f"{name} (clipped)"
-            p.add_mesh(grid, scalars=name, cmap="viridis", opacity=0.9, show_edges=True,
+            vals = np.asarray(mem[name], dtype=float)
+            vals = vals if vals.ndim == 1 else np.linalg.norm(vals, axis=1)
+            scale, unit = (1e-6, "MPa") if _is_stress(name) else (1.0, _unit_of(name))
+            shown = f"{name} [{unit}]" if unit else name
+            if name in membrane.cell_data:
+                mem.cell_data[shown] = vals * scale
+            else:
+                mem.point_data[shown] = vals * scale
+            clim = _robust_range(vals * scale)
+            bar_title = shown + ("\nelement values" if name in membrane.cell_data else "")
+            if clim[1] < np.nanmax(vals * scale):
+                # a few corner elements (singular point attachment) lie above the range
+                bar_title += f"\n(max {np.nanmax(vals * scale):.3g} at corners)"
+            p.add_mesh(mem, scalars=shown, cmap="viridis", opacity=0.9, show_edges=True,
                        edge_color="#555555", line_width=0.5, clim=clim,
-                       scalar_bar_args=_scalar_bar(bar_title, position_x=0.08))
+                       scalar_bar_args=_scalar_bar(bar_title, position_x=0.04))
         else:
-            p.add_mesh(grid, color="#f4c27a", opacity=0.75, show_edges=True,
+            p.add_mesh(mem, color="#f4c27a", opacity=0.75, show_edges=True,
                        edge_color="#9a6a2a", line_width=0.5)
     else:
-        poly = _ugrid(pv, X, [("polygon", membrane_corner_nodes(system)[:, None])])
-        p.add_mesh(poly, color="#f4c27a", opacity=0.6, show_edges=True, edge_color="#9a6a2a")
+        p.add_mesh(mem, color="#f4c27a", opacity=0.6, show_edges=True, edge_color="#9a6a2a")
 
     p.add_mesh(pv.PolyData(np.ascontiguousarray(X.T)), color="black", point_size=8,
                render_points_as_spheres=True)
@@ -178,13 +186,17 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
     if labels:
         # labels a little above their node, so the node marker does not hide them
         at = X + np.array([[0.0], [0.0], [0.025 * size]])
-        p.add_point_labels(np.ascontiguousarray(at.T), system.node_labels, font_size=12,
-                           point_size=1, shape_opacity=0.0, text_color="#222222",
-                           always_visible=True, show_points=False)
+        p.add_point_labels(np.ascontiguousarray(at.T), system.node_labels, font_size=11,
+                           point_size=1, shape="rounded_rect", shape_color="white",
+                           shape_opacity=0.7, text_color="#222222", always_visible=True,
+                           show_points=False)
     if title:
         p.add_text(title, position="upper_edge", font_size=12, color="black")
+    p.add_legend([["bar", "black"], ["tendon (taut)", "#2171b5"], ["tendon (slack)", "#e41a1c"],
+                  ["membrane", "#f4c27a"]], bcolor="white", border=True, size=(0.2, 0.14),
+                 loc="upper right", face="rectangle")
     _set_view(p, X)
-    p.camera.zoom(1.3)
+    p.camera.zoom(1.1)          # reset_camera frames the model; 1.3 cropped the 2-3's lowest node
     return _screenshot(p, png_path)
 
 
@@ -229,32 +241,42 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
     """
     png_path = check_path(png_path, suffixes=(".png",))
     pv = _pv()
-    X, S, f = check_modes(points, shapes, freq_hz)
-    n = X.shape[1]
-    if not (isinstance(k, (int, np.integer)) and 1 <= k <= S.shape[1]):
-        raise InputError(f"k: expected 1 <= k <= {S.shape[1]} modes, found {k!r}")
-    blocks = _normalise_cells(cells, n)
+    # drawn from the same meshio.Mesh that write_modes writes (checks included)
+    mesh = modes_mesh(points, cells, shapes, freq_hz)
+    f = mesh.field_data["frequency_hz"]
+    X = mesh.points.T
+    if not (isinstance(k, (int, np.integer)) and 1 <= k <= f.size):
+        raise InputError(f"k: expected 1 <= k <= {f.size} modes, found {k!r}")
     cols = min(k, 3 if k <= 6 else 4)
     rows = math.ceil(k / cols)
     if window_size is None:
         window_size = (500 * cols, 420 * rows)
-    base = _ugrid(pv, X, blocks)
+    base = pv.from_meshio(mesh)
     p = pv.Plotter(off_screen=True, shape=(rows, cols), window_size=list(window_size),
                    border=False)
     for m in range(k):
         p.subplot(m // cols, m % cols)
         p.set_background(BACKGROUND)
-        u = S[:, m].reshape(n, 3).T
-        s = _mode_scale(X, S[:, m]) if scale is None else float(scale)
-        g = _ugrid(pv, X + s * u, blocks)
-        g.point_data["|u|"] = np.linalg.norm(u, axis=0)
+        u = mesh.point_data[f"mode_{m + 1}"].T
+        s = _mode_scale(X, u.T.ravel()) if scale is None else float(scale)
+        g = base.copy()
+        g.points = base.points + s * u.T
+        mag = np.linalg.norm(u, axis=0)
+        name = f"|u| / max |u|, mode {m + 1}"          # one array name per panel: own bar
+        g.point_data[name] = mag / (mag.max() or 1.0)
         p.add_mesh(base, color="#bbbbbb", style="wireframe", line_width=1)
-        p.add_mesh(g, scalars="|u|", cmap="plasma", show_scalar_bar=False, line_width=3,
-                   show_edges=False)
+        p.add_mesh(g, scalars=name, cmap="plasma", clim=[0.0, 1.0], line_width=3,
+                   show_edges=False,
+                   scalar_bar_args={"title": "|u| / max|u|", "color": "black", "fmt": "%.1f",
+                                    "vertical": True, "position_x": 0.86, "position_y": 0.15,
+                                    "width": 0.06, "height": 0.6, "n_labels": 3,
+                                    "title_font_size": 10, "label_font_size": 9})
         p.add_text(f"mode {m + 1}: {f[m]:.4g} Hz", position="upper_edge", font_size=10,
                    color="black")
         _set_view(p, X)
+        p.camera.zoom(1.25)
     if title:
-        p.subplot(0, 0)
-        p.add_text(title, position="lower_left", font_size=9, color="black")
+        p.subplot(rows - 1, 0)
+        p.add_text(title + " (grey: prestressed state; shapes scaled)", position="lower_left",
+                   font_size=8, color="black")
     return _screenshot(p, png_path)

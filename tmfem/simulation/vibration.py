@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 from tmfem.io.run import RunOutputs
-from tmfem.io.vtk import MembraneField
 from tmfem.models.com.plant import COMPlant
 from tmfem.models.mtc.dynamics import MTCDynamics, tendon_transverse
 from tmfem.models.mtc.post import member_state
@@ -30,6 +30,11 @@ log = logging.getLogger(__name__)
 @dataclass
 class FreeVibration:
     """Result of :func:`free_vibration` (control-oriented model)."""
+
+    def __repr__(self) -> str:
+        return (f"FreeVibration({self.t.size} times to t = {self.t[-1]:.4g} s, "
+                f"{self.z.shape[1]} coordinates, {self.wall_time:.2f} s wall)")
+
 
     t: np.ndarray
     z: np.ndarray
@@ -94,7 +99,7 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
             out.series.append_configuration(
                 t, system, q=(model.P @ z)[: model.nq], tendon_forces=force, rest_lengths=rest,
                 membrane=MembraneField(mesh=model.membrane.mesh, x=xm,
-                                       point_data={"deflection_Of": defl}))
+                                       point_data={DISPLACEMENT_FIELD: defl}))
         T.append(t); Z.append(z.copy()); ZD.append(zd.copy()); W.append(w); XS.append(pos)
         out.row(t, np.concatenate([z, zd, w, pos.T.ravel()]))
 
@@ -120,6 +125,11 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
 @dataclass
 class MTCVibration:
     """Result of :func:`mtc_free_vibration` (histories as arrays, one row per time)."""
+
+    def __repr__(self) -> str:
+        return (f"MTCVibration({self.t.size} times to t = {self.t[-1]:.4g} s, "
+                f"{self.q.shape[1]} coordinates, {self.wall_time:.2f} s wall)")
+
 
     t: np.ndarray
     q: np.ndarray                 # (nt, nq) generalised coordinates recovered from the bars

@@ -33,6 +33,12 @@ class Modes:
     shapes : (ndof, k) M-orthonormal mode shapes, full vectors with zeros at fixed dofs.
     """
 
+    def __repr__(self) -> str:
+        f = ", ".join(f"{v:.4g}" for v in self.freq_hz[:6])
+        return (f"Modes({self.freq_hz.size} modes of {self.shapes.shape[0]} dofs, f = [{f}"
+                + (", ..." if self.freq_hz.size > 6 else "") + "] Hz)")
+
+
     omega2: np.ndarray
     omega: np.ndarray
     freq_hz: np.ndarray

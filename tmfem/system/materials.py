@@ -7,12 +7,22 @@ from dataclasses import dataclass
 from tmfem.errors import InputError
 
 
+# Largest magnitude accepted for a material constant or size: far beyond any material
+# (diamond: E ~ 1.2e12 Pa) but small enough that products such as E A l^2 or E I stay
+# finite in double precision (E = 1e300 overflowed in the stiffness and was reported as
+# a geometric failure).
+MAX_MAGNITUDE = 1e20
+
+
 def _positive(owner: str, **values: float | None) -> None:
     for name, v in values.items():
         if v is None:
             continue
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+        if isinstance(v, bool) or not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
             raise InputError(f"{owner}: expected {name} > 0, found {v!r}")
+        if v > MAX_MAGNITUDE:
+            raise InputError(f"{owner}: expected {name} <= {MAX_MAGNITUDE:g} (SI units), found "
+                             f"{v!r}")
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import tomllib
 from pathlib import Path
 
@@ -102,19 +103,75 @@ def _num(d: dict, key: str, where: str, default=None):
     return float(v)
 
 
+def _is_number(v) -> bool:
+    """A TOML number (int or float, not a bool; strings such as "1.5" are not numbers)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
 def _floats(d: dict, key: str, where: str, n: int | None = None, default=None) -> np.ndarray:
     if key not in d:
         if default is not None:
             return np.asarray(default, dtype=float)
         raise InputError(f"{where}: missing list '{key}'")
+    v = d[key]
+    items = v if isinstance(v, list) else [v]
+    flat = []
+    for x in items:                               # one level of nesting: rows [x, y, z]
+        flat += x if isinstance(x, list) else [x]
+    if not all(_is_number(x) and math.isfinite(x) for x in flat):
+        raise InputError(f"{where}: expected '{key}' to be a list of finite numbers, found {v!r}")
     try:
-        a = np.asarray(d[key], dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{where}: expected '{key}' to be a list of numbers, found {d[key]!r}") from None
+        a = np.asarray(v, dtype=float)
+    except ValueError:                            # ragged rows
+        raise InputError(f"{where}: expected '{key}' to be a list of numbers with rows of "
+                         f"equal length, found {v!r}") from None
     a = np.atleast_1d(a)
     if n is not None and a.shape[0] != n:
         raise InputError(f"{where}: expected '{key}' to have {n} entries, found {a.shape[0]}")
     return a
+
+
+def _optional_num(d: dict, key: str, where: str):
+    """An optional finite number (None when absent)."""
+    return _num(d, key, where) if key in d else None
+
+
+def _string(d: dict, key: str, where: str, default: str = "") -> str:
+    v = d.get(key, default)
+    if not isinstance(v, str):
+        raise InputError(f"{where}: expected '{key}' to be a string, found {v!r}")
+    return v
+
+
+# Entries of [printed] that commands compare with their results, hence numbers (others
+# such as 'source' or 'k_H = "not printed"' are free-form notes).
+_PRINTED_NUMBERS = re.compile(r"bar_critical_load|bar_load(_stage\d+)?|membrane_max_sigma_p1|"
+                              r"membrane_max_von_mises|tendon_max_stress")
+
+
+def _printed(d: dict, where: str) -> dict:
+    """The optional [printed] table, its compared entries checked to be numbers."""
+    p = d.get("printed", {})
+    for k, v in p.items():
+        if _PRINTED_NUMBERS.fullmatch(k) and not (_is_number(v) and math.isfinite(v)):
+            raise InputError(f"{where} [printed]: expected '{k}' to be a finite number, found {v!r}")
+    if "rest_lengths" in p:
+        _rest_lengths(p, f"{where} [printed]")
+    return dict(p)
+
+
+def _rest_lengths(d: dict, where: str):
+    """The optional [rest_lengths] table: group or tendon name -> finite positive number [m]."""
+    rest = d.get("rest_lengths")
+    if rest is None or rest == {}:
+        return None
+    if not isinstance(rest, dict):
+        raise InputError(f"{where}: expected [rest_lengths] to be a table of numbers, found {rest!r}")
+    for k, v in rest.items():
+        if not (_is_number(v) and math.isfinite(v) and v > 0):
+            raise InputError(f"{where} [rest_lengths]: expected '{k}' to be a positive rest "
+                             f"length in m, found {v!r}")
+    return rest
 
 
 def _materials(d: dict, where: str):
@@ -123,7 +180,7 @@ def _materials(d: dict, where: str):
                                 nu=_num(m, "nu", f"{where} [membrane]"),
                                 rho=_num(m, "rho", f"{where} [membrane]"),
                                 h=_num(m, "h", f"{where} [membrane]"),
-                                yield_stress=m.get("yield_stress"))
+                                yield_stress=_optional_num(m, "yield_stress", f"{where} [membrane]"))
     b = _table(d, "bar", where)
     bar = BarSection(E=_num(b, "E", f"{where} [bar]"), rho=_num(b, "rho", f"{where} [bar]"),
                      d=_num(b, "d", f"{where} [bar]"))
@@ -133,8 +190,9 @@ def _materials(d: dict, where: str):
         if not isinstance(t, dict):
             raise InputError(f"{w}: expected a table, found {t!r}")
         _check_keys(t, "tendons.*", w)
-        sections[key] = TendonSection(E=_num(t, "E", w), d=_num(t, "d", w), rho=t.get("rho"),
-                                      yield_stress=t.get("yield_stress"))
+        sections[key] = TendonSection(E=_num(t, "E", w), d=_num(t, "d", w),
+                                      rho=_optional_num(t, "rho", w),
+                                      yield_stress=_optional_num(t, "yield_stress", w))
     return membrane, bar, sections
 
 
@@ -181,13 +239,23 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     N = d.get("N")
     if not isinstance(N, int) or isinstance(N, bool) or N < 3:
         raise InputError(f"{where}: expected integer N >= 3 (bars per stage), found {N!r}")
-    deployable = bool(d.get("deployable", False))
-    k_H = d.get("k_H")
+    deployable = d.get("deployable", False)
+    if not isinstance(deployable, bool):
+        raise InputError(f"{where}: expected 'deployable' to be true or false, found {deployable!r}")
+    k_H = _optional_num(d, "k_H", where)
+    for key, kind in (("tendons", dict), ("printed", dict), ("notes", list), ("tendon", list)):
+        if key in d and not isinstance(d[key], kind):
+            raise InputError(f"{where}: expected '{key}' to be a "
+                             f"{'table' if kind is dict else 'list'}, found {d[key]!r}")
+    notes = d.get("notes", [])
+    if not all(isinstance(n, str) for n in notes):
+        raise InputError(f"{where}: expected 'notes' to be a list of strings, found {notes!r}")
     membrane, bar, sections = _materials(d, where)
     mtab = d["membrane"]
-    rest = d.get("rest_lengths") or None
-    common = dict(name=str(d.get("name", where)), description=str(d.get("description", "")),
-                  notes=tuple(d.get("notes", ())), printed=dict(d.get("printed", {})),
+    rest = _rest_lengths(d, where)
+    common = dict(name=_string(d, "name", where, where),
+                  description=_string(d, "description", where),
+                  notes=tuple(notes), printed=_printed(d, where),
                   **_monitor(d, where), model_defaults=_model_defaults(d, where))
     for k, t in enumerate(d.get("tendon", ())):
         wt = f"{where} [[tendon]] entry {k + 1}"
@@ -197,6 +265,15 @@ def system_from_dict(d: dict, where: str = "system") -> System:
         missing = {"name", "family", "ends"} - set(t)
         if missing:
             raise InputError(f"{wt}: missing keys {sorted(missing)}")
+        for key in ("name", "family"):
+            _string(t, key, wt)
+        ends = t["ends"]
+        if not (isinstance(ends, list) and len(ends) == 2 and all(isinstance(e, str) for e in ends)):
+            raise InputError(f"{wt}: expected 'ends' to be two node labels, found {ends!r}")
+        for key in ("stage", "j"):
+            v = t.get(key, 1)
+            if not (isinstance(v, int) and not isinstance(v, bool) and v >= 1):
+                raise InputError(f"{wt}: expected '{key}' to be an integer >= 1, found {v!r}")
     if ("symmetric" in d) == ("general" in d):
         raise InputError(f"{where}: expected exactly one of [symmetric] or [general]")
     if "symmetric" in d:
@@ -239,9 +316,12 @@ def load_system(path) -> System:
     """Read a system file (TOML); errors name the file and what is wrong."""
     path = Path(path)
     try:
-        text = path.read_text()
+        text = path.read_bytes().decode("utf-8")
     except OSError as exc:
         raise InputError(f"cannot read system file {path}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: expected UTF-8 text (TOML), found byte 0x{exc.object[exc.start]:02x} "
+                         f"at offset {exc.start} that is not UTF-8") from None
     try:
         d = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

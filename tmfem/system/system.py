@@ -106,7 +106,7 @@ class System:
             raise InputError(f"expected N >= 3 bars per stage, found N={N!r}")
         if self.deployable and M != 1:
             raise InputError(f"a 1-N(D) system has one stage, found M={M}")
-        if self.deployable and not (self.k_H is not None and 0 < self.k_H < 1):
+        if self.deployable and not (isinstance(self.k_H, (int, float)) and 0 < self.k_H < 1):
             raise InputError(f"a 1-N(D) system needs 0 < k_H < 1, found k_H={self.k_H!r}")
         base = np.asarray(self.base, dtype=float)
         l = np.broadcast_to(np.asarray(self.l, dtype=float), (M, N)).copy()
@@ -150,6 +150,14 @@ class System:
             object.__setattr__(self, "rest_lengths", rest_length_array(self.rest_lengths,
                                                                        len(tendons)))
 
+    def __repr__(self) -> str:
+        """One line (the arrays are attributes; ``tmfem.system.system_to_dict`` shows all)."""
+        kind = f"{self.M}-{self.N}" + ("(D)" if self.deployable else "")
+        rest = "" if self.rest_lengths is None else ", rest lengths given"
+        return (f"System({self.name!r}, {kind}, {len(self.node_labels)} nodes, "
+                f"{self.M * self.N} bars, {len(self.tendons)} tendons"
+                + ("" if self.symmetric is None else ", symmetric") + rest + ")")
+
     # ------------------------------------------------------------------ construction
     @classmethod
     def symmetric_system(cls, *, name: str, N: int, config: SymmetricConfig, r_mb: float,
@@ -187,6 +195,9 @@ class System:
                 if v is None:
                     raise InputError(f"no rest length for tendon {t.name} (group {t.group}); "
                                      f"given keys: {sorted(rest)}")
+                if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)):
+                    raise InputError(f"rest length of tendon {t.name}: expected a number in m, "
+                                     f"found {v!r}")
                 values.append(float(v))
             rest = np.array(values)
         return self.replace(rest_lengths=np.asarray(rest, dtype=float))

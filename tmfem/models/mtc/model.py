@@ -63,6 +63,11 @@ class StaticResult:
         Wall time [s].
     """
 
+    def __repr__(self) -> str:
+        return (f"StaticResult({self.x.shape[1]} nodes, {self.iterations} iterations, "
+                f"|r| {self.residual_history[0]:.3g} -> {self.residual_history[-1]:.3g} N)")
+
+
     x: np.ndarray
     iterations: int
     residual_history: list

@@ -35,16 +35,18 @@ def run(*, reduced: bool = False) -> dict:
 def plot(result: dict, png):
     """Deformed axes at several lambda (FE, 16 points per element) with the elastica arcs,
     equal axes, and the tip displacements against lambda."""
-    from tmfem.post.plots import _plt, _save
-    from tmfem.io.vtk import check_path
+    from matplotlib import colormaps
+
+    from tmfem.post.plots import new_figure, save_figure
+    from tmfem.io.paths import check_path
     png = check_path(png, suffixes=(".png",))
-    plt = _plt()
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.8), gridspec_kw={"width_ratios": [1.25, 1]})
+    fig = new_figure(figsize=(12, 4.8))
+    ax, bx = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1.25, 1]})
     L = 12.0
     shapes = result["shapes"]
     keys = sorted(shapes, key=float)
     pick = [k for k in keys if np.isclose((4 * float(k)) % 1.0, 0.0) or np.isclose((4 * float(k)) % 1.0, 1.0)]
-    cmap = plt.get_cmap("viridis")
+    cmap = colormaps["viridis"]
     s = np.linspace(0.0, 1.0, 200)
     for i, k in enumerate(pick):
         lam = float(k)
@@ -76,4 +78,4 @@ def plot(result: dict, png):
     bx.legend(fontsize=8)
     bx.grid(True, alpha=0.3)
     fig.tight_layout()
-    return _save(fig, png)
+    return save_figure(fig, png)

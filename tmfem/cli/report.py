@@ -1,0 +1,80 @@
+"""``tmfem report``: the complete analysis of one system as a report directory.
+
+Design (ch. 3), statics, modes and free vibration of the membrane-truss-cable and
+control-oriented models beside the dissertation's tables, at the designed prestress and at
+the prestress the dissertation's results imply; every table, plot and ParaView file linked
+from ``index.md`` (:func:`tmfem.reference.report.write_report`). ``make demo`` runs
+``tmfem report --preset 1-4 --out out/1-4``.
+"""
+from __future__ import annotations
+
+import sys
+import textwrap
+
+from tmfem.cli.common import (Progress, add_system_args, check_mesh_budget, check_time_steps,
+                              output_dir, positive_float, positive_int, system_from_args)
+
+NAME = "report"
+HELP = ("complete analysis of a system (design, FE statics, 12 modes of the MTC and COM "
+        "models beside the dissertation, free vibration) as a report directory with index.md")
+
+
+def configure(parser) -> None:
+    add_system_args(parser)
+    parser.add_argument("--out", required=True,
+                        help="output directory (created; checked writable before any work)")
+    parser.add_argument("--mesh", type=positive_int, default=10, metavar="n",
+                        help="membrane mesh n x n per quadrilateral patch (default 10, as in 6.2)")
+    parser.add_argument("--modes", type=positive_int, default=12,
+                        help="number of modes (default 12, as in Table 6.6)")
+    parser.add_argument("--t-end", type=positive_float, default=10.0,
+                        help="free-vibration duration [s] (default 10)")
+    parser.add_argument("--dt", type=positive_float, default=0.01,
+                        help="time step [s] (default 0.01, as in 6.5)")
+    parser.add_argument("--no-render", action="store_true",
+                        help="skip the pyvista renders (default: render)")
+
+
+def run(args) -> dict:
+    from tmfem.reference.report import STEPS, write_report
+
+    system = system_from_args(args)
+    check_mesh_budget(N=system.N, n=args.mesh)
+    check_time_steps(t_end=args.t_end, dt=args.dt)
+    out = output_dir(args.out, option="--out")
+    with Progress(total=len(STEPS), desc=f"report {system.name}") as bar:
+        bar.note(STEPS[0])
+        nxt = iter(STEPS[1:])
+        result = write_report(system, out, mesh_n=args.mesh, modes=args.modes, t_end=args.t_end,
+                              dt=args.dt, render=not args.no_render,
+                              progress=lambda done: bar.step(next(nxt, "done")))
+    print(f"tmfem report: done: {out / 'index.md'}", file=sys.stderr)
+    return result
+
+
+def format_text(r: dict) -> str:
+    from tabulate import tabulate
+
+    f = r["frequencies_hz"]
+    pr = r.get("printed_frequencies_hz") or {}
+    head = ["mode"] + [f"{k} [Hz]" for k in f] + ([f"{m} printed" for m in ("MTC", "COM")] if pr else [])
+    rows = []
+    for i in range(r["modes"]):
+        row = [i + 1] + [f"{v[i]:.4f}" if i < len(v) else "-" for v in f.values()]
+        if pr:
+            row += [f"{pr[m][i]:.4f}" if i < len(pr[m]) else "-" for m in ("MTC", "COM")]
+        rows.append(row)
+    st = r["statics"]
+    srows = [[k, f"{v['tendon_stress_max_MPa']:.2f}", f"{v['bar_load_max_N']:.3f}",
+              f"{v['membrane_max_von_mises_MPa']:.3f}"] for k, v in st.items()]
+    lines = [f"report of {r['system']}: design checks "
+             + ("passed" if r["design_ok"] else "FAILED: " + ", ".join(r["failed_checks"])), "",
+             tabulate(srows, headers=["MTC statics", "tendon stress [MPa]", "bar load [N]",
+                                      "membrane von Mises [MPa]"], disable_numparse=True), "",
+             tabulate(rows, headers=head, disable_numparse=True), "",
+             f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+    if r.get("notes"):
+        lines += ["", "why ours and the printed values differ (docs/errata.md):"]
+        lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
+                  for n in r["notes"]]
+    return "\n".join(lines)

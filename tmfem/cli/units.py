@@ -1,0 +1,56 @@
+"""Units of the keys of the commands' JSON documents (``--json``): every document carries a
+``units`` table {key: unit} for the keys it contains (SI; stresses in Pa unless the key says
+MPa; angles in rad unless the key ends in ``_deg``), so no number is without its unit."""
+from __future__ import annotations
+
+import re
+
+# exact keys, then suffix rules; first match wins
+_EXACT = {
+    "F_Delta": "N", "Delta": "m", "Delta_design": "m", "Delta_mean": "m", "residual": "-",
+    "nodes": "m", "tendon_forces": "N", "tendon_force": "N", "tendon_lengths": "m",
+    "length": "m", "force": "N", "force_density": "N/m", "force_densities": "N/m",
+    "rest_lengths": "m", "rest_length": "m", "design_rest_lengths": "m",
+    "design_tendon_forces": "N", "equilibrium_tendon_forces": "N", "stress": "Pa",
+    "tendon_stress": "Pa", "tendon_stress_max": "Pa", "bar_loads": "N", "bar_load_max": "N",
+    "bar_load_by_stage": "N", "bar_critical": "N", "bar_critical_load": "N", "bar_force": "N",
+    "membrane_max_principal": "Pa", "membrane_max_von_mises": "Pa",
+    "membrane_max_sigma_p1": "Pa", "membrane_max_sigma_p1_element_mean": "Pa",
+    "membrane_max_von_mises_element_mean": "Pa", "membrane_min_minor_principal": "Pa",
+    "max_deviation_from_design": "m", "freq_hz": "Hz", "highest_hz": "Hz", "MTC": "Hz",
+    "SBC": "Hz", "COM": "Hz", "t_end": "s", "dt": "s", "patch": "m", "r_mb": "m",
+    "corner_radial_displacement": "m", "max_tendon_deflection_m": "m", "mesh_n": "-",
+    "dofs": "-", "steps": "-", "relative_difference": "-", "relative_difference_to_MTC": "-",
+    "energy_drift_J": "J", "initial_kinetic_energy_J": "J", "static_time_s": "s",
+}
+_SUFFIX = [(r".*_deg$", "deg"), (r".*_hz$", "Hz"), (r".*_MPa$", "MPa"), (r".*_mm$", "mm"),
+           (r".*_m$", "m"), (r".*_N$", "N"), (r".*_s$", "s"), (r".*_J$", "J"),
+           (r".*_Pa$", "Pa"), (r".*_N_per_m$", "N/m")]
+
+
+def unit_of(key: str) -> str | None:
+    """The unit of a JSON key, or None when the key is not a physical quantity."""
+    if key in _EXACT:
+        return _EXACT[key]
+    for pattern, unit in _SUFFIX:
+        if re.match(pattern, key):
+            return unit
+    return None
+
+
+def units_of(doc) -> dict:
+    """{key: unit} for every key of ``doc`` (nested dicts and lists included) with a unit."""
+    out: dict = {}
+
+    def walk(obj):
+        if isinstance(obj, dict):
+            for k, v in obj.items():
+                u = unit_of(str(k))
+                if u is not None:
+                    out.setdefault(str(k), u)
+                walk(v)
+        elif isinstance(obj, (list, tuple)):
+            for v in obj:
+                walk(v)
+    walk(doc)
+    return dict(sorted(out.items()))

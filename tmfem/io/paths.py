@@ -1,0 +1,45 @@
+"""Output paths checked before any work: a known suffix, a writable parent directory."""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from tmfem.errors import InputError
+
+SUFFIXES = (".vtu", ".xdmf", ".vtk")
+
+
+def check_path(path, *, suffixes=SUFFIXES) -> Path:
+    """Validate an output path: a known suffix, not a directory; create missing parents."""
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise InputError(f"output file {str(path)!r}: expected a suffix in {list(suffixes)}, "
+                         f"found {path.suffix or 'none'!r}")
+    if path.is_dir():
+        raise InputError(f"output file {str(path)!r} is a directory")
+    parent = path.parent
+    if parent.exists() and not parent.is_dir():
+        raise InputError(f"output file {str(path)!r}: parent {str(parent)!r} is not a directory")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"output file {str(path)!r}: cannot create directory "
+                         f"{str(parent)!r} ({exc.strerror})") from None
+    if not os.access(parent, os.W_OK):
+        raise InputError(f"output file {str(path)!r}: directory {str(parent)!r} is not writable")
+    return path
+
+
+def check_dir(path) -> Path:
+    """Validate an output directory before any work: not a file, creatable, writable."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise InputError(f"output directory {str(path)!r} is a file")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"output directory {str(path)!r}: cannot create it "
+                         f"({exc.strerror})") from None
+    if not os.access(path, os.W_OK):
+        raise InputError(f"output directory {str(path)!r} is not writable")
+    return path

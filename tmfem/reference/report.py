@@ -1,0 +1,432 @@
+"""The complete analysis of one dissertation system, written as a report directory.
+
+:func:`write_report` runs, for a preset such as ``1-4`` (6.2-6.5):
+
+1. the equilibrium design of ch. 3 beside the printed Tables 6.2-6.3 (:mod:`tmfem.reference.study`);
+2. the static equilibrium of the membrane-truss-cable (MTC) FE model (4.4, 6.2) for the
+   designed rest lengths *and* for the prestress the dissertation's own results imply
+   (:data:`IMPLIED_PRESTRESS`, docs/errata.md);
+3. the 12 lowest modes of the MTC model and of the control-oriented model (COM, ch. 5) at
+   both prestress levels, beside Table 6.6 (eq. 5.32);
+4. free vibration of both models after the perturbation of 6.5 (Park's method, eq. 5.34-5.35);
+
+and writes every table (CSV with units in the headers, Markdown), plot (PNG), ParaView file
+(VTU/PVD) and an ``index.md`` that links them and explains where and why the numbers differ
+from the printed ones. The CLI front end is ``tmfem report``; ``make demo`` runs it for 1-4.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import logging
+from pathlib import Path
+
+import numpy as np
+from tabulate import tabulate
+
+log = logging.getLogger(__name__)
+
+#: Rest lengths [m] that the dissertation's printed results imply where its printed rest
+#: length contradicts them (docs/errata.md, "1-4 prestress"): Table 6.3's tendon stress and
+#: bar load and the 12 frequencies of Table 6.6 all give r_1^S = 1.5025 m, not 1.529 m.
+IMPLIED_PRESTRESS = {"1-4": {"rest_lengths": {"S1": 1.5025},
+                             "source": "docs/errata.md, 1-4 prestress (Tables 6.3, 6.6)"}}
+
+#: Perturbation of the free-vibration runs of 6.5 (initial rate [rad/s] of one coordinate).
+VIBRATION_PERTURBATION = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}
+
+#: What the study and the report say beside their tables (reasons in docs/errata.md):
+#: ``design`` beside the equilibrium table, ``models`` beside the MTC/COM results.
+EXPLANATIONS = {
+    "1-4": {"design": [
+        "The tendon stress, bar load and membrane stresses of the design are 22-34 % below "
+        "Tables 6.3: the design of ch. 3 on the 4 x 10 x 10 mesh gives r_1^S = 1.5089 m and "
+        "less prestress than the dissertation's results imply. The printed r_1^S = 1.529 m "
+        "contradicts the dissertation's other tables: Table 6.3's tendon stress (37.98 MPa) "
+        "and bar load (14.53 N) and all 12 frequencies of Table 6.6 agree on r_1^S = "
+        "1.5025 m (docs/errata.md, '1-4 prestress'); `tmfem report` runs the models at it.",
+        "Membrane peak stresses sit in the elements at the point-attached corners: they "
+        "grow like 1/h under mesh refinement and are a property of the mesh, not of the "
+        "membrane (docs/errata.md, 'F_Delta and the membrane peak stresses are properties "
+        "of the mesh'); the renders show element values.",
+    ], "models": [
+        "At the implied prestress the MTC frequencies match Table 6.6 to < 0.1 %; the COM "
+        "matches the printed COM column at 1.29 x the designed prestress (docs/errata.md, "
+        "'COM frequencies').",
+        "The MTC tendon stress at the implied prestress is ~2.6 % above the printed 37.98 "
+        "MPa: the total-Lagrangian truss uses Green strain, eq. 3.8 the linear strain.",
+    ]},
+}
+
+
+def explanations(name: str, part: str) -> list[str]:
+    """The notes of :data:`EXPLANATIONS` for system ``name`` (``part``: design or models)."""
+    return list(EXPLANATIONS.get(name, {}).get(part, []))
+
+#: Steps of :func:`write_report`, for a progress bar.
+STEPS = ("equilibrium design", "MTC statics (designed)", "MTC statics (implied)",
+         "MTC modes", "COM modes", "COM free vibration", "MTC free vibration", "index")
+
+
+def _csv(path: Path, header: list, rows: list) -> Path:
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(header)
+        w.writerows(rows)
+    return path
+
+
+def _num(v, nd=5):
+    if v is None or (isinstance(v, float) and not np.isfinite(v)):
+        return "-"
+    return f"{v:.{nd}g}"
+
+
+def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float = 10.0,
+                 dt: float = 0.01, render: bool = True, progress=None) -> dict:
+    """Run the complete analysis of ``system`` and write it to the directory ``out``.
+
+    Parameters
+    ----------
+    system : System
+        A preset with printed values (``1-4`` reproduces 6.2-6.5 in full).
+    out : Path
+        Output directory (must exist and be writable; the CLI checks it first).
+    mesh_n : int
+        Membrane elements per side of each of the N quadrilaterals (6.2: 10).
+    modes : int
+        Number of modes (Table 6.6: 12).
+    t_end, dt : float
+        Free-vibration duration and time step [s] (6.5: dt = 0.01 s).
+    render : bool
+        Draw the pyvista renders.
+    progress : callable, optional
+        ``progress(step_name)`` after each entry of :data:`STEPS`.
+
+    Returns
+    -------
+    dict (JSON-able): ``files`` (name -> path), ``tables``, ``ok`` and the summaries.
+    """
+    from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.io.writer import write_configuration, write_modes
+    from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.models.mtc.post import member_state, q_from_positions, static_summary
+    from tmfem.post.fields import placed_membrane_field
+    from tmfem.post.mtc import membrane_field, model_cells, plot_membrane_stress
+    from tmfem.post.plots import plot_free_vibration
+    from tmfem.reference.com_modal import modal_summary
+    from tmfem.reference.study import plot_configuration, plot_membrane_stress as plot_design_stress
+    from tmfem.reference.study import write_tables
+    from tmfem.reference.tables import FREQUENCIES
+    from tmfem.simulation.vibration import free_vibration, mtc_free_vibration
+
+    out = Path(out)
+    name = system.name
+    step = progress or (lambda s: None)
+    files: dict[str, str] = {}
+    notes = explanations(name, "design") + explanations(name, "models")
+    implied = IMPLIED_PRESTRESS.get(name)
+    perturb = VIBRATION_PERTURBATION.get(name, {"theta_11_dot": 0.01})
+
+    def add(key, path):
+        files[key] = str(Path(path).relative_to(out))
+
+    # 1. design (ch. 3) ------------------------------------------------------------------
+    d = design_equilibrium(system, mesh_n=mesh_n)
+    tables = write_tables(out, d, system, notes=explanations(name, "design"))
+    for f in ("equilibrium.md", "equilibrium.csv", "tendons.csv"):
+        add(f, out / f)
+    add("configuration.png", plot_configuration(out / "configuration.png", d, system))
+    add("membrane_stress.png", plot_design_stress(out / "membrane_stress.png", d))
+    membrane = placed_membrane_field(system, d.membrane_model, d.membrane)
+    add("configuration.vtu", write_configuration(
+        out / "configuration.vtu", system, tendon_forces=d.tendon_forces,
+        rest_lengths=d.rest_lengths, membrane=membrane, bar_forces=-d.bar_loads.ravel()))
+    if render:
+        from tmfem.post.render import render_configuration
+        add("render.png", render_configuration(out / "render.png", system,
+                                               tendon_forces=d.tendon_forces, membrane=membrane,
+                                               membrane_field="von_mises",
+                                               title=f"{name}: equilibrium design (ch. 3)"))
+    step(STEPS[0])
+
+    # 2. MTC statics at both prestress levels --------------------------------------------
+    cases = {"designed": ("design", system)}
+    if implied is not None:
+        cases["implied"] = ("system", system.with_rest_lengths(implied["rest_lengths"]))
+    mtc, statics = {}, {}
+    for k, (label, (rest, sys_k)) in enumerate(cases.items()):
+        model = MTCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
+        res = model.solve_static(start="undeformed")
+        mtc[label] = (model, res)
+        statics[label] = static_summary(model, res.x, result=res)
+        X = res.x[:, model.topology.system_node]
+        q = q_from_positions(sys_k, X)
+        ms = member_state(model, res.x)
+        mf = membrane_field(model, res.x)
+        add(f"static_{label}.vtu", write_configuration(
+            out / f"static_{label}.vtu", sys_k, q=q, tendon_forces=ms["tendon_force"],
+            rest_lengths=model.rest_lengths, membrane=mf, bar_forces=ms["bar_force"]))
+        add(f"static_{label}_stress.png", plot_membrane_stress(
+            out / f"static_{label}_stress.png", model, res.x,
+            title=f"{name} MTC equilibrium, {label} prestress: membrane stresses (O_f frame)"))
+        if render:
+            from tmfem.post.render import render_configuration
+            add(f"static_{label}.png", render_configuration(
+                out / f"static_{label}.png", sys_k, q=q, tendon_forces=ms["tendon_force"],
+                membrane=mf, membrane_field="von_mises",
+                title=f"{name} MTC equilibrium, {label} prestress"))
+        step(STEPS[1 + k])
+    if implied is None:
+        step(STEPS[2])
+    add("statics.csv", _statics_table(out / "statics.csv", system, statics))
+
+    # 3. modes -------------------------------------------------------------------------------
+    freqs = {}
+    for label, (model, res) in mtc.items():
+        md = model.modes(res.x, k=modes)
+        freqs[f"MTC {label}"] = md.freq_hz
+        if label == "designed":
+            shapes = model.topology.T @ md.shapes
+            cells = model_cells(model)
+            add("modes.vtu", write_modes(out / "modes.vtu", res.x, cells, shapes, md.freq_hz,
+                                         cell_data=_kind_cell_data(cells)))
+            if render:
+                from tmfem.post.render import render_modes
+                add("modes.png", render_modes(out / "modes.png", points=res.x, cells=cells,
+                                              shapes=shapes, freq_hz=md.freq_hz,
+                                              k=min(modes, 12),
+                                              title=f"{name} MTC modes, designed prestress"))
+    step(STEPS[3])
+    K = default_membrane_modes(system)
+    com_design = modal_summary(system, modes=modes, membrane_modes=K)
+    freqs["COM designed"] = np.array(com_design["freq_hz"])
+    scale = com_design.get("printed_stress_prestress_scale")
+    if scale is not None:
+        com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale)
+        freqs[f"COM x{scale:.4f}"] = np.array(com_implied["freq_hz"])
+    step(STEPS[4])
+    printed = FREQUENCIES.get(name)
+    add("frequencies.csv", _frequency_table(out / "frequencies.csv", freqs, printed, modes))
+    add("frequencies.png", _frequency_plot(out / "frequencies.png", freqs, printed, modes, name))
+
+    # 4. free vibration -----------------------------------------------------------------------
+    com = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n)
+    vdir = out / "vibration_com"
+    r_com = free_vibration(com, t_end=t_end, dt=dt, perturb=perturb,
+                           csv_path=out / "vibration_com.csv", jacobian="reuse",
+                           vtk_dir=vdir, vtk_every=max(1, int(round(0.1 / dt))))
+    add("vibration_com.csv", out / "vibration_com.csv")
+    add("vibration_com.pvd", Path(r_com.stats["pvd"]))
+    add("vibration_com.png", plot_free_vibration(
+        r_com, out / "vibration_com.png",
+        title=f"{name} COM free vibration, K = {K}, " + ", ".join(f"{k} = {v:g}" for k, v in perturb.items())))
+    step(STEPS[5])
+    model, res = mtc["designed"]
+    r_mtc = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
+                               csv_path=out / "vibration_mtc.csv")
+    add("vibration_mtc.csv", out / "vibration_mtc.csv")
+    add("vibration_mtc.png", plot_free_vibration(
+        r_mtc, out / "vibration_mtc.png",
+        title=f"{name} MTC free vibration, mesh {mesh_n}, " + ", ".join(f"{k} = {v:g}" for k, v in perturb.items())))
+    step(STEPS[6])
+
+    vibration = {"COM": _vibration_summary(r_com), "MTC": _vibration_summary(r_mtc)}
+    summary = {"system": name, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
+               "perturbation": perturb, "design_ok": bool(d.ok),
+               "failed_checks": [c.name for c in d.failed],
+               "implied_prestress": implied,
+               "statics": {k: _static_brief(v) for k, v in statics.items()},
+               "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
+               "printed_frequencies_hz": printed, "vibration": vibration}
+    (out / "report.json").write_text(json.dumps(summary, indent=1))
+    add("report.json", out / "report.json")
+    _index(out, system, summary, files, tables["rows"], notes, freqs, printed, statics)
+    add("index.md", out / "index.md")
+    step(STEPS[7])
+    summary["files"] = files
+    summary["notes"] = notes
+    summary["out"] = str(out)
+    summary["ok"] = bool(d.ok)
+    return summary
+
+
+def _kind_cell_data(cells) -> dict:
+    """Cell data ``kind`` (0 bar, 1 tendon, 2 membrane; tmfem.io.codes.KIND_CODES) for the
+    three cell blocks of an MTC mesh, so ParaView can separate them (Threshold on kind)."""
+    from tmfem.io.codes import KIND_CODES
+
+    codes = (KIND_CODES["bar"], KIND_CODES["tendon"], KIND_CODES["membrane"])
+    return {"kind": [np.full(c.shape[1], k, dtype=np.int64) for (_, c), k in zip(cells, codes)]}
+
+
+def _static_brief(s: dict) -> dict:
+    return {"tendon_stress_max_MPa": s["tendon_stress_max"] / 1e6,
+            "bar_load_max_N": s["bar_load_max"],
+            "membrane_max_sigma_p1_MPa": s["membrane_max_sigma_p1"] / 1e6,
+            "membrane_max_von_mises_MPa": s["membrane_max_von_mises"] / 1e6,
+            "Delta_mean_mm": float(np.mean(s["Delta"])) * 1e3,
+            "rest_lengths_m": s["rest_lengths"], "iterations": s.get("iterations"),
+            "slack_tendons": s["tendon_slack"]}
+
+
+def _statics_rows(system, statics: dict) -> list:
+    p = system.printed
+    rows = []
+    spec = [("max tendon stress", "MPa", "tendon_stress_max_MPa", p.get("tendon_max_stress"), 1e-6),
+            ("max bar load (compression)", "N", "bar_load_max_N", p.get("bar_load"), 1.0),
+            ("membrane max sigma_p1", "MPa", "membrane_max_sigma_p1_MPa",
+             p.get("membrane_max_sigma_p1"), 1e-6),
+            ("membrane max von Mises", "MPa", "membrane_max_von_mises_MPa",
+             p.get("membrane_max_von_mises"), 1e-6),
+            ("mean corner displacement Delta", "mm", "Delta_mean_mm", None, 1.0)]
+    briefs = {k: _static_brief(v) for k, v in statics.items()}
+    for q, unit, key, pr, f in spec:
+        row = [q, unit, None if pr is None else pr * f]
+        for label in statics:
+            v = briefs[label][key]
+            row += [v, None if pr is None else v / (pr * f) - 1]
+        rows.append(row)
+    r = ["rest length S_11", "m", (p.get("rest_lengths") or {}).get("S1")]
+    for label in statics:
+        r += [next(iter(briefs[label]["rest_lengths_m"].values())), None]
+    rows.append(r)
+    return rows
+
+
+def _statics_header(statics: dict) -> list:
+    h = ["quantity", "unit", "printed"]
+    for label in statics:
+        h += [f"MTC {label}", f"rel_diff {label}"]
+    return h
+
+
+def _statics_table(path: Path, system, statics: dict) -> Path:
+    rows = _statics_rows(system, statics)
+    return _csv(path, _statics_header(statics),
+                [[r[0], r[1]] + [_num(v, 6) for v in r[2:]] for r in rows])
+
+
+def _frequency_table(path: Path, freqs: dict, printed, modes: int) -> Path:
+    cols = list(freqs)
+    head = ["mode"] + [f"{c} [Hz]" for c in cols]
+    if printed:
+        head += [f"{m} {printed['source'].split()[-1]} printed [Hz]" for m in ("MTC", "SBC", "COM")]
+    rows = []
+    for i in range(modes):
+        row = [i + 1] + [_num(float(freqs[c][i]), 6) if i < len(freqs[c]) else "-" for c in cols]
+        if printed:
+            row += [_num(printed[m][i], 6) if i < len(printed[m]) else "-" for m in ("MTC", "SBC", "COM")]
+        rows.append(row)
+    return _csv(path, head, rows)
+
+
+def _frequency_plot(png: Path, freqs: dict, printed, modes: int, name: str) -> Path:
+    from tmfem.post.plots import mode_styles, new_figure, save_figure
+
+    fig = new_figure(figsize=(7.5, 4.8))
+    ax = fig.subplots()
+    k = np.arange(1, modes + 1)
+    series = dict(freqs)
+    if printed:
+        series.update({f"{m} printed ({printed['source'].split('dissertation ')[-1]})":
+                       np.asarray(printed[m]) for m in ("MTC", "COM")})
+    for (label, f), style in zip(series.items(), mode_styles(len(series))):
+        n = min(modes, len(f))
+        ax.plot(k[:n], f[:n], label=label, ms=5, lw=1.0, **style)
+    ax.set_xlabel("mode number")
+    ax.set_ylabel("natural frequency [Hz]")
+    ax.set_xticks(k)
+    ax.set_title(f"{name}: natural frequencies (eq. 5.32) beside the printed table", fontsize=10)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="upper left")
+    return save_figure(fig, png)
+
+
+def _vibration_summary(r) -> dict:
+    return {"steps": int(r.stats["steps"]), "wall_time_s": float(r.wall_time),
+            "min_tendon_force_N": float(r.stats["min_tendon_force"]),
+            "min_tendon_force_tendon": r.stats["min_tendon_force_tendon"],
+            "peak_to_peak_mm": {k: (1e3 * np.ptp(v, axis=0)).tolist() for k, v in r.nodes.items()}}
+
+
+def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, freqs, printed,
+           statics) -> None:
+    from tmfem.reference.study import markdown_table
+
+    name = system.name
+    link = lambda key, text=None: f"[{text or key}]({files[key]})" if key in files else "-"  # noqa: E731
+    img = lambda key, alt: f"![{alt}]({files[key]})" if key in files else ""  # noqa: E731
+    L = [f"# Report: the {name} system", "", system.description, "",
+         f"Membrane mesh {system.N} x {summary['mesh_n']} x {summary['mesh_n']}, 3 truss elements "
+         f"per tendon, {summary['modes']} modes, free vibration for {summary['t_end_s']:g} s in "
+         f"steps of {summary['dt_s']:g} s. Made by `tmfem report --preset {name}`; every number "
+         "below is in the linked CSV files (units in the headers). Printed values: "
+         f"{system.printed.get('source', 'none')}.", ""]
+    if notes:
+        L += ["## Why ours and the printed values differ", ""] + [f"- {n}" for n in notes] + [""]
+    L += ["## 1. Equilibrium design (ch. 3)", "",
+          f"Files: {link('equilibrium.md')}, {link('equilibrium.csv')}, {link('tendons.csv')}, "
+          f"{link('configuration.vtu')} (ParaView: bars, tendons with forces, membrane with "
+          "stresses; cell data `kind` 0 bar, 1 tendon, 2 membrane).", "",
+          markdown_table(design_rows), "",
+          "Checks: " + ("all passed." if summary["design_ok"] else
+                        "FAILED: " + ", ".join(summary["failed_checks"])), "",
+          img("render.png", "design render"), "",
+          img("configuration.png", "design configuration"), img("membrane_stress.png",
+                                                                "design membrane stress"), ""]
+    L += ["## 2. Statics of the membrane-truss-cable model (6.2)", "",
+          "From the undeformed membrane the rest lengths pull the system into equilibrium. "
+          "'designed': the rest lengths of the design above; 'implied': "
+          + ("rest lengths " + ", ".join(f"{g} = {v} m" for g, v in
+                                         summary['implied_prestress']['rest_lengths'].items())
+             + f" ({summary['implied_prestress']['source']})."
+             if summary["implied_prestress"] else "not available for this system."), "",
+          f"Files: {link('statics.csv')}, " + ", ".join(
+              link(f"static_{k}.vtu") for k in statics) + ".", ""]
+    rows = _statics_rows(system, statics)
+    L.append(tabulate([[r[0], r[1]] + [_num(v) if j % 2 == 1 or j == 0 else
+                                        ("" if v is None else f"{100 * v:+.1f} %")
+                                        for j, v in enumerate(r[2:])] for r in rows],
+                      headers=_statics_header(statics), tablefmt="github",
+                      disable_numparse=True))
+    L += ["", "Membrane stresses are element values (means over the Gauss points in the "
+          "stress maps, maxima over Gauss points in the table); the peaks sit at the "
+          "point-attached corners.", ""]
+    for k in statics:
+        L += [img(f"static_{k}.png", f"MTC equilibrium {k}"), "",
+              img(f"static_{k}_stress.png", f"MTC membrane stress {k}"), ""]
+    L += ["## 3. Natural frequencies and mode shapes (6.4, eq. 5.32)", "",
+          f"Files: {link('frequencies.csv')}, {link('modes.vtu')} (ParaView: Warp By Vector "
+          "with `mode_k`; field data `mode_k_hz`; cell data `kind`).", ""]
+    head = ["mode"] + [f"{c} [Hz]" for c in freqs]
+    if printed:
+        head += [f"{m} printed [Hz]" for m in ("MTC", "SBC", "COM")]
+    body = []
+    for i in range(summary["modes"]):
+        row = [i + 1] + [_num(float(f[i]), 5) if i < len(f) else "-" for f in freqs.values()]
+        if printed:
+            row += [_num(printed[m][i], 5) if i < len(printed[m]) else "-" for m in ("MTC", "SBC", "COM")]
+        body.append(row)
+    L += [tabulate(body, headers=head, tablefmt="github", disable_numparse=True), "",
+          f"Printed: {printed['source'] if printed else 'none'}. SBC (shell-beam-cable) is not "
+          "implemented yet; its column is the dissertation's.", "",
+          img("frequencies.png", "frequencies"), "", img("modes.png", "mode shapes"), ""]
+    v = summary["vibration"]
+    L += ["## 4. Free vibration (6.5)", "",
+          "Perturbation " + ", ".join(f"`{k} = {x:g}`" for k, x in summary["perturbation"].items())
+          + f", Park's method, dt = {summary['dt_s']:g} s.", "",
+          f"Files: {link('vibration_com.csv')}, {link('vibration_com.pvd')} (ParaView series), "
+          f"{link('vibration_mtc.csv')}.", ""]
+    body = [[m, s["steps"], f"{s['wall_time_s']:.1f}", f"{s['min_tendon_force_N']:.4g} "
+             f"({s['min_tendon_force_tendon']})",
+             "; ".join(f"{n}: " + ", ".join(f"{a:.3f}" for a in p) for n, p in s["peak_to_peak_mm"].items())]
+            for m, s in v.items()]
+    L += [tabulate(body, headers=["model", "steps", "wall time [s]", "smallest tendon force [N]",
+                                  "peak-to-peak x, y, z [mm]"], tablefmt="github",
+                   disable_numparse=True), "",
+          img("vibration_com.png", "COM free vibration"), "",
+          img("vibration_mtc.png", "MTC free vibration"), "",
+          "## All files", ""] + [f"- [{k}]({p})" for k, p in sorted(files.items())]
+    (out / "index.md").write_text("\n".join(L) + "\n")
