@@ -221,7 +221,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     add("vibration_com.pvd", Path(r_com.stats["pvd"]))
     add("vibration_com.png", plot_free_vibration(
         r_com, out / "vibration_com.png",
-        title=f"{name} COM free vibration, K = {K}, " + ", ".join(f"{k} = {v:g}" for k, v in perturb.items())))
+        title=f"{name} COM free vibration, K = {K}, " + _perturbation_text(perturb)))
     step(STEPS[5])
     model, res = mtc["designed"]
     r_mtc = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
@@ -229,7 +229,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     add("vibration_mtc.csv", out / "vibration_mtc.csv")
     add("vibration_mtc.png", plot_free_vibration(
         r_mtc, out / "vibration_mtc.png",
-        title=f"{name} MTC free vibration, mesh {mesh_n}, " + ", ".join(f"{k} = {v:g}" for k, v in perturb.items())))
+        title=f"{name} MTC free vibration, mesh {mesh_n}, " + _perturbation_text(perturb)))
     step(STEPS[6])
 
     vibration = {"COM": _vibration_summary(r_com), "MTC": _vibration_summary(r_mtc)}
@@ -250,6 +250,15 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     summary["out"] = str(out)
     summary["ok"] = bool(d.ok)
     return summary
+
+
+def _perturbation_text(perturb: dict) -> str:
+    """``theta_12_dot = 0.01 rad/s`` (rates in rad/s, angles in rad, positions in m)."""
+    def unit(k):
+        base = k[:-4] if k.endswith("_dot") else k
+        u = "rad" if base.startswith(("theta", "psi")) else "m"
+        return u + "/s" if k.endswith("_dot") else u
+    return ", ".join(f"{k} = {v:g} {unit(k)}" for k, v in perturb.items())
 
 
 def _kind_cell_data(cells) -> dict:
