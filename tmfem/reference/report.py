@@ -108,6 +108,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     dict (JSON-able): ``files`` (name -> path), ``tables``, ``ok`` and the summaries.
     """
     from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.io.codes import kind_cell_data
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
@@ -191,7 +192,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
             shapes = model.topology.T @ md.shapes
             cells = model_cells(model)
             add("modes.vtu", write_modes(out / "modes.vtu", res.x, cells, shapes, md.freq_hz,
-                                         cell_data=_kind_cell_data(cells)))
+                                         cell_data=kind_cell_data(cells)))
             if render:
                 from tmfem.post.render import render_modes
                 add("modes.png", render_modes(out / "modes.png", points=res.x, cells=cells,
@@ -259,15 +260,6 @@ def _perturbation_text(perturb: dict) -> str:
         u = "rad" if base.startswith(("theta", "psi")) else "m"
         return u + "/s" if k.endswith("_dot") else u
     return ", ".join(f"{k} = {v:g} {unit(k)}" for k, v in perturb.items())
-
-
-def _kind_cell_data(cells) -> dict:
-    """Cell data ``kind`` (0 bar, 1 tendon, 2 membrane; tmfem.io.codes.KIND_CODES) for the
-    three cell blocks of an MTC mesh, so ParaView can separate them (Threshold on kind)."""
-    from tmfem.io.codes import KIND_CODES
-
-    codes = (KIND_CODES["bar"], KIND_CODES["tendon"], KIND_CODES["membrane"])
-    return {"kind": [np.full(c.shape[1], k, dtype=np.int64) for (_, c), k in zip(cells, codes)]}
 
 
 def _static_brief(s: dict) -> dict:
