@@ -69,8 +69,10 @@ def run(args) -> dict:
         shapes = model.topology.T @ modes.shapes
         cells = model_cells(model)
         if args.vtk:
+            from tmfem.io.codes import kind_cell_data
             from tmfem.io.writer import write_modes
-            out["vtk"] = str(write_modes(args.vtk, res.x, cells, shapes, modes.freq_hz))
+            out["vtk"] = str(write_modes(args.vtk, res.x, cells, shapes, modes.freq_hz,
+                                         cell_data=kind_cell_data(cells)))
         if args.png:
             from tmfem.post.render import render_modes
             out["png"] = str(render_modes(args.png, points=res.x, cells=cells, shapes=shapes,

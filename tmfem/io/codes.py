@@ -57,3 +57,15 @@ def configuration_cells(system) -> list:
 def membrane_corner_nodes(system) -> np.ndarray:
     """Indices of the membrane corners B_M1..B_MN in ``system.node_labels``."""
     return np.array([system.node_index(label("B", system.M, j)) for j in range(1, system.N + 1)])
+
+
+def kind_cell_data(cells) -> dict:
+    """Cell data ``kind`` (:data:`KIND_CODES`: 0 bar, 1 tendon, 2 membrane) for the three cell
+    blocks of an MTC mesh (bars, tendon elements, membrane quads; ``model_cells``), so that
+    ParaView can separate them in a modes file (Threshold on ``kind``)."""
+    codes = (KIND_CODES["bar"], KIND_CODES["tendon"], KIND_CODES["membrane"])
+    if len(cells) != 3:
+        raise InputError(f"cells: expected the 3 blocks bars, tendons, membrane, found {len(cells)}")
+    return {"kind": [np.full(np.asarray(c).shape[1], k, dtype=np.int64)
+                     for (_, c), k in zip(cells, codes)]}
+

@@ -108,6 +108,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     dict (JSON-able): ``files`` (name -> path), ``tables``, ``ok`` and the summaries.
     """
     from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.io.codes import kind_cell_data
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
@@ -191,7 +192,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
             shapes = model.topology.T @ md.shapes
             cells = model_cells(model)
             add("modes.vtu", write_modes(out / "modes.vtu", res.x, cells, shapes, md.freq_hz,
-                                         cell_data=_kind_cell_data(cells)))
+                                         cell_data=kind_cell_data(cells)))
             if render:
                 from tmfem.post.render import render_modes
                 add("modes.png", render_modes(out / "modes.png", points=res.x, cells=cells,
@@ -221,7 +222,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     add("vibration_com.pvd", Path(r_com.stats["pvd"]))
     add("vibration_com.png", plot_free_vibration(
         r_com, out / "vibration_com.png",
-        title=f"{name} COM free vibration, K = {K}, " + ", ".join(f"{k} = {v:g}" for k, v in perturb.items())))
+        title=f"{name} COM free vibration, K = {K}, " + _perturbation_text(perturb)))
     step(STEPS[5])
     model, res = mtc["designed"]
     r_mtc = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
@@ -229,7 +230,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     add("vibration_mtc.csv", out / "vibration_mtc.csv")
     add("vibration_mtc.png", plot_free_vibration(
         r_mtc, out / "vibration_mtc.png",
-        title=f"{name} MTC free vibration, mesh {mesh_n}, " + ", ".join(f"{k} = {v:g}" for k, v in perturb.items())))
+        title=f"{name} MTC free vibration, mesh {mesh_n}, " + _perturbation_text(perturb)))
     step(STEPS[6])
 
     vibration = {"COM": _vibration_summary(r_com), "MTC": _vibration_summary(r_mtc)}
@@ -252,13 +253,13 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     return summary
 
 
-def _kind_cell_data(cells) -> dict:
-    """Cell data ``kind`` (0 bar, 1 tendon, 2 membrane; tmfem.io.codes.KIND_CODES) for the
-    three cell blocks of an MTC mesh, so ParaView can separate them (Threshold on kind)."""
-    from tmfem.io.codes import KIND_CODES
-
-    codes = (KIND_CODES["bar"], KIND_CODES["tendon"], KIND_CODES["membrane"])
-    return {"kind": [np.full(c.shape[1], k, dtype=np.int64) for (_, c), k in zip(cells, codes)]}
+def _perturbation_text(perturb: dict) -> str:
+    """``theta_12_dot = 0.01 rad/s`` (rates in rad/s, angles in rad, positions in m)."""
+    def unit(k):
+        base = k[:-4] if k.endswith("_dot") else k
+        u = "rad" if base.startswith(("theta", "psi")) else "m"
+        return u + "/s" if k.endswith("_dot") else u
+    return ", ".join(f"{k} = {v:g} {unit(k)}" for k, v in perturb.items())
 
 
 def _static_brief(s: dict) -> dict:
