@@ -2,7 +2,7 @@
 rank by rank (tmfem.models.mtc.distributed), Newton to the static equilibrium from the design
 and 12 modes with the PETSc backend; rank 0 prints one JSON document.
 
-usage: python tests/mpi/mtc_distributed.py PRESET MESH_N [--fail-rank R]
+usage: python tests/mpi/mtc_distributed.py PRESET MESH_N [--replicated] [--fail-rank R] [--nan-rank R]
 --fail-rank R: the element kernel of rank R raises (a failure on one rank: the other ranks
 wait in a collective call, mpi_main aborts the job); --nan-rank R: rank R's element
 matrices are not finite (caught collectively by the assembler: one clean error).
@@ -22,6 +22,9 @@ def main():
     ap.add_argument("mesh_n", type=int)
     ap.add_argument("--fail-rank", type=int, default=None)
     ap.add_argument("--nan-rank", type=int, default=None)
+    ap.add_argument("--replicated", action="store_true",
+                    help="MTCModel(backend='petsc') itself: every rank assembles the whole model, "
+                         "the static continuation from the undeformed membrane and the modes")
     args = ap.parse_args()
     from tmfem.models.mtc.distributed import DistributedMTC
     from tmfem.models.mtc.model import MTCModel
@@ -31,6 +34,12 @@ def main():
     comm = comm_world()
 
     def run():
+        if args.replicated:
+            model = MTCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend="petsc")
+            st = model.solve_static()
+            md = model.modes(st.x, k=12)
+            return json.dumps({"ranks": comm.size, "x": model.reduce(st.x).tolist(),
+                               "omega2": md.omega2.tolist(), "iterations": st.iterations})
         model = MTCModel(load_preset(args.preset), mesh_n=args.mesh_n)
         d = DistributedMTC(model)
         be = PetscBackend()

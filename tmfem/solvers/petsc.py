@@ -161,7 +161,12 @@ class PetscBackend:
         Al = A[lo:hi]
         ip = Al.indptr.astype(self.PETSc.IntType)
         ix = Al.indices.astype(self.PETSc.IntType)
-        key = ("csr", n, hashlib.sha1(ip.tobytes() + ix.tobytes()).hexdigest()) if cache else None
+        key = None
+        if cache:
+            digest = hashlib.sha1(ip.tobytes() + ix.tobytes()).hexdigest()
+            if self.comm.size > 1:      # every rank must take the same branch (collective calls)
+                digest = "".join(self.comm.tompi4py().allgather(digest))
+            key = ("csr", n, digest)
         entry = self._cache.get(key)
         if entry is None:
             M = self.PETSc.Mat().createAIJ(size=((hi - lo, n), (hi - lo, n)), csr=(ip, ix, Al.data),
@@ -173,10 +178,29 @@ class PetscBackend:
         M.assemble()
         return M, key
 
-    def _symmetric(self, M) -> bool:
-        """Whether M equals its transpose to 1e-12 of its largest entry."""
-        scale = M.norm(self.PETSc.NormType.INFINITY)
-        return bool(M.isSymmetric(tol=1e-12 * max(scale, 1e-300)))
+    def _symmetric(self, A, M) -> bool:
+        """Whether A (scipy, the same on every rank) or its PETSc Mat M equals its transpose
+        to 1e-12 of its largest entry; the same answer on every rank (petsc4py 3.18's
+        ``isSymmetric`` of an MPIAIJ matrix answers per rank)."""
+        if sp.issparse(A):
+            A = sp.csr_matrix(A)
+            big = abs(A).max() if A.nnz else 0.0
+            D = A - A.T
+            return bool((abs(D).max() if D.nnz else 0.0) <= 1e-12 * big)
+        if not hasattr(A, "mat"):
+            A = np.asarray(A, dtype=float)
+            return bool(np.abs(A - A.T).max(initial=0.0) <= 1e-12 * np.abs(A).max(initial=0.0))
+        # distributed: compare M x with M^T x for a random x (collective norms; a transpose
+        # of the matrix would double its memory)
+        x, y = M.createVecs()
+        z = y.duplicate()
+        lo, hi = M.getOwnershipRange()
+        x.setArray(np.random.default_rng(7).standard_normal(M.getSize()[0])[lo:hi])
+        M.mult(x, y)
+        M.multTranspose(x, z)
+        scale = y.norm()
+        z.axpy(-1.0, y)
+        return bool(z.norm() <= 1e-12 * max(scale, 1e-300))
 
     def _configure(self, ksp, symmetric: bool, prefix: str = "") -> None:
         """Defaults of the module docstring, then the options database (PETSC_OPTIONS and
@@ -221,7 +245,7 @@ class PetscBackend:
         PETSc = self.PETSc
         M, key = self._mat(A)
         n = M.getSize()[0]
-        sym = self._symmetric(M)
+        sym = self._symmetric(A, M)
         entry = self._cache.get(key)
         if entry is None or entry[3] != sym:
             ksp = PETSc.KSP().create(comm=self.comm)
@@ -313,7 +337,7 @@ class PetscBackend:
         k = int(k)
         if not 1 <= k < n:
             raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
-        sym = self._symmetric(Kp) and self._symmetric(Mp)
+        sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
         E = SLEPc.EPS().create(comm=self.comm)
         try:
             E.setOperators(Kp, Mp)
