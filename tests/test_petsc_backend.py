@@ -201,14 +201,28 @@ needs_mpi = pytest.mark.skipif(not (HAVE_PETSC and MPIEXEC), reason="petsc4py or
                                "(install: make install)")
 
 
-def _mpirun(n, *args, timeout=120):
+def _mpirun(n, *args, timeout=120, program=None):
     # this pytest process initialised MPI as a singleton, which puts Open MPI's own variables
     # into os.environ: a child mpiexec that sees them thinks it is nested and exits
     env = {k: v for k, v in os.environ.items()
            if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
-    cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", str(n), sys.executable,
-           str(ROOT / "tests" / "mpi" / "mtc_distributed.py"), *args]
+    program = program or [sys.executable, str(ROOT / "tests" / "mpi" / "mtc_distributed.py")]
+    cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", str(n), *program, *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env)
+
+
+@needs_mpi
+def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
+    # source: the same command on 1 process (rank-0 output must be the serial document)
+    tmfem = [sys.executable, "-m", "tmfem"]
+    argv = ["modal", "--model", "mtc", "--preset", "2-3", "--mesh", "4", "--modes", "4", "--json"]
+    p2 = _mpirun(2, *argv, "--backend", "petsc", program=tmfem)
+    assert p2.returncode == 0, p2.stderr
+    p1 = subprocess.run(tmfem + argv, capture_output=True, text=True, cwd=ROOT)
+    d2, d1 = json.loads(p2.stdout), json.loads(p1.stdout)     # exactly one document
+    assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
+    p = _mpirun(2, *argv, program=tmfem)
+    assert p.returncode == 2 and p.stderr.count("expected --backend petsc") == 1
 
 
 @needs_mpi

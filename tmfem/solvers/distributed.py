@@ -93,7 +93,7 @@ def _find_tmfem_error(name: str):
     return TmfemError
 
 
-def mpi_main(main, *, comm=None, grace: float = 5.0) -> int:
+def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
     """Run ``main()`` on every rank; return its exit code (0, or the error's ``exit_code``).
 
     ``main`` returns the text to print (or None); rank 0 prints it. When ``main`` raises,
@@ -102,6 +102,7 @@ def mpi_main(main, *, comm=None, grace: float = 5.0) -> int:
     lowest failing rank's message once as ``error: ...`` and every rank returns the code.
     If not (the other ranks wait in a collective call for the failed one), the failing rank
     prints its message and aborts the MPI job with the code: a non-zero exit, never a hang.
+    ``label`` prefixes the error line (the CLI's ``"tmfem static: "``).
     """
     import time
     comm = comm_world() if comm is None else comm
@@ -118,7 +119,7 @@ def mpi_main(main, *, comm=None, grace: float = 5.0) -> int:
         t0 = time.monotonic()
         while not req.Test():
             if failure is not None and time.monotonic() - t0 > grace:
-                print(f"error: rank {comm.rank} of {comm.size}: {failure[1]}", file=sys.stderr,
+                print(f"{label}error: rank {comm.rank} of {comm.size}: {failure[1]}", file=sys.stderr,
                       flush=True)
                 comm.Abort(failure[0])
             time.sleep(0.01)
@@ -130,7 +131,7 @@ def mpi_main(main, *, comm=None, grace: float = 5.0) -> int:
         r, (code, msg) = bad[0]
         if comm.rank == 0:
             where = f"rank {r} of {comm.size}: " if comm.size > 1 and len(bad) < comm.size else ""
-            print(f"error: {where}{msg}", file=sys.stderr, flush=True)
+            print(f"{label}error: {where}{msg}", file=sys.stderr, flush=True)
         return code
     if comm.rank == 0 and text:
         print(text, flush=True)
