@@ -21,6 +21,7 @@ $(STAMP): pyproject.toml $(VENV)/.syslibs
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	@bash scripts/install_petsc.sh $(VENV)
 	@touch $@
 
 demo: $(STAMP)

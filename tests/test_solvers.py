@@ -146,17 +146,16 @@ def test_backends():
     assert get_backend().name == "scipy" and get_backend("scipy").name == "scipy"
     with pytest.raises(InputError, match="expected one of"):
         get_backend("mumps")
-    # 'petsc' is a placeholder (tmfem.solvers.backends.PetscBackend): it must refuse in both
-    # cases, naming the install command when petsc4py is missing (the former test checked
-    # nothing where petsc4py is installed)
+    # 'petsc' (tmfem.solvers.petsc; tests/test_petsc_backend.py): available where petsc4py is
+    # installed, else refused naming the install command (simulated there)
     try:
         import petsc4py  # noqa: F401
         import slepc4py  # noqa: F401
-        expected = "not implemented yet"
     except ImportError:
-        expected = "pip install petsc petsc4py slepc slepc4py"
-    with pytest.raises(BackendUnavailable, match=expected):
-        get_backend("petsc")
+        with pytest.raises(BackendUnavailable, match="make install"):
+            get_backend("petsc")
+    else:
+        assert get_backend("petsc").name == "petsc"
 
 
 def test_nested_dissection_ordering_solves_and_reduces_fill():

@@ -131,6 +131,8 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     mod = args._module
     _setup_logging()
+    if _mpi_size() > 1:
+        return _main_mpi(args, mod)
     previous = _install_interrupt_handler(args.command)
     try:
         result = mod.run(args)
@@ -166,6 +168,40 @@ def main(argv=None) -> int:
               "(exit 1; see docs/cli.md)", file=sys.stderr)
         return 1
     return 0
+
+
+def _mpi_size() -> int:
+    """Number of ranks when started by mpiexec (Open MPI's or MPICH's variable), else 1."""
+    import os
+    return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
+
+
+def _main_mpi(args, mod) -> int:
+    """Under ``mpiexec -n P`` (P > 1): the PETSc backend only; the command runs on every rank,
+    rank 0 prints (docs/backends.md#mpi), an error is printed once with a non-zero exit."""
+    import contextlib
+    import io
+    import os
+    rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
+    if getattr(args, "backend", None) != "petsc":
+        if rank == 0:
+            print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
+                  f"--backend petsc, found --backend {getattr(args, 'backend', None) or 'scipy'} "
+                  "(every rank would solve the whole problem alone)", file=sys.stderr)
+        return 2
+    from tmfem.solvers.distributed import mpi_main
+
+    def body():
+        # progress lines on stderr from rank 0 only (errors are printed by mpi_main)
+        with contextlib.redirect_stderr(sys.stderr if rank == 0 else io.StringIO()):
+            result = mod.run(args)
+        if args.json:
+            if isinstance(result, dict) and "units" not in result:
+                from tmfem.cli.units import units_of
+                result = {**result, "units": units_of(result)}
+            return json.dumps(_finite(result), default=json_default, allow_nan=False)
+        return getattr(mod, "format_text", _default_text)(result)
+    return mpi_main(body, label=f"tmfem {args.command}: ")
 
 
 def _finite(obj):

@@ -9,10 +9,10 @@ provides
                               ``sigma``; ``v0`` a start vector (Krylov methods) that makes
                               the basis of a repeated eigenvalue reproducible.
 
-``get_backend("scipy")`` is always available (SuperLU + ARPACK shift-invert). The name
-``"petsc"`` is reserved for a PETSc/SLEPc backend (KSP/EPS through petsc4py/slepc4py); while
-that is not implemented or not installed, asking for it raises :class:`BackendUnavailable`
-naming the install command.
+``get_backend("scipy")`` is always available (SuperLU + ARPACK shift-invert).
+``get_backend("petsc")`` is the PETSc/SLEPc backend (:mod:`tmfem.solvers.petsc`: KSP with
+MUMPS, SLEPc shift-invert, MPI); without petsc4py/slepc4py it raises
+:class:`tmfem.errors.BackendUnavailable` naming the install command.
 """
 from __future__ import annotations
 
@@ -22,11 +22,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from tmfem.errors import BackendUnavailable, ConvergenceError, InputError
+from tmfem.errors import ConvergenceError, InputError
 
-PETSC_INSTALL = ("PETSC_CONFIGURE_OPTIONS=\"--with-fc=0 --with-cuda=0 --with-x=0 --with-debugging=0\" "
-                 ".venv/bin/pip install petsc petsc4py slepc slepc4py   "
-                 "(needs apt-get install libopenblas-dev libopenmpi-dev; builds PETSc, tens of minutes)")
 
 
 class Backend(Protocol):
@@ -185,23 +182,14 @@ def nested_dissection(A) -> np.ndarray:
     return np.concatenate([members[first[g]:first[g] + counts[g]] for g in np.asarray(order)])
 
 
-class PetscBackend:   # pragma: no cover - exercised only where petsc4py is installed
-    """Placeholder of the scale-out backend; raises until petsc4py/slepc4py are present."""
-
-    name = "petsc"
-
-    def __init__(self):
-        try:
-            import petsc4py  # noqa: F401
-            import slepc4py  # noqa: F401
-        except ImportError:
-            raise BackendUnavailable(f"backend 'petsc': expected petsc4py and slepc4py importable, "
-                                     f"found them missing; install with: {PETSC_INSTALL}") from None
-        raise BackendUnavailable("backend 'petsc': petsc4py/slepc4py are installed but the PETSc "
-                                 "backend is not implemented yet in this tmfem version; use 'scipy'")
+def _petsc_backend():
+    """The PETSc/SLEPc backend with its defaults (:class:`tmfem.solvers.petsc.PetscBackend`,
+    imported lazily; options through ``PETSC_OPTIONS``)."""
+    from tmfem.solvers.petsc import PetscBackend
+    return PetscBackend()
 
 
-_BACKENDS = {"scipy": ScipyBackend, "petsc": PetscBackend}
+_BACKENDS = {"scipy": ScipyBackend, "petsc": _petsc_backend}
 
 
 def backend_names() -> list[str]:

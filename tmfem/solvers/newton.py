@@ -35,7 +35,12 @@ def free_index(free, n: int) -> np.ndarray:
 
 
 def submatrix(K, idx):
-    """The square block K[idx][:, idx] of a sparse or dense matrix (the free dofs)."""
+    """The square block K[idx][:, idx] of a sparse or dense matrix (the free dofs); a
+    backend's own matrix type (e.g. a distributed PETSc matrix) passes through when every
+    dof is free."""
+    if not (sp.issparse(K) or isinstance(K, np.ndarray)) and idx.size == K.shape[0] \
+            and (idx.size == 0 or (idx[0] == 0 and np.all(np.diff(idx) == 1))):
+        return K
     if sp.issparse(K):
         K = sp.csr_matrix(K)
         return K[idx][:, idx]

@@ -1,0 +1,182 @@
+"""Backends at scale: 1-4 MTC static (from the undeformed membrane) + 12 modes, scipy vs PETSc.
+
+    .venv/bin/python benchmarks/bench_backends.py [--meshes 40,80,160] [--configs scipy,petsc,petsc2]
+
+Configurations (each run in a fresh process, so that peak memory is per run):
+  scipy    the embedded backend (SuperLU symmetric mode with nested dissection, ARPACK)
+  petsc    PETSc/SLEPc on 1 rank (MUMPS Cholesky, SLEPc Krylov-Schur shift-invert)
+  petsc2   the same under ``mpiexec -n 2`` (every rank assembles the model; matrix rows,
+           MUMPS factorisation and SLEPc distributed over the 2 ranks)
+  dist2    ``mpiexec -n 2`` with the distributed assembly (tmfem.models.mtc.distributed):
+           Newton from the converged 1-rank state's neighbourhood is not the continuation, so
+           this row times one distributed tangent assembly + factorisation + solve
+           ("s/it") and the 12 modes only
+Columns: free DOFs, iterations of the static solve on the finest mesh, time per iteration
+(static time over all iterations, mesh sequencing from n = 10 included), static time, eigen
+time, time inside the backend's factorisations (incl. MUMPS/SuperLU analysis) and solves,
+peak resident memory per rank (max over ranks), first frequency.
+OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
+Targets (issue 11, 2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
+scipy time of 4x80x80; 1.2 M DOF < 5 min and < 16 GB.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.abspath(__file__)
+
+
+class TimedBackend:
+    """A backend wrapper that adds up the time spent in factorisations and solves."""
+
+    def __init__(self, inner):
+        self.inner, self.name = inner, inner.name
+        self.t_factor = self.t_solve = self.t_eig = 0.0
+        self.n_factor = 0
+
+    def factorize(self, A):
+        t = time.perf_counter()
+        solve = self.inner.factorize(A)
+        self.t_factor += time.perf_counter() - t
+        self.n_factor += 1
+
+        def timed(b):
+            t = time.perf_counter()
+            x = solve(b)
+            self.t_solve += time.perf_counter() - t
+            return x
+        return timed
+
+    def eigsh(self, K, M, k, sigma):
+        t = time.perf_counter()
+        out = self.inner.eigsh(K, M, k, sigma)
+        self.t_eig += time.perf_counter() - t
+        return out
+
+
+def system_1_4(rest_length: float):
+    from tmfem.system import load_preset
+    return load_preset("1-4", as_printed=True).with_rest_lengths({"S1": rest_length})
+
+
+def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
+    """One configuration on one mesh (in this process); rank 0's dict, max memory over ranks."""
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.backends import get_backend
+    rank, size, comm = 0, 1, None
+    if config != "scipy":
+        from tmfem.solvers.distributed import comm_world
+        comm = comm_world()
+        rank, size = comm.rank, comm.size
+    inner = get_backend("scipy" if config == "scipy" else "petsc")
+    be = TimedBackend(inner)
+    system = system_1_4(rest_length)
+    t0 = time.perf_counter()
+    if config == "dist2":
+        return _run_distributed(mesh, system, be, comm, t0)
+    m = MTCModel(system, mesh_n=mesh, tendon_elements=3, backend=be)
+    t1 = time.perf_counter()
+    res = m.solve_static(sequence=sequence or None)
+    t2 = time.perf_counter()
+    modes = m.modes(res.x, k=12)
+    t3 = time.perf_counter()
+    its = (res.newton_iterations_tangent or [res.iterations])[-1]
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    if comm is not None:
+        rss = comm.allreduce(rss, op=__import__("mpi4py").MPI.MAX)
+    return dict(config=config, ranks=size, mesh=f"4x{mesh}x{mesh}", dofs=m.ndof, build_s=t1 - t0,
+                iterations=its, total_iterations=res.iterations, s_per_it=(t2 - t1) / res.iterations,
+                static_s=t2 - t1, eigen_s=t3 - t2, factor_s=be.t_factor, n_factor=be.n_factor,
+                solve_s=be.t_solve, rss_mb=rss, f1_hz=float(modes.freq_hz[0]))
+
+
+def _run_distributed(mesh, system, be, comm, t0):
+    """dist2 row: distributed assembly of the tangent at the (replicated, scipy) equilibrium."""
+    import numpy as np
+    from mpi4py import MPI
+    from tmfem.models.mtc.distributed import DistributedMTC
+    from tmfem.models.mtc.model import MTCModel
+    m = MTCModel(system, mesh_n=mesh, tendon_elements=3)
+    d = DistributedMTC(m)
+    t1 = time.perf_counter()
+    # a state near equilibrium: the design (no continuation on the distributed path yet)
+    u = d.unknowns(m.reduce(m.initial_positions("design")))
+    ta = time.perf_counter()
+    r, K = d.residual(u)
+    tb = time.perf_counter()
+    du = be.factorize(K)(-r)
+    tc = time.perf_counter()
+    w, _ = be.eigsh(K, d.mass(), 12, -1.0)
+    t3 = time.perf_counter()
+    rss = comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0, op=MPI.MAX)
+    return dict(config="dist2", ranks=comm.size, mesh=f"4x{mesh}x{mesh}", dofs=d.N, build_s=t1 - t0,
+                iterations=1, total_iterations=1, s_per_it=tc - ta, assembly_s=tb - ta,
+                static_s=float("nan"), eigen_s=t3 - tc, factor_s=be.t_factor, n_factor=be.n_factor,
+                solve_s=be.t_solve, rss_mb=rss,
+                f1_hz=float(np.sqrt(abs(w[0])) / (2 * np.pi)), step_norm=float(np.linalg.norm(du)))
+
+
+def launch(mesh: int, config: str, args) -> dict:
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
+    env["OPENBLAS_NUM_THREADS"] = "1"
+    cmd = [sys.executable, HERE, "--run", str(mesh), config, "--rest-length", str(args.rest_length),
+           "--sequence", str(args.sequence)]
+    if config in ("petsc2", "dist2"):
+        cmd = [shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"] + cmd
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if p.returncode != 0:
+        return dict(config=config, mesh=f"4x{mesh}x{mesh}", error=p.stderr.strip().splitlines()[-1:])
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--meshes", default="40,80,160")
+    ap.add_argument("--configs", default="scipy,petsc,petsc2,dist2")
+    ap.add_argument("--rest-length", type=float, default=1.5025,
+                    help="rest length of the S tendons [m] (the value Tables 6.3/6.6 imply)")
+    ap.add_argument("--sequence", type=int, default=10, help="coarsest mesh of the mesh sequencing")
+    ap.add_argument("--run", nargs=2, metavar=("MESH", "CONFIG"), help=argparse.SUPPRESS)
+    ap.add_argument("--json", action="store_true", help="one JSON document of all rows")
+    args = ap.parse_args(argv)
+    if args.run:
+        from tmfem.solvers.distributed import mpi_main
+        if args.run[1] == "scipy":
+            print(json.dumps(run_one(int(args.run[0]), "scipy", args.rest_length, args.sequence)))
+            return 0
+        return mpi_main(lambda: json.dumps(run_one(int(args.run[0]), args.run[1], args.rest_length,
+                                                   args.sequence)))
+    rows = []
+    if not args.json:
+        print(f"# 1-4 MTC, static from the undeformed membrane + 12 modes; {os.cpu_count()} cpus, "
+              f"load average {os.getloadavg()[0]:.2f}")
+        print(f"{'config':>7s} {'mesh':>11s} {'dofs':>8s} {'its':>4s} {'s/it':>7s} {'static s':>9s} "
+              f"{'eigen s':>8s} {'factor s':>9s} {'solve s':>8s} {'RSS MB/rank':>11s}  f1 [Hz]")
+    for mesh in [int(v) for v in args.meshes.split(",")]:
+        for config in args.configs.split(","):
+            row = launch(mesh, config, args)
+            rows.append(row)
+            if args.json:
+                continue
+            if "error" in row:
+                print(f"{config:>7s} {row['mesh']:>11s}  error: {row['error']}", flush=True)
+                continue
+            print(f"{config:>7s} {row['mesh']:>11s} {row['dofs']:8d} {row['iterations']:4d} "
+                  f"{row['s_per_it']:7.3f} {row['static_s']:9.2f} {row['eigen_s']:8.2f} "
+                  f"{row['factor_s']:9.2f} {row['solve_s']:8.2f} {row['rss_mb']:11.0f}  "
+                  f"{row['f1_hz']:.6f}", flush=True)
+    if args.json:
+        print(json.dumps(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,291 @@
+"""PETSc/SLEPc backend (tmfem.solvers.petsc) against the scipy backend, and MPI runs.
+
+Source of every expected number: an independent formulation -- the scipy backend (SuperLU,
+ARPACK/LAPACK) on the same matrices, the residual of the linear system itself, and the
+serial run for the 2-rank run. The model-level statics use the solver layer's Newton on
+the MTC residual from the design (``MTCModel.solve_static`` has no ``backend=`` yet).
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from tmfem.errors import BackendUnavailable, ConvergenceError, InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_missing_petsc4py_raises_backend_unavailable_naming_the_command(monkeypatch):
+    # source: the install contract of issue 11 (a missing backend names the command)
+    monkeypatch.setitem(sys.modules, "petsc4py", None)
+    from tmfem.solvers.backends import get_backend
+    with pytest.raises(BackendUnavailable, match="make install"):
+        get_backend("petsc")
+
+
+try:
+    import petsc4py  # noqa: F401
+    import slepc4py  # noqa: F401
+    HAVE_PETSC = True
+except ImportError:
+    HAVE_PETSC = False
+needs_petsc = pytest.mark.skipif(not HAVE_PETSC, reason="petsc4py/slepc4py not importable "
+                                 "(install: make install, i.e. scripts/install_petsc.sh)")
+
+
+@pytest.fixture(scope="module")
+def models():
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    return {p: MTCModel(load_preset(p), mesh_n=n) for p, n in (("1-4", 6), ("2-3", 4))}
+
+
+@pytest.fixture(scope="module")
+def equilibria(models):
+    # scipy reference: the model's own static solver from the design
+    return {p: m.solve_static(start="design") for p, m in models.items()}
+
+
+@needs_petsc
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_tangent_solves_agree(models, equilibria, preset):
+    from tmfem.solvers.backends import get_backend
+    m = models[preset]
+    _, K = m.residual(m.reduce(equilibria[preset].x))
+    Kf = K[m.free][:, m.free]
+    b = np.random.default_rng(1).standard_normal((Kf.shape[0], 2))
+    xs = get_backend("scipy").factorize(Kf)(b)
+    xp = get_backend("petsc").factorize(Kf)(b)
+    assert xp.shape == b.shape
+    assert np.linalg.norm(Kf @ xp - b) <= 1e-10 * np.linalg.norm(b) * 1e3
+    assert np.linalg.norm(xp - xs) <= 1e-9 * np.linalg.norm(xs)
+
+
+@needs_petsc
+def test_lu_for_unsymmetric_and_refactorisation_of_a_pattern():
+    from tmfem.solvers.backends import get_backend
+    be = get_backend("petsc")
+    n = 300
+    A = sp.diags([-np.ones(n - 1), 4 * np.ones(n), -2 * np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    b = np.linspace(0, 1, n)
+    solve = be.factorize(A)
+    x = solve(b)
+    assert np.linalg.norm(A @ x - b) <= 1e-12 * np.linalg.norm(b)
+    # same pattern, new values: the old solve refuses (no silent use of the new factors)
+    solve2 = be.factorize(2.0 * A)
+    assert np.allclose(solve2(b), x / 2, rtol=1e-12, atol=0)
+    with pytest.raises(InputError, match="earlier factorisation"):
+        solve(b)
+
+
+@needs_petsc
+def test_singular_matrix_is_the_scipy_error_type():
+    from tmfem.solvers.backends import SingularMatrix, get_backend
+    n = 40
+    A = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tolil()
+    A[7, :] = 0
+    A[:, 7] = 0
+    for name in ("scipy", "petsc"):
+        with pytest.raises(SingularMatrix, match="singular"):
+            get_backend(name).factorize(A.tocsr())(np.ones(n))
+
+
+@needs_petsc
+def test_iterative_cg_gamg_meets_the_unpreconditioned_tolerance(models, equilibria):
+    from tmfem.solvers.petsc import PetscBackend
+    m = models["1-4"]
+    _, K = m.residual(m.reduce(equilibria["1-4"].x))
+    Kf = sp.csr_matrix(K[m.free][:, m.free])
+    Mf = m.mass()[m.free][:, m.free]
+    A = Kf + 10.0 * Mf                       # SPD (K_T at a stable equilibrium, plus mass)
+    b = np.random.default_rng(2).standard_normal(A.shape[0])
+    for rtol in (1e-6, 1e-10):
+        x = PetscBackend(solver="iterative", rtol=rtol).factorize(A)(b)
+        assert np.linalg.norm(A @ x - b) <= rtol * np.linalg.norm(b) * 1.0001
+    with pytest.raises(InputError, match="'iterative' only"):
+        PetscBackend(rtol=1e-8)
+
+
+@needs_petsc
+def test_petsc_options_are_honoured():
+    # an unpreconditioned CG capped at 2 iterations cannot solve a 200-dof Laplacian: the
+    # options reach the KSP (from options=, and from PETSC_OPTIONS in a fresh process)
+    from tmfem.solvers.petsc import PetscBackend
+    n = 200
+    A = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    b = np.ones(n)
+    be = PetscBackend(solver="iterative", options="-pc_type none -ksp_max_it 2")
+    with pytest.raises(ConvergenceError, match="DIVERGED_ITS"):
+        be.factorize(A)(b)
+    # options do not leak into the next backend
+    x = PetscBackend(solver="iterative").factorize(A)(b)
+    assert np.linalg.norm(A @ x - b) <= 1e-10 * np.linalg.norm(b) * 1.0001
+    code = ("import numpy as np, scipy.sparse as sp; from tmfem.solvers.backends import get_backend\n"
+            f"n={n}; A=sp.diags([-np.ones(n-1),2*np.ones(n),-np.ones(n-1)],[-1,0,1]).tocsr()\n"
+            "get_backend('petsc').factorize(A)(np.ones(n))")
+    env = dict(os.environ, PETSC_OPTIONS="-ksp_type cg -pc_type none -ksp_max_it 2 "
+               "-ksp_error_if_not_converged 0")
+    p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert p.returncode != 0 and "DIVERGED_ITS" in p.stderr
+    with pytest.raises(InputError, match="'-name value' pairs"):
+        PetscBackend(options="ksp_type cg")
+
+
+@pytest.fixture(scope="module")
+def petsc_runs():
+    # the model on the PETSc backend: statics from the undeformed membrane (the trust-region
+    # continuation) and 12 modes, every factorisation and eigensolve through the backend
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    out = {}
+    for p, n in (("1-4", 6), ("2-3", 4)):
+        m = MTCModel(load_preset(p), mesh_n=n, backend="petsc")
+        st = m.solve_static()
+        out[p] = (m, st, m.modes(st.x, k=12))
+    return out
+
+
+@needs_petsc
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_static_equilibrium_and_frequencies_agree(models, petsc_runs, preset):
+    m = models[preset]
+    assert m.backend.name == "scipy"
+    ms, sts, mds = petsc_runs[preset]
+    assert ms.backend.name == "petsc"
+    st = m.solve_static()
+    x0 = m.initial_positions("undeformed")
+    u_scipy, u_petsc = st.x - x0, sts.x - x0
+    assert np.linalg.norm(u_petsc - u_scipy) <= 1e-9 * np.linalg.norm(u_scipy)
+    assert sts.iterations == st.iterations
+    md = m.modes(st.x, k=12)
+    assert np.allclose(mds.freq_hz, md.freq_hz, rtol=1e-8, atol=0)
+
+
+@needs_petsc
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_repeated_pairs_are_full_m_orthonormal_pairs(models, equilibria, preset):
+    from tmfem.solvers.petsc import PetscBackend
+    m = models[preset]
+    _, K = m.residual(m.reduce(equilibria[preset].x))
+    Kf, Mf = K[m.free][:, m.free], m.mass()[m.free][:, m.free]
+    # the backend's own eigenpairs (before lowest_modes' Rayleigh-Ritz) vs scipy's
+    w, V = PetscBackend().eigsh(Kf, Mf, 12, -1.0)
+    from tmfem.solvers.backends import ScipyBackend
+    ws, W = ScipyBackend().eigsh(Kf, Mf, 12, -1.0)
+    o = np.argsort(ws)
+    ws, W = ws[o], W[:, o]
+    W = W / np.sqrt(np.einsum("ij,ij->j", W, Mf @ W))
+    assert np.allclose(w, ws, rtol=1e-8, atol=0)
+    assert np.allclose(V.T @ (Mf @ V), np.eye(12), atol=1e-10)
+    assert np.linalg.norm(Kf @ V - Mf @ V * w) <= 1e-8 * np.linalg.norm(Kf @ V)
+    gaps = np.abs(np.diff(ws)) <= 1e-6 * np.abs(ws[1:])
+    assert gaps.any(), "expected at least one repeated pair (cyclic symmetry)"
+    # each cluster: the same M-orthogonal projector from both backends
+    start = 0
+    for j in range(1, 13):
+        if j == 12 or not gaps[j - 1]:
+            Pp = V[:, start:j] @ (V[:, start:j].T @ Mf)
+            Ps = W[:, start:j] @ (W[:, start:j].T @ Mf)
+            assert np.abs(Pp - Ps).max() <= 1e-6
+            start = j
+
+
+MPIEXEC = shutil.which("mpiexec")
+needs_mpi = pytest.mark.skipif(not (HAVE_PETSC and MPIEXEC), reason="petsc4py or mpiexec missing "
+                               "(install: make install)")
+
+
+def _mpirun(n, *args, timeout=120, program=None):
+    # this pytest process initialised MPI as a singleton, which puts Open MPI's own variables
+    # into os.environ: a child mpiexec that sees them thinks it is nested and exits
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
+    program = program or [sys.executable, str(ROOT / "tests" / "mpi" / "mtc_distributed.py")]
+    cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", str(n), *program, *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env)
+
+
+@needs_mpi
+def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
+    # source: the same command on 1 process (rank-0 output must be the serial document)
+    tmfem = [sys.executable, "-m", "tmfem"]
+    argv = ["modal", "--model", "mtc", "--preset", "2-3", "--mesh", "4", "--modes", "4", "--json"]
+    p2 = _mpirun(2, *argv, "--backend", "petsc", program=tmfem)
+    assert p2.returncode == 0, p2.stderr
+    p1 = subprocess.run(tmfem + argv, capture_output=True, text=True, cwd=ROOT)
+    d2, d1 = json.loads(p2.stdout), json.loads(p1.stdout)     # exactly one document
+    assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
+    p = _mpirun(2, *argv, program=tmfem)
+    assert p.returncode == 2 and p.stderr.count("expected --backend petsc") == 1
+
+
+@needs_mpi
+def test_one_and_two_ranks_agree(models, equilibria):
+    runs = {}
+    for n in (1, 2):
+        p = _mpirun(n, "1-4", "6")
+        assert p.returncode == 0, p.stderr
+        lines = p.stdout.strip().splitlines()
+        assert len(lines) == 1          # one document, from rank 0 only
+        runs[n] = json.loads(lines[0])
+        assert runs[n]["ranks"] == n
+    m = models["1-4"]
+    x0 = m.reduce(m.initial_positions("design"))
+    xs = m.reduce(equilibria["1-4"].x)
+    for n in (1, 2):
+        x = np.array(runs[n]["x"])
+        assert np.linalg.norm(x - xs) <= 1e-9 * np.linalg.norm(xs - x0)
+    assert np.allclose(runs[2]["omega2"], runs[1]["omega2"], rtol=2e-8, atol=0)
+    from tmfem.solvers.eigen import lowest_modes
+    _, K = m.residual(xs)
+    ref = lowest_modes(K, m.mass(), k=12, free=m.free, sigma=-1.0, backend="scipy")
+    assert np.allclose(runs[2]["omega2"], ref.omega2, rtol=2e-8, atol=0)
+
+
+@needs_mpi
+def test_model_on_petsc_under_two_ranks_agrees(models):
+    # MTCModel(backend="petsc") unchanged under mpiexec -n 2 (rows, MUMPS and SLEPc
+    # distributed; the pattern cache must take the same branch on every rank): the static
+    # continuation from the undeformed membrane and the modes agree with the scipy model
+    p = _mpirun(2, "1-4", "6", "--replicated")
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip())
+    m = models["1-4"]
+    st = m.solve_static()
+    x0 = m.reduce(m.initial_positions("undeformed"))
+    xs = m.reduce(st.x)
+    assert np.linalg.norm(np.array(run["x"]) - xs) <= 1e-9 * np.linalg.norm(xs - x0)
+    assert run["iterations"] == st.iterations
+    assert np.allclose(run["omega2"], m.modes(st.x, k=12).omega2, rtol=2e-8, atol=0)
+
+
+@needs_mpi
+def test_rank_local_pattern_changes_neither_hang_nor_mislead():
+    # source: the residual of the linear systems; rank 1's rows change pattern, rank 0's do
+    # not (the pattern cache and the symmetry test must agree over the ranks)
+    cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable,
+           str(ROOT / "tests" / "mpi" / "pattern_cache.py")]
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=env)
+    assert p.returncode == 0, p.stderr
+    assert max(json.loads(p.stdout)) <= 1e-12
+
+
+@needs_mpi
+def test_failure_on_one_rank_one_error_nonzero_exit():
+    # non-finite element matrices on rank 1: caught collectively, one message from rank 0
+    p = _mpirun(2, "1-4", "4", "--nan-rank", "1")
+    assert p.returncode != 0
+    assert p.stderr.count("error: ") == 1 and "non-finite entries" in p.stderr
+    assert p.stdout.strip() == ""
+    # an exception in rank 1 only while rank 0 waits in a collective call: aborted, no hang
+    p = _mpirun(2, "1-4", "4", "--fail-rank", "1", timeout=60)
+    assert p.returncode != 0
+    assert p.stderr.count("error: rank 1 of 2: FloatingPointError") == 1

@@ -1,0 +1,401 @@
+"""PETSc/SLEPc backend: KSP linear solves (MUMPS by default) and SLEPc shift-invert eigensolves.
+
+Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py/slepc4py:
+
+``factorize(A) -> solve``
+    KSP ``preonly`` with MUMPS: Cholesky (symmetric LDL^T, MUMPS ``SYM=2``, also for
+    indefinite tangents) when A is symmetric, LU otherwise. ``solver="iterative"``: CG
+    (symmetric) or GMRES with GAMG, stopping on the *unpreconditioned* residual
+    ||b - A x|| <= rtol ||b|| (PETSc's default preconditioned norm stops 10-100x short of
+    the requested accuracy).
+``eigsh(K, M, k, sigma) -> (w, V)``
+    SLEPc EPS Krylov-Schur for the generalised Hermitian problem K v = w M v (eq. 5.32)
+    with shift-and-invert about ``sigma`` (the factorisation of K - sigma M by the same
+    MUMPS Cholesky); the k eigenvalues nearest to sigma, vectors M-orthonormal (SLEPc's
+    B-inner product, then a Rayleigh-Ritz step in their span, so that repeated eigenvalues
+    come out as full M-orthonormal pairs).
+
+Matrices are scipy sparse matrices (the same on every rank) or a
+:class:`tmfem.solvers.distributed.DistributedMatrix` assembled rank by rank. Vectors in
+and out are full numpy arrays on every rank; under ``mpiexec -n P`` the matrix rows and
+the factorisation are distributed over the P ranks (MUMPS in parallel).
+
+PETSc options: every KSP/PC/EPS/ST reads the options database after the defaults above,
+so ``PETSC_OPTIONS="-ksp_type cg -pc_type hypre"`` in the environment, the ``options=``
+argument (a dict ``{"ksp_type": "cg"}`` or a string ``"-ksp_type cg -pc_type gamg"``)
+override them as PETSc users expect; ``options=`` wins over the environment. The eigen
+solver's factorisation reads the ``st_`` prefix (``-st_pc_factor_mat_solver_type``),
+SLEPc its ``eps_`` options (``-eps_tol``, ``-eps_ncv``).
+"""
+from __future__ import annotations
+
+import hashlib
+import logging
+import shlex
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.errors import BackendUnavailable, ConvergenceError, InputError
+
+log = logging.getLogger(__name__)
+
+PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/backends.md)"
+
+#: PETSc's KSP converged reasons by value (for messages)
+_KSP_REASONS = {-2: "DIVERGED_NULL", -3: "DIVERGED_ITS", -4: "DIVERGED_DTOL",
+                -5: "DIVERGED_BREAKDOWN", -6: "DIVERGED_BREAKDOWN_BICG",
+                -7: "DIVERGED_NONSYMMETRIC", -8: "DIVERGED_INDEFINITE_PC", -9: "DIVERGED_NANORINF",
+                -10: "DIVERGED_INDEFINITE_MAT", -11: "DIVERGED_PC_FAILED"}
+
+
+def petsc_modules():
+    """``(PETSc, SLEPc)`` imported (and initialised) lazily; :class:`BackendUnavailable`
+    naming the install command when petsc4py/slepc4py are missing or do not load."""
+    try:
+        import petsc4py
+        import slepc4py
+        petsc4py.init()
+        slepc4py.init()
+        from petsc4py import PETSc
+        from slepc4py import SLEPc
+    except ImportError as exc:
+        raise BackendUnavailable(f"backend 'petsc': expected petsc4py and slepc4py importable, found "
+                                 f"{exc}; install with: {PETSC_INSTALL}") from None
+    return PETSc, SLEPc
+
+
+def parse_options(options) -> dict:
+    """PETSc options as ``{name: value}`` (names without the leading '-') from a dict, a
+    string ``"-ksp_type cg -ksp_rtol 1e-9 -ksp_view"`` or None."""
+    if options is None:
+        return {}
+    if isinstance(options, dict):
+        return {str(k).lstrip("-"): ("" if v is None else str(v)) for k, v in options.items()}
+    if not isinstance(options, str):
+        raise InputError(f"petsc options: expected a dict or a string such as '-ksp_type cg', "
+                         f"found {type(options).__name__}")
+    out, key = {}, None
+    for tok in shlex.split(options):
+        if tok.startswith("-") and not _is_number(tok):
+            key = tok.lstrip("-")
+            out[key] = ""
+        elif key is None:
+            raise InputError(f"petsc options: expected '-name value' pairs, found {tok!r} first")
+        else:
+            out[key] = tok
+            key = None
+    return out
+
+
+def _is_number(tok: str) -> bool:
+    try:
+        float(tok)
+        return True
+    except ValueError:
+        return False
+
+
+class PetscBackend:
+    """PETSc/SLEPc backend (module docstring).
+
+    Parameters
+    ----------
+    solver : {"direct", "iterative"}
+        MUMPS factorisation (default) or a Krylov method with algebraic multigrid.
+    rtol : float
+        Relative tolerance of the iterative solver on the unpreconditioned residual,
+        ||b - A x|| <= rtol ||b||; set it at or below the Newton tolerance (an iterative
+        step with rtol = 1e-10 leaves the Newton residual of a 1e-9 target intact).
+        Ignored by nothing: ``solver="direct"`` refuses an explicit rtol.
+    options : dict or str, optional
+        PETSc options database entries (``{"pc_type": "hypre"}`` or ``"-pc_type hypre"``),
+        applied after the defaults and after ``PETSC_OPTIONS``.
+    eig_tol : float
+        SLEPc's relative residual tolerance of the eigenpairs.
+    """
+
+    name = "petsc"
+
+    def __init__(self, *, solver: str = "direct", rtol: float | None = None, options=None,
+                 eig_tol: float = 1e-12):
+        self.PETSc, self.SLEPc = petsc_modules()
+        if solver not in ("direct", "iterative"):
+            raise InputError(f"backend 'petsc': expected solver 'direct' or 'iterative', found {solver!r}")
+        if rtol is not None and solver == "direct":
+            raise InputError("backend 'petsc': rtol applies to solver='iterative' only; the direct "
+                             "MUMPS solve has no tolerance")
+        self.solver = solver
+        self.rtol = 1e-10 if rtol is None else float(rtol)
+        if not 0 < self.rtol < 1:
+            raise InputError(f"backend 'petsc': expected 0 < rtol < 1, found {self.rtol}")
+        self.options = parse_options(options)
+        self.eig_tol = float(eig_tol)
+        self.comm = self.PETSc.COMM_WORLD
+        self._cache = {}          # sparsity pattern -> [Mat, KSP, generation]
+
+    # ------------------------------------------------------------------ matrices
+    def ownership(self, n: int) -> tuple[int, int]:
+        """Rows [lo, hi) of an n x n matrix owned by this rank (PETSc's default split)."""
+        P, r = self.comm.size, self.comm.rank
+        base, extra = divmod(n, P)
+        lo = r * base + min(r, extra)
+        return lo, lo + base + (1 if r < extra else 0)
+
+    def _mat(self, A, *, cache: bool = True):
+        """(PETSc Mat, key) of A: a DistributedMatrix's Mat, or this rank's rows of a
+        replicated scipy matrix. With ``cache`` a new A of an earlier pattern only updates
+        that Mat's values, so that MUMPS keeps its symbolic analysis."""
+        from tmfem.solvers.distributed import DistributedMatrix
+        if isinstance(A, DistributedMatrix):
+            return A.mat, ("dist", id(A.pattern))
+        if not sp.issparse(A):
+            A = np.asarray(A, dtype=float)
+        A = sp.csr_matrix(A, dtype=float)
+        A.sum_duplicates()
+        A.sort_indices()
+        n = A.shape[0]
+        if A.shape != (n, n):
+            raise InputError(f"petsc: expected a square matrix, found shape {A.shape}")
+        lo, hi = self.ownership(n)
+        Al = A[lo:hi]
+        ip = Al.indptr.astype(self.PETSc.IntType)
+        ix = Al.indices.astype(self.PETSc.IntType)
+        key = None
+        if cache:
+            digest = hashlib.sha1(ip.tobytes() + ix.tobytes()).hexdigest()
+            if self.comm.size > 1:      # every rank must take the same branch (collective calls)
+                digest = "".join(self.comm.tompi4py().allgather(digest))
+            key = ("csr", n, digest)
+        entry = self._cache.get(key)
+        if entry is None:
+            M = self.PETSc.Mat().createAIJ(size=((hi - lo, n), (hi - lo, n)), csr=(ip, ix, Al.data),
+                                           comm=self.comm)
+        else:
+            M = entry[0]
+            M.setValuesCSR(ip, ix, Al.data)
+            entry[2] += 1              # earlier solves of this Mat are stale now
+        M.assemble()
+        return M, key
+
+    def _symmetric(self, A, M) -> bool:
+        """Whether A (scipy, the same on every rank) or its PETSc Mat M equals its transpose
+        to 1e-12 of its largest entry; the same answer on every rank (petsc4py 3.18's
+        ``isSymmetric`` of an MPIAIJ matrix answers per rank)."""
+        if sp.issparse(A):
+            A = sp.csr_matrix(A)
+            big = abs(A).max() if A.nnz else 0.0
+            D = A - A.T
+            return bool((abs(D).max() if D.nnz else 0.0) <= 1e-12 * big)
+        if not hasattr(A, "mat"):
+            A = np.asarray(A, dtype=float)
+            return bool(np.abs(A - A.T).max(initial=0.0) <= 1e-12 * np.abs(A).max(initial=0.0))
+        # distributed: compare M x with M^T x for a random x (collective norms; a transpose
+        # of the matrix would double its memory)
+        x, y = M.createVecs()
+        z = y.duplicate()
+        lo, hi = M.getOwnershipRange()
+        x.setArray(np.random.default_rng(7).standard_normal(M.getSize()[0])[lo:hi])
+        M.mult(x, y)
+        M.multTranspose(x, z)
+        scale = y.norm()
+        z.axpy(-1.0, y)
+        return bool(z.norm() <= 1e-12 * max(scale, 1e-300))
+
+    def _configure(self, ksp, symmetric: bool, prefix: str = "") -> None:
+        """Defaults of the module docstring, then the options database (PETSC_OPTIONS and
+        ``options=``, which wins)."""
+        PETSc = self.PETSc
+        pc = ksp.getPC()
+        if self.solver == "direct":
+            ksp.setType("preonly")
+            pc.setType("cholesky" if symmetric else "lu")
+            pc.setFactorSolverType("mumps")
+        else:
+            ksp.setType("cg" if symmetric else "gmres")
+            pc.setType("gamg")
+            ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
+            ksp.setTolerances(rtol=self.rtol, atol=0.0, max_it=10000)
+        opts = PETSc.Options()
+        saved = {}
+        for k, v in self.options.items():
+            name = prefix + k if not k.startswith(("eps_", "st_")) else k
+            saved[name] = opts.getString(name, None) if opts.hasName(name) else None
+            opts.setValue(name, v)
+        try:
+            ksp.setFromOptions()
+        finally:
+            for name, old in saved.items():
+                if old is None:
+                    opts.delValue(name)
+                else:
+                    opts.setValue(name, old)
+
+    # ------------------------------------------------------------------ linear solves
+    def factorize(self, A):
+        """``solve(b)`` of the square matrix A (module docstring); :class:`SingularMatrix`
+        when the factorisation fails (zero pivot) or a solution is not finite.
+
+        The returned ``solve`` accepts b of shape (n,) or (n, m) (full arrays on every
+        rank) and returns x of the same shape on every rank. Factorising another matrix of
+        the same sparsity pattern reuses the PETSc objects (and MUMPS' analysis): an older
+        ``solve`` of that pattern then raises instead of silently using the new factors.
+        """
+        from tmfem.solvers.backends import SingularMatrix
+        PETSc = self.PETSc
+        M, key = self._mat(A)
+        n = M.getSize()[0]
+        sym = self._symmetric(A, M)
+        entry = self._cache.get(key)
+        if entry is None or entry[3] != sym:
+            ksp = PETSc.KSP().create(comm=self.comm)
+            M.setOption(PETSc.Mat.Option.SYMMETRIC, sym)
+            ksp.setOperators(M)
+            self._configure(ksp, sym)
+            entry = [M, ksp, 0, sym]
+            if len(self._cache) >= 4:
+                old = self._cache.pop(next(iter(self._cache)))
+                old[1].destroy()
+            self._cache[key] = entry
+        else:
+            ksp = entry[1]
+            ksp.setOperators(M)
+        entry[2] += 1
+        generation = entry[2]
+        version = getattr(A, "version", None)
+        try:
+            ksp.setUp()
+        except PETSc.Error as exc:
+            raise SingularMatrix(f"linear solve (petsc {ksp.getPC().getType()}/mumps): expected a "
+                                 f"non-singular {n}x{n} matrix, found the factorisation failing "
+                                 f"(PETSc error {exc.ierr})") from None
+        pc = ksp.getPC()
+        if pc.getType() in ("lu", "cholesky") and pc.getFactorSolverType() == "mumps":
+            info = pc.getFactorMatrix().getMumpsInfog(1)
+            if info < 0:             # -10: numerically singular (a zero pivot)
+                raise SingularMatrix(f"linear solve (petsc {pc.getType()}/mumps): expected a "
+                                     f"non-singular {n}x{n} matrix, found a singular one (MUMPS "
+                                     f"INFOG(1) = {info})")
+        lo, hi = M.getOwnershipRange()
+        x_vec, b_vec = M.createVecs()
+
+        def solve(b, *, rtol: float | None = None):
+            if entry[2] != generation or getattr(A, "version", None) != version:
+                raise InputError("petsc: this solve belongs to an earlier factorisation of a matrix "
+                                 "of the same pattern, which has since been refactorised")
+            b = np.asarray(b, dtype=float)
+            if b.shape[0] != n:
+                raise InputError(f"petsc solve: expected a right-hand side of {n} rows, found {b.shape}")
+            if rtol is not None:
+                if self.solver == "direct":
+                    raise InputError("petsc solve: rtol applies to solver='iterative' only")
+                ksp.setTolerances(rtol=float(rtol))
+            cols = b.reshape(n, -1)
+            out = np.empty_like(cols)
+            for j in range(cols.shape[1]):
+                b_vec.setArray(cols[lo:hi, j])
+                ksp.solve(b_vec, x_vec)
+                reason = ksp.getConvergedReason()
+                if reason < 0:
+                    what = _KSP_REASONS.get(reason, str(reason))
+                    if self.solver == "direct" or reason in (-11,):
+                        raise SingularMatrix(f"linear solve (petsc): expected a non-singular {n}x{n} "
+                                             f"matrix, found a singular one (KSP {what})")
+                    raise ConvergenceError(f"linear solve (petsc {ksp.getType()}/{ksp.getPC().getType()}): "
+                                           f"expected ||b - A x|| <= {ksp.getTolerances()[0]:.1e} ||b|| "
+                                           f"within {ksp.getTolerances()[3]} iterations, found KSP {what} "
+                                           f"after {ksp.getIterationNumber()} iterations "
+                                           f"(residual {ksp.getResidualNorm():.3e})")
+                out[:, j] = self.gather(x_vec)
+            if not np.all(np.isfinite(out)):
+                raise SingularMatrix(f"linear solve (petsc): expected a non-singular {n}x{n} matrix, "
+                                     "found a numerically singular one (non-finite solution; a "
+                                     "mechanism or an unloaded cable/membrane direction?)")
+            return out.reshape(b.shape)
+        return solve
+
+    def gather(self, vec) -> np.ndarray:
+        """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
+        local = vec.getArray(readonly=True)
+        if self.comm.size == 1:
+            return np.array(local)
+        mpi = self.comm.tompi4py()
+        counts = np.array(mpi.allgather(local.size))
+        out = np.empty(int(counts.sum()))
+        mpi.Allgatherv(np.ascontiguousarray(local), [out, counts])
+        return out
+
+    # ------------------------------------------------------------------ eigenproblems
+    def eigsh(self, K, M, k, sigma):
+        """The k eigenpairs of K v = w M v nearest to ``sigma`` (eq. 5.32), ascending, by
+        SLEPc Krylov-Schur with shift-and-invert (module docstring); V (n, k) M-orthonormal."""
+        import scipy.linalg as la
+        PETSc, SLEPc = self.PETSc, self.SLEPc
+        Kp, _ = self._mat(K)
+        Mp, _ = self._mat(M, cache=False)
+        n = Kp.getSize()[0]
+        k = int(k)
+        if not 1 <= k < n:
+            raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
+        sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
+        E = SLEPc.EPS().create(comm=self.comm)
+        try:
+            E.setOperators(Kp, Mp)
+            E.setProblemType(SLEPc.EPS.ProblemType.GHEP if sym else SLEPc.EPS.ProblemType.GNHEP)
+            E.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
+            E.setDimensions(nev=k, ncv=min(n, max(2 * k + 1, k + 16)))
+            E.setTarget(float(sigma))
+            E.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+            E.setTolerances(tol=self.eig_tol, max_it=1000)
+            st = E.getST()
+            st.setType(SLEPc.ST.Type.SINVERT)
+            st.setShift(float(sigma))
+            ksp = st.getKSP()
+            ksp.setType("preonly")
+            ksp.getPC().setType("cholesky" if sym else "lu")
+            ksp.getPC().setFactorSolverType("mumps")
+            opts = PETSc.Options()
+            saved = {}
+            for key, v in self.options.items():
+                if key.startswith(("eps_", "st_")):
+                    saved[key] = opts.getString(key, None) if opts.hasName(key) else None
+                    opts.setValue(key, v)
+            try:
+                E.setFromOptions()
+            finally:
+                for key, old in saved.items():
+                    if old is None:
+                        opts.delValue(key)
+                    else:
+                        opts.setValue(key, old)
+            try:
+                E.solve()
+            except PETSc.Error as exc:
+                from tmfem.solvers.backends import SingularMatrix
+                raise SingularMatrix(f"eigen (petsc): expected K - sigma M non-singular for sigma="
+                                     f"{sigma:g}, found the shift-invert factorisation failing "
+                                     f"(PETSc error {exc.ierr})") from None
+            nconv = E.getConverged()
+            if nconv < k:
+                raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "
+                                       f"sigma={sigma:g} in {E.getIterationNumber()} restarts")
+            vr, _ = Kp.createVecs()
+            w = np.empty(nconv)
+            V = np.empty((n, nconv))
+            for i in range(nconv):
+                w[i] = E.getEigenpair(i, vr).real
+                V[:, i] = self.gather(vr)
+        finally:
+            E.destroy()
+        order = np.argsort(np.abs(w - sigma), kind="stable")[:k]
+        w, V = w[order], V[:, order]
+        # Rayleigh-Ritz in span(V) (scipy operators on the full arrays): exactly M-orthonormal,
+        # also inside clusters of equal eigenvalues
+        Ks = sp.csr_matrix(K) if sp.issparse(K) else None
+        if Ks is not None:
+            Ms = sp.csr_matrix(M)
+            Kr, Mr = V.T @ (Ks @ V), V.T @ (Ms @ V)
+            w, Y = la.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
+            V = V @ Y
+        o = np.argsort(w)
+        return w[o], V[:, o]
