@@ -26,6 +26,7 @@ $(STAMP): pyproject.toml $(VENV)/.syslibs
 
 demo: $(STAMP)
 	$(BIN)/tmfem report --preset 1-4 --out $(OUT)/1-4
+	$(BIN)/tmfem deploy --preset 1-4D --uncertainty exact --t-end 16 --plot $(OUT)/1-4/deploy-1-4D.png --gif $(OUT)/1-4/deploy-1-4D.gif --csv $(OUT)/1-4/deploy-1-4D.csv
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

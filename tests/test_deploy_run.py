@@ -69,3 +69,15 @@ def test_1_6D_switch_time():
     # printed 18.44 s (7.4.2); ours within 1 s
     assert r.switch_time == pytest.approx(18.44, abs=1.0)
     assert r.stress["bar_critical_load_N"] == pytest.approx(479.6, rel=1e-3)
+
+
+@pytest.mark.slow
+def test_1_4D_switch_to_lmi_hinf():
+    # the LMI H-infinity controller of 7.3 (issue 12) after the switch stabilises the whole
+    # system at the deployed equilibrium (7.4.1: "rapidly stabilized"), membrane included
+    s = setup("1-4D", controller="adaptive-hinf", uncertainty="exact")
+    r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+                       t_end=16.0, dt=0.01, stress_every=50)
+    assert r.controller[-1] == "hinf-lmi" and 6.79 < r.switch_time < 10.0
+    assert np.max(np.abs(r.z[-1] - s.z_e)) < 1e-4
+    assert np.max(np.abs(r.w[-100:])) < 1e-4
