@@ -62,6 +62,11 @@ def test_against_mtc_same_mesh(sbc_1_4):
     f = m.member_forces(res.state)
     assert np.abs(f["bar"]) == pytest.approx(np.abs(ms["bar_force"]), rel=2e-3)
     assert modes.freq_hz == pytest.approx(fm, rel=3e-2)
+    # and the SBC/MTC differences are the dissertation's own (Table 6.6: the shell lowers
+    # modes 5 and 10-12 by 0.5-0.7 %) within 0.2 percentage points
+    ref = FREQUENCIES["1-4"]
+    printed = np.array(ref["SBC"]) / np.array(ref["MTC"]) - 1
+    np.testing.assert_allclose(modes.freq_hz / fm - 1, printed, atol=2e-3)
     # the bars hardly bend: their largest moment against the tendon force x bar length
     M = m.beam.section_forces(res.state)
     assert np.max(np.hypot(M["M1"], M["M2"])) < 1e-6 * np.max(f["tendon"]) * m.system.l.max()
