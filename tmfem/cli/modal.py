@@ -48,6 +48,8 @@ def run(args) -> dict:
     from tmfem.models.mtc.post import static_summary
     from tmfem.post.mtc import model_cells
     model, options = model_from_args(args, NAME)
+    if args.model == "sbc":
+        return sbc_modal(args, model, FREQUENCIES)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
     res, modes = mtc_modes(model, k=args.modes, start=options["start"],
@@ -81,7 +83,27 @@ def run(args) -> dict:
     return out
 
 
+def sbc_modal(args, model, tables) -> dict:
+    """``tmfem modal --model sbc``: equilibrium from the undeformed membrane, modes, and the
+    printed SBC column of Tables 6.6/6.7 (``tables``) when the system has one."""
+    from tmfem.models.sbc.post import modal_summary
+    if args.vtk or args.png:
+        raise InputError("modal --model sbc: option does not apply yet: --vtk/--png (mode-shape "
+                         "output of the shell model is not built; use --model mtc)")
+    print(f"tmfem modal: {model.system.name} SBC, {model.ndof} free dofs", file=sys.stderr)
+    res = model.solve_static(monitor=default_monitor(model.system))
+    out = modal_summary(model, res, model.modes(res.state, k=args.modes))
+    ref = tables.get(model.system.name)
+    if ref is not None:
+        n = min(len(ref["SBC"]), args.modes)
+        out["dissertation"] = {"source": ref["source"], "MTC": ref["MTC"][:n], "SBC": ref["SBC"][:n]}
+    return out
+
+
 def format_text(r: dict) -> str:
+    if r.get("model") == "sbc":
+        from tmfem.models.sbc.post import format_static
+        return format_static(r)
     if r.get("model") != "mtc":
         from tmfem.reference.com_modal import format_summary
         return format_summary(r)

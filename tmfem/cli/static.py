@@ -91,12 +91,24 @@ def write_outputs(args, model, x, summary) -> None:
 
 def run(args) -> dict:
     model, options = model_from_args(args, NAME)
+    if args.model == "sbc":
+        from tmfem.errors import InputError
+        from tmfem.models.sbc.post import static_summary as sbc_summary
+        if args.vtk or args.png or args.stress_plot:
+            raise InputError("static --model sbc: option does not apply yet: --vtk/--png/--stress-plot "
+                             "(field output of the shell model is not built; use --model mtc)")
+        monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
+        return sbc_summary(model, model.solve_static(monitor=monitor,
+                                                     progress=static_progress(args.progress)))
     res, summary = solve(args, model, options)
     write_outputs(args, model, res.x, summary)
     return summary
 
 
 def format_text(r: dict) -> str:
+    if r.get("model") == "sbc":
+        from tmfem.models.sbc.post import format_static
+        return format_static(r)
     pr = r.get("printed", {})
     lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "

@@ -121,6 +121,7 @@ def _load_builtin() -> None:
     # the built-in models register themselves when their spec modules are imported
     import tmfem.models.com.spec  # noqa: F401
     import tmfem.models.mtc.spec  # noqa: F401
+    import tmfem.models.sbc.spec  # noqa: F401
 
 
 def all_models() -> dict[str, ModelSpec]:

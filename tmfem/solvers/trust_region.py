@@ -42,8 +42,8 @@ class TrustRegionResult:
 def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale: np.ndarray,
                         force_scale: Callable, tol: float = 1e-9, max_iter: int = 200,
                         newton_first: bool = False, backend=None, callback: Callable | None = None,
-                        describe: Callable | None = None,
-                        what: str = "static solve") -> TrustRegionResult:
+                        describe: Callable | None = None, what: str = "static solve",
+                        update: Callable | None = None) -> TrustRegionResult:
     """Minimise the energy to an equilibrium r(u) = 0 on the free dofs (module docstring).
 
     Parameters
@@ -66,10 +66,14 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
         ``callback(iteration, u, rnorm, mu, rho)`` after every accepted step.
     describe : callable, optional
         ``describe(u) -> str``: the state at a failure, for the error message.
+    update : callable, optional
+        ``update(u, du) -> u_new`` (du on all dofs, zero at the fixed ones) for unknowns that
+        are not a vector to add to, e.g. a state with finite rotations composed by the
+        exponential map; ``u0`` and the returned ``u`` are then such states.
     """
     be = get_backend(backend)
     free = np.asarray(free, dtype=bool)
-    u = np.array(u0, dtype=float, copy=True)
+    u = np.array(u0, dtype=float, copy=True) if update is None else u0
     Dm = sp.diags(np.asarray(scale, dtype=float))
     r, K = residual(u)
     rn = float(np.linalg.norm(r[free]))
@@ -92,8 +96,13 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
                 du = np.full(g.shape, np.nan)        # regularise harder
             ok = bool(np.all(np.isfinite(du)) and float(g @ du) < 0)
             if ok:
-                ut = u.copy()
-                ut[free] += du
+                if update is None:
+                    ut = u.copy()
+                    ut[free] += du
+                else:
+                    dfull = np.zeros(free.size)
+                    dfull[free] = du
+                    ut = update(u, dfull)
                 Wt = energy(ut)
                 pred = -(float(g @ du) + 0.5 * float(du @ (Kf @ du)))
                 actual = W - Wt

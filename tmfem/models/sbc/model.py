@@ -1,0 +1,256 @@
+"""The shell-beam-cable (SBC) model of a tensegrity-membrane system (dissertation 4.3, 6.2-6.4).
+
+Built from the same :class:`~tmfem.system.System` and the same gmsh membrane mesh as the MTC
+model (:mod:`tmfem.models.mtc`), whose numbering, rest lengths and start placement it reuses:
+
+* **membrane**: MITC4 shells (:class:`tmfem.fem.mitc4.MITC4Shell`, 4.3.1) of thickness
+  ``system.membrane.h`` (51 um for the presets; docs/shells.md, "the thin limit");
+* **bars**: four-node beams (:class:`tmfem.fem.beam.BeamElement`, 4.3.2), ``bar_elements``
+  per bar (6.2: one), solid circular section of diameter ``system.bar.d``; Poisson's ratio
+  :data:`BAR_NU` (the system carries none);
+* **tendons**: ``k`` tension-only trusses each (the MTC model's, eqs. 4.23-4.24);
+* **supports**: A_1j translations fixed, rotations free; the rigid spin of every bar about its
+  axis removed by :func:`tmfem.fem.beam.spin_constraint` (mass-orthogonal: the elastic
+  spectrum is unchanged);
+* **attachment**: the bar top B_Mj is a dependent node whose translations follow the membrane
+  corner (``point``) or the MTC model's corner patch (``distributed``); its rotations are the
+  bar's own (a pin).
+
+Statics (6.2) start from the undeformed membrane exactly as the MTC model's (flat, unstressed,
+in the plane of the design bar tops; bars at the design; the bar tops moved onto the corners)
+and use the same mass-scaled trust-region Newton iteration
+(:func:`tmfem.solvers.trust_region.trust_region_newton`) through its ``update=`` path: the
+unknown is a :class:`~tmfem.fem.element.State` and an increment adds translations and composes
+the nodal rotations by the exponential map, which is the update the shell and beam tangents
+differentiate. Modes about the prestressed state solve (K_T - omega^2 M) phi = 0 (eq. 5.32)
+with the symmetric part of the tangent (symmetric at equilibrium) and the mass at the current
+directors; repeated pairs are M-orthonormalised by the Rayleigh-Ritz step of
+:func:`tmfem.solvers.eigen.lowest_modes` as in the MTC model.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.errors import InputError
+from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, spin_constraint
+from tmfem.fem.constraints import ConstraintMap
+from tmfem.fem.element import State, assemble
+from tmfem.fem.mitc4 import MITC4Shell, ShellSection
+from tmfem.fem.truss import TrussElement, TrussSet, truss_internal
+from tmfem.models.mtc.model import MTCModel
+from tmfem.models.sbc.topology import SBCNumbering, number_sbc
+from tmfem.solvers.eigen import lowest_modes
+from tmfem.solvers.trust_region import trust_region_newton
+
+#: Poisson's ratio of the bars (steel; ``system.bar`` has E, rho and d only)
+BAR_NU = 0.3
+
+
+@dataclass
+class SBCStaticResult:
+    """Equilibrium of an SBC model: the nodal ``state`` (positions ``x`` and rotations), the
+    iterations, residual norms [N] (start first), monitored node positions, trust-region mu."""
+
+    state: State
+    iterations: int
+    residual_history: list
+    monitor: dict
+    mu_history: list
+    time: float
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.state.x
+
+
+class SBCModel:
+    """Shell-beam-cable model of an M-N ``System`` (module docstring).
+
+    Parameters
+    ----------
+    system : System
+    mesh_n : int
+        Shell elements along each side of the N membrane quadrilaterals.
+    tendon_elements : int
+        Truss elements per tendon (6.2: 3).
+    bar_elements : int
+        Four-node beam elements per bar (6.2: 1).
+    attachment : {"point", "distributed"}
+    patch : float, optional
+        Patch radius [m] of the distributed attachment (MTC model's default).
+    rest_lengths : ndarray or {"system", "design", "mtc"}, optional
+        As :class:`tmfem.models.mtc.model.MTCModel` (``"mtc"``: the MTC model's consistent
+        rest lengths).
+    backend : str or Backend
+    """
+
+    def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3, bar_elements: int = 1,
+                 attachment: str = "point", patch: float | None = None, rest_lengths=None,
+                 backend="scipy"):
+        if system.deployable:
+            raise InputError("SBC model: 1-N(D) systems (tendons at H_1j along the bars) are not "
+                             "built yet; expected an M-N system, found deployable=True")
+        self.system = system
+        self.mtc = MTCModel(system, mesh_n=mesh_n, tendon_elements=tendon_elements,
+                            attachment=attachment, patch=patch, rest_lengths=rest_lengths,
+                            backend=backend)
+        self.backend = self.mtc.backend
+        mt = self.mtc.topology
+        self.numbering: SBCNumbering = number_sbc(mt, mt.bar_conn, bar_elements=bar_elements)
+        num = self.numbering
+        dm = self.dofmap = num.dofmap
+        # reference configuration: the undeformed membrane placed as in 6.2, bars at the design
+        x_start = self.mtc.initial_positions("undeformed")
+        X = np.zeros((3, dm.n_nodes))
+        X[:, :num.n_mtc_nodes] = x_start
+        X[:, mt.system_node] = system.nodes()
+        X[:, num.bar_chain] = self._along_bars(X)
+        self.X = X
+        mem = system.membrane
+        self.shell = MITC4Shell(X=X, conn=mt.mesh.t, dofmap=dm,
+                                section=ShellSection(E=mem.E, nu=mem.nu, thickness=mem.h, rho=mem.rho))
+        bar = system.bar
+        self.beam = BeamElement(BeamSet(conn=num.beam_conn, section=BeamSection.circle(d=bar.d),
+                                        E=bar.E, nu=BAR_NU, rho=bar.rho), dm, X=X)
+        self.tendon_element = None
+        self._set_tendons()
+        spins = [spin_constraint(self.beam, nodes=chain) for chain in num.bar_chain]
+        self.constraints = ConstraintMap.build(
+            dm, dependent=[(mt.top_nodes[j], nodes, w) for j, (nodes, w) in enumerate(mt.weights)],
+            fixed_nodes=mt.fixed_nodes, dependent_dofs=spins)
+        self.free = self.constraints.free
+        # start: the MTC start (bar tops on the corners), bar interiors on the chords
+        x0 = X.copy()
+        x0[:, :num.n_mtc_nodes] = x_start
+        x0[:, num.bar_chain] = self._along_bars(x0)
+        self._start = State(x=x0, R=np.broadcast_to(np.eye(3), (dm.n_nodes, 3, 3)).copy(),
+                            frames=self.shell.frames)
+
+    # ------------------------------------------------------------------ set-up
+    def _along_bars(self, x: np.ndarray) -> np.ndarray:
+        """Positions (3, n_bars, 3 e + 1) equally spaced on the chord of each bar's ends in x."""
+        ch = self.numbering.bar_chain
+        s = np.linspace(0.0, 1.0, ch.shape[1])
+        a, b = x[:, ch[:, 0]], x[:, ch[:, -1]]
+        return a[:, :, None] + (b - a)[:, :, None] * s[None, None, :]
+
+    def _set_tendons(self) -> None:
+        t = self.mtc.tendons
+        self.tendons = TrussSet(conn=t.conn, L=t.L.copy(), EA=t.EA, rhoA=t.rhoA,
+                                tension_only=t.tension_only)
+        self.tendon_element = TrussElement(self.tendons, self.dofmap)
+        self._M = None
+
+    def set_rest_lengths(self, rest) -> None:
+        """Tendon rest lengths, as :meth:`MTCModel.set_rest_lengths`."""
+        self.mtc.set_rest_lengths(rest)
+        self._set_tendons()
+
+    @property
+    def rest_lengths(self) -> np.ndarray:
+        return self.mtc.rest_lengths
+
+    @property
+    def elements(self) -> list:
+        """The element sets (shell, beams, tendons) on :attr:`dofmap`."""
+        return [self.shell, self.beam, self.tendon_element]
+
+    @property
+    def ndof(self) -> int:
+        """Number of free (reduced) dofs."""
+        return int(self.free.sum())
+
+    def node(self, lab: str) -> int:
+        """Global node of a system label (``"B_14"``)."""
+        return int(self.mtc.topology.system_node[self.system.node_index(lab)])
+
+    # ------------------------------------------------------------------ operators
+    def start_state(self) -> State:
+        """The start of 6.2: the undeformed membrane, bars at the design (module docstring)."""
+        return State(x=self._start.x.copy(), R=self._start.R.copy(), frames=self._start.frames)
+
+    def residual(self, state: State, *, tangent: bool = True):
+        """Reduced internal force T^T f and tangent T^T K T (eqs. 4.4-4.6) at ``state``."""
+        c = self.constraints
+        f, K = assemble(self.elements, state, tangent=tangent)
+        return c.residual(f), (c.tangent(K) if tangent else None)
+
+    def energy(self, state: State) -> float:
+        """Strain energy [J] of shells, beams and tendons (eq. 4.9)."""
+        return sum(e.energy(state) for e in self.elements)
+
+    def advance(self, state: State, du: np.ndarray) -> State:
+        """State after the reduced increment du: translations added, rotations by the
+        exponential map (the ``update=`` of the trust-region solver)."""
+        return state.advanced(self.constraints.full(du), self.dofmap)
+
+    def mass(self, state: State | None = None) -> sp.csr_matrix:
+        """Reduced mass T^T M T: shell (with rotary inertia) and beams at the directors of
+        ``state`` (reference by default), consistent tendon mass."""
+        M = self.shell.mass(state) + self.beam.mass(state) + self.tendon_element.mass()
+        return self.constraints.tangent(M)
+
+    def member_forces(self, state: State) -> dict:
+        """Tendon axial forces [N] (per tendon, first element) and bar axial forces [N]
+        (mean over each bar's Gauss points; compression negative)."""
+        k = self.mtc.topology.tendon_elements
+        N = truss_internal(state.x, self.tendons, tangent=False, dofmap=self.dofmap).N
+        Nb = self.beam.section_forces(state)["N"].reshape(-1, self.numbering.bar_elements *
+                                                           self.beam.r_gauss.size).mean(axis=1)
+        return {"tendon": N.reshape(-1, k).mean(axis=1), "bar": Nb}
+
+    def _force_scale(self, state: State) -> float:
+        f = self.member_forces(state)
+        return 1.0 + float(np.sum(np.abs(f["tendon"])) + np.sum(np.abs(f["bar"])))
+
+    # ------------------------------------------------------------------ statics
+    def solve_static(self, *, start: State | None = None, tol: float = 1e-9, max_iter: int = 200,
+                     monitor=(), progress=None) -> SBCStaticResult:
+        """Equilibrium reached from the undeformed membrane (6.2) or from ``start``.
+
+        Converged when |r_free| <= tol x (1 N + sum of |member forces|) after a pure Newton
+        step (:func:`trust_region_newton`). ``monitor``: node labels recorded every iteration;
+        ``progress(iteration, rnorm, mu, rho)``.
+        """
+        t0 = time.perf_counter()
+        s0 = self.start_state() if start is None else start
+        idx = {lab: self.node(lab) for lab in monitor}
+        hist = {lab: [s0.x[:, n].copy()] for lab, n in idx.items()}
+        Md = np.asarray(self.mass().diagonal())[self.free]
+
+        def record(it, s, rn, mu, rho):
+            for lab, n in idx.items():
+                hist[lab].append(s.x[:, n].copy())
+            if callable(progress):
+                progress(it, rn, mu, rho)
+
+        res = trust_region_newton(
+            self.residual, self.energy, s0, free=self.free, scale=np.maximum(Md, 1e-9 * Md.max()),
+            force_scale=self._force_scale, tol=tol, max_iter=max_iter, backend=self.backend,
+            callback=record, newton_first=start is not None, update=self.advance,
+            describe=lambda s: self.mtc._state_note(self.mtc.reduce(s.x[:, :self.numbering.n_mtc_nodes])),
+            what="SBC static solve")
+        return SBCStaticResult(state=res.u, iterations=res.iterations,
+                               residual_history=res.residual_history,
+                               monitor={k: np.array(v) for k, v in hist.items()},
+                               mu_history=res.mu_history, time=time.perf_counter() - t0)
+
+    # ------------------------------------------------------------------ modes
+    def modes(self, state: State, *, k: int = 12, sigma: float = -1.0):
+        """Lowest ``k`` modes about the prestressed ``state`` (eq. 5.32): symmetric part of
+        the reduced tangent, mass at the current directors. Shapes are reduced vectors
+        (:meth:`full_shapes`)."""
+        _, K = self.residual(state)
+        K = 0.5 * (K + K.T)
+        return lowest_modes(K.tocsr(), self.mass(state), k=k, free=self.free, sigma=sigma,
+                            backend=self.backend)
+
+    def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
+        """Translations (3, n_nodes, k) of the mode shapes from reduced vectors (n_red, k)."""
+        S = self.constraints.T @ shapes
+        tr = self.dofmap.translation_dofs(np.arange(self.dofmap.n_nodes))     # (n, 3)
+        return S[tr].transpose(1, 0, 2)

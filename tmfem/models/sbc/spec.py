@@ -1,0 +1,36 @@
+"""The SBC model in the model registry: its command-line options and how they build it."""
+from __future__ import annotations
+
+from tmfem.errors import InputError
+from tmfem.models.base import ModelSpec, Option, register
+from tmfem.models.mtc.spec import apply_rest_lengths
+from tmfem.models.sbc.model import SBCModel
+
+
+def build(system, options: dict, backend) -> SBCModel:
+    """The SBC model of ``system`` with the registry's option values."""
+    if options["patch"] is not None and options["attachment"] != "distributed":
+        raise InputError(f"--patch: option does not apply with --attachment {options['attachment']} "
+                         f"(expected --attachment distributed), found --patch {options['patch']}")
+    system, rest = apply_rest_lengths(system, options["rest_lengths"])
+    return SBCModel(system, mesh_n=options["mesh"], tendon_elements=options["tendon_elements"],
+                    bar_elements=options["bar_elements"], attachment=options["attachment"],
+                    patch=options["patch"], rest_lengths=rest, backend=backend)
+
+
+SPEC = register(ModelSpec(
+    name="sbc", help="shell-beam-cable finite-element model (4.3): MITC4 shell membrane, 4-node "
+                     "beam bars, tension-only truss tendons",
+    commands=("static", "modal"), build=build, shared=("mesh",),
+    own=(
+        Option("--tendon-elements", 3, None, dict(type=int, help="truss elements per tendon (6.2: 3)")),
+        Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1)")),
+        Option("--attachment", "point", None, dict(choices=("point", "distributed"), help=(
+            "membrane corners pinned to the bar tops (point) or spread over a small corner patch "
+            "(distributed)"))),
+        Option("--patch", None, None, dict(type=float, metavar="R", help=(
+            "patch radius [m] of --attachment distributed (default 10%% of r_mb)"))),
+        Option("--rest-lengths", None, None, dict(help=(
+            "tendon rest lengths: 'system', 'design' (eq. 3.8), 'mtc' (the MTC model's consistent "
+            "ones) or values per group/tendon, e.g. 'S1=1.5025'"))),
+    )))
