@@ -48,9 +48,9 @@ def submatrix(K, idx):
 
 
 def factorize(A, backend):
-    """``solve(b)`` of a tangent: a small dense one by LU in place (LAPACK), a sparse one by the
-    backend; a singular matrix raises :class:`~tmfem.solvers.backends.SingularMatrix`."""
-    if sp.issparse(A):
+    """``solve(b)`` of a tangent: a small dense one (ndarray) by LU in place (LAPACK), any other
+    (sparse, a backend's distributed matrix) by the backend; a singular matrix raises :class:`~tmfem.solvers.backends.SingularMatrix`."""
+    if not isinstance(A, np.ndarray):        # sparse, or a backend's own (distributed) matrix
         return backend.factorize(A)
     A = np.asarray(A, dtype=float)
     lu, piv = sla.lu_factor(A, check_finite=False)
