@@ -1,0 +1,135 @@
+"""Gridded LPV state-feedback synthesis (eqs. 5.90-5.99) on small plants with known answers."""
+import numpy as np
+import pytest
+
+from tmfem.control.lpv_plant import GriddedLPV
+from tmfem.control.lpv_synthesis import GeneralisedLPV, synthesize_state_feedback
+from tmfem.control.lpv_verify import verify
+from tmfem.errors import InfeasibleController, InputError
+
+
+def scalar_gp(a, rate=0.0):
+    """x' = a(rho) x + w + u, p = [x; u] on a grid rho = 0, 1, ..."""
+    a = np.asarray(a, dtype=float); s = (a.size,)
+    return GeneralisedLPV.from_matrices(
+        axes=[np.arange(a.size, dtype=float)], parameter_names=["r"], rate_bounds=[[-rate, rate]],
+        A=a.reshape(s + (1, 1)), B1=np.ones(s + (1, 1)), B2=np.ones(s + (1, 1)),
+        C1=np.broadcast_to([[1.0], [0.0]], s + (2, 1)), D11=np.zeros(s + (2, 1)),
+        D12=np.broadcast_to([[0.0], [1.0]], s + (2, 1)))
+
+
+def gamma_scalar(a):
+    """Closed form for x' = a x + w + u, p = [x; u], a < 0: static state feedback is optimal,
+    |T(jw)| = sqrt(1 + k^2) / |jw - (a + k)| peaks at w = 0; minimising over k gives k = 1/a."""
+    k = 1.0 / a
+    return np.sqrt(1 + k ** 2) / abs(a + k)
+
+
+@pytest.mark.parametrize("solver", ["CLARABEL", "SCS"])
+def test_scalar_plant_closed_form(solver):
+    r = synthesize_state_feedback(scalar_gp([-1.0]), solver=solver)
+    assert r.gamma == pytest.approx(gamma_scalar(-1.0), rel=1e-4)        # 1/sqrt(2)
+    assert r.gain([0.0])[0, 0] == pytest.approx(1 / -1.0, rel=1e-2)
+
+
+def test_two_point_grid_zero_rate_is_the_worst_point():
+    # with two grid points the affine P(rho), Q(rho) of eq. 5.99 take any values at both, so
+    # the gridded optimum is the larger of the two pointwise optima
+    r = synthesize_state_feedback(scalar_gp([-1.0, -2.0]))
+    assert r.gamma == pytest.approx(max(gamma_scalar(-1.0), gamma_scalar(-2.0)), rel=1e-4)
+
+
+def test_rate_bound_cannot_lower_gamma():
+    g0 = synthesize_state_feedback(scalar_gp([-1.0, -0.2, 0.5])).gamma
+    g1 = synthesize_state_feedback(scalar_gp([-1.0, -0.2, 0.5], rate=5.0)).gamma
+    assert g1 >= g0 * (1 - 1e-5)
+
+
+def lti_plant():
+    A = np.array([[0.0, 1.0, 0.0], [-2.0, -0.1, 1.0], [0.0, 0.0, 0.5]])
+    B1 = np.array([[1.0, 0.0], [0.0, 0.3], [0.2, 0.0]])
+    B2 = np.array([[0.0], [1.0], [1.0]])
+    C1 = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    D12 = np.array([[0.0], [0.5]])
+    return A, B1, B2, C1, D12
+
+
+def riccati_gamma(A, B1, B2, C1, D12, lo=1e-2, hi=1e2, tol=1e-6):
+    """Independent LTI state-feedback H-inf optimum (C1^T D12 = 0): gamma is achievable iff
+    the Hamiltonian [[A, B1 B1^T / g^2 - B2 R^-1 B2^T], [-C1^T C1, -A^T]] (R = D12^T D12) has
+    no imaginary-axis eigenvalue and its stable subspace gives X = X2 X1^-1 >= 0; bisection."""
+    import scipy.linalg as sla
+    n = A.shape[0]
+    R = D12.T @ D12
+
+    def ok(g):
+        H = np.block([[A, B1 @ B1.T / g ** 2 - B2 @ np.linalg.solve(R, B2.T)], [-C1.T @ C1, -A.T]])
+        if np.min(np.abs(np.linalg.eigvals(H).real)) < 1e-9:
+            return False
+        T, Z, sdim = sla.schur(H, sort="lhp")
+        X = Z[n:, :n] @ np.linalg.inv(Z[:n, :n])
+        return sdim == n and np.linalg.eigvalsh((X + X.T) / 2).min() > -1e-9
+    while hi - lo > tol * hi:
+        mid = np.sqrt(lo * hi)
+        lo, hi = (lo, mid) if ok(mid) else (mid, hi)
+    return hi
+
+
+def test_single_point_zero_rate_is_the_lti_state_feedback_problem():
+    """On one grid point with zero rate bounds eqs. 5.95-5.96 are the LTI state-feedback
+    bounded-real LMI: its gamma equals the Riccati/Hamiltonian bisection optimum (independent)
+    and the closed-loop H-inf norm of K = Q P^-1 (python-control / SLICOT ab13dd)."""
+    import control
+    A, B1, B2, C1, D12 = lti_plant()
+    nw = 2
+    gp = GeneralisedLPV.from_matrices(axes=[[0.0]], parameter_names=["r"], rate_bounds=[[0, 0]],
+                                      A=A[None], B1=B1[None], B2=B2[None], C1=C1[None],
+                                      D11=np.zeros((1, 2, nw)), D12=D12[None])
+    r = synthesize_state_feedback(gp, margin=1e-9)
+    assert r.gamma == pytest.approx(riccati_gamma(A, B1, B2, C1, D12), rel=1e-4)
+    K = r.gain([0.0])
+    cl = control.ss(A + B2 @ K, B1, C1 + D12 @ K, np.zeros((2, nw)))
+    assert control.norm(cl, p="inf") <= r.gamma * (1 + 1e-6)
+    assert control.norm(cl, p="inf") >= r.gamma * (1 - 1e-3)
+
+
+def oscillator_plant(shift=0.0):
+    """x'' + 0.1 x' + (1 + rho) x = u + w, rho in [0, 2]: A affine in rho, so the multilinear
+    interpolation between grid points is exact and the finer grid is the true plant."""
+    rho = np.array([0.0, 1.0, 2.0])
+    A = np.array([[[shift, 1.0], [-(1 + r), -0.1 + shift]] for r in rho])
+    B = np.broadcast_to([[0.0], [1.0]], (3, 2, 1))
+    C = np.broadcast_to(np.eye(2)[:1], (3, 1, 2))
+    return GriddedLPV(axes=[rho], parameter_names=["rho"], A=A, B=B, C=C, D=np.zeros((3, 1, 1)),
+                      rate_bounds=[[-0.5, 0.5]], state_names=["x", "v"], input_names=["u"],
+                      output_names=["x"])
+
+
+def gp_of(plant):
+    s = plant.grid_shape
+    return GeneralisedLPV.from_matrices(
+        axes=plant.axes, parameter_names=plant.parameter_names, rate_bounds=plant.rate_bounds,
+        A=plant.A, B1=plant.B, B2=plant.B, C1=np.concatenate([plant.C, np.zeros(s + (1, 2))], -2),
+        D11=np.zeros(s + (2, 1)), D12=np.broadcast_to([[0.0], [0.3]], s + (2, 1)))
+
+
+def test_interpolation_is_exact_for_affine_plant_and_refuses_outside():
+    pl = oscillator_plant()
+    A, *_ = pl.at([0.7])
+    np.testing.assert_allclose(A, [[0, 1], [-1.7, -0.1]], atol=1e-14)
+    assert [a.size for a in pl.refined(4)] == [9]
+    with pytest.raises(InputError, match="outside the grid"):
+        pl.at([2.5])
+
+
+def test_off_grid_verification_passes_and_refuses_a_wrong_plant():
+    pl = oscillator_plant()
+    ctrl = synthesize_state_feedback(gp_of(pl))
+    fine = gp_of(pl.resampled(pl.refined(4)))
+    v = verify(ctrl, fine)
+    assert v.passed and v.grid == (9,) and v.max_lmi_eig < 0 and v.max_cl_real < 0
+    # the same controller on a plant with every eigenvalue shifted by +3/s is refused
+    bad = gp_of(oscillator_plant(shift=3.0).resampled(pl.refined(4)))
+    with pytest.raises(InfeasibleController, match="fails its verification"):
+        verify(ctrl, bad)
+    assert not verify(ctrl, bad, allow_failure=True).passed

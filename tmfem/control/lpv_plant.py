@@ -1,0 +1,272 @@
+"""Gridded linear-parameter-varying plants (eq. 5.90) and their build from the COM.
+
+An LPV plant x' = A(rho) x + B(rho) u, y = C(rho) x + D(rho) u (eq. 5.90) is known here on a
+rectangular grid of parameter values (any number of parameters), the gridding approach of
+8.3: state-space matrices at every grid point, named states/inputs/outputs shared by all
+points, multilinear interpolation between grid points and bounds on the parameter rates.
+
+:func:`com_lpv_plant` builds it for a symmetric tensegrity-membrane system from
+linearisations of the control-oriented model (eq. 5.33) at the symmetric equilibria of
+eq. 5.97 on a (theta, psi) grid, rho_1 = theta_13, rho_2 = psi_13 (8.3), with the membrane
+point deflections of eq. 5.17 as coordinates.
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import RegularGridInterpolator
+
+from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
+from tmfem.errors import InputError
+from tmfem.models.com.linearize import linearize
+from tmfem.models.com.model import ControlOrientedModel
+from tmfem.system.geometry import membrane_corners_regular
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class GriddedLPV:
+    """State-space models on a rectangular parameter grid (eq. 5.90, gridding of 8.3).
+
+    Attributes
+    ----------
+    axes : list of (n_k,) arrays
+        Grid values of each parameter (strictly increasing; radians for angles).
+    parameter_names : list of str
+    A, B, C, D : arrays of shape ``grid_shape + (rows, cols)``
+    rate_bounds : (n_p, 2) array
+        Lower and upper bound of each parameter rate d rho_k / dt (per second).
+    state_names, input_names, output_names : list of str
+    x_e, u_e, y_e : arrays of shape ``grid_shape + (n,)``, optional
+        Equilibrium state, input and output at each grid point (the linearisations are
+        about them); zeros when not given.
+    """
+
+    axes: list
+    parameter_names: list
+    A: np.ndarray
+    B: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    rate_bounds: np.ndarray
+    state_names: list
+    input_names: list
+    output_names: list
+    x_e: np.ndarray | None = None
+    u_e: np.ndarray | None = None
+    y_e: np.ndarray | None = None
+    _interp: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self):
+        self.axes = [np.atleast_1d(np.asarray(a, dtype=float)) for a in self.axes]
+        shape = tuple(a.size for a in self.axes)
+        if len(self.parameter_names) != len(self.axes):
+            raise InputError(f"LPV plant: expected {len(self.axes)} parameter names, found "
+                             f"{len(self.parameter_names)}")
+        for k, a in enumerate(self.axes):
+            if a.size > 1 and np.any(np.diff(a) <= 0):
+                raise InputError(f"LPV plant: axis {self.parameter_names[k]!r} must be strictly "
+                                 f"increasing, found {a.tolist()}")
+        for nm in ("A", "B", "C", "D"):
+            M = np.asarray(getattr(self, nm), dtype=float)
+            if M.shape[:-2] != shape or not np.all(np.isfinite(M)):
+                raise InputError(f"LPV plant: {nm} must have shape {shape} + (rows, cols) with "
+                                 f"finite entries, found shape {M.shape}")
+            setattr(self, nm, M)
+        n, m, p = self.nx, self.nu, self.ny
+        if self.A.shape[-2:] != (n, n) or self.B.shape[-2:] != (n, m) or \
+                self.C.shape[-2:] != (p, n) or self.D.shape[-2:] != (p, m):
+            raise InputError(f"LPV plant: inconsistent sizes A {self.A.shape[-2:]}, B "
+                             f"{self.B.shape[-2:]}, C {self.C.shape[-2:]}, D {self.D.shape[-2:]}")
+        if (len(self.state_names), len(self.input_names), len(self.output_names)) != (n, m, p):
+            raise InputError(f"LPV plant: expected {n} state, {m} input and {p} output names, found "
+                             f"{len(self.state_names)}, {len(self.input_names)}, {len(self.output_names)}")
+        rb = np.asarray(self.rate_bounds, dtype=float).reshape(len(self.axes), 2)
+        if np.any(rb[:, 0] > rb[:, 1]) or not np.all(np.isfinite(rb)):
+            raise InputError(f"LPV plant: rate bounds must be finite [lower, upper] with lower <= "
+                             f"upper, found {rb.tolist()}")
+        self.rate_bounds = rb
+        for nm, k in (("x_e", n), ("u_e", m), ("y_e", p)):
+            v = getattr(self, nm)
+            v = np.zeros(shape + (k,)) if v is None else np.asarray(v, dtype=float)
+            if v.shape != shape + (k,):
+                raise InputError(f"LPV plant: {nm} must have shape {shape + (k,)}, found {v.shape}")
+            setattr(self, nm, v)
+
+    # ------------------------------------------------------------------ sizes and points
+    @property
+    def grid_shape(self) -> tuple:
+        return tuple(a.size for a in self.axes)
+
+    @property
+    def nx(self) -> int:
+        return self.A.shape[-1]
+
+    @property
+    def nu(self) -> int:
+        return self.B.shape[-1]
+
+    @property
+    def ny(self) -> int:
+        return self.C.shape[-2]
+
+    def points(self):
+        """Iterate over ``(index, rho)`` of all grid points (C order)."""
+        for idx in itertools.product(*(range(s) for s in self.grid_shape)):
+            yield idx, np.array([a[i] for a, i in zip(self.axes, idx)])
+
+    def rate_vertices(self) -> np.ndarray:
+        """Vertices of the rate box (eq. 5.94: dP/dt is affine in the rates), one row each;
+        a parameter with equal lower and upper bound contributes one value."""
+        cols = [np.unique(rb) for rb in self.rate_bounds]
+        return np.array(list(itertools.product(*cols)), dtype=float).reshape(-1, len(cols))
+
+    def _check_inside(self, rho):
+        rho = np.asarray(rho, dtype=float).reshape(-1)
+        if rho.size != len(self.axes):
+            raise InputError(f"LPV plant: expected {len(self.axes)} parameter values, found {rho.size}")
+        for k, (a, r) in enumerate(zip(self.axes, rho)):
+            tol = 1e-12 * max(1.0, abs(a[-1]))
+            if r < a[0] - tol or r > a[-1] + tol:
+                raise InputError(f"LPV plant: {self.parameter_names[k]} = {r:.6g} outside the grid "
+                                 f"[{a[0]:.6g}, {a[-1]:.6g}]")
+        return np.clip(rho, [a[0] for a in self.axes], [a[-1] for a in self.axes])
+
+    def interpolate(self, name: str, rho) -> np.ndarray:
+        """Multilinear interpolation of ``A``, ``B``, ``C``, ``D``, ``x_e``, ``u_e`` or ``y_e``
+        at ``rho`` (inside the grid; axes with one point are constant)."""
+        rho = self._check_inside(rho)
+        keep = [k for k, a in enumerate(self.axes) if a.size > 1]
+        M = getattr(self, name)
+        if not keep:
+            return M[(0,) * len(self.axes)].copy()
+        if name not in self._interp:
+            Mk = M[tuple(slice(None) if k in keep else 0 for k in range(len(self.axes)))]
+            self._interp[name] = RegularGridInterpolator([self.axes[k] for k in keep], Mk)
+        return self._interp[name](rho[keep])[0]
+
+    def at(self, rho):
+        """(A, B, C, D) at ``rho`` by multilinear interpolation between grid points."""
+        return tuple(self.interpolate(nm, rho) for nm in ("A", "B", "C", "D"))
+
+    def refined(self, factor: int) -> list:
+        """Axes of a grid ``factor`` times finer in each parameter (the design points kept)."""
+        if int(factor) != factor or factor < 1:
+            raise InputError(f"refinement factor: expected an integer >= 1, found {factor!r}")
+        return [a if a.size == 1 else np.concatenate(
+            [np.linspace(a[i], a[i + 1], int(factor) + 1)[:-1] for i in range(a.size - 1)] + [a[-1:]])
+            for a in self.axes]
+
+    def resampled(self, axes) -> "GriddedLPV":
+        """The plant interpolated onto other grid axes (inside this grid)."""
+        shape = tuple(np.size(a) for a in axes)
+        out = {nm: np.zeros(shape + getattr(self, nm).shape[len(self.axes):])
+               for nm in ("A", "B", "C", "D", "x_e", "u_e", "y_e")}
+        for idx in itertools.product(*(range(s) for s in shape)):
+            rho = [np.atleast_1d(a)[i] for a, i in zip(axes, idx)]
+            for nm in out:
+                out[nm][idx] = self.interpolate(nm, rho)
+        return GriddedLPV(axes=list(axes), parameter_names=list(self.parameter_names),
+                          rate_bounds=self.rate_bounds.copy(), state_names=self.state_names,
+                          input_names=self.input_names, output_names=self.output_names, **out)
+
+    def to_ss(self, index):
+        """python-control ``StateSpace`` with named signals at grid point ``index``."""
+        import control
+        idx = tuple(index)
+        return control.ss(self.A[idx], self.B[idx], self.C[idx], self.D[idx], states=self.state_names,
+                          inputs=self.input_names, outputs=self.output_names)
+
+
+def choose_membrane_points(model, *, rings=(0.2, 0.4, 0.6), per_ring: int = 12) -> list:
+    """K point coordinates (eq. 5.17) for ``model`` chosen greedily among (u, v, w) at points
+    on rings about the membrane centre (radii as fractions of r_mb): each step adds the
+    candidate that maximises the smallest singular value of the rows of T_v_eta picked so
+    far. Ch. 8 does not print its points (docs/errata.md); this rule keeps T_v_eta well
+    conditioned."""
+    system = model.system
+    c = membrane_corners_regular(system.N, system.r_mb).mean(axis=1)      # centre in O_f
+    nd = model.layout.n_delta
+    cands, rows = [], []
+    for fr in rings:
+        for t in np.radians(7.5) + 2 * np.pi * np.arange(per_ring) / per_ring:
+            xy = c + fr * system.r_mb * np.array([np.cos(t), np.sin(t)])
+            for comp, k in (("w", 2), ("u", 0), ("v", 1)):
+                try:
+                    r = model.membrane.point_matrix(xy[:, None], k)[0, 1 + nd:]
+                except InputError:
+                    continue
+                cands.append((comp, float(xy[0]), float(xy[1])))
+                rows.append(r)
+    R = np.array(rows)
+    R = R / np.linalg.norm(R, axis=1, keepdims=True).max()
+    picked = []
+    for _ in range(model.K):
+        best = max((i for i in range(len(cands)) if i not in picked),
+                   key=lambda i: np.linalg.svd(R[picked + [i]], compute_uv=False).min())
+        picked.append(best)
+    return [cands[i] for i in picked]
+
+
+def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int = 4,
+                  membrane_points=None, mesh_n: int = 10, damping: float = 0.0,
+                  rate_bounds=None, progress=None) -> GriddedLPV:
+    """Gridded LPV plant of a symmetric system from COM linearisations (8.3, eqs. 5.33, 5.97).
+
+    At each (theta, psi) of the grid the symmetric configuration of eq. 5.97 (stage bases
+    from ``bases(theta, psi)``, e.g. :func:`tmfem.reference.tables.deployment_bases`) is
+    built, the control-oriented model designs its rest lengths there (the equilibrium u_e,
+    eq. 3.16) and is linearised (eq. 5.33) with the membrane point coordinates of eq. 5.17
+    (``membrane_points``; default :func:`choose_membrane_points` at the first grid point).
+    rho_1 = theta_13 = theta and rho_2 = psi_13 = psi (8.3).
+
+    Parameters
+    ----------
+    theta, psi : arrays [rad]
+        Grid axes.
+    rate_bounds : (2, 2) array, optional
+        [[min, max] of d theta/dt, [min, max] of d psi/dt] [rad/s]; default +-10 deg/s (8.3).
+    progress : callable, optional
+        Called with (done, total) after each grid point.
+    """
+    theta = np.atleast_1d(np.asarray(theta, dtype=float))
+    psi = np.atleast_1d(np.asarray(psi, dtype=float))
+    if rate_bounds is None:
+        rb = np.radians(10.0)
+        rate_bounds = [[-rb, rb], [-rb, rb]]
+    pts = membrane_points
+    shape = (theta.size, psi.size)
+    mats, names = {}, None
+    total = theta.size * psi.size
+    for a, th in enumerate(theta):
+        for b, ps in enumerate(psi):
+            rule = bases(th, ps) if bases else {}
+            s = with_configuration(system, configuration_5_97(system, th, ps, **rule))
+            if pts is None:                      # chosen once, at the first grid point
+                pts = choose_membrane_points(ControlOrientedModel(s, membrane_modes=membrane_modes,
+                                                                  mesh_n=mesh_n))
+            m = ControlOrientedModel(s, membrane_modes=membrane_modes, mesh_n=mesh_n, damping=damping,
+                                     membrane_points=pts)
+            L = linearize(m)
+            got = (L.state_names, L.input_names, L.output_names)
+            if names is None:
+                names = got
+                for nm, v in (("A", L.A), ("B", L.B), ("C", L.Cy), ("D", L.D),
+                              ("x_e", np.concatenate([L.z_e, np.zeros_like(L.z_e)])),
+                              ("u_e", L.u_e), ("y_e", L.y_e)):
+                    mats[nm] = np.zeros(shape + v.shape)
+            for nm, v in (("A", L.A), ("B", L.B), ("C", L.Cy), ("D", L.D),
+                          ("x_e", np.concatenate([L.z_e, np.zeros_like(L.z_e)])),
+                          ("u_e", L.u_e), ("y_e", L.y_e)):
+                mats[nm][a, b] = v
+            log.info("LPV plant: point theta = %.2f deg, psi = %.2f deg linearised",
+                     np.degrees(th), np.degrees(ps))
+            if progress is not None:
+                progress(a * psi.size + b + 1, total)
+    return GriddedLPV(axes=[theta, psi], parameter_names=["theta_13", "psi_13"],
+                      rate_bounds=np.asarray(rate_bounds, dtype=float), state_names=names[0],
+                      input_names=names[1], output_names=names[2], **mats)
