@@ -80,6 +80,8 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
+    from tmfem.simulation.driver import check_time_grid
+    check_time_grid(args.t_end, args.dt)            # refused before the controller design
     t0 = time.perf_counter()
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty)
     from tmfem.control.deploy import run_deployment
