@@ -101,6 +101,14 @@ SHARED_OPTIONS = {
     "mesh": Option("--mesh", 10, None, dict(type=int, metavar="N", help=(
         "membrane elements per side of each of the N quadrilateral patches (the dissertation's "
         "4 x 10 x 10: 10)"))),
+    "tendon_elements": Option("--tendon-elements", 3, None, dict(
+        type=int, help="truss elements per tendon (6.2: 3)")),
+    "attachment": Option("--attachment", "point", None, dict(
+        choices=("point", "distributed"), help=(
+            "membrane corners pinned to the bar tops (point) or spread over a small corner patch "
+            "(distributed)"))),
+    "patch": Option("--patch", None, None, dict(type=float, metavar="R", help=(
+        "patch radius [m] of --attachment distributed (default 10%% of r_mb)"))),
 }
 
 MODELS: dict[str, ModelSpec] = {}

@@ -46,14 +46,9 @@ def build(system, options: dict, backend) -> MTCModel:
 SPEC = register(ModelSpec(
     name="mtc", help="membrane-truss-cable finite-element model (4.4): membrane elements, truss "
                      "bars, tension-only truss tendons",
-    commands=("static", "modal", "vibrate"), build=build, shared=("mesh",),
+    commands=("static", "modal", "vibrate"), build=build,
+    shared=("mesh", "tendon_elements", "attachment", "patch"),
     own=(
-        Option("--tendon-elements", 3, None, dict(type=int, help="truss elements per tendon (6.2: 3)")),
-        Option("--attachment", "point", None, dict(choices=("point", "distributed"), help=(
-            "membrane corners pinned to the bar tops (point) or spread over a small corner patch "
-            "(distributed)"))),
-        Option("--patch", None, None, dict(type=float, metavar="R", help=(
-            "patch radius [m] of --attachment distributed (default 10%% of r_mb)"))),
         Option("--rest-lengths", None, None, dict(help=(
             "tendon rest lengths: 'system' (default when the system has them), 'design' (eq. 3.8), "
             "'mtc' (those that make the design an exact equilibrium of this model) or values per "

@@ -21,15 +21,10 @@ def build(system, options: dict, backend) -> SBCModel:
 SPEC = register(ModelSpec(
     name="sbc", help="shell-beam-cable finite-element model (4.3): MITC4 shell membrane, 4-node "
                      "beam bars, tension-only truss tendons",
-    commands=("static", "modal"), build=build, shared=("mesh",),
+    commands=("static", "modal"), build=build,
+    shared=("mesh", "tendon_elements", "attachment", "patch"),
     own=(
-        Option("--tendon-elements", 3, None, dict(type=int, help="truss elements per tendon (6.2: 3)")),
         Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1)")),
-        Option("--attachment", "point", None, dict(choices=("point", "distributed"), help=(
-            "membrane corners pinned to the bar tops (point) or spread over a small corner patch "
-            "(distributed)"))),
-        Option("--patch", None, None, dict(type=float, metavar="R", help=(
-            "patch radius [m] of --attachment distributed (default 10%% of r_mb)"))),
         Option("--rest-lengths", None, None, dict(help=(
             "tendon rest lengths: 'system', 'design' (eq. 3.8), 'mtc' (the MTC model's consistent "
             "ones) or values per group/tendon, e.g. 'S1=1.5025'"))),
