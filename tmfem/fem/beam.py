@@ -337,14 +337,7 @@ class BeamElement:
             raise InputError(f"beam: expected reference positions of shape (3, {dofmap.n_nodes}), "
                              f"found {X.shape}")
         conn = beams.conn
-        if beams.ne and (conn.min() < 0 or conn.max() >= dofmap.n_nodes):
-            raise InputError(f"beam: expected node indices in [0, {dofmap.n_nodes}), found "
-                             f"[{conn.min()}, {conn.max()}]")
-        nodes = np.unique(conn)
-        bad = nodes[dofmap.counts[nodes] != 6]
-        if bad.size:
-            raise InputError(f"beam: expected six dofs at every beam node, found "
-                             f"{dofmap.counts[bad[:5]].tolist()} at nodes {bad[:5].tolist()}")
+        dofmap.check_element_nodes(conn, 6, element="beam", dofs="six dofs")
         self.beams, self.dofmap, self.integration = beams, dofmap, integration
         self.triads = reference_directors(X, conn, beams.v1)         # (ne, 4, 3, 3)
         r, w = _gauss(INTEGRATION[integration])

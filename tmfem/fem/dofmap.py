@@ -94,6 +94,19 @@ class DofMap:
         d = pick(conn.T.ravel())
         return d.reshape(conn.shape[1], -1)
 
+    def check_element_nodes(self, conn, count: int, *, element: str, dofs: str) -> None:
+        """Refuse an element connectivity ``conn`` whose nodes are out of range or do not carry
+        ``count`` dofs each (``dofs`` names them in the message, e.g. "six dofs")."""
+        conn = np.asarray(conn)
+        if conn.size and (conn.min() < 0 or conn.max() >= self.n_nodes):
+            raise InputError(f"{element}: expected node indices in [0, {self.n_nodes}), found "
+                             f"[{conn.min()}, {conn.max()}]")
+        nodes = np.unique(conn)
+        bad = nodes[self.counts[nodes] != count]
+        if bad.size:
+            raise InputError(f"{element}: expected {dofs} at every {element} node, found "
+                             f"{self.counts[bad[:5]].tolist()} at nodes {bad[:5].tolist()}")
+
     def translation_mask(self) -> np.ndarray:
         """Boolean (ndof,): True at translational dofs."""
         m = np.zeros(self.ndof, dtype=bool)

@@ -259,16 +259,10 @@ class MITC4Shell:
                              f"found {X.shape}")
         if conn.ndim != 2 or conn.shape[0] != 4 or conn.shape[1] == 0:
             raise InputError(f"MITC4: expected connectivity of shape (4, ne) with ne >= 1, found {conn.shape}")
-        if conn.min() < 0 or conn.max() >= dofmap.n_nodes:
-            raise InputError(f"MITC4: expected node indices in [0, {dofmap.n_nodes}), found "
-                             f"[{conn.min()}, {conn.max()}]")
-        nodes = np.unique(conn)
-        bad = nodes[dofmap.counts[nodes] != 5]
-        if bad.size:
-            raise InputError(f"MITC4: expected 5 dofs (3 translations, 2 rotations) at every shell node, "
-                             f"found {dofmap.counts[bad[:5]].tolist()} at nodes {bad[:5].tolist()}")
+        dofmap.check_element_nodes(conn, 5, element="MITC4",
+                                   dofs="5 dofs (3 translations, 2 rotations)")
         self.X, self.conn, self.section, self.dofmap = X, conn, section, dofmap
-        self.nodes = nodes
+        nodes = self.nodes = np.unique(conn)
         if normals is None:
             Vn = nodal_normals(X, conn)
         else:
