@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from tmfem.errors import TmfemError
+from tmfem.models.com.dae import matrices_newton
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.model import default_membrane_modes
 from tmfem.models.com.model import ControlOrientedModel
@@ -68,13 +69,13 @@ def bench(name: str, t_end: float) -> None:
     t_build = time.perf_counter() - t0
     print(f"\n== {name}: {model.nz} coordinates (nq = {model.nq}, K = {K}), "
           f"{model.n_t} inputs; build {t_build:.2f} s "
-          f"(casadi graph of the fast path: {model._fast.n_nodes()} nodes)")
+          f"(casadi graph of the fast path: {model.graphs.fast.n_nodes()} nodes)")
     z, zd = model.z0, np.full(model.nz, 1e-3)
     print(f"one M_hat, F_hat, B_hat (fast path, one casadi call): "
           f"{1e6 * per_call(lambda: model.matrices(z, zd), 300):8.1f} us")
     print(f"one M_hat, F_hat, B_hat (Newton zeta + numeric 5.23-5.28): "
-          f"{1e6 * per_call(lambda: model.matrices_newton(z, zd), 100):8.1f} us")
-    print(f"one Newton matrix K + cv C + ca M (AD, {model._newton.n_nodes()} nodes): "
+          f"{1e6 * per_call(lambda: matrices_newton(model, z, zd), 100):8.1f} us")
+    print(f"one Newton matrix K + cv C + ca M (AD, {model.graphs.newton.n_nodes()} nodes): "
           f"{1e3 * per_call(lambda: model.newton_matrix(z, zd, zd, 0.0, 1.0, 1.0), 10):8.2f} ms")
     z_e = model.equilibrium()
     print(f"one linearisation (eq. 5.33, at the equilibrium): "

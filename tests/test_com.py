@@ -5,6 +5,7 @@ import pytest
 
 from tmfem.errors import InputError
 from tmfem.models.com.constraints import ZetaLayout, zeta_closed_form
+from tmfem.models.com.dae import dae_terms, matrices_newton
 from tmfem.models.com.linearize import linearize, output_jacobian
 from tmfem.models.com.model import ControlOrientedModel
 from tmfem.solvers.park import park_integrate
@@ -251,7 +252,7 @@ def test_fast_path_equals_newton_partitioning(m14):
     # Newton on Phi and eqs. 5.23-5.28 evaluated numerically from the DAE matrices
     for seed in (7, 8):
         z, zd = _random_state(m14, seed)
-        for a, b in zip(m14.matrices(z, zd), m14.matrices_newton(z, zd)):
+        for a, b in zip(m14.matrices(z, zd), matrices_newton(m14, z, zd)):
             assert np.allclose(a, b, rtol=1e-10, atol=1e-10 * np.abs(a).max())
     w, X = m14.fast_outputs(z)
     assert np.allclose(w, m14.membrane_w(z), atol=1e-14)
@@ -298,13 +299,30 @@ def test_dae_with_multipliers_equals_partitioned_ode(m14):
     [M Phi_x^T; Phi_x 0] [x''; lambda] = [-F - B u; -gamma], gives the same z'' as the ODE
     5.27 of the coordinate partitioning; and T_z^T Phi_x^T = 0 (eq. 5.26)."""
     z, zd = _random_state(m14, seed=21)
-    d = m14.dae_terms(z, zd)
+    d = dae_terms(m14, z, zd)
     assert np.allclose(d["T_z"].T @ d["Phi_x"].T, 0.0, atol=1e-12)
     nx, nc = d["M"].shape[0], d["Phi_x"].shape[0]
     A = np.block([[d["M"], d["Phi_x"].T], [d["Phi_x"], np.zeros((nc, nc))]])
     rhs = np.concatenate([-d["F"] - d["B"] @ m14.u0, -d["gamma"]])
     xdd = np.linalg.solve(A, rhs)[:nx]
     assert np.allclose(xdd[:m14.nz], m14.acceleration(z, zd), rtol=1e-8, atol=1e-10)
+
+
+def test_model_interface_modes_and_plant(m14):
+    """The Model protocol (tmfem.models.base): modes solve K v = omega^2 M v of the
+    linearisation (eq. 5.33) with M-normalised shapes, at the frequencies of
+    Linearization.frequencies_hz (checked against Table 6.6 above); the plant starts at
+    the equilibrium (residual of eq. 5.27 zero there) with the perturbation by name."""
+    lin = linearize(m14)
+    md = m14.modes(k=6)
+    assert np.allclose(lin.K @ md.shapes, lin.M @ md.shapes * md.omega2, atol=1e-9 * np.abs(lin.K).max())
+    assert np.allclose(md.shapes.T @ lin.M @ md.shapes, np.eye(6), atol=1e-8)
+    assert np.allclose(md.freq_hz, lin.frequencies_hz()[:6], rtol=1e-12)
+    plant = m14.plant(perturb={"theta_12_dot": 0.01})
+    zero = np.zeros(m14.nz)
+    r = plant.residual(plant.x0, zero, zero, 0.0, plant.u0)
+    assert np.linalg.norm(r) < 1e-9 * np.linalg.norm(m14.input_matrix(plant.x0) @ plant.u0)
+    assert plant.v0[m14.z_names.index("theta_12")] == 0.01 and np.count_nonzero(plant.v0) == 1
 
 
 def test_frequencies_interlace_with_K(sys14, m14):

@@ -78,7 +78,7 @@ class SwitchingController:
         self.switch_time = float(t)
         yl = np.asarray(self.measure(y), dtype=float)
         x2 = np.asarray(self.second.reset(t, yl, self.dt), dtype=float)
-        _, _, C, D = self.second._d
+        _, _, C, D = self.second.discrete
         if x2.size and self._u_prev is not None:
             rhs = self._u_prev - self.second.u_e - D @ (yl - self.second.y_e)
             x2 = np.linalg.lstsq(C, rhs, rcond=None)[0]

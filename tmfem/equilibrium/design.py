@@ -30,6 +30,7 @@ from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix, fr
 from tmfem.equilibrium.symmetric import closed_form_1N, closed_form_1ND
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
 from tmfem.fem.plane_stress import PlaneStressMembrane, PlaneStressSolution
+from tmfem.fem.truss import linear_rest_length
 from tmfem.system.system import rest_length_array
 from tmfem.system.geometry import beta
 
@@ -418,7 +419,7 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
     EA = system.tendon_EA
     # eqs. 3.8-3.9; a tendon that would have to push has no rest length (NaN)
     rest = np.full_like(T, np.nan)
-    rest[T > 0] = EA[T > 0] * L[T > 0] / (T[T > 0] + EA[T > 0])
+    rest[T > 0] = linear_rest_length(L[T > 0], T[T > 0], EA[T > 0])
     sections = [system.tendon_section(t) for t in system.tendons]
     area = np.array([s.area for s in sections])
     stress = T / area

@@ -345,6 +345,11 @@ class MembraneElement:
         self._asm = Assembler(dofmap.element_dofs(nodes[t]), dofmap.ndof)
         self._M = None
 
+    @property
+    def element_dofs(self) -> np.ndarray:
+        """(n_elements, 12) global dofs of each quadrilateral (its assembly numbering)."""
+        return self._asm.dofs
+
     def internal(self, state, *, tangent: bool = True):
         """Internal force and tangent of eqs. 4.4-4.6 in the global numbering."""
         fe, Ke = self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent)

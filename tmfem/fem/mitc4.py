@@ -60,6 +60,7 @@ from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import skew
+from tmfem.fem.plane_stress import von_mises
 
 #: transverse shear correction factor of the plane-stress lamina law
 SHEAR_FACTOR = 5.0 / 6.0
@@ -510,8 +511,7 @@ class MITC4Shell:
             c = self._strains(pts, u, d, w)[0][:, 0]                          # (ne, nz, 5)
             out[key] = np.einsum("ab,ezbc,ezc->eza", D, pts.Q[:, 0], c)
         sig = out["surf"]
-        s11, s22, s12, s13, s23 = np.moveaxis(sig, -1, 0)
-        vm = np.sqrt(s11**2 - s11 * s22 + s22**2 + 3 * (s12**2 + s13**2 + s23**2))
+        vm = von_mises(np.moveaxis(sig, -1, 0))
         zg = np.polynomial.legendre.leggauss(2)[0] * self.half                # physical z of the Gauss points
         sg = out["gauss"]
         N = self.half * sg[..., :3].sum(axis=1)

@@ -103,9 +103,16 @@ def principal_stresses(sigma: np.ndarray) -> np.ndarray:
 
 
 def von_mises(sigma: np.ndarray) -> np.ndarray:
-    """von Mises stress of eq. 5.30 for a plane stress state (sigma_p3 = 0)."""
-    p = principal_stresses(sigma)
-    return np.sqrt(0.5 * ((p[0] - p[1])**2 + (p[1] - p[2])**2 + (p[2] - p[0])**2))
+    """von Mises stress of eq. 5.30 with sigma_33 = 0,
+    sqrt(s11^2 - s11 s22 + s22^2 + 3 (s12^2 + s13^2 + s23^2)), of the components along axis 0:
+    [s11, s22, s12] (plane stress, s13 = s23 = 0) or [s11, s22, s12, s13, s23] (a shell
+    lamina with its transverse shear, :mod:`tmfem.fem.mitc4`)."""
+    s = np.asarray(sigma, dtype=float)
+    if s.shape[0] not in (3, 5):
+        raise InputError(f"von Mises: expected 3 or 5 stress components along axis 0, found {s.shape[0]}")
+    s11, s22, s12 = s[:3]
+    shear = s12**2 if s.shape[0] == 3 else s12**2 + s[3]**2 + s[4]**2
+    return np.sqrt(s11**2 - s11 * s22 + s22**2 + 3 * shear)
 
 
 def radial_directions(corners) -> np.ndarray:

@@ -84,7 +84,8 @@ class LinearController:
                              f"{self.u_e.size} outputs (plant inputs), found {system.ninputs} and "
                              f"{system.noutputs}")
         self.system, self.name = system, name
-        self._d = None
+        #: (A_d, B_d, C_k, D_k) of the zero-order-hold discretisation, set by :meth:`reset`
+        self.discrete = None
 
     def reset(self, t0, y0, dt):
         """Discretise for dt; the controller state starts at zero (bumpless when the plant
@@ -93,18 +94,18 @@ class LinearController:
         n = self.system.nstates
         if n:
             sd = control.sample_system(self.system, dt, method="zoh")
-            self._d = (np.asarray(sd.A), np.asarray(sd.B), np.asarray(sd.C), np.asarray(sd.D))
+            self.discrete = (np.asarray(sd.A), np.asarray(sd.B), np.asarray(sd.C), np.asarray(sd.D))
         else:
             D = np.asarray(self.system.D)
-            self._d = (np.zeros((0, 0)), np.zeros((0, D.shape[1])), np.zeros((D.shape[0], 0)), D)
+            self.discrete = (np.zeros((0, 0)), np.zeros((0, D.shape[1])), np.zeros((D.shape[0], 0)), D)
         return np.zeros(n)
 
     def output(self, t, y, xc):
-        _, _, C, D = self._d
+        _, _, C, D = self.discrete
         return self.u_e + C @ xc + D @ (np.asarray(y) - self.y_e)
 
     def update(self, t, y, xc):
-        A, B, _, _ = self._d
+        A, B, _, _ = self.discrete
         return A @ xc + B @ (np.asarray(y) - self.y_e)
 
 

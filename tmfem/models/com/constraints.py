@@ -103,6 +103,29 @@ def zeta_closed_form(system, layout: ZetaLayout, q=None) -> np.ndarray:
     return np.concatenate([[st.delta[c, i] for i, c in layout.corner_components], st.gamma])
 
 
+def zeta_closed_form_sx(system, layout: ZetaLayout, q):
+    """zeta(q) of :func:`zeta_closed_form` as a casadi SX expression: x_f along
+    B_MN -> B_M1, z_f normal to (B_MN, B_M1, B_M,N-1), y_f = z_f x x_f (3.2); Delta_i the
+    corner positions in O_f minus the undeformed corners, gamma the 3-2-1 Euler angles of
+    R = [x_f, y_f, z_f] (eq. 3.3). An exact root of Phi (eq. 3.5): the graphs evaluate zeta(q)
+    with it instead of a Newton loop, and the "substituted" formulation substitutes it into
+    the Lagrangian."""
+    N = system.N
+    _, _, B = bars_sx(system, q)
+    BM = B[(system.M - 1) * N:]
+    ex = BM[0] - BM[N - 1]; ex = ex / ca.norm_2(ex)
+    nz = ca.cross(ex, BM[N - 2] - BM[N - 1]); ez = nz / ca.norm_2(nz)
+    ey = ca.cross(ez, ex)
+    R = ca.horzcat(ex, ey, ez)
+    c = system.membrane_corners
+    out = []
+    for (i, comp) in layout.corner_components:
+        rel = ca.dot(R[:, comp], BM[i] - BM[N - 1])
+        out.append(rel - (float(c[comp, i]) if comp < 2 else 0.0))
+    g1 = ca.atan2(R[1, 0], R[0, 0]); g2 = -ca.asin(R[2, 0]); g3 = ca.atan2(R[2, 1], R[2, 2])
+    return ca.vertcat(*out, g1, g2, g3)
+
+
 class ConstraintSolver:
     """Newton solution of Phi(q, zeta) = 0 for zeta (eq. 3.5) and the Jacobians of eq. 5.23.
 

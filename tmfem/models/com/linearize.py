@@ -16,6 +16,7 @@ import numpy as np
 
 from tmfem.errors import InputError
 from tmfem.models.base import LinearPlant
+from tmfem.solvers.eigen import Modes
 
 
 @dataclass
@@ -39,10 +40,19 @@ class Linearization:
 
     def frequencies_hz(self) -> np.ndarray:
         """Undamped natural frequencies sqrt(eig(M^-1 K)) / 2 pi, ascending."""
+        return self.modes().freq_hz
+
+    def modes(self, k: int | None = None) -> Modes:
+        """The ``k`` lowest (default all) undamped modes of K v = omega^2 M v (eq. 5.32 in
+        the COM's coordinates), ascending in omega^2 (real parts; negative: unstable),
+        shapes M-normalised (v^T M v = 1)."""
         import scipy.linalg as sla
-        lam = sla.eigvals(self.K, self.M)
-        lam = np.sort(lam.real)
-        return np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
+        lam, V = sla.eig(self.K, self.M)
+        order = np.argsort(lam.real)
+        lam, V = lam.real[order][:k], V.real[:, order][:, :k]
+        V = V / np.sqrt(np.einsum("ik,ij,jk->k", V, self.M, V))
+        omega = np.sign(lam) * np.sqrt(np.abs(lam))
+        return Modes(omega2=lam, omega=omega, freq_hz=omega / (2 * np.pi), shapes=V)
 
     def plant(self, *, x0=None, v0=None):
         """The linearised model as a simulation plant (:class:`tmfem.models.base.LinearPlant`)
@@ -95,6 +105,6 @@ def output_jacobian(model, z) -> np.ndarray:
     zm = model.P @ np.asarray(z, dtype=float)
     zeta = model.zeta(zm[:nq])
     dzq = model.constraints.dzeta_dq(zm[:nq], zeta)[:nd]          # eq. 5.23
-    W = model._Wout
+    W = model.W_out
     Jw = np.hstack([W[:, 1:1 + nd] @ dzq, W[:, 1 + nd:]]) @ model.P
     return np.vstack([np.eye(nq, model.nz), Jw])

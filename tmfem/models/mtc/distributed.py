@@ -39,8 +39,8 @@ class DistributedMTC:
         self.n_full = n
         T, free = topo.constraints.T, model.free
         mem = model.membrane_element
-        self._mshare = element_share(mem._asm.dofs.shape[0], self.comm)
-        self.membrane = DistributedAssembler(mem._asm.dofs[self._mshare], n, T=T, keep=free,
+        self._mshare = element_share(mem.element_dofs.shape[0], self.comm)
+        self.membrane = DistributedAssembler(mem.element_dofs[self._mshare], n, T=T, keep=free,
                                              comm=self.comm)
         # trusses (bars, tendons: a few hundred elements): the entries of their assembled
         # tangents (a fixed CSR pattern per set) are shared out as (row, column) pairs

@@ -373,7 +373,7 @@ class MTCModel:
             tol=tol, max_iter=max_iter, backend=self.backend, callback=record,
             # from the design the tangent is already positive definite: try Newton first
             newton_first=(x0 is not None or start == "design"),
-            describe=self._state_note, what="MTC static solve")
+            describe=self.state_note, what="MTC static solve")
         return StaticResult(x=self.full(res.u), iterations=res.iterations,
                             residual_history=res.residual_history,
                             monitor={k: np.array(v) for k, v in hist.items()},
@@ -385,7 +385,7 @@ class MTCModel:
         return 1.0 + float(np.sum(np.abs(truss_internal(x, self.tendons, tangent=False).N))
                            + np.sum(np.abs(truss_internal(x, self.bars, tangent=False).N)))
 
-    def _state_note(self, xr) -> str:
+    def state_note(self, xr) -> str:
         """Slack tendons and stretch of the membrane at independent positions xr, for errors."""
         from tmfem.models.mtc.post import member_state
         x = self.full(xr)

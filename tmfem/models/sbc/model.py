@@ -232,7 +232,7 @@ class SBCModel:
             self.residual, self.energy, s0, free=self.free, scale=np.maximum(Md, 1e-9 * Md.max()),
             force_scale=self._force_scale, tol=tol, max_iter=max_iter, backend=self.backend,
             callback=record, newton_first=start is not None, update=self.advance,
-            describe=lambda s: self.mtc._state_note(self.mtc.reduce(s.x[:, :self.numbering.n_mtc_nodes])),
+            describe=lambda s: self.mtc.state_note(self.mtc.reduce(s.x[:, :self.numbering.n_mtc_nodes])),
             what="SBC static solve")
         return SBCStaticResult(state=res.u, iterations=res.iterations,
                                residual_history=res.residual_history,
