@@ -60,7 +60,6 @@ from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import skew
-from tmfem.fem.shell_directors import DIRECTOR_INTERPOLATIONS, DirectorField
 from tmfem.fem.plane_stress import von_mises
 
 #: transverse shear correction factor of the plane-stress lamina law
@@ -185,12 +184,8 @@ class _Points:
         self.wt13, self.wt23 = shell._tie_weights(self.xi)           # (nt, nq) each
         Xe, De = shell._Xe, shell._De                                # (ne, 4, 3)
         Ga = np.einsum("kaq,eki->eqai", self.dh, Xe)                 # (ne, nq, 2, 3)
-        # reference director field (D, D_alpha interpolated, then as shell.directors says)
-        self.D0 = np.einsum("kq,eki->eqi", self.h, De)               # (ne, nq, 3)
-        self.Da0 = np.einsum("kaq,eki->eqai", self.dh, De)           # (ne, nq, 2, 3)
-        ref = DirectorField(self.D0, self.Da0, 0.0, 0.0, half=shell.half,
-                            interpolation=shell.directors)
-        Gb, G3 = ref.aa, ref.a
+        Gb = np.einsum("kaq,eki->eqai", self.dh, De)
+        G3 = np.einsum("kq,eki->eqi", self.h, De)                    # (ne, nq, 3)
         G = Ga[:, :, None] + self.r3[None, None, :, None, None] * Gb[:, :, None]   # (ne,nq,nz,2,3)
         G3z = np.broadcast_to(G3[:, :, None, :], G.shape[:3] + (3,))
         J = np.concatenate([G, G3z[:, :, :, None, :]], axis=3)       # rows G_1, G_2, G_3
@@ -257,7 +252,7 @@ class MITC4Shell:
     """
 
     def __init__(self, *, X, conn, section: ShellSection, dofmap: DofMap, normals=None,
-                 shear: str = "mitc", directors: str = "normalized"):
+                 shear: str = "mitc"):
         X = np.asarray(X, dtype=float)
         conn = np.asarray(conn, dtype=np.int64)
         if X.shape != (3, dofmap.n_nodes):
@@ -291,9 +286,6 @@ class MITC4Shell:
         if shear not in ("mitc", "direct"):
             raise InputError(f"MITC4: expected shear 'mitc' or 'direct', found {shear!r}")
         self.shear = shear
-        if directors not in DIRECTOR_INTERPOLATIONS:
-            raise InputError(f"MITC4: expected directors in {DIRECTOR_INTERPOLATIONS}, found {directors!r}")
-        self.directors = directors
         if shear == "mitc":
             # tying points (eqs. 4.17-4.18): A, C for eps_13; D, B for eps_23
             self._tie_xi = np.array([[0.5, 0.5, 1.0, 0.0], [1.0, 0.0, 0.5, 0.5]])
@@ -306,10 +298,7 @@ class MITC4Shell:
         self._tie_h, self._tie_dh = _quad_shape(self._tie_xi)
         Gt = np.einsum("kat,eki->etai", self._tie_dh, self._Xe)              # (ne, 2 nt, 2, 3)
         self._tie_G = np.stack([Gt[:, :nt, 0], Gt[:, nt:, 1]], axis=1)      # (ne, 2 comp, nt, 3)
-        self._tie_D0 = np.einsum("kt,eki->eti", self._tie_h, self._De).reshape(self.ne, 2, nt, 3)
-        self._tie_Da0 = np.einsum("kat,eki->etai", self._tie_dh, self._De).reshape(self.ne, 2, nt, 2, 3)
-        self._tie_G3 = DirectorField(self._tie_D0, self._tie_Da0, 0.0, 0.0, half=self.half,
-                                     interpolation=directors).a               # (ne, 2 comp, nt, 3)
+        self._tie_G3 = np.einsum("kt,eki->eti", self._tie_h, self._De).reshape(self.ne, 2, nt, 3)
         rz, wz = np.polynomial.legendre.leggauss(2)
         self._gauss = _Points(self, xq, wq, rz, wz)
         self._asm = Assembler(dofmap.element_dofs(conn, rotations=True), dofmap.ndof)
@@ -347,14 +336,11 @@ class MITC4Shell:
         return u, d, w, V
 
     def _strains(self, pts: _Points, u, d, w):
-        """Covariant strains c (ne, nq, nz, 5), the current base vectors g_alpha (ne, nq, nz,
-        2, 3) and director field at the points, and at the tying points the current g_alpha
-        and g_3 (ne, 2, nt, 3) with their director field."""
+        """Covariant strains c (ne, nq, nz, 5) and current base vectors at the points and at
+        the tying points."""
         ua = np.einsum("kaq,eki->eqai", pts.dh, u)                           # (ne, nq, 2, 3)
-        fq = DirectorField(pts.D0, pts.Da0, np.einsum("kq,eki->eqi", pts.h, w),
-                           np.einsum("kaq,eki->eqai", pts.dh, w), half=self.half,
-                           interpolation=self.directors)
-        Ux = ua[:, :, None] + pts.r3[None, None, :, None, None] * fq.daa[:, :, None]  # (ne,nq,nz,2,3)
+        ub = np.einsum("kaq,eki->eqai", pts.dh, w)
+        Ux = ua[:, :, None] + pts.r3[None, None, :, None, None] * ub[:, :, None]  # (ne,nq,nz,2,3)
         G = pts.Ga[:, :, None] + pts.r3[None, None, :, None, None] * pts.Gb[:, :, None]
         g = G + Ux
         e11 = 2 * np.einsum("...i,...i->...", Ux[..., 0, :], G[..., 0, :]) + np.einsum("...i,...i->...", Ux[..., 0, :], Ux[..., 0, :])
@@ -366,11 +352,7 @@ class MITC4Shell:
         ut = np.einsum("kat,eki->etai", self._tie_dh, u)
         nt = self._nt
         ut = np.stack([ut[:, :nt, 0], ut[:, nt:, 1]], axis=1)                # (ne, 2, nt, 3)
-        ft = DirectorField(self._tie_D0, self._tie_Da0,
-                           np.einsum("kt,eki->eti", self._tie_h, w).reshape(self.ne, 2, nt, 3),
-                           np.einsum("kat,eki->etai", self._tie_dh, w).reshape(self.ne, 2, nt, 2, 3),
-                           half=self.half, interpolation=self.directors)
-        u3 = ft.da
+        u3 = np.einsum("kt,eki->eti", self._tie_h, w).reshape(self.ne, 2, nt, 3)
         gam_t = (np.einsum("ecti,ecti->ect", ut, self._tie_G3) + np.einsum("ecti,ecti->ect", self._tie_G, u3)
                  + np.einsum("ecti,ecti->ect", ut, u3))                       # (ne, 2, 2)
         g13 = np.einsum("tq,et->eq", pts.wt13, gam_t[:, 0])
@@ -380,7 +362,7 @@ class MITC4Shell:
                       np.repeat(g13[:, :, None], nz, axis=2), np.repeat(g23[:, :, None], nz, axis=2)], axis=-1)
         gt = self._tie_G + ut                                                # current g_a at tying points
         g3t = self._tie_G3 + u3
-        return c, g, fq, gt, g3t, ft
+        return c, g, gt, g3t
 
     # ------------------------------------------------------------------ element arrays
     def element_arrays(self, state, *, tangent: bool = True):
@@ -389,42 +371,29 @@ class MITC4Shell:
         eqs. 4.17-4.18)."""
         u, d, w, V = self._nodal(state)
         pts = self._gauss
-        c, g, fq, gt, g3t, ft = self._strains(pts, u, d, w)
+        c, g, gt, g3t = self._strains(pts, u, d, w)
         ne, nq, nz = c.shape[:3]
         S = np.einsum("eqzab,eqzb->eqza", pts.C, c)                          # contravariant 2nd PK
         Sw = S * pts.dV[..., None]
-        dh, h, r3 = pts.dh, pts.h, pts.r3
-        # B of the in-plane rows in extended nodal dofs (x_k, d_k): (ne, nq, nz, 3, 4, 2, 3);
-        # d-part: r3 (d a_d,alpha / d d_k)^T g_beta = r3 (h_k,alpha sP g_beta - h_k m(D_alpha, g_beta))
+        dh, r3 = pts.dh, pts.r3
+        # B of the in-plane rows in extended nodal dofs (x_k, d_k): (ne, nq, nz, 3, 4, 2, 3)
         Bm = np.empty((ne, nq, nz, 3, 4, 2, 3))
         h1 = np.transpose(dh[:, 0, :])[None, :, None, :, None]               # (1, nq, 1, 4, 1)
         h2 = np.transpose(dh[:, 1, :])[None, :, None, :, None]
-        h0 = np.transpose(h)[None, :, None, :, None]
         g1 = g[..., 0, :][:, :, :, None, :]                                  # (ne, nq, nz, 1, 3)
         g2 = g[..., 1, :][:, :, :, None, :]
         Bm[:, :, :, 0, :, 0] = h1 * g1
         Bm[:, :, :, 1, :, 0] = h2 * g2
         Bm[:, :, :, 2, :, 0] = h1 * g2 + h2 * g1
-        rz = r3[None, None, :, None, None]
-        if fq.normalized:
-            sPg = fq.sP(g)[:, :, :, :, None, :]                              # (ne, nq, nz, 2, 1, 3)
-            Dz = fq.Da[:, :, None]                                           # (ne, nq, 1, 2, 3)
-            m11, m22 = fq.m(Dz[..., 0, :], g[..., 0, :]), fq.m(Dz[..., 1, :], g[..., 1, :])
-            m12 = fq.m(Dz[..., 0, :], g[..., 1, :]) + fq.m(Dz[..., 1, :], g[..., 0, :])
-            Bm[:, :, :, 0, :, 1] = rz * (h1 * sPg[:, :, :, 0] - h0 * m11[:, :, :, None])
-            Bm[:, :, :, 1, :, 1] = rz * (h2 * sPg[:, :, :, 1] - h0 * m22[:, :, :, None])
-            Bm[:, :, :, 2, :, 1] = rz * (h1 * sPg[:, :, :, 1] + h2 * sPg[:, :, :, 0] - h0 * m12[:, :, :, None])
-        else:
-            Bm[:, :, :, :, :, 1] = r3[None, None, :, None, None, None] * Bm[:, :, :, :, :, 0]
-        # shear rows at the tying points: d gamma_a3 / d x_k = h_k,a g_3, / d d_k = h_k sP g_a
+        Bm[:, :, :, :, :, 1] = r3[None, None, :, None, None, None] * Bm[:, :, :, :, :, 0]
+        # shear rows at the tying points: d gamma_a3 / d x_k = h_k,a g_3, / d d_k = h_k g_a
         nt = self._nt
         Bt = np.empty((ne, 2, nt, 4, 2, 3))                                  # (ne, comp, pt, k, x/d, 3)
         tdh = self._tie_dh.reshape(4, 2, 2, nt)                              # (k, a, comp, pt)
         th = self._tie_h.reshape(4, 2, nt)                                   # (k, comp, pt)
-        sPgt = ft.sP(gt)
         for comp in range(2):
             Bt[:, comp, :, :, 0] = np.transpose(tdh[:, comp, comp, :])[None, :, :, None] * g3t[:, comp, :, None, :]
-            Bt[:, comp, :, :, 1] = np.transpose(th[:, comp, :])[None, :, :, None] * sPgt[:, comp, :, None, :]
+            Bt[:, comp, :, :, 1] = np.transpose(th[:, comp, :])[None, :, :, None] * gt[:, comp, :, None, :]
         Bs = np.stack([np.einsum("tq,etkxi->eqkxi", pts.wt13, Bt[:, 0]),
                        np.einsum("tq,etkxi->eqkxi", pts.wt23, Bt[:, 1])], axis=2)   # (ne, nq, 2, 4, 2, 3)
         B = np.concatenate([Bm.reshape(ne, nq, nz, 3, 24),
@@ -437,7 +406,24 @@ class MITC4Shell:
         Bf = B.reshape(ne, nq * nz * 5, 24)
         CB = np.einsum("eqzst,eqztj->eqzsj", pts.C * pts.dV[..., None, None], B).reshape(ne, -1, 24)
         Kx = np.matmul(np.swapaxes(Bf, 1, 2), CB)                            # (ne, 24, 24)
-        Kx += self._initial_stress(Sw, g, fq, gt, ft, pts, tdh, th).reshape(ne, 24, 24)
+        # initial-stress part: scalar couplings of (x_k, d_k) pairs, times I_3
+        Smat = np.empty((ne, nq, nz, 2, 2))
+        Smat[..., 0, 0], Smat[..., 1, 1] = Sw[..., 0], Sw[..., 1]
+        Smat[..., 0, 1] = Smat[..., 1, 0] = Sw[..., 2]
+        A = np.einsum("kaq,eqzab,lbq->eqzkl", dh, Smat, dh)
+        H = np.zeros((ne, 4, 2, 4, 2))
+        H[:, :, 0, :, 0] = A.sum(axis=(1, 2))
+        H[:, :, 0, :, 1] = np.einsum("eqzkl,z->ekl", A, r3)
+        H[:, :, 1, :, 0] = H[:, :, 0, :, 1]
+        H[:, :, 1, :, 1] = np.einsum("eqzkl,z->ekl", A, r3**2)
+        # transverse shear: S^a3 at the tying points, Delta delta gamma_a3 = h_k,a h_l (dx_k . Dd_l) + sym
+        St13 = np.einsum("eqz,tq->et", Sw[..., 3], pts.wt13)
+        St23 = np.einsum("eqz,tq->et", Sw[..., 4], pts.wt23)
+        for comp, St in ((0, St13), (1, St23)):
+            Cxd = np.einsum("et,kt,lt->ekl", St, tdh[:, comp, comp, :], th[:, comp, :])
+            H[:, :, 0, :, 1] += Cxd
+            H[:, :, 1, :, 0] += np.swapaxes(Cxd, 1, 2)
+        Kx += np.einsum("ekxly,ij->ekxilyj", H, np.eye(3)).reshape(ne, 24, 24)
         Lb = self._lam_block(L)                                              # (ne, 24, 20)
         Ke = np.matmul(np.swapaxes(Lb, 1, 2), np.matmul(Kx, Lb))
         # second variation of the directors: -(alpha alpha' + beta beta') V_n . (dW/dV_n)
@@ -445,56 +431,6 @@ class MITC4Shell:
         idx = 5 * np.arange(4)[:, None] + np.array([3, 4])[None, :]
         Ke[:, idx, idx] -= m[:, :, None]
         return fe, Ke
-
-    def _initial_stress(self, Sw, g, fq, gt, ft, pts, tdh, th):
-        """Initial-stress part (ne, 4, 2, 3, 4, 2, 3) of the tangent in the extended dofs
-        (x_k, d_k): S . Delta delta c. In-plane, with g_alpha = X_alpha + r3 a_d,alpha and
-        J_alpha,k = d a_d,alpha / d d_k = h_k,alpha sP - h_k (s/rho) M(D_alpha):
-        S^ab (delta g_a . Delta g_b) gives the x-x (scalar times I), x-d (r3 h_k,a J_b,l) and
-        d-d (r3^2 J_a,k^T J_b,l) blocks, S^ab r3 g_b . Delta delta a_d,a the Hessian of the
-        director field (module ``shell_directors``). Transverse shear at the tying points:
-        S^a3 (h_k,a h_l sP) in x-d and S^a3 h_k h_l (-(s/rho) M(g_a)) in d-d."""
-        ne, nq, nz = Sw.shape[:3]
-        dh, h, r3 = pts.dh, pts.h, pts.r3
-        Smat = np.empty((ne, nq, nz, 2, 2))
-        Smat[..., 0, 0], Smat[..., 1, 1] = Sw[..., 0], Sw[..., 1]
-        Smat[..., 0, 1] = Smat[..., 1, 0] = Sw[..., 2]
-        S0, S1, S2 = (np.einsum("eqzab,z->eqab", Smat, r3**p) for p in range(3))
-        Hxx = np.einsum("kaq,eqab,lbq->ekl", dh, S0, dh)
-        T1 = np.einsum("kaq,eqab,lbq->eqkl", dh, S1, dh)
-        T2 = np.einsum("kaq,eqab,lbq->eqkl", dh, S2, dh)
-        St = np.stack([np.einsum("eqz,tq->et", Sw[..., 3], pts.wt13),
-                       np.einsum("eqz,tq->et", Sw[..., 4], pts.wt23)], axis=1)   # (ne, comp, nt)
-        tdc = np.stack([tdh[:, c, c, :] for c in range(2)], axis=1)          # (k, comp, nt)
-        Hs = np.einsum("ect,kct,lct->ekl", St, tdc, th)
-        H = np.zeros((ne, 4, 2, 3, 4, 2, 3))
-        eye = np.eye(3)
-        H[:, :, 0, :, :, 0, :] = np.einsum("ekl,ij->ekilj", Hxx, eye)
-        if not fq.normalized:
-            Hxd = np.einsum("ekl,ij->ekilj", T1.sum(axis=1) + Hs, eye)
-            Hdd = np.einsum("ekl,ij->ekilj", T2.sum(axis=1), eye)
-        else:
-            sPm = fq.sP_matrix()                                             # (ne, nq, 3, 3)
-            Mb = np.stack([fq.M_matrix(fq.Da[:, :, b]) for b in range(2)], axis=2)   # (ne, nq, 2, 3, 3)
-            Hxd = (np.einsum("eqkl,eqij->ekilj", T1, sPm)
-                   - np.einsum("kaq,eqab,lq,eqbij->ekilj", dh, S1, h, Mb, optimize=True)
-                   + np.einsum("ect,kct,lct,ectij->ekilj", St, tdc, th, ft.sP_matrix(), optimize=True))
-            sPMb = np.matmul(sPm[:, :, None], Mb)                            # (ne, nq, 2, 3, 3)
-            X2 = np.einsum("kaq,eqab,lq,eqbij->ekilj", dh, S2, h, sPMb, optimize=True)
-            MM = np.einsum("eqab,eqaij,eqbjm->eqim", S2, Mb, Mb, optimize=True)
-            v = np.einsum("eqzab,eqzbi,z->eqai", Smat, g, r3)                # S^ab r3 g_b, summed in z
-            hDD = fq.hess_DD(v[:, :, 0], 0) + fq.hess_DD(v[:, :, 1], 1)
-            MV = fq.M_matrix(v)                                              # (ne, nq, 2, 3, 3)
-            HMV = np.einsum("kq,laq,eqaij->ekilj", h, dh, MV, optimize=True)
-            Hdd = (np.einsum("eqkl,eqij->ekilj", T2, np.matmul(sPm, sPm))
-                   - X2 - np.transpose(X2, (0, 3, 4, 1, 2))
-                   + np.einsum("kq,lq,eqim->ekilm", h, h, MM + hDD, optimize=True)
-                   - HMV - np.transpose(HMV, (0, 3, 4, 1, 2))
-                   - np.einsum("ect,kct,lct,ectij->ekilj", St, th, th, ft.M_matrix(gt), optimize=True))
-        H[:, :, 0, :, :, 1, :] = Hxd
-        H[:, :, 1, :, :, 0, :] = np.transpose(Hxd, (0, 3, 4, 1, 2))
-        H[:, :, 1, :, :, 1, :] = Hdd
-        return H
 
     def _lam(self, V):
         """Per-node map (ne, 4, 6, 5) from [u, alpha, beta] to the extended [x, d] variations:
