@@ -68,7 +68,12 @@ def factorize(A, backend, *, equilibrate: bool = False):
     docs/shells.md "Thin shells") this keeps the Newton increment accurate."""
     if equilibrate:
         d = jacobi_scaling(A)
-        As = (sp.diags(d) @ A @ sp.diags(d)) if sp.issparse(A) else A * d[:, None] * d[None, :]
+        if sp.issparse(A):
+            A = sp.csr_matrix(A)
+            rows = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+            As = sp.csr_matrix((A.data * d[rows] * d[A.indices], A.indices, A.indptr), shape=A.shape)
+        else:
+            As = A * d[:, None] * d[None, :]
         solve_scaled = factorize(As, backend)
 
         def solve(b):
