@@ -36,6 +36,7 @@ from tmfem.fem.element import State, assemble
 from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
 from tmfem.solvers import arc_length, lowest_modes, newton
 from tmfem.solvers.backends import get_backend
+from tmfem.solvers.newton import factorize
 
 log = logging.getLogger(__name__)
 
@@ -401,7 +402,7 @@ class Structure:
     def solve_linear(self) -> StructureState:
         """Linear statics about the reference state: K0 u = F (pressure on the reference
         surface, prescribed displacements at their values). Rotations are applied as finite
-        rotations of the small solution (for output)."""
+        rotations of the small solution (for output). Solved with Jacobi equilibration."""
         cm = self.constraints
         s0 = self.reference_state()
         r, K = self.residual(self._with_prescribed(s0, 0.0), 0.0)
@@ -411,12 +412,12 @@ class Structure:
         up = cm.reduce(self._prescribed) if np.any(self._prescribed) else np.zeros(cm.n_reduced)
         rhs = rhs - K @ up
         u = up.copy()
-        u[idx] = get_backend().factorize(K[idx][:, idx])(rhs[idx])
+        u[idx] = factorize(K[idx][:, idx], get_backend(), equilibrate=True)(rhs[idx])
         return StructureState(state=s0.advanced(cm.full(u), self.dofmap), lam=1.0, iterations=1)
 
     def solve(self, *, steps: int = 10, lam_end: float = 1.0, tol: float = 1e-8, max_iter: int = 30,
               line_search: bool = False, min_step: float = 1e-4, start: StructureState | None = None,
-              callback=None) -> list[StructureState]:
+              callback=None, equilibrate: bool = True) -> list[StructureState]:
         """Nonlinear statics by load (and displacement) control from ``start`` (default the
         reference state at lam = 0) to ``lam_end`` in ``steps`` equal increments; a step whose
         Newton iteration fails is retried in halves down to ``min_step``.
@@ -425,6 +426,8 @@ class Structure:
         reaction of the prescribed displacements). ``line_search`` is off by default: the
         residual norm is a poor merit function for bending-dominated shells (a linear
         predictor stretches the mid-surface), and the full Newton step converges.
+        ``equilibrate``: each Newton system is solved with symmetric Jacobi scaling
+        (:func:`tmfem.solvers.newton.factorize`; thin shells, docs/shells.md).
         Returns the converged states, the start included.
         """
         if not (isinstance(steps, (int, np.integer)) and steps >= 1):
@@ -441,7 +444,7 @@ class Structure:
             try:
                 res = newton(lambda s: self.residual(s, target), s_try, free=self.constraints.free,
                              tol=tol, scale=scale, max_iter=max_iter, line_search=line_search,
-                             load_factor=target, update=self.advance)
+                             load_factor=target, update=self.advance, equilibrate=equilibrate)
             except ConvergenceError as exc:
                 dlam = 0.5 * d
                 log.info("structure: step to lam = %g failed (%s); halving", target, exc)
