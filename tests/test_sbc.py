@@ -211,3 +211,18 @@ def test_1nd_cli_modal_json(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["system"] == "1-6D" and len(out["bar_bow"]) == 6 and out["bar_elements"] == 2
     assert len(out["theta_deg"]) == 6 and min(out["freq_hz"]) > 0
+
+
+def test_smallest_rotation_turns_a_onto_b():
+    # the predictor's director map (state_from_mtc): R a = b, R (a x b) = a x b (the axis), and
+    # the identity for parallel directions
+    from tmfem.fem.element import smallest_rotation
+    rng = np.random.default_rng(1)
+    a, b = rng.normal(size=(3, 5)), rng.normal(size=(3, 5))
+    a[:, 4] = b[:, 4]
+    R = smallest_rotation(a, b)
+    an, bn = a / np.linalg.norm(a, axis=0), b / np.linalg.norm(b, axis=0)
+    np.testing.assert_allclose(np.einsum("nij,jn->in", R, an), bn, atol=1e-12)
+    ax = np.cross(an, bn, axis=0)
+    np.testing.assert_allclose(np.einsum("nij,jn->in", R, ax), ax, atol=1e-12)
+    np.testing.assert_allclose(R[4], np.eye(3), atol=1e-12)

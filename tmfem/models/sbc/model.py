@@ -34,12 +34,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.spatial.transform import Rotation
 
 from tmfem.errors import InputError
 from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, spin_constraint
 from tmfem.fem.constraints import ConstraintMap
-from tmfem.fem.element import State, assemble
+from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellSection, nodal_normals
 from tmfem.fem.truss import TrussElement, TrussSet, truss_internal
 from tmfem.models.mtc.model import MTCModel
@@ -48,16 +47,6 @@ from tmfem.models.sbc.topology import SBCNumbering, number_sbc
 from tmfem.solvers.eigen import lowest_modes
 from tmfem.solvers.trust_region import trust_region_newton
 from tmfem.system.topology import label
-
-def smallest_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Rotations (n, 3, 3) turning the directions a (3, n) onto b (3, n) about a x b by the
-    angle between them (identity for parallel directions)."""
-    a = a / np.linalg.norm(a, axis=0)
-    b = b / np.linalg.norm(b, axis=0)
-    axis = np.cross(a.T, b.T)
-    sn = np.linalg.norm(axis, axis=1, keepdims=True)
-    ang = np.arctan2(sn, np.sum(a * b, axis=0)[:, None])
-    return Rotation.from_rotvec(np.where(sn > 0, axis / np.where(sn > 0, sn, 1.0), 0.0) * ang).as_matrix()
 
 
 #: Poisson's ratio of the bars (steel; ``system.bar`` has E, rho and d only)
@@ -251,11 +240,11 @@ class SBCModel:
         R[ch] = turn[:, None]
         return State(x=x, R=R, frames=self.shell.frames)
 
-    def solve_static(self, *, start: State | None = None, predictor: str = "mtc", tol: float = 1e-9,
-                     max_iter: int = 200, monitor=(), progress=None) -> SBCStaticResult:
+    def solve_static(self, *, start: State | None = None, predictor: str | None = None,
+                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress=None) -> SBCStaticResult:
         """Equilibrium reached from the undeformed membrane (6.2) or from ``start``.
 
-        ``predictor="mtc"`` (default): the MTC model of the same mesh and rest lengths is
+        ``predictor="mtc"`` (the default without ``start``): the MTC model of the same mesh and rest lengths is
         solved first from the same undeformed start (with its mesh sequencing above 20 x 20;
         1-N(D) systems with rigid bar points, :func:`build_topology`), its equilibrium
         mapped by :meth:`state_from_mtc`, and Newton's method continues on the SBC model
@@ -265,11 +254,12 @@ class SBCModel:
         step (:func:`trust_region_newton`). ``monitor``: node labels recorded every iteration
         (predictor iterations first); ``progress(iteration, rnorm, mu, rho)``.
         """
-        if predictor not in ("mtc", "none"):
+        if predictor not in (None, "mtc", "none"):
             raise InputError(f"predictor: expected 'mtc' or 'none', found {predictor!r}")
-        if start is not None and predictor != "none":
-            raise InputError("predictor: does not apply with an explicit start (expected "
-                             "predictor='none')")
+        if start is not None and predictor == "mtc":
+            raise InputError("predictor: does not apply with an explicit start, found "
+                             "predictor='mtc'")
+        predictor = predictor or ("mtc" if start is None else "none")
         t0 = time.perf_counter()
         pre = None
         if start is not None:
