@@ -120,10 +120,9 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
                     rt, Kt = residual(ut)
                     rtn = float(np.linalg.norm(rt[free]))
                     if tiny and rtn > 0.5 * rn and rn <= 1e3 * tol * force_scale(u):
-                        # the round-off floor: neither the energy nor |r| can fall further
+                        # the round-off floor: neither the energy nor |r| can fall further;
+                        # the last (round-off sized) step is taken and the iteration ends
                         floor, rho = True, 1.0
-                        if rtn >= rn:
-                            ut, rt, Kt, Wt, rtn = u, r, K, W, rn
                         break
                     if (actual > 0 and not tiny) or rtn < rn:
                         rho = actual / pred if pred > 0 and not tiny else 1.0
