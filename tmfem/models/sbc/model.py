@@ -14,12 +14,15 @@ model (:mod:`tmfem.models.mtc`), whose numbering, rest lengths and start placeme
   spectrum is unchanged);
 * **attachment**: the bar top B_Mj is a dependent node whose translations follow the membrane
   corner (``point``) or the MTC model's corner patch (``distributed``); its rotations are the
-  bar's own (a pin).
+  bar's own (a pin);
+* **1-N(D) systems**: H_1j is a node of bar j's beam chain at k_H (two segments), where the
+  SL, SU tendons end.
 
 Statics (6.2) start from the undeformed membrane exactly as the MTC model's (flat, unstressed,
 in the plane of the design bar tops; bars at the design; the bar tops moved onto the corners)
 and use the same mass-scaled trust-region Newton iteration
-(:func:`tmfem.solvers.trust_region.trust_region_newton`) through its ``update=`` path: the
+(:func:`tmfem.solvers.trust_region.trust_region_newton`), by default after the MTC model's
+own solve from that start as a predictor (:meth:`SBCModel.solve_static`), through its ``update=`` path: the
 unknown is a :class:`~tmfem.fem.element.State` and an increment adds translations and composes
 the nodal rotations by the exponential map, which is the update the shell and beam tangents
 differentiate. Modes about the prestressed state solve (K_T - omega^2 M) phi = 0 (eq. 5.32)
@@ -85,7 +88,8 @@ class SBCModel:
     tendon_elements : int
         Truss elements per tendon (6.2: 3).
     bar_elements : int
-        Four-node beam elements per bar (6.2: 1).
+        Four-node beam elements per bar (6.2: 1); for a 1-N(D) system per segment A_1j-H_1j
+        and H_1j-B_1j (H_1j is a beam node, :mod:`tmfem.models.sbc.topology`).
     attachment : {"point", "distributed"}
     patch : float, optional
         Patch radius [m] of the distributed attachment (MTC model's default).
