@@ -11,7 +11,7 @@ from tmfem.errors import InputError
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.sbc.model import SBCModel
 from tmfem.reference.tables import FREQUENCIES
-from tmfem.system import TendonSection, load_preset
+from tmfem.system import load_preset
 
 
 def paper_1_4():
@@ -106,6 +106,10 @@ def test_residual_is_energy_gradient_with_rotations():
 
 def test_bad_input_refused(capsys):
     s = load_preset("1-4", as_printed=True)
+    with pytest.raises(InputError, match="1-N\\(D\\)"):
+        SBCModel(load_preset("1-4D"), mesh_n=2, rest_lengths="mtc")
+    with pytest.raises(InputError, match="predictor"):
+        SBCModel(s, mesh_n=2).solve_static(predictor="mtc", start=SBCModel(s, mesh_n=2).start_state())
     with pytest.raises(InputError, match="bar_elements"):
         SBCModel(s, mesh_n=2, bar_elements=0)
     assert main(["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "2", "--patch", "0.3"]) != 0

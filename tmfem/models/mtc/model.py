@@ -162,6 +162,10 @@ class MTCModel:
             elif rest == "design":
                 r = self._design_rest_lengths()
             elif rest == "mtc":
+                if self.system.deployable:
+                    raise InputError("rest_lengths='mtc': does not apply to a 1-N(D) system (the "
+                                     "consistent rest lengths balance truss bars without points "
+                                     "H_1j); expected 'design' (eq. 3.8), 'system' or values")
                 r = self.consistent_rest_lengths()["rest_lengths"]
             else:
                 raise InputError(f"rest_lengths: expected an array or one of 'system', 'design', "
