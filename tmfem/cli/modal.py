@@ -92,7 +92,7 @@ def sbc_modal(args, model, tables) -> dict:
                          "output of the shell model is not built; use --model mtc)")
     print(f"tmfem modal: {model.system.name} SBC, {model.ndof} free dofs", file=sys.stderr)
     res = model.solve_static(monitor=default_monitor(model.system))
-    out = modal_summary(model, res, model.modes(res.state, k=args.modes))
+    out = modal_summary(model, res, model.modes(res.state, k=args.modes, tangent=res.tangent))
     ref = tables.get(model.system.name)
     if ref is not None:
         n = min(len(ref["SBC"]), args.modes)

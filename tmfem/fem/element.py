@@ -98,6 +98,19 @@ def skew(v: np.ndarray) -> np.ndarray:
     return S
 
 
+def smallest_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotations (n, 3, 3) turning the directions a (3, n) onto b (3, n) about a x b by the
+    angle between them (identity for parallel directions): e.g. a shell director onto the
+    normal of a deformed surface."""
+    a = np.asarray(a, dtype=float) / np.linalg.norm(a, axis=0)
+    b = np.asarray(b, dtype=float) / np.linalg.norm(b, axis=0)
+    axis = np.cross(a, b, axis=0)
+    sn = np.linalg.norm(axis, axis=0)
+    ang = np.arctan2(sn, np.einsum("in,in->n", a, b))
+    rv = np.where(sn > 0, axis / np.where(sn > 0, sn, 1.0) * ang, 0.0)
+    return Rotation.from_rotvec(rv.T).as_matrix()
+
+
 class Element(Protocol):
     """A set of elements of one kind on the global dofs of a :class:`DofMap` (module docstring)."""
 

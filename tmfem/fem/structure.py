@@ -32,7 +32,7 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.dofmap import DofMap
-from tmfem.fem.element import State, assemble
+from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
 from tmfem.solvers import arc_length, lowest_modes, newton
 from tmfem.solvers.backends import get_backend
@@ -337,7 +337,6 @@ class Structure:
         of the same mesh): every shell node's director is turned by the smallest rotation onto
         the normal of the surface through x (averaged element normals), other nodes keep their
         orientation. A start for Newton, not an equilibrium."""
-        from scipy.spatial.transform import Rotation
         from tmfem.fem.mitc4 import nodal_normals
         x = np.asarray(x, dtype=float)
         if x.shape != self.X.shape:
@@ -345,13 +344,8 @@ class Structure:
         st = self.reference_state()
         R = st.R
         for sh in self.shells:
-            n = nodal_normals(x, sh.conn)[:, sh.nodes]
-            V0 = self.frames[sh.nodes][:, :, 2].T
-            axis = np.cross(V0, n, axis=0)
-            ang = np.arctan2(np.linalg.norm(axis, axis=0), np.einsum("in,in->n", V0, n))
-            nrm = np.linalg.norm(axis, axis=0)
-            rv = np.where(nrm > 0, axis / np.where(nrm > 0, nrm, 1.0) * ang, 0.0)
-            R[sh.nodes] = Rotation.from_rotvec(rv.T).as_matrix()
+            R[sh.nodes] = smallest_rotation(self.frames[sh.nodes][:, :, 2].T,
+                                            nodal_normals(x, sh.conn)[:, sh.nodes])
         return StructureState(state=State(x=x.copy(), R=R, frames=self.frames), lam=lam)
 
     def external(self, state: State, lam: float, *, tangent: bool = True):

@@ -9,7 +9,10 @@ and is accepted when it lowers the energy W (or, on the round-off floor where en
 differences vanish, the residual). The ratio rho = actual / predicted decrease of W
 (predicted by the quadratic model -(g du + du K du / 2)) steers mu: rho > 0.75 divides it by 8
 (down to 0: pure Newton, quadratic convergence), rho < 0.25 multiplies it by 4; a rejected
-step multiplies it by 4 and retries. The solver knows nothing of tensegrities: it sees a
+step multiplies it by 4 and retries. Converged when |r| <= tol x force scale after a pure
+Newton step, or on the round-off floor: a step whose energy change is round-off and which
+no longer halves |r| while |r| <= 1e3 tol x force scale (stiff beams and shells put that
+floor near tol). The solver knows nothing of tensegrities: it sees a
 residual with its tangent, an energy, a dof scale and a convergence scale.
 """
 from __future__ import annotations
@@ -29,7 +32,9 @@ log = logging.getLogger(__name__)
 
 @dataclass
 class TrustRegionResult:
-    """Solution, iterations, residual norms (start included), the mu of every accepted step."""
+    """Solution, iterations, residual norms (start included), the mu of every accepted step,
+    and the tangent at the solution as ``residual`` returned it (for a modal analysis about
+    the equilibrium without assembling it again)."""
 
     u: np.ndarray
     iterations: int
@@ -37,6 +42,7 @@ class TrustRegionResult:
     mu_history: list
     converged: bool = True
     extra: dict = field(default_factory=dict)
+    tangent: object = None
 
 
 def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale: np.ndarray,
@@ -84,7 +90,7 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     mu_scale = float(np.median(Kd[Kd > 0]) / np.median(Md)) if np.any(Kd > 0) else 1.0
     mu = 0.0 if newton_first else 1e-3 * mu_scale
     it = 0
-    converged = False
+    converged = floor = False
     for it in range(1, max_iter + 1):
         Kf = K[free][:, free]
         g = r[free]
@@ -106,14 +112,21 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
                 Wt = energy(ut)
                 pred = -(float(g @ du) + 0.5 * float(du @ (Kf @ du)))
                 actual = W - Wt
-                rt, Kt = residual(ut)
-                rtn = float(np.linalg.norm(rt[free]))
                 # near the solution energy differences drown in round-off: accept a step
-                # that reduces the residual there
+                # that reduces the residual there; the residual and tangent of a trial state
+                # are only assembled when the energy does not reject it
                 tiny = abs(pred) < 1e-11 * max(abs(W), 1e-30)
-                if np.isfinite(Wt) and (actual > 0 or (tiny and rtn < rn)):
-                    rho = actual / pred if pred > 0 and not tiny else 1.0
-                    break
+                if np.isfinite(Wt) and (actual > 0 or tiny):
+                    rt, Kt = residual(ut)
+                    rtn = float(np.linalg.norm(rt[free]))
+                    if tiny and rtn > 0.5 * rn and rn <= 1e3 * tol * force_scale(u):
+                        # the round-off floor: neither the energy nor |r| can fall further;
+                        # the last (round-off sized) step is taken and the iteration ends
+                        floor, rho = True, 1.0
+                        break
+                    if (actual > 0 and not tiny) or rtn < rn:
+                        rho = actual / pred if pred > 0 and not tiny else 1.0
+                        break
             mu = max(4.0 * mu, 1e-8 * mu_scale)
             if mu > 1e12 * mu_scale:
                 break
@@ -138,7 +151,7 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
             callback(it, u, rn, mu_used, rho)
         log.debug("%s it %3d |r| = %.3e N mu = %.3g rho = %.3g", what, it, rn, mu_used, rho)
         step = float(np.abs(du).max())
-        if rn <= tol * force_scale(u) and (mu_used == 0.0 or step < 1e-9):
+        if floor or (rn <= tol * force_scale(u) and (mu_used == 0.0 or step < 1e-9)):
             converged = True
             break
         if it >= 60 and min(res_hist[-40:]) > 0.1 * min(res_hist[:-40]):
@@ -147,4 +160,5 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
         note = f" ({describe(u)})" if describe is not None else ""
         raise ConvergenceError(f"{what}: no equilibrium after {it} iterations{note}; residual "
                                f"history {np.array(res_hist[-6:])} N, mu = {mu:.3g}")
-    return TrustRegionResult(u=u, iterations=it, residual_history=res_hist, mu_history=mu_hist)
+    return TrustRegionResult(u=u, iterations=it, residual_history=res_hist, mu_history=mu_hist,
+                             tangent=K)

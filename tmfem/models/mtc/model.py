@@ -107,18 +107,24 @@ class MTCModel:
         Membrane law (:mod:`tmfem.fem.tension_field`): St.Venant-Kirchhoff (eq. 4.9, default)
         or the tension-field (wrinkling) law. The prestress is the static equilibrium of this
         model, so it passes through the same law.
+    rigid_bar_points : bool
+        Accept a 1-N(D) system, its H_1j on bars rigid in bending
+        (:func:`tmfem.models.mtc.topology.build_topology`): the SBC model's predictor, not
+        the dissertation's MTC model.
     """
 
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
-                 lumped_tendon_mass: bool = False, backend="scipy", membrane_law: str = "svk"):
+                 lumped_tendon_mass: bool = False, backend="scipy", membrane_law: str = "svk",
+                 rigid_bar_points: bool = False):
         self.system = system
         self.membrane_law = check_law_name(membrane_law)
         self.backend = get_backend(backend)
         self.mesh_n, self.patch = mesh_n, patch
         self.topology: MTCTopology = build_topology(system, mesh_n=mesh_n,
                                                     tendon_elements=tendon_elements,
-                                                    attachment=attachment, patch=patch)
+                                                    attachment=attachment, patch=patch,
+                                                    rigid_bar_points=rigid_bar_points)
         topo = self.topology
         self.membrane = MembraneTL(mesh=topo.mesh, material=system.membrane, law=self.membrane_law)
         self.membrane_element = MembraneElement(self.membrane, np.arange(topo.n_mesh), topo.dofmap)
@@ -156,6 +162,10 @@ class MTCModel:
             elif rest == "design":
                 r = self._design_rest_lengths()
             elif rest == "mtc":
+                if self.system.deployable:
+                    raise InputError("rest_lengths='mtc': does not apply to a 1-N(D) system (the "
+                                     "consistent rest lengths balance truss bars without points "
+                                     "H_1j); expected 'design' (eq. 3.8), 'system' or values")
                 r = self.consistent_rest_lengths()["rest_lengths"]
             else:
                 raise InputError(f"rest_lengths: expected an array or one of 'system', 'design', "

@@ -61,7 +61,7 @@ class MTCTopology:
     T : csr (3 n_nodes, 3 n_red)
         Full positions from independent ones, ``x_full = T x_red``.
     red_node : ndarray (n_nodes,)
-        Index of each node among the independent nodes (-1 for the B_Mj).
+        Index of each node among the independent nodes (-1 for the B_Mj and rigid bar points).
     weights : list of (nodes, w)
         Attachment patch of each corner.
     """
@@ -90,7 +90,7 @@ class MTCTopology:
 
 
 def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str = "point",
-                   patch: float | None = None) -> MTCTopology:
+                   patch: float | None = None, rigid_bar_points: bool = False) -> MTCTopology:
     """Number the nodes and members of the MTC model of ``system`` (4.4, 6.2).
 
     Parameters
@@ -104,8 +104,14 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
     patch : float, optional
         Patch radius of the distributed attachment [m]; default 10 % of r_mb (or of the
         polygon's circumradius).
+    rigid_bar_points : bool
+        Accept a 1-N(D) system with its H_1j as dependent nodes on the straight bar,
+        x_H = (1 - k_H) x_A + k_H x_B (x_B itself the corner attachment): the statics of bars
+        rigid in bending (the load at H_1j reaches the bar ends as a pinned rigid bar's
+        reactions). Not the dissertation's MTC model (truss bars carry no point loads); the
+        shell-beam-cable model's predictor (:mod:`tmfem.models.sbc.model`).
     """
-    if system.deployable:
+    if system.deployable and not rigid_bar_points:
         raise InputError("MTC model: 1-N(D) systems (H_1j nodes along the bars) need bars "
                          "with an interior node and bending, which truss bars do not have; "
                          "expected an M-N system, found deployable=True")
@@ -132,15 +138,19 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
     if patch is None:
         patch = default_patch_radius(system.membrane_corners, system.r_mb)
     weights = attachment_weights(mesh, attachment=attachment, patch=patch)
+    dep = [(top_nodes[j], nodes, w) for j, (nodes, w) in enumerate(weights)]
+    if system.deployable:
+        kH = float(system.k_H)
+        dep += [(system_node[system.node_index(label("H", 1, j + 1))],
+                 np.concatenate([[fixed_nodes[j]], nodes]), np.concatenate([[1.0 - kH], kH * w]))
+                for j, (nodes, w) in enumerate(weights)]
 
     dofmap = DofMap.translations(n_nodes)
-    constraints = ConstraintMap.build(dofmap, dependent=[(top_nodes[j], nodes, w)
-                                                         for j, (nodes, w) in enumerate(weights)],
-                                      fixed_nodes=fixed_nodes)
+    constraints = ConstraintMap.build(dofmap, dependent=dep, fixed_nodes=fixed_nodes)
     dependent = np.zeros(n_nodes, dtype=bool)
-    dependent[top_nodes] = True
+    dependent[[d[0] for d in dep]] = True
     red_node = np.full(n_nodes, -1, dtype=np.int64)
-    red_node[~dependent] = np.arange(n_nodes - N)
+    red_node[~dependent] = np.arange(n_nodes - dependent.sum())
     return MTCTopology(mesh=mesh, n_mesh=nm, n_nodes=n_nodes, system_node=system_node,
                        bar_conn=bar_conn, tendon_conn=tendon_conn,
                        tendon_of_element=tendon_of_element, tendon_internal=internal,

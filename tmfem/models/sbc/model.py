@@ -14,12 +14,15 @@ model (:mod:`tmfem.models.mtc`), whose numbering, rest lengths and start placeme
   spectrum is unchanged);
 * **attachment**: the bar top B_Mj is a dependent node whose translations follow the membrane
   corner (``point``) or the MTC model's corner patch (``distributed``); its rotations are the
-  bar's own (a pin).
+  bar's own (a pin);
+* **1-N(D) systems**: H_1j is a node of bar j's beam chain at k_H (two segments), where the
+  SL, SU tendons end.
 
 Statics (6.2) start from the undeformed membrane exactly as the MTC model's (flat, unstressed,
 in the plane of the design bar tops; bars at the design; the bar tops moved onto the corners)
 and use the same mass-scaled trust-region Newton iteration
-(:func:`tmfem.solvers.trust_region.trust_region_newton`) through its ``update=`` path: the
+(:func:`tmfem.solvers.trust_region.trust_region_newton`), by default after the MTC model's
+own solve from that start as a predictor (:meth:`SBCModel.solve_static`), through its ``update=`` path: the
 unknown is a :class:`~tmfem.fem.element.State` and an increment adds translations and composes
 the nodal rotations by the exponential map, which is the update the shell and beam tangents
 differentiate. Modes about the prestressed state solve (K_T - omega^2 M) phi = 0 (eq. 5.32)
@@ -38,13 +41,16 @@ import scipy.sparse as sp
 from tmfem.errors import InputError
 from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, spin_constraint
 from tmfem.fem.constraints import ConstraintMap
-from tmfem.fem.element import State, assemble
-from tmfem.fem.mitc4 import MITC4Shell, ShellSection
+from tmfem.fem.element import State, assemble, smallest_rotation
+from tmfem.fem.mitc4 import MITC4Shell, ShellSection, nodal_normals
 from tmfem.fem.truss import TrussElement, TrussSet, truss_internal
 from tmfem.models.mtc.model import MTCModel
+from tmfem.models.mtc.spec import sequence_of
 from tmfem.models.sbc.topology import SBCNumbering, number_sbc
 from tmfem.solvers.eigen import lowest_modes
 from tmfem.solvers.trust_region import trust_region_newton
+from tmfem.system.topology import label
+
 
 #: Poisson's ratio of the bars (steel; ``system.bar`` has E, rho and d only)
 BAR_NU = 0.3
@@ -53,7 +59,9 @@ BAR_NU = 0.3
 @dataclass
 class SBCStaticResult:
     """Equilibrium of an SBC model: the nodal ``state`` (positions ``x`` and rotations), the
-    iterations, residual norms [N] (start first), monitored node positions, trust-region mu."""
+    SBC iterations, residual norms [N] (start first; the predictor's first when there is
+    one), monitored node positions, trust-region mu, the predictor's iterations and the
+    reduced tangent at the equilibrium (:meth:`SBCModel.modes` reuses it)."""
 
     state: State
     iterations: int
@@ -61,6 +69,8 @@ class SBCStaticResult:
     monitor: dict
     mu_history: list
     time: float
+    predictor_iterations: int = 0
+    tangent: object = None
 
     @property
     def x(self) -> np.ndarray:
@@ -78,7 +88,8 @@ class SBCModel:
     tendon_elements : int
         Truss elements per tendon (6.2: 3).
     bar_elements : int
-        Four-node beam elements per bar (6.2: 1).
+        Four-node beam elements per bar (6.2: 1); for a 1-N(D) system per segment A_1j-H_1j
+        and H_1j-B_1j (H_1j is a beam node, :mod:`tmfem.models.sbc.topology`).
     attachment : {"point", "distributed"}
     patch : float, optional
         Patch radius [m] of the distributed attachment (MTC model's default).
@@ -91,16 +102,17 @@ class SBCModel:
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3, bar_elements: int = 1,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
                  backend="scipy"):
-        if system.deployable:
-            raise InputError("SBC model: 1-N(D) systems (tendons at H_1j along the bars) are not "
-                             "built yet; expected an M-N system, found deployable=True")
         self.system = system
         self.mtc = MTCModel(system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                             attachment=attachment, patch=patch, rest_lengths=rest_lengths,
-                            backend=backend)
+                            backend=backend, rigid_bar_points=system.deployable)
         self.backend = self.mtc.backend
         mt = self.mtc.topology
-        self.numbering: SBCNumbering = number_sbc(mt, mt.bar_conn, bar_elements=bar_elements)
+        points = None
+        if system.deployable:
+            points = np.array([self.node(label("H", 1, j)) for j in range(1, system.N + 1)])
+        self.numbering: SBCNumbering = number_sbc(mt, mt.bar_conn, bar_elements=bar_elements,
+                                                  bar_points=points, k_point=system.k_H)
         num = self.numbering
         dm = self.dofmap = num.dofmap
         # reference configuration: the undeformed membrane placed as in 6.2, bars at the design
@@ -132,9 +144,10 @@ class SBCModel:
 
     # ------------------------------------------------------------------ set-up
     def _along_bars(self, x: np.ndarray) -> np.ndarray:
-        """Positions (3, n_bars, 3 e + 1) equally spaced on the chord of each bar's ends in x."""
+        """Positions (3, n_bars, 3 e + 1) of the bar chain nodes on the chord of each bar's
+        ends in x (at the fractions ``numbering.chain_s``)."""
         ch = self.numbering.bar_chain
-        s = np.linspace(0.0, 1.0, ch.shape[1])
+        s = self.numbering.chain_s
         a, b = x[:, ch[:, 0]], x[:, ch[:, -1]]
         return a[:, :, None] + (b - a)[:, :, None] * s[None, None, :]
 
@@ -195,12 +208,15 @@ class SBCModel:
         return self.constraints.tangent(M)
 
     def member_forces(self, state: State) -> dict:
-        """Tendon axial forces [N] (per tendon, first element) and bar axial forces [N]
-        (mean over each bar's Gauss points; compression negative)."""
+        """Tendon axial forces [N] (per tendon, mean of its elements) and bar axial forces [N]
+        (mean over each bar's Gauss points; compression negative). A bar carrying H_1j
+        (1-N(D)) reports the larger compression of its two segments A-H and H-B, as
+        :func:`tmfem.equilibrium.design.bar_axial_loads` does."""
         k = self.mtc.topology.tendon_elements
         N = truss_internal(state.x, self.tendons, tangent=False, dofmap=self.dofmap).N
-        Nb = self.beam.section_forces(state)["N"].reshape(-1, self.numbering.bar_elements *
-                                                           self.beam.r_gauss.size).mean(axis=1)
+        segments = 2 if self.system.deployable else 1
+        Nb = self.beam.section_forces(state)["N"].reshape(
+            self.numbering.bar_chain.shape[0], segments, -1).mean(axis=2).min(axis=1)
         return {"tendon": N.reshape(-1, k).mean(axis=1), "bar": Nb}
 
     def _force_scale(self, state: State) -> float:
@@ -208,16 +224,56 @@ class SBCModel:
         return 1.0 + float(np.sum(np.abs(f["tendon"])) + np.sum(np.abs(f["bar"])))
 
     # ------------------------------------------------------------------ statics
-    def solve_static(self, *, start: State | None = None, tol: float = 1e-9, max_iter: int = 200,
-                     monitor=(), progress=None) -> SBCStaticResult:
+    def state_from_mtc(self, x_mtc: np.ndarray) -> State:
+        """SBC state of an MTC (predictor) solution ``x_mtc`` (3, n_mtc_nodes) on the same
+        numbering: positions copied, bar interiors on the chords; every shell director
+        turned onto the normal of the deformed membrane and every bar's triads by the turn
+        of its chord from the design, each by the smallest rotation (so the predictor carries
+        no spurious transverse shear)."""
+        num = self.numbering
+        x = self.X.copy()
+        x[:, :num.n_mtc_nodes] = x_mtc
+        x[:, num.bar_chain] = self._along_bars(x)
+        R = np.broadcast_to(np.eye(3), (self.dofmap.n_nodes, 3, 3)).copy()
+        mesh = self.mtc.topology.mesh
+        nodes = np.arange(mesh.p.shape[1])
+        R[nodes] = smallest_rotation(self.shell.frames[nodes, :, 2].T,
+                                     nodal_normals(x[:, nodes], mesh.t))
+        ch = num.bar_chain
+        turn = smallest_rotation(self.X[:, ch[:, -1]] - self.X[:, ch[:, 0]], x[:, ch[:, -1]] - x[:, ch[:, 0]])
+        R[ch] = turn[:, None]
+        return State(x=x, R=R, frames=self.shell.frames)
+
+    def solve_static(self, *, start: State | None = None, predictor: str | None = None,
+                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress=None) -> SBCStaticResult:
         """Equilibrium reached from the undeformed membrane (6.2) or from ``start``.
 
+        ``predictor="mtc"`` (the default without ``start``): the MTC model of the same mesh and rest lengths is
+        solved first from the same undeformed start (with its mesh sequencing above 20 x 20;
+        1-N(D) systems with rigid bar points, :func:`build_topology`), its equilibrium
+        mapped by :meth:`state_from_mtc`, and Newton's method continues on the SBC model
+        (the membrane's bending stiffness and the bars' bending only correct it). ``"none"``:
+        the trust-region iteration on the SBC model all the way from the undeformed membrane.
         Converged when |r_free| <= tol x (1 N + sum of |member forces|) after a pure Newton
-        step (:func:`trust_region_newton`). ``monitor``: node labels recorded every iteration;
-        ``progress(iteration, rnorm, mu, rho)``.
+        step (:func:`trust_region_newton`). ``monitor``: node labels recorded every iteration
+        (predictor iterations first); ``progress(iteration, rnorm, mu, rho)``.
         """
+        if predictor not in (None, "mtc", "none"):
+            raise InputError(f"predictor: expected 'mtc' or 'none', found {predictor!r}")
+        if start is not None and predictor == "mtc":
+            raise InputError("predictor: does not apply with an explicit start, found "
+                             "predictor='mtc'")
+        predictor = predictor or ("mtc" if start is None else "none")
         t0 = time.perf_counter()
-        s0 = self.start_state() if start is None else start
+        pre = None
+        if start is not None:
+            s0 = start
+        elif predictor == "mtc":
+            pre = self.mtc.solve_static(tol=tol, max_iter=max_iter, monitor=monitor, progress=progress,
+                                        sequence=sequence_of(self.mtc.topology.mesh.n, None))
+            s0 = self.state_from_mtc(pre.x)
+        else:
+            s0 = self.start_state()
         idx = {lab: self.node(lab) for lab in monitor}
         hist = {lab: [s0.x[:, n].copy()] for lab, n in idx.items()}
         Md = np.asarray(self.mass().diagonal())[self.free]
@@ -231,20 +287,27 @@ class SBCModel:
         res = trust_region_newton(
             self.residual, self.energy, s0, free=self.free, scale=np.maximum(Md, 1e-9 * Md.max()),
             force_scale=self._force_scale, tol=tol, max_iter=max_iter, backend=self.backend,
-            callback=record, newton_first=start is not None, update=self.advance,
+            callback=record, newton_first=start is not None or pre is not None, update=self.advance,
             describe=lambda s: self.mtc.state_note(self.mtc.reduce(s.x[:, :self.numbering.n_mtc_nodes])),
             what="SBC static solve")
-        return SBCStaticResult(state=res.u, iterations=res.iterations,
-                               residual_history=res.residual_history,
-                               monitor={k: np.array(v) for k, v in hist.items()},
-                               mu_history=res.mu_history, time=time.perf_counter() - t0)
+        mon = {k: np.array(v) for k, v in hist.items()}
+        rh = res.residual_history
+        if pre is not None:
+            mon = {k: np.concatenate([pre.monitor[k], v[1:]]) for k, v in mon.items()}
+            rh = pre.residual_history + rh[1:]
+        return SBCStaticResult(state=res.u, iterations=res.iterations, residual_history=rh,
+                               monitor=mon, mu_history=res.mu_history,
+                               time=time.perf_counter() - t0,
+                               predictor_iterations=0 if pre is None else pre.iterations,
+                               tangent=res.tangent)
 
     # ------------------------------------------------------------------ modes
-    def modes(self, state: State, *, k: int = 12, sigma: float = -1.0):
+    def modes(self, state: State, *, k: int = 12, sigma: float = -1.0, tangent=None):
         """Lowest ``k`` modes about the prestressed ``state`` (eq. 5.32): symmetric part of
-        the reduced tangent, mass at the current directors. Shapes are reduced vectors
-        (:meth:`full_shapes`)."""
-        _, K = self.residual(state)
+        the reduced tangent, mass at the current directors. ``tangent``: the reduced tangent
+        at ``state`` when already assembled (``SBCStaticResult.tangent``). Shapes are reduced
+        vectors (:meth:`full_shapes`)."""
+        K = self.residual(state)[1] if tangent is None else tangent
         K = 0.5 * (K + K.T)
         return lowest_modes(K.tocsr(), self.mass(state), k=k, free=self.free, sigma=sigma,
                             backend=self.backend)

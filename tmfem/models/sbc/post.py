@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from tmfem.models.mtc.post import q_from_positions
+from tmfem.system.coordinates import q_index
 from tmfem.system.topology import label
 
 
@@ -36,7 +38,31 @@ def static_summary(model, result) -> dict:
         out["Delta_mean"] = float(r.mean() - sysm.r_mb)
     out["top_nodes"] = {label("B", sysm.M, j): x[:, sysm.node_index(label("B", sysm.M, j))].tolist()
                         for j in range(1, sysm.N + 1)}
+    out.update(bar_angles(sysm, x))
+    out["predictor_iterations"] = result.predictor_iterations
+    if sysm.deployable:
+        out["bar_bow"] = bar_bow(sysm, x).tolist()
     return out
+
+
+def bar_angles(system, x: np.ndarray) -> dict:
+    """theta_ij, psi_ij [deg] of the bar chords A_ij -> B_ij at labelled positions x (3.2,
+    :func:`tmfem.models.mtc.post.q_from_positions`) and at the design."""
+    q = q_from_positions(system, x)
+    _, ti, pi_ = q_index(system.M, system.N)
+    deg = lambda v: np.degrees(v).ravel().tolist()          # noqa: E731
+    return {"theta_deg": deg(q[ti]), "theta_design_deg": deg(system.q[ti]),
+            "psi_deg": deg(q[pi_]), "psi_design_deg": deg(system.q[pi_])}
+
+
+def bar_bow(system, x: np.ndarray) -> np.ndarray:
+    """Distance [m] of each H_1j from the chord A_1j B_1j of its bar at labelled positions x
+    (3, n_labels): the bending deflection at the tendon attachment (1-N(D))."""
+    nb = system.N
+    A, B, H = x[:, :nb], x[:, nb:2 * nb], x[:, 2 * nb:]
+    u = (B - A) / np.linalg.norm(B - A, axis=0)
+    d = H - A
+    return np.linalg.norm(d - np.sum(d * u, axis=0) * u, axis=0)
 
 
 def format_static(r: dict) -> str:
@@ -44,12 +70,20 @@ def format_static(r: dict) -> str:
     lines = [f"SBC model of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} elements/"
              f"tendon, {r['bar_elements']} beam element(s)/bar, {r['attachment']} attachment, "
              f"{r['dofs']} free dofs",
-             f"converged in {r['iterations']} iterations ({r['static_time_s']:.2f} s); residual "
+             f"converged in {r['predictor_iterations']} MTC predictor + {r['iterations']} SBC "
+             f"iterations ({r['static_time_s']:.2f} s); residual "
              f"{r['residual_history'][0]:.3e} -> {r['residual_history'][-1]:.3e} N",
              f"max distance of a node from the design: {r['max_deviation_from_design'] * 1e3:.3f} mm"
              + (f"; Delta {r['Delta_mean'] * 1e3:.4f} mm" if "Delta_mean" in r else ""),
+             "theta [deg] (design): " + ", ".join(f"{a:.3f} ({b:.3f})" for a, b in
+                                                   zip(r["theta_deg"], r["theta_design_deg"])),
+             "psi   [deg] (design): " + ", ".join(f"{a:.3f} ({b:.3f})" for a, b in
+                                                   zip(r["psi_deg"], r["psi_design_deg"])),
              f"max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, max bar load "
              f"{r['bar_load_max']:.3f} N, max bar bending moment {r['bar_moment_max']:.3e} N m"]
+    if "bar_bow" in r:
+        lines.append("bending deflection of the bars at H_1j [mm]: "
+                     + ", ".join(f"{v * 1e3:.3f}" for v in r["bar_bow"]))
     if "freq_hz" in r:
         d = r.get("dissertation")
         lines.append(f"{'mode':>4s} {'SBC [Hz]':>10s}" + (f" {'SBC paper':>10s} {'diff':>8s}   ({d['source']})"

@@ -24,7 +24,7 @@ SPEC = register(ModelSpec(
     commands=("static", "modal"), build=build,
     shared=("mesh", "tendon_elements", "attachment", "patch"),
     own=(
-        Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1)")),
+        Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1); per bar segment A-H, H-B of a 1-N(D) system")),
         Option("--rest-lengths", None, None, dict(help=(
             "tendon rest lengths: 'system', 'design' (eq. 3.8), 'mtc' (the MTC model's consistent "
             "ones) or values per group/tendon, e.g. 'S1=1.5025'"))),

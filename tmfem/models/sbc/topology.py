@@ -10,6 +10,11 @@ appends the interior nodes of the bars:
 * then                    the bar interior nodes, ``3 e - 1`` per bar for ``e`` four-node
                           beam elements per bar, 6 dofs each.
 
+A 1-N(D) system's point H_1j on bar j (at k_H of its length) is a node of the bar: the bar is
+two segments A_1j-H_1j and H_1j-B_1j of ``e`` elements each (``2 e`` per bar, ``2 (3 e - 1)``
+interior nodes), so the tendon forces at H_1j and the kink of the bending moment there are
+represented exactly.
+
 Only the numbering lives here; the constraints (pinned bases, bar tops pinned to the membrane
 corners, the bars' spin) are built by :class:`tmfem.models.sbc.model.SBCModel`, which needs the
 beam element for the spin constraint.
@@ -37,6 +42,11 @@ class SBCNumbering:
         Four-node beam elements, bar-major.
     n_mtc_nodes : int
         Nodes shared with the MTC numbering (membrane, system labels, tendon internals).
+    bar_elements : int
+        Four-node beam elements per bar (``2 e`` when the bars carry points H_1j).
+    chain_s : ndarray (3 bar_elements + 1,)
+        Fraction of the bar length from A_ij of every chain node (straight bar, equally
+        spaced nodes within each segment).
     """
 
     dofmap: DofMap
@@ -44,9 +54,11 @@ class SBCNumbering:
     beam_conn: np.ndarray
     n_mtc_nodes: int
     bar_elements: int
+    chain_s: np.ndarray
 
 
-def number_sbc(mtc_topology, bar_connectivity: np.ndarray, *, bar_elements: int) -> SBCNumbering:
+def number_sbc(mtc_topology, bar_connectivity: np.ndarray, *, bar_elements: int,
+               bar_points: np.ndarray | None = None, k_point: float | None = None) -> SBCNumbering:
     """Append the bar interior nodes to the MTC numbering ``mtc_topology`` (module docstring).
 
     Parameters
@@ -55,15 +67,30 @@ def number_sbc(mtc_topology, bar_connectivity: np.ndarray, *, bar_elements: int)
     bar_connectivity : ndarray (2, n_bars)
         Global nodes (A, B) of each bar in the MTC numbering (``mtc_topology.bar_conn``).
     bar_elements : int
-        Four-node beam elements per bar (6.2: 1).
+        Four-node beam elements per bar, or per bar segment with ``bar_points`` (6.2: 1).
+    bar_points : ndarray (n_bars,), optional
+        Global node of the point H_1j of each bar (1-N(D) systems), at the fraction
+        ``k_point`` (k_H) of the bar length from A.
     """
     if not (isinstance(bar_elements, (int, np.integer)) and bar_elements >= 1):
         raise InputError(f"bar_elements: expected an integer >= 1, found {bar_elements!r}")
     e = int(bar_elements)
     n0 = mtc_topology.n_nodes
     nb = bar_connectivity.shape[1]
-    interior = n0 + np.arange(nb * (3 * e - 1)).reshape(nb, 3 * e - 1)
-    chain = np.concatenate([bar_connectivity[0][:, None], interior, bar_connectivity[1][:, None]], axis=1)
+    A, B = bar_connectivity[0][:, None], bar_connectivity[1][:, None]
+    if bar_points is None:
+        interior = n0 + np.arange(nb * (3 * e - 1)).reshape(nb, 3 * e - 1)
+        chain = np.concatenate([A, interior, B], axis=1)
+        s = np.linspace(0.0, 1.0, 3 * e + 1)
+    else:
+        if not (k_point is not None and 0.0 < k_point < 1.0):
+            raise InputError(f"bar points: expected 0 < k_H < 1, found {k_point!r}")
+        interior = n0 + np.arange(nb * 2 * (3 * e - 1)).reshape(nb, 2, 3 * e - 1)
+        chain = np.concatenate([A, interior[:, 0], np.asarray(bar_points)[:, None], interior[:, 1], B],
+                               axis=1)
+        s = np.concatenate([np.linspace(0.0, k_point, 3 * e + 1),
+                            np.linspace(k_point, 1.0, 3 * e + 1)[1:]])
+        e = 2 * e
     starts = 3 * np.arange(e)
     beam_conn = chain[:, starts[:, None] + np.arange(4)[None, :]].reshape(nb * e, 4).T   # (4, nb e)
     counts = np.full(n0 + interior.size, 6, dtype=np.int64)
@@ -71,4 +98,4 @@ def number_sbc(mtc_topology, bar_connectivity: np.ndarray, *, bar_elements: int)
     internal = np.asarray(mtc_topology.tendon_internal).ravel()
     counts[internal] = 3
     return SBCNumbering(dofmap=DofMap(counts), bar_chain=chain, beam_conn=beam_conn,
-                        n_mtc_nodes=n0, bar_elements=e)
+                        n_mtc_nodes=n0, bar_elements=e, chain_s=s)
