@@ -26,7 +26,8 @@ DEPLOYMENTS = {
     "1-6D": {"omega_r": 0.35, "table_7_1": (4.0, 10.0, 20.0, 0.7), "uncertainty": "no-MG",
              "points": [(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], "u_m": 0.02},
     "2-3-deploy": {"omega_r": 0.5, "table_7_1": (1.0, 24.0, 5.0, 0.9), "uncertainty": "no-MG",
-                   "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01},
+                   "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01,
+                   "bases": "table-7-7-rule", "hinf_method": "riccati"},
 }
 CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
                "adaptive": "none"}
@@ -43,10 +44,15 @@ def inside_points(system, points, *, inset: float = 1e-3):
     return out
 
 
-def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None):
-    """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`)."""
+def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
+          allocation: str = "bounded"):
+    """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`); the
+    2-3 path keeps the stage-2 base on the reconstructed Table 7.7 rule
+    (:func:`tmfem.reference.tables.deployment_bases`) and its H-infinity controller comes
+    from the Riccati route (its LMI does not solve, docs/control.md)."""
     from tmfem.control.adaptive import Gains
     from tmfem.control.deploy import build_deployment
+    from tmfem.reference.tables import deployment_bases
     from tmfem.system.presets import load_preset
     if preset not in DEPLOYMENTS:
         raise InputError(f"deploy: expected a preset among {sorted(DEPLOYMENTS)}, found {preset!r}")
@@ -59,7 +65,9 @@ def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | 
                             gains=Gains(omega_0=w0, omega_e=we, tau=tau, d_c=dc),
                             uncertainty=uncertainty or p["uncertainty"],
                             output_points=inside_points(final, p["points"]),
-                            linear=CONTROLLERS[controller], u_m=p["u_m"])
+                            linear=CONTROLLERS[controller], u_m=p["u_m"],
+                            bases=deployment_bases(final) if p.get("bases") else None,
+                            hinf_method=p.get("hinf_method", "lmi"), allocation=allocation)
 
 
 def configure(parser) -> None:
@@ -71,6 +79,10 @@ def configure(parser) -> None:
                              "state feedback) or adaptive (no switch)")
     parser.add_argument("--uncertainty", choices=["initial", "no-MG", "exact"],
                         help="controller model error (default: the 7.4 choice of the preset)")
+    parser.add_argument("--allocation", choices=["bounded", "clip"], default="bounded",
+                        help="rest-length limits in the PFL: bounded (the admissible rest lengths "
+                             "closest in acceleration, default) or clip (eq. 5.58 as is, saturated "
+                             "by the plant)")
     parser.add_argument("--t-end", type=float, default=20.0)
     parser.add_argument("--dt", type=float, default=0.01)
     parser.add_argument("--csv", help="write every named signal (one column each)")
@@ -83,13 +95,15 @@ def run(args) -> dict:
     from tmfem.simulation.driver import check_time_grid
     check_time_grid(args.t_end, args.dt)            # refused before the controller design
     t0 = time.perf_counter()
-    s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty)
+    s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+              allocation=args.allocation)
     from tmfem.control.deploy import run_deployment
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset}") as bar:
         r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
                            z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar)
     out = {"preset": args.preset, "controller": args.controller,
-           "uncertainty": s.adaptive.uncertainty, **r.summary(), **s.info,
+           "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
+           **r.summary(), **s.info,
            "total_wall_time_s": time.perf_counter() - t0}
     if args.csv:
         out["csv"] = write_csv(args.csv, r)

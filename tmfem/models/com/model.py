@@ -185,6 +185,14 @@ class ControlOrientedModel:
         z = self.P @ np.asarray(z, dtype=float)
         return z if zd is None else (z, self.P @ np.asarray(zd, dtype=float))
 
+    def mg_term(self, z, zd) -> np.ndarray:
+        """T_z^T M(x) G of F_hat (eq. 5.28) at (z, z'), modal coordinates, partitioned
+        formulation: the part of F_hat from the constraint accelerations (7.4's uncertainty
+        model of 1-6(D) and 2-3 ignores it)."""
+        if self.graphs.fast_mg is None or self.membrane_points is not None:
+            raise InputError("mg_term: expected the partitioned formulation in modal coordinates")
+        return self.graphs.fast_mg(np.concatenate([z, zd])).full().ravel()
+
     def matrices(self, z, zd):
         """M_hat, F_hat, B_hat of eq. 5.28 at (z, z'), in the model's coordinates."""
         zm, zdm = self._to_modal(z, zd)
