@@ -252,3 +252,22 @@ def test_stress_recovery_superposition_against_direct_solves():
         assert bar[k] == pytest.approx(want, rel=1e-9)
         assert vm[k] == pytest.approx(sol.max_von_mises, rel=1e-9)
     assert rc.critical_load == pytest.approx(891.9, rel=1e-3)       # 7.4.1
+
+
+def test_1ND_delta_path_keeps_the_stretch_linear():
+    # 1-N(D): psi_r from eq. 3.22 with Delta linear in the progress s between its end values
+    # (closed form of eq. 3.22 via SymmetricConfig.membrane_delta); ends on the presets,
+    # equilibria along it (eq. 3.41), the stage-count and rule conflicts refused
+    from tmfem.control.deploy import _equilibrium_checker
+    f, i = load_preset("1-4D"), load_preset("1-4D-initial")
+    ref = DeploymentReference(initial=i.symmetric, final=f.symmetric, N=4, q_names=list(f.q_names),
+                              omega_r=0.7, r_mb=f.r_mb)
+    D0, De = i.symmetric.membrane_delta(4, f.r_mb), f.symmetric.membrane_delta(4, f.r_mb)
+    for s in (0.0, 0.3, 0.7, 1.0):
+        assert ref.config(s).membrane_delta(4, f.r_mb) == pytest.approx(D0 + s * (De - D0), abs=1e-12)
+    assert np.allclose(ref(0.0)[0], i.q, atol=1e-9)
+    ref.check_equilibria(checker=_equilibrium_checker(f), n=6)
+    f23 = load_preset("2-3-deploy")
+    with pytest.raises(InputError, match="one-stage"):
+        DeploymentReference(initial=load_preset("2-3-deploy-initial").symmetric, final=f23.symmetric,
+                            N=3, q_names=list(f23.q_names), omega_r=0.5, r_mb=f23.r_mb)

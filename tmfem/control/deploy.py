@@ -255,10 +255,12 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      n_centres: int = 10, w_bar: float = 100.0, gamma: float = 0.01,
                      u_m: float = 0.01, membrane_modes: int | None = None,
                      check_path: bool = True, bases=None, allocation: str = "bounded",
-                     hinf_method: str = "lmi", r_min: float = 1e-3) -> DeploymentSetup:
+                     hinf_method: str = "lmi", r_min: float = 1e-3,
+                     delta_path: bool = False) -> DeploymentSetup:
     """The model (built at the final configuration with its printed rest lengths), the
     reference from ``initial`` to ``final`` (:class:`DeploymentReference`, stage bases from
-    ``bases`` when given), the adaptive PFL (eq. 5.58, limits treated by ``allocation``) and,
+    ``bases`` when given, psi_r from eq. 3.22 with Delta linear in s when ``delta_path``,
+    one-stage systems), the adaptive PFL (eq. 5.58, limits treated by ``allocation``) and,
     unless ``linear="none"``, the switch (eq. 5.70) to a linear controller about the final
     equilibrium: ``"lmi"`` (issue 12's H-infinity output feedback of 7.3 with alpha-stability,
     :func:`lmi_hinf_controller`, synthesised by ``hinf_method``), ``"lqr"``
@@ -276,7 +278,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     model = ControlOrientedModel(final, membrane_modes=K, rest_lengths="system",
                                  output_points=output_points)
     ref = DeploymentReference(initial=initial.symmetric, final=final.symmetric, N=final.N,
-                              q_names=list(final.q_names), omega_r=omega_r, bases=bases)
+                              q_names=list(final.q_names), omega_r=omega_r, bases=bases,
+                              r_mb=final.r_mb if delta_path else None)
     if check_path:
         ref.check_equilibria(checker=_equilibrium_checker(final))
     t_settle = 8.0 / omega_r
