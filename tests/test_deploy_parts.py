@@ -271,3 +271,15 @@ def test_1ND_delta_path_keeps_the_stretch_linear():
     with pytest.raises(InputError, match="one-stage"):
         DeploymentReference(initial=load_preset("2-3-deploy-initial").symmetric, final=f23.symmetric,
                             N=3, q_names=list(f23.q_names), omega_r=0.5, r_mb=f23.r_mb)
+
+
+def test_partition_with_several_force_columns(model14):
+    # F_q of eq. 5.41 is linear in F_hat: columns give the one-vector results
+    m = model14
+    M, F, B = m.matrices(m.z0, np.zeros(m.nz))
+    G = np.random.default_rng(2).standard_normal(F.size)
+    two = partition(M, np.column_stack([F, G]), B, nq=m.nq)
+    for col, f in enumerate((F, G)):
+        one = partition(M, f, B, nq=m.nq)
+        assert np.allclose(two.F_q[:, col], one.F_q, rtol=1e-12, atol=1e-12)
+        assert np.allclose(two.B_q, one.B_q) and np.allclose(two.F2[:, col], one.F2)

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.pfl import bounded_inversion, check_input_matrix, partition
+from tmfem.control.pfl import PFLTerms, bounded_inversion, check_input_matrix, partition
 from tmfem.control.limits import tendon_lengths
 from tmfem.control.rbf import GaussianRBF, euler_step
 from tmfem.errors import InputError, SingularInputMatrix
@@ -144,13 +144,14 @@ class AdaptivePFL:
         q, qd = z[:nq], zd[:nq]
         M, F, B = self.model.matrices(z, zd)
         try:
-            exact = partition(M, F, B, nq=nq)
-            if self.uncertainty == "exact":
-                F_q = exact.F_q
-            elif self.uncertainty == "initial":
-                F_q = self._F_initial
+            if self.uncertainty == "no-MG":
+                both = partition(M, np.column_stack([F, F - self.model.mg_term(z, zd)]), B, nq=nq)
+                exact = PFLTerms(M_q=both.M_q, F_q=both.F_q[:, 0], B_q=both.B_q, M12=both.M12,
+                                 M22=both.M22, F2=both.F2[:, 0])
+                F_q = both.F_q[:, 1]
             else:
-                F_q = partition(M, F - self.model.mg_term(z, zd), B, nq=nq).F_q
+                exact = partition(M, F, B, nq=nq)
+                F_q = exact.F_q if self.uncertainty == "exact" else self._F_initial
             if self._samples % self.cond_every == 0:
                 self.condition_numbers.append(check_input_matrix(exact.B_q,
                                                                  where=f" at t = {t:.4g} s"))

@@ -41,18 +41,25 @@ class PFLTerms:
 
 def partition(M_hat, F_hat, B_hat, *, nq: int) -> PFLTerms:
     """Eqs. 5.39-5.41 from M_hat, F_hat, B_hat (eq. 5.28) with the first nq coordinates
-    actuated. B_hat's eta rows are zero for the COM (eq. 5.39); they are not used."""
+    actuated. B_hat's eta rows are zero for the COM (eq. 5.39); they are not used.
+    ``F_hat`` may hold several force vectors as columns (n, k): F_q (and F2) are then
+    (nq, k), from the same factorisations."""
     M11, M12, M22 = M_hat[:nq, :nq], M_hat[:nq, nq:], M_hat[nq:, nq:]
-    F1, F2 = F_hat[:nq], F_hat[nq:]
+    F_hat = np.asarray(F_hat, dtype=float)
+    Fc = F_hat.reshape(F_hat.shape[0], -1)
+    k = Fc.shape[1]
+    F1, F2 = Fc[:nq], Fc[nq:]
     if M22.size:
         X = np.linalg.solve(M22, np.column_stack([M12.T, F2]))
         Mq = M11 - M12 @ X[:, :nq]
-        rhs = np.column_stack([F1 - M12 @ X[:, nq], B_hat[:nq]])
+        rhs = np.column_stack([F1 - M12 @ X[:, nq:], B_hat[:nq]])
     else:
         Mq = M11
         rhs = np.column_stack([F1, B_hat[:nq]])
     sol = np.linalg.solve(Mq, rhs)
-    return PFLTerms(M_q=Mq, F_q=sol[:, 0], B_q=sol[:, 1:], M12=M12, M22=M22, F2=F2)
+    if F_hat.ndim == 1:
+        return PFLTerms(M_q=Mq, F_q=sol[:, 0], B_q=sol[:, 1:], M12=M12, M22=M22, F2=F2[:, 0])
+    return PFLTerms(M_q=Mq, F_q=sol[:, :k], B_q=sol[:, k:], M12=M12, M22=M22, F2=F2)
 
 
 def check_input_matrix(B_q, *, where: str = "", cond_limit: float = COND_LIMIT) -> float:
