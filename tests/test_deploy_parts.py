@@ -283,3 +283,11 @@ def test_partition_with_several_force_columns(model14):
         one = partition(M, f, B, nq=m.nq)
         assert np.allclose(two.F_q[:, col], one.F_q, rtol=1e-12, atol=1e-12)
         assert np.allclose(two.B_q, one.B_q) and np.allclose(two.F2[:, col], one.F2)
+
+
+def test_setup_refuses_a_path_of_the_other_system_kind():
+    from tmfem.cli.deploy import setup
+    with pytest.raises(InputError, match="expected 'linear' or 'delta'"):
+        setup("1-4D", path="table-7-7-bases")
+    with pytest.raises(InputError, match="allocation"):
+        setup("1-4D", allocation="scale")

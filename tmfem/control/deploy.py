@@ -271,6 +271,9 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     from tmfem.control.rbf import GaussianRBF
     from tmfem.control.switching import SwitchingController
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+    from tmfem.control.adaptive import ALLOCATION
+    if allocation not in ALLOCATION:
+        raise InputError(f"allocation: expected one of {ALLOCATION}, found {allocation!r}")
     if linear not in ("lmi", "lqr", "hinf", "none"):
         raise InputError(f"linear controller: expected 'lmi', 'lqr', 'hinf' or 'none', found "
                          f"{linear!r}")
