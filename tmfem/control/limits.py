@@ -29,12 +29,14 @@ def tendon_lengths(system, q) -> np.ndarray:
         import casadi as ca
         from tmfem.models.com.kinematics import tendon_lengths_sx
         qs = ca.SX.sym("q", q.size)
-        entry = {"f": ca.Function("tendon_lengths", [qs], [tendon_lengths_sx(system, qs)]),
+        from tmfem.models.com.graphs import BufferedFunction
+        f = ca.Function("tendon_lengths", [qs], [ca.densify(tendon_lengths_sx(system, qs))])
+        entry = {"f": BufferedFunction(f),
                  "system": weakref.ref(system, lambda _, k=id(system): _FUNCTIONS.pop(k, None)),
                  "q": None, "L": None}
         _FUNCTIONS[id(system)] = entry
     if entry["q"] is None or not np.array_equal(entry["q"], q):
-        entry["q"], entry["L"] = q.copy(), entry["f"](q).full().ravel()
+        entry["q"], entry["L"] = q.copy(), entry["f"](q)
     return entry["L"]
 
 

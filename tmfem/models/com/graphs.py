@@ -25,10 +25,38 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from tmfem.errors import InputError
 from tmfem.models.com.constraints import phi_sx, zeta_closed_form_sx
 from tmfem.models.com.energies import (lagrange_terms_sx, membrane_kinetic_energy_sx,
                                        membrane_potential_sx, tendon_energy_sx)
 from tmfem.models.com.kinematics import bar_kinetic_energy_sx, nodes_sx, tendon_lengths_sx
+
+
+class BufferedFunction:
+    """A casadi Function of one dense vector input and one dense output, evaluated through
+    casadi's function buffer: ``f(x)`` copies x into a fixed input array, evaluates in place
+    and returns a copy of the output array (no DM conversions; about 2.5x faster than
+    ``f(x).full()`` for the 1175 outputs of the 2-3 ``fast`` graph)."""
+
+    def __init__(self, f: ca.Function):
+        if not (f.n_in() == 1 and f.n_out() == 1 and f.sparsity_in(0).is_dense()
+                and f.sparsity_out(0).is_dense()):
+            raise InputError(f"buffered casadi function {f.name()}: expected one dense input "
+                             "and one dense output")
+        self.f = f
+        self._buffer = None
+
+    def __call__(self, x) -> np.ndarray:
+        if self._buffer is None:
+            buf, ev = self.f.buffer()
+            self._in = np.zeros(self.f.nnz_in(0))
+            self._out = np.zeros(self.f.nnz_out(0))
+            buf.set_arg(0, memoryview(self._in))
+            buf.set_res(0, memoryview(self._out))
+            self._buffer = (buf, ev)
+        self._in[:] = x
+        self._buffer[1]()
+        return self._out.copy()
 
 
 @dataclass(frozen=True)
