@@ -398,3 +398,22 @@ def test_driven_run_frames_carry_the_driven_rest_lengths_and_forces(m14, tmp_pat
     # the driven tendon S_12 differs from the nominal-u force by k du
     assert abs(T[1] - m14.tendon_forces(res.z[-1])[1]) == pytest.approx(
         m14.k[1] * 1e-3, rel=1e-9)
+
+
+def test_buffered_function_equals_the_casadi_call(m14):
+    # in-place evaluation (casadi function buffer) against casadi's own call, twice in a row
+    # (the output is a copy, not the buffer), and refused for a two-input function
+    import casadi as ca
+    from tmfem.errors import InputError
+    from tmfem.models.com.graphs import BufferedFunction
+    f = m14.graphs.fast
+    bf = BufferedFunction(f)
+    rng = np.random.default_rng(4)
+    x1, x2 = (np.concatenate([m14.z0, np.zeros(m14.nz)]) + 1e-3 * rng.standard_normal(2 * m14.nz)
+              for _ in range(2))
+    y1 = bf(x1)
+    y2 = bf(x2)
+    assert np.array_equal(y1, f(x1).full().ravel()) and np.array_equal(y2, f(x2).full().ravel())
+    a, b = ca.SX.sym("a"), ca.SX.sym("b")
+    with pytest.raises(InputError, match="one dense input"):
+        BufferedFunction(ca.Function("g", [a, b], [a + b]))

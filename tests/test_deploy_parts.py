@@ -48,6 +48,9 @@ def test_reference_ends_and_derivatives(ref14):
     qp, qm = ref(t + h)[0], ref(t - h)[0]
     assert np.allclose(qd, (qp - qm) / (2 * h), atol=1e-6)
     assert np.allclose(qdd, (qp - 2 * q + qm) / h**2, atol=1e-4)
+    # the spline of s -> q against the exact map between its knots
+    for t in (0.37, 1.91, 5.55):
+        assert np.allclose(ref(t)[0], ref.q_of_s(float(ref.progress(t)[0])), atol=1e-10)
 
 
 @pytest.fixture(scope="module")
@@ -174,3 +177,117 @@ def test_switching_bumpless():
     u = sw.output(0.01, y, xc)
     assert sw.switch_time == 0.01 and sw.name == "lin"
     assert u[0] == pytest.approx(0.3) and sw.switch_jump == pytest.approx(0.0, abs=1e-12)
+
+
+def test_bounded_inversion_kkt_and_exact_inside():
+    # eq. 5.46 with rest-length limits: inside the limits the exact B_q^-1 v; outside, the
+    # minimiser of (B_q u - v)^T M_q (B_q u - v) over the box, checked by its KKT
+    # conditions (gradient zero on free entries, of the right sign on active bounds)
+    from tmfem.control.pfl import PFLTerms, bounded_inversion
+    rng = np.random.default_rng(3)
+    n = 6
+    A = rng.standard_normal((n, n))
+    Mq = A @ A.T + n * np.eye(n)
+    Bq = rng.standard_normal((n, n)) + 3 * np.eye(n)
+    t = PFLTerms(M_q=Mq, F_q=np.zeros(n), B_q=Bq, M12=None, M22=None, F2=None)
+    u_in = rng.uniform(0.4, 0.6, n)
+    u, active = bounded_inversion(t, Bq @ u_in, lower=0.1, upper=np.ones(n))
+    assert not active and np.allclose(u, u_in, atol=1e-12)
+    u_out = u_in.copy()
+    u_out[[1, 4]] = [1.3, -0.2]
+    v = Bq @ u_out
+    lo, hi = np.full(n, 0.1), np.ones(n)
+    u, active = bounded_inversion(t, v, lower=lo, upper=hi)
+    assert active and np.all(u >= lo) and np.all(u <= hi)
+    g = Bq.T @ Mq @ (Bq @ u - v)
+    free = (u > lo + 1e-9) & (u < hi - 1e-9)
+    scale = np.abs(Bq.T @ Mq @ v).max()
+    assert np.all(np.abs(g[free]) < 1e-8 * scale)
+    assert np.all(g[u >= hi - 1e-9] <= 1e-8 * scale) and np.all(g[u <= lo + 1e-9] >= -1e-8 * scale)
+    # closer in acceleration than clipping each rest length
+    err = lambda w: (Bq @ w - v) @ Mq @ (Bq @ w - v)                 # noqa: E731
+    assert err(u) < err(np.clip(np.linalg.solve(Bq, v), lo, hi))
+
+
+def test_2_3_path_on_the_table_7_7_rule():
+    # the 2-3 reference with the stage-2 base rule of Table 7.7 (deployment_bases): it ends
+    # on the presets, keeps Delta = 1 mm (eq. 3.22, the rule's definition) along the path and
+    # every point is a symmetric equilibrium (positive null vector of 3.3.2)
+    from tmfem.cli.deploy import setup
+    from tmfem.control.deploy import _equilibrium_checker
+    from tmfem.equilibrium.symmetric import membrane_delta_system
+    from tmfem.equilibrium.symmetric_map import with_configuration
+    from tmfem.reference.tables import deployment_bases
+    f, i = load_preset("2-3-deploy"), load_preset("2-3-deploy-initial")
+    ref = DeploymentReference(initial=i.symmetric, final=f.symmetric, N=3, q_names=list(f.q_names),
+                              omega_r=0.5, bases=deployment_bases(f))
+    assert np.allclose(ref(0.0)[0], i.q, atol=1e-6)
+    d = ref(80.0)[0] - f.q
+    assert np.allclose(np.angle(np.exp(1j * d)), 0, atol=1e-6)
+    ss = ref.check_equilibria(checker=_equilibrium_checker(f), n=6)
+    for s in ss:
+        assert membrane_delta_system(with_configuration(f, ref.config(s))) == pytest.approx(1e-3, rel=1e-6)
+    # a rule that misses an end is refused
+    with pytest.raises(InputError, match="stage bases of the initial"):
+        DeploymentReference(initial=i.symmetric, final=f.symmetric, N=3, q_names=list(f.q_names),
+                            omega_r=0.5, bases=deployment_bases(f, Delta=2e-3))
+    assert setup("2-3-deploy", controller="adaptive").reference.bases is not None
+
+
+def test_stress_recovery_superposition_against_direct_solves():
+    # the recovery superposes unit corner-displacement solutions (linear plane stress,
+    # eq. 5.8): von Mises (eq. 5.30) and bar compression against a direct FE solve per sample
+    from tmfem.control.recovery import StressRecovery
+    from tmfem.equilibrium.design import bar_axial_loads, membrane_state
+    sysm = load_preset("1-4D")
+    rc = StressRecovery(sysm, mesh_n=6)
+    rng = np.random.default_rng(5)
+    q = sysm.q + 2e-3 * rng.standard_normal((3, sysm.q.size))
+    T = rng.uniform(5, 20, (3, len(sysm.tendons)))
+    bar, vm = rc.bars_and_membrane(q, T)
+    for k in range(3):
+        E, _, sol = membrane_state(sysm, q[k], mesh_n=6)
+        F3 = np.vstack([sol.corner_forces, np.zeros((1, sysm.N))])
+        want = np.max(bar_axial_loads(sysm, q[k], T[k], -(E.state.R @ F3)))
+        assert bar[k] == pytest.approx(want, rel=1e-9)
+        assert vm[k] == pytest.approx(sol.max_von_mises, rel=1e-9)
+    assert rc.critical_load == pytest.approx(891.9, rel=1e-3)       # 7.4.1
+
+
+def test_1ND_delta_path_keeps_the_stretch_linear():
+    # 1-N(D): psi_r from eq. 3.22 with Delta linear in the progress s between its end values
+    # (closed form of eq. 3.22 via SymmetricConfig.membrane_delta); ends on the presets,
+    # equilibria along it (eq. 3.41), the stage-count and rule conflicts refused
+    from tmfem.control.deploy import _equilibrium_checker
+    f, i = load_preset("1-4D"), load_preset("1-4D-initial")
+    ref = DeploymentReference(initial=i.symmetric, final=f.symmetric, N=4, q_names=list(f.q_names),
+                              omega_r=0.7, r_mb=f.r_mb)
+    D0, De = i.symmetric.membrane_delta(4, f.r_mb), f.symmetric.membrane_delta(4, f.r_mb)
+    for s in (0.0, 0.3, 0.7, 1.0):
+        assert ref.config(s).membrane_delta(4, f.r_mb) == pytest.approx(D0 + s * (De - D0), abs=1e-12)
+    assert np.allclose(ref(0.0)[0], i.q, atol=1e-9)
+    ref.check_equilibria(checker=_equilibrium_checker(f), n=6)
+    f23 = load_preset("2-3-deploy")
+    with pytest.raises(InputError, match="one-stage"):
+        DeploymentReference(initial=load_preset("2-3-deploy-initial").symmetric, final=f23.symmetric,
+                            N=3, q_names=list(f23.q_names), omega_r=0.5, r_mb=f23.r_mb)
+
+
+def test_partition_with_several_force_columns(model14):
+    # F_q of eq. 5.41 is linear in F_hat: columns give the one-vector results
+    m = model14
+    M, F, B = m.matrices(m.z0, np.zeros(m.nz))
+    G = np.random.default_rng(2).standard_normal(F.size)
+    two = partition(M, np.column_stack([F, G]), B, nq=m.nq)
+    for col, f in enumerate((F, G)):
+        one = partition(M, f, B, nq=m.nq)
+        assert np.allclose(two.F_q[:, col], one.F_q, rtol=1e-12, atol=1e-12)
+        assert np.allclose(two.B_q, one.B_q) and np.allclose(two.F2[:, col], one.F2)
+
+
+def test_setup_refuses_a_path_of_the_other_system_kind():
+    from tmfem.cli.deploy import setup
+    with pytest.raises(InputError, match="expected 'linear' or 'delta'"):
+        setup("1-4D", path="table-7-7-bases")
+    with pytest.raises(InputError, match="allocation"):
+        setup("1-4D", allocation="scale")

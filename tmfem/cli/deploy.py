@@ -22,11 +22,12 @@ HELP = "deploy a system from its packaged to its deployed configuration (adaptiv
 #: 7.4: omega_r (eq. 5.68), Table 7.1 (omega_0, omega_e, tau, d_c), uncertainty, points (5.73-5.75)
 DEPLOYMENTS = {
     "1-4D": {"omega_r": 0.7, "table_7_1": (15.0, 150.0, 20.0, 1.5), "uncertainty": "initial",
-             "points": [(1.0, 1.0), (2.0, 1.0), (1.0, 2.0)], "u_m": 0.01},
+             "points": [(1.0, 1.0), (2.0, 1.0), (1.0, 2.0)], "u_m": 0.01, "path": "delta"},
     "1-6D": {"omega_r": 0.35, "table_7_1": (4.0, 10.0, 20.0, 0.7), "uncertainty": "no-MG",
-             "points": [(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], "u_m": 0.02},
+             "points": [(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], "u_m": 0.02, "path": "delta"},
     "2-3-deploy": {"omega_r": 0.5, "table_7_1": (1.0, 24.0, 5.0, 0.9), "uncertainty": "no-MG",
-                   "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01},
+                   "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01,
+                   "path": "table-7-7-bases", "hinf_method": "riccati"},
 }
 CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
                "adaptive": "none"}
@@ -43,23 +44,36 @@ def inside_points(system, points, *, inset: float = 1e-3):
     return out
 
 
-def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None):
-    """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`)."""
+def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
+          allocation: str = "bounded", path: str | None = None):
+    """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`).
+    ``path`` (default the preset's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
+    membrane stretch Delta linear in s), ``"table-7-7-bases"`` (2-3: the stage-2 base on the
+    reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
+    ``"linear"`` (every symmetric parameter linear in s). The 2-3 H-infinity controller
+    comes from the Riccati route (its LMI does not solve, docs/control.md)."""
     from tmfem.control.adaptive import Gains
     from tmfem.control.deploy import build_deployment
+    from tmfem.reference.tables import deployment_bases
     from tmfem.system.presets import load_preset
     if preset not in DEPLOYMENTS:
         raise InputError(f"deploy: expected a preset among {sorted(DEPLOYMENTS)}, found {preset!r}")
     if controller not in CONTROLLERS:
         raise InputError(f"--controller: expected one of {sorted(CONTROLLERS)}, found {controller!r}")
     p = DEPLOYMENTS[preset]
+    path = path or p["path"]
+    if path not in ("linear", p["path"]):
+        raise InputError(f"--path for {preset}: expected 'linear' or {p['path']!r}, found {path!r}")
     final, initial = load_preset(preset), load_preset(preset + "-initial")
     w0, we, tau, dc = p["table_7_1"]
     return build_deployment(final=final, initial=initial, omega_r=p["omega_r"],
                             gains=Gains(omega_0=w0, omega_e=we, tau=tau, d_c=dc),
                             uncertainty=uncertainty or p["uncertainty"],
                             output_points=inside_points(final, p["points"]),
-                            linear=CONTROLLERS[controller], u_m=p["u_m"])
+                            linear=CONTROLLERS[controller], u_m=p["u_m"],
+                            bases=deployment_bases(final) if path == "table-7-7-bases" else None,
+                            delta_path=path == "delta",
+                            hinf_method=p.get("hinf_method", "lmi"), allocation=allocation)
 
 
 def configure(parser) -> None:
@@ -71,6 +85,13 @@ def configure(parser) -> None:
                              "state feedback) or adaptive (no switch)")
     parser.add_argument("--uncertainty", choices=["initial", "no-MG", "exact"],
                         help="controller model error (default: the 7.4 choice of the preset)")
+    parser.add_argument("--path", choices=["delta", "table-7-7-bases", "linear"],
+                        help="deployment path (default: delta for 1-N(D), table-7-7-bases for 2-3; "
+                             "linear: every symmetric parameter linear in the progress)")
+    parser.add_argument("--allocation", choices=["bounded", "clip"], default="bounded",
+                        help="rest-length limits in the PFL: bounded (the admissible rest lengths "
+                             "closest in acceleration, default) or clip (eq. 5.58 as is, saturated "
+                             "by the plant)")
     parser.add_argument("--t-end", type=float, default=20.0)
     parser.add_argument("--dt", type=float, default=0.01)
     parser.add_argument("--csv", help="write every named signal (one column each)")
@@ -83,13 +104,16 @@ def run(args) -> dict:
     from tmfem.simulation.driver import check_time_grid
     check_time_grid(args.t_end, args.dt)            # refused before the controller design
     t0 = time.perf_counter()
-    s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty)
+    s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+              allocation=args.allocation, path=args.path)
     from tmfem.control.deploy import run_deployment
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset}") as bar:
         r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
                            z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar)
     out = {"preset": args.preset, "controller": args.controller,
-           "uncertainty": s.adaptive.uncertainty, **r.summary(), **s.info,
+           "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
+           "path": args.path or DEPLOYMENTS[args.preset]["path"],
+           **r.summary(), **s.info,
            "total_wall_time_s": time.perf_counter() - t0}
     if args.csv:
         out["csv"] = write_csv(args.csv, r)

@@ -18,6 +18,13 @@ uncertainty models of 7.4:
 
 The controller reads the full state: the plant outputs are y = [z, z'] (the dissertation
 assumes full-state measurement in 7.2; :class:`tmfem.control.deploy.StatePlant`).
+
+Rest-length limits (7.4, "treated as control limits"): with ``allocation="bounded"`` the
+inversion of eq. 5.58 honours r_min <= u <= |tendon|(q) by
+:func:`tmfem.control.pfl.bounded_inversion` (the admissible u closest in acceleration);
+``"clip"`` returns eq. 5.58 unchanged and leaves the limits to the plant-side saturation
+(:class:`tmfem.control.deploy.RestLengthLimits`). The dissertation does not say how it
+treats an active limit; the two differ only while one is active.
 """
 from __future__ import annotations
 
@@ -25,12 +32,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.pfl import check_input_matrix, partition
+from tmfem.control.pfl import PFLTerms, bounded_inversion, check_input_matrix, partition
+from tmfem.control.limits import tendon_lengths
 from tmfem.control.rbf import GaussianRBF, euler_step
-from tmfem.errors import InputError
-from tmfem.models.com.dae import dae_terms
+from tmfem.errors import InputError, SingularInputMatrix
 
 UNCERTAINTY = ("initial", "no-MG", "exact")
+ALLOCATION = ("bounded", "clip")
 
 
 @dataclass
@@ -67,15 +75,30 @@ class AdaptivePFL:
     uncertainty : {"initial", "no-MG", "exact"}
     z_initial : array, optional
         Configuration at which ``"initial"`` evaluates F_q* (default: q_d(0), eta = 0).
+    allocation : {"bounded", "clip"}
+        Treatment of the rest-length limits (module docstring).
+    r_min : float
+        Smallest rest length [m] of the limits.
+    cond_every : int
+        The condition number of B_q (eq. 5.46) is computed and checked every ``cond_every``
+        samples (an exactly singular B_q fails its solve at any sample and is named then).
     """
 
     name = "adaptive-pfl"
 
     def __init__(self, *, model, reference, gains: Gains, rbf: GaussianRBF, w_bar: float,
                  gamma: float = 0.01, alpha: float = 1.0, beta: float = 1.0,
-                 uncertainty: str = "initial", z_initial=None):
+                 uncertainty: str = "initial", z_initial=None, allocation: str = "bounded",
+                 r_min: float = 1e-3, cond_every: int = 10):
         if uncertainty not in UNCERTAINTY:
             raise InputError(f"uncertainty: expected one of {UNCERTAINTY}, found {uncertainty!r}")
+        if allocation not in ALLOCATION:
+            raise InputError(f"allocation: expected one of {ALLOCATION}, found {allocation!r}")
+        if not r_min > 0:
+            raise InputError(f"r_min: expected > 0, found {r_min!r}")
+        if not (isinstance(cond_every, (int, np.integer)) and cond_every >= 1):
+            raise InputError(f"cond_every: expected an integer >= 1, found {cond_every!r}")
+        self.allocation, self.r_min = allocation, float(r_min)
         if model.membrane_points is not None:
             raise InputError("adaptive PFL: expected a model in modal coordinates "
                              "(membrane_points=None), found point coordinates")
@@ -97,12 +120,17 @@ class AdaptivePFL:
             self._F_initial = partition(M, F, B, nq=nq).F_q
         self._cache = (None, None)
         self.condition_numbers: list = []
+        self.allocation_active: list = []
+        self.cond_every = int(cond_every)
+        self._samples = 0
         self.dt = None
 
     def reset(self, t0, y0, dt):
         """W_F(0) = 0 (7.4); the controller state is vec(W_F) (m x n_q, column-major)."""
         self.dt = dt
         self.condition_numbers = []
+        self.allocation_active = []
+        self._samples = 0
         self._cache = (None, None)
         return np.zeros(self.rbf.m * self.nq)
 
@@ -115,22 +143,40 @@ class AdaptivePFL:
         z, zd = y[:nz], y[nz:2 * nz]
         q, qd = z[:nq], zd[:nq]
         M, F, B = self.model.matrices(z, zd)
-        exact = partition(M, F, B, nq=nq)
-        if self.uncertainty == "exact":
-            F_q = exact.F_q
-        elif self.uncertainty == "initial":
-            F_q = self._F_initial
-        else:
-            d = dae_terms(self.model, z, zd)
-            F_q = partition(M, d["T_z"].T @ d["F"], B, nq=nq).F_q
-        self.condition_numbers.append(check_input_matrix(exact.B_q, where=f" at t = {t:.4g} s"))
+        try:
+            if self.uncertainty == "no-MG":
+                both = partition(M, np.column_stack([F, F - self.model.mg_term(z, zd)]), B, nq=nq)
+                exact = PFLTerms(M_q=both.M_q, F_q=both.F_q[:, 0], B_q=both.B_q, M12=both.M12,
+                                 M22=both.M22, F2=both.F2[:, 0])
+                F_q = both.F_q[:, 1]
+            else:
+                exact = partition(M, F, B, nq=nq)
+                F_q = exact.F_q if self.uncertainty == "exact" else self._F_initial
+            if self._samples % self.cond_every == 0:
+                self.condition_numbers.append(check_input_matrix(exact.B_q,
+                                                                 where=f" at t = {t:.4g} s"))
+            self._samples += 1
+            return self._law(t, q, qd, xc, exact, F_q, key)
+        except np.linalg.LinAlgError as exc:
+            raise SingularInputMatrix(f"eq. 5.46 at t = {t:.4g} s: expected invertible M_q and "
+                                      f"B_q, found a singular matrix ({exc})") from None
+
+    def _law(self, t, q, qd, xc, exact, F_q, key):
+        """Eq. 5.58 and the adaptation term Y of eq. 5.51 from the PFL terms."""
+        nq = self.nq
         q_d, qd_d, qdd_d = self.reference(t)
         e, ed = q - q_d, qd - qd_d
         d_q, k_q = self.gains(t)
         W = xc.reshape(self.rbf.m, nq, order="F")
         phi = self.rbf(np.concatenate([q, qd]))
         v = -F_q - W.T @ phi - qdd_d + d_q * ed + k_q * e
-        u = np.linalg.solve(exact.B_q, v)
+        if self.allocation == "bounded":
+            u, active = bounded_inversion(exact, v, lower=self.r_min,
+                                          upper=tendon_lengths(self.model.system, q))
+            if active:
+                self.allocation_active.append(float(t))
+        else:
+            u = np.linalg.solve(exact.B_q, v)
         Y = -self.gamma * np.outer(phi, self.alpha * e + self.beta * ed)        # eq. 5.51
         out = (u, Y, W, e)
         self._cache = (key, out)

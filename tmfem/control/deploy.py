@@ -6,16 +6,16 @@ Measurement. The deployment controller is a full-state feedback (7.2): the plant
 y = [z, z'] (modal membrane coordinates). A linear controller on the measured outputs
 [q, w] of eq. 5.62 reads them through ``measure`` (:func:`output_measure`).
 
-Rest-length limits (7.4). A tendon cannot push: its rest length may not exceed its current
-length, and it stays positive. :class:`RestLengthLimits` saturates every commanded input to
-[r_min, |tendon|(q)] at each sample, records the samples where a limit is active and the
-smallest margin |tendon| - r.
+Rest-length limits (7.4): :class:`tmfem.control.limits.RestLengthLimits` saturates the
+commanded inputs to [r_min, |tendon|(q)]; the adaptive PFL may already honour them in its
+inversion (``allocation="bounded"``, :mod:`tmfem.control.adaptive`).
 
-Stress recovery, every ``stress_every`` samples: tendon stress T / A with T = k (|d| - r)
-(eq. 3.8), the bar compression from the equilibrium of each bar under the tendon and
-membrane-corner forces (as in the design checks, eq. 5.31 against the Euler load) and the
-maximum von Mises stress of the in-plane membrane solution for the current corner
-displacements (eq. 5.30, the linear plane-stress FE of the equilibrium design). Zero
+Stress recovery after the run (:mod:`tmfem.control.recovery`): tendon stress T / A with
+T = k (|d| - r) (eq. 3.8) at every sample; every ``stress_every`` samples the bar
+compression from the equilibrium of each bar under the tendon and membrane-corner forces (as
+in the design checks, eq. 5.31 against the Euler load) and the maximum von Mises stress of
+the in-plane membrane solution for the current corner displacements (eq. 5.30, the linear
+plane-stress FE of the equilibrium design). Zero
 dynamics (7.6): the energy of the membrane coordinates, E_eta = 1/2 |eta'|^2 +
 1/2 sum omega_i^2 eta_i^2 (mass-normalised modes).
 """
@@ -27,8 +27,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tmfem.control.limits import RestLengthLimits
 from tmfem.control.switching import relative_error
-from tmfem.equilibrium.design import bar_axial_loads, membrane_state
 from tmfem.errors import InputError
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.plant import COMPlant
@@ -56,36 +56,6 @@ def output_measure(model):
     """y = [z, z'] -> [q, w] of the model (the measured outputs of eq. 5.62)."""
     nz = model.nz
     return lambda y: model.outputs(np.asarray(y)[:nz])
-
-
-class RestLengthLimits:
-    """Saturation of a controller's rest lengths to [r_min, |tendon|(q)] (module docstring)."""
-
-    def __init__(self, controller, *, model, r_min: float = 1e-3):
-        if not r_min > 0:
-            raise InputError(f"r_min: expected > 0, found {r_min!r}")
-        self.inner, self.model, self.r_min = controller, model, float(r_min)
-        self.active: list = []
-        self.margins: list = []
-
-    @property
-    def name(self) -> str:
-        return self.inner.name
-
-    def reset(self, t0, y0, dt):
-        self.active, self.margins = [], []
-        return self.inner.reset(t0, y0, dt)
-
-    def output(self, t, y, xc):
-        u = np.asarray(self.inner.output(t, y, xc), dtype=float)
-        L = self.model.system.tendon_lengths(np.asarray(y)[: self.model.nq])
-        us = np.clip(u, self.r_min, L)
-        self.active.append((float(t), int(np.sum(us != u))))
-        self.margins.append(float(np.min(L - us)))
-        return us
-
-    def update(self, t, y, xc):
-        return self.inner.update(t, y, xc)
 
 
 def lqr_state_feedback(model, *, u_e, z_e=None, u_m: float = 0.01, q_weight: float = 1.0):
@@ -127,23 +97,31 @@ def hinf_output_feedback(model, *, u_e, z_e=None, w_e: float = 0.5, w_n: float =
     return LinearController(Kc, u_e=lin.u_e, y_e=lin.y_e, name="hinf-riccati"), lin, float(gam)
 
 
-def lmi_hinf_controller(system, *, membrane_modes: int):
+#: names of the H-infinity controllers of 7.3 by synthesis method
+HINF_NAMES = {"lmi": "hinf-lmi", "riccati": "hinf-shifted-riccati"}
+
+
+def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "lmi"):
     """The H-infinity controller of 7.3 (eqs. 5.62-5.67, :func:`tmfem.control.design.
-    deployed_hinf`: eliminated LMIs with the 7.4 weights and alpha_1) as a
-    :class:`LinearController`, with ``measure`` mapping the modal state y = [z, z'] of
-    :class:`StatePlant` onto the design's measured signals [q, v, q', v'] (membrane point
-    coordinates of eq. 5.18: z_points = P^-1 z_modal, the same linear map for the rates).
+    deployed_hinf` with the 7.4 weights and alpha_1: eliminated LMIs, or ``method=
+    "riccati"``, python-control ``hinfsyn`` on the alpha-shifted plant where the LMI does not
+    solve, the 2-3 system) as a :class:`LinearController`, with ``measure`` mapping the
+    modal state y = [z, z'] of :class:`StatePlant` onto the design's measured signals
+    [q, v, q', v'] (membrane point coordinates of eq. 5.18: z_points = P^-1 z_modal, the
+    same linear map for the rates).
 
     Returns
     -------
     controller, measure, gamma
     """
     from tmfem.control.design import deployed_hinf
-    d = deployed_hinf(system, membrane_modes=membrane_modes)
+    if method not in HINF_NAMES:
+        raise InputError(f"H-infinity method: expected one of {sorted(HINF_NAMES)}, found {method!r}")
+    d = deployed_hinf(system, membrane_modes=membrane_modes, method=method)
     pl = d.plant
     P = pl.model.P
     y_e = np.concatenate([pl.z_e, np.zeros(pl.z_e.size)])
-    ctrl = LinearController(d.design.controller, u_e=pl.u_e, y_e=y_e, name="hinf-lmi")
+    ctrl = LinearController(d.design.controller, u_e=pl.u_e, y_e=y_e, name=HINF_NAMES[method])
     nz = P.shape[0]
 
     def measure(y):
@@ -173,6 +151,7 @@ class DeploymentResult:
     stress: dict
     condition_numbers: np.ndarray
     wall_time: float
+    allocation_active: np.ndarray = field(default_factory=lambda: np.zeros(0))
     names: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
@@ -187,6 +166,9 @@ class DeploymentResult:
                 "min_rest_length_margin_m": self.min_margin,
                 "final_tracking_error": float(self.relative_error[-1]),
                 "limits_active_s": float(np.sum(self.limits_active > 0) * dt),
+                "allocation_active_s": float(self.allocation_active.size * dt),
+                "last_limit_active_s": float(self.t[np.flatnonzero(self.limits_active > 0)[-1]])
+                if np.any(self.limits_active > 0) else None,
                 "max_eta_energy_J": float(np.max(self.eta_energy)),
                 "B_q_condition_max": float(np.max(self.condition_numbers))
                 if self.condition_numbers.size else None,
@@ -198,69 +180,59 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
                    mesh_n: int = 10, jacobian: str = "reuse") -> DeploymentResult:
     """Deploy: the COM plant (:class:`StatePlant`) from z0 under ``controller`` (reading
     y = [z, z']) saturated by :class:`RestLengthLimits`, integrated by Park's method
-    (eqs. 5.34-5.35) at step dt, with the recovery of the module docstring. ``jacobian``:
-    the Newton-matrix policy of :func:`tmfem.solvers.park.park_integrate` (``"reuse"`` keeps
-    the matrix over steps while Newton converges within a few iterations)."""
+    (eqs. 5.34-5.35) at step dt. The run records the state and the inputs only; outputs,
+    reference, energies and stresses are recovered after it (:mod:`tmfem.control.recovery`:
+    tendon stresses at every sample, bars and membrane every ``stress_every`` samples).
+    ``jacobian``: the Newton-matrix policy of :func:`tmfem.solvers.park.park_integrate`
+    (``"reuse"`` keeps the matrix over steps while Newton converges within a few iterations)."""
+    from tmfem.control.recovery import StressRecovery
     if stress_every < 1:
         raise InputError(f"stress_every: expected >= 1, found {stress_every}")
     plant = StatePlant(model, z0=z0)
     lim = RestLengthLimits(controller, model=model, r_min=r_min)
-    sysm = model.system
-    nq, nz = model.nq, model.nz
-    area = np.array([sysm.tendon_section(t).area for t in sysm.tendons])
-    crit = np.vectorize(sysm.bar.euler_critical_load)(sysm.l)
-    pm = membrane_state(sysm, sysm.q, mesh_n=mesh_n)[1]
-    rec = {"t": [], "z": [], "zd": [], "u": [], "L": [], "w": [], "qd": [], "E": [], "rel": []}
-    stress = {"bar": [], "vm": [], "tendon": [], "t_bar": []}
-    omega2 = model.membrane.omega**2
-    q_e = getattr(reference, "q_e", None)
+    nq = model.nq
+    X, V, U = [], [], []
 
     def record(t, x, v, a, u, y):
-        w, _, L = model.fast_outputs(x, with_lengths=True)
-        rec["t"].append(t); rec["z"].append(x.copy()); rec["zd"].append(v.copy())
-        rec["u"].append(u.copy()); rec["L"].append(L); rec["w"].append(w)
-        rec["qd"].append(reference(t)[0])
-        eta, etad = x[nq:], v[nq:]
-        rec["E"].append(0.5 * etad @ etad + 0.5 * np.sum(omega2 * eta**2))
-        rec["rel"].append(relative_error(x[:nq], q_e) if q_e is not None else np.nan)
-        T = model.k * (L - u)
-        stress["tendon"].append(float(np.max(T / area)))
-        if len(rec["t"]) % stress_every == 1 or stress_every == 1:
-            E, _, sol = membrane_state(sysm, x[:nq], model=pm)
-            F3 = np.vstack([sol.corner_forces, np.zeros((1, sysm.N))])
-            loads = bar_axial_loads(sysm, x[:nq], T, -(E.state.R @ F3))
-            stress["bar"].append(float(np.max(loads)))
-            stress["vm"].append(float(sol.max_von_mises))
-            stress["t_bar"].append(t)
+        X.append(x.copy()); V.append(v.copy()); U.append(u.copy())
         return False
 
     t0 = time.perf_counter()
     sim = simulate(plant, t_end=t_end, dt=dt, controller=lim, record=record, progress=progress,
                    outputs=False, jacobian=jacobian)
     wall = time.perf_counter() - t0
+    z, zd, u = np.array(X), np.array(V), np.array(U)
+    out = [model.fast_outputs(zk, with_lengths=True) for zk in z]
+    w = np.array([o[0] for o in out])
+    L = np.array([o[2] for o in out])
+    q_d = np.array([reference(tk)[0] for tk in sim.t])
+    eta, etad = z[:, nq:], zd[:, nq:]
+    E = 0.5 * np.sum(etad**2, axis=1) + 0.5 * np.sum(model.membrane.omega**2 * eta**2, axis=1)
+    q_e = getattr(reference, "q_e", None)
+    rel = relative_error(z[:, :nq], q_e) if q_e is not None else np.full(sim.t.size, np.nan)
+    rc = StressRecovery(model.system, mesh_n=mesh_n)
+    sigma_t = rc.tendon_stress(model.k, L, u)
+    idx = np.arange(0, sim.t.size, stress_every)
+    bar, vm = rc.bars_and_membrane(z[idx, :nq], model.k * (L[idx] - u[idx]))
     act = np.array([a for _, a in lim.active])
-    inner = controller
-    cond = []
-    for c in (inner, getattr(inner, "first", None)):
+    cond, alloc = [], []
+    for c in (controller, getattr(controller, "first", None)):
         if c is not None and hasattr(c, "condition_numbers"):
-            cond = c.condition_numbers
-    rel = np.array(rec["rel"])
+            cond, alloc = c.condition_numbers, getattr(c, "allocation_active", [])
     return DeploymentResult(
-        t=np.array(rec["t"]), z=np.array(rec["z"]), zd=np.array(rec["zd"]),
-        u=np.array(rec["u"]), u_commanded=np.array(rec["u"]), lengths=np.array(rec["L"]),
-        w=np.array(rec["w"]), q_d=np.array(rec["qd"]), controller=list(sim.controller),
-        eta_energy=np.array(rec["E"]), relative_error=rel,
+        t=sim.t, z=z, zd=zd, u=u, u_commanded=u, lengths=L, w=w, q_d=q_d,
+        controller=list(sim.controller), eta_energy=E, relative_error=rel,
         switch_time=getattr(controller, "switch_time", None), limits_active=act,
         min_margin=float(np.min(lim.margins)),
-        stress={"peak_bar_compression_N": float(np.max(stress["bar"])),
-                "bar_critical_load_N": float(np.min(crit)),
-                "max_von_mises_Pa": float(np.max(stress["vm"])),
-                "max_tendon_stress_Pa": float(np.max(stress["tendon"])),
-                "bar_t": np.array(stress["t_bar"]), "bar": np.array(stress["bar"]),
-                "von_mises": np.array(stress["vm"])},
+        stress={"peak_bar_compression_N": float(np.max(bar)),
+                "bar_critical_load_N": rc.critical_load,
+                "max_von_mises_Pa": float(np.max(vm)),
+                "max_tendon_stress_Pa": float(np.max(sigma_t)),
+                "bar_t": sim.t[idx], "bar": bar, "von_mises": vm, "tendon": sigma_t},
         condition_numbers=np.asarray(cond, dtype=float), wall_time=wall,
+        allocation_active=np.asarray(alloc, dtype=float),
         names={"q": list(model.system.q_names), "u": model.input_names,
-               "tendons": [t.name for t in sysm.tendons],
+               "tendons": [t.name for t in model.system.tendons],
                "w": [f"w_{i + 1}" for i in range(len(model.output_points))]})
 
 
@@ -282,18 +254,26 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      output_points=None, linear: str = "lqr", R_c: float = 0.01,
                      n_centres: int = 10, w_bar: float = 100.0, gamma: float = 0.01,
                      u_m: float = 0.01, membrane_modes: int | None = None,
-                     check_path: bool = True) -> DeploymentSetup:
+                     check_path: bool = True, bases=None, allocation: str = "bounded",
+                     hinf_method: str = "lmi", r_min: float = 1e-3,
+                     delta_path: bool = False) -> DeploymentSetup:
     """The model (built at the final configuration with its printed rest lengths), the
-    reference from ``initial`` to ``final`` (:class:`DeploymentReference`), the adaptive PFL
-    (eq. 5.58) and, unless ``linear="none"``, the switch (eq. 5.70) to a linear controller
-    about the final equilibrium: ``"lmi"`` (issue 12's H-infinity output feedback by LMIs
-    with alpha-stability, :func:`lmi_hinf_controller`), ``"lqr"`` (:func:`lqr_state_feedback`)
-    or ``"hinf"`` (:func:`hinf_output_feedback`, python-control Riccati)."""
+    reference from ``initial`` to ``final`` (:class:`DeploymentReference`, stage bases from
+    ``bases`` when given, psi_r from eq. 3.22 with Delta linear in s when ``delta_path``,
+    one-stage systems), the adaptive PFL (eq. 5.58, limits treated by ``allocation``) and,
+    unless ``linear="none"``, the switch (eq. 5.70) to a linear controller about the final
+    equilibrium: ``"lmi"`` (issue 12's H-infinity output feedback of 7.3 with alpha-stability,
+    :func:`lmi_hinf_controller`, synthesised by ``hinf_method``), ``"lqr"``
+    (:func:`lqr_state_feedback`) or ``"hinf"`` (:func:`hinf_output_feedback`, python-control
+    Riccati on [q, w])."""
     from tmfem.control.adaptive import AdaptivePFL, reference_centres
     from tmfem.control.reference_trajectory import DeploymentReference
     from tmfem.control.rbf import GaussianRBF
     from tmfem.control.switching import SwitchingController
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+    from tmfem.control.adaptive import ALLOCATION
+    if allocation not in ALLOCATION:
+        raise InputError(f"allocation: expected one of {ALLOCATION}, found {allocation!r}")
     if linear not in ("lmi", "lqr", "hinf", "none"):
         raise InputError(f"linear controller: expected 'lmi', 'lqr', 'hinf' or 'none', found "
                          f"{linear!r}")
@@ -301,13 +281,15 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     model = ControlOrientedModel(final, membrane_modes=K, rest_lengths="system",
                                  output_points=output_points)
     ref = DeploymentReference(initial=initial.symmetric, final=final.symmetric, N=final.N,
-                              q_names=list(final.q_names), omega_r=omega_r)
+                              q_names=list(final.q_names), omega_r=omega_r, bases=bases,
+                              r_mb=final.r_mb if delta_path else None)
     if check_path:
         ref.check_equilibria(checker=_equilibrium_checker(final))
     t_settle = 8.0 / omega_r
     C, sig = reference_centres(ref, t_end=t_settle, m=n_centres)
     ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centres=C, sigma=sig),
-                     w_bar=w_bar, gamma=gamma, uncertainty=uncertainty)
+                     w_bar=w_bar, gamma=gamma, uncertainty=uncertainty, allocation=allocation,
+                     r_min=r_min)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
     z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)]))
     info = {"rbf_centres": n_centres, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
@@ -315,7 +297,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     ctrl = ad
     if linear != "none":
         if linear == "lmi":
-            lin_ctrl, measure, g = lmi_hinf_controller(final, membrane_modes=K)
+            lin_ctrl, measure, g = lmi_hinf_controller(final, membrane_modes=K, method=hinf_method)
             info["hinf_gamma"] = g
         elif linear == "lqr":
             lin_ctrl, _ = lqr_state_feedback(model, u_e=model.u0, z_e=z_e, u_m=u_m)

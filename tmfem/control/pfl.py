@@ -11,7 +11,9 @@ and eliminating eta'' gives (eqs. 5.40-5.41)
     M_q = M11 - M12 M22^-1 M12^T,  F_q* = M_q^-1 (F1 - M12 M22^-1 F2),  B_q* = M_q^-1 B1.
 
 The control law of eq. 5.46 inverts B_q: it must be square and invertible
-(:func:`check_input_matrix`).
+(:func:`check_input_matrix`). With the rest-length limits of 7.4 (r_min <= u <= |tendon|)
+the inverse may lie outside them; :func:`bounded_inversion` then returns the admissible
+rest lengths whose acceleration is closest to the commanded one.
 """
 from __future__ import annotations
 
@@ -39,18 +41,25 @@ class PFLTerms:
 
 def partition(M_hat, F_hat, B_hat, *, nq: int) -> PFLTerms:
     """Eqs. 5.39-5.41 from M_hat, F_hat, B_hat (eq. 5.28) with the first nq coordinates
-    actuated. B_hat's eta rows are zero for the COM (eq. 5.39); they are not used."""
+    actuated. B_hat's eta rows are zero for the COM (eq. 5.39); they are not used.
+    ``F_hat`` may hold several force vectors as columns (n, k): F_q (and F2) are then
+    (nq, k), from the same factorisations."""
     M11, M12, M22 = M_hat[:nq, :nq], M_hat[:nq, nq:], M_hat[nq:, nq:]
-    F1, F2 = F_hat[:nq], F_hat[nq:]
+    F_hat = np.asarray(F_hat, dtype=float)
+    Fc = F_hat.reshape(F_hat.shape[0], -1)
+    k = Fc.shape[1]
+    F1, F2 = Fc[:nq], Fc[nq:]
     if M22.size:
         X = np.linalg.solve(M22, np.column_stack([M12.T, F2]))
         Mq = M11 - M12 @ X[:, :nq]
-        rhs = np.column_stack([F1 - M12 @ X[:, nq], B_hat[:nq]])
+        rhs = np.column_stack([F1 - M12 @ X[:, nq:], B_hat[:nq]])
     else:
         Mq = M11
         rhs = np.column_stack([F1, B_hat[:nq]])
     sol = np.linalg.solve(Mq, rhs)
-    return PFLTerms(M_q=Mq, F_q=sol[:, 0], B_q=sol[:, 1:], M12=M12, M22=M22, F2=F2)
+    if F_hat.ndim == 1:
+        return PFLTerms(M_q=Mq, F_q=sol[:, 0], B_q=sol[:, 1:], M12=M12, M22=M22, F2=F2[:, 0])
+    return PFLTerms(M_q=Mq, F_q=sol[:, :k], B_q=sol[:, k:], M12=M12, M22=M22, F2=F2)
 
 
 def check_input_matrix(B_q, *, where: str = "", cond_limit: float = COND_LIMIT) -> float:
@@ -71,3 +80,30 @@ def check_input_matrix(B_q, *, where: str = "", cond_limit: float = COND_LIMIT) 
         raise SingularInputMatrix(f"eq. 5.46{where}: expected an invertible B_q (condition number "
                                   f"<= {cond_limit:g}), found {c:.3g}")
     return c
+
+
+def bounded_inversion(terms: PFLTerms, v, *, lower, upper) -> tuple[np.ndarray, bool]:
+    """Rest lengths u with B_q u = v (eq. 5.46, ``v`` = the bracket of eq. 5.58) inside the
+    limits [lower, upper]; where the exact solution leaves them, the admissible u whose
+    acceleration q'' = -F_q* - B_q u is closest to the commanded one in the kinetic-energy
+    metric of the bars,
+
+        min_u (B_q u - v)^T M_q (B_q u - v)   subject to  lower <= u <= upper,
+
+    a bounded-variable least-squares problem (scipy ``lsq_linear`` on R B_q u = R v with
+    M_q = R^T R). Clipping each rest length instead would leave the other tendons
+    compensating a force the clipped one does not give.
+
+    Returns
+    -------
+    u : ndarray
+    active : bool
+        True when the limits changed the solution of eq. 5.46.
+    """
+    u = np.linalg.solve(terms.B_q, v)
+    if np.all(u >= lower) and np.all(u <= upper):
+        return u, False
+    from scipy.optimize import lsq_linear
+    R = np.linalg.cholesky(0.5 * (terms.M_q + terms.M_q.T)).T
+    sol = lsq_linear(R @ terms.B_q, R @ v, bounds=(lower, upper), method="bvls")
+    return np.clip(sol.x, lower, upper), True

@@ -23,13 +23,15 @@ import numpy as np
 from tmfem.errors import InputError
 
 
-def relative_error(q, q_e) -> float:
-    """|| (q - q_e) / q_e ||_2 of eq. 5.70."""
+def relative_error(q, q_e):
+    """|| (q - q_e) / q_e ||_2 of eq. 5.70: a float for one configuration q, an array for
+    a history q (n, n_q)."""
     q_e = np.asarray(q_e, dtype=float)
     if np.any(q_e == 0):
         raise InputError("eq. 5.70: expected nonzero final coordinates q_e (element-wise "
                          f"division), found zeros at {np.flatnonzero(q_e == 0).tolist()}")
-    return float(np.linalg.norm((np.asarray(q) - q_e) / q_e))
+    r = np.linalg.norm((np.asarray(q, dtype=float) - q_e) / q_e, axis=-1)
+    return float(r) if np.ndim(r) == 0 else r
 
 
 class SwitchingController:
@@ -55,6 +57,8 @@ class SwitchingController:
             raise InputError(f"R_c: expected > 0, found {R_c!r}")
         self.first, self.second = first, second
         self.q_of_y, self.q_e, self.measure, self.R_c = q_of_y, np.asarray(q_e, float), measure, R_c
+        relative_error(self.q_e, self.q_e)                   # refuses zero entries of q_e
+        self._inv_q_e = 1.0 / self.q_e                       # eq. 5.70, element-wise
         self.switch_time = None
         self.switch_jump = None
         self._n1 = 0
@@ -73,7 +77,8 @@ class SwitchingController:
         return x1
 
     def _maybe_switch(self, t, y, xc):
-        if self.switch_time is not None or relative_error(self.q_of_y(y), self.q_e) > self.R_c:
+        if self.switch_time is not None or \
+                np.linalg.norm((self.q_of_y(y) - self.q_e) * self._inv_q_e) > self.R_c:
             return xc
         self.switch_time = float(t)
         yl = np.asarray(self.measure(y), dtype=float)

@@ -127,10 +127,13 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         ``progress(step, n_steps)`` called every step (e.g. to print to stderr).
     sampled : bool
         The callback may change the system's inputs (a zero-order-hold controller): after
-        each callback the acceleration is re-solved from r(x, v, a, t) = 0 with the new
-        inputs, so that the trapezoidal rule integrates every sample interval as a smooth
-        problem (second order). Park's multistep formula sees the input steps through its
-        history and is first order across them.
+        each callback that precedes a trapezoidal step (every step of ``"trapezoidal"``, the
+        two starting steps of ``"park"``) the acceleration is re-solved from
+        r(x, v, a, t) = 0 with the new inputs, so that the trapezoidal rule integrates every
+        sample interval as a smooth problem (second order) and the start uses the
+        acceleration of the first input, not of the system's inputs before the first
+        callback. Park's multistep formula does not use the acceleration: it sees the input
+        steps through its history and is first order across them.
 
     Returns
     -------
@@ -234,7 +237,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
             progress(k, n_steps)
         if callback is not None and callback(t, x, v, a):
             break
-        if sampled:
+        if sampled and (scheme == "trapezoidal" or len(hx) < 3):
             a = initial_acceleration(system, x, v, t, a0=a)
     if store:
         res.x, res.v, res.a = X[: last + 1], V[: last + 1], A[: last + 1]

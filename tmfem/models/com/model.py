@@ -32,7 +32,7 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.models.com.constraints import ConstraintSolver, ZetaLayout
 from tmfem.models.com.coordinates import point_coordinates
 from tmfem.models.com.design import StaticDesign, check_membrane_stretched, design_rest_lengths
-from tmfem.models.com.graphs import build_graphs, output_graph, static_graph
+from tmfem.models.com.graphs import BufferedFunction, build_graphs, output_graph, static_graph
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.membrane_modes import build_membrane_basis
 from tmfem.models.com.plant import COMPlant
@@ -146,8 +146,13 @@ class ControlOrientedModel:
         #: point matrix of the output deflections: w = W_out [0; Delta; eta] (eq. 5.1)
         self.W_out = self.membrane.point_matrix(np.array(self.output_points).T, 2) \
             if self.output_points else np.zeros((0, 1 + self.layout.n_delta + self.K))
-        self._outputs_fn = output_graph(system, self.layout, self.W_out, self.K)
         self._delta0 = delta0
+        # the per-step graphs, evaluated in place (BufferedFunction)
+        self._fast = BufferedFunction(self.graphs.fast)
+        self._fast_residual = BufferedFunction(self.graphs.fast_residual)
+        self._fast_mg = BufferedFunction(self.graphs.fast_mg) if self.graphs.fast_mg is not None \
+            else None
+        self._outputs = BufferedFunction(output_graph(system, self.layout, self.W_out, self.K))
 
     # ------------------------------------------------------------------ names
     @property
@@ -185,10 +190,18 @@ class ControlOrientedModel:
         z = self.P @ np.asarray(z, dtype=float)
         return z if zd is None else (z, self.P @ np.asarray(zd, dtype=float))
 
+    def mg_term(self, z, zd) -> np.ndarray:
+        """T_z^T M(x) G of F_hat (eq. 5.28) at (z, z'), modal coordinates, partitioned
+        formulation: the part of F_hat from the constraint accelerations (7.4's uncertainty
+        model of 1-6(D) and 2-3 ignores it)."""
+        if self._fast_mg is None or self.membrane_points is not None:
+            raise InputError("mg_term: expected the partitioned formulation in modal coordinates")
+        return self._fast_mg(np.concatenate([z, zd]))
+
     def matrices(self, z, zd):
         """M_hat, F_hat, B_hat of eq. 5.28 at (z, z'), in the model's coordinates."""
         zm, zdm = self._to_modal(z, zd)
-        flat = self.graphs.fast(np.concatenate([zm, zdm])).full().ravel()
+        flat = self._fast(np.concatenate([zm, zdm]))
         out, k = [], 0
         for shp in self.graphs.fast_shapes:
             n = shp[0] * shp[1]
@@ -211,7 +224,7 @@ class ControlOrientedModel:
         u = self.u0 if u is None else u
         if self.formulation == "partitioned":
             if self.membrane_points is None:
-                return self.graphs.fast_residual(np.concatenate([z, zd, zdd, u])).full().ravel()
+                return self._fast_residual(np.concatenate([z, zd, zdd, u]))
             M, F, B = self.matrices(z, zd)
             return M @ zdd + F + B @ u
         zm, zdm = self._to_modal(z, zd)
@@ -274,7 +287,7 @@ class ControlOrientedModel:
     # ------------------------------------------------------------------ outputs
     def fast_outputs(self, z, with_lengths: bool = False):
         """(w at the output points, node coordinates (3, n_nodes)[, tendon lengths]) for z."""
-        v = self._outputs_fn(self.P @ np.asarray(z, dtype=float)).full().ravel()
+        v = self._outputs(self.P @ np.asarray(z, dtype=float))
         nw = len(self.output_points)
         L = v[nw:nw + self.n_t]
         X = v[nw + self.n_t:].reshape(3, -1, order="F")
