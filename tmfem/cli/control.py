@@ -28,12 +28,14 @@ def configure(parser) -> None:
                         help="alpha_1: closed-loop poles with Re < -alpha_1 (default 7.4's)")
     parser.add_argument("--u-m", type=float, default=None,
                         help="u_m [m] of W_u = I/u_m (default 7.4's: 0.01, 0.02 for 1-6D)")
-    parser.add_argument("--solver", choices=("CLARABEL", "SCS"), default=None,
-                        help="SDP solver (default CLARABEL)")
+    parser.add_argument("--solver", choices=("ARE", "CLARABEL", "SCS"), default=None,
+                        help="how the eliminated LMIs are solved: ARE (default; their Riccati "
+                             "characterisation, bisection on gamma, LMIs re-checked), or the SDP "
+                             "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
+                             "docs/control.md)")
     parser.add_argument("--method", choices=("lmi", "riccati"), default=None,
-                        help="lmi (default): eliminated LMIs of eq. 5.65 (Clarabel); riccati: "
-                             "hinfsyn on the alpha-shifted plant (needed for 2-3-deploy, whose "
-                             "50-state LMI fails in Clarabel; docs/control.md)")
+                        help="lmi (default): eliminated LMIs of eq. 5.65; riccati: python-control "
+                             "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant")
     parser.add_argument("--pbh-tol", type=float, default=None,
                         help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
     parser.add_argument("--save", help="write plant and controller to this .npz")
@@ -56,10 +58,12 @@ def run(args) -> dict:
         if given:
             raise InputError(f"pbh: options {['--' + k.replace('_', '-') for k in given]} apply to "
                              "`tmfem control hinf` only")
+    if args.method == "riccati" and args.solver is not None:
+        raise InputError(f"--solver {args.solver}: applies to --method lmi only, found --method riccati")
     system = system_from_args(args)
     print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
-                        solver=args.solver or "CLARABEL", synthesize=args.action == "hinf",
+                        solver=args.solver or "ARE", synthesize=args.action == "hinf",
                         pbh_tol=args.pbh_tol, method=args.method or "lmi")
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
