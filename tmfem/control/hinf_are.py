@@ -168,3 +168,39 @@ def strict_point(P, *, alpha: float, gamma: float, eps_rel: float = 1e-6):
     R = gamma * np.linalg.inv(X)
     S = gamma * np.linalg.inv(Y)
     return (R + R.T) / 2, (S + S.T) / 2, rho
+
+
+def state_feedback_gamma(A, B1, B2, C1, D11, D12, *, eps: float = 1e-8, rtol: float = 1e-6,
+                         gamma_max: float = 1e8) -> float:
+    """Optimal level of static state feedback u = K x (the state-feedback LMI of
+    :func:`tmfem.control.hinf.hinf_state_feedback`), by bisection on its Riccati test:
+    gamma > ||D11|| (the w -> p feedthrough no static gain changes) and the game Riccati
+    equation of the module docstring (with C1^T C1 + eps I: modes on the imaginary axis
+    that p does not see, such as integrators of a tracking error outside p, leave the
+    unperturbed Hamiltonian without a stabilising solution; gamma(eps) decreases to the
+    optimum as eps -> 0).
+
+    Raises
+    ------
+    InfeasibleController
+        No gamma up to ``gamma_max`` (not stabilisable).
+    """
+    if np.linalg.matrix_rank(D12) < D12.shape[1]:
+        raise InputError(f"state-feedback Riccati test: expected D12 of full column rank "
+                         f"{D12.shape[1]}, found rank {np.linalg.matrix_rank(D12)}")
+
+    def ok(g):
+        return (g > np.linalg.norm(D11, 2) and g > np.linalg.norm(_projector_off(D12) @ D11, 2)
+                and game_riccati(A, B1, B2, C1, D11, D12, g, eps=eps) is not None)
+
+    lo = float(np.linalg.norm(D11, 2)) if D11.size else 0.0
+    hi = max(2.0 * lo, 1e-3)
+    while not ok(hi):
+        lo, hi = hi, 4.0 * hi
+        if hi > gamma_max:
+            raise InfeasibleController(f"state-feedback Riccati test: expected a feasible gamma <= "
+                                       f"{gamma_max:g}, found none (not stabilisable)")
+    while hi - lo > rtol * hi:
+        mid = np.sqrt(lo * hi) if lo > 0 else hi / 2
+        lo, hi = (lo, mid) if ok(mid) else (mid, hi)
+    return float(hi)
