@@ -204,3 +204,32 @@ def state_feedback_gamma(A, B1, B2, C1, D11, D12, *, eps: float = 1e-8, rtol: fl
         mid = np.sqrt(lo * hi) if lo > 0 else hi / 2
         lo, hi = (lo, mid) if ok(mid) else (mid, hi)
     return float(hi)
+
+
+def state_feedback_gain(A, B1, B2, C1, D11, D12, gamma: float, *, eps: float = 1e-8) -> np.ndarray:
+    """A static gain K (u = K x) meeting the state-feedback LMI at ``gamma`` (above the
+    optimum): Y = gamma X^-1 from the game Riccati equation, W from the projection formula
+    of :func:`tmfem.control.hinf._projection_solution` applied to the LMI in W, K = W Y^-1.
+
+    Raises
+    ------
+    InfeasibleController
+        When the Riccati equation has no admissible solution or the LMI in W fails.
+    """
+    from tmfem.control.hinf import _projection_solution
+    n, nw, npp = A.shape[0], B1.shape[1], C1.shape[0]
+    X = game_riccati(A, B1, B2, C1, D11, D12, gamma, eps=eps)
+    if X is None:
+        raise InfeasibleController(f"state-feedback Riccati test: expected a stabilising solution at "
+                                   f"gamma = {gamma:.6g}, found none")
+    Y = gamma * np.linalg.inv(X)
+    Y = (Y + Y.T) / 2
+    Psi = np.block([[A @ Y + Y @ A.T, B1, Y @ C1.T], [B1.T, -gamma * np.eye(nw), D11.T],
+                    [C1 @ Y, D11, -gamma * np.eye(npp)]])
+    G = np.vstack([B2, np.zeros((nw, B2.shape[1])), D12])
+    L = np.hstack([np.eye(n), np.zeros((n, nw + npp))])
+    W, lam = _projection_solution(Psi, G, L)
+    if W is None or not lam < 0:
+        raise InfeasibleController(f"state-feedback LMI at gamma = {gamma:.6g}: expected a gain, found "
+                                   f"largest eigenvalue {lam:.3g}")
+    return np.linalg.solve(Y, W.T).T
