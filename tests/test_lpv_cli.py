@@ -16,6 +16,8 @@ from tmfem.cli import main
     (["control", "lpv", "--alpha", "0.4"], "do not apply"),
     (["control", "lpv", "--solver", "ARE"], "applies to `tmfem control hinf` only"),
     (["control", "pbh", "--preset", "1-4D", "--grid", "2x2"], "apply to `tmfem control lpv` only"),
+    (["control", "hinf", "--preset", "1-4D", "--gamma", "3"], "apply to `tmfem control lpv` only"),
+    (["control", "hinf", "--preset", "1-4D", "--solver", "EIGOPT"], "applies to `tmfem control lpv` only"),
 ])
 def test_lpv_cli_refuses_bad_input(argv, msg, capsys):
     assert main(argv) == 2

@@ -33,11 +33,12 @@ def configure(parser) -> None:
                         help="alpha_1: closed-loop poles with Re < -alpha_1 (default 7.4's)")
     parser.add_argument("--u-m", type=float, default=None,
                         help="u_m [m] of W_u = I/u_m (default 7.4's: 0.01, 0.02 for 1-6D)")
-    parser.add_argument("--solver", choices=("ARE", "CLARABEL", "SCS"), default=None,
-                        help="how the eliminated LMIs are solved: ARE (default; their Riccati "
+    parser.add_argument("--solver", choices=("ARE", "CLARABEL", "SCS", "EIGOPT"), default=None,
+                        help="hinf: how the eliminated LMIs are solved: ARE (default; their Riccati "
                              "characterisation, bisection on gamma, LMIs re-checked), or the SDP "
                              "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
-                             "docs/control.md)")
+                             "docs/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (a feasible "
+                             "point at --gamma, docs/lpv.md)")
     parser.add_argument("--method", choices=("lmi", "riccati"), default=None,
                         help="lmi (default): eliminated LMIs of eq. 5.65; riccati: python-control "
                              "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant")
@@ -75,6 +76,8 @@ def run(args) -> dict:
         if given:
             raise InputError(f"pbh: options {['--' + k.replace('_', '-') for k in given]} apply to "
                              "`tmfem control hinf` only")
+    if args.solver == "EIGOPT":
+        raise InputError("--solver EIGOPT: applies to `tmfem control lpv` only")
     if args.method == "riccati" and args.solver is not None:
         raise InputError(f"--solver {args.solver}: applies to --method lmi only, found --method riccati")
     system = system_from_args(args)

@@ -9,7 +9,7 @@ import numpy as np
 from tmfem.errors import InfeasibleController, InputError
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
-LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only")
+LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma")
 
 
 def configure(parser) -> None:
@@ -19,6 +19,8 @@ def configure(parser) -> None:
     parser.add_argument("--refine", type=int, default=None,
                         help="lpv: verification grid refinement factor (>= 4, default 4)")
     parser.add_argument("--max-iter", type=int, default=None, help="lpv: SDP solver iteration limit")
+    parser.add_argument("--gamma", type=float, default=None,
+                        help="lpv: the fixed level of --solver EIGOPT (required there)")
     parser.add_argument("--bound-only", action="store_true", default=None,
                         help="lpv: only the pointwise state-feedback lower bound of gamma (no SDP)")
 
@@ -68,7 +70,8 @@ def run(args) -> dict:
     if args.bound_only:
         return out
     try:
-        ctrl = synthesize_state_feedback(gp, solver=args.solver or "SCS", max_iter=args.max_iter)
+        ctrl = synthesize_state_feedback(gp, solver=args.solver or "SCS", max_iter=args.max_iter,
+                                         gamma=args.gamma)
     except InfeasibleController as exc:
         raise InfeasibleController(f"{exc} (pointwise state-feedback lower bound of gamma: "
                                    f"{bound.lower_bound:.4g} at rho = {bound.at})") from None
