@@ -38,6 +38,7 @@ def _grid(spec: str, printed: dict):
 
 
 def run(args) -> dict:
+    from tmfem.cli.common import progress_bar
     from tmfem.control.lpv_bounds import pointwise_state_feedback_bound
     from tmfem.control.lpv_plant import com_lpv_plant
     from tmfem.control.lpv_synthesis import interconnection_8_1, synthesize_state_feedback
@@ -62,7 +63,9 @@ def run(args) -> dict:
     th, ps = _grid(args.grid or "6x3", printed)
     rb = np.radians(rate)
     print(f"tmfem control lpv: {preset}: linearising at {th.size * ps.size} grid points", file=sys.stderr)
-    plant = com_lpv_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bounds=[[-rb, rb], [-rb, rb]])
+    with progress_bar(th.size * ps.size, 1, "LPV plant (grid points)") as bar:
+        plant = com_lpv_plant(s, theta=th, psi=ps, bases=deployment_bases(s),
+                              rate_bounds=[[-rb, rb], [-rb, rb]], progress=bar)
     gp = interconnection_8_1(plant, tracked=s.q_names)
     bound = pointwise_state_feedback_bound(gp)
     out = {"action": "lpv", "preset": preset, "grid": list(plant.grid_shape), "rate_bound_deg": rate,
@@ -76,8 +79,9 @@ def run(args) -> dict:
         raise InfeasibleController(f"{exc} (pointwise state-feedback lower bound of gamma: "
                                    f"{bound.lower_bound:.4g} at rho = {bound.at})") from None
     fine_axes = plant.refined(refine)
-    fine = com_lpv_plant(s, theta=fine_axes[0], psi=fine_axes[1], bases=deployment_bases(s),
-                         rate_bounds=plant.rate_bounds)
+    with progress_bar(fine_axes[0].size * fine_axes[1].size, 1, "verification plant (grid points)") as bar:
+        fine = com_lpv_plant(s, theta=fine_axes[0], psi=fine_axes[1], bases=deployment_bases(s),
+                             rate_bounds=plant.rate_bounds, progress=bar)
     v = verify(ctrl, interconnection_8_1(fine, tracked=s.q_names))
     if args.save:
         ctrl.save(args.save)

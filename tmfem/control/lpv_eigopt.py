@@ -43,7 +43,7 @@ def _points(gp, T, c_of):
     return out
 
 
-def _start(pts, gamma, eps):
+def _start(pts, gamma, eps, centre: int):
     """Pointwise Riccati solutions at gamma, the balancing L and the affine fit (balanced)."""
     Pi, Qi = [], []
     for p in pts:
@@ -57,7 +57,7 @@ def _start(pts, gamma, eps):
         Y = (Y + Y.T) / 2
         Pi.append(Y)
         Qi.append(state_feedback_gain(*args, gamma, eps=eps) @ Y)
-    L = np.linalg.cholesky(Pi[len(Pi) // 2])
+    L = np.linalg.cholesky(Pi[centre])
     Li = np.linalg.inv(L)
     for p in pts:
         p["A"], p["B1"], p["B2"], p["C1"] = Li @ p["A"] @ L, Li @ p["B1"], Li @ p["B2"], p["C1"] @ L
@@ -97,7 +97,8 @@ def feasible_point(gp, gamma: float, *, T, c_of, dvs, t_schedule=(1e-3, 1e-4, 3e
     """
     t0 = time.perf_counter()
     pts = _points(gp, T, c_of)
-    L, P0, Q0 = _start(pts, gamma, eps)
+    shp = gp.grid_shape
+    L, P0, Q0 = _start(pts, gamma, eps, int(np.ravel_multi_index(tuple(k // 2 for k in shp), shp)))
     nb, n, nu = P0.shape[0], P0.shape[1], Q0.shape[1]
     nP = nb * n * n
     ms = _matrices(pts, dvs, P0, Q0, gamma)
@@ -118,7 +119,10 @@ def feasible_point(gp, gamma: float, *, T, c_of, dvs, t_schedule=(1e-3, 1e-4, 3e
         nev[0] += 1
         P, Q = unpack(z)
         ms = _matrices(pts, dvs, P, Q, gamma)
-        eig = [np.linalg.eigh(M / s) for (*_, M), s in zip(ms, scale)]
+        try:
+            eig = [np.linalg.eigh(M / s) for (*_, M), s in zip(ms, scale)]
+        except np.linalg.LinAlgError:                   # a line-search trial far out: rejected
+            return np.inf, np.zeros_like(z)
         top = max(e[0][-1] for e in eig)
         tot = sum(np.exp((e[0] - top) / t).sum() for e in eig)
         gP, gQ = np.zeros_like(P), np.zeros_like(Q)
