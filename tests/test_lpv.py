@@ -133,3 +133,18 @@ def test_off_grid_verification_passes_and_refuses_a_wrong_plant():
     with pytest.raises(InfeasibleController, match="fails its verification"):
         verify(ctrl, bad)
     assert not verify(ctrl, bad, allow_failure=True).passed
+
+
+def test_eigenvalue_optimisation_finds_a_feasible_point_above_the_optimum_only():
+    # the conic optimum (Clarabel) of the oscillator; EIGOPT at a fixed level above it returns a
+    # controller whose re-computed LMIs are negative and that passes the off-grid check, below
+    # it none (a feasibility method cannot beat the optimum)
+    pl = oscillator_plant()
+    g_opt = synthesize_state_feedback(gp_of(pl)).gamma
+    r = synthesize_state_feedback(gp_of(pl), solver="EIGOPT", gamma=1.3 * g_opt)
+    assert r.solver == "EIGOPT" and r.gamma == 1.3 * g_opt and r.max_lmi_eig < 0 and r.min_P_eig > 0
+    assert verify(r, gp_of(pl.resampled(pl.refined(4)))).passed
+    with pytest.raises(InfeasibleController):
+        synthesize_state_feedback(gp_of(pl), solver="EIGOPT", gamma=0.97 * g_opt)
+    with pytest.raises(InputError, match="fixed level"):
+        synthesize_state_feedback(gp_of(pl), solver="EIGOPT")

@@ -2,25 +2,30 @@
 
 ``tmfem control hinf --preset 1-4D [--alpha 0.5] [--save k.npz] [--plot out.png] [--json]``:
 H-infinity output feedback by LMIs with alpha-stability; ``tmfem control pbh --preset ...``:
-the PBH tests alone; ``tmfem control recheck k.npz``: re-verify a saved design.
+the PBH tests alone; ``tmfem control recheck k.npz``: re-verify a saved design;
+``tmfem control lpv --preset 2-3-lpv [--grid 6x3] [--rate-bound-deg 10] [--save lpv.npz]``: the
+gridded LPV state feedback of ch. 8 (:mod:`tmfem.cli.control_lpv`).
 """
 from __future__ import annotations
 
 import sys
 
+from tmfem.cli import control_lpv
 from tmfem.cli.common import add_system_args, system_from_args
 from tmfem.errors import InputError
 
 NAME = "control"
-HELP = "linear control at a deployed configuration: PBH tests, H-infinity LMI synthesis (7.3-7.4)"
+HELP = ("linear control: PBH tests, H-infinity LMI synthesis at a deployed configuration (7.3-7.4), "
+        "gridded LPV state feedback (ch. 8)")
 
 _HINF_ONLY = ("alpha", "u_m", "save", "plot", "solver", "method")
 
 
 def configure(parser) -> None:
-    parser.add_argument("action", choices=("hinf", "pbh", "recheck"),
+    parser.add_argument("action", choices=("hinf", "pbh", "recheck", "lpv"),
                         help="hinf: synthesis; pbh: controllability/observability only; "
-                             "recheck FILE.npz: re-verify a saved design")
+                             "recheck FILE.npz: re-verify a saved design; lpv: gridded LPV state "
+                             "feedback with rate bounds (ch. 8)")
     add_system_args(parser)
     parser.add_argument("--membrane-modes", type=int, default=None,
                         help="K (default 7.4's: 3 for 1-4D, 5 for 1-6D, 4 for 2-3-deploy)")
@@ -28,19 +33,34 @@ def configure(parser) -> None:
                         help="alpha_1: closed-loop poles with Re < -alpha_1 (default 7.4's)")
     parser.add_argument("--u-m", type=float, default=None,
                         help="u_m [m] of W_u = I/u_m (default 7.4's: 0.01, 0.02 for 1-6D)")
-    parser.add_argument("--solver", choices=("CLARABEL", "SCS"), default=None,
-                        help="SDP solver (default CLARABEL)")
+    parser.add_argument("--solver", choices=("ARE", "CLARABEL", "SCS", "EIGOPT"), default=None,
+                        help="hinf: how the eliminated LMIs are solved: ARE (default; their Riccati "
+                             "characterisation, bisection on gamma, LMIs re-checked), or the SDP "
+                             "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
+                             "docs/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (a feasible "
+                             "point at --gamma, docs/lpv.md)")
     parser.add_argument("--method", choices=("lmi", "riccati"), default=None,
-                        help="lmi (default): eliminated LMIs of eq. 5.65 (Clarabel); riccati: "
-                             "hinfsyn on the alpha-shifted plant (needed for 2-3-deploy, whose "
-                             "50-state LMI fails in Clarabel; docs/control.md)")
+                        help="lmi (default): eliminated LMIs of eq. 5.65; riccati: python-control "
+                             "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant")
     parser.add_argument("--pbh-tol", type=float, default=None,
                         help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
     parser.add_argument("--save", help="write plant and controller to this .npz")
     parser.add_argument("--plot", help="write the closed-loop analysis figure (PNG)")
+    control_lpv.configure(parser)
 
 
 def run(args) -> dict:
+    if args.action == "lpv":
+        given = [k for k in ("alpha", "u_m", "plot", "method", "membrane_modes", "pbh_tol")
+                 if getattr(args, k) is not None]
+        if given or args.as_printed:
+            raise InputError(f"lpv: options {['--' + k.replace('_', '-') for k in given] or ['--as-printed']} "
+                             "do not apply")
+        return control_lpv.run(args)
+    lpv_given = [k for k in control_lpv.LPV_ONLY if getattr(args, k) is not None]
+    if lpv_given:
+        raise InputError(f"{args.action}: options {['--' + k.replace('_', '-') for k in lpv_given]} apply "
+                         "to `tmfem control lpv` only")
     if args.action == "recheck":
         from tmfem.control.design import recheck
         if args.spec is None or args.preset is not None:
@@ -56,10 +76,14 @@ def run(args) -> dict:
         if given:
             raise InputError(f"pbh: options {['--' + k.replace('_', '-') for k in given]} apply to "
                              "`tmfem control hinf` only")
+    if args.solver == "EIGOPT":
+        raise InputError("--solver EIGOPT: applies to `tmfem control lpv` only")
+    if args.method == "riccati" and args.solver is not None:
+        raise InputError(f"--solver {args.solver}: applies to --method lmi only, found --method riccati")
     system = system_from_args(args)
     print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
-                        solver=args.solver or "CLARABEL", synthesize=args.action == "hinf",
+                        solver=args.solver or "ARE", synthesize=args.action == "hinf",
                         pbh_tol=args.pbh_tol, method=args.method or "lmi")
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
@@ -79,6 +103,8 @@ def run(args) -> dict:
 
 
 def format_text(r: dict) -> str:
+    if r["action"] == "lpv":
+        return control_lpv.format_text(r)
     if r["action"] == "recheck":
         return (f"{r['file']}: gamma = {r['gamma']:.6g}, ||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}, "
                 f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} (alpha_1 = {r['alpha']:g}): ok")

@@ -180,10 +180,9 @@ def _elimination_problem(P: GeneralizedPlant, alpha: float, eps: float, *, gamma
                          bound=None, regularization: float = 0.0, coupling_weight: float = 1.0):
     """cvxpy problem of the eliminated H-infinity LMIs in (R, S, gamma) for A + alpha I."""
     import cvxpy as cp
-    n, nw, nu, np_, ny = (P.sizes[k] for k in ("n", "nw", "nu", "np", "ny"))
+    n = P.A.shape[0]
     Aa = P.A + alpha * np.eye(n)
-    NR = null_basis(np.hstack([P.B2.T, P.D12.T]))           # (n + np) x k_R
-    NS = null_basis(np.hstack([P.C2, P.D21]))               # (n + nw) x k_S
+    NR, NS, Bw, Cp, _ = _elimination_bases(P)
     R = cp.Variable((n, n), symmetric=True)
     S = cp.Variable((n, n), symmetric=True)
     g = cp.Variable() if gamma_fixed is None else gamma_fixed
@@ -192,11 +191,6 @@ def _elimination_problem(P: GeneralizedPlant, alpha: float, eps: float, *, gamma
     t = cp.Variable() if gamma_fixed is not None else None
     marg = eps if t is None else t
     cons, sizes = [], {}
-    # channel compression (exact): w enters the primal LMI only through [B1; D11], p the dual
-    # one only through [C1, D11]; a congruence with an orthogonal basis splits off the
-    # directions outside their ranges as -g I blocks, which hold for any g > 0.
-    Bw = _range_basis(np.vstack([P.B1, P.D11]))               # nw x r_w
-    Cp = _range_basis(np.hstack([P.C1, P.D11]).T)             # np x r_p
     B1c, D11w = P.B1 @ Bw, P.D11 @ Bw                         # w -> Bw w_c
     C1c, D11p = Cp.T @ P.C1, Cp.T @ P.D11                     # p_c = Cp^T p
     rw, rp = Bw.shape[1], Cp.shape[1]
@@ -228,6 +222,25 @@ def _elimination_problem(P: GeneralizedPlant, alpha: float, eps: float, *, gamma
     obj = (cp.Minimize(g + regularization * (cp.trace(R) + cp.trace(S)) / (2 * n))
            if gamma_fixed is None else cp.Maximize(t))
     return cp.Problem(obj, cons), R, S, g, sizes, (NR, NS)
+
+
+def _elimination_bases(P: GeneralizedPlant):
+    """N_R = ker [B2^T, D12^T], N_S = ker [C2, D21] and the channel compressions Bw, Cp
+    (orthonormal bases of the ranges of [B1; D11]^T and [C1, D11]): w enters the primal LMI
+    only through [B1; D11], p the dual one only through [C1, D11], so an orthogonal
+    congruence splits off the other directions as -g I blocks (exact, they hold for any
+    g > 0). Returns (N_R, N_S, Bw, Cp, LMI sizes)."""
+    NR = null_basis(np.hstack([P.B2.T, P.D12.T]))           # (n + np) x k_R
+    NS = null_basis(np.hstack([P.C2, P.D21]))               # (n + nw) x k_S
+    Bw = _range_basis(np.vstack([P.B1, P.D11]))               # nw x r_w
+    Cp = _range_basis(np.hstack([P.C1, P.D11]).T)             # np x r_p
+    sizes = {}
+    if NR.shape[1]:
+        sizes["primal (N_R)"] = NR.shape[1] + Bw.shape[1]
+    if NS.shape[1]:
+        sizes["dual (N_S)"] = NS.shape[1] + Cp.shape[1]
+    sizes["coupling [R I; I S]"] = 2 * P.A.shape[0]
+    return NR, NS, Bw, Cp, sizes
 
 
 def _balance_RS(P: GeneralizedPlant, R, S):
@@ -328,15 +341,17 @@ def _controller_from_RS(P: GeneralizedPlant, alpha: float, R, S, gamma: float):
 def _projection_solution(Psi, G, L, *, factor: float = 2.0):
     """One solution Theta of  Psi + G Theta L + (G Theta L)^T < 0  (G full column rank, L full
     row rank), by the explicit formula of Skelton, Iwasaki & Grigoriadis (1998, Thm. 2.3.12)
-    with the free contraction L = 0 and R^-1 = rho I:
+    with the free contraction L = 0:
 
-        Theta = -rho G^T Phi L^T (L Phi L^T)^-1,   Phi = (rho G G^T - Psi)^-1 > 0.
+        Theta = -Rs^-1 G^T Phi L^T (L Phi L^T)^-1,   Phi = (G Rs^-1 G^T - Psi)^-1 > 0.
 
-    rho is ``factor`` times the smallest admissible value, computed from the Schur
-    complement in the coordinates of a QR factorisation of G (G = Q [G1; 0]), so that rho
-    G G^T does not swamp Psi in floating point. Returns (Theta, max eigenvalue of the LMI);
-    (None, inf) when Psi is not negative definite on the null space of G^T (the elimination
-    condition fails in floating point).
+    The free weight is chosen in the coordinates of a QR factorisation G = Q [G1; 0]:
+    Rs^-1 = rho G1^-1 G1^-T, so that G Rs^-1 G^T = rho Q diag(I, 0) Q^T and rho is compared
+    with Psi itself (rho = ``factor`` x the largest eigenvalue of the Schur complement of
+    Q^T Psi Q on the range of G), not with Psi seen through an ill-conditioned G (a weight
+    rho I makes rho G G^T swamp Psi in floating point when G is badly scaled). Returns
+    (Theta, max eigenvalue of the LMI); (None, inf) when Psi is not negative definite on the
+    null space of G^T (the elimination condition fails in floating point).
     """
     import scipy.linalg as sla
     m = G.shape[1]
@@ -348,21 +363,17 @@ def _projection_solution(Psi, G, L, *, factor: float = 2.0):
     if P22.size and np.linalg.eigvalsh(P22)[-1] >= 0:
         return None, np.inf
     Z = Pt[:m, :m] - (Pt[:m, m:] @ np.linalg.solve(P22, Pt[m:, :m]) if P22.size else 0.0)
-    G1i = np.linalg.inv(G1)
-    W = G1i @ Z @ G1i.T
-    rho_min = max(float(np.linalg.eigvalsh((W + W.T) / 2)[-1]), 0.0)
-    scale = max(float(np.abs(np.linalg.eigvalsh((W + W.T) / 2)).max()), 1e-300)
-    rho = factor * rho_min + 1e-6 * scale
+    ez = np.linalg.eigvalsh((Z + Z.T) / 2)
+    rho = factor * max(float(ez[-1]), 0.0) + 1e-6 * max(float(np.abs(ez).max()), 1e-300)
     Mt = -Pt.copy()
-    Mt[:m, :m] += rho * G1 @ G1.T
+    Mt[:m, :m] += rho * np.eye(m)
     try:
         Lc = sla.cho_factor(Mt)
     except np.linalg.LinAlgError:
         return None, np.inf
     Lq = L @ Q                                                   # L in the QR coordinates
-    PhiLt = sla.cho_solve(Lc, Lq.T)                              # Phi L^T (Q coordinates)
-    Gq = Q.T @ G
-    Th = -rho * np.linalg.solve(Lq @ PhiLt, (Gq.T @ PhiLt).T).T
+    PhiLt = sla.cho_solve(Lc, Lq.T)                              # Phi_q L_q^T
+    Th = -rho * sla.solve_triangular(G1, np.linalg.solve(Lq @ PhiLt, PhiLt[:m].T).T)
     GTL = G @ Th @ L
     lam = max_eig(Psi + GTL + GTL.T)
     return Th, lam
@@ -404,6 +415,15 @@ def verify(plant: GeneralizedPlant, controller, *, gamma: float, alpha: float,
 def _minimise_gamma(plant, *, alpha, solver, eps, regularization, scale, residual_tol):
     """Stage 1 of :func:`hinf_lmi`: minimise gamma over the eliminated LMIs (eq. 5.65 form)."""
     Ps, t = plant.scaled() if scale else (plant, np.ones(plant.A.shape[0]))
+    if solver.upper() == "ARE":
+        from tmfem.control import hinf_are
+        NR, NS, _, _, sizes = _elimination_bases(Ps)
+        g_opt, steps, dt = hinf_are.minimise_gamma(Ps, alpha=alpha)
+        n = Ps.A.shape[0]
+        rep = SolverReport(solver="ARE", status=f"optimal (Riccati bisection, {steps} steps)",
+                           solve_time_s=dt, n_variables=n * (n + 1) + 1, lmi_sizes=sizes,
+                           iterations=steps)
+        return g_opt, rep, (Ps, None, None, sizes, NR, NS, max(1.0, g_opt))
     prob, R, S, g, sizes, (NR, NS) = _elimination_problem(Ps, alpha, eps, regularization=regularization)
     rep = solve(prob, solver=solver, what="H-infinity LMIs (eliminated, eq. 5.65)",
                 lmi_sizes=sizes, accept_inaccurate=True)
@@ -448,8 +468,10 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
         Eq. 5.62 (D22 = 0).
     alpha : float
         alpha_1 >= 0: closed-loop poles with Re < -alpha_1 (7.3).
-    solver : {"CLARABEL", "SCS"}
-        SDP solver (SCS: first order, less accurate; see docs/control.md).
+    solver : {"CLARABEL", "SCS", "ARE"}
+        SDP solver (SCS: first order, less accurate; see docs/control.md), or "ARE": the
+        same LMIs solved through their Riccati characterisation (regular plants only,
+        :mod:`tmfem.control.hinf_are`; the LMIs are re-evaluated at its point).
     eps : float
         Strictness margin of the LMIs (F <= -eps I), in the units of the scaled plant.
     gamma_relax : float
@@ -482,8 +504,16 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
         plant, alpha=alpha, solver=solver, eps=eps, regularization=regularization, scale=scale,
         residual_tol=residual_tol)
     gamma = g_opt * (1 + gamma_relax)
-    (Ak, Bk, Ck, Dk), cond, lam = _controller_from_RS(Ps, alpha, Rv, Sv, gamma)
-    if not (np.isfinite(cond) and cond <= max_cond and lam < 0):
+    if rep.solver == "ARE":
+        Rv, Sv, (Ak, Bk, Ck, Dk), cond, lam = _are_point(Ps, alpha, gamma, max_cond)
+        rep.residuals = _lmi_residuals(Ps, alpha, Rv, Sv, gamma, 0.0, NR, NS)
+        scale_RS = max(1.0, gamma, np.abs(Rv).max(), np.abs(Sv).max())
+        if max(rep.residuals.values()) > residual_tol * scale_RS:
+            raise InfeasibleController(f"H-infinity LMIs (Riccati point): expected every LMI "
+                                       f"satisfied, found residuals {rep.residuals}")
+    else:
+        (Ak, Bk, Ck, Dk), cond, lam = _controller_from_RS(Ps, alpha, Rv, Sv, gamma)
+    if rep.solver != "ARE" and not (np.isfinite(cond) and cond <= max_cond and lam < 0):
         log.info("status %s, cond(I - RS) = %.3g, BRL residual %.3g: re-solving at gamma = "
                  "%.6g for a strictly feasible, better-conditioned R, S", rep.status, cond, lam, gamma)
         # state coordinates in which R and S are equal and diagonal (the balancing of
@@ -515,6 +545,38 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
                       plant=plant, kind="output feedback (eliminated LMIs)", R=Rv, S=Sv,
                       cond_I_minus_RS=cond, operating_point=dict(operating_point or {}),
                       gamma_lmi=g_opt)
+
+
+def _are_point(P, alpha, gamma, max_cond, eps_ladder=(1e-3, 1e-4, 1e-5, 1e-6, 1e-2)):
+    """(R, S) from the perturbed Riccati equations (:func:`tmfem.control.hinf_are.strict_point`)
+    and the recovered controller: the first perturbation of ``eps_ladder`` whose recovery
+    gives a negative closed-loop bounded real lemma with cond(I - RS) <= ``max_cond``, else
+    the first with a negative one. Returns (R, S, (A_k, B_k, C_k, D_k), cond, lam), R and S
+    in the coordinates of ``P``."""
+    from tmfem.control.hinf_are import strict_point
+    found, why = [], []
+    for e in eps_ladder:
+        try:
+            R, S, _ = strict_point(P, alpha=alpha, gamma=gamma, eps_rel=e)
+        except InfeasibleController as exc:
+            why.append(f"eps {e:g}: {exc}")
+            continue
+        # recovered in the coordinates where R = S is diagonal (the controller, a map y -> u,
+        # does not depend on the plant's state coordinates)
+        Pb, Rb, Sb = _balance_RS(P, R, S)
+        K, cond, lam = _controller_from_RS(Pb, alpha, Rb, Sb, gamma)
+        why.append(f"eps {e:g}: cond(I - RS) {cond:.3g}, BRL {lam:.3g}")
+        if lam < 0:
+            found.append((R, S, K, cond, lam))
+            if cond <= max_cond:
+                break
+    if not found:
+        raise InfeasibleController(f"controller recovery (eq. 5.67) from the Riccati points at "
+                                   f"gamma = {gamma:.6g}: expected a negative closed-loop bounded "
+                                   f"real lemma, found {'; '.join(why)}")
+    log.info("Riccati points of the eliminated LMIs: %s", "; ".join(why))
+    ok = [f for f in found if f[3] <= max_cond]
+    return ok[0] if ok else min(found, key=lambda f: f[3])
 
 
 def _controller_ss(plant, Ak, Bk, Ck, Dk):

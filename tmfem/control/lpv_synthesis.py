@@ -242,7 +242,7 @@ def _sym_basis(n: int) -> sp.csr_matrix:
 
 def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", margin: float = 1e-6,
                               scale: bool = True, accuracy: float = 1e-5,
-                              max_iter: int | None = None) -> LPVStateFeedback:
+                              max_iter: int | None = None, gamma: float | None = None) -> LPVStateFeedback:
     """Minimise gamma subject to eqs. 5.95-5.96 at every grid point and rate vertex (8.3).
 
     The LMIs are written directly as a sparse conic program (vec(M) = vec(M_0) + G x with
@@ -252,9 +252,14 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
 
     Parameters
     ----------
-    solver : {"CLARABEL", "SCS"}
+    solver : {"CLARABEL", "SCS", "EIGOPT"}
         Interior-point Clarabel (accurate, memory grows with the square of each LMI's svec
         size) or first-order SCS; when Clarabel fails or is inaccurate, SCS is tried.
+        "EIGOPT": a feasible point at the given ``gamma`` by eigenvalue optimisation
+        (:mod:`tmfem.control.lpv_eigopt`; for plants too large for the conic solvers),
+        accepted only when every re-computed LMI is negative.
+    gamma : float, optional
+        The fixed level of "EIGOPT" (required there, refused by the other solvers).
     margin : float
         Strictness: LMI <= -margin I and P >= margin I (in the scaled coordinates).
     scale : bool
@@ -268,8 +273,11 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
     InfeasibleController
         Infeasible, unbounded or inaccurate solve (status and residuals in the message).
     """
-    if solver not in ("CLARABEL", "SCS"):
-        raise InputError(f"solver: expected 'CLARABEL' or 'SCS', found {solver!r}")
+    if solver not in ("CLARABEL", "SCS", "EIGOPT"):
+        raise InputError(f"solver: expected 'CLARABEL', 'SCS' or 'EIGOPT', found {solver!r}")
+    if (gamma is None) == (solver == "EIGOPT"):
+        raise InputError(f"gamma: expected a fixed level with solver EIGOPT only, found gamma = {gamma!r} "
+                         f"with solver {solver}")
     t0 = time.perf_counter()
     shp = gp.grid_shape
     n, nw, nu, npp = (gp.sizes[k] for k in ("n_x", "n_w", "n_u", "n_p"))
@@ -290,6 +298,15 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
              "lmis": int(np.prod(shp)) * len(verts), "lmi_size": N, "n_x": n, "n_w": nw,
              "n_u": nu, "n_p": npp, "decision_variables": nvar}
     log.info("LPV synthesis: %s", sizes)
+    if solver == "EIGOPT":
+        from tmfem.control.lpv_eigopt import feasible_point
+        t1 = time.perf_counter()
+        Ps, Qs, _, nev = feasible_point(
+            gp, gamma, T=T, c_of=lambda r: np.concatenate([[1.0], ((r - centre) / half)[varying]]),
+            dvs=[np.concatenate([[0.0], (v / half)[varying]]) for v in verts], max_iter=max_iter or 150)
+        return _accepted(gp, [Tm_back(P, T) for P in Ps], [Q * T[None, :] for Q in Qs], gamma, T, verts,
+                         centre, half, varying, solver="EIGOPT", status=f"feasible point ({nev} evaluations)",
+                         solve=time.perf_counter() - t1, build=t1 - t0, sizes=sizes, tol=-1e-300)
 
     def pcol(k):
         return k * (ms + mq)
@@ -298,7 +315,6 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
         B = block.tocoo()
         return sp.coo_matrix((B.data, (B.row, B.col + col0)), shape=(B.shape[0], nvar))
 
-    data, blocks_by_solver = [], {}
     lmi_parts = []          # (G, m0) per LMI, solver independent
     psd_parts = []
     for idx in np.ndindex(*shp):
@@ -309,7 +325,6 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
         B2 = Ti[:, None] * gp.B2[idx]
         C1 = gp.C1[idx] * T[None, :]
         D11, D12 = gp.D11[idx], gp.D12[idx]
-        data.append((idx, c))
         LA = (sp.kron(In, sp.csr_matrix(A)) + sp.kron(sp.csr_matrix(A), In)) @ S     # A P + P A^T
         LB = sp.kron(In, sp.csr_matrix(B2))                                           # B2 Q
         LC = sp.kron(In, sp.csr_matrix(C1)) @ S                                       # C1 P
@@ -367,31 +382,51 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
         g = float(x[-1])
         Pv = [Tm_back(_unsym(x[pcol(k):pcol(k) + ms], n), T) for k in range(nb)]
         Qv = [x[pcol(k) + ms:pcol(k) + ms + mq].reshape(nu, n, order="F") * T[None, :] for k in range(nb)]
-        worst, minP = -np.inf, np.inf
-        for idx, c in data:
-            P = sum(ck * Pk for ck, Pk in zip(c, Pv)); Q = sum(ck * Qk for ck, Qk in zip(c, Qv))
-            minP = min(minP, np.linalg.eigvalsh((P * Ti[:, None] * Ti[None, :])).min())
-            for v in verts:
-                dP = sum((v[k] / half[k]) * Pv[1 + j] for j, k in enumerate(varying)) if varying \
-                    else np.zeros((n, n))
-                M = lmi_matrix(A=gp.A[idx], B1=gp.B1[idx], B2=gp.B2[idx], C1=gp.C1[idx],
-                               D11=gp.D11[idx], D12=gp.D12[idx], P=P, Q=Q, dP=dP, gamma=g)
-                worst = max(worst, _max_eig_congruent(M, T, nw + npp))
-        if worst > accuracy * scale_data or minP <= 0:
-            last = (f"{s}: status {status} but the LMI re-computed from the solution has "
-                    f"largest eigenvalue {worst:.3e} (expected < {accuracy * scale_data:.3e}) and "
-                    f"min eig P {minP:.3e} (expected > 0)")
+        try:
+            return _accepted(gp, Pv, Qv, g, T, verts, centre, half, varying, solver=s, status=status,
+                             solve=solve, build=build, sizes=sizes, tol=accuracy * scale_data)
+        except InfeasibleController as exc:
+            last = f"{s}: status {status} but {exc}"
             log.warning("LPV synthesis: %s", last)
-            continue
-        log.info("LPV synthesis: gamma = %.6g (%s, %s, %.1f s)", g, s, status, solve)
-        return LPVStateFeedback(gamma=g, P=Pv, Q=Qv, centre=centre, half_width=half, varying=varying,
-                                axes=[a.copy() for a in gp.axes], parameter_names=list(gp.parameter_names),
-                                rate_bounds=gp.rate_bounds.copy(), state_names=list(gp.state_names),
-                                solver=s, status=status, solve_time=solve, build_time=build,
-                                sizes=sizes, max_lmi_eig=float(worst), min_P_eig=float(minP))
     raise InfeasibleController(f"LPV state-feedback synthesis (eqs. 5.95-5.96) on a {shp} grid with "
                                f"{len(verts)} rate vertices failed: {last}; expected an optimal, "
                                "accurate solution")
+
+
+def _accepted(gp, Pv, Qv, g, T, verts, centre, half, varying, *, solver, status, solve, build, sizes,
+              tol) -> LPVStateFeedback:
+    """The result, after re-computing every LMI (eq. 5.95) and P(rho_i) from P_k, Q_k in
+    floating point (largest eigenvalue in the scaled coordinates <= ``tol``, P > 0).
+
+    Raises
+    ------
+    InfeasibleController
+        When an LMI or P fails.
+    """
+    Ti = 1.0 / T
+    n, nw, npp = gp.sizes["n_x"], gp.sizes["n_w"], gp.sizes["n_p"]
+    worst, minP = -np.inf, np.inf
+    for idx in np.ndindex(*gp.grid_shape):
+        rho = np.array([a[i] for a, i in zip(gp.axes, idx)])
+        c = np.concatenate([[1.0], ((rho - centre) / half)[varying]])
+        P = sum(ck * Pk for ck, Pk in zip(c, Pv)); Q = sum(ck * Qk for ck, Qk in zip(c, Qv))
+        minP = min(minP, np.linalg.eigvalsh((P * Ti[:, None] * Ti[None, :])).min())
+        for v in verts:
+            dP = sum((v[k] / half[k]) * Pv[1 + j] for j, k in enumerate(varying)) if varying \
+                else np.zeros((n, n))
+            M = lmi_matrix(A=gp.A[idx], B1=gp.B1[idx], B2=gp.B2[idx], C1=gp.C1[idx],
+                           D11=gp.D11[idx], D12=gp.D12[idx], P=P, Q=Q, dP=dP, gamma=g)
+            worst = max(worst, _max_eig_congruent(M, T, nw + npp))
+    if not (worst <= tol and minP > 0):
+        raise InfeasibleController(f"the LMI re-computed from the solution has largest eigenvalue "
+                                   f"{worst:.3e} (expected <= {tol:.3e}) and min eig P {minP:.3e} "
+                                   "(expected > 0)")
+    log.info("LPV synthesis: gamma = %.6g (%s, %s, %.1f s)", g, solver, status, solve)
+    return LPVStateFeedback(gamma=g, P=Pv, Q=Qv, centre=centre, half_width=half, varying=varying,
+                            axes=[a.copy() for a in gp.axes], parameter_names=list(gp.parameter_names),
+                            rate_bounds=gp.rate_bounds.copy(), state_names=list(gp.state_names),
+                            solver=solver, status=status, solve_time=solve, build_time=build,
+                            sizes=sizes, max_lmi_eig=float(worst), min_P_eig=float(minP))
 
 
 def _unsym(p: np.ndarray, n: int) -> np.ndarray:

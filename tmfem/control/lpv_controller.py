@@ -1,0 +1,74 @@
+"""The scheduled LPV state feedback of ch. 8 as a simulation controller (8.3-8.4).
+
+u = u_e(rho) + K(rho) [x_z - x_e(rho); xi],   xi' = q_d(t) - q,   K(rho) = Q(rho) P(rho)^-1
+
+(eq. 5.99 with the integral of the tracking error of eq. 5.98 as the extra states of
+Fig. 8.1). The parameters rho are read from the measured outputs (8.4 schedules on the
+measured theta_13, psi_13) and held inside the design grid; u_e(rho), x_e(rho) are the
+equilibria of the grid points (:class:`~tmfem.control.lpv_plant.GriddedLPV`) interpolated
+multilinearly. Protocol of :mod:`tmfem.simulation.controllers`: the integrator advances by
+forward Euler over the sample time dt (zero-order hold of q_d - q).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tmfem.control.lpv_plant import GriddedLPV
+from tmfem.control.lpv_synthesis import LPVStateFeedback
+from tmfem.errors import InputError
+
+
+class LPVController:
+    """Scheduled state feedback with integral action (module docstring).
+
+    Parameters
+    ----------
+    design : LPVStateFeedback
+        P_k, Q_k of eq. 5.99 over the states [x_z, xi] (``n_x + n_q``).
+    plant : GriddedLPV
+        The design plant: grid, equilibria x_e, u_e and the state order of x_z.
+    state_index, q_index, rho_index : sequences of int
+        Positions in the measured output vector y of x_z (in ``plant.state_names`` order), of
+        the tracked coordinates q (in the order of the integrators) and of the scheduling
+        parameters rho (in ``plant.parameter_names`` order).
+    reference : callable
+        t -> q_d(t), the tracked reference (absolute values, as q in y).
+    """
+
+    def __init__(self, design: LPVStateFeedback, plant: GriddedLPV, *, state_index, q_index, rho_index,
+                 reference, name: str = "lpv"):
+        self.design, self.plant, self.name = design, plant, name
+        self.state_index = np.asarray(state_index, dtype=int)
+        self.q_index = np.asarray(q_index, dtype=int)
+        self.rho_index = np.asarray(rho_index, dtype=int)
+        n, nq = plant.nx, self.q_index.size
+        nk = design.P[0].shape[0]
+        if self.state_index.size != n or nk != n + nq or self.rho_index.size != len(plant.axes):
+            raise InputError(f"LPV controller: expected {n} state, {nk - n} tracked and {len(plant.axes)} "
+                             f"scheduling indices, found {self.state_index.size}, {nq} and "
+                             f"{self.rho_index.size}")
+        if not callable(reference):
+            raise InputError("LPV controller: expected the reference q_d(t) as a callable")
+        self.reference = reference
+        self._lo = np.array([a[0] for a in plant.axes])
+        self._hi = np.array([a[-1] for a in plant.axes])
+        self._dt = None
+
+    def rho(self, y) -> np.ndarray:
+        """Scheduling parameters from y, held inside the design grid."""
+        return np.clip(np.asarray(y, dtype=float)[self.rho_index], self._lo, self._hi)
+
+    def reset(self, t0, y0, dt):
+        if not (np.isfinite(dt) and dt > 0):
+            raise InputError(f"LPV controller: expected a sample time dt > 0, found {dt!r}")
+        self._dt = float(dt)
+        return np.zeros(self.q_index.size)
+
+    def output(self, t, y, xc):
+        y = np.asarray(y, dtype=float)
+        r = self.rho(y)
+        x = np.concatenate([y[self.state_index] - self.plant.interpolate("x_e", r), xc])
+        return self.plant.interpolate("u_e", r) + self.design.gain(r) @ x
+
+    def update(self, t, y, xc):
+        return xc + self._dt * (np.asarray(self.reference(t), dtype=float) - np.asarray(y)[self.q_index])
