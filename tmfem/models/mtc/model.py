@@ -234,16 +234,18 @@ class MTCModel:
         keep = self.topology.red_node >= 0
         return np.ascontiguousarray(x[:, keep].T).ravel()
 
-    def _straight_tendons(self, x: np.ndarray) -> None:
+    def with_straight_tendons(self, x: np.ndarray) -> np.ndarray:
+        """x (3, n_nodes) with every tendon's internal nodes on its chord (evenly spaced)."""
         topo = self.topology
         k = topo.tendon_elements
         if k == 1:
-            return
+            return x
         c = self.system.tendon_connectivity
         a = x[:, topo.system_node[c[0]]]
         b = x[:, topo.system_node[c[1]]]
         s = np.arange(1, k) / k
         x[:, topo.tendon_internal] = a[:, :, None] + (b - a)[:, :, None] * s[None, None, :]
+        return x
 
     def initial_positions(self, start: str = "undeformed") -> np.ndarray:
         """Start configuration (3, n_nodes) of the static solve.
@@ -263,8 +265,7 @@ class MTCModel:
         x[:, :topo.n_mesh] = membrane_placement(sysm, topo.mesh, Btop,
                                                 stretch_to_corners=(start == "design"))
         x = self.full(self.reduce(x))          # the bar tops follow the attachment
-        self._straight_tendons(x)
-        return x
+        return self.with_straight_tendons(x)
 
     def interpolate_from(self, other: "MTCModel", x_other: np.ndarray) -> np.ndarray:
         """Positions (3, n_nodes) of this model from a solution of ``other`` (same system,
@@ -288,8 +289,7 @@ class MTCModel:
         x[:, :st.n_mesh] = xm.T
         x[:, st.system_node] = x_other[:, ot.system_node]
         x = self.full(self.reduce(x))
-        self._straight_tendons(x)
-        return x
+        return self.with_straight_tendons(x)
 
     # ------------------------------------------------------------------ operators
     def internal_full(self, x: np.ndarray, *, tangent: bool = True):

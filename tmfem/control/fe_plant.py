@@ -1,0 +1,170 @@
+"""The membrane-truss-cable finite-element model as the plant of the deployment controllers.
+
+The controllers of chapters 7-8 are designed on the control-oriented model (COM, eq. 5.27)
+and read its state z = [q, eta] (bar coordinates and membrane modal coordinates, or the
+membrane point coordinates of eqs. 5.17-5.18) with its rates. On a finite-element plant that
+state does not exist: it has to be measured. :class:`COMStateEstimator` computes it from the
+FE state as sensors would give it:
+
+* q from the bar nodes (eqs. 3.1-3.2, :func:`tmfem.models.mtc.post.q_from_positions`);
+* eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
+  nodes are taken into the floating frame of the current corners (eq. 3.3), interpolated at
+  the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
+  corner constraints, eqs. 3.5, 5.14) is subtracted and the rest is projected on the
+  relative modes in the mass inner product (:meth:`MembraneBasis.modal_coordinates`) -- a
+  full-field measurement of the membrane (photogrammetry), the best case of the "projection
+  on the control-oriented model's membrane basis";
+* the rates z' as the directional derivative of that map along the FE velocity, by a central
+  difference with a displacement step of 1e-5 m (second order: error ~1e-10 relative).
+
+Where the FE membrane moves exactly as the COM's field (eqs. 5.1, 5.3) the estimate is exact
+(test); otherwise it is the COM state closest in the kinetic-energy norm, and what it leaves
+out (modes above K, tendon vibration) is what the controller does not see.
+
+:class:`FEStatePlant` is an FE plant (:class:`tmfem.models.mtc.dynamics.MTCDynamics`: the
+tendon rest lengths as inputs, M a + C v + f_int(x; u) = 0) whose outputs are that estimate
+y = [z, z'], so every controller built for the COM plant (the adaptive PFL, the switch, the
+linear controllers) runs on it unchanged. :func:`fe_state_of` places the FE model in the
+configuration of a COM state (bars at q, membrane on the COM's field, tendons straight), the
+start of a deployment.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.fem.membrane import point_matrix
+from tmfem.models.mtc.post import q_from_positions
+from tmfem.models.mtc.topology import to_floating
+from tmfem.system.coordinates import q_index
+
+#: displacement step [m] of the central difference along the FE velocity (module docstring)
+RATE_STEP = 1e-5
+
+
+class COMStateEstimator:
+    """The COM state (z, z') of an FE state (module docstring).
+
+    Parameters
+    ----------
+    com : ControlOrientedModel
+        The controllers' design model, of the same system as the FE model.
+    dyn : MTCDynamics
+        The FE plant: ``positions(x)`` gives all node positions of a free-DOF state.
+    """
+
+    def __init__(self, com, dyn):
+        fe = dyn.model
+        if fe.system is not com.system:
+            raise InputError("FE plant: expected the FE model and the control-oriented model of "
+                             f"the same System, found {fe.system.name!r} and {com.system.name!r}")
+        self.com, self.dyn = com, dyn
+        basis = com.membrane
+        self._nd = com.layout.n_delta
+        self._P0 = basis.shapes[0]
+        self._Psi = basis.shapes[1:1 + self._nd]
+        # FE nodal field -> values at the COM basis nodes (reference coordinates in O_f)
+        self._I = point_matrix(fe.membrane.skmesh, self._P0[:2])
+        topo = fe.topology
+        self._system_node, self._n_mesh = topo.system_node, topo.n_mesh
+        self._corners = topo.mesh.corners
+        _, _, psi = q_index(com.system.M, com.system.N)
+        self._psi = psi.ravel()
+
+    def modal(self, x) -> np.ndarray:
+        """[q, eta] (modal coordinates) of the free-DOF FE positions x."""
+        xf = self.dyn.positions(x)
+        q = q_from_positions(self.com.system, xf[:, self._system_node])
+        xm = xf[:, :self._n_mesh]
+        r = to_floating((self._I @ xm.T).T, xm[:, self._corners])
+        delta = self.com.zeta(q)[:self._nd]
+        d_rel = r - self._P0 - np.einsum("k,kcn->cn", delta, self._Psi)
+        return np.concatenate([q, self.com.membrane.modal_coordinates(d_rel)])
+
+    def state(self, x, v) -> tuple[np.ndarray, np.ndarray]:
+        """(z, z') in the COM's coordinates (modal, or the point coordinates of eq. 5.18)."""
+        x, v = np.asarray(x, dtype=float), np.asarray(v, dtype=float)
+        zm = self.modal(x)
+        vmax = float(np.max(np.abs(v))) if v.size else 0.0
+        if vmax == 0.0:
+            zdm = np.zeros_like(zm)
+        else:
+            h = RATE_STEP / vmax
+            dz = self.modal(x + h * v) - self.modal(x - h * v)
+            dz[self._psi] = np.remainder(dz[self._psi] + np.pi, 2 * np.pi) - np.pi
+            zdm = dz / (2 * h)
+        P = self.com.P
+        return np.linalg.solve(P, zm), np.linalg.solve(P, zdm)
+
+
+class FEStatePlant:
+    """An FE plant whose outputs are the estimated COM state y = [z, z'] (module docstring).
+
+    Parameters
+    ----------
+    dyn : MTCDynamics
+    com : ControlOrientedModel
+    x0, v0 : ndarray, optional
+        Start state (free DOFs); default the plant's own (its equilibrium and perturbation).
+    """
+
+    def __init__(self, dyn, com, *, x0=None, v0=None):
+        self.dyn, self.estimator = dyn, COMStateEstimator(com, dyn)
+        self.input_names = list(dyn.input_names)
+        if self.input_names != list(com.input_names):
+            raise InputError(f"FE plant: expected the COM's inputs {com.input_names}, found "
+                             f"{self.input_names}")
+        self.output_names = list(com.state_names)
+        self.u0 = dyn.u0
+        self.x0 = dyn.x0 if x0 is None else np.asarray(x0, dtype=float)
+        self.v0 = dyn.v0 if v0 is None else np.asarray(v0, dtype=float)
+        if self.x0.shape != dyn.x0.shape or self.v0.shape != dyn.v0.shape:
+            raise InputError(f"FE plant start state: expected {dyn.x0.shape} free DOFs, found "
+                             f"{self.x0.shape} and {self.v0.shape}")
+
+    def residual(self, x, v, a, t, u=None):
+        return self.dyn.residual(x, v, a, t, u)
+
+    def jacobians(self, x, v, a, t, u=None):
+        return self.dyn.jacobians(x, v, a, t, u)
+
+    def newton_matrix(self, x, v, a, t, cv, ca, u=None):
+        return self.dyn.newton_matrix(x, v, a, t, cv, ca, u)
+
+    def factorize(self, S):
+        return self.dyn.factorize(S)
+
+    def outputs(self, x, v=None, u=None) -> np.ndarray:
+        """y = [z, z'], the COM state estimated from the FE state."""
+        z, zd = self.estimator.state(x, np.zeros_like(x) if v is None else v)
+        return np.concatenate([z, zd])
+
+
+def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Free-DOF positions and velocities of the FE model in the configuration of the COM
+    state (z, z'): labelled nodes at q (eqs. 3.1-3.2), membrane nodes on the COM's field
+    (eqs. 5.1, 5.3, interpolated from the COM basis nodes at the FE reference nodes), tendon
+    internal nodes on the chords; velocities by a central difference of that placement along
+    z' (``step`` in the coordinates).
+    """
+    fe = dyn.model
+    if fe.system is not com.system:
+        raise InputError("FE start state: expected the FE model and the control-oriented model of "
+                         "the same System")
+    topo = fe.topology
+    interp = point_matrix(com.membrane.scalar_basis.mesh, topo.mesh.p)
+
+    def place(zz):
+        zm = com.P @ zz
+        x = np.zeros((3, topo.n_nodes))
+        x[:, topo.system_node] = com.system.nodes(zm[:com.nq])
+        xm, _ = com.membrane_positions(zz)
+        x[:, :topo.n_mesh] = (interp @ xm.T).T
+        return fe.reduce(fe.with_straight_tendons(fe.full(fe.reduce(x))))[fe.free]
+
+    z = np.asarray(z, dtype=float)
+    x = place(z)
+    if zd is None or not np.any(zd):
+        return x, np.zeros_like(x)
+    zd = np.asarray(zd, dtype=float)
+    return x, (place(z + step * zd) - place(z - step * zd)) / (2 * step)
