@@ -1,10 +1,10 @@
 """The MTC finite-element model as the plant of controllers designed on the control-oriented
-model (issue 15): the COM-state estimate (tmfem.control.fe_plant) and a closed loop."""
+model (issue 15): the COM-state estimate (tmfem.control.state_estimate) and a closed loop."""
 import numpy as np
 import pytest
 
 from tmfem.control.deploy import StatePlant, lqr_state_feedback
-from tmfem.control.fe_plant import COMStateEstimator, FEStatePlant, fe_state_of
+from tmfem.control.state_estimate import COMStateEstimator, FEStatePlant, fe_state_of
 from tmfem.errors import InputError
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.models.mtc.dynamics import MTCDynamics
