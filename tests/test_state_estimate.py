@@ -66,3 +66,74 @@ def test_lqr_designed_on_the_com_damps_the_mtc_plant(models):
         assert late < 0.5 * peak, (name, peak, late)
     peak = np.max(np.abs(runs["com"]))
     assert np.max(np.abs(runs["mtc"] - runs["com"])) < 0.25 * peak
+
+
+@pytest.mark.parametrize("law", ["cable", "fixed-rate"])
+def test_tendon_law_of_a_changed_rest_length(law):
+    """A straight tendon (3 Green-strain trusses, eq. 4.1) of length l at rest length u:
+    N = EA' (l^2 - u^2) / (2 u^2) l / u with EA' = EA ("cable", eq. 3.9 at the current rest
+    length) or EA u / r_0 ("fixed-rate": the spring rate EA / r_0 of eq. 5.19's B(x) u)."""
+    from tmfem.models.mtc.post import member_state
+    s = load_preset("2-3-deploy")
+    fe = MTCModel(s, mesh_n=4, rest_lengths="system", tendon_law=law)
+    x = fe.full(fe.reduce(fe.with_straight_tendons(fe.initial_positions("design"))))
+    l = s.tendon_lengths(s.q)
+    u = 0.97 * l
+    fe.set_tendon_lengths(u)
+    N = member_state(fe, x)["tendon_force"]
+    EA = s.tendon_EA * (u / fe.nominal_rest_lengths if law == "fixed-rate" else 1.0)
+    np.testing.assert_allclose(N, EA * (l**2 - u**2) / (2 * u**2) * l / u, rtol=1e-9)
+
+
+def test_tendon_law_refused():
+    with pytest.raises(InputError, match="tendon_law"):
+        MTCModel(load_preset("2-3-deploy"), mesh_n=4, tendon_law="spring")
+
+
+def test_start_rest_lengths_hold_the_packaged_design():
+    """The packaged 2-3 design's tendon forces T = EA (|d| - r) / r (eqs. 3.8-3.9) are what
+    each tendon law produces at the start rest lengths (cable: the design's own; fixed rate
+    k = EA / r_0: r = |d| - T r_0 / EA)."""
+    from tmfem.control.state_estimate import start_rest_lengths
+    init, final = load_preset("2-3-deploy-initial"), load_preset("2-3-deploy")
+    L = init.tendon_lengths(init.q)
+    T = init.tendon_EA * (L - init.rest_lengths) / init.rest_lengths
+    r0 = final.rest_lengths
+    np.testing.assert_array_equal(start_rest_lengths(init, "cable", r0), init.rest_lengths)
+    r = start_rest_lengths(init, "fixed-rate", r0)
+    np.testing.assert_allclose(init.tendon_EA / r0 * (L - r), T, rtol=1e-12)
+
+
+@pytest.mark.parametrize("argv, code, needle", [
+    (["deploy", "--preset", "2-3-deploy", "--plant-mesh", "8"], 2, "--plant-mesh belongs to --plant mtc"),
+    (["deploy", "--preset", "1-4D", "--plant", "mtc"], 2, "1-N(D) system"),
+    (["deploy", "--preset", "2-3-deploy", "--plant", "mtc", "--plant-mesh", "1"], 2, "expected an integer >= 2"),
+    (["deploy", "--preset", "2-3-deploy", "--plant", "mtc", "--plant-mesh", "4000"], 3, "--plant-mesh 4000"),
+])
+def test_deploy_plant_options_refused_before_work(argv, code, needle, capsys):
+    """Options of the FE plant that do not apply or cannot fit are refused with one line
+    before the controller design (exit 2 bad input, 3 resource limit; docs/cli.md)."""
+    from tmfem.cli import main
+    rc = main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == code and needle in err[-1]
+
+
+def test_deployment_start_on_the_mtc_plant():
+    """The first 0.3 s of the 2-3 deployment (adaptive PFL of 7.4) on the MTC plant with the
+    COM's fixed-rate tendons, through run_deployment's plant hook: the plant starts at rest in
+    its own equilibrium of the packaged design (within 2.5 mrad of the COM's z0), the run
+    records the estimated state and the FE report, and the bars follow the reference within
+    5 mrad (the COM plant: within 1 mrad)."""
+    from tmfem.cli.deploy import setup
+    from tmfem.control.deploy import run_deployment
+    from tmfem.control.state_estimate import mtc_deployment_plant
+    s = setup("2-3-deploy", controller="adaptive")
+    plant = mtc_deployment_plant(s.model, load_preset("2-3-deploy-initial"), mesh_n=10,
+                                 tendon_law="fixed-rate")
+    nq = s.model.nq
+    assert np.max(np.abs(plant.outputs(plant.x0)[:nq] - s.z0[:nq])) < 2.5e-3
+    r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+                       t_end=0.3, dt=0.01, plant=plant, jacobian="step")
+    assert r.plant_report["model"] == "mtc" and r.w.shape == (31, 3)
+    assert np.max(np.abs(r.z[:, :nq] - r.q_d)) < 5e-3

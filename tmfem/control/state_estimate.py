@@ -34,12 +34,23 @@ import numpy as np
 
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
-from tmfem.models.mtc.post import q_from_positions
+from tmfem.models.mtc.post import member_state, q_from_positions
 from tmfem.models.mtc.topology import to_floating
 from tmfem.system.coordinates import q_index
 
 #: displacement step [m] of the central difference along the FE velocity (module docstring)
 RATE_STEP = 1e-5
+
+
+def _probe(skmesh, p: np.ndarray):
+    """Interpolation matrix of ``skmesh``'s nodal field at the reference points p (2, n); the
+    boundary nodes of another mesh lie on this mesh's boundary only up to round-off, so where
+    a point falls outside, all are pulled toward their centroid by 1e-9 of their distance."""
+    try:
+        return point_matrix(skmesh, p)
+    except InputError:
+        c = p.mean(axis=1, keepdims=True)
+        return point_matrix(skmesh, c + (1.0 - 1e-9) * (p - c))
 
 
 class COMStateEstimator:
@@ -64,7 +75,7 @@ class COMStateEstimator:
         self._P0 = basis.shapes[0]
         self._Psi = basis.shapes[1:1 + self._nd]
         # FE nodal field -> values at the COM basis nodes (reference coordinates in O_f)
-        self._I = point_matrix(fe.membrane.skmesh, self._P0[:2])
+        self._I = _probe(fe.membrane.skmesh, self._P0[:2])
         topo = fe.topology
         self._system_node, self._n_mesh = topo.system_node, topo.n_mesh
         self._corners = topo.mesh.corners
@@ -139,6 +150,28 @@ class FEStatePlant:
         z, zd = self.estimator.state(x, np.zeros_like(x) if v is None else v)
         return np.concatenate([z, zd])
 
+    def recover(self, states, inputs) -> dict:
+        """What the FE model alone knows over a run, from its recorded states (n, n_free) and
+        inputs (n, n_t): the membrane deflections w_k its sensors measure at the plant's
+        output points (eqs. 5.36-5.38, :meth:`MTCDynamics.outputs`), the tendon forces of its
+        tension-only truss elements and how often one went slack (the COM's tendons cannot).
+        """
+        dyn = self.dyn
+        fe = dyn.model
+        nq = len(fe.system.q_names)
+        w, T, slack = [], [], []
+        for x, u in zip(states, inputs):
+            w.append(dyn.outputs(x)[nq:])
+            fe.set_tendon_lengths(u)
+            m = member_state(fe, dyn.positions(x))
+            T.append(m["tendon_force"]); slack.append(int(np.sum(m["tendon_slack"])))
+        fe.set_tendon_lengths(dyn.u0)
+        T, slack = np.array(T), np.array(slack)
+        return {"w": np.array(w), "model": "mtc", "free_dofs": int(dyn.x0.size),
+                "max_tendon_stress_Pa": float(np.max(T / fe.tendon_area)),
+                "min_tendon_force_N": float(np.min(T)),
+                "tendon_slack_samples": int(np.sum(slack > 0))}
+
 
 def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
     """Free-DOF positions and velocities of the FE model in the configuration of the COM
@@ -152,7 +185,7 @@ def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray
         raise InputError("FE start state: expected the FE model and the control-oriented model of "
                          "the same System")
     topo = fe.topology
-    interp = point_matrix(com.membrane.scalar_basis.mesh, topo.mesh.p)
+    interp = _probe(com.membrane.scalar_basis.mesh, topo.mesh.p)
 
     def place(zz):
         zm = com.P @ zz
@@ -168,3 +201,46 @@ def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray
         return x, np.zeros_like(x)
     zd = np.asarray(zd, dtype=float)
     return x, (place(z + step * zd) - place(z - step * zd)) / (2 * step)
+
+
+def start_rest_lengths(initial, tendon_law: str, nominal) -> np.ndarray:
+    """Rest lengths that hold the packaged design ``initial`` (a System with its designed
+    rest lengths) in equilibrium under a plant's tendon law: the design's tendon forces
+    T = EA (|d| - r) / r (eqs. 3.8-3.9) produced by k = EA / r (``"cable"``: the design's own
+    rest lengths) or by the fixed rate k = EA / r_0 of the ``nominal`` rest lengths
+    (``"fixed-rate"``: r = |d| - T r_0 / EA)."""
+    if initial.rest_lengths is None:
+        raise InputError(f"FE plant start: expected designed rest lengths in {initial.name!r}, "
+                         "found none")
+    r = np.asarray(initial.rest_lengths, dtype=float)
+    if tendon_law == "cable":
+        return r
+    EA = initial.tendon_EA
+    L = initial.tendon_lengths(initial.q)
+    T = EA * (L - r) / r
+    return L - T * np.asarray(nominal, dtype=float) / EA
+
+
+def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
+                         tendon_law: str = "cable") -> FEStatePlant:
+    """The MTC model of the COM's system (its rest lengths, N x mesh_n x mesh_n membrane,
+    ``tendon_elements`` trusses per tendon, the tendon law of :class:`MTCModel`) as the plant
+    of a deployment, its sensors at the COM's output points.
+
+    The start is the plant's own equilibrium at rest in the packaged configuration: from the
+    placement of the COM configuration of ``initial`` (:func:`fe_state_of`, bars at its q, eta
+    = 0) the FE statics are solved under :func:`start_rest_lengths` -- the bars take their
+    axial strain, the membrane and tendons their FE shapes -- so that the run starts without
+    the transient of an FE state out of equilibrium."""
+    from tmfem.models.mtc.dynamics import MTCDynamics
+    from tmfem.models.mtc.model import MTCModel
+    fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
+                  rest_lengths=com.u0, tendon_law=tendon_law)
+    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points)
+    z0 = np.linalg.solve(com.P, np.concatenate([np.asarray(initial.q, dtype=float),
+                                                np.zeros(com.K)]))
+    x_place, _ = fe_state_of(com, dyn, z0)
+    fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
+    st = fe.solve_static(x0=dyn.positions(x_place))
+    fe.set_tendon_lengths(com.u0)
+    return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free])
