@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from tmfem.cli.common import progress_bar
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError
 
 NAME = "deploy"
 HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
@@ -99,6 +99,10 @@ def configure(parser) -> None:
     parser.add_argument("--plant-mesh", type=int, metavar="N",
                         help="membrane elements per side of each of the FE plant's N "
                              "quadrilaterals (--plant mtc; default 10, the paper's mesh)")
+    parser.add_argument("--plant-tendons", choices=["cable", "fixed-rate"],
+                        help="tendon law of the FE plant (--plant mtc): cable (EA fixed, the rate "
+                             "EA/r of eq. 3.9 follows the rest length; default) or fixed-rate (the "
+                             "rate frozen at the final rest lengths, as eq. 5.19 and the COM)")
     parser.add_argument("--t-end", type=float, default=20.0)
     parser.add_argument("--dt", type=float, default=0.01)
     parser.add_argument("--csv", help="write every named signal (one column each)")
@@ -118,12 +122,22 @@ def run(args) -> dict:
     plant = None
     if args.plant == "mtc":
         from tmfem.control.state_estimate import mtc_deployment_plant
-        plant = mtc_deployment_plant(s.model, s.z0, mesh_n=mesh_n)
+        from tmfem.system.presets import load_preset
+        plant = mtc_deployment_plant(s.model, load_preset(args.preset + "-initial"),
+                                     mesh_n=mesh_n, tendon_law=args.plant_tendons or "cable")
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {args.plant}") as bar:
-        r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
-                           z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,
-                           jacobian="reuse" if plant is None else "step")
+        try:
+            r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
+                               z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,
+                               jacobian="reuse" if plant is None else "step")
+        except ConvergenceError as exc:
+            if plant is None:
+                raise
+            raise ConvergenceError(f"the closed loop on the {args.plant} plant diverged: {exc} "
+                                   "(docs/fe-plant.md)") from None
     out = {"preset": args.preset, "controller": args.controller, "plant": args.plant,
+           **({"plant_tendons": args.plant_tendons or "cable", "plant_mesh": mesh_n}
+              if args.plant == "mtc" else {}),
            "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
            "path": args.path or DEPLOYMENTS[args.preset]["path"],
            **r.summary(), **s.info,
@@ -154,9 +168,10 @@ def check_plant(args) -> int | None:
     from tmfem.cli.common import check_mesh_budget
     from tmfem.system.presets import load_preset
     if args.plant == "com":
-        if args.plant_mesh is not None:
-            raise InputError("--plant-mesh belongs to --plant mtc (the COM plant has no membrane "
-                             f"mesh), found --plant-mesh {args.plant_mesh} with --plant com")
+        for opt, val in (("--plant-mesh", args.plant_mesh), ("--plant-tendons", args.plant_tendons)):
+            if val is not None:
+                raise InputError(f"{opt} belongs to --plant mtc (the COM plant has neither a "
+                                 f"membrane mesh nor FE tendons), found {opt} {val} with --plant com")
         return None
     system = load_preset(args.preset)
     if system.deployable:
