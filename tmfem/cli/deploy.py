@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from tmfem.cli.common import progress_bar
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError
 
 NAME = "deploy"
 HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
@@ -92,6 +92,17 @@ def configure(parser) -> None:
                         help="rest-length limits in the PFL: bounded (the admissible rest lengths "
                              "closest in acceleration, default) or clip (eq. 5.58 as is, saturated "
                              "by the plant)")
+    parser.add_argument("--plant", choices=["com", "mtc"], default="com",
+                        help="the model the controller drives: com (the control-oriented model it "
+                             "is designed on, default) or mtc (the membrane-truss-cable FE model, "
+                             "read through the COM-state estimate; systems without H_1j nodes)")
+    parser.add_argument("--plant-mesh", type=int, metavar="N",
+                        help="membrane elements per side of each of the FE plant's N "
+                             "quadrilaterals (--plant mtc; default 10, the paper's mesh)")
+    parser.add_argument("--plant-tendons", choices=["cable", "fixed-rate"],
+                        help="tendon law of the FE plant (--plant mtc): cable (EA fixed, the rate "
+                             "EA/r of eq. 3.9 follows the rest length; default) or fixed-rate (the "
+                             "rate frozen at the final rest lengths, as eq. 5.19 and the COM)")
     parser.add_argument("--t-end", type=float, default=20.0)
     parser.add_argument("--dt", type=float, default=0.01)
     parser.add_argument("--csv", help="write every named signal (one column each)")
@@ -103,14 +114,30 @@ def configure(parser) -> None:
 def run(args) -> dict:
     from tmfem.simulation.driver import check_time_grid
     check_time_grid(args.t_end, args.dt)            # refused before the controller design
+    mesh_n = check_plant(args)
     t0 = time.perf_counter()
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path)
     from tmfem.control.deploy import run_deployment
-    with progress_bar(args.t_end, args.dt, f"deploy {args.preset}") as bar:
-        r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
-                           z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar)
-    out = {"preset": args.preset, "controller": args.controller,
+    plant = None
+    if args.plant == "mtc":
+        from tmfem.control.state_estimate import mtc_deployment_plant
+        from tmfem.system.presets import load_preset
+        plant = mtc_deployment_plant(s.model, load_preset(args.preset + "-initial"),
+                                     mesh_n=mesh_n, tendon_law=args.plant_tendons or "cable")
+    with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {args.plant}") as bar:
+        try:
+            r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
+                               z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,
+                               jacobian="reuse" if plant is None else "step")
+        except ConvergenceError as exc:
+            if plant is None:
+                raise
+            raise ConvergenceError(f"the closed loop on the {args.plant} plant diverged: {exc} "
+                                   "(docs/fe-plant.md)") from None
+    out = {"preset": args.preset, "controller": args.controller, "plant": args.plant,
+           **({"plant_tendons": args.plant_tendons or "cable", "plant_mesh": mesh_n}
+              if args.plant == "mtc" else {}),
            "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
            "path": args.path or DEPLOYMENTS[args.preset]["path"],
            **r.summary(), **s.info,
@@ -132,6 +159,30 @@ def run(args) -> dict:
         out["pvd"] = str(write_series(args.vtk, ((float(r.t[k]), sysm.nodes(r.z[k, :s.model.nq]),
                                                   cells) for k in idx), name=args.preset))
     return out
+
+
+def check_plant(args) -> int | None:
+    """The FE plant's options, checked before any work: ``--plant-mesh`` belongs to
+    ``--plant mtc``; the MTC model has no nodes along the bars, so no 1-N(D) system; the
+    mesh within the machine's budget. Returns the plant mesh (None for the COM plant)."""
+    from tmfem.cli.common import check_mesh_budget
+    from tmfem.system.presets import load_preset
+    if args.plant == "com":
+        for opt, val in (("--plant-mesh", args.plant_mesh), ("--plant-tendons", args.plant_tendons)):
+            if val is not None:
+                raise InputError(f"{opt} belongs to --plant mtc (the COM plant has neither a "
+                                 f"membrane mesh nor FE tendons), found {opt} {val} with --plant com")
+        return None
+    system = load_preset(args.preset)
+    if system.deployable:
+        raise InputError(f"--plant mtc: {args.preset} is a 1-N(D) system (tendons attached at "
+                         "H_1j along the bars), which the MTC model cannot represent; expected a "
+                         "system without H_1j nodes (2-3-deploy), or --plant com")
+    n = 10 if args.plant_mesh is None else args.plant_mesh
+    if n < 2:
+        raise InputError(f"--plant-mesh: expected an integer >= 2, found {n}")
+    check_mesh_budget(N=system.N, n=n, option="--plant-mesh")
+    return n
 
 
 def write_csv(path, r) -> str:
@@ -156,6 +207,8 @@ def format_text(r: dict) -> str:
             "bar_critical_load_N", "max_von_mises_Pa", "max_tendon_stress_Pa",
             "min_rest_length_margin_m", "final_tracking_error", "limits_active_s",
             "max_eta_energy_J", "B_q_condition_max", "wall_time_s"]
-    lines = [f"deployment {r['preset']} ({r['controller']}, uncertainty {r['uncertainty']})"]
+    keys += [k for k in r if k.startswith("plant_")]
+    lines = [f"deployment {r['preset']} on the {r['plant']} plant ({r['controller']}, "
+             f"uncertainty {r['uncertainty']})"]
     lines += [f"  {k}: {r[k]:.6g}" if isinstance(r[k], float) else f"  {k}: {r[k]}" for k in keys]
     return "\n".join(lines + [f"{k}: {r[k]}" for k in ("csv", "plot", "gif", "pvd") if k in r])

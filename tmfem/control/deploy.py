@@ -152,6 +152,7 @@ class DeploymentResult:
     condition_numbers: np.ndarray
     wall_time: float
     allocation_active: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    plant_report: dict | None = None
     names: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
@@ -172,29 +173,40 @@ class DeploymentResult:
                 "max_eta_energy_J": float(np.max(self.eta_energy)),
                 "B_q_condition_max": float(np.max(self.condition_numbers))
                 if self.condition_numbers.size else None,
-                "wall_time_s": self.wall_time}
+                "wall_time_s": self.wall_time,
+                **{f"plant_{k}": v for k, v in (self.plant_report or {}).items()}}
 
 
 def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float = 0.01,
                    r_min: float = 1e-3, stress_every: int = 10, progress=None,
-                   mesh_n: int = 10, jacobian: str = "reuse") -> DeploymentResult:
+                   mesh_n: int = 10, jacobian: str = "reuse", plant=None) -> DeploymentResult:
     """Deploy: the COM plant (:class:`StatePlant`) from z0 under ``controller`` (reading
     y = [z, z']) saturated by :class:`RestLengthLimits`, integrated by Park's method
     (eqs. 5.34-5.35) at step dt. The run records the state and the inputs only; outputs,
     reference, energies and stresses are recovered after it (:mod:`tmfem.control.recovery`:
     tendon stresses at every sample, bars and membrane every ``stress_every`` samples).
     ``jacobian``: the Newton-matrix policy of :func:`tmfem.solvers.park.park_integrate`
-    (``"reuse"`` keeps the matrix over steps while Newton converges within a few iterations)."""
+    (``"reuse"`` keeps the matrix over steps while Newton converges within a few iterations).
+
+    ``plant``: the plant the controller drives; default the COM plant from z0. Any plant whose
+    outputs are the COM state y = [z, z'] serves (a finite-element plant through its state
+    estimate, :class:`tmfem.control.state_estimate.FEStatePlant`): the run records that y as
+    z, z', and a plant with a ``recover(states)`` method adds what only it knows (the FE
+    tendon forces and slack, the membrane deflections its sensors measure) as ``plant_report``."""
     from tmfem.control.recovery import StressRecovery
     if stress_every < 1:
         raise InputError(f"stress_every: expected >= 1, found {stress_every}")
-    plant = StatePlant(model, z0=z0)
+    plant = StatePlant(model, z0=z0) if plant is None else plant
     lim = RestLengthLimits(controller, model=model, r_min=r_min)
-    nq = model.nq
-    X, V, U = [], [], []
+    nq, nz = model.nq, model.nz
+    X, V, U, S = [], [], [], []
+    recover = getattr(plant, "recover", None)
 
     def record(t, x, v, a, u, y):
-        X.append(x.copy()); V.append(v.copy()); U.append(u.copy())
+        y = plant.outputs(x, v, u) if y is None else y
+        X.append(y[:nz].copy()); V.append(y[nz:].copy()); U.append(u.copy())
+        if recover is not None:
+            S.append(x.copy())
         return False
 
     t0 = time.perf_counter()
@@ -205,6 +217,9 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     out = [model.fast_outputs(zk, with_lengths=True) for zk in z]
     w = np.array([o[0] for o in out])
     L = np.array([o[2] for o in out])
+    report = recover(np.array(S), u) if recover is not None else None
+    if report is not None:
+        w = report.pop("w")
     q_d = np.array([reference(tk)[0] for tk in sim.t])
     eta, etad = z[:, nq:], zd[:, nq:]
     E = 0.5 * np.sum(etad**2, axis=1) + 0.5 * np.sum(model.membrane.omega**2 * eta**2, axis=1)
@@ -230,7 +245,7 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
                 "max_tendon_stress_Pa": float(np.max(sigma_t)),
                 "bar_t": sim.t[idx], "bar": bar, "von_mises": vm, "tendon": sigma_t},
         condition_numbers=np.asarray(cond, dtype=float), wall_time=wall,
-        allocation_active=np.asarray(alloc, dtype=float),
+        allocation_active=np.asarray(alloc, dtype=float), plant_report=report,
         names={"q": list(model.system.q_names), "u": model.input_names,
                "tendons": [t.name for t in model.system.tendons],
                "w": [f"w_{i + 1}" for i in range(len(model.output_points))]})

@@ -58,6 +58,8 @@ class MembraneBasis:
         Designed in-plane prestress (s_xx, s_yy, s_xy) used in K_G (eq. 5.8).
     delta0 : ndarray (3, N)
         Corner displacements of the design, in O_f.
+    node_mass : scipy.sparse matrix (n_nodes, n_nodes)
+        Consistent scalar mass rho h int N_a N_b dA of the bilinear mesh (one component).
     """
 
     layout: ZetaLayout
@@ -72,6 +74,7 @@ class MembraneBasis:
     first: np.ndarray
     tau: np.ndarray
     delta0: np.ndarray
+    node_mass: object = None
     n_in_plane_candidates: int = 0
 
     @property
@@ -96,6 +99,23 @@ class MembraneBasis:
         position."""
         Pr = self.probe(points)
         return Pr @ self.shapes[:, component, :].T
+
+    def modal_coordinates(self, d_rel) -> np.ndarray:
+        """The relative-mode coordinates eta of a relative deflection field (eq. 5.1).
+
+        eta_i = sum_c phi_i,c^T M_s d_c: the mass-weighted least-squares fit of d_rel by the
+        modes phi_i (mass-normalised, phi_i^T M phi_j = delta_ij), i.e. the orthogonal
+        projection of d_rel on their span in the kinetic-energy inner product.
+
+        Parameters
+        ----------
+        d_rel : ndarray (3, n_nodes)
+            u, v, w in O_f at the nodes of this basis, minus the prestressing part
+            sum_k Psi_k Delta_k.
+        """
+        phi = self.shapes[1 + self.n_delta:]                     # (K, 3, n)
+        Md = (self.node_mass @ np.asarray(d_rel, dtype=float).T)  # (n, 3)
+        return np.einsum("kcn,nc->k", phi, Md)
 
 
 def _mass_matrix(basis, rho_h: float):
@@ -245,7 +265,7 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
     return MembraneBasis(layout=layout, plane=ps, scalar_basis=sb, shapes=shapes,
                          omega=np.sqrt(np.array(omega2, dtype=float)), mode_kind=kind, S=S,
                          mass=mass, Jt=Jt, first=first, tau=tau, delta0=delta0,
-                         n_in_plane_candidates=n_modes)
+                         node_mass=Ms, n_in_plane_candidates=n_modes)
 
 
 def _lowest_modes(K, M, k, backend):

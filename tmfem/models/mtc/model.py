@@ -111,12 +111,21 @@ class MTCModel:
         Accept a 1-N(D) system, its H_1j on bars rigid in bending
         (:func:`tmfem.models.mtc.topology.build_topology`): the SBC model's predictor, not
         the dissertation's MTC model.
+    tendon_law : {"cable", "fixed-rate"}
+        What a change of rest length (:meth:`set_tendon_lengths`, a plant's input) does to a
+        tendon. ``"cable"`` (default): a cable reeled in or out, EA fixed, so its spring rate
+        follows eq. 3.9, k = EA / r, at the current rest length. ``"fixed-rate"``: the rate
+        stays k = EA / r_0 of the nominal rest lengths r_0 (EA scales with r / r_0), the
+        control-affine tendon of eq. 5.19 (B(x) u) that the control-oriented model uses.
     """
 
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
                  lumped_tendon_mass: bool = False, backend="scipy", membrane_law: str = "svk",
-                 rigid_bar_points: bool = False):
+                 rigid_bar_points: bool = False, tendon_law: str = "cable"):
+        if tendon_law not in ("cable", "fixed-rate"):
+            raise InputError(f"tendon_law: expected 'cable' or 'fixed-rate', found {tendon_law!r}")
+        self.tendon_law = tendon_law
         self.system = system
         self.membrane_law = check_law_name(membrane_law)
         self.backend = get_backend(backend)
@@ -177,6 +186,7 @@ class MTCModel:
         if r.shape != (n_t,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
             raise InputError(f"expected {n_t} positive tendon rest lengths, found {r}")
         self.rest_lengths = r
+        self.nominal_rest_lengths = r.copy()
         self.rest_lengths_source = source
         self._set_tendons(r)
 
@@ -199,7 +209,10 @@ class MTCModel:
         if np.array_equal(u, self.rest_lengths):
             return
         self.rest_lengths = u.copy()
-        self.tendons.L = u[self.topology.tendon_of_element] / self.topology.tendon_elements
+        e = self.topology.tendon_of_element
+        self.tendons.L = u[e] / self.topology.tendon_elements
+        if self.tendon_law == "fixed-rate":
+            self.tendons.EA = self.tendon_EA[e] * (u / self.nominal_rest_lengths)[e]
 
     @property
     def elements(self) -> list:
@@ -234,16 +247,18 @@ class MTCModel:
         keep = self.topology.red_node >= 0
         return np.ascontiguousarray(x[:, keep].T).ravel()
 
-    def _straight_tendons(self, x: np.ndarray) -> None:
+    def with_straight_tendons(self, x: np.ndarray) -> np.ndarray:
+        """x (3, n_nodes) with every tendon's internal nodes on its chord (evenly spaced)."""
         topo = self.topology
         k = topo.tendon_elements
         if k == 1:
-            return
+            return x
         c = self.system.tendon_connectivity
         a = x[:, topo.system_node[c[0]]]
         b = x[:, topo.system_node[c[1]]]
         s = np.arange(1, k) / k
         x[:, topo.tendon_internal] = a[:, :, None] + (b - a)[:, :, None] * s[None, None, :]
+        return x
 
     def initial_positions(self, start: str = "undeformed") -> np.ndarray:
         """Start configuration (3, n_nodes) of the static solve.
@@ -263,8 +278,7 @@ class MTCModel:
         x[:, :topo.n_mesh] = membrane_placement(sysm, topo.mesh, Btop,
                                                 stretch_to_corners=(start == "design"))
         x = self.full(self.reduce(x))          # the bar tops follow the attachment
-        self._straight_tendons(x)
-        return x
+        return self.with_straight_tendons(x)
 
     def interpolate_from(self, other: "MTCModel", x_other: np.ndarray) -> np.ndarray:
         """Positions (3, n_nodes) of this model from a solution of ``other`` (same system,
@@ -288,8 +302,7 @@ class MTCModel:
         x[:, :st.n_mesh] = xm.T
         x[:, st.system_node] = x_other[:, ot.system_node]
         x = self.full(self.reduce(x))
-        self._straight_tendons(x)
-        return x
+        return self.with_straight_tendons(x)
 
     # ------------------------------------------------------------------ operators
     def internal_full(self, x: np.ndarray, *, tangent: bool = True):

@@ -1,0 +1,89 @@
+"""Speed of a COM-designed controller on the MTC finite-element plant (issue 15).
+
+The deployed 2-3 system (preset 2-3-deploy, Table 7.7) on the MTC model with N x n x n
+membrane elements, in closed loop with the LQR state feedback of the COM linearisation
+(:func:`tmfem.control.deploy.lqr_state_feedback`) through the COM-state estimate
+(:class:`tmfem.control.state_estimate.FEStatePlant`), from theta_11' = 0.02 rad/s, dt = 0.01 s.
+Target (issue 15): a 20 s 2-3 deployment on the 3x10x10 MTC model in under 10 minutes, i.e.
+under 0.3 s per step. Prints the time per step and where it goes.
+
+    .venv/bin/python benchmarks/bench_fe_plant.py [--mesh 10] [--t-end 2] [--jacobian step]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import time
+
+from tmfem.control.deploy import lqr_state_feedback
+from tmfem.control.state_estimate import FEStatePlant
+from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+from tmfem.models.mtc.dynamics import MTCDynamics
+from tmfem.models.mtc.model import MTCModel
+from tmfem.simulation.driver import simulate
+from tmfem.system import load_preset
+
+
+class Timed:
+    """Proxy that times the plant calls the driver and the integrator make."""
+
+    KEYS = ("residual", "newton_matrix", "factorize", "outputs")
+
+    def __init__(self, plant):
+        self.plant = plant
+        self.t = dict.fromkeys(self.KEYS, 0.0)
+        self.n = dict.fromkeys(self.KEYS, 0)
+
+    def __getattr__(self, name):
+        fn = getattr(self.plant, name)
+        if name not in self.KEYS:
+            return fn
+
+        def timed(*a, **kw):
+            t0 = time.perf_counter()
+            out = fn(*a, **kw)
+            self.t[name] += time.perf_counter() - t0
+            self.n[name] += 1
+            return out
+        return timed
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--mesh", type=int, default=10)
+    ap.add_argument("--t-end", type=float, default=2.0)
+    ap.add_argument("--jacobian", default="step", choices=["iteration", "step", "reuse"])
+    a = ap.parse_args()
+    s = load_preset("2-3-deploy")
+    t0 = time.perf_counter()
+    com = ControlOrientedModel(s, membrane_modes=default_membrane_modes(s), rest_lengths="system")
+    z_e = com.equilibrium(com.u0, z0=com.z0)
+    ctrl, _ = lqr_state_feedback(com, u_e=com.u0, z_e=z_e, u_m=0.01)
+    t_com = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    fe = MTCModel(s, mesh_n=a.mesh, rest_lengths="system")
+    x_eq = fe.solve_static().x
+    plant = Timed(FEStatePlant(MTCDynamics(fe, x_eq, perturb={"theta_11_dot": 0.02}), com))
+    t_fe = time.perf_counter() - t0
+    print(f"2-3 on MTC {s.N}x{a.mesh}x{a.mesh}: {plant.x0.size} free DOFs; COM + LQR {t_com:.2f} s, "
+          f"MTC build + static {t_fe:.2f} s")
+    c0, w0 = time.process_time(), time.perf_counter()
+    sim = simulate(plant, t_end=a.t_end, dt=0.01, controller=ctrl, jacobian=a.jacobian)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    steps = sim.stats["steps"]
+    print(f"{a.t_end:g} s closed loop, dt = 0.01 s, jacobian={a.jacobian}: wall {wall:.2f} s, "
+          f"CPU {cpu:.2f} s, {cpu / steps * 1e3:.1f} ms CPU per step (target < 300 ms: "
+          f"{'met' if cpu / steps < 0.3 else 'NOT met'}); load average {os.getloadavg()[0]:.1f} "
+          f"on {os.cpu_count()} cores")
+    print(f"  {steps} steps, {sim.stats['newton_iterations']} Newton iterations, "
+          f"{sim.stats['jacobian_evaluations']} Newton matrices")
+    for k in Timed.KEYS:
+        if plant.n[k]:
+            print(f"  {k:<14} {plant.n[k]:6d} calls {plant.t[k]:7.2f} s "
+                  f"({1e3 * plant.t[k] / plant.n[k]:6.2f} ms/call, {100 * plant.t[k] / wall:4.1f} %)")
+    rest = wall - sum(plant.t.values())
+    print(f"  {'rest (Park loop, solves, controller)':<14} {rest:6.2f} s ({100 * rest / wall:4.1f} %)")
+
+
+if __name__ == "__main__":
+    main()

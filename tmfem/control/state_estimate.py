@@ -1,0 +1,246 @@
+"""The membrane-truss-cable finite-element model as the plant of the deployment controllers.
+
+The controllers of chapters 7-8 are designed on the control-oriented model (COM, eq. 5.27)
+and read its state z = [q, eta] (bar coordinates and membrane modal coordinates, or the
+membrane point coordinates of eqs. 5.17-5.18) with its rates. On a finite-element plant that
+state does not exist: it has to be measured. :class:`COMStateEstimator` computes it from the
+FE state as sensors would give it:
+
+* q from the bar nodes (eqs. 3.1-3.2, :func:`tmfem.models.mtc.post.q_from_positions`);
+* eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
+  nodes are taken into the floating frame of the current corners (eq. 3.3), interpolated at
+  the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
+  corner constraints, eqs. 3.5, 5.14) is subtracted and the rest is projected on the
+  relative modes in the mass inner product (:meth:`MembraneBasis.modal_coordinates`) -- a
+  full-field measurement of the membrane (photogrammetry), the best case of the "projection
+  on the control-oriented model's membrane basis";
+* the rates z' as the directional derivative of that map along the FE velocity, by a central
+  difference with a displacement step of 1e-5 m (second order: error ~1e-10 relative).
+
+Where the FE membrane moves exactly as the COM's field (eqs. 5.1, 5.3) the estimate is exact
+(test); otherwise it is the COM state closest in the kinetic-energy norm, and what it leaves
+out (modes above K, tendon vibration) is what the controller does not see.
+
+:class:`FEStatePlant` is an FE plant (:class:`tmfem.models.mtc.dynamics.MTCDynamics`: the
+tendon rest lengths as inputs, M a + C v + f_int(x; u) = 0) whose outputs are that estimate
+y = [z, z'], so every controller built for the COM plant (the adaptive PFL, the switch, the
+linear controllers) runs on it unchanged. :func:`fe_state_of` places the FE model in the
+configuration of a COM state (bars at q, membrane on the COM's field, tendons straight), the
+start of a deployment.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.fem.membrane import point_matrix
+from tmfem.models.mtc.post import member_state, q_from_positions
+from tmfem.models.mtc.topology import to_floating
+from tmfem.system.coordinates import q_index
+
+#: displacement step [m] of the central difference along the FE velocity (module docstring)
+RATE_STEP = 1e-5
+
+
+def _probe(skmesh, p: np.ndarray):
+    """Interpolation matrix of ``skmesh``'s nodal field at the reference points p (2, n); the
+    boundary nodes of another mesh lie on this mesh's boundary only up to round-off, so where
+    a point falls outside, all are pulled toward their centroid by 1e-9 of their distance."""
+    try:
+        return point_matrix(skmesh, p)
+    except InputError:
+        c = p.mean(axis=1, keepdims=True)
+        return point_matrix(skmesh, c + (1.0 - 1e-9) * (p - c))
+
+
+class COMStateEstimator:
+    """The COM state (z, z') of an FE state (module docstring).
+
+    Parameters
+    ----------
+    com : ControlOrientedModel
+        The controllers' design model, of the same system as the FE model.
+    dyn : MTCDynamics
+        The FE plant: ``positions(x)`` gives all node positions of a free-DOF state.
+    """
+
+    def __init__(self, com, dyn):
+        fe = dyn.model
+        if fe.system is not com.system:
+            raise InputError("FE plant: expected the FE model and the control-oriented model of "
+                             f"the same System, found {fe.system.name!r} and {com.system.name!r}")
+        self.com, self.dyn = com, dyn
+        basis = com.membrane
+        self._nd = com.layout.n_delta
+        self._P0 = basis.shapes[0]
+        self._Psi = basis.shapes[1:1 + self._nd]
+        # FE nodal field -> values at the COM basis nodes (reference coordinates in O_f)
+        self._I = _probe(fe.membrane.skmesh, self._P0[:2])
+        topo = fe.topology
+        self._system_node, self._n_mesh = topo.system_node, topo.n_mesh
+        self._corners = topo.mesh.corners
+        _, _, psi = q_index(com.system.M, com.system.N)
+        self._psi = psi.ravel()
+
+    def modal(self, x) -> np.ndarray:
+        """[q, eta] (modal coordinates) of the free-DOF FE positions x."""
+        xf = self.dyn.positions(x)
+        q = q_from_positions(self.com.system, xf[:, self._system_node])
+        xm = xf[:, :self._n_mesh]
+        r = to_floating((self._I @ xm.T).T, xm[:, self._corners])
+        delta = self.com.zeta(q)[:self._nd]
+        d_rel = r - self._P0 - np.einsum("k,kcn->cn", delta, self._Psi)
+        return np.concatenate([q, self.com.membrane.modal_coordinates(d_rel)])
+
+    def state(self, x, v) -> tuple[np.ndarray, np.ndarray]:
+        """(z, z') in the COM's coordinates (modal, or the point coordinates of eq. 5.18)."""
+        x, v = np.asarray(x, dtype=float), np.asarray(v, dtype=float)
+        zm = self.modal(x)
+        vmax = float(np.max(np.abs(v))) if v.size else 0.0
+        if vmax == 0.0:
+            zdm = np.zeros_like(zm)
+        else:
+            h = RATE_STEP / vmax
+            dz = self.modal(x + h * v) - self.modal(x - h * v)
+            dz[self._psi] = np.remainder(dz[self._psi] + np.pi, 2 * np.pi) - np.pi
+            zdm = dz / (2 * h)
+        P = self.com.P
+        return np.linalg.solve(P, zm), np.linalg.solve(P, zdm)
+
+
+class FEStatePlant:
+    """An FE plant whose outputs are the estimated COM state y = [z, z'] (module docstring).
+
+    Parameters
+    ----------
+    dyn : MTCDynamics
+    com : ControlOrientedModel
+    x0, v0 : ndarray, optional
+        Start state (free DOFs); default the plant's own (its equilibrium and perturbation).
+    """
+
+    def __init__(self, dyn, com, *, x0=None, v0=None):
+        self.dyn, self.estimator = dyn, COMStateEstimator(com, dyn)
+        self.input_names = list(dyn.input_names)
+        if self.input_names != list(com.input_names):
+            raise InputError(f"FE plant: expected the COM's inputs {com.input_names}, found "
+                             f"{self.input_names}")
+        self.output_names = list(com.state_names)
+        self.u0 = dyn.u0
+        self.x0 = dyn.x0 if x0 is None else np.asarray(x0, dtype=float)
+        self.v0 = dyn.v0 if v0 is None else np.asarray(v0, dtype=float)
+        if self.x0.shape != dyn.x0.shape or self.v0.shape != dyn.v0.shape:
+            raise InputError(f"FE plant start state: expected {dyn.x0.shape} free DOFs, found "
+                             f"{self.x0.shape} and {self.v0.shape}")
+
+    def residual(self, x, v, a, t, u=None):
+        return self.dyn.residual(x, v, a, t, u)
+
+    def jacobians(self, x, v, a, t, u=None):
+        return self.dyn.jacobians(x, v, a, t, u)
+
+    def newton_matrix(self, x, v, a, t, cv, ca, u=None):
+        return self.dyn.newton_matrix(x, v, a, t, cv, ca, u)
+
+    def factorize(self, S):
+        return self.dyn.factorize(S)
+
+    def outputs(self, x, v=None, u=None) -> np.ndarray:
+        """y = [z, z'], the COM state estimated from the FE state."""
+        z, zd = self.estimator.state(x, np.zeros_like(x) if v is None else v)
+        return np.concatenate([z, zd])
+
+    def recover(self, states, inputs) -> dict:
+        """What the FE model alone knows over a run, from its recorded states (n, n_free) and
+        inputs (n, n_t): the membrane deflections w_k its sensors measure at the plant's
+        output points (eqs. 5.36-5.38, :meth:`MTCDynamics.outputs`), the tendon forces of its
+        tension-only truss elements and how often one went slack (the COM's tendons cannot).
+        """
+        dyn = self.dyn
+        fe = dyn.model
+        nq = len(fe.system.q_names)
+        w, T, slack = [], [], []
+        for x, u in zip(states, inputs):
+            w.append(dyn.outputs(x)[nq:])
+            fe.set_tendon_lengths(u)
+            m = member_state(fe, dyn.positions(x))
+            T.append(m["tendon_force"]); slack.append(int(np.sum(m["tendon_slack"])))
+        fe.set_tendon_lengths(dyn.u0)
+        T, slack = np.array(T), np.array(slack)
+        return {"w": np.array(w), "model": "mtc", "free_dofs": int(dyn.x0.size),
+                "max_tendon_stress_Pa": float(np.max(T / fe.tendon_area)),
+                "min_tendon_force_N": float(np.min(T)),
+                "tendon_slack_samples": int(np.sum(slack > 0))}
+
+
+def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
+    """Free-DOF positions and velocities of the FE model in the configuration of the COM
+    state (z, z'): labelled nodes at q (eqs. 3.1-3.2), membrane nodes on the COM's field
+    (eqs. 5.1, 5.3, interpolated from the COM basis nodes at the FE reference nodes), tendon
+    internal nodes on the chords; velocities by a central difference of that placement along
+    z' (``step`` in the coordinates).
+    """
+    fe = dyn.model
+    if fe.system is not com.system:
+        raise InputError("FE start state: expected the FE model and the control-oriented model of "
+                         "the same System")
+    topo = fe.topology
+    interp = _probe(com.membrane.scalar_basis.mesh, topo.mesh.p)
+
+    def place(zz):
+        zm = com.P @ zz
+        x = np.zeros((3, topo.n_nodes))
+        x[:, topo.system_node] = com.system.nodes(zm[:com.nq])
+        xm, _ = com.membrane_positions(zz)
+        x[:, :topo.n_mesh] = (interp @ xm.T).T
+        return fe.reduce(fe.with_straight_tendons(fe.full(fe.reduce(x))))[fe.free]
+
+    z = np.asarray(z, dtype=float)
+    x = place(z)
+    if zd is None or not np.any(zd):
+        return x, np.zeros_like(x)
+    zd = np.asarray(zd, dtype=float)
+    return x, (place(z + step * zd) - place(z - step * zd)) / (2 * step)
+
+
+def start_rest_lengths(initial, tendon_law: str, nominal) -> np.ndarray:
+    """Rest lengths that hold the packaged design ``initial`` (a System with its designed
+    rest lengths) in equilibrium under a plant's tendon law: the design's tendon forces
+    T = EA (|d| - r) / r (eqs. 3.8-3.9) produced by k = EA / r (``"cable"``: the design's own
+    rest lengths) or by the fixed rate k = EA / r_0 of the ``nominal`` rest lengths
+    (``"fixed-rate"``: r = |d| - T r_0 / EA)."""
+    if initial.rest_lengths is None:
+        raise InputError(f"FE plant start: expected designed rest lengths in {initial.name!r}, "
+                         "found none")
+    r = np.asarray(initial.rest_lengths, dtype=float)
+    if tendon_law == "cable":
+        return r
+    EA = initial.tendon_EA
+    L = initial.tendon_lengths(initial.q)
+    T = EA * (L - r) / r
+    return L - T * np.asarray(nominal, dtype=float) / EA
+
+
+def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
+                         tendon_law: str = "cable") -> FEStatePlant:
+    """The MTC model of the COM's system (its rest lengths, N x mesh_n x mesh_n membrane,
+    ``tendon_elements`` trusses per tendon, the tendon law of :class:`MTCModel`) as the plant
+    of a deployment, its sensors at the COM's output points.
+
+    The start is the plant's own equilibrium at rest in the packaged configuration: from the
+    placement of the COM configuration of ``initial`` (:func:`fe_state_of`, bars at its q, eta
+    = 0) the FE statics are solved under :func:`start_rest_lengths` -- the bars take their
+    axial strain, the membrane and tendons their FE shapes -- so that the run starts without
+    the transient of an FE state out of equilibrium."""
+    from tmfem.models.mtc.dynamics import MTCDynamics
+    from tmfem.models.mtc.model import MTCModel
+    fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
+                  rest_lengths=com.u0, tendon_law=tendon_law)
+    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points)
+    z0 = np.linalg.solve(com.P, np.concatenate([np.asarray(initial.q, dtype=float),
+                                                np.zeros(com.K)]))
+    x_place, _ = fe_state_of(com, dyn, z0)
+    fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
+    st = fe.solve_static(x0=dyn.positions(x_place))
+    fe.set_tendon_lengths(com.u0)
+    return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free])
