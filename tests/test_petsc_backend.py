@@ -289,3 +289,60 @@ def test_failure_on_one_rank_one_error_nonzero_exit():
     p = _mpirun(2, "1-4", "4", "--fail-rank", "1", timeout=60)
     assert p.returncode != 0
     assert p.stderr.count("error: rank 1 of 2: FloatingPointError") == 1
+
+
+# ---------------------------------------------------------------- CLI under mpiexec: output
+def _cli_in_rank_dirs(tmp_path, n, *argv, timeout=120):
+    """``tmfem ARGV`` under ``mpiexec -n n``, each rank r in its own working directory
+    tmp_path/rank<r> (relative output paths then show which ranks wrote files)."""
+    return _mpirun(n, str(tmp_path), *argv, timeout=timeout,
+                   program=[sys.executable, str(ROOT / "tests" / "mpi" / "in_rank_dir.py")])
+
+
+def _written(tmp_path, rank):
+    d = tmp_path / f"rank{rank}"
+    return sorted(str(p.relative_to(d)) for p in d.rglob("*") if p.is_file())
+
+
+@needs_mpi
+def test_cli_static_writes_each_output_once_from_rank_0(tmp_path):
+    # source: the serial run of the same command (the document rank 0 prints must be it)
+    argv = ["static", "--preset", "2-3", "--mesh", "4", "--backend", "petsc", "--json",
+            "--vtk", "out/s.vtu", "--monitor", "B_11"]
+    p = _cli_in_rank_dirs(tmp_path, 2, *argv)
+    assert p.returncode == 0, p.stderr
+    d2 = json.loads(p.stdout)                  # exactly one document on stdout
+    assert _written(tmp_path, 0) == ["out/s.vtu"] and _written(tmp_path, 1) == []
+    assert p.stderr.count("tmfem static: 2-3") == 1       # progress line from rank 0 only
+    p1 = subprocess.run([sys.executable, "-m", "tmfem", *argv[:-4]], capture_output=True,
+                        text=True, cwd=tmp_path)
+    d1 = json.loads(p1.stdout)
+    assert d2["iterations"] == d1["iterations"]
+    assert d2["tendon_force"].keys() == d1["tendon_force"].keys()
+    assert np.allclose(list(d2["tendon_force"].values()), list(d1["tendon_force"].values()),
+                       rtol=1e-9, atol=0)
+
+
+@needs_mpi
+def test_cli_converge_writes_csv_and_plot_once_from_rank_0(tmp_path):
+    conv = ["converge", "--preset", "2-3", "--mesh", "2,3", "--tendon-elements", "1",
+            "--modes", "3", "--backend", "petsc", "--csv", "c.csv", "--plot", "c.png"]
+    p = _cli_in_rank_dirs(tmp_path, 2, *conv)
+    assert p.returncode == 0, p.stderr
+    assert _written(tmp_path, 0) == ["c.csv", "c.png"] and _written(tmp_path, 1) == []
+    assert (tmp_path / "rank0" / "c.csv").read_text().count("\n") == 3   # header + 2 rows
+    assert p.stdout.count("MTC convergence") == 1
+
+
+@needs_mpi
+def test_cli_output_refused_on_rank_0_only_is_one_error_exit_2(tmp_path):
+    # an output directory that rank 0 cannot create (a file is in the way in its working
+    # directory only): rank 0's check is collective, so every rank stops at once with the
+    # serial run's exit code 2 and one message, before any work (no abort after a grace)
+    (tmp_path / "rank0").mkdir(parents=True)
+    (tmp_path / "rank0" / "out").write_text("a file")
+    p = _cli_in_rank_dirs(tmp_path, 2, "modal", "--preset", "2-3", "--mesh", "4", "--backend",
+                          "petsc", "--vtk", "out/m.vtu", timeout=60)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.count("error:") == 1 and "--vtk" in p.stderr and "MPI_ABORT" not in p.stderr
+    assert p.stdout == ""
