@@ -38,6 +38,7 @@ class TimedBackend:
 
     def __init__(self, inner):
         self.inner, self.name = inner, inner.name
+        self.distributed_assembly = getattr(inner, "distributed_assembly", False)
         self.t_factor = self.t_solve = self.t_eig = 0.0
         self.n_factor = 0
 

@@ -200,12 +200,13 @@ class MembraneTL:
                              f"found {x.shape}")
         return x
 
-    def strain(self, x):
+    def strain(self, x, *, elements: slice = slice(None)):
         """Deformation gradient F (3, 2, ne, nqp) and Green-Lagrange strain E (2, 2, ...) at
-        the Gauss points (eq. 4.7)."""
+        the Gauss points (eq. 4.7) of the ``elements`` (a slice; default all):
+        F_ia = delta_ia + sum_k u_i(node k) N_k,a, u = x - X (X = (x_f, y_f, 0))."""
         x = self._check_x(x)
-        u = (x - self.X).T.ravel()
-        F = np.array(self.basis.interpolate(u).grad)
+        ue = (x - self.X)[:, self.skmesh.t[:, elements]]                # (3, 4, ne)
+        F = np.einsum("ike,kaeq->iaeq", ue, self._dN[:, :, elements], optimize=True)
         F[0, 0] += 1.0
         F[1, 1] += 1.0
         C = np.einsum("ia...,ib...->ab...", F, F)
@@ -221,12 +222,13 @@ class MembraneTL:
         S, _ = self.law.stress(Eg, tangent=False)
         return F, Eg, S
 
-    def strain_energy(self, x) -> float:
+    def strain_energy(self, x, *, elements: slice = slice(None)) -> float:
         """Strain energy [J] at current positions x (3, nn): h int W(E) dA with the law's
-        energy density (SVK: lam tr(E)^2 / 2 + mu E:E, the potential of eq. 4.9)."""
-        _, Eg = self.strain(x)
+        energy density (SVK: lam tr(E)^2 / 2 + mu E:E, the potential of eq. 4.9), of the
+        ``elements`` (a slice; default all)."""
+        _, Eg = self.strain(x, elements=elements)
         dens = self.law.energy_density(Eg)
-        return self.material.h * float(np.sum(dens * np.asarray(self.basis.dx)))
+        return self.material.h * float(np.sum(dens * self._dx[elements]))
 
     def wrinkling(self, x) -> dict:
         """State of each element under the mixed criterion of the law
@@ -252,17 +254,18 @@ class MembraneTL:
         fe, Ke = self.element_arrays(x, tangent=tangent)
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
 
-    def element_arrays(self, x, *, tangent: bool = True):
+    def element_arrays(self, x, *, tangent: bool = True, elements: slice = slice(None)):
         """Element internal forces fe (ne, 12) and tangents Ke (ne, 12, 12) (or None) at
-        current positions x (3, nn), local dofs node-major (3 per node).
+        current positions x (3, nn), local dofs node-major (3 per node), of the ``elements``
+        (a slice; default all).
 
         Vectorised B-matrix kernel of eqs. 4.4-4.6: the variation of the Green-Lagrange strain
         of node k, component i is (Voigt) B = [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1].
         """
-        F, Eg = self.strain(x)
+        F, Eg = self.strain(x, elements=elements)
         S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
-        dN, dx = self._dN, self._dx
+        dN, dx = self._dN[:, :, elements], self._dx[elements]
         P = h * np.einsum("ia...,ab...->ib...", F, S)                 # (3, 2, ne, nqp)
         fe = np.einsum("ibeq,kbeq,eq->eki", P, dN, dx).reshape(-1, 12)
         if not tangent:
@@ -345,19 +348,26 @@ class MembraneElement:
         self._asm = Assembler(dofmap.element_dofs(nodes[t]), dofmap.ndof)
         self._M = None
 
-    @property
-    def element_dofs(self) -> np.ndarray:
-        """(n_elements, 12) global dofs of each quadrilateral (its assembly numbering)."""
-        return self._asm.dofs
-
     def internal(self, state, *, tangent: bool = True):
         """Internal force and tangent of eqs. 4.4-4.6 in the global numbering."""
         fe, Ke = self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent)
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
 
-    def energy(self, state) -> float:
-        """Strain energy (:meth:`MembraneTL.strain_energy`)."""
-        return self.membrane.strain_energy(state.x[:, self.nodes])
+    def energy(self, state, *, elements: slice = slice(None)) -> float:
+        """Strain energy (:meth:`MembraneTL.strain_energy`) of the ``elements`` (default all)."""
+        return self.membrane.strain_energy(state.x[:, self.nodes], elements=elements)
+
+    @property
+    def element_dofs(self) -> np.ndarray:
+        """(n_elements, 12) global dofs of each quadrilateral (its assembly numbering; the
+        share protocol of :class:`tmfem.fem.distributed.DistributedElements`)."""
+        return self._asm.dofs
+
+    def element_arrays(self, state, *, tangent: bool = True, elements: slice = slice(None)):
+        """Element forces (ne, 12) and tangents (ne, 12, 12) of the ``elements`` at ``state``
+        (:meth:`MembraneTL.element_arrays`), local dofs ordered as :attr:`element_dofs`."""
+        return self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent,
+                                            elements=elements)
 
     def mass(self) -> sp.csr_matrix:
         """Consistent mass (:meth:`MembraneTL.mass`) on the global dofs."""

@@ -26,7 +26,7 @@ converged state (eq. 5.32).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -142,6 +142,7 @@ class MTCModel:
         self.bar_element = TrussElement(self.bars, topo.dofmap)
         self.free = topo.constraints.free
         self._M = None
+        self._dist = None
         self.rest_lengths_source = None
         if rest_lengths is None:
             rest_lengths = "system" if system.rest_lengths is not None else "design"
@@ -188,6 +189,7 @@ class MTCModel:
         self.tendon_element = TrussElement(self.tendons, self.topology.dofmap,
                                            lumped_mass=self.lumped_tendon_mass)
         self._M = None
+        self._dist = None
 
     def set_tendon_lengths(self, u) -> None:
         """Tendon rest lengths as time-varying inputs (a plant's u): the reference lengths of
@@ -302,6 +304,21 @@ class MTCModel:
         f, K = self.internal_full(self.full(xr), tangent=tangent)
         return c.residual(f), (c.tangent(K) if tangent else None)
 
+    @property
+    def distributed(self):
+        """The element sets assembled rank by rank on the free dofs
+        (:class:`tmfem.fem.distributed.DistributedElements`) when the backend assembles
+        distributed matrices (PETSc, on one rank or under ``mpiexec``), else None. The
+        static solve and the modes then work on it: each rank evaluates and assembles its
+        share of the membrane elements."""
+        if not getattr(self.backend, "distributed_assembly", False):
+            return None
+        if self._dist is None:
+            from tmfem.fem.distributed import DistributedElements
+            self._dist = DistributedElements(self.elements, State(x=self.initial_positions("design")),
+                                             self.topology.T, self.free)
+        return self._dist
+
     def mass(self) -> sp.csr_matrix:
         """Reduced mass matrix T^T M T (membrane consistent, bars consistent, tendons
         consistent or lumped)."""
@@ -377,14 +394,36 @@ class MTCModel:
             if callable(progress):
                 progress(it, rn, mu, rho)
 
+        xr0 = self.reduce(x)
+        dist = self.distributed
+        if dist is None:                   # unknowns: all independent positions xr
+            residual, energy, u0, unknowns = self.residual, self.energy, xr0, free
+
+            def positions(u):
+                return u
+        else:                              # unknowns: the free ones, assembled rank by rank
+            u0, unknowns = xr0[free], np.ones(dist.N, bool)
+
+            def positions(u):
+                xr = xr0.copy()
+                xr[free] = u
+                return xr
+
+            def residual(u):
+                return dist.residual(State(x=self.full(positions(u))))
+
+            def energy(u):
+                return dist.energy(State(x=self.full(positions(u))))
+
         res = trust_region_newton(
-            self.residual, self.energy, self.reduce(x), free=free,
-            scale=np.maximum(Md, 1e-9 * Md.max()), force_scale=lambda xr: self._force_scale(self.full(xr)),
-            tol=tol, max_iter=max_iter, backend=self.backend, callback=record,
+            residual, energy, u0, free=unknowns, scale=np.maximum(Md, 1e-9 * Md.max()),
+            force_scale=lambda u: self._force_scale(self.full(positions(u))),
+            tol=tol, max_iter=max_iter, backend=self.backend,
+            callback=lambda it, u, rn, mu, rho: record(it, positions(u), rn, mu, rho),
             # from the design the tangent is already positive definite: try Newton first
             newton_first=(x0 is not None or start == "design"),
-            describe=self.state_note, what="MTC static solve")
-        return StaticResult(x=self.full(res.u), iterations=res.iterations,
+            describe=lambda u: self.state_note(positions(u)), what="MTC static solve")
+        return StaticResult(x=self.full(positions(res.u)), iterations=res.iterations,
                             residual_history=res.residual_history,
                             monitor={k: np.array(v) for k, v in hist.items()},
                             dt2_history=res.mu_history, time=time.perf_counter() - t0)
@@ -416,8 +455,15 @@ class MTCModel:
         Returns a ``Modes`` of :func:`tmfem.solvers.lowest_modes` whose ``shapes`` are the
         reduced vectors; :meth:`full_shapes` maps them to all nodes.
         """
-        _, K = self.residual(self.reduce(x))
-        return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma, backend=self.backend)
+        dist = self.distributed
+        if dist is None:
+            _, K = self.residual(self.reduce(x))
+            return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma, backend=self.backend)
+        _, K = dist.residual(State(x=self.full(self.reduce(x))))
+        modes = lowest_modes(K, dist.mass(), k=k, sigma=sigma, backend=self.backend)
+        shapes = np.zeros((self.free.size, modes.shapes.shape[1]))
+        shapes[self.free] = modes.shapes
+        return replace(modes, shapes=shapes)
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
         """Mode shapes (3, n_nodes, k) from reduced vectors (3 n_red, k)."""
