@@ -329,13 +329,20 @@ def test_cli_static_writes_each_output_once_from_rank_0(tmp_path):
 
 @needs_mpi
 def test_cli_converge_writes_csv_and_plot_once_from_rank_0(tmp_path):
+    # source: the serial scipy run of the same study (frequencies to 1e-8)
     conv = ["converge", "--preset", "2-3", "--mesh", "2,3", "--tendon-elements", "1",
-            "--modes", "3", "--backend", "petsc", "--csv", "c.csv", "--plot", "c.png"]
-    p = _cli_in_rank_dirs(tmp_path, 2, *conv)
+            "--modes", "3", "--json", "--csv", "c.csv", "--plot", "c.png"]
+    p = _cli_in_rank_dirs(tmp_path, 2, *conv, "--backend", "petsc")
     assert p.returncode == 0, p.stderr
     assert _written(tmp_path, 0) == ["c.csv", "c.png"] and _written(tmp_path, 1) == []
     assert (tmp_path / "rank0" / "c.csv").read_text().count("\n") == 3   # header + 2 rows
-    assert p.stdout.count("MTC convergence") == 1
+    rows2 = json.loads(p.stdout)["rows"]
+    p1 = subprocess.run([sys.executable, "-m", "tmfem", *conv[:-4]], capture_output=True,
+                        text=True, cwd=tmp_path)
+    rows1 = json.loads(p1.stdout)["rows"]
+    for r1, r2 in zip(rows1, rows2, strict=True):
+        f1, f2 = ([r[f"f{i}"] for i in (1, 2, 3)] for r in (r1, r2))
+        assert np.allclose(f2, f1, rtol=1e-8, atol=0)
 
 
 @needs_mpi
