@@ -139,6 +139,13 @@ def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
     return 0
 
 
+class Pattern:
+    """Identity of a sparsity pattern (one per :class:`DistributedAssembler`); the backend
+    keys its factorisations by it and frees them when the pattern is gone."""
+
+    __slots__ = ("__weakref__",)
+
+
 class DistributedMatrix:
     """A parallel PETSc AIJ matrix assembled by a :class:`DistributedAssembler`.
 
@@ -273,7 +280,7 @@ class DistributedAssembler:
         self._indices = (okeys % self.N if self.N else okeys).astype(self.PETSc.IntType)
         self._indptr = np.zeros(self.hi - self.lo + 1, dtype=self.PETSc.IntType)
         np.cumsum(np.bincount(orow, minlength=self.hi - self.lo), out=self._indptr[1:])
-        self._pattern = object()
+        self._pattern = Pattern()
 
     def _check(self, Xe, g, what):
         """Every rank agrees that the local arrays are finite and of the right shape."""

@@ -195,6 +195,10 @@ class PetscBackend:
         key = ("dist", id(A.pattern))
         entry = self._cache.get(key)
         if entry is None:
+            import weakref
+            # the factorisation lives as long as the pattern (the model's assembler): the id
+            # of a dead pattern may come back, its Mat must not
+            weakref.finalize(A.pattern, self._drop, key).atexit = False
             M = base.mat.duplicate(copy=True)
         else:
             M = entry[0]
@@ -206,6 +210,13 @@ class PetscBackend:
             d.setArray(A.d[lo:hi])
             M.setDiagonal(d, addv=self.PETSc.InsertMode.ADD_VALUES)
         return M, key
+
+    def _drop(self, key) -> None:
+        """Free the cached Mat and KSP (MUMPS factors) of ``key``."""
+        entry = self._cache.pop(key, None)
+        if entry is not None:
+            entry[1].destroy()
+            entry[0].destroy()
 
     def _symmetric(self, A, M) -> bool:
         """Whether A (scipy, the same on every rank) or its PETSc Mat M equals its transpose
@@ -282,8 +293,7 @@ class PetscBackend:
             self._configure(ksp, sym)
             entry = [M, ksp, 0, sym]
             if len(self._cache) >= 4:
-                old = self._cache.pop(next(iter(self._cache)))
-                old[1].destroy()
+                self._drop(next(iter(self._cache)))
             self._cache[key] = entry
         else:
             ksp = entry[1]
@@ -401,9 +411,6 @@ class PetscBackend:
             E.setTarget(float(sigma))
             E.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
             E.setTolerances(tol=self.eig_tol, max_it=1000)
-            # no purification (one more solve per vector): the Rayleigh-Ritz step below
-            # (and the callers') gives the M-orthonormal vectors
-            E.setPurify(False)
             st = E.getST()
             st.setType(SLEPc.ST.Type.SINVERT)
             st.setShift(float(sigma))

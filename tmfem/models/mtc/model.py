@@ -372,8 +372,10 @@ class MTCModel:
                               membrane_law=self.membrane_law)
             rc = coarse.solve_static(start=start, tol=tol, max_iter=max_iter, monitor=monitor,
                                      progress=progress, sequence=sequence)
-            fine = self.solve_static(x0=self.interpolate_from(coarse, rc.x), tol=tol,
-                                     max_iter=max_iter, monitor=monitor, progress=progress)
+            x_fine = self.interpolate_from(coarse, rc.x)
+            del coarse                 # its element arrays and factorisations, before the fine level
+            fine = self.solve_static(x0=x_fine, tol=tol, max_iter=max_iter, monitor=monitor,
+                                     progress=progress)
             return StaticResult(
                 x=fine.x, iterations=rc.iterations + fine.iterations,
                 residual_history=rc.residual_history + fine.residual_history[1:],
