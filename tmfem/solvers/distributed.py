@@ -139,6 +139,18 @@ def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
     return 0
 
 
+def gather(vec) -> np.ndarray:
+    """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
+    local = vec.getArray(readonly=True)
+    comm = vec.getComm().tompi4py()
+    if comm.size == 1:
+        return np.array(local)
+    counts = np.array(comm.allgather(local.size))
+    out = np.empty(int(counts.sum()))
+    comm.Allgatherv(np.ascontiguousarray(local), [out, counts])
+    return out
+
+
 class Pattern:
     """Identity of a sparsity pattern (one per :class:`DistributedAssembler`); the backend
     keys its factorisations by it and frees them when the pattern is gone."""
@@ -161,21 +173,11 @@ class DistributedMatrix:
         self.mat, self.pattern, self.shape = mat, pattern, shape
         self.version = 0
 
-    def _gather(self, vec) -> np.ndarray:
-        local = vec.getArray(readonly=True)
-        comm = self.mat.getComm().tompi4py()
-        if comm.size == 1:
-            return np.array(local)
-        counts = np.array(comm.allgather(local.size))
-        out = np.empty(int(counts.sum()))
-        comm.Allgatherv(np.ascontiguousarray(local), [out, counts])
-        return out
-
     def diagonal(self) -> np.ndarray:
         """The diagonal (N,) on every rank."""
         d, _ = self.mat.createVecs()
         self.mat.getDiagonal(d)
-        return self._gather(d)
+        return gather(d)
 
     def __matmul__(self, x):
         x = np.asarray(x, dtype=float)
@@ -189,7 +191,7 @@ class DistributedMatrix:
         for j in range(cols.shape[1]):
             xv.setArray(cols[lo:hi, j])
             self.mat.mult(xv, yv)
-            out[:, j] = self._gather(yv)
+            out[:, j] = gather(yv)
         return out.reshape(x.shape)
 
     def __add__(self, D):

@@ -380,14 +380,8 @@ class PetscBackend:
 
     def gather(self, vec) -> np.ndarray:
         """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
-        local = vec.getArray(readonly=True)
-        if self.comm.size == 1:
-            return np.array(local)
-        mpi = self.comm.tompi4py()
-        counts = np.array(mpi.allgather(local.size))
-        out = np.empty(int(counts.sum()))
-        mpi.Allgatherv(np.ascontiguousarray(local), [out, counts])
-        return out
+        from tmfem.solvers.distributed import gather
+        return gather(vec)
 
     # ------------------------------------------------------------------ eigenproblems
     def eigsh(self, K, M, k, sigma):
