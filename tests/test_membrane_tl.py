@@ -230,3 +230,14 @@ def test_zero_area_reference_element_is_rejected():
     t[:, 0] = t[0, 0]
     with pytest.raises(InputError, match=r"positive area, found 1 of zero area \(elements \[0\]\)"):
         MembraneTL(mesh=MembraneMesh(p=m.p, t=t, corners=m.corners, n=m.n), material=KAPTON)
+
+
+def test_gauss_arrays_equal_scikit_fem_basis(mem):
+    # source: scikit-fem's Basis(mesh, ElementQuad1(), intorder=3) on the distorted mesh
+    from skfem import Basis, ElementQuad1
+    sb = Basis(mem.skmesh, ElementQuad1(), intorder=3)
+    for k in range(4):
+        np.testing.assert_allclose(mem._N[k], np.array(sb.basis[k][0].value), atol=1e-14)
+        np.testing.assert_allclose(mem._dN[k], np.array(sb.basis[k][0].grad), rtol=1e-12,
+                                   atol=1e-12 * np.abs(mem._dN).max())
+    np.testing.assert_allclose(mem._dx, np.array(sb.dx), rtol=1e-13)

@@ -72,6 +72,30 @@ def _forms():
     return residual, tangent
 
 
+def _q1_gauss_arrays(p: np.ndarray, t: np.ndarray):
+    """Shape functions N (4, ne, nqp), their reference-plane gradients dN (4, 2, ne, nqp) and
+    the weights dx = |det J| w (ne, nqp) of four-node quadrilaterals (nodes p (2, nn),
+    connectivity t (4, ne)) at scikit-fem's intorder-3 (2 x 2 Gauss) points: its reference
+    element and quadrature (so the values equal those of ``Basis(mesh, ElementQuad1(),
+    intorder=3)``), evaluated in closed form on the elements (the Basis object holds ~10 kB
+    per element, 4 GB transient at 4 x 320 x 320): J_ia = sum_k X_i(node k) dphi_k/dxi_a,
+    dN_k = J^-T dphi_k."""
+    from skfem import ElementQuad1
+    from skfem.quadrature import get_quadrature
+    from skfem.refdom import RefQuad
+    Xq, Wq = get_quadrature(RefQuad, 3)
+    el = ElementQuad1()
+    ref = [el.lbasis(Xq, k) for k in range(4)]
+    phi = np.stack([r[0] for r in ref])                               # (4, nqp)
+    dphi = np.stack([r[1] for r in ref])                              # (4, 2, nqp)
+    J = np.einsum("ike,kaq->iaeq", p[:, t], dphi)                     # (2, 2, ne, nqp)
+    det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+    Jinv = np.stack([np.stack([J[1, 1], -J[0, 1]]), np.stack([-J[1, 0], J[0, 0]])]) / det
+    dN = np.einsum("kaq,aieq->kieq", dphi, Jinv)                      # Jinv[a, i] = dxi_a/dX_i
+    N = np.broadcast_to(phi[:, None, :], (4, t.shape[1], Xq.shape[1])).copy()
+    return N, dN, np.abs(det) * Wq
+
+
 @dataclass
 class MembraneStresses:
     """Stresses of the membrane at the 2 x 2 Gauss points of each element.
@@ -157,8 +181,6 @@ class MembraneTL:
     """
 
     def __init__(self, *, mesh: MembraneMesh, material: MembraneMaterial, law="svk"):
-        from skfem import Basis, ElementQuad1
-
         p = np.asarray(mesh.p, dtype=float)
         if p.ndim != 2 or p.shape[0] != 2:
             raise InputError(f"membrane: expected a flat reference mesh with p of shape (2, nn), "
@@ -179,12 +201,8 @@ class MembraneTL:
         self.X = np.vstack([p, np.zeros((1, self.nn))])
         self.law = membrane_law(law, material)
         self._M = None
-        sb = Basis(self.skmesh, ElementQuad1(), intorder=3)
-        self._N = np.stack([np.array(sb.basis[k][0].value) for k in range(4)])  # (4, ne, nqp)
-        self._dN = np.stack([np.array(sb.basis[k][0].grad) for k in range(4)])  # (4, 2, ne, nqp)
-        self._dx = np.array(sb.dx)                                              # (ne, nqp)
-        del sb
-        self._asm = Assembler(element_dofs(self.skmesh.t, 3), self.ndof)
+        self._N, self._dN, self._dx = _q1_gauss_arrays(p, t)
+        self._asm_cache = None
         if not np.array_equal(np.asarray(self.skmesh.t), np.asarray(mesh.t)):
             raise RuntimeError("scikit-fem reordered the quadrilateral connectivity")
 
@@ -263,6 +281,15 @@ class MembraneTL:
         fe, Ke = self.element_arrays(x, tangent=tangent)
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
 
+    @property
+    def _asm(self) -> Assembler:
+        """The CSR assembler of the membrane's own dofs, built on first use (its pattern
+        index is 144 entries per element: 0.5 GB at 4 x 320 x 320, unused by the
+        distributed assembly)."""
+        if self._asm_cache is None:
+            self._asm_cache = Assembler(element_dofs(self.skmesh.t, 3), self.ndof)
+        return self._asm_cache
+
     def element_arrays(self, x, *, tangent: bool = True, elements: slice = slice(None)):
         """Element internal forces fe (ne, 12) and tangents Ke (ne, 12, 12) (or None) at
         current positions x (3, nn), local dofs node-major (3 per node), of the ``elements``
@@ -305,13 +332,17 @@ class MembraneTL:
         return f, K.tocsr()
 
     def mass(self) -> sp.csr_matrix:
-        """Consistent mass matrix rho h int u.v dA: element blocks rho h sum_q N_k N_l dx_q
-        times the 3 x 3 identity (the 2 x 2 Gauss points of the kernels)."""
+        """Consistent mass matrix rho h int u.v dA: the scalar element blocks rho h sum_q
+        N_k N_l dx_q (the 2 x 2 Gauss points of the kernels) times the 3 x 3 identity
+        (kron with the node-interleaved dofs 3 node + component)."""
         if self._M is None:
             rhoh = self.material.rho * self.material.h
             me = rhoh * np.einsum("keq,leq,eq->ekl", self._N, self._N, self._dx)
-            Me = me[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
-            self._M = self._asm.matrix(Me.reshape(-1, 12, 12))
+            t = np.asarray(self.skmesh.t)
+            rows = np.broadcast_to(t.T[:, :, None], me.shape).ravel()
+            cols = np.broadcast_to(t.T[:, None, :], me.shape).ravel()
+            Ms = sp.csr_matrix((me.ravel(), (rows, cols)), shape=(self.nn, self.nn))
+            self._M = sp.kron(Ms, sp.identity(3), format="csr")
         return self._M
 
     def area(self) -> float:
@@ -359,13 +390,22 @@ class MembraneElement:
                              f"{nodes.shape}")
         self.membrane, self.nodes, self.dofmap = membrane, nodes, dofmap
         t = np.asarray(membrane.skmesh.t)
-        self._asm = Assembler(dofmap.element_dofs(nodes[t]), dofmap.ndof)
+        self._dofs = dofmap.element_dofs(nodes[t])
+        self._asm_cache = None
         self._M = None
 
     def internal(self, state, *, tangent: bool = True):
         """Internal force and tangent of eqs. 4.4-4.6 in the global numbering."""
         fe, Ke = self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent)
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
+
+    @property
+    def _asm(self) -> Assembler:
+        """The CSR assembler on the global dofs, built on first use (the distributed
+        assembly has its own)."""
+        if self._asm_cache is None:
+            self._asm_cache = Assembler(self._dofs, self.dofmap.ndof)
+        return self._asm_cache
 
     def energy(self, state, *, elements: slice = slice(None)) -> float:
         """Strain energy (:meth:`MembraneTL.strain_energy`) of the ``elements`` (default all)."""
@@ -375,7 +415,7 @@ class MembraneElement:
     def element_dofs(self) -> np.ndarray:
         """(n_elements, 12) global dofs of each quadrilateral (its assembly numbering; the
         share protocol of :class:`tmfem.fem.distributed.DistributedElements`)."""
-        return self._asm.dofs
+        return self._dofs
 
     def element_arrays(self, state, *, tangent: bool = True, elements: slice = slice(None)):
         """Element forces (ne, 12) and tangents (ne, 12, 12) of the ``elements`` at ``state``
