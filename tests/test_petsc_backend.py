@@ -360,3 +360,24 @@ def test_cli_output_refused_on_rank_0_only_is_one_error_exit_2(tmp_path):
     assert p.returncode == 2, p.stderr
     assert p.stderr.count("error:") == 1 and "--vtk" in p.stderr and "MPI_ABORT" not in p.stderr
     assert p.stdout == ""
+
+
+@needs_petsc
+def test_distributed_tangent_held_by_a_caller_is_not_overwritten(models):
+    # source: the scipy tangent of the same states (a solver holds its iterate's tangent
+    # while it evaluates trial points: a refill in place would hand it another state's)
+    from tmfem.fem.element import State
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("2-3"), mesh_n=4, backend="petsc")
+    d, ms = m.distributed, models["2-3"]
+    x0 = m.initial_positions("design")
+    xs = [x0, 1.001 * x0, 1.002 * x0]
+    held = [d.residual(State(x=x))[1] for x in xs]          # all three alive at once
+    for x, K in zip(xs, held):
+        Ks = ms.residual(ms.reduce(x))[1][ms.free][:, ms.free]
+        assert np.allclose(K.diagonal(), Ks.diagonal(), rtol=1e-12, atol=0)
+    n_before = len(d._K)
+    del held
+    d.residual(State(x=x0))
+    assert len(d._K) == n_before                            # a dropped one is refilled

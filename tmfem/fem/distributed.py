@@ -21,11 +21,14 @@ How an element set is shared out over the ranks:
   rank contributes its block of the entries of its assembled tangent (the set's CSR pattern
   is fixed) and, on rank 0, its force and energy.
 
-Every rank holds the full state (vectors are replicated, O(n) per rank). Two tangents are
-kept (:meth:`DistributedElements.residual` alternates between them), so that a solver can
-hold the tangent of its iterate while it evaluates a trial point.
+Every rank holds the full state (vectors are replicated, O(n) per rank). A tangent that a
+caller still references is never refilled (:meth:`DistributedElements.residual` reuses an
+unreferenced one, else assembles a new one): a solver holds the tangent of its iterate
+while it evaluates trial points (two or three matrices in all).
 """
 from __future__ import annotations
+
+import sys
 
 import numpy as np
 import scipy.sparse as sp
@@ -78,8 +81,7 @@ class DistributedElements:
                 self._entries.append((K0.indptr.copy(), K0.indices.copy()))
         self.assembler = DistributedAssembler(groups, self.n, T=self.T, keep=self.free,
                                               comm=self.comm)
-        self._K = [None, None]
-        self._next = 0
+        self._K = []
         self._M = None
 
     @property
@@ -89,8 +91,8 @@ class DistributedElements:
 
     def residual(self, state, *, tangent: bool = True):
         """``(r, K)``: the internal force on the free dofs (N,), the same on every rank, and
-        the tangent (a :class:`~tmfem.solvers.distributed.DistributedMatrix`; the second
-        call from now reuses the matrix of this one), eqs. 4.4-4.6."""
+        the tangent (a :class:`~tmfem.solvers.distributed.DistributedMatrix`, refilled in a
+        later call only once the caller has dropped it), eqs. 4.4-4.6."""
         f = np.zeros(self.n)
         values = []
         for e, share, entries in zip(self.elements, self._shares, self._entries):
@@ -113,10 +115,14 @@ class DistributedElements:
         r = self.assembler.vector(f)
         if not tangent:
             return r, None
-        i = self._next
-        self._next = 1 - i
-        self._K[i] = self.assembler.matrix(*values, out=self._K[i])
-        return r, self._K[i]
+        # a tangent the caller still holds (the iterate's, while it evaluates trial points)
+        # is never overwritten: refill one that nobody references, else assemble a new one
+        for K in self._K:
+            if sys.getrefcount(K) <= 3:        # the list's, the loop's, the argument's
+                return r, self.assembler.matrix(*values, out=K)
+        K = self.assembler.matrix(*values)
+        self._K.append(K)
+        return r, K
 
     def energy(self, state) -> float:
         """Strain energy [J] of all sets, summed over the ranks (the same on every rank)."""
