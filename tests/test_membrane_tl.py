@@ -185,6 +185,20 @@ def test_consistent_mass(mem):
     assert one @ M @ one == pytest.approx(KAPTON.rho * KAPTON.h * 4.0, rel=1e-12)
     assert abs(M[0::3, 1::3]).max() == 0.0
     assert np.all(np.linalg.eigvalsh(M.toarray()) > 0)
+    # source: scikit-fem's form rho h u.v on the vector basis (the kernel's own quadrature)
+    from skfem import BilinearForm
+    from skfem.helpers import dot
+    Mf = BilinearForm(lambda u, v, w: KAPTON.rho * KAPTON.h * dot(u, v)).assemble(mem.basis)
+    assert abs(M - Mf).max() <= 1e-14 * abs(Mf).max()
+
+
+def test_gauss_points_and_area_from_the_kernel_arrays(mem):
+    # source: scikit-fem's mapping of the vector basis (the stress points) and its dx
+    x = 1.01 * mem.X
+    pts = mem.stresses(x).points
+    np.testing.assert_allclose(pts, np.array(mem.basis.mapping.F(mem.basis.X)), atol=1e-14)
+    assert mem.area() == pytest.approx(float(np.sum(mem.basis.dx)), rel=1e-14)
+    assert mem.area() == pytest.approx(4.0, rel=1e-12)
 
 
 def test_wrong_shape_is_an_input_error(mem):
@@ -216,3 +230,14 @@ def test_zero_area_reference_element_is_rejected():
     t[:, 0] = t[0, 0]
     with pytest.raises(InputError, match=r"positive area, found 1 of zero area \(elements \[0\]\)"):
         MembraneTL(mesh=MembraneMesh(p=m.p, t=t, corners=m.corners, n=m.n), material=KAPTON)
+
+
+def test_gauss_arrays_equal_scikit_fem_basis(mem):
+    # source: scikit-fem's Basis(mesh, ElementQuad1(), intorder=3) on the distorted mesh
+    from skfem import Basis, ElementQuad1
+    sb = Basis(mem.skmesh, ElementQuad1(), intorder=3)
+    for k in range(4):
+        np.testing.assert_allclose(mem._N[k], np.array(sb.basis[k][0].value), atol=1e-14)
+        np.testing.assert_allclose(mem._dN[k], np.array(sb.basis[k][0].grad), rtol=1e-12,
+                                   atol=1e-12 * np.abs(mem._dN).max())
+    np.testing.assert_allclose(mem._dx, np.array(sb.dx), rtol=1e-13)

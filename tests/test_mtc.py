@@ -294,3 +294,31 @@ def test_two_stage_system_lands_on_its_design():
     m2 = MTCModel(s, mesh_n=4, tendon_elements=1, rest_lengths="design")
     st2 = static_summary(m2, m2.solve_static(start="design").x)
     assert st2["max_deviation_from_design"] < 1e-3
+
+
+def test_mesh_interpolation_is_linear_and_matches_scipy_interpolate():
+    # source: closed form (piecewise-linear interpolation reproduces an affine field) and
+    # scipy.interpolate.LinearNDInterpolator on the same triangulation (independent code)
+    from scipy.interpolate import LinearNDInterpolator
+    s = load_preset("1-4")
+    coarse, fine = MTCModel(s, mesh_n=3, tendon_elements=1), MTCModel(s, mesh_n=5, tendon_elements=1)
+    A = np.array([[1.1, 0.2], [-0.1, 0.9], [0.3, 0.05]])
+    xc = coarse.initial_positions("design")
+    xc[:, :coarse.topology.n_mesh] = A @ coarse.topology.mesh.p + np.array([[0.1], [0.2], [1.0]])
+    xf = fine.interpolate_from(coarse, xc)
+    pf = fine.topology.mesh.p
+    c = pf.mean(axis=1, keepdims=True)
+    pts = c + (1.0 - 1e-9) * (pf - c)
+    nm = fine.topology.n_mesh
+    inner = np.ones(nm, bool)
+    inner[fine.topology.mesh.corners] = False            # corners follow the attachment
+    assert np.allclose(xf[:, :nm][:, inner], (A @ pts + np.array([[0.1], [0.2], [1.0]]))[:, inner],
+                       rtol=0, atol=1e-12)
+    # a non-affine field: the same values as scipy's interpolator
+    xc[:, :coarse.topology.n_mesh] = np.sin(3 * coarse.topology.mesh.p[[0, 1, 0]]) \
+        + coarse.topology.mesh.p[[1, 0, 1]] ** 2
+    xf = fine.interpolate_from(coarse, xc)
+    ref = LinearNDInterpolator(coarse.topology.mesh.p.T, xc[:, :coarse.topology.n_mesh].T)(pts.T).T
+    ok = np.all(np.isfinite(ref), axis=0) & inner
+    assert ok.sum() > 0.8 * nm
+    assert np.allclose(xf[:, :nm][:, ok], ref[:, ok], rtol=0, atol=1e-12)

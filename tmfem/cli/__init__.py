@@ -27,7 +27,7 @@ import threading
 
 import numpy as np
 
-from tmfem.errors import TmfemError
+from tmfem.errors import InputError, ResourceLimit, TmfemError
 
 
 def _subcommands() -> dict:
@@ -136,14 +136,7 @@ def main(argv=None) -> int:
     previous = _install_interrupt_handler(args.command)
     try:
         result = mod.run(args)
-        if args.json:
-            if isinstance(result, dict) and "units" not in result:
-                from tmfem.cli.units import units_of
-                result = {**result, "units": units_of(result)}
-            text = json.dumps(_finite(result), default=json_default, allow_nan=False)
-        else:
-            text = getattr(mod, "format_text", _default_text)(result)
-        print(text)
+        print(render(args, mod, result))
     except TmfemError as exc:
         print(f"tmfem {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
@@ -151,37 +144,60 @@ def main(argv=None) -> int:
         print(f"tmfem {args.command}: interrupted", file=sys.stderr)
         return 130
     except OSError as exc:                     # an output that cannot be written
-        where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
-        print(f"tmfem {args.command}: error: cannot write{where}: "
-              f"{exc.strerror or _one_line(exc)}", file=sys.stderr)
+        print(f"tmfem {args.command}: error: {_one_line(_unwritable(exc))}", file=sys.stderr)
         return 2
     except MemoryError:
-        print(f"tmfem {args.command}: error: out of memory; use a coarser mesh or fewer "
-              "modes/steps", file=sys.stderr)
+        print(f"tmfem {args.command}: error: {_OUT_OF_MEMORY}", file=sys.stderr)
         return 3
     finally:
         if previous is not None:
             signal.signal(signal.SIGINT, previous)
+    return _checks_exit(args, result)
+
+
+_OUT_OF_MEMORY = "out of memory; use a coarser mesh or fewer modes/steps"
+
+
+def render(args, mod, result) -> str:
+    """The text a command prints: one JSON document (``--json``, with the units) or the
+    module's ``format_text``."""
+    if args.json:
+        if isinstance(result, dict) and "units" not in result:
+            from tmfem.cli.units import units_of
+            result = {**result, "units": units_of(result)}
+        return json.dumps(_finite(result), default=json_default, allow_nan=False)
+    return getattr(mod, "format_text", _default_text)(result)
+
+
+def _unwritable(exc: OSError) -> str:
+    """The message of an output that cannot be written."""
+    where = f" {exc.filename}" if getattr(exc, "filename", None) else ""
+    return f"cannot write{where}: {exc.strerror or exc}"
+
+
+def _checks_exit(args, result, *, printing: bool = True) -> int:
+    """Exit code of a finished command: 1 when checks failed (listed on stderr when
+    ``printing``) unless ``--allow-infeasible``, else 0."""
     failed = failed_checks(result)
     if failed and not getattr(args, "allow_infeasible", False):
-        print(f"tmfem {args.command}: failed checks: {', '.join(map(str, failed))} "
-              "(exit 1; see docs/cli.md)", file=sys.stderr)
+        if printing:
+            print(f"tmfem {args.command}: failed checks: {', '.join(map(str, failed))} "
+                  "(exit 1; see docs/cli.md)", file=sys.stderr)
         return 1
     return 0
 
 
 def _mpi_size() -> int:
     """Number of ranks when started by mpiexec (Open MPI's or MPICH's variable), else 1."""
-    import os
     return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
 
 
 def _main_mpi(args, mod) -> int:
     """Under ``mpiexec -n P`` (P > 1): the PETSc backend only; the command runs on every rank,
-    rank 0 prints (docs/backends.md#mpi), an error is printed once with a non-zero exit."""
+    rank 0 alone prints and writes the output files (docs/backends.md#mpi), an error is
+    printed once with a non-zero exit, never a hang."""
     import contextlib
     import io
-    import os
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
     if getattr(args, "backend", None) != "petsc":
         if rank == 0:
@@ -189,19 +205,36 @@ def _main_mpi(args, mod) -> int:
                   f"--backend petsc, found --backend {getattr(args, 'backend', None) or 'scipy'} "
                   "(every rank would solve the whole problem alone)", file=sys.stderr)
         return 2
-    from tmfem.solvers.distributed import mpi_main
+    from tmfem.cli.common import OUTPUT_SUFFIXES, check_outputs
+    from tmfem.solvers.distributed import collective, mpi_main
+    if rank != 0:
+        # the other ranks compute the same result (and take part in every collective call)
+        # but write nothing: no output files, no progress, no log lines
+        for dest in OUTPUT_SUFFIXES:
+            if getattr(args, dest, None) is not None:
+                setattr(args, dest, None)
+        logging.getLogger("tmfem").setLevel(logging.CRITICAL)
+        logging.getLogger("py.warnings").setLevel(logging.CRITICAL)
+    result = {}
 
     def body():
-        # progress lines on stderr from rank 0 only (errors are printed by mpi_main)
+        with collective(what=f"tmfem {args.command}"):
+            # the output paths are checked by rank 0 before any work: every rank learns of a
+            # refused one at once instead of waiting for rank 0 in the first collective call
+            if rank == 0:
+                check_outputs(args, args.command)
         with contextlib.redirect_stderr(sys.stderr if rank == 0 else io.StringIO()):
-            result = mod.run(args)
-        if args.json:
-            if isinstance(result, dict) and "units" not in result:
-                from tmfem.cli.units import units_of
-                result = {**result, "units": units_of(result)}
-            return json.dumps(_finite(result), default=json_default, allow_nan=False)
-        return getattr(mod, "format_text", _default_text)(result)
-    return mpi_main(body, label=f"tmfem {args.command}: ")
+            try:
+                result["value"] = mod.run(args)
+            except OSError as exc:             # rank 0's output that cannot be written
+                raise InputError(_unwritable(exc)) from None
+            except MemoryError:
+                raise ResourceLimit(_OUT_OF_MEMORY) from None
+        return render(args, mod, result["value"])
+    code = mpi_main(body, label=f"tmfem {args.command}: ")
+    if code == 0:
+        code = _checks_exit(args, result["value"], printing=rank == 0)
+    return code
 
 
 def _finite(obj):

@@ -78,14 +78,26 @@ def model_options_from_args(args, command: str):
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
         check_mesh_budget(N=system.N, n=options["mesh"])
-    for dest, suffixes in (("vtk", (".vtu", ".vtk", ".xdmf")), ("png", (".png",)),
-                           ("stress_plot", (".png",)), ("csv", (".csv",)), ("plot", (".png",))):
-        if getattr(args, dest, None) is not None and not (command == "vibrate" and dest == "vtk"):
-            output_file(getattr(args, dest), option="--" + dest.replace("_", "-"),
-                        suffixes=suffixes)
-    if command == "vibrate":
-        output_dir(getattr(args, "vtk", None), option="--vtk")
+    check_outputs(args, command)
     return system, options
+
+
+#: output options of the finite-element commands (static, modal, vibrate, converge) and their
+#: suffixes; ``vibrate --vtk`` names a directory
+OUTPUT_SUFFIXES = {"vtk": (".vtu", ".vtk", ".xdmf"), "png": (".png",), "stress_plot": (".png",),
+                   "wrinkle_plot": (".png",), "csv": (".csv",), "plot": (".png",)}
+
+
+def check_outputs(args, command: str) -> None:
+    """Check the output options of ``args`` (:data:`OUTPUT_SUFFIXES`) before any work."""
+    for dest, suffixes in OUTPUT_SUFFIXES.items():
+        path = getattr(args, dest, None)
+        if path is None:
+            continue
+        if command == "vibrate" and dest == "vtk":
+            output_dir(path, option="--vtk")
+        else:
+            output_file(path, option="--" + dest.replace("_", "-"), suffixes=suffixes)
 
 
 def model_from_args(args, command: str):

@@ -4,7 +4,7 @@ from __future__ import annotations
 import csv
 
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
-                              check_mesh_budget, output_file, system_from_args)
+                              check_mesh_budget, check_outputs, system_from_args)
 from tmfem.errors import InputError
 from tmfem.models.mtc.spec import apply_rest_lengths
 from tmfem.post.convergence import plot_convergence_study
@@ -53,8 +53,7 @@ def run(args) -> dict:
     tendons = _ints(args.tendon_elements, "--tendon-elements")
     for n in meshes:
         check_mesh_budget(N=system.N, n=n)
-    output_file(args.csv, option="--csv", suffixes=(".csv",))
-    output_file(args.plot, option="--plot", suffixes=(".png",))
+    check_outputs(args, NAME)
     rows = []
     writer = fh = None
     try:

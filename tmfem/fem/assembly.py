@@ -43,7 +43,9 @@ class Assembler:
         rows = np.broadcast_to(dofs[:, :, None], (ne, nd, nd)).ravel()
         cols = np.broadcast_to(dofs[:, None, :], (ne, nd, nd)).ravel()
         keys = rows * self.n + cols
-        ukeys, self._inverse = np.unique(keys, return_inverse=True)
+        ukeys, inverse = np.unique(keys, return_inverse=True)
+        self._inverse = inverse.astype(np.int32) if ukeys.size < 2**31 else inverse
+        del inverse, keys
         self._indices = (ukeys % self.n).astype(np.int32 if self.n < 2**31 else np.int64)
         urows = ukeys // self.n
         self._indptr = np.zeros(self.n + 1, dtype=self._indices.dtype)

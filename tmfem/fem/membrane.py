@@ -49,7 +49,7 @@ from tmfem.system.materials import MembraneMaterial
 def _forms():
     """The scikit-fem forms (built lazily so that importing this module stays cheap)."""
     from skfem import BilinearForm, LinearForm
-    from skfem.helpers import dot, grad
+    from skfem.helpers import grad
 
     @LinearForm
     def residual(v, w):
@@ -69,11 +69,31 @@ def _forms():
         geometric = np.einsum("ab...,ib...,ia...->...", S, gu, gv)
         return h * (material + geometric)
 
-    @BilinearForm
-    def mass(u, v, w):
-        return w["rhoh"] * dot(u, v)
+    return residual, tangent
 
-    return residual, tangent, mass
+
+def _q1_gauss_arrays(p: np.ndarray, t: np.ndarray):
+    """Shape functions N (4, ne, nqp), their reference-plane gradients dN (4, 2, ne, nqp) and
+    the weights dx = |det J| w (ne, nqp) of four-node quadrilaterals (nodes p (2, nn),
+    connectivity t (4, ne)) at scikit-fem's intorder-3 (2 x 2 Gauss) points: its reference
+    element and quadrature (so the values equal those of ``Basis(mesh, ElementQuad1(),
+    intorder=3)``), evaluated in closed form on the elements (the Basis object holds ~10 kB
+    per element, 4 GB transient at 4 x 320 x 320): J_ia = sum_k X_i(node k) dphi_k/dxi_a,
+    dN_k = J^-T dphi_k."""
+    from skfem import ElementQuad1
+    from skfem.quadrature import get_quadrature
+    from skfem.refdom import RefQuad
+    Xq, Wq = get_quadrature(RefQuad, 3)
+    el = ElementQuad1()
+    ref = [el.lbasis(Xq, k) for k in range(4)]
+    phi = np.stack([r[0] for r in ref])                               # (4, nqp)
+    dphi = np.stack([r[1] for r in ref])                              # (4, 2, nqp)
+    J = np.einsum("ike,kaq->iaeq", p[:, t], dphi)                     # (2, 2, ne, nqp)
+    det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
+    Jinv = np.stack([np.stack([J[1, 1], -J[0, 1]]), np.stack([-J[1, 0], J[0, 0]])]) / det
+    dN = np.einsum("kaq,aieq->kieq", dphi, Jinv)                      # Jinv[a, i] = dxi_a/dX_i
+    N = np.broadcast_to(phi[:, None, :], (4, t.shape[1], Xq.shape[1])).copy()
+    return N, dN, np.abs(det) * Wq
 
 
 @dataclass
@@ -154,12 +174,13 @@ class MembraneTL:
         Reference positions (x_f, y_f, 0).
     basis : skfem.Basis
         ``Basis(mesh, ElementVector(ElementQuad1(), dim=3), intorder=3)``; its dofs are
-        node-interleaved (dof = 3 node + component), as everywhere in tmfem.
+        node-interleaved (dof = 3 node + component), as everywhere in tmfem. Built on first
+        use (the reference forms of :meth:`internal_forms`): it holds ~13 kB per element,
+        5 GB at 4 x 320 x 320; the kernels use the shape functions and their gradients at
+        the same 2 x 2 Gauss points only.
     """
 
     def __init__(self, *, mesh: MembraneMesh, material: MembraneMaterial, law="svk"):
-        from skfem import Basis, ElementQuad1, ElementVector
-
         p = np.asarray(mesh.p, dtype=float)
         if p.ndim != 2 or p.shape[0] != 2:
             raise InputError(f"membrane: expected a flat reference mesh with p of shape (2, nn), "
@@ -174,23 +195,29 @@ class MembraneTL:
         self.mesh = mesh
         self.material = material
         self.skmesh = mesh.to_skfem()
-        self.basis = Basis(self.skmesh, ElementVector(ElementQuad1(), dim=3), intorder=3)
-        nd = self.basis.nodal_dofs
-        if not np.array_equal(nd, 3 * np.arange(p.shape[1])[None, :] + np.arange(3)[:, None]):
-            raise RuntimeError("scikit-fem changed its vector dof numbering: expected "
-                               "node-interleaved nodal_dofs (dof = 3 node + component)")
+        self._basis = None
         self.nn = p.shape[1]
         self.ndof = 3 * self.nn
         self.X = np.vstack([p, np.zeros((1, self.nn))])
         self.law = membrane_law(law, material)
-        self._residual, self._tangent, self._mass = _forms()
         self._M = None
-        sb = Basis(self.skmesh, ElementQuad1(), intorder=3)
-        self._dN = np.stack([np.array(sb.basis[k][0].grad) for k in range(4)])  # (4, 2, ne, nqp)
-        self._dx = np.array(sb.dx)                                              # (ne, nqp)
-        self._asm = Assembler(element_dofs(self.skmesh.t, 3), self.ndof)
+        self._N, self._dN, self._dx = _q1_gauss_arrays(p, t)
+        self._asm_cache = None
         if not np.array_equal(np.asarray(self.skmesh.t), np.asarray(mesh.t)):
             raise RuntimeError("scikit-fem reordered the quadrilateral connectivity")
+
+    @property
+    def basis(self):
+        """The vector scikit-fem basis (class docstring), built on first use."""
+        if self._basis is None:
+            from skfem import Basis, ElementQuad1, ElementVector
+            basis = Basis(self.skmesh, ElementVector(ElementQuad1(), dim=3), intorder=3)
+            nd = basis.nodal_dofs
+            if not np.array_equal(nd, 3 * np.arange(self.nn)[None, :] + np.arange(3)[:, None]):
+                raise RuntimeError("scikit-fem changed its vector dof numbering: expected "
+                                   "node-interleaved nodal_dofs (dof = 3 node + component)")
+            self._basis = basis
+        return self._basis
 
     # ------------------------------------------------------------------ kinematics
     def _check_x(self, x) -> np.ndarray:
@@ -200,12 +227,13 @@ class MembraneTL:
                              f"found {x.shape}")
         return x
 
-    def strain(self, x):
+    def strain(self, x, *, elements: slice = slice(None)):
         """Deformation gradient F (3, 2, ne, nqp) and Green-Lagrange strain E (2, 2, ...) at
-        the Gauss points (eq. 4.7)."""
+        the Gauss points (eq. 4.7) of the ``elements`` (a slice; default all):
+        F_ia = delta_ia + sum_k u_i(node k) N_k,a, u = x - X (X = (x_f, y_f, 0))."""
         x = self._check_x(x)
-        u = (x - self.X).T.ravel()
-        F = np.array(self.basis.interpolate(u).grad)
+        ue = (x - self.X)[:, self.skmesh.t[:, elements]]                # (3, 4, ne)
+        F = np.einsum("ike,kaeq->iaeq", ue, self._dN[:, :, elements], optimize=True)
         F[0, 0] += 1.0
         F[1, 1] += 1.0
         C = np.einsum("ia...,ib...->ab...", F, F)
@@ -221,12 +249,13 @@ class MembraneTL:
         S, _ = self.law.stress(Eg, tangent=False)
         return F, Eg, S
 
-    def strain_energy(self, x) -> float:
+    def strain_energy(self, x, *, elements: slice = slice(None)) -> float:
         """Strain energy [J] at current positions x (3, nn): h int W(E) dA with the law's
-        energy density (SVK: lam tr(E)^2 / 2 + mu E:E, the potential of eq. 4.9)."""
-        _, Eg = self.strain(x)
+        energy density (SVK: lam tr(E)^2 / 2 + mu E:E, the potential of eq. 4.9), of the
+        ``elements`` (a slice; default all)."""
+        _, Eg = self.strain(x, elements=elements)
         dens = self.law.energy_density(Eg)
-        return self.material.h * float(np.sum(dens * np.asarray(self.basis.dx)))
+        return self.material.h * float(np.sum(dens * self._dx[elements]))
 
     def wrinkling(self, x) -> dict:
         """State of each element under the mixed criterion of the law
@@ -252,17 +281,27 @@ class MembraneTL:
         fe, Ke = self.element_arrays(x, tangent=tangent)
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
 
-    def element_arrays(self, x, *, tangent: bool = True):
+    @property
+    def _asm(self) -> Assembler:
+        """The CSR assembler of the membrane's own dofs, built on first use (its pattern
+        index is 144 entries per element: 0.5 GB at 4 x 320 x 320, unused by the
+        distributed assembly)."""
+        if self._asm_cache is None:
+            self._asm_cache = Assembler(element_dofs(self.skmesh.t, 3), self.ndof)
+        return self._asm_cache
+
+    def element_arrays(self, x, *, tangent: bool = True, elements: slice = slice(None)):
         """Element internal forces fe (ne, 12) and tangents Ke (ne, 12, 12) (or None) at
-        current positions x (3, nn), local dofs node-major (3 per node).
+        current positions x (3, nn), local dofs node-major (3 per node), of the ``elements``
+        (a slice; default all).
 
         Vectorised B-matrix kernel of eqs. 4.4-4.6: the variation of the Green-Lagrange strain
         of node k, component i is (Voigt) B = [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1].
         """
-        F, Eg = self.strain(x)
+        F, Eg = self.strain(x, elements=elements)
         S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
-        dN, dx = self._dN, self._dx
+        dN, dx = self._dN[:, :, elements], self._dx[elements]
         P = h * np.einsum("ia...,ab...->ib...", F, S)                 # (3, 2, ne, nqp)
         fe = np.einsum("ibeq,kbeq,eq->eki", P, dN, dx).reshape(-1, 12)
         if not tangent:
@@ -285,21 +324,30 @@ class MembraneTL:
         S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
         P = h * np.einsum("ia...,ab...->ib...", F, S)
-        f = self._residual.assemble(self.basis, P=P)
+        residual, tangent_form = _forms()
+        f = residual.assemble(self.basis, P=P)
         if not tangent:
             return f, None
-        K = self._tangent.assemble(self.basis, F=F, S=S, D=np.ascontiguousarray(D), h=h)
+        K = tangent_form.assemble(self.basis, F=F, S=S, D=np.ascontiguousarray(D), h=h)
         return f, K.tocsr()
 
     def mass(self) -> sp.csr_matrix:
-        """Consistent mass matrix (rho h int u.v dA)."""
+        """Consistent mass matrix rho h int u.v dA: the scalar element blocks rho h sum_q
+        N_k N_l dx_q (the 2 x 2 Gauss points of the kernels) times the 3 x 3 identity
+        (kron with the node-interleaved dofs 3 node + component)."""
         if self._M is None:
-            self._M = self._mass.assemble(self.basis, rhoh=self.material.rho * self.material.h).tocsr()
+            rhoh = self.material.rho * self.material.h
+            me = rhoh * np.einsum("keq,leq,eq->ekl", self._N, self._N, self._dx)
+            t = np.asarray(self.skmesh.t)
+            rows = np.broadcast_to(t.T[:, :, None], me.shape).ravel()
+            cols = np.broadcast_to(t.T[:, None, :], me.shape).ravel()
+            Ms = sp.csr_matrix((me.ravel(), (rows, cols)), shape=(self.nn, self.nn))
+            self._M = sp.kron(Ms, sp.identity(3), format="csr")
         return self._M
 
     def area(self) -> float:
         """Reference area of the membrane."""
-        return float(np.sum(self.basis.dx))
+        return float(np.sum(self._dx))
 
     # ------------------------------------------------------------------ stresses
     def stresses(self, x) -> MembraneStresses:
@@ -325,7 +373,7 @@ class MembraneTL:
         U /= np.sqrt(C[0, 0] + C[1, 1] + 2.0 * j)
         sig = np.einsum("ab...,bc...,cd...->ad...", U, S, U) / J
         cauchy = np.stack([sig[0, 0], sig[1, 1], sig[0, 1]])
-        points = np.array(self.basis.mapping.F(self.basis.X))
+        points = np.einsum("keq,jke->jeq", self._N, self.X[:2, self.skmesh.t])
         return MembraneStresses(S=np.stack([S[0, 0], S[1, 1], S[0, 1]]),
                                 cauchy=cauchy, principal=principal_stresses(cauchy),
                                 von_mises=von_mises(cauchy), points=points)
@@ -342,22 +390,38 @@ class MembraneElement:
                              f"{nodes.shape}")
         self.membrane, self.nodes, self.dofmap = membrane, nodes, dofmap
         t = np.asarray(membrane.skmesh.t)
-        self._asm = Assembler(dofmap.element_dofs(nodes[t]), dofmap.ndof)
+        self._dofs = dofmap.element_dofs(nodes[t])
+        self._asm_cache = None
         self._M = None
-
-    @property
-    def element_dofs(self) -> np.ndarray:
-        """(n_elements, 12) global dofs of each quadrilateral (its assembly numbering)."""
-        return self._asm.dofs
 
     def internal(self, state, *, tangent: bool = True):
         """Internal force and tangent of eqs. 4.4-4.6 in the global numbering."""
         fe, Ke = self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent)
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
 
-    def energy(self, state) -> float:
-        """Strain energy (:meth:`MembraneTL.strain_energy`)."""
-        return self.membrane.strain_energy(state.x[:, self.nodes])
+    @property
+    def _asm(self) -> Assembler:
+        """The CSR assembler on the global dofs, built on first use (the distributed
+        assembly has its own)."""
+        if self._asm_cache is None:
+            self._asm_cache = Assembler(self._dofs, self.dofmap.ndof)
+        return self._asm_cache
+
+    def energy(self, state, *, elements: slice = slice(None)) -> float:
+        """Strain energy (:meth:`MembraneTL.strain_energy`) of the ``elements`` (default all)."""
+        return self.membrane.strain_energy(state.x[:, self.nodes], elements=elements)
+
+    @property
+    def element_dofs(self) -> np.ndarray:
+        """(n_elements, 12) global dofs of each quadrilateral (its assembly numbering; the
+        share protocol of :class:`tmfem.fem.distributed.DistributedElements`)."""
+        return self._dofs
+
+    def element_arrays(self, state, *, tangent: bool = True, elements: slice = slice(None)):
+        """Element forces (ne, 12) and tangents (ne, 12, 12) of the ``elements`` at ``state``
+        (:meth:`MembraneTL.element_arrays`), local dofs ordered as :attr:`element_dofs`."""
+        return self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent,
+                                            elements=elements)
 
     def mass(self) -> sp.csr_matrix:
         """Consistent mass (:meth:`MembraneTL.mass`) on the global dofs."""

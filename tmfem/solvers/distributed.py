@@ -4,15 +4,16 @@ Solver-layer facility of the PETSc backend; it knows element dofs and matrices, 
 the structure they come from.
 
 * :func:`element_share` -- the contiguous block of elements this rank assembles.
-* :class:`DistributedAssembler` -- each rank passes the element vectors/matrices of *its*
-  share (global dofs, optionally mapped by a constraint matrix ``u = T u_r`` and restricted
-  to the unknowns ``keep``); matrices become one parallel PETSc AIJ matrix
-  (:class:`DistributedMatrix`) preallocated exactly from the union of the ranks' patterns,
-  vectors a full array on every rank. The pattern is exchanged once: each rank sends the
-  (row, column) keys of its entries to the rank owning the row (PETSc's default row split),
-  which builds the CSR pattern of its rows; every later assembly is one ``np.bincount`` per
-  rank and one ``Alltoallv`` of values (the COO assembly of PETSc >= 3.19, which the
-  petsc4py 3.18 of Debian bookworm does not expose).
+* :class:`DistributedAssembler` -- each rank passes the element matrices of *its* share
+  (groups of element matrices or of single entries, global dofs, mapped by a constraint
+  matrix ``u = T u_r`` and restricted to the unknowns ``keep``); they become one parallel
+  PETSc AIJ matrix (:class:`DistributedMatrix`) preallocated exactly from the union of the
+  ranks' patterns; vectors (each rank's contribution to the full force) are summed into
+  T^T f on the unknowns, a full array on every rank. The pattern is exchanged once: each
+  rank sends the (row, column) keys of its entries to the rank owning the row (PETSc's
+  default row split), which builds the CSR pattern of its rows; every later assembly is one
+  ``np.bincount`` per rank and one ``Alltoallv`` of values (the COO assembly of PETSc >=
+  3.19, which the petsc4py 3.18 of Debian bookworm does not expose).
 * :class:`collective` -- a block every rank enters: an exception on any rank is raised on
   all ranks (with the failing rank's message), so no rank waits in a collective call for a
   rank that has died (the assemblers check their element arrays so).
@@ -138,44 +139,107 @@ def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
     return 0
 
 
+def gather(vec) -> np.ndarray:
+    """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
+    local = vec.getArray(readonly=True)
+    comm = vec.getComm().tompi4py()
+    if comm.size == 1:
+        return np.array(local)
+    counts = np.array(comm.allgather(local.size))
+    out = np.empty(int(counts.sum()))
+    comm.Allgatherv(np.ascontiguousarray(local), [out, counts])
+    return out
+
+
+class Pattern:
+    """Identity of a sparsity pattern (one per :class:`DistributedAssembler`); the backend
+    keys its factorisations by it and frees them when the pattern is gone."""
+
+    __slots__ = ("__weakref__",)
+
+
 class DistributedMatrix:
     """A parallel PETSc AIJ matrix assembled by a :class:`DistributedAssembler`.
 
     ``mat`` is the petsc4py Mat; ``version`` counts value updates (the backend refuses a
-    solve of an older version); ``pattern`` identifies the sparsity pattern; ``shape``."""
+    solve of an older version); ``pattern`` identifies the sparsity pattern (matrices of one
+    assembler share it, so that the backend keeps one factorisation and its analysis for
+    them); ``shape``. The operations the solvers use are those of a scipy matrix: ``A @ x``
+    (x (N,) or (N, m), full arrays on every rank), ``A.diagonal()`` and ``A + D`` with a
+    diagonal scipy matrix D (a :class:`ShiftedMatrix`, formed by the backend when it
+    factorises it)."""
 
     def __init__(self, mat, pattern, shape):
         self.mat, self.pattern, self.shape = mat, pattern, shape
         self.version = 0
 
+    def diagonal(self) -> np.ndarray:
+        """The diagonal (N,) on every rank."""
+        d, _ = self.mat.createVecs()
+        self.mat.getDiagonal(d)
+        return gather(d)
+
+    def __matmul__(self, x):
+        x = np.asarray(x, dtype=float)
+        n = self.shape[0]
+        if x.shape[0] != n or x.ndim > 2:
+            raise InputError(f"distributed matrix: expected x of {n} rows, found shape {x.shape}")
+        lo, hi = self.mat.getOwnershipRange()
+        xv, yv = self.mat.createVecs()
+        cols = x.reshape(n, -1)
+        out = np.empty_like(cols)
+        for j in range(cols.shape[1]):
+            xv.setArray(cols[lo:hi, j])
+            self.mat.mult(xv, yv)
+            out[:, j] = gather(yv)
+        return out.reshape(x.shape)
+
+    def __add__(self, D):
+        if not (sp.issparse(D) and D.shape == self.shape
+                and sp.dia_matrix(D).offsets.tolist() in ([0], [])):
+            raise InputError(f"distributed matrix: expected a diagonal scipy matrix of shape "
+                             f"{self.shape} to add, found {type(D).__name__}"
+                             + (f" {D.shape}" if hasattr(D, "shape") else ""))
+        return ShiftedMatrix(self, np.asarray(D.diagonal(), dtype=float))
+
+    __radd__ = __add__
+
+
+class ShiftedMatrix:
+    """``base + diag(d)`` of a :class:`DistributedMatrix` (the regularised tangent of a
+    trust-region step), formed only in the backend's own copy of ``base``'s pattern."""
+
+    def __init__(self, base: DistributedMatrix, d: np.ndarray):
+        self.base, self.d, self.shape = base, d, base.shape
+        self.pattern, self.version = base.pattern, (base.version, id(d))
+
 
 class DistributedAssembler:
-    """Assemble this rank's element vectors/matrices into replicated vectors and one
-    distributed matrix (module docstring).
+    """Assemble this rank's element matrices into one distributed matrix (module docstring).
 
     Parameters
     ----------
-    dofs : ndarray (ne_local, nd)
-        Global dofs of the elements of this rank's share (full numbering, ``n`` dofs).
+    groups : list of (dofs, kind)
+        ``kind`` ``"element"``: dofs (ne_local, nd) of element matrices (nd, nd) of this
+        rank's share, full numbering; ``"entry"``: dofs (m_local, 2) (row, column) of single
+        entries (the share of an assembled matrix). A single dofs array is one element group.
     n : int
         Number of full dofs.
     T : sparse (n, n_r), optional
-        Constraint map u = T u_r: vectors become T^T f and matrices T^T K T.
+        Constraint map u = T u_r: matrices become T^T K T.
     keep : bool mask (n_r,), optional
         The unknowns (free dofs); the others are dropped and the result is numbered
         0 .. keep.sum() - 1 in their order.
     comm : mpi4py communicator, optional (COMM_WORLD)
     """
 
-    def __init__(self, dofs, n: int, *, T=None, keep=None, comm=None):
+    def __init__(self, groups, n: int, *, T=None, keep=None, comm=None):
         from tmfem.solvers.petsc import petsc_modules
         self.PETSc, _ = petsc_modules()
         self.comm = comm_world() if comm is None else comm
-        dofs = np.asarray(dofs, dtype=np.int64)
-        if dofs.ndim != 2 or (dofs.size and (dofs.min() < 0 or dofs.max() >= n)):
-            raise InputError(f"distributed assembly: expected dofs (ne, nd) in [0, {n}), found shape "
-                             f"{dofs.shape}" + (f", range [{dofs.min()}, {dofs.max()}]" if dofs.size else ""))
-        ne, nd = dofs.shape
+        if isinstance(groups, np.ndarray) or (isinstance(groups, list) and groups
+                                              and not isinstance(groups[0], tuple)):
+            groups = [(groups, "element")]
         T = sp.identity(n, format="csr") if T is None else sp.csr_matrix(T)
         if T.shape[0] != n:
             raise InputError(f"distributed assembly: expected T with {n} rows, found {T.shape}")
@@ -186,88 +250,71 @@ class DistributedAssembler:
         number = np.full(nr, -1, np.int64)
         number[keep] = np.arange(int(keep.sum()))
         self.N = int(keep.sum())
-        # each element dof -> up to p (unknown, weight) pairs of its T row; padding weight 0
-        counts = np.diff(T.indptr)
-        p = max(1, int(counts[dofs].max())) if dofs.size else 1
-        C = np.full((ne, nd, p), -1, np.int64)
-        W = np.zeros((ne, nd, p))
-        for i in range(p):                      # p is small (1 for plain dofs)
-            has = counts[dofs] > i
-            pos = T.indptr[dofs] + i
-            C[has, i] = number[T.indices[pos[has]]]
-            W[has, i] = T.data[pos[has]]
-        W[C < 0] = 0.0
-        self._p, self._C, self._W = p, C, W
-        # vector entries: (ne, nd, p)
-        self._vrows = np.where(C >= 0, C, 0).ravel()
-        # matrix entries: (ne, nd, p, nd, p)
-        rows = np.broadcast_to(C[:, :, :, None, None], (ne, nd, p, nd, p)).ravel()
-        cols = np.broadcast_to(C[:, None, None, :, :], (ne, nd, p, nd, p)).ravel()
-        valid = (rows >= 0) & (cols >= 0)
-        self._valid = valid
-        keys = rows[valid] * self.N + cols[valid]
-        ukeys, self._inverse = np.unique(keys, return_inverse=True)
+        self.T, self.keep, self.n = T, keep, int(n)
+        self._groups, keys = [], []
+        for dofs, kind in groups:
+            g = _EntryMap(np.asarray(dofs, dtype=np.int64), kind, n, T, number)
+            self._groups.append(g)
+            keys.append(g.keys(self.N))
+        keys = np.concatenate(keys) if keys else np.zeros(0, np.int64)
+        ukeys, inverse = np.unique(keys, return_inverse=True)
+        idx = np.int32 if ukeys.size < 2**31 else np.int64
+        self._inverse = inverse.astype(idx)
         self._nu = ukeys.size
         # owners of the rows (PETSc's default split) and the exchange of the pattern
         P = self.comm.size
         base, extra = divmod(self.N, P)
         starts = np.array([r * base + min(r, extra) for r in range(P + 1)])
         self.lo, self.hi = int(starts[self.comm.rank]), int(starts[self.comm.rank + 1])
-        owner = np.searchsorted(starts, ukeys // self.N, side="right") - 1
+        owner = np.searchsorted(starts, ukeys // self.N, side="right") - 1 if self.N else ukeys
         self._sendcounts = np.bincount(owner, minlength=P)
         self._recvcounts = np.array(self.comm.alltoall(self._sendcounts.tolist()))
-        recv = np.empty(int(self._recvcounts.sum()), np.int64)
-        self.comm.Alltoallv([ukeys, self._sendcounts], [recv, self._recvcounts])
-        okeys, self._recv_inverse = np.unique(recv, return_inverse=True)
+        if P == 1:
+            okeys, self._recv_inverse = ukeys, None
+        else:
+            recv = np.empty(int(self._recvcounts.sum()), np.int64)
+            self.comm.Alltoallv([ukeys, self._sendcounts], [recv, self._recvcounts])
+            okeys, rinv = np.unique(recv, return_inverse=True)
+            self._recv_inverse = rinv.astype(idx)
+        del ukeys, keys
         self._nnz = okeys.size
-        orow = okeys // self.N - self.lo
-        self._indices = (okeys % self.N).astype(self.PETSc.IntType)
+        orow = okeys // self.N - self.lo if self.N else okeys
+        self._indices = (okeys % self.N if self.N else okeys).astype(self.PETSc.IntType)
         self._indptr = np.zeros(self.hi - self.lo + 1, dtype=self.PETSc.IntType)
         np.cumsum(np.bincount(orow, minlength=self.hi - self.lo), out=self._indptr[1:])
-        self._pattern = object()
+        self._pattern = Pattern()
 
-    def _weighted(self, Xe, kind: str) -> np.ndarray:
-        """Element arrays times the constraint weights, flattened like the entry lists."""
-        W = self._W
-        if kind == "vector":
-            return (np.asarray(Xe, float)[:, :, None] * W).ravel()
-        Ke = np.asarray(Xe, float)
-        if self._p == 1:
-            return (Ke * W[:, :, 0, None] * W[:, None, :, 0]).ravel()
-        return (Ke[:, :, None, :, None] * W[:, :, :, None, None] * W[:, None, None, :, :]).ravel()
-
-    def _check(self, Xe, shape, what):
+    def _check(self, Xe, g, what):
         """Every rank agrees that the local arrays are finite and of the right shape."""
         with collective(self.comm, what):
             Xe = np.asarray(Xe, dtype=float)
-            if Xe.shape != shape:
-                raise InputError(f"{what}: expected element arrays of shape {shape}, found {Xe.shape}")
+            if Xe.shape != g.value_shape:
+                raise InputError(f"{what}: expected arrays of shape {g.value_shape}, found {Xe.shape}")
             bad = int(np.sum(~np.isfinite(Xe)))
             if bad:
                 raise errors.ConvergenceError(f"{what}: expected finite element arrays, found {bad} "
                                               "non-finite entries")
         return Xe
 
-    def vector(self, fe) -> np.ndarray:
-        """Sum over all ranks of the element vectors ``fe`` (ne_local, nd): (N,) on every rank."""
-        fe = self._check(fe, self._C.shape[:2], "distributed vector")
-        local = np.bincount(self._vrows, weights=self._weighted(fe, "vector"), minlength=self.N)
-        out = np.empty_like(local)
-        from mpi4py import MPI
-        self.comm.Allreduce(local, out, op=MPI.SUM)
-        return out
-
-    def matrix(self, Ke, *, out: DistributedMatrix | None = None) -> DistributedMatrix:
-        """Sum over all ranks of the element matrices ``Ke`` (ne_local, nd, nd): a
+    def matrix(self, *values, out: DistributedMatrix | None = None) -> DistributedMatrix:
+        """Sum over all ranks of this rank's element matrices / entries, one array per group
+        (element groups (ne_local, nd, nd), entry groups (m_local,)): a
         :class:`DistributedMatrix` (N, N); ``out`` (an earlier result of this assembler)
         is updated in place, keeping the PETSc objects (and a factorisation's analysis)."""
-        ne, nd = self._C.shape[:2]
-        Ke = self._check(Ke, (ne, nd, nd), "distributed matrix")
-        vals = np.bincount(self._inverse, weights=self._weighted(Ke, "matrix")[self._valid],
+        if len(values) != len(self._groups):
+            raise InputError(f"distributed matrix: expected {len(self._groups)} arrays (one per "
+                             f"group), found {len(values)}")
+        parts = [g.weighted(self._check(v, g, "distributed matrix"))
+                 for g, v in zip(self._groups, values)]
+        vals = np.bincount(self._inverse, weights=np.concatenate(parts) if parts else None,
                            minlength=self._nu)
-        recv = np.empty(int(self._recvcounts.sum()))
-        self.comm.Alltoallv([vals, self._sendcounts], [recv, self._recvcounts])
-        data = np.bincount(self._recv_inverse, weights=recv, minlength=self._nnz)
+        del parts
+        if self._recv_inverse is None:
+            data = vals
+        else:
+            recv = np.empty(int(self._recvcounts.sum()))
+            self.comm.Alltoallv([vals, self._sendcounts], [recv, self._recvcounts])
+            data = np.bincount(self._recv_inverse, weights=recv, minlength=self._nnz)
         PETSc = self.PETSc
         nloc = self.hi - self.lo
         if out is None:
@@ -283,6 +330,25 @@ class DistributedAssembler:
         out.version += 1
         return out
 
+    def vector(self, f_local: np.ndarray) -> np.ndarray:
+        """T^T f summed over the ranks and restricted to the unknowns: (N,) on every rank,
+        from this rank's contribution ``f_local`` (n,) to the full internal force."""
+        from mpi4py import MPI
+        f_local = np.asarray(f_local, dtype=float)
+        with collective(self.comm, "distributed vector"):
+            if f_local.shape != (self.n,):
+                raise InputError(f"distributed vector: expected ({self.n},), found {f_local.shape}")
+            bad = int(np.sum(~np.isfinite(f_local)))
+            if bad:
+                raise errors.ConvergenceError(f"distributed vector: expected finite element "
+                                              f"vectors, found {bad} non-finite entries")
+        local = (self.T.T @ f_local)[self.keep]
+        if self.comm.size == 1:
+            return local
+        out = np.empty_like(local)
+        self.comm.Allreduce(local, out, op=MPI.SUM)
+        return out
+
     def scipy(self, D: DistributedMatrix) -> sp.csr_matrix:
         """The full matrix as scipy CSR on every rank (for checks and small problems)."""
         ip, ix, v = D.mat.getValuesCSR()
@@ -291,3 +357,63 @@ class DistributedAssembler:
         indptr = np.concatenate([[0], np.cumsum(lens)])
         return sp.csr_matrix((np.concatenate([r[2] for r in rows]),
                               np.concatenate([r[1] for r in rows]), indptr), shape=D.shape)
+
+
+class _EntryMap:
+    """Where the entries of one group of a :class:`DistributedAssembler` go: each full dof
+    maps to up to p (unknown, weight) pairs of its row of T (p = 1 for plain dofs; padding
+    weight 0), an entry (i, j, v) to the entries (a, b, T_ia T_jb v) on the unknowns."""
+
+    def __init__(self, dofs, kind, n, T, number):
+        if kind not in ("element", "entry"):
+            raise InputError(f"distributed assembly: expected group kind 'element' or 'entry', "
+                             f"found {kind!r}")
+        if dofs.ndim != 2 or (kind == "entry" and dofs.shape[1] != 2) or \
+                (dofs.size and (dofs.min() < 0 or dofs.max() >= n)):
+            raise InputError(f"distributed assembly: expected {kind} dofs (m, {'2' if kind == 'entry' else 'nd'}) "
+                             f"in [0, {n}), found shape {dofs.shape}"
+                             + (f", range [{dofs.min()}, {dofs.max()}]" if dofs.size else ""))
+        self.kind = kind
+        ne, nd = dofs.shape
+        self.value_shape = (ne, nd, nd) if kind == "element" else (ne,)
+        counts = np.diff(T.indptr)
+        p = max(1, int(counts[dofs].max())) if dofs.size else 1
+        C = np.full((ne, nd, p), -1, np.int64)
+        W = np.zeros((ne, nd, p))
+        for i in range(p):                      # p is small (1 for plain dofs)
+            has = counts[dofs] > i
+            pos = T.indptr[dofs] + i
+            C[has, i] = number[T.indices[pos[has]]]
+            W[has, i] = T.data[pos[has]]
+        W[C < 0] = 0.0
+        self.p, self.C, self.W = p, C, W
+
+    def _rows_cols(self):
+        C, p = self.C, self.p
+        ne, nd = C.shape[:2]
+        if self.kind == "element":
+            rows = np.broadcast_to(C[:, :, :, None, None], (ne, nd, p, nd, p)).ravel()
+            cols = np.broadcast_to(C[:, None, None, :, :], (ne, nd, p, nd, p)).ravel()
+        else:
+            rows = np.broadcast_to(C[:, 0, :, None], (ne, p, p)).ravel()
+            cols = np.broadcast_to(C[:, 1, None, :], (ne, p, p)).ravel()
+        return rows, cols
+
+    def keys(self, N: int) -> np.ndarray:
+        """Linear keys row * N + column of the valid (unknown, unknown) entries."""
+        rows, cols = self._rows_cols()
+        self.valid = (rows >= 0) & (cols >= 0)
+        self.all_valid = bool(self.valid.all())
+        return rows[self.valid] * N + cols[self.valid]
+
+    def weighted(self, X) -> np.ndarray:
+        """Values of the valid entries: T_ia T_jb X_ij, flattened like :meth:`keys`."""
+        W = self.W
+        if self.kind == "element":
+            if self.p == 1:
+                v = (X * W[:, :, 0, None] * W[:, None, :, 0]).ravel()
+            else:
+                v = (X[:, :, None, :, None] * W[:, :, :, None, None] * W[:, None, None, :, :]).ravel()
+        else:
+            v = (X[:, None, None] * W[:, 0, :, None] * W[:, 1, None, :]).ravel()
+        return v if self.all_valid else v[self.valid]

@@ -69,8 +69,7 @@ def lowest_modes(K, M, *, k: int, free=None, sigma: float | None = None, backend
     Kf, Mf = submatrix(K, idx), submatrix(M, idx)
     if sp.issparse(Kf):
         Kf, Mf = sp.csr_matrix(Kf), sp.csr_matrix(Mf)
-    dK = Kf.diagonal() if sp.issparse(Kf) else np.diag(Kf)
-    dM = Mf.diagonal() if sp.issparse(Mf) else np.diag(Mf)
+    dK, dM = Kf.diagonal(), Mf.diagonal()        # sparse, dense or a backend's distributed matrix
     if np.any(dM <= 0):
         raise InputError(f"eigen: expected positive mass on every free dof, found {np.sum(dM <= 0)} "
                          f"free dofs with diagonal mass <= 0")

@@ -117,6 +117,10 @@ class PetscBackend:
 
     name = "petsc"
 
+    #: the models assemble their tangents rank by rank into distributed matrices for it
+    #: (:class:`tmfem.solvers.distributed.DistributedAssembler`)
+    distributed_assembly = True
+
     def __init__(self, *, solver: str = "direct", rtol: float | None = None, options=None,
                  eig_tol: float = 1e-12):
         self.PETSc, self.SLEPc = petsc_modules()
@@ -146,9 +150,9 @@ class PetscBackend:
         """(PETSc Mat, key) of A: a DistributedMatrix's Mat, or this rank's rows of a
         replicated scipy matrix. With ``cache`` a new A of an earlier pattern only updates
         that Mat's values, so that MUMPS keeps its symbolic analysis."""
-        from tmfem.solvers.distributed import DistributedMatrix
-        if isinstance(A, DistributedMatrix):
-            return A.mat, ("dist", id(A.pattern))
+        from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix
+        if isinstance(A, (DistributedMatrix, ShiftedMatrix)):
+            return self._dist_mat(A, cache=cache)
         if not sp.issparse(A):
             A = np.asarray(A, dtype=float)
         A = sp.csr_matrix(A, dtype=float)
@@ -178,6 +182,42 @@ class PetscBackend:
         M.assemble()
         return M, key
 
+    def _dist_mat(self, A, *, cache: bool):
+        """(PETSc Mat, key) of a DistributedMatrix or ShiftedMatrix: with ``cache`` the
+        values are copied into this backend's own Mat of that pattern (one factorisation
+        and one MUMPS analysis per pattern, whichever assembled matrix of the pattern or
+        shift of it comes; a later update of A leaves the factors of this one intact), the
+        shift added to its diagonal."""
+        from tmfem.solvers.distributed import ShiftedMatrix
+        base = A.base if isinstance(A, ShiftedMatrix) else A
+        if not cache and base is A:
+            return A.mat, None
+        key = ("dist", id(A.pattern))
+        entry = self._cache.get(key)
+        if entry is None:
+            import weakref
+            # the factorisation lives as long as the pattern (the model's assembler): the id
+            # of a dead pattern may come back, its Mat must not
+            weakref.finalize(A.pattern, self._drop, key).atexit = False
+            M = base.mat.duplicate(copy=True)
+        else:
+            M = entry[0]
+            base.mat.copy(M, structure=self.PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            entry[2] += 1              # earlier solves of this Mat are stale now
+        if base is not A:
+            d, _ = M.createVecs()
+            lo, hi = M.getOwnershipRange()
+            d.setArray(A.d[lo:hi])
+            M.setDiagonal(d, addv=self.PETSc.InsertMode.ADD_VALUES)
+        return M, key
+
+    def _drop(self, key) -> None:
+        """Free the cached Mat and KSP (MUMPS factors) of ``key``."""
+        entry = self._cache.pop(key, None)
+        if entry is not None:
+            entry[1].destroy()
+            entry[0].destroy()
+
     def _symmetric(self, A, M) -> bool:
         """Whether A (scipy, the same on every rank) or its PETSc Mat M equals its transpose
         to 1e-12 of its largest entry; the same answer on every rank (petsc4py 3.18's
@@ -187,8 +227,7 @@ class PetscBackend:
             big = abs(A).max() if A.nnz else 0.0
             D = A - A.T
             return bool((abs(D).max() if D.nnz else 0.0) <= 1e-12 * big)
-        if not hasattr(A, "mat"):
-            A = np.asarray(A, dtype=float)
+        if isinstance(A, np.ndarray):
             return bool(np.abs(A - A.T).max(initial=0.0) <= 1e-12 * np.abs(A).max(initial=0.0))
         # distributed: compare M x with M^T x for a random x (collective norms; a transpose
         # of the matrix would double its memory)
@@ -254,15 +293,13 @@ class PetscBackend:
             self._configure(ksp, sym)
             entry = [M, ksp, 0, sym]
             if len(self._cache) >= 4:
-                old = self._cache.pop(next(iter(self._cache)))
-                old[1].destroy()
+                self._drop(next(iter(self._cache)))
             self._cache[key] = entry
         else:
             ksp = entry[1]
             ksp.setOperators(M)
         entry[2] += 1
         generation = entry[2]
-        version = getattr(A, "version", None)
         try:
             ksp.setUp()
         except PETSc.Error as exc:
@@ -280,7 +317,7 @@ class PetscBackend:
         x_vec, b_vec = M.createVecs()
 
         def solve(b, *, rtol: float | None = None):
-            if entry[2] != generation or getattr(A, "version", None) != version:
+            if entry[2] != generation:
                 raise InputError("petsc: this solve belongs to an earlier factorisation of a matrix "
                                  "of the same pattern, which has since been refactorised")
             b = np.asarray(b, dtype=float)
@@ -291,6 +328,13 @@ class PetscBackend:
                     raise InputError("petsc solve: rtol applies to solver='iterative' only")
                 ksp.setTolerances(rtol=float(rtol))
             cols = b.reshape(n, -1)
+            if cols.shape[1] > 1 and self.solver == "direct":
+                out = self._mat_solve(ksp, cols)
+                if not np.all(np.isfinite(out)):
+                    raise SingularMatrix(f"linear solve (petsc): expected a non-singular {n}x{n} "
+                                         "matrix, found a numerically singular one (non-finite "
+                                         "solution)")
+                return out.reshape(b.shape)
             out = np.empty_like(cols)
             for j in range(cols.shape[1]):
                 b_vec.setArray(cols[lo:hi, j])
@@ -314,16 +358,30 @@ class PetscBackend:
             return out.reshape(b.shape)
         return solve
 
+    def _mat_solve(self, ksp, B: np.ndarray) -> np.ndarray:
+        """X = A^-1 B for the m columns of B (n, m) at once (MUMPS' multiple right-hand
+        sides, MatMatSolve: 5-7x less time per column than m single solves at m = 12-28)."""
+        PETSc = self.PETSc
+        n, m = B.shape
+        F = ksp.getPC().getFactorMatrix()
+        lo, hi = F.getOwnershipRange()
+        Bm = PETSc.Mat().createDense(((hi - lo, n), (None, m)), comm=self.comm)
+        Bm.setUp()
+        Bm.getDenseArray()[:] = B[lo:hi]
+        Bm.assemble()
+        Xm = Bm.duplicate()
+        F.matSolve(Bm, Xm)
+        local = np.array(Xm.getDenseArray())
+        Bm.destroy()
+        Xm.destroy()
+        if self.comm.size == 1:
+            return local
+        return np.concatenate(self.comm.tompi4py().allgather(local), axis=0)
+
     def gather(self, vec) -> np.ndarray:
         """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
-        local = vec.getArray(readonly=True)
-        if self.comm.size == 1:
-            return np.array(local)
-        mpi = self.comm.tompi4py()
-        counts = np.array(mpi.allgather(local.size))
-        out = np.empty(int(counts.sum()))
-        mpi.Allgatherv(np.ascontiguousarray(local), [out, counts])
-        return out
+        from tmfem.solvers.distributed import gather
+        return gather(vec)
 
     # ------------------------------------------------------------------ eigenproblems
     def eigsh(self, K, M, k, sigma):
@@ -331,7 +389,7 @@ class PetscBackend:
         SLEPc Krylov-Schur with shift-and-invert (module docstring); V (n, k) M-orthonormal."""
         import scipy.linalg as la
         PETSc, SLEPc = self.PETSc, self.SLEPc
-        Kp, _ = self._mat(K)
+        Kp, _ = self._mat(K, cache=False)
         Mp, _ = self._mat(M, cache=False)
         n = Kp.getSize()[0]
         k = int(k)

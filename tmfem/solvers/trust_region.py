@@ -26,6 +26,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError
 from tmfem.solvers.backends import SingularMatrix, get_backend
+from tmfem.solvers.newton import free_index, submatrix
 
 log = logging.getLogger(__name__)
 
@@ -79,6 +80,7 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     """
     be = get_backend(backend)
     free = np.asarray(free, dtype=bool)
+    idx = free_index(free, free.size)
     u = np.array(u0, dtype=float, copy=True) if update is None else u0
     Dm = sp.diags(np.asarray(scale, dtype=float))
     r, K = residual(u)
@@ -92,7 +94,7 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     it = 0
     converged = floor = False
     for it in range(1, max_iter + 1):
-        Kf = K[free][:, free]
+        Kf = submatrix(K, idx)
         g = r[free]
         for _attempt in range(40):
             A = (Kf + mu * Dm) if mu > 0 else Kf

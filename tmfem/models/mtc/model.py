@@ -26,7 +26,7 @@ converged state (eq. 5.32).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -151,6 +151,7 @@ class MTCModel:
         self.bar_element = TrussElement(self.bars, topo.dofmap)
         self.free = topo.constraints.free
         self._M = None
+        self._dist = None
         self.rest_lengths_source = None
         if rest_lengths is None:
             rest_lengths = "system" if system.rest_lengths is not None else "design"
@@ -198,6 +199,7 @@ class MTCModel:
         self.tendon_element = TrussElement(self.tendons, self.topology.dofmap,
                                            lumped_mass=self.lumped_tendon_mass)
         self._M = None
+        self._dist = None
 
     def set_tendon_lengths(self, u) -> None:
         """Tendon rest lengths as time-varying inputs (a plant's u): the reference lengths of
@@ -285,19 +287,26 @@ class MTCModel:
         another mesh or tendon subdivision): membrane nodes by linear interpolation over the
         other mesh's nodes (reference coordinates), labelled nodes copied, tendons straight.
         Used for mesh sequencing (nested iteration) of :meth:`solve_static`."""
-        from scipy.interpolate import LinearNDInterpolator, NearestNDInterpolator
+        from scipy.spatial import Delaunay, cKDTree
         if other.system is not self.system:
             raise InputError("interpolate_from: expected a model of the same system")
         ot, st = other.topology, self.topology
         c = st.mesh.p.mean(axis=1, keepdims=True)
         pts = (c + (1.0 - 1e-9) * (st.mesh.p - c)).T     # boundary points strictly inside
         # piecewise-linear interpolation on a Delaunay triangulation of the other mesh's nodes
-        # (skfem's probes() falls back to a dense points x elements search on boundaries)
+        # (skfem's probes() falls back to a dense points x elements search on boundaries;
+        # scipy.interpolate's LinearNDInterpolator is the same, at 0.5 s of imports)
         vals = x_other[:, :ot.n_mesh].T
-        xm = LinearNDInterpolator(ot.mesh.p.T, vals)(pts)
-        bad = ~np.all(np.isfinite(xm), axis=1)
-        if bad.any():
-            xm[bad] = NearestNDInterpolator(ot.mesh.p.T, vals)(pts[bad])
+        tri = Delaunay(ot.mesh.p.T)
+        simplex = tri.find_simplex(pts)
+        inside = simplex >= 0
+        T = tri.transform[simplex[inside]]                       # (m, 3, 2): barycentric map
+        b = np.einsum("mij,mj->mi", T[:, :2], pts[inside] - T[:, 2])
+        bary = np.column_stack([b, 1.0 - b.sum(axis=1)])
+        xm = np.empty((pts.shape[0], vals.shape[1]))
+        xm[inside] = np.einsum("mk,mkc->mc", bary, vals[tri.simplices[simplex[inside]]])
+        if not inside.all():
+            xm[~inside] = vals[cKDTree(ot.mesh.p.T).query(pts[~inside])[1]]
         x = np.zeros((3, st.n_nodes))
         x[:, :st.n_mesh] = xm.T
         x[:, st.system_node] = x_other[:, ot.system_node]
@@ -314,6 +323,21 @@ class MTCModel:
         c = self.topology.constraints
         f, K = self.internal_full(self.full(xr), tangent=tangent)
         return c.residual(f), (c.tangent(K) if tangent else None)
+
+    @property
+    def distributed(self):
+        """The element sets assembled rank by rank on the free dofs
+        (:class:`tmfem.fem.distributed.DistributedElements`) when the backend assembles
+        distributed matrices (PETSc, on one rank or under ``mpiexec``), else None. The
+        static solve and the modes then work on it: each rank evaluates and assembles its
+        share of the membrane elements."""
+        if not getattr(self.backend, "distributed_assembly", False):
+            return None
+        if self._dist is None:
+            from tmfem.fem.distributed import DistributedElements
+            self._dist = DistributedElements(self.elements, State(x=self.initial_positions("design")),
+                                             self.topology.T, self.free)
+        return self._dist
 
     def mass(self) -> sp.csr_matrix:
         """Reduced mass matrix T^T M T (membrane consistent, bars consistent, tendons
@@ -368,8 +392,10 @@ class MTCModel:
                               membrane_law=self.membrane_law)
             rc = coarse.solve_static(start=start, tol=tol, max_iter=max_iter, monitor=monitor,
                                      progress=progress, sequence=sequence)
-            fine = self.solve_static(x0=self.interpolate_from(coarse, rc.x), tol=tol,
-                                     max_iter=max_iter, monitor=monitor, progress=progress)
+            x_fine = self.interpolate_from(coarse, rc.x)
+            del coarse                 # its element arrays and factorisations, before the fine level
+            fine = self.solve_static(x0=x_fine, tol=tol, max_iter=max_iter, monitor=monitor,
+                                     progress=progress)
             return StaticResult(
                 x=fine.x, iterations=rc.iterations + fine.iterations,
                 residual_history=rc.residual_history + fine.residual_history[1:],
@@ -390,14 +416,36 @@ class MTCModel:
             if callable(progress):
                 progress(it, rn, mu, rho)
 
+        xr0 = self.reduce(x)
+        dist = self.distributed
+        if dist is None:                   # unknowns: all independent positions xr
+            residual, energy, u0, unknowns = self.residual, self.energy, xr0, free
+
+            def positions(u):
+                return u
+        else:                              # unknowns: the free ones, assembled rank by rank
+            u0, unknowns = xr0[free], np.ones(dist.N, bool)
+
+            def positions(u):
+                xr = xr0.copy()
+                xr[free] = u
+                return xr
+
+            def residual(u):
+                return dist.residual(State(x=self.full(positions(u))))
+
+            def energy(u):
+                return dist.energy(State(x=self.full(positions(u))))
+
         res = trust_region_newton(
-            self.residual, self.energy, self.reduce(x), free=free,
-            scale=np.maximum(Md, 1e-9 * Md.max()), force_scale=lambda xr: self._force_scale(self.full(xr)),
-            tol=tol, max_iter=max_iter, backend=self.backend, callback=record,
+            residual, energy, u0, free=unknowns, scale=np.maximum(Md, 1e-9 * Md.max()),
+            force_scale=lambda u: self._force_scale(self.full(positions(u))),
+            tol=tol, max_iter=max_iter, backend=self.backend,
+            callback=lambda it, u, rn, mu, rho: record(it, positions(u), rn, mu, rho),
             # from the design the tangent is already positive definite: try Newton first
             newton_first=(x0 is not None or start == "design"),
-            describe=self.state_note, what="MTC static solve")
-        return StaticResult(x=self.full(res.u), iterations=res.iterations,
+            describe=lambda u: self.state_note(positions(u)), what="MTC static solve")
+        return StaticResult(x=self.full(positions(res.u)), iterations=res.iterations,
                             residual_history=res.residual_history,
                             monitor={k: np.array(v) for k, v in hist.items()},
                             dt2_history=res.mu_history, time=time.perf_counter() - t0)
@@ -429,8 +477,15 @@ class MTCModel:
         Returns a ``Modes`` of :func:`tmfem.solvers.lowest_modes` whose ``shapes`` are the
         reduced vectors; :meth:`full_shapes` maps them to all nodes.
         """
-        _, K = self.residual(self.reduce(x))
-        return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma, backend=self.backend)
+        dist = self.distributed
+        if dist is None:
+            _, K = self.residual(self.reduce(x))
+            return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma, backend=self.backend)
+        _, K = dist.residual(State(x=self.full(self.reduce(x))))
+        modes = lowest_modes(K, dist.mass(), k=k, sigma=sigma, backend=self.backend)
+        shapes = np.zeros((self.free.size, modes.shapes.shape[1]))
+        shapes[self.free] = modes.shapes
+        return replace(modes, shapes=shapes)
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
         """Mode shapes (3, n_nodes, k) from reduced vectors (3 n_red, k)."""

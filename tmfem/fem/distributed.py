@@ -1,0 +1,164 @@
+"""Element sets assembled rank by rank into one distributed tangent (``mpiexec -n P``, PETSc).
+
+The finite-element side of :mod:`tmfem.solvers.distributed`: a model's element sets (the
+interface of :mod:`tmfem.fem.element`) on the unknowns u = (T u_r)[free] of its constraint
+map, with
+
+* the internal force r = (T^T f)[free] (eqs. 4.4-4.6) on every rank, summed over the ranks'
+  contributions;
+* the tangent (T^T K T)[free][:, free] as one parallel PETSc matrix, preallocated once from
+  the union of the ranks' patterns (:class:`~tmfem.solvers.distributed.DistributedAssembler`);
+* the strain energy summed over the ranks, and the mass matrix.
+
+How an element set is shared out over the ranks:
+
+* sets that provide the *share protocol* -- ``element_dofs`` (ne, nd) and
+  ``element_arrays(state, tangent=, elements=slice)``, ``energy(state, elements=slice)``
+  (the membrane, :class:`tmfem.fem.membrane.MembraneElement`) -- evaluate only the
+  contiguous block of elements of this rank (:func:`~tmfem.solvers.distributed.element_share`):
+  the kernel work, the element arrays and the matrix entries are split P ways;
+* any other set (trusses: a few hundred elements) is evaluated whole on every rank, and each
+  rank contributes its block of the entries of its assembled tangent (the set's CSR pattern
+  is fixed) and, on rank 0, its force and energy.
+
+Every rank holds the full state (vectors are replicated, O(n) per rank). A tangent that a
+caller still references is never refilled (:meth:`DistributedElements.residual` reuses an
+unreferenced one, else assembles a new one): a solver holds the tangent of its iterate
+while it evaluates trial points (two or three matrices in all).
+"""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.solvers.distributed import DistributedAssembler, comm_world, element_share
+
+
+def _shares(e) -> bool:
+    """Whether element set ``e`` provides the share protocol (module docstring)."""
+    return hasattr(e, "element_dofs") and hasattr(e, "element_arrays")
+
+
+class DistributedElements:
+    """Residual, tangent, energy and mass of element sets on the free dofs, rank by rank.
+
+    Parameters
+    ----------
+    elements : list of element sets on one dof map (n full dofs)
+    state0 : State
+        A state at which the pattern of the tangent of every set is the one of all states
+        (any state: the kernels keep their patterns).
+    T : sparse (n, n_r)
+        Constraint map u = T u_r.
+    free : bool mask (n_r,)
+        The unknowns.
+    comm : mpi4py communicator, optional (COMM_WORLD)
+    """
+
+    def __init__(self, elements, state0, T, free, *, comm=None):
+        self.comm = comm_world() if comm is None else comm
+        self.elements = list(elements)
+        self.n = self.elements[0].dofmap.ndof
+        self.T, self.free = sp.csr_matrix(T), np.asarray(free, bool)
+        self.root = self.comm.rank == 0
+        groups, self._shares, self._entries = [], [], []
+        for e in self.elements:
+            if _shares(e):
+                dofs = np.asarray(e.element_dofs)
+                share = element_share(dofs.shape[0], self.comm)
+                groups.append((dofs[share], "element"))
+                self._shares.append(share)
+                self._entries.append(None)
+            else:
+                K0 = sp.csr_matrix(e.internal(state0, tangent=True)[1])
+                K0.sort_indices()
+                share = element_share(K0.nnz, self.comm)
+                rows = np.repeat(np.arange(self.n), np.diff(K0.indptr))
+                groups.append((np.stack([rows[share], K0.indices[share]], axis=1), "entry"))
+                self._shares.append(share)
+                self._entries.append((K0.indptr.copy(), K0.indices.copy()))
+        self.assembler = DistributedAssembler(groups, self.n, T=self.T, keep=self.free,
+                                              comm=self.comm)
+        self._K = []
+        self._M = None
+
+    @property
+    def N(self) -> int:
+        """Number of unknowns (free dofs)."""
+        return self.assembler.N
+
+    def residual(self, state, *, tangent: bool = True):
+        """``(r, K)``: the internal force on the free dofs (N,), the same on every rank, and
+        the tangent (a :class:`~tmfem.solvers.distributed.DistributedMatrix`, refilled in a
+        later call only once the caller has dropped it), eqs. 4.4-4.6."""
+        f = np.zeros(self.n)
+        values = []
+        for e, share, entries in zip(self.elements, self._shares, self._entries):
+            if entries is None:
+                fe, Ke = e.element_arrays(state, tangent=tangent, elements=share)
+                f += np.bincount(np.asarray(e.element_dofs)[share].ravel(), weights=fe.ravel(),
+                                 minlength=self.n)
+                values.append(Ke)
+            else:
+                fs, Ks = e.internal(state, tangent=tangent)
+                if self.root:
+                    f += fs
+                if tangent:
+                    Ks = sp.csr_matrix(Ks)
+                    Ks.sort_indices()
+                    if not (np.array_equal(Ks.indptr, entries[0])
+                            and np.array_equal(Ks.indices, entries[1])):
+                        Ks = _on_pattern(Ks, *entries)
+                    values.append(Ks.data[share])
+        r = self.assembler.vector(f)
+        if not tangent:
+            return r, None
+        # a tangent the caller still holds (the iterate's, while it evaluates trial points)
+        # is never overwritten: refill one that nobody references, else assemble a new one
+        for K in self._K:
+            if sys.getrefcount(K) <= 3:        # the list's, the loop's, the argument's
+                return r, self.assembler.matrix(*values, out=K)
+        K = self.assembler.matrix(*values)
+        self._K.append(K)
+        return r, K
+
+    def energy(self, state) -> float:
+        """Strain energy [J] of all sets, summed over the ranks (the same on every rank)."""
+        local = 0.0
+        for e, share, entries in zip(self.elements, self._shares, self._entries):
+            if entries is None:
+                local += e.energy(state, elements=share)
+            elif self.root:
+                local += e.energy(state)
+        return float(self.comm.allreduce(local))
+
+    def mass(self):
+        """Mass matrix (T^T M T)[free][:, free] (a DistributedMatrix), assembled once from the
+        sets' mass matrices (entries shared out over the ranks)."""
+        if self._M is None:
+            M = sp.csr_matrix(sum(e.mass() for e in self.elements))
+            M.sort_indices()
+            rows = np.repeat(np.arange(self.n), np.diff(M.indptr))
+            share = element_share(M.nnz, self.comm)
+            asm = DistributedAssembler([(np.stack([rows[share], M.indices[share]], axis=1), "entry")],
+                                       self.n, T=self.T, keep=self.free, comm=self.comm)
+            self._M = asm.matrix(M.data[share])
+        return self._M
+
+
+def _on_pattern(K: sp.csr_matrix, indptr, indices) -> sp.csr_matrix:
+    """K on the sparsity pattern (indptr, indices) (the set's pattern at the state the
+    assembler was built at; zeros where K has no entry); an entry of K outside it is refused."""
+    n = K.shape[1]
+    keys = np.repeat(np.arange(K.shape[0]), np.diff(indptr)) * n + indices
+    kk = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)) * n + K.indices
+    pos = np.minimum(np.searchsorted(keys, kk), keys.size - 1)
+    if keys.size == 0 or np.any(keys[pos] != kk):
+        from tmfem.errors import InputError
+        raise InputError(f"distributed assembly: expected the tangent of an element set on its "
+                         f"pattern of {indices.size} entries, found entries outside it")
+    data = np.zeros(indices.size)
+    np.add.at(data, pos, K.data)
+    return sp.csr_matrix((data, indices, indptr), shape=K.shape)
