@@ -133,15 +133,15 @@ def test_2_3_clipped_inversion_leaves_the_reference(run23):
 @pytest.mark.slow
 def test_2_3_deployment_switches_to_hinf():
     # 7.4.3: switch at 17.86 s (eq. 5.70, R_c = 0.01), then the H-infinity controller of
-    # 7.3 (Riccati route: the 2-3 LMI does not solve, docs/control.md) holds the deployed
-    # configuration; reduced: the LQR stand-in after the switch
+    # 7.3 (eliminated LMIs, docs/control.md) holds the deployed configuration; reduced: the
+    # LQR stand-in after the switch
     s = setup("2-3-deploy", controller="adaptive-lqr" if REDUCED else "adaptive-hinf")
     r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
                        t_end=20.0, dt=0.01, stress_every=50)
     assert r.switch_time == pytest.approx(17.86, abs=1.0)
     i = np.searchsorted(r.t, r.switch_time)
     assert r.relative_error[i] <= 0.01 < r.relative_error[i - 1]
-    assert r.controller[-1] in ("lqr", "hinf-shifted-riccati")
+    assert r.controller[-1] in ("lqr", "hinf-lmi")
     assert np.all(r.u <= r.lengths + 1e-12) and r.min_margin >= 0
     assert np.max(np.abs(r.w)) < 6e-3
     assert r.relative_error[-1] < 0.01

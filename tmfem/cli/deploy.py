@@ -27,7 +27,7 @@ DEPLOYMENTS = {
              "points": [(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], "u_m": 0.02, "path": "delta"},
     "2-3-deploy": {"omega_r": 0.5, "table_7_1": (1.0, 24.0, 5.0, 0.9), "uncertainty": "no-MG",
                    "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01,
-                   "path": "table-7-7-bases", "hinf_method": "riccati"},
+                   "path": "table-7-7-bases"},
 }
 CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
                "adaptive": "none"}
@@ -50,8 +50,7 @@ def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | 
     ``path`` (default the preset's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
     membrane stretch Delta linear in s), ``"table-7-7-bases"`` (2-3: the stage-2 base on the
     reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
-    ``"linear"`` (every symmetric parameter linear in s). The 2-3 H-infinity controller
-    comes from the Riccati route (its LMI does not solve, docs/control.md)."""
+    ``"linear"`` (every symmetric parameter linear in s)."""
     from tmfem.control.adaptive import Gains
     from tmfem.control.deploy import build_deployment
     from tmfem.reference.tables import deployment_bases
@@ -73,7 +72,7 @@ def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | 
                             linear=CONTROLLERS[controller], u_m=p["u_m"],
                             bases=deployment_bases(final) if path == "table-7-7-bases" else None,
                             delta_path=path == "delta",
-                            hinf_method=p.get("hinf_method", "lmi"), allocation=allocation)
+                            allocation=allocation)
 
 
 def configure(parser) -> None:
