@@ -22,6 +22,8 @@ from tmfem.fem.structure import Structure
 from tmfem.fem.tension_field import SLACK, TAUT, WRINKLED, TensionFieldLaw
 from tmfem.system.materials import MembraneMaterial
 
+from test_mitc4 import _fd_tangent   # central differences along the finite-rotation update
+
 SEC = ShellSection(E=1e3, nu=0.3, thickness=0.02, rho=2.0)
 # homogeneous in-plane stretches (lam_x, lam_y) that put the lamina in one state
 STATES = {"taut": (1.02, 1.01, TAUT), "wrinkled": (1.02, 0.98, WRINKLED), "slack": (0.98, 0.97, SLACK)}
@@ -50,15 +52,6 @@ def _stretched(X, conn, case, rot=0.0, seed=1, law="tension-field", noise=1e-3):
     return sh, dm, s0.advanced(du.ravel(), dm)
 
 
-def _fd(fun, s, dm, eps=1e-7):
-    cols = []
-    for j in range(dm.ndof):
-        e = np.zeros(dm.ndof)
-        e[j] = eps
-        cols.append((fun(s.advanced(e, dm)) - fun(s.advanced(-e, dm))) / (2 * eps))
-    return np.array(cols).T
-
-
 @pytest.mark.parametrize("case", sorted(STATES))
 def test_tangent_and_force_are_derivatives_in_every_state(case):
     X, conn = _flat_patch()
@@ -67,10 +60,10 @@ def test_tangent_and_force_are_derivatives_in_every_state(case):
     assert np.all(sh.wrinkling(s)["state_qp"] == STATES[case][2])
     f, K = sh.internal(s)
     K = K.toarray()
-    Kfd = _fd(lambda t: sh.internal(t, tangent=False)[0], s, dm)
+    Kfd = _fd_tangent(lambda t: sh.internal(t, tangent=False)[0], s, dm)
     assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()
     assert np.abs(K - K.T).max() <= 1e-10 * np.abs(K).max()
-    g = _fd(lambda t: np.array([sh.energy(t)]), s, dm)[0]
+    g = _fd_tangent(lambda t: np.array([sh.energy(t)]), s, dm)[0]
     assert np.abs(g - f).max() <= 1e-6 * np.abs(f).max()
 
 
@@ -80,7 +73,7 @@ def test_tangent_with_mixed_states_at_large_rotations():
     st = sh.wrinkling(s)["state_qp"]
     assert len(np.unique(st)) == 3                       # taut, wrinkled and slack points
     K = sh.internal(s)[1].toarray()
-    Kfd = _fd(lambda t: sh.internal(t, tangent=False)[0], s, dm)
+    Kfd = _fd_tangent(lambda t: sh.internal(t, tangent=False)[0], s, dm)
     assert np.abs(K - Kfd).max() <= 1e-6 * np.abs(K).max()
 
 

@@ -6,7 +6,6 @@ the tension-field membrane on the same mesh and rest lengths; docs/wrinkling.md,
 MTC").
 """
 import numpy as np
-import pytest
 
 from tmfem.cli import main
 from tmfem.models.mtc.model import MTCModel
