@@ -476,7 +476,7 @@ class MITC4Shell:
         points from the covariant strains c: C~ c and C~ for SVK (eq. 4.10), Q^T s_loc and
         Q^T D_loc Q for the tension-field lamina (module docstring)."""
         if self.law.name == "svk":
-            return np.einsum("...ab,...b->...a", pts.C, c), pts.C
+            return np.einsum("eqzab,eqzb->eqza", pts.C, c), pts.C
         s, D = self._local_law(np.einsum("...ap,...p->...a", pts.Q, c), tangent=tangent)
         S = np.einsum("...ap,...a->...p", pts.Q, s)
         if not tangent:
