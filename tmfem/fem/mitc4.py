@@ -28,6 +28,16 @@ G_2 x e_3) and the plane-stress law with transverse shear modulus k G (k = 5/6) 
 S = C~ c with C~ = Q^T D Q (eq. 4.10). C~ is a property of the reference configuration and
 is computed once.
 
+Tension-field lamina (``law="tension-field"``, beyond the dissertation; docs/wrinkling.md).
+The in-plane part of the lamina law is replaced by the relaxed membrane law of
+:mod:`tmfem.fem.tension_field` evaluated on the local in-plane Green-Lagrange strain
+E_loc = [[e_11, e_12], [e_12, e_22]] (eps_loc = Q c) at every lamina integration point:
+s_loc = [S_11, S_22, S_12](E_loc), transverse shear k G [2 e_13, 2 e_23] as before, and the
+contravariant stress and tangent are S = Q^T s_loc and C = Q^T D_loc(E_loc) Q, with D_loc the
+law's consistent tangent (state dependent: taut, wrinkled, slack) bordered by k G. The
+energy density is W(E_loc) + k G ((2 e_13)^2 + (2 e_23)^2) / 2. With ``law="svk"``
+(default) the constant C~ above is used unchanged.
+
 Integration: 2 x 2 Gauss points in the plane (scikit-fem's ``get_quadrature(RefQuad, 3)``)
 times 2 Gauss points through the thickness (exact for the linear-in-r_3 part of the strain,
 the classical choice for the MITC4; the r_3^2 terms are integrated approximately). All
@@ -61,6 +71,7 @@ from tmfem.fem.assembly import Assembler
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import skew
 from tmfem.fem.plane_stress import von_mises
+from tmfem.fem.tension_field import element_wrinkling, membrane_law
 
 #: transverse shear correction factor of the plane-stress lamina law
 SHEAR_FACTOR = 5.0 / 6.0
@@ -174,6 +185,13 @@ def nodal_normals(X: np.ndarray, conn: np.ndarray) -> np.ndarray:
     return acc
 
 
+def _in_plane(eps: np.ndarray) -> np.ndarray:
+    """Local in-plane Green-Lagrange strain tensor E_loc (2, 2, ...) from the local
+    engineering strains eps (..., 5) = [e_11, e_22, 2 e_12, 2 e_13, 2 e_23]."""
+    E12 = 0.5 * eps[..., 2]
+    return np.stack([np.stack([eps[..., 0], E12]), np.stack([E12, eps[..., 1]])])
+
+
 class _Points:
     """Reference quantities of the MITC4 element set at a tensor grid of points: in-plane
     points xi (2, nq) with weights wq, thickness coordinates r3 (nz,) with weights wz."""
@@ -243,6 +261,12 @@ class MITC4Shell:
         Reference directors V_n^0 (default: :func:`nodal_normals` of the mesh). Pass the exact
         surface normals of a curved shell where known; each is turned to the side of the
         element normals g_1 x g_2 (the mesh orientation decides the side).
+    shear : {"mitc", "direct"}
+        Mixed-interpolated (eqs. 4.17-4.18) or displacement-based transverse shear.
+    law : {"svk", "tension-field"} or MembraneLaw
+        In-plane lamina law (module docstring): St.Venant-Kirchhoff (eq. 4.9, default) or the
+        tension-field law of :mod:`tmfem.fem.tension_field` (a law object must be built on
+        ``section``, e.g. ``TensionFieldLaw(section, eta=...)``).
 
     Attributes
     ----------
@@ -252,7 +276,7 @@ class MITC4Shell:
     """
 
     def __init__(self, *, X, conn, section: ShellSection, dofmap: DofMap, normals=None,
-                 shear: str = "mitc"):
+                 shear: str = "mitc", law="svk"):
         X = np.asarray(X, dtype=float)
         conn = np.asarray(conn, dtype=np.int64)
         if X.shape != (3, dofmap.n_nodes):
@@ -263,6 +287,7 @@ class MITC4Shell:
         dofmap.check_element_nodes(conn, 5, element="MITC4",
                                    dofs="5 dofs (3 translations, 2 rotations)")
         self.X, self.conn, self.section, self.dofmap = X, conn, section, dofmap
+        self.law = membrane_law(law, section)
         nodes = self.nodes = np.unique(conn)
         if normals is None:
             Vn = nodal_normals(X, conn)
@@ -373,7 +398,7 @@ class MITC4Shell:
         pts = self._gauss
         c, g, gt, g3t = self._strains(pts, u, d, w)
         ne, nq, nz = c.shape[:3]
-        S = np.einsum("eqzab,eqzb->eqza", pts.C, c)                          # contravariant 2nd PK
+        S, C = self._lamina(pts, c, tangent=tangent)                         # contravariant 2nd PK
         Sw = S * pts.dV[..., None]
         dh, r3 = pts.dh, pts.r3
         # B of the in-plane rows in extended nodal dofs (x_k, d_k): (ne, nq, nz, 3, 4, 2, 3)
@@ -404,7 +429,7 @@ class MITC4Shell:
         if not tangent:
             return fe, None
         Bf = B.reshape(ne, nq * nz * 5, 24)
-        CB = np.einsum("eqzst,eqztj->eqzsj", pts.C * pts.dV[..., None, None], B).reshape(ne, -1, 24)
+        CB = np.einsum("eqzst,eqztj->eqzsj", C * pts.dV[..., None, None], B).reshape(ne, -1, 24)
         Kx = np.matmul(np.swapaxes(Bf, 1, 2), CB)                            # (ne, 24, 24)
         # initial-stress part: scalar couplings of (x_k, d_k) pairs, times I_3
         Smat = np.empty((ne, nq, nz, 2, 2))
@@ -432,6 +457,32 @@ class MITC4Shell:
         Ke[:, idx, idx] -= m[:, :, None]
         return fe, Ke
 
+    def _local_law(self, eps, *, tangent: bool = True):
+        """Tension-field lamina (module docstring): local stresses s_loc (..., 5) and tangent
+        D_loc (..., 5, 5) (or None) from the local engineering strains eps (..., 5)."""
+        Sl, Dl = self.law.stress(_in_plane(eps), tangent=tangent)
+        kG = self.section.shear_factor * self.law.mu
+        s = np.concatenate([np.stack([Sl[0, 0], Sl[1, 1], Sl[0, 1]], axis=-1), kG * eps[..., 3:]],
+                           axis=-1)
+        if not tangent:
+            return s, None
+        D = np.zeros(eps.shape + (5,))
+        D[..., :3, :3] = np.moveaxis(Dl, (0, 1), (-2, -1))
+        D[..., 3, 3] = D[..., 4, 4] = kG
+        return s, D
+
+    def _lamina(self, pts: _Points, c, *, tangent: bool = True):
+        """Contravariant stress S (..., 5) and tangent C = dS/dc (..., 5, 5) (or None) at the
+        points from the covariant strains c: C~ c and C~ for SVK (eq. 4.10), Q^T s_loc and
+        Q^T D_loc Q for the tension-field lamina (module docstring)."""
+        if self.law.name == "svk":
+            return np.einsum("eqzab,eqzb->eqza", pts.C, c), pts.C
+        s, D = self._local_law(np.einsum("...ap,...p->...a", pts.Q, c), tangent=tangent)
+        S = np.einsum("...ap,...a->...p", pts.Q, s)
+        if not tangent:
+            return S, None
+        return S, np.einsum("...ba,...bc,...cd->...ad", pts.Q, D, pts.Q)
+
     def _lam(self, V):
         """Per-node map (ne, 4, 6, 5) from [u, alpha, beta] to the extended [x, d] variations:
         delta x = delta u, delta d = (a/2)(-V_2 alpha + V_1 beta)."""
@@ -457,11 +508,17 @@ class MITC4Shell:
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
 
     def energy(self, state) -> float:
-        """Strain energy [J]: int c . C~ c / 2 dV (SVK, eq. 4.9)."""
+        """Strain energy [J]: int c . C~ c / 2 dV (SVK, eq. 4.9), or
+        int W(E_loc) + k G ((2 e_13)^2 + (2 e_23)^2) / 2 dV (tension-field lamina)."""
         u, d, w, _ = self._nodal(state)
         pts = self._gauss
         c = self._strains(pts, u, d, w)[0]
-        return 0.5 * float(np.einsum("eqza,eqzab,eqzb,eqz->", c, pts.C, c, pts.dV))
+        if self.law.name == "svk":
+            return 0.5 * float(np.einsum("eqza,eqzab,eqzb,eqz->", c, pts.C, c, pts.dV))
+        eps = np.einsum("...ap,...p->...a", pts.Q, c)
+        W = self.law.energy_density(_in_plane(eps)) \
+            + 0.5 * self.section.shear_factor * self.law.mu * (eps[..., 3]**2 + eps[..., 4]**2)
+        return float(np.sum(W * pts.dV))
 
     def mass(self, state=None) -> sp.csr_matrix:
         """Consistent mass with rotary inertia int rho N^T N dV (ndof, ndof); the rotational
@@ -493,7 +550,8 @@ class MITC4Shell:
 
         The results frame is that of eq. 4.16 at the point (e_3 along G_3, e_1 = e_y x e_3
         normalised, e_z where e_3 is parallel to e_y; the same on every element of a flat
-        mesh), the stresses D Q_out c of the isotropic lamina law in that frame.
+        mesh), the stresses D Q_out c of the isotropic lamina law in that frame (the tension-field
+        lamina's s_loc(Q_out c), the law being isotropic).
 
         Returns ``dict`` with ``sigma`` (ne, 3, 5): [s11, s22, s12, s13, s23] in that frame
         at r_3 = -1, 0, 1 (bottom, mid, top), ``von_mises``
@@ -509,7 +567,10 @@ class MITC4Shell:
                             ("gauss", *np.polynomial.legendre.leggauss(2))):
             pts = _Points(self, xi, np.ones(1), r3, wz, output_frame=True)
             c = self._strains(pts, u, d, w)[0][:, 0]                          # (ne, nz, 5)
-            out[key] = np.einsum("ab,ezbc,ezc->eza", D, pts.Q[:, 0], c)
+            if self.law.name == "svk":
+                out[key] = np.einsum("ab,ezbc,ezc->eza", D, pts.Q[:, 0], c)
+            else:
+                out[key] = self._local_law(np.einsum("ezbc,ezc->ezb", pts.Q[:, 0], c), tangent=False)[0]
         sig = out["surf"]
         vm = von_mises(np.moveaxis(sig, -1, 0))
         zg = np.polynomial.legendre.leggauss(2)[0] * self.half                # physical z of the Gauss points
@@ -518,6 +579,20 @@ class MITC4Shell:
         M = self.half * np.einsum("eza,z->ea", sg[..., :3], zg)
         Qs = self.half * sg[..., 3:].sum(axis=1)
         return {"sigma": sig, "von_mises": vm, "N": N, "M": M, "Qs": Qs}
+
+
+    def wrinkling(self, state, *, xi=(0.5, 0.5)) -> dict:
+        """States of the lamina law at one in-plane point of every element, at the two
+        thickness Gauss points: :func:`tmfem.fem.tension_field.element_wrinkling` of the local
+        in-plane strains in the results frame of :meth:`stresses` (``direction``: the tension
+        direction in that frame, [e_1, e_2, 0]). With the SVK law these are the states the
+        lamina would take if it could wrinkle."""
+        u, d, w, _ = self._nodal(state)
+        pts = _Points(self, np.asarray(xi, dtype=float).reshape(2, 1), np.ones(1),
+                      *np.polynomial.legendre.leggauss(2), output_frame=True)
+        c = self._strains(pts, u, d, w)[0]
+        eps = np.einsum("...ap,...p->...a", pts.Q, c).reshape(self.ne, -1, 5)
+        return element_wrinkling(self.law, _in_plane(eps))
 
 
 class ShellPressure:

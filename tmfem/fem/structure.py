@@ -138,24 +138,27 @@ class Structure:
 
     # ------------------------------------------------------------------ building
     @classmethod
-    def shell(cls, mesh, *, section: ShellSection, normals=None, shear: str = "mitc") -> "Structure":
+    def shell(cls, mesh, *, section: ShellSection, normals=None, shear: str = "mitc",
+              law="svk") -> "Structure":
         """A shell structure from a quad mesh (scikit-fem ``MeshQuad``, ``meshio.Mesh``,
         meshio-readable path or ``(points, quads)``; flat or curved in 3-D): every node a 5-dof
-        shell node, one MITC4 element set. ``normals`` (3, n): reference directors; ``shear``:
-        see :class:`MITC4Shell`."""
+        shell node, one MITC4 element set. ``normals`` (3, n): reference directors; ``shear``
+        and ``law`` (in-plane lamina law, "svk" or "tension-field"): see :class:`MITC4Shell`."""
         p, t = read_quad_mesh(mesh)
         s = cls(points=p, dofs=5)
-        s.add_shell(t, section=section, normals=normals, shear=shear)
+        s.add_shell(t, section=section, normals=normals, shear=shear, law=law)
         return s
 
     @property
     def n_nodes(self) -> int:
         return self.X.shape[1]
 
-    def add_shell(self, quads, *, section: ShellSection, normals=None, shear: str = "mitc") -> MITC4Shell:
-        """Add MITC4 elements on the 5-dof nodes ``quads`` (4, ne)."""
+    def add_shell(self, quads, *, section: ShellSection, normals=None, shear: str = "mitc",
+                  law="svk") -> MITC4Shell:
+        """Add MITC4 elements on the 5-dof nodes ``quads`` (4, ne); ``law``: the in-plane
+        lamina law ("svk" or "tension-field", :class:`MITC4Shell`)."""
         sh = MITC4Shell(X=self.X, conn=quads, section=section, dofmap=self.dofmap, normals=normals,
-                        shear=shear)
+                        shear=shear, law=law)
         self.frames[sh.nodes] = sh.frames[sh.nodes]
         self.shells.append(sh)
         self.elements.append(sh)

@@ -79,14 +79,17 @@ class MembraneLaw:
 
     Parameters
     ----------
-    material : MembraneMaterial
+    material : MembraneMaterial or ShellSection
+        Isotropic material: its modulus E and Poisson ratio nu are used (a shell section
+        gives the law of the shell's lamina, :mod:`tmfem.fem.mitc4`).
     """
 
     name = ""
 
-    def __init__(self, material: MembraneMaterial):
-        if not isinstance(material, MembraneMaterial):
-            raise InputError(f"membrane law: expected a MembraneMaterial, found "
+    def __init__(self, material):
+        from tmfem.fem.mitc4 import ShellSection     # mitc4 imports this module
+        if not isinstance(material, (MembraneMaterial, ShellSection)):
+            raise InputError(f"membrane law: expected a MembraneMaterial or ShellSection, found "
                              f"{type(material).__name__}")
         self.material = material
         E, nu = material.E, material.nu
@@ -200,9 +203,10 @@ class TensionFieldLaw(MembraneLaw):
         return (1.0 - self.eta) * W_tf + self.eta * W_svk
 
 
-def membrane_law(law, material: MembraneMaterial) -> MembraneLaw:
+def membrane_law(law, material) -> MembraneLaw:
     """The law object for ``law``: a name of :data:`MEMBRANE_LAWS` or a :class:`MembraneLaw`
-    (returned as is when it carries the same material)."""
+    (returned as is when it carries the same material: a MembraneMaterial, or the
+    ShellSection of a shell)."""
     if isinstance(law, MembraneLaw):
         if law.material != material:
             raise InputError(f"membrane law: its material {law.material} differs from the "

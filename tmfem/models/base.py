@@ -31,6 +31,7 @@ from typing import Protocol
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.fem.tension_field import MEMBRANE_LAWS
 
 
 class Plant(Protocol):
@@ -109,6 +110,9 @@ SHARED_OPTIONS = {
             "(distributed)"))),
     "patch": Option("--patch", None, None, dict(type=float, metavar="R", help=(
         "patch radius [m] of --attachment distributed (default 10%% of r_mb)"))),
+    "membrane_law": Option("--membrane-law", "svk", None, dict(choices=MEMBRANE_LAWS, help=(
+        "membrane law (of the shell's lamina in the SBC model): St.Venant-Kirchhoff (svk, "
+        "eq. 4.9) or tension-field (wrinkling, docs/wrinkling.md)"))),
 }
 
 MODELS: dict[str, ModelSpec] = {}

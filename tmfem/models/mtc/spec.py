@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 from tmfem.errors import InputError
-from tmfem.fem.tension_field import MEMBRANE_LAWS
 from tmfem.models.base import ModelSpec, Option, register
 from tmfem.models.mtc.model import MTCModel
 
@@ -47,15 +46,12 @@ SPEC = register(ModelSpec(
     name="mtc", help="membrane-truss-cable finite-element model (4.4): membrane elements, truss "
                      "bars, tension-only truss tendons",
     commands=("static", "modal", "vibrate"), build=build,
-    shared=("mesh", "tendon_elements", "attachment", "patch"),
+    shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law"),
     own=(
         Option("--rest-lengths", None, None, dict(help=(
             "tendon rest lengths: 'system' (default when the system has them), 'design' (eq. 3.8), "
             "'mtc' (those that make the design an exact equilibrium of this model) or values per "
             "group/tendon, e.g. 'S1=1.5025'"))),
-        Option("--membrane-law", "svk", None, dict(choices=MEMBRANE_LAWS, help=(
-            "membrane law: St.Venant-Kirchhoff (svk, eq. 4.9) or tension-field (wrinkling, "
-            "docs/wrinkling.md)"))),
         Option("--start", "undeformed", ("static", "modal"), dict(
             choices=("undeformed", "design"),
             help="start of the static iteration (the undeformed membrane, as in 6.2)")),

@@ -97,15 +97,19 @@ class SBCModel:
         As :class:`tmfem.models.mtc.model.MTCModel` (``"mtc"``: the MTC model's consistent
         rest lengths).
     backend : str or Backend
+    membrane_law : {"svk", "tension-field"}
+        In-plane law of the shells' lamina (:class:`tmfem.fem.mitc4.MITC4Shell`; the MTC
+        model built alongside takes the same).
     """
 
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3, bar_elements: int = 1,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
-                 backend="scipy"):
+                 backend="scipy", membrane_law: str = "svk"):
         self.system = system
         self.mtc = MTCModel(system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                             attachment=attachment, patch=patch, rest_lengths=rest_lengths,
-                            backend=backend, rigid_bar_points=system.deployable)
+                            backend=backend, rigid_bar_points=system.deployable,
+                            membrane_law=membrane_law)
         self.backend = self.mtc.backend
         mt = self.mtc.topology
         points = None
@@ -124,7 +128,8 @@ class SBCModel:
         self.X = X
         mem = system.membrane
         self.shell = MITC4Shell(X=X, conn=mt.mesh.t, dofmap=dm,
-                                section=ShellSection(E=mem.E, nu=mem.nu, thickness=mem.h, rho=mem.rho))
+                                section=ShellSection(E=mem.E, nu=mem.nu, thickness=mem.h, rho=mem.rho),
+                                law=self.mtc.membrane_law)
         bar = system.bar
         self.beam = BeamElement(BeamSet(conn=num.beam_conn, section=BeamSection.circle(d=bar.d),
                                         E=bar.E, nu=BAR_NU, rho=bar.rho), dm, X=X)

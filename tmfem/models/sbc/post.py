@@ -23,7 +23,8 @@ def static_summary(model, result) -> dict:
     c = st.x[:, mt.mesh.corners]
     out = {"system": sysm.name, "model": "sbc", "dofs": model.ndof, "mesh_n": mt.mesh.n,
            "tendon_elements": mt.tendon_elements, "bar_elements": model.numbering.bar_elements,
-           "attachment": mt.attachment, "rest_lengths_source": model.mtc.rest_lengths_source,
+           "attachment": mt.attachment, "membrane_law": model.shell.law.name,
+           "rest_lengths_source": model.mtc.rest_lengths_source,
            "rest_lengths": {t.name: float(r) for t, r in zip(sysm.tendons, model.rest_lengths)},
            "iterations": result.iterations, "static_time_s": result.time,
            "residual_history": [float(v) for v in result.residual_history],
@@ -69,7 +70,7 @@ def format_static(r: dict) -> str:
     """Text of :func:`static_summary` (and of the modes when present)."""
     lines = [f"SBC model of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} elements/"
              f"tendon, {r['bar_elements']} beam element(s)/bar, {r['attachment']} attachment, "
-             f"{r['dofs']} free dofs",
+             f"{r['membrane_law']} lamina, {r['dofs']} free dofs",
              f"converged in {r['predictor_iterations']} MTC predictor + {r['iterations']} SBC "
              f"iterations ({r['static_time_s']:.2f} s); residual "
              f"{r['residual_history'][0]:.3e} -> {r['residual_history'][-1]:.3e} N",

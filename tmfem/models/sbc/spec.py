@@ -15,14 +15,15 @@ def build(system, options: dict, backend) -> SBCModel:
     system, rest = apply_rest_lengths(system, options["rest_lengths"])
     return SBCModel(system, mesh_n=options["mesh"], tendon_elements=options["tendon_elements"],
                     bar_elements=options["bar_elements"], attachment=options["attachment"],
-                    patch=options["patch"], rest_lengths=rest, backend=backend)
+                    patch=options["patch"], rest_lengths=rest, backend=backend,
+                    membrane_law=options["membrane_law"])
 
 
 SPEC = register(ModelSpec(
     name="sbc", help="shell-beam-cable finite-element model (4.3): MITC4 shell membrane, 4-node "
                      "beam bars, tension-only truss tendons",
     commands=("static", "modal"), build=build,
-    shared=("mesh", "tendon_elements", "attachment", "patch"),
+    shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law"),
     own=(
         Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1); per bar segment A-H, H-B of a 1-N(D) system")),
         Option("--rest-lengths", None, None, dict(help=(
