@@ -18,51 +18,7 @@ from tmfem.io.meshes import block_data, to_meshio
 from tmfem.io.paths import check_path
 from tmfem.io.writer import write_mesh
 from tmfem.models.mtc.topology import to_floating
-
-#: surfaces of :meth:`MITC4Shell.stresses` (r_3 = -1, 0, 1)
-SURFACES = ("bottom", "mid", "top")
-
-
-def shell_stresses(model, state) -> dict:
-    """Principal stresses sigma_p1 >= sigma_p2 and von Mises stress [Pa] of the shell at the
-    element centres and at the 2 x 2 Gauss points, on the bottom, middle and top surfaces.
-
-    The shell's stresses are second Piola-Kirchhoff components in the element results frame of
-    eq. 4.16 (:meth:`tmfem.fem.mitc4.MITC4Shell.stresses`); principal values and von Mises
-    (eqs. 5.29-5.30, in-plane with the transverse shear) do not depend on the in-plane frame,
-    so they are those of the floating frame O_f. Returns ``centre`` and ``gauss`` dicts of
-    arrays (3 surfaces, ne) and (3 surfaces, ne, 4).
-    """
-    sh = model.shell
-    out = {}
-    for key, pts in (("centre", [(0.5, 0.5)]), ("gauss", list(sh._gxi.T))):
-        p1, p2, vm = [], [], []
-        for xi in pts:
-            s = sh.stresses(state, xi=tuple(xi))
-            s11, s22, s12 = s["sigma"][..., 0], s["sigma"][..., 1], s["sigma"][..., 2]
-            c, r = 0.5 * (s11 + s22), np.hypot(0.5 * (s11 - s22), s12)
-            p1.append((c + r).T); p2.append((c - r).T); vm.append(s["von_mises"].T)
-        out[key] = {"sigma_p1": np.stack(p1, -1), "sigma_p2": np.stack(p2, -1),
-                    "von_mises": np.stack(vm, -1)}
-    out["centre"] = {k: v[..., 0] for k, v in out["centre"].items()}
-    return out
-
-
-def membrane_peaks(model, state) -> dict:
-    """Peak membrane stresses [Pa] of an SBC state (Tables 6.3, 6.5): the largest sigma_p1 and
-    von Mises over the 2 x 2 Gauss points per surface and at the element centres (mid
-    surface), and the element-centre maxima (the MTC model's element means)."""
-    st = shell_stresses(model, state)
-    g, c = st["gauss"], st["centre"]
-    out = {f"max_{k}_{s}": float(g[k][i].max()) for k in ("sigma_p1", "von_mises")
-           for i, s in enumerate(SURFACES)}
-    out["max_sigma_p1"] = max(out[f"max_sigma_p1_{s}"] for s in SURFACES)
-    out["max_von_mises"] = max(out[f"max_von_mises_{s}"] for s in SURFACES)
-    out["max_sigma_p1_element_centre"] = float(c["sigma_p1"][1].max())
-    out["max_von_mises_element_centre"] = float(c["von_mises"][1].max())
-    out["min_sigma_p2_mid"] = float(g["sigma_p2"][1].min())
-    return out
-
+from tmfem.models.sbc.post import SURFACES, shell_stresses
 
 def rotation_vectors(model, state, d=None) -> np.ndarray:
     """Rotation vectors (3, n_nodes) [rad]: of the nodal rotations R of ``state`` (``d`` None)
