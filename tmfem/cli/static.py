@@ -89,17 +89,37 @@ def write_outputs(args, model, x, summary) -> None:
         summary["png"] = str(p)
 
 
+def sbc_static(args, model) -> dict:
+    """``tmfem static --model sbc``: the equilibrium from the undeformed membrane (6.2), its
+    summary and the ParaView file / PNG of the shells, beams and tendons."""
+    from tmfem.errors import InputError
+    from tmfem.models.sbc.post import static_summary as sbc_summary
+    if args.stress_plot or args.wrinkle_plot:
+        raise InputError("static --model sbc: option does not apply: --stress-plot/--wrinkle-plot "
+                         "(maps of the MTC membrane; the SBC shell stresses are in --vtk)")
+    monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
+    res = model.solve_static(monitor=monitor, progress=static_progress(args.progress))
+    out = sbc_summary(model, res)
+    if args.vtk:
+        from tmfem.post.sbc import write_sbc_state
+        out["vtk"] = write_sbc_state(args.vtk, model, res.state)
+    if args.png:
+        from tmfem.models.mtc.post import q_from_positions
+        from tmfem.post.render import render_configuration
+        from tmfem.post.sbc import shell_field
+        st = res.state
+        q = q_from_positions(model.system, st.x[:, model.mtc.topology.system_node])
+        out["png"] = str(render_configuration(
+            args.png, model.system, q=q, tendon_forces=model.member_forces(st)["tendon"],
+            membrane=shell_field(model, st), membrane_field="von_mises_top",
+            title=f"{model.system.name} SBC equilibrium (shell von Mises, top surface)"))
+    return out
+
+
 def run(args) -> dict:
     model, options = model_from_args(args, NAME)
     if args.model == "sbc":
-        from tmfem.errors import InputError
-        from tmfem.models.sbc.post import static_summary as sbc_summary
-        if args.vtk or args.png or args.stress_plot:
-            raise InputError("static --model sbc: option does not apply yet: --vtk/--png/--stress-plot "
-                             "(field output of the shell model is not built; use --model mtc)")
-        monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
-        return sbc_summary(model, model.solve_static(monitor=monitor,
-                                                     progress=static_progress(args.progress)))
+        return sbc_static(args, model)
     res, summary = solve(args, model, options)
     write_outputs(args, model, res.x, summary)
     return summary

@@ -164,6 +164,7 @@ def format_static(r: dict) -> str:
                 lines.append(f"{i + 1:4d} {fr:10.4f} {d['SBC'][i]:10.4f} {100 * (fr / d['SBC'][i] - 1):7.2f}%")
             else:
                 lines.append(f"{i + 1:4d} {fr:10.4f}")
+    lines += [f"wrote {r[k]}" for k in ("vtk", "png") if k in r]
     return "\n".join(lines)
 
 
