@@ -43,7 +43,10 @@ def membrane_peaks(model, state) -> dict:
     """Peak membrane stresses [Pa] of an SBC state (Tables 6.3, 6.5): the largest sigma_p1 and
     von Mises over the 2 x 2 Gauss points on each surface and over all three
     (``max_sigma_p1``, ``max_von_mises``), the element-centre maxima on the mid surface (the
-    counterpart of the MTC model's element means) and the smallest mid-surface sigma_p2."""
+    counterpart of the MTC model's element means), the smallest mid-surface sigma_p2 and the
+    fractions of mid-surface Gauss points taut (sigma_p2 > 0), wrinkled (sigma_p2 <= 0 <
+    sigma_p1) and slack (sigma_p1 <= 0), the tension-field criterion of the MTC model's
+    membrane (:mod:`tmfem.fem.tension_field`) applied to the shell's stresses."""
     st = shell_stresses(model, state)
     g, c = st["gauss"], st["centre"]
     out = {f"max_{k}_{s}": float(g[k][i].max()) for k in ("sigma_p1", "von_mises")
@@ -53,6 +56,10 @@ def membrane_peaks(model, state) -> dict:
     out["max_sigma_p1_element_centre"] = float(c["sigma_p1"][1].max())
     out["max_von_mises_element_centre"] = float(c["von_mises"][1].max())
     out["min_sigma_p2_mid"] = float(g["sigma_p2"][1].min())
+    p1, p2 = g["sigma_p1"][1], g["sigma_p2"][1]
+    out["state_fractions"] = {"taut": float(np.mean(p2 > 0)),
+                              "wrinkled": float(np.mean((p2 <= 0) & (p1 > 0))),
+                              "slack": float(np.mean(p1 <= 0))}
     return out
 
 
