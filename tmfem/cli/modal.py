@@ -96,9 +96,10 @@ def sbc_modal(args, model, tables) -> dict:
         shapes, rotations = mode_data(model, res.state, modes)
         cells = sbc_cells(model)
         if args.vtk:
+            from tmfem.io.codes import kind_cell_data
             from tmfem.io.writer import write_modes
             out["vtk"] = str(write_modes(args.vtk, res.state.x, cells, shapes, modes.freq_hz,
-                                         point_data=rotations))
+                                         point_data=rotations, cell_data=kind_cell_data(cells)))
         if args.png:
             from tmfem.post.render import render_modes
             out["png"] = str(render_modes(args.png, points=res.state.x, cells=cells, shapes=shapes,

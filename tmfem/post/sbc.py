@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from tmfem.io.codes import kind_cell_data
 from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 from tmfem.io.meshes import block_data, to_meshio
 from tmfem.io.paths import check_path
@@ -71,24 +72,22 @@ def sbc_cells(model) -> list:
     return [("line", seg), ("line", model.tendons.conn), ("quad", model.mtc.topology.mesh.t)]
 
 
-def _cell_data(model, state) -> dict:
-    """Per block (beams, tendons, shells): kind code, axial force [N], bending moment [N m],
-    von Mises (top, mid, bottom) [Pa]; NaN where a quantity does not exist."""
+def _cell_data(model, state, cells) -> dict:
+    """Per block (beams, tendons, shells): ``kind`` (:func:`tmfem.io.codes.kind_cell_data`),
+    axial force [N], bending moment |M| [N m], shell sigma_p1 and von Mises [Pa] per surface;
+    NaN where a quantity does not exist."""
     sec = model.beam.section_forces(state)
     per = 3                                                  # segments per four-node element
     Nb = np.repeat(sec["N"].mean(axis=1), per)
     Mb = np.repeat(np.hypot(sec["M1"], sec["M2"]).mean(axis=1), per)
     Nt = model.member_forces(state)["tendon_element"]
-    ne = model.shell.ne
     c = shell_stresses(model, state)["centre"]
-    nb, nt = Nb.size, Nt.size
-    nan = np.full
-    out = {"kind": [np.zeros(nb), np.ones(nt), np.full(ne, 2.0)],
-           "axial_force": [Nb, Nt, nan(ne, np.nan)],
-           "bending_moment": [Mb, nan(nt, np.nan), nan(ne, np.nan)]}
+    none = [np.full(conn.shape[1], np.nan) for _, conn in cells]        # beams, tendons, shells
+    out = {**kind_cell_data(cells), "axial_force": [Nb, Nt, none[2]],
+           "bending_moment": [Mb, none[1], none[2]]}
     for i, s in enumerate(SURFACES):
-        out[f"von_mises_{s}"] = [nan(nb, np.nan), nan(nt, np.nan), c["von_mises"][i]]
-        out[f"sigma_p1_{s}"] = [nan(nb, np.nan), nan(nt, np.nan), c["sigma_p1"][i]]
+        for k in ("von_mises", "sigma_p1"):
+            out[f"{k}_{s}"] = [none[0], none[1], c[k][i]]
     return out
 
 
@@ -101,7 +100,7 @@ def write_sbc_state(path, model, state) -> str:
     cells = sbc_cells(model)
     pdata, cdata = block_data({"displacement": state.x - model.X,
                                "rotation": rotation_vectors(model, state)},
-                              _cell_data(model, state), cells, state.x.shape[1])
+                              _cell_data(model, state, cells), cells, state.x.shape[1])
     return str(write_mesh(path, to_meshio(state.x, cells, point_data=pdata, cell_data=cdata)))
 
 

@@ -38,12 +38,9 @@ class SBCDynamics(FEPlant):
     model : SBCModel
     state_eq : State
         The static equilibrium (``model.solve_static().state``).
-    alpha, beta : float
-        Rayleigh damping C = alpha M + beta K_0 [1/s, s] (default: undamped).
-    perturb : dict, optional
-        Initial perturbation by coordinate name (``theta_12_dot=0.01``).
-    output_points : array (2, n) or list of (x_f, y_f), optional
-        Default ``system.monitor_points``.
+    alpha, beta, perturb, output_points :
+        Rayleigh damping, initial perturbation and monitored points, as for
+        :class:`tmfem.models.mtc.dynamics.MTCDynamics`.
     """
 
     def __init__(self, model, state_eq, *, alpha: float = 0.0, beta: float = 0.0,
