@@ -22,7 +22,7 @@ def configure(parser) -> None:
     parser.add_argument("--preset", required=True, help="system of Tables 6.6/6.7: 1-4 or 2-3")
     parser.add_argument("--mesh", type=positive_int, default=10,
                         help="FE membrane elements per side of each quadrilateral (6.4: 10; "
-                             "6.5.1 uses 20 for 1-4)")
+                             "6.5: 10, the '20 x 20' square of 6.5.1 is 4 x 10 x 10)")
     parser.add_argument("--tendon-elements", type=positive_int, default=3,
                         help="truss elements per tendon of the FE models (6.4: 3)")
     parser.add_argument("--backend", choices=backend_names(), default="scipy",

@@ -68,7 +68,8 @@ def three_model_vibration(name: str, *, t_end: float, dt: float = 0.01, perturb=
     perturb : dict, optional
         Initial perturbation by coordinate name (default :data:`PERTURBATION`).
     mesh_n, tendon_elements : int
-        Membrane mesh (6.5.1 uses 20 for 1-4, 6.5.2 10 for 2-3) and truss elements per tendon
+        Membrane mesh (6.5: 10; the "20 x 20 mesh for the square membrane" of 6.5.1 is
+        4 x 10 x 10) and truss elements per tendon
         of the FE models; the COM's membrane basis is computed on the same mesh.
     progress : callable, optional
         ``progress(model_name)`` before each model's run; it may return a
