@@ -227,3 +227,19 @@ def test_sbc_convergence_answer():
     assert np.all(per[:4] < 8e-3)
     assert np.all(per[4:] > 1.5e-2)
     assert fit["sigma_p1_max_MPa_exponent"] == pytest.approx(-1.0, abs=0.15)
+
+
+def test_sbc_plant_newton_matrix_is_the_derivative_of_its_residual():
+    # the plant's state is the total rotation vector from the equilibrium: its Newton matrix
+    # K_T dexp (models/sbc/dynamics.py) against central differences of the residual at a
+    # state with finite (0.05 rad) rotations; the spin tangent alone is off by O(|theta|)
+    from tmfem.models.sbc.dynamics import SBCDynamics
+    m = SBCModel(paper_1_4(), mesh_n=3, tendon_elements=2)
+    d = SBCDynamics(m, m.solve_static().state)
+    rng = np.random.default_rng(0)
+    u = 0.05 * rng.standard_normal(int(d.free.sum()))
+    z, v, h = np.zeros_like(u), rng.standard_normal(u.size), 1e-6
+    fd = (d.residual(u + h * v, z, z, 0.0) - d.residual(u - h * v, z, z, 0.0)) / (2 * h)
+    assert np.linalg.norm(d._tangent(u) @ v - fd) <= 1e-6 * np.linalg.norm(fd)
+    _, Ks = m.residual(d.configuration(u))
+    assert np.linalg.norm(Ks[d.free][:, d.free] @ v - fd) > 1e-4 * np.linalg.norm(fd)
