@@ -2,9 +2,9 @@
 
 6.3 studies the shell-beam-cable (SBC) model; the membrane-truss-cable (MTC) model runs the
 same study. Each row solves the statics and the modes of one (mesh n, tendon elements k): the
-MTC model from the design, the SBC model from the MTC equilibrium on the same mesh
-(:meth:`SBCModel.start_from`: directors on the normals of that surface, a few Newton steps),
-both with the rest lengths held over the study (:func:`resolve_rest_lengths`).
+MTC model from the design, the SBC model from the MTC equilibrium on the same mesh (its MTC
+predictor, :meth:`SBCModel.solve_static`), both with the rest lengths held over the study
+(:func:`resolve_rest_lengths`).
 """
 from __future__ import annotations
 
@@ -71,14 +71,11 @@ def _sbc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
     is the MITC4 shell; "element mean" stresses are the element centres, mid surface)."""
     from tmfem.models.sbc.model import SBCModel
     from tmfem.models.sbc.post import static_summary as sbc_summary
-    mtc = MTCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
-                   patch=patch, rest_lengths=rest, backend=backend)
-    xm = mtc.solve_static(start="design").x
     m = SBCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
-                 patch=patch, rest_lengths=mtc.rest_lengths, backend=backend)
-    res = m.solve_static(start=m.start_from(xm))
+                 patch=patch, rest_lengths=rest, backend=backend)
+    res = m.solve_static()
     t1 = time.perf_counter()
-    md = m.modes(res.state, k=modes)
+    md = m.modes(res.state, k=modes, tangent=res.tangent)
     st = sbc_summary(m, res)
     return m.mtc, res.iterations, md.freq_hz, t1, {
         "Delta_mm": 1e3 * st["Delta_mean"], "tendon_stress_max_MPa": st["tendon_stress_max"] / 1e6,

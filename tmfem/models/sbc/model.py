@@ -314,24 +314,6 @@ class SBCModel:
                                predictor_iterations=0 if pre is None else pre.iterations,
                                tangent=res.tangent)
 
-    def start_from(self, x: np.ndarray) -> State:
-        """A start for :meth:`solve_static` from positions x (3, n) of the MTC numbering (an
-        MTC equilibrium on the same mesh, say): bar interiors on the chords; every shell
-        director turned by the smallest rotation onto the normal of the placed mesh, every bar
-        node by the one that turns its reference chord onto the current one."""
-        from tmfem.fem.mitc4 import nodal_normals
-        s = self.start_state()
-        s.x[:, :self.numbering.n_mtc_nodes] = x
-        ch = self.numbering.bar_chain
-        s.x[:, ch] = self._along_bars(s.x)
-        nodes = self.shell.nodes
-        n1 = nodal_normals(s.x, self.shell.conn)[:, nodes]
-        s.R[nodes] = _smallest_rotation(self.shell.frames[nodes][:, :, 2].T, n1)
-        d0 = self.X[:, ch[:, -1]] - self.X[:, ch[:, 0]]
-        d1 = s.x[:, ch[:, -1]] - s.x[:, ch[:, 0]]
-        s.R[ch] = _smallest_rotation(d0, d1)[:, None]
-        return s
-
     # ------------------------------------------------------------------ modes
     def modes(self, state: State, *, k: int = 12, sigma: float = -1.0, tangent=None):
         """Lowest ``k`` modes about the prestressed ``state`` (eq. 5.32): symmetric part of
@@ -348,16 +330,3 @@ class SBCModel:
         S = self.constraints.T @ shapes
         tr = self.dofmap.translation_dofs(np.arange(self.dofmap.n_nodes))     # (n, 3)
         return S[tr].transpose(1, 0, 2)
-
-
-def _smallest_rotation(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Rotation matrices (n, 3, 3) that turn the directions a (3, n) onto b (3, n) about
-    a x b (Rodrigues)."""
-    from scipy.spatial.transform import Rotation
-    a = a / np.linalg.norm(a, axis=0)
-    b = b / np.linalg.norm(b, axis=0)
-    ax = np.cross(a.T, b.T)
-    s = np.linalg.norm(ax, axis=1)
-    ang = np.arctan2(s, np.einsum("in,in->n", a, b))
-    rv = np.where(s[:, None] > 0, ax / np.maximum(s, 1e-300)[:, None], 0.0) * ang[:, None]
-    return Rotation.from_rotvec(rv).as_matrix()
