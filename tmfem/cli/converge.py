@@ -54,9 +54,6 @@ def run(args) -> dict:
     tendons = _ints(args.tendon_elements, "--tendon-elements")
     for n in meshes:
         check_mesh_budget(N=system.N, n=n, dofs_per_node=5 if args.model == "sbc" else 3)
-    if args.model == "sbc" and args.membrane_law != "svk":
-        raise InputError(f"converge --model sbc: option does not apply: --membrane-law "
-                         f"{args.membrane_law} (the MITC4 shell is St.Venant-Kirchhoff)")
     check_outputs(args, NAME)
     rows = []
     writer = fh = None

@@ -72,7 +72,7 @@ def _sbc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
     from tmfem.models.sbc.model import SBCModel
     from tmfem.models.sbc.post import static_summary as sbc_summary
     m = SBCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
-                 patch=patch, rest_lengths=rest, backend=backend)
+                 patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
     res = m.solve_static()
     t1 = time.perf_counter()
     md = m.modes(res.state, k=modes, tangent=res.tangent)
@@ -84,7 +84,7 @@ def _sbc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
         "von_mises_max_MPa": st["membrane_max_von_mises"] / 1e6,
         "sigma_p1_elem_max_MPa": st["membrane_max_sigma_p1_element_centre"] / 1e6,
         "von_mises_elem_max_MPa": st["membrane_max_von_mises_element_centre"] / 1e6,
-        "membrane_law": "svk", "wrinkled_fraction": st["membrane_state_fractions"]["wrinkled"],
+        "membrane_law": membrane_law, "wrinkled_fraction": st["membrane_state_fractions"]["wrinkled"],
         "slack_fraction": st["membrane_state_fractions"]["slack"], "dofs": m.ndof}
 
 
@@ -100,16 +100,13 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
     Each row: mesh size, DOFs, static iterations and time, landing (Delta), peak stresses
     (Gauss-point maxima and element-mean maxima; SBC: element centres), and the frequencies
     ``f1 .. f<modes>`` [Hz]. ``h`` is the element size sqrt(area / elements). ``model``:
-    ``"mtc"`` or ``"sbc"`` (module docstring). ``membrane_law`` selects the membrane law of
-    :class:`MTCModel` (the SBC shell is St.Venant-Kirchhoff); the rows carry the fractions of
-    wrinkled and slack Gauss points (criterion of :mod:`tmfem.fem.tension_field`; SBC: the
-    sign of the mid-surface principal stresses).
+    ``"mtc"`` or ``"sbc"`` (module docstring). ``membrane_law`` selects the membrane law (of
+    the shell's lamina in the SBC model); the rows carry the fractions of wrinkled and slack
+    Gauss points (criterion of :mod:`tmfem.fem.tension_field`; SBC: the sign of the
+    mid-surface principal stresses).
     """
     if model not in ROWS:
         raise InputError(f"convergence: expected model one of {sorted(ROWS)}, found {model!r}")
-    if model == "sbc" and membrane_law != "svk":
-        raise InputError(f"convergence --model sbc: option does not apply: --membrane-law "
-                         f"{membrane_law} (the MITC4 shell is St.Venant-Kirchhoff)")
     rest = resolve_rest_lengths(system, rest_lengths=rest_lengths)
     for n in meshes:
         for k in tendon_elements:
