@@ -10,7 +10,8 @@ import pytest
 
 from tmfem.errors import InputError
 from tmfem.models.mtc.model import MTCModel
-from tmfem.models.mtc.dynamics import MTCDynamics, fit_frequency, initial_state
+from tmfem.models.fe_plant import initial_state
+from tmfem.models.mtc.dynamics import MTCDynamics, fit_frequency
 from tmfem.simulation.vibration import mtc_free_vibration
 from tmfem.solvers.park import park_integrate
 from tmfem.system import load_preset

@@ -114,7 +114,8 @@ def test_bad_input_refused(capsys):
         SBCModel(s, mesh_n=2, bar_elements=0)
     assert main(["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "2", "--patch", "0.3"]) != 0
     assert "does not apply" in capsys.readouterr().err
-    assert main(["static", "--model", "sbc", "--preset", "1-4", "--mesh", "2", "--png", "x.png"]) != 0
+    assert main(["static", "--model", "sbc", "--preset", "1-4", "--mesh", "2", "--wrinkle-plot",
+                 "x.png"]) != 0
     assert "does not apply" in capsys.readouterr().err
     assert main(["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "2", "--start", "design"]) != 0
     capsys.readouterr()

@@ -1,4 +1,4 @@
-"""``tmfem converge``: mesh and tendon-subdivision convergence of the MTC model (6.3)."""
+"""``tmfem converge``: mesh and tendon-subdivision convergence of the MTC or SBC model (6.3)."""
 from __future__ import annotations
 
 import csv
@@ -26,8 +26,9 @@ def _ints(text: str, what: str) -> list[int]:
 
 def configure(parser) -> None:
     add_system_args(parser)
-    parser.add_argument("--model", choices=("mtc",), default="mtc",
-                        help="finite-element model (mtc: membrane-truss-cable, 4.4)")
+    parser.add_argument("--model", choices=("mtc", "sbc"), default="mtc",
+                        help="finite-element model (mtc: membrane-truss-cable, 4.4; sbc: "
+                             "shell-beam-cable, 4.3, the model of 6.3)")
     parser.add_argument("--backend", choices=backend_names(), default="scipy",
                         help="linear-algebra backend (default scipy; docs/backends.md)")
     parser.add_argument("--mesh", default="10",
@@ -52,7 +53,7 @@ def run(args) -> dict:
     meshes = _ints(args.mesh, "--mesh")
     tendons = _ints(args.tendon_elements, "--tendon-elements")
     for n in meshes:
-        check_mesh_budget(N=system.N, n=n)
+        check_mesh_budget(N=system.N, n=n, dofs_per_node=5 if args.model == "sbc" else 3)
     check_outputs(args, NAME)
     rows = []
     writer = fh = None
@@ -62,7 +63,7 @@ def run(args) -> dict:
         for row in convergence_rows(system, meshes=meshes, tendon_elements=tendons,
                                     attachment=args.attachment, rest_lengths=rest,
                                     modes=args.modes, patch=args.patch, backend=args.backend,
-                                    membrane_law=args.membrane_law):
+                                    membrane_law=args.membrane_law, model=args.model):
             rows.append(row)
             if fh is not None:
                 if writer is None:
@@ -74,7 +75,7 @@ def run(args) -> dict:
     finally:
         if fh is not None:
             fh.close()
-    out = {"system": system.name, "attachment": args.attachment,
+    out = {"system": system.name, "model": args.model, "attachment": args.attachment,
            "membrane_law": args.membrane_law, "rows": rows}
     if len(meshes) >= 3 and len(tendons) == 1:
         out["fit"] = fit_convergence(rows, modes=args.modes)
@@ -84,7 +85,7 @@ def run(args) -> dict:
             abs(r[f"f{i + 1}"] / f0[i] - 1) for r in rows for i in range(args.modes))
     if args.plot:
         out["plot"] = str(plot_convergence_study(args.plot, rows, args.modes, system.name,
-                                                 args.attachment,
+                                                 args.attachment, model=args.model.upper(),
                                                  by_tendons=len(meshes) == 1 and len(tendons) > 1))
     if args.csv:
         out["csv"] = args.csv
@@ -98,7 +99,7 @@ def format_text(r: dict) -> str:
     nf = sum(1 for k in rows[0] if k.startswith("f") and k[1:].isdigit())
     head = f"{'n':>3s} {'k':>2s} {'elem':>6s} {'dofs':>7s} {'Delta mm':>9s} {'sp1 MPa':>8s} {'vm MPa':>8s} " \
            + " ".join(f"{'f' + str(i + 1):>7s}" for i in range(nf))
-    lines = [f"{r['system']} MTC convergence, {r['attachment']} attachment, "
+    lines = [f"{r['system']} {r.get('model', 'mtc').upper()} convergence, {r['attachment']} attachment, "
              f"{r.get('membrane_law', 'svk')} membrane", head]
     for w in rows:
         lines.append(f"{w['mesh_n']:3d} {w['tendon_elements']:2d} {w['elements']:6d} {w['dofs']:7d} "
@@ -110,6 +111,10 @@ def format_text(r: dict) -> str:
                      + ", ".join(f"{p:.2f}" for p in fit["frequency_rates"]))
         lines.append("change between the two finest meshes: "
                      + ", ".join(f"{100 * c:.3f}%" for c in fit["frequency_change_last"]))
+        lines.append("successive changes per halving of h ~ h^q (q <= 0: no convergence), q: "
+                     + ", ".join(f"{q:.2f}" for q in fit["successive_change_rates"]))
+        lines.append("change per halving between the two finest meshes: "
+                     + ", ".join(f"{100 * c:.2f}%" for c in fit["frequency_change_per_halving_last"]))
         lines.append(f"peak stress ~ h^p: sigma_p1 p = {fit['sigma_p1_max_MPa_exponent']:.2f}, "
                      f"von Mises p = {fit['von_mises_max_MPa_exponent']:.2f}, element-mean sigma_p1 "
                      f"p = {fit['sigma_p1_elem_max_MPa_exponent']:.2f}; Delta p = "

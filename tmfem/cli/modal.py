@@ -87,12 +87,24 @@ def sbc_modal(args, model, tables) -> dict:
     """``tmfem modal --model sbc``: equilibrium from the undeformed membrane, modes, and the
     printed SBC column of Tables 6.6/6.7 (``tables``) when the system has one."""
     from tmfem.models.sbc.post import modal_summary
-    if args.vtk or args.png:
-        raise InputError("modal --model sbc: option does not apply yet: --vtk/--png (mode-shape "
-                         "output of the shell model is not built; use --model mtc)")
     print(f"tmfem modal: {model.system.name} SBC, {model.ndof} free dofs", file=sys.stderr)
     res = model.solve_static(monitor=default_monitor(model.system))
-    out = modal_summary(model, res, model.modes(res.state, k=args.modes, tangent=res.tangent))
+    modes = model.modes(res.state, k=args.modes, tangent=res.tangent)
+    out = modal_summary(model, res, modes)
+    if args.vtk or args.png:
+        from tmfem.post.sbc import mode_data, sbc_cells
+        shapes, rotations = mode_data(model, res.state, modes)
+        cells = sbc_cells(model)
+        if args.vtk:
+            from tmfem.io.codes import kind_cell_data
+            from tmfem.io.writer import write_modes
+            out["vtk"] = str(write_modes(args.vtk, res.state.x, cells, shapes, modes.freq_hz,
+                                         point_data=rotations, cell_data=kind_cell_data(cells)))
+        if args.png:
+            from tmfem.post.render import render_modes
+            out["png"] = str(render_modes(args.png, points=res.state.x, cells=cells, shapes=shapes,
+                                          freq_hz=modes.freq_hz, k=min(6, args.modes),
+                                          title=f"{model.system.name} SBC modes"))
     ref = tables.get(model.system.name)
     if ref is not None:
         n = min(len(ref["SBC"]), args.modes)

@@ -89,17 +89,37 @@ def write_outputs(args, model, x, summary) -> None:
         summary["png"] = str(p)
 
 
+def sbc_static(args, model) -> dict:
+    """``tmfem static --model sbc``: the equilibrium from the undeformed membrane (6.2), its
+    summary and the ParaView file / PNG of the shells, beams and tendons."""
+    from tmfem.errors import InputError
+    from tmfem.models.sbc.post import static_summary as sbc_summary
+    if args.stress_plot or args.wrinkle_plot:
+        raise InputError("static --model sbc: option does not apply: --stress-plot/--wrinkle-plot "
+                         "(maps of the MTC membrane; the SBC shell stresses are in --vtk)")
+    monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
+    res = model.solve_static(monitor=monitor, progress=static_progress(args.progress))
+    out = sbc_summary(model, res)
+    if args.vtk:
+        from tmfem.post.sbc import write_sbc_state
+        out["vtk"] = write_sbc_state(args.vtk, model, res.state)
+    if args.png:
+        from tmfem.models.mtc.post import q_from_positions
+        from tmfem.post.render import render_configuration
+        from tmfem.post.sbc import shell_field
+        st = res.state
+        q = q_from_positions(model.system, st.x[:, model.mtc.topology.system_node])
+        out["png"] = str(render_configuration(
+            args.png, model.system, q=q, tendon_forces=model.member_forces(st)["tendon"],
+            membrane=shell_field(model, st), membrane_field="von_mises_top",
+            title=f"{model.system.name} SBC equilibrium (shell von Mises, top surface)"))
+    return out
+
+
 def run(args) -> dict:
     model, options = model_from_args(args, NAME)
     if args.model == "sbc":
-        from tmfem.errors import InputError
-        from tmfem.models.sbc.post import static_summary as sbc_summary
-        if args.vtk or args.png or args.stress_plot:
-            raise InputError("static --model sbc: option does not apply yet: --vtk/--png/--stress-plot "
-                             "(field output of the shell model is not built; use --model mtc)")
-        monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
-        return sbc_summary(model, model.solve_static(monitor=monitor,
-                                                     progress=static_progress(args.progress)))
+        return sbc_static(args, model)
     res, summary = solve(args, model, options)
     write_outputs(args, model, res.x, summary)
     return summary
@@ -109,7 +129,6 @@ def format_text(r: dict) -> str:
     if r.get("model") == "sbc":
         from tmfem.models.sbc.post import format_static
         return format_static(r)
-    pr = r.get("printed", {})
     lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
              f"membrane, {r['dofs']} free dofs",
@@ -129,18 +148,8 @@ def format_text(r: dict) -> str:
         h = np.asarray(h)
         lines.append(f"history of {lab}: start {np.round(h[0], 5).tolist()} -> "
                      f"{np.round(h[-1], 5).tolist()} (design {np.round(r['nodes'][lab]['design'], 5).tolist()})")
-    rows = [("membrane max sigma_p1 [MPa]", r["membrane_max_sigma_p1"] / 1e6,
-             pr.get("membrane_max_sigma_p1", np.nan) / 1e6),
-            ("membrane max von Mises [MPa]", r["membrane_max_von_mises"] / 1e6,
-             pr.get("membrane_max_von_mises", np.nan) / 1e6),
-            ("tendon max stress [MPa]", r["tendon_stress_max"] / 1e6,
-             pr.get("tendon_max_stress", np.nan) / 1e6)]
-    if "bar_load_by_stage" in r:
-        for i, v in enumerate(r["bar_load_by_stage"]):
-            rows.append((f"bar load, stage {i + 1} [N]", v, pr.get(f"bar_load_stage{i + 1}", np.nan)))
-    else:
-        rows.append(("bar load [N]", r["bar_load_max"], pr.get("bar_load", np.nan)))
-    rows.append(("bar critical load [N]", r["bar_critical_load"], pr.get("bar_critical_load", np.nan)))
+    from tmfem.models.mtc.post import check_lines, printed_rows
+    rows = printed_rows(r)
     lines.append(f"{'':32s} {'MTC':>12s} {'dissertation':>12s}")
     lines += [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
               for a, b, c in rows]
@@ -148,9 +157,7 @@ def format_text(r: dict) -> str:
                                                    list(r["tendon_force"].items())[:12]))
     if r["tendon_slack"]:
         lines.append(f"SLACK tendons: {r['tendon_slack']}")
-    for c in r["checks"]:
-        lines.append(f"check {c['check']:36s} {'ok' if c['ok'] else 'VIOLATED'}  "
-                     f"({c['value']:.4g} vs {c['limit']:.4g}, eq. {c['equation']})")
+    lines += check_lines(r["checks"])
     for k in ("vtk", "png", "stress_plot", "wrinkle_plot"):
         if k in r:
             lines.append(f"wrote {r[k]}")

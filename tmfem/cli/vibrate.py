@@ -1,5 +1,5 @@
-"""``tmfem vibrate``: free vibration of the control-oriented model or of the membrane-truss-cable
-model (6.5, Park's method)."""
+"""``tmfem vibrate``: free vibration of the control-oriented model or of a finite-element model
+(membrane-truss-cable, shell-beam-cable; 6.5, Park's method)."""
 from __future__ import annotations
 
 import sys
@@ -11,7 +11,7 @@ from tmfem.cli.common import (add_model_args, finite_float, add_system_args, mod
 from tmfem.models.mtc.spec import sequence_of
 
 NAME = "vibrate"
-HELP = "free vibration after an initial perturbation (COM or MTC model, Park's method)"
+HELP = "free vibration after an initial perturbation (COM, MTC or SBC model, Park's method)"
 
 
 def configure(parser) -> None:
@@ -36,8 +36,8 @@ def configure(parser) -> None:
 def run(args) -> dict:
     check_time_steps(t_end=args.t_end, dt=args.dt)
     model, options = model_from_args(args, NAME)
-    if args.model == "mtc":
-        return run_mtc(args, model, options)
+    if args.model in ("mtc", "sbc"):
+        return run_fe(args, model, options)
     from tmfem.simulation.vibration import free_vibration
 
     system = model.system
@@ -75,27 +75,32 @@ def _run_summary(res, args, *, title: str) -> dict:
     return out
 
 
-def run_mtc(args, model, options) -> dict:
-    """Free vibration of the MTC model about its static equilibrium."""
-    from tmfem.models.mtc.dynamics import perturbation_names
-    from tmfem.simulation.vibration import mtc_free_vibration
+def run_fe(args, model, options) -> dict:
+    """Free vibration of a finite-element model (MTC or SBC) about its static equilibrium."""
+    from tmfem.models.fe_plant import perturbation_names
+    from tmfem.simulation.vibration import mtc_free_vibration, sbc_free_vibration
 
-    system = model.system
+    system, name = model.system, args.model.upper()
     pert = parse_perturbation(args.perturb, perturbation_names(system))
     rayleigh = options["rayleigh"] or (0.0, 0.0)
-    print(f"tmfem vibrate: {system.name} MTC, mesh {system.N}x{options['mesh']}x{options['mesh']}, "
+    print(f"tmfem vibrate: {system.name} {name}, mesh {system.N}x{options['mesh']}x{options['mesh']}, "
           f"{model.ndof} DOFs, static equilibrium", file=sys.stderr)
-    st = model.solve_static(start="undeformed", sequence=sequence_of(options["mesh"], options["sequence"]))
-    with progress_bar(args.t_end, args.dt, f"vibrate {system.name} MTC") as bar:
-        res = mtc_free_vibration(model, st.x, t_end=args.t_end, dt=args.dt, perturb=pert,
-                                 csv_path=args.csv, scheme=args.scheme, alpha=rayleigh[0],
-                                 beta=rayleigh[1], progress=bar, vtk_dir=args.vtk,
-                                 vtk_every=args.vtk_every)
-    out = {"system": system.name, "model": "mtc", "mesh": options["mesh"], "ndof": model.ndof,
+    if args.model == "mtc":
+        st = model.solve_static(start="undeformed",
+                                sequence=sequence_of(options["mesh"], options["sequence"]))
+        run, eq = mtc_free_vibration, st.x
+    else:
+        st = model.solve_static()
+        run, eq = sbc_free_vibration, st.state
+    with progress_bar(args.t_end, args.dt, f"vibrate {system.name} {name}") as bar:
+        res = run(model, eq, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
+                  scheme=args.scheme, alpha=rayleigh[0], beta=rayleigh[1], progress=bar,
+                  vtk_dir=args.vtk, vtk_every=args.vtk_every)
+    out = {"system": system.name, "model": args.model, "mesh": options["mesh"], "ndof": model.ndof,
            "tendon_elements": options["tendon_elements"], "t_end": args.t_end, "dt": args.dt,
            "perturbation": pert, "scheme": args.scheme, "rayleigh": list(rayleigh),
            "static_time_s": st.time,
-           **_run_summary(res, args, title=f"{system.name} MTC free vibration, mesh {options['mesh']}"),
+           **_run_summary(res, args, title=f"{system.name} {name} free vibration, mesh {options['mesh']}"),
            "max_tendon_deflection_m": res.stats["max_tendon_deflection"],
            "max_tendon_deflection_tendon": res.stats["max_tendon_deflection_tendon"],
            "energy_drift_J": float(np.max(np.abs(res.energy - res.energy[0]))),
@@ -105,8 +110,8 @@ def run_mtc(args, model, options) -> dict:
 
 
 def format_text(r: dict) -> str:
-    if r.get("model") == "mtc":
-        return _format_mtc(r)
+    if r.get("model") in ("mtc", "sbc"):
+        return _format_fe(r)
     lines = [f"{r['system']} COM free vibration: {r['steps']} steps of {r['dt']} s "
              f"({r['scheme']}), {r['wall_time_s']:.2f} s wall, {r['newton_iterations']} Newton "
              f"iterations, {r['jacobian_evaluations']} Jacobians",
@@ -115,8 +120,8 @@ def format_text(r: dict) -> str:
     return "\n".join(lines + _format_outputs(r))
 
 
-def _format_mtc(r: dict) -> str:
-    lines = [f"{r['system']} MTC free vibration ({r['ndof']} DOFs): {r['steps']} steps of "
+def _format_fe(r: dict) -> str:
+    lines = [f"{r['system']} {r['model'].upper()} free vibration ({r['ndof']} DOFs): {r['steps']} steps of "
              f"{r['dt']} s ({r['scheme']}), {r['wall_time_s']:.2f} s wall (static "
              f"{r['static_time_s']:.2f} s), {r['newton_iterations']} Newton iterations, "
              f"{r['jacobian_evaluations']} Jacobians",

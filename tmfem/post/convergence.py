@@ -7,7 +7,8 @@ from tmfem.io.paths import check_path
 from tmfem.post.plots import new_figure, save_figure
 
 
-def plot_convergence_study(path, rows, modes, name, attachment, *, by_tendons: bool):
+def plot_convergence_study(path, rows, modes, name, attachment, *, by_tendons: bool,
+                           model: str = "MTC"):
     """Frequencies (left) and peak membrane stresses (right) of the rows of a convergence
     study (6.3, Figs. 6.11-6.14) against the membrane elements (log axis) or the elements
     per tendon."""
@@ -21,11 +22,12 @@ def plot_convergence_study(path, rows, modes, name, attachment, *, by_tendons: b
     ax[0].set_xlabel("elements per tendon" if by_tendons else "membrane elements")
     ax[0].set_ylabel("frequency [Hz]")
     law = rows[0].get("membrane_law", "svk") if rows else "svk"
-    ax[0].set_title(f"{name} MTC, {attachment} attachment, {law} membrane")
+    ax[0].set_title(f"{name} {model}, {attachment} attachment, {law} membrane")
     ax[0].legend(fontsize=6, ncol=2)
     for key, lab in (("sigma_p1_max_MPa", "max sigma_p1 (Gauss pt)"),
                      ("von_mises_max_MPa", "max von Mises (Gauss pt)"),
-                     ("sigma_p1_elem_max_MPa", "max sigma_p1 (element mean)")):
+                     ("sigma_p1_elem_max_MPa", "max sigma_p1 (element mean"
+                                               + (", SBC: centre)" if model == "SBC" else ")"))):
         ax[1].plot(x, [r[key] for r in rows], "o-", label=lab)
     ax[1].set_xlabel(ax[0].get_xlabel())
     ax[1].set_ylabel("stress [MPa]")

@@ -1,4 +1,11 @@
-"""Mesh and tendon-subdivision convergence of the MTC model (dissertation 6.3, Figs. 6.11-6.14)."""
+"""Mesh and tendon-subdivision convergence of the FE models (dissertation 6.3, Figs. 6.11-6.14).
+
+6.3 studies the shell-beam-cable (SBC) model; the membrane-truss-cable (MTC) model runs the
+same study. Each row solves the statics and the modes of one (mesh n, tendon elements k): the
+MTC model from the design, the SBC model from the MTC equilibrium on the same mesh (its MTC
+predictor, :meth:`SBCModel.solve_static`), both with the rest lengths held over the study
+(:func:`resolve_rest_lengths`).
+"""
 from __future__ import annotations
 
 import logging
@@ -6,6 +13,7 @@ import time
 
 import numpy as np
 
+from tmfem.errors import InputError
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.mtc.post import static_summary
 
@@ -14,7 +22,8 @@ log = logging.getLogger(__name__)
 ROW_KEYS = ("mesh_n", "tendon_elements", "attachment", "elements", "h", "dofs", "iterations",
             "static_s", "modal_s", "Delta_mm", "tendon_stress_max_MPa", "bar_load_max_N",
             "sigma_p1_max_MPa", "von_mises_max_MPa", "sigma_p1_elem_max_MPa",
-            "von_mises_elem_max_MPa", "membrane_law", "wrinkled_fraction", "slack_fraction")
+            "von_mises_elem_max_MPa", "membrane_law", "wrinkled_fraction", "slack_fraction",
+            "model")
 
 
 def resolve_rest_lengths(system, *, rest_lengths):
@@ -36,47 +45,86 @@ def resolve_rest_lengths(system, *, rest_lengths):
     return m.rest_lengths.copy()
 
 
+def _mtc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_law):
+    """(model, static iterations, frequencies, summary values) of one MTC run."""
+    m = MTCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
+                 patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
+    res = m.solve_static(start="design")
+    t1 = time.perf_counter()
+    md = m.modes(res.x, k=modes)
+    st = static_summary(m, res.x)
+    return m, res.iterations, md.freq_hz, t1, {
+        "Delta_mm": 1e3 * float(np.mean(st["Delta"])),
+        "tendon_stress_max_MPa": st["tendon_stress_max"] / 1e6,
+        "bar_load_max_N": st["bar_load_max"],
+        "sigma_p1_max_MPa": st["membrane_max_sigma_p1"] / 1e6,
+        "von_mises_max_MPa": st["membrane_max_von_mises"] / 1e6,
+        "sigma_p1_elem_max_MPa": st["membrane_max_sigma_p1_element_mean"] / 1e6,
+        "von_mises_elem_max_MPa": st["membrane_max_von_mises_element_mean"] / 1e6,
+        "membrane_law": m.membrane_law,
+        "wrinkled_fraction": st["membrane_state_fractions"]["wrinkled"],
+        "slack_fraction": st["membrane_state_fractions"]["slack"]}
+
+
+def _sbc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_law):
+    """(model, static iterations, frequencies, summary values) of one SBC run (its membrane
+    is the MITC4 shell; "element mean" stresses are the element centres, mid surface)."""
+    from tmfem.models.sbc.model import SBCModel
+    from tmfem.models.sbc.post import static_summary as sbc_summary
+    m = SBCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
+                 patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
+    res = m.solve_static()
+    t1 = time.perf_counter()
+    md = m.modes(res.state, k=modes, tangent=res.tangent)
+    st = sbc_summary(m, res)
+    return m.mtc, res.iterations, md.freq_hz, t1, {
+        "Delta_mm": 1e3 * st["Delta_mean"], "tendon_stress_max_MPa": st["tendon_stress_max"] / 1e6,
+        "bar_load_max_N": st["bar_load_max"],
+        "sigma_p1_max_MPa": st["membrane_max_sigma_p1"] / 1e6,
+        "von_mises_max_MPa": st["membrane_max_von_mises"] / 1e6,
+        "sigma_p1_elem_max_MPa": st["membrane_max_sigma_p1_element_centre"] / 1e6,
+        "von_mises_elem_max_MPa": st["membrane_max_von_mises_element_centre"] / 1e6,
+        "membrane_law": membrane_law, "wrinkled_fraction": st["membrane_state_fractions"]["wrinkled"],
+        "slack_fraction": st["membrane_state_fractions"]["slack"], "dofs": m.ndof}
+
+
+ROWS = {"mtc": _mtc_row, "sbc": _sbc_row}
+
+
 def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "point",
                      rest_lengths=None, modes: int = 12, patch: float | None = None,
-                     progress: bool = True, backend="scipy", membrane_law: str = "svk"):
+                     progress: bool = True, backend="scipy", membrane_law: str = "svk",
+                     model: str = "mtc"):
     """Yield one result row (dict) per (mesh n, tendon elements k) pair, as it is computed.
 
     Each row: mesh size, DOFs, static iterations and time, landing (Delta), peak stresses
-    (Gauss-point maxima and element-mean maxima), and the frequencies ``f1 .. f<modes>`` [Hz].
-    ``h`` is the element size sqrt(area / elements). ``membrane_law`` selects the membrane
-    law of :class:`MTCModel`; the rows carry the fractions of wrinkled and slack Gauss points
-    (criterion of :mod:`tmfem.fem.tension_field`).
+    (Gauss-point maxima and element-mean maxima; SBC: element centres), and the frequencies
+    ``f1 .. f<modes>`` [Hz]. ``h`` is the element size sqrt(area / elements). ``model``:
+    ``"mtc"`` or ``"sbc"`` (module docstring). ``membrane_law`` selects the membrane law (of
+    the shell's lamina in the SBC model); the rows carry the fractions of wrinkled and slack
+    Gauss points (criterion of :mod:`tmfem.fem.tension_field`; SBC: the sign of the
+    mid-surface principal stresses).
     """
+    if model not in ROWS:
+        raise InputError(f"convergence: expected model one of {sorted(ROWS)}, found {model!r}")
     rest = resolve_rest_lengths(system, rest_lengths=rest_lengths)
     for n in meshes:
         for k in tendon_elements:
             t0 = time.perf_counter()
-            m = MTCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
-                         patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
-            res = m.solve_static(start="design")
-            t1 = time.perf_counter()
-            md = m.modes(res.x, k=modes)
+            m, its, freq, t1, vals = ROWS[model](system, n, k, attachment=attachment, patch=patch,
+                                                 rest=rest, modes=modes, backend=backend,
+                                                 membrane_law=membrane_law)
             t2 = time.perf_counter()
-            st = static_summary(m, res.x)
             ne = m.topology.mesh.t.shape[1]
             row = {"mesh_n": int(n), "tendon_elements": int(k), "attachment": attachment,
-                   "elements": ne, "h": float(np.sqrt(m.membrane.area() / ne)), "dofs": m.ndof,
-                   "iterations": res.iterations, "static_s": t1 - t0, "modal_s": t2 - t1,
-                   "Delta_mm": 1e3 * float(np.mean(st["Delta"])),
-                   "tendon_stress_max_MPa": st["tendon_stress_max"] / 1e6,
-                   "bar_load_max_N": st["bar_load_max"],
-                   "sigma_p1_max_MPa": st["membrane_max_sigma_p1"] / 1e6,
-                   "von_mises_max_MPa": st["membrane_max_von_mises"] / 1e6,
-                   "sigma_p1_elem_max_MPa": st["membrane_max_sigma_p1_element_mean"] / 1e6,
-                   "von_mises_elem_max_MPa": st["membrane_max_von_mises_element_mean"] / 1e6,
-                   "membrane_law": m.membrane_law,
-                   "wrinkled_fraction": st["membrane_state_fractions"]["wrinkled"],
-                   "slack_fraction": st["membrane_state_fractions"]["slack"]}
-            for i, f in enumerate(md.freq_hz):
+                   "elements": ne, "h": float(np.sqrt(m.membrane.area() / ne)),
+                   "dofs": vals.pop("dofs", m.ndof), "iterations": its, "static_s": t1 - t0,
+                   "modal_s": t2 - t1, **vals, "model": model}
+            for i, f in enumerate(freq):
                 row[f"f{i + 1}"] = float(f)
             if progress:
-                log.info("converge: n=%3d k=%d %s: %d dofs, f1 = %.5f Hz, max sigma_p1 = %.3f MPa "
-                         "(%.1f s)", n, k, attachment, m.ndof, md.freq_hz[0],
+                log.info("converge %s: n=%3d k=%d %s: %d dofs, f1 = %.5f Hz, max sigma_p1 = %.3f MPa "
+                         "(%.1f s)", model, n, k, attachment, row["dofs"], freq[0],
                          row["sigma_p1_max_MPa"], t2 - t0)
             yield row
 
@@ -84,7 +132,10 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
 def fit_convergence(rows, *, by: str = "h", modes: int = 12) -> dict:
     """Rates from ``np.polyfit`` on log h.
 
-    Frequencies: |f(h) - f(h_min)| ~ C h^p over all but the finest row (p > 0 converges).
+    Frequencies: |f(h) - f(h_min)| ~ C h^p over all but the finest row (p > 0 converges),
+    and the successive changes per halving of h ~ C h^q (``successive_change_rates``: q ~ p
+    for a converging sequence, q <= 0 when every refinement moves the frequency as much as the
+    last; ``frequency_change_per_halving_last`` the finest pair's).
     Peak stresses: sigma_max ~ C h^p over all rows (p < 0: grows without bound as h -> 0).
     """
     rows = sorted(rows, key=lambda r: -r[by])
@@ -102,6 +153,14 @@ def fit_convergence(rows, *, by: str = "h", modes: int = 12) -> dict:
                      if ok.sum() >= 2 else float("nan"))
     out["frequency_rates"] = rates
     out["frequency_change_last"] = (np.abs(F[-1] - F[-2]) / F[-1]).tolist()
+    # successive changes per halving of h, |f_i+1 - f_i| / f / log2(h_i / h_i+1) ~ h^q: they
+    # fall like h^p for a sequence converging at rate p, stay level (q ~ 0) for a drift like
+    # log h -- a test that does not take the finest mesh for the limit
+    per = np.abs(np.diff(F, axis=0)) / F[1:] * np.log(2) / np.log(h[:-1] / h[1:])[:, None]
+    hm = np.sqrt(h[:-1] * h[1:])
+    out["frequency_change_per_halving_last"] = per[-1].tolist()
+    out["successive_change_rates"] = [
+        float(np.polyfit(np.log(hm), np.log(np.maximum(per[:, c], 1e-16)), 1)[0]) for c in range(modes)]
     for key in ("sigma_p1_max_MPa", "von_mises_max_MPa", "sigma_p1_elem_max_MPa",
                 "von_mises_elem_max_MPa", "Delta_mm", "tendon_stress_max_MPa"):
         v = np.array([r[key] for r in rows])

@@ -1,4 +1,4 @@
-"""Free vibration of the control-oriented and the membrane-truss-cable models (6.5).
+"""Free vibration of the control-oriented and the finite-element (MTC, SBC) models (6.5).
 
 Each model's plant starts at its static equilibrium with an initial perturbation (the rate
 theta_12' = 0.01 rad/s of 6.5.1, theta_11' = 0.01 rad/s of 6.5.2) and is integrated by the
@@ -19,8 +19,9 @@ from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 from tmfem.io.run import RunOutputs
 from tmfem.models.com.plant import COMPlant
 from tmfem.models.mtc.dynamics import MTCDynamics, tendon_transverse
-from tmfem.models.mtc.post import member_state
+from tmfem.models.sbc.dynamics import SBCDynamics
 from tmfem.post.mtc import membrane_field
+from tmfem.post.sbc import shell_field
 from tmfem.simulation.controllers import OpenLoop
 from tmfem.simulation.driver import check_time_grid, simulate
 
@@ -123,14 +124,15 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
 
 
 @dataclass
-class MTCVibration:
-    """Result of :func:`mtc_free_vibration` (histories as arrays, one row per time)."""
+class FEVibration:
+    """Result of :func:`fe_free_vibration` (histories as arrays, one row per time)."""
 
     def __repr__(self) -> str:
-        return (f"MTCVibration({self.t.size} times to t = {self.t[-1]:.4g} s, "
+        return (f"FEVibration({self.model}, {self.t.size} times to t = {self.t[-1]:.4g} s, "
                 f"{self.q.shape[1]} coordinates, {self.wall_time:.2f} s wall)")
 
 
+    model: str
     t: np.ndarray
     q: np.ndarray                 # (nt, nq) generalised coordinates recovered from the bars
     w: np.ndarray                 # (nt, n_points) transverse deflections in O_f [m]
@@ -147,52 +149,73 @@ class MTCVibration:
         return self.kinetic + self.strain
 
 
-def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: dict | None = None,
-                       csv_path=None, scheme: str = "park", jacobian: str = "step",
-                       alpha: float = 0.0, beta: float = 0.0, monitor_nodes=None,
-                       output_points=None, progress=None, vtk_dir=None,
-                       vtk_every: int = 10, tol: float = 1e-10) -> MTCVibration:
-    """Free vibration of an MTC model from its equilibrium ``x_eq`` (6.5, eqs. 5.34-5.35).
+def mtc_free_vibration(model, x_eq, *, alpha: float = 0.0, beta: float = 0.0, perturb=None,
+                       output_points=None, **kwargs) -> FEVibration:
+    """Free vibration of an MTC model from its equilibrium ``x_eq`` (3, n_nodes) (6.5,
+    eqs. 5.34-5.35): :func:`fe_free_vibration` of its :class:`MTCDynamics` plant."""
+    dyn = MTCDynamics(model, x_eq, alpha=alpha, beta=beta, perturb=perturb,
+                      output_points=output_points)
+    return fe_free_vibration(dyn, name="mtc",
+                             membrane=lambda u: membrane_field(model, dyn.positions(u)), **kwargs)
+
+
+def sbc_free_vibration(model, state_eq, *, alpha: float = 0.0, beta: float = 0.0, perturb=None,
+                       output_points=None, **kwargs) -> FEVibration:
+    """Free vibration of an SBC model from its equilibrium ``state_eq`` (a ``State``) (6.5):
+    :func:`fe_free_vibration` of its :class:`~tmfem.models.sbc.dynamics.SBCDynamics` plant;
+    ParaView frames carry the shells with their stresses (:func:`tmfem.post.sbc.shell_field`)."""
+    dyn = SBCDynamics(model, state_eq, alpha=alpha, beta=beta, perturb=perturb,
+                      output_points=output_points)
+    return fe_free_vibration(dyn, name="sbc",
+                             membrane=lambda u: shell_field(model, dyn.configuration(u)), **kwargs)
+
+
+def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_path=None,
+                      scheme: str = "park", jacobian: str = "step", monitor_nodes=None,
+                      progress=None, vtk_dir=None, vtk_every: int = 10, tol: float = 1e-10,
+                      membrane=None) -> FEVibration:
+    """Free vibration of a finite-element plant ``dyn`` (:class:`tmfem.models.fe_plant.FEPlant`)
+    from its perturbed equilibrium (6.5, eqs. 5.34-5.35).
 
     Parameters
     ----------
-    model : MTCModel
-    x_eq : ndarray (3, n_nodes)
-        Static equilibrium of ``model``.
+    dyn : MTCDynamics or SBCDynamics
+        The plant, built with its perturbation (``{"theta_12_dot": 0.01}`` etc.,
+        :func:`tmfem.models.fe_plant.initial_state`), damping and output points.
+    name : str
+        Model name of the result and the ParaView series.
     t_end, dt : float
         Duration and time step (6.5: dt = 0.01 s).
-    perturb : dict
-        ``{"theta_12_dot": 0.01}`` etc. (see :func:`tmfem.models.mtc.dynamics.initial_state`).
     scheme, jacobian, tol :
         Passed to the integrator (default ``"step"``: one factorisation per step, modified
         Newton; measured on 2-3 at n = 10 it needs half the factorisations of ``"reuse"``,
         whose stale matrices diverge at times and restart with full Newton).
-    alpha, beta : float
-        Rayleigh damping (default none).
     monitor_nodes : list of str, optional
         Labelled nodes recorded (default ``system.monitor_nodes``).
-    output_points : list of (x_f, y_f), optional
-        Membrane points for w (default ``system.monitor_points``, eqs. 5.36, 5.38).
     csv_path, vtk_dir, vtk_every :
         Histories written row by row; ParaView frames every ``vtk_every`` steps.
+    membrane : callable, optional
+        ``membrane(u) -> MembraneField`` of a free-dof state, for the ParaView frames.
     progress : callable, optional
         ``progress(step, n_steps)``.
+
+    Outputs per step: q, w_k (eqs. 5.36, 5.38), the monitored bar ends, the largest tendon
+    transverse deflection (eq. 5.37, relative to the equilibrium), kinetic and strain energy.
     """
     check_time_grid(t_end, dt)
-    system, topo = model.system, model.topology
-    dyn = MTCDynamics(model, x_eq, alpha=alpha, beta=beta, perturb=perturb,
-                      output_points=output_points)
+    mtc = dyn.mtc
+    system, topo = mtc.system, mtc.topology
     labels = list(system.monitor_nodes) if monitor_nodes is None else list(monitor_nodes)
     lab_nodes = [topo.system_node[system.node_index(n)] for n in labels]
     has_int = topo.tendon_internal.size > 0
-    td0 = tendon_transverse(model, model.full(dyn.xr_eq)) if has_int else None
+    td0 = tendon_transverse(mtc, dyn.positions(dyn.state0())) if has_int else None
     nq = len(system.q_names)
     wn = [f"w_{i + 1}" for i in range(len(dyn.output_points))]
     columns = (["t"] + list(system.q_names) + wn + [f"{n}_{c}" for n in labels for c in "xyz"]
                + ["tendon_deflection", "kinetic_energy", "strain_energy"])
     T, Q, W, XS, TD, KE, SE = [], [], [], [], [], [], []
     out = RunOutputs(csv_path=csv_path, columns=columns, vtk_dir=vtk_dir, vtk_every=vtk_every,
-                     name=f"mtc_{system.name}")
+                     name=f"{name}_{system.name}")
     element_tendon = [system.tendons[k].name for k in topo.tendon_of_element]
     worst = [0.0, ""]
 
@@ -200,7 +223,7 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
         x = dyn.positions(u)
         q, w = y[:nq], y[nq:]
         if has_int:
-            d = np.linalg.norm(tendon_transverse(model, x) - td0, axis=-1)      # (n_t, k-1)
+            d = np.linalg.norm(tendon_transverse(mtc, x) - td0, axis=-1)      # (n_t, k-1)
             k = int(np.argmax(d.max(axis=1)))
             td = float(d[k].max())
             if td > worst[0]:
@@ -208,13 +231,13 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
         else:
             td = 0.0
         ke, se = dyn.kinetic_energy(v), dyn.strain_energy(u)
-        ms = member_state(model, x)
+        ms = dyn.member_forces(u)
         out.tendon_forces(t, ms["element_force"], element_tendon)
         pos = x[:, lab_nodes]
         if out.frame_due():
             out.series.append_configuration(t, system, q=q, tendon_forces=ms["tendon_force"],
-                                            rest_lengths=model.rest_lengths,
-                                            membrane=membrane_field(model, x),
+                                            rest_lengths=dyn.model.rest_lengths,
+                                            membrane=None if membrane is None else membrane(u),
                                             bar_forces=ms["bar_force"])
         T.append(t); Q.append(q); W.append(w); XS.append(pos); TD.append(td); KE.append(ke)
         SE.append(se)
@@ -230,9 +253,9 @@ def mtc_free_vibration(model, x_eq, *, t_end: float, dt: float = 0.01, perturb: 
     stats.update({"ndof": int(dyn.free.sum()), "max_tendon_deflection": worst[0],
                   "max_tendon_deflection_tendon": worst[1]})
     if stats["min_tendon_force"] <= 0:
-        log.warning("tendon %s went slack at t = %.4g s (tension-only in the MTC model)",
-                    stats["min_tendon_force_tendon"], stats["min_tendon_force_time"])
-    return MTCVibration(t=np.array(T), q=np.array(Q), w=np.array(W),
-                        nodes={n: Xa[:, :, k] for k, n in enumerate(labels)},
-                        tendon_deflection=np.array(TD), kinetic=np.array(KE), strain=np.array(SE),
-                        columns=columns, wall_time=sim.wall_time, stats=stats)
+        log.warning("tendon %s went slack at t = %.4g s (tension-only in the %s model)",
+                    stats["min_tendon_force_tendon"], stats["min_tendon_force_time"], name.upper())
+    return FEVibration(model=name, t=np.array(T), q=np.array(Q), w=np.array(W),
+                       nodes={n: Xa[:, :, k] for k, n in enumerate(labels)},
+                       tendon_deflection=np.array(TD), kinetic=np.array(KE), strain=np.array(SE),
+                       columns=columns, wall_time=sim.wall_time, stats=stats)

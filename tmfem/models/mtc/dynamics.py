@@ -25,7 +25,7 @@ corner moves -- the counterpart of the COM, where the membrane follows the bars 
 floating frame and corner-deformation fields (eqs. 5.1-5.3) and the membrane modal rates start
 at zero. Giving the corner alone a velocity would instead excite the mesh-scale modes around it.
 
-**Outputs per step** (:class:`MTCVibration`, CSV row by row): theta and psi of every bar
+**Outputs per step** (:class:`tmfem.simulation.vibration.FEVibration`, CSV row by row): theta and psi of every bar
 (recovered from the bar vectors, :func:`tmfem.models.mtc.post.q_from_positions`), the monitored bar
 ends (``MONITOR_NODES``: B_12, B_14 for 1-4; A_21, B_11, B_21 for 2-3; Figs. 6.21-6.22,
 6.25-6.27), the membrane transverse deflections w_1..w_3 at the material points of eqs.
@@ -38,24 +38,21 @@ local frame e_t1 (chord), e_t2 = e_t1 x e_z / |.|, e_t3 = e_t1 x e_t2 (eq. 5.37;
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
-from tmfem.equilibrium.general import node_jacobian
 from tmfem.errors import InputError
-from tmfem.fem.membrane import point_matrix
-from tmfem.models.base import split_perturbation
-from tmfem.models.mtc.post import q_from_positions
-from tmfem.models.mtc.topology import to_floating
+from tmfem.models.fe_plant import FEPlant
 
 
-class MTCDynamics:
-    """The MTC equation of motion on the free DOFs as a :class:`tmfem.models.base.Plant`.
+class MTCDynamics(FEPlant):
+    """The MTC equation of motion on the free DOFs as a :class:`tmfem.models.base.Plant`
+    (:class:`tmfem.models.fe_plant.FEPlant`: inputs, outputs, initial state).
 
     Inputs u: the tendon rest lengths ``r_<tendon>`` (each tendon's k elements get u / k);
     outputs y: the bar coordinates q recovered from the bar nodes (eqs. 3.1-3.2) and the
     transverse deflections w_k in the floating frame at ``output_points`` (eqs. 5.36-5.38),
-    as a sensor would measure them. The start state ``x0, v0`` is the equilibrium with the
-    perturbation of :func:`initial_state`.
+    as a sensor would measure them. The state is the free independent node positions; the
+    start state ``x0, v0`` is the equilibrium with the perturbation of
+    :func:`tmfem.models.fe_plant.initial_state`.
 
     Parameters
     ----------
@@ -72,28 +69,13 @@ class MTCDynamics:
 
     def __init__(self, model, x_eq, *, alpha: float = 0.0, beta: float = 0.0,
                  perturb: dict | None = None, output_points=None):
-        if not (np.isfinite(alpha) and np.isfinite(beta) and alpha >= 0 and beta >= 0):
-            raise InputError(f"Rayleigh damping: expected alpha, beta >= 0, found {alpha}, {beta}")
-        self.model = model
+        self.model = self.mtc = model
+        self.dofmap, self.constraints = model.topology.dofmap, model.topology.constraints
         self.free = model.free
         self.xr_eq = model.reduce(np.asarray(x_eq, dtype=float))
-        f = self.free
-        self.M = model.mass()[f][:, f].tocsc()
-        _, K0 = model.residual(self.xr_eq)
-        self.K0 = K0[f][:, f].tocsc()
-        self.alpha, self.beta = float(alpha), float(beta)
-        self.C = (self.alpha * self.M + self.beta * self.K0).tocsc() if (alpha or beta) else None
-        system = model.system
-        pts = system.monitor_points.T if output_points is None else np.reshape(output_points, (-1, 2))
-        self.output_points = [tuple(map(float, p)) for p in pts]
-        self._P = point_matrix(model.membrane.skmesh, np.asarray(self.output_points).T) \
-            if self.output_points else None
-        self.u0 = np.asarray(model.rest_lengths, dtype=float)
-        self.input_names = [f"r_{t.name}" for t in system.tendons]
-        self.output_names = list(system.q_names) + [f"w_{i + 1}" for i in range(len(self.output_points))]
-        self.x0, self.v0 = initial_state(self, perturb)
+        self._setup(model.mass(), alpha=alpha, beta=beta, perturb=perturb,
+                    output_points=output_points)
 
-    # state <-> positions
     def state0(self) -> np.ndarray:
         """The equilibrium as a free-DOF state."""
         return self.xr_eq[self.free].copy()
@@ -104,137 +86,21 @@ class MTCDynamics:
         xr[self.free] = u
         return xr
 
+    configuration = reduced
+
     def positions(self, u) -> np.ndarray:
         """Full node positions (3, n_nodes) of the free-DOF state u."""
         return self.model.full(self.reduced(u))
-
-    # Plant protocol (tmfem.models.base)
-    def _inputs(self, u) -> None:
-        # the plant drives its model: the tendon rest lengths are the inputs of this call
-        # (the nominal u0 when none are given), so the model is left at the last u
-        self.model.set_tendon_lengths(self.u0 if u is None else u)
-
-    def residual(self, x, v, a, t, u=None):
-        """r = M a + C v + f_int(x; u) on the free DOFs (module docstring)."""
-        self._inputs(u)
-        r, _ = self.model.residual(self.reduced(x), tangent=False)
-        out = r[self.free] + self.M @ a
-        if self.C is not None:
-            out = out + self.C @ v
-        return out
-
-    def _tangent(self, x):
-        """Tangent K_T (eqs. 4.4-4.6) on the free DOFs at the free-DOF state x."""
-        _, K = self.model.residual(self.reduced(x))
-        return K[self.free][:, self.free]
-
-    def jacobians(self, x, v, a, t, u=None):
-        """(dr/dx, dr/dv, dr/da) = (K_T, C, M)."""
-        self._inputs(u)
-        K = self._tangent(x)
-        C = self.C if self.C is not None else sp.csc_matrix(K.shape)
-        return K, C, self.M
-
-    def newton_matrix(self, x, v, a, t, cv, ca, u=None):
-        """K_T + cv C + ca M, the Newton matrix of Park's method (eq. 5.34)."""
-        self._inputs(u)
-        S = self._tangent(x) + ca * self.M
-        if self.C is not None:
-            S = S + cv * self.C
-        return S.tocsc()
-
-    def factorize(self, S):
-        """Solver of the Newton matrix: the model's backend (symmetric-mode sparse LU)."""
-        return self.model.backend.factorize(S)
-
-    def outputs(self, x, v=None, u=None) -> np.ndarray:
-        """y = [q, w_k]: bar coordinates from the bar nodes (eqs. 3.1-3.2) and membrane
-        deflections along z_f of the floating frame at the output points (eqs. 5.36-5.38)."""
-        xf = self.positions(x)
-        topo = self.model.topology
-        q = q_from_positions(self.model.system, xf[:, topo.system_node])
-        if self._P is None:
-            return q
-        xm = xf[:, :topo.n_mesh]
-        w = to_floating((self._P @ xm.T).T, xm[:, topo.mesh.corners])[2]
-        return np.concatenate([q, w])
-
-    # energies
-    def kinetic_energy(self, v) -> float:
-        """v^T M v / 2 [J] of the free-DOF velocities v."""
-        return 0.5 * float(v @ (self.M @ v))
 
     def strain_energy(self, x) -> float:
         """Strain energy [J] of membrane, bars and tendons (:meth:`MTCModel.energy`)."""
         return self.model.energy(self.reduced(x))
 
-
-def perturbation_names(system) -> list:
-    """Accepted perturbation names: the q of 3.2 and their rates (``theta_12_dot``)."""
-    return list(system.q_names) + [n + "_dot" for n in system.q_names]
-
-
-def initial_state(dyn: MTCDynamics, perturb: dict | None):
-    """Free-DOF positions and velocities (u0, v0) of the perturbed equilibrium (module docstring).
-
-    The labelled-node field dX/dq (exact, :func:`tmfem.equilibrium.general.node_jacobian`) is
-    taken at the q recovered from the equilibrium; the other free DOFs follow by static
-    condensation of the equilibrium tangent.
-    """
-    model = dyn.model
-    system, topo = model.system, model.topology
-    u0 = dyn.state0()
-    if not perturb:
-        return u0, np.zeros_like(u0)
-    dq, dqd = split_perturbation(perturb, system.q_names)
-    x_eq = model.full(dyn.xr_eq)
-    q_e = q_from_positions(system, x_eq[:, topo.system_node])
-    X_e = system.nodes(q_e)
-    dX_pos = system.nodes(q_e + dq) - X_e if np.any(dq) else np.zeros_like(X_e)
-    J = node_jacobian(system, q_e) @ dqd                       # dX/dq q' (eqs. 3.1-3.2)
-    # reduced node carrying each labelled node (point attachment: B_Mj is the corner node)
-    red_of = np.full(len(system.node_labels), -1)
-    for i, n in enumerate(topo.system_node):
-        if topo.red_node[n] >= 0:
-            red_of[i] = topo.red_node[n]
-        else:
-            row = topo.T[3 * n]
-            if topo.attachment != "point" or row.nnz != 1:
-                if np.any(J[:, i]) or np.any(dX_pos[:, i]):
-                    raise InputError(f"perturbation of {system.node_labels[i]}: needs "
-                                     f"attachment='point' (the bar top is a weighted patch "
-                                     f"point here)")
-                continue
-            red_of[i] = row.indices[0] // 3
-    # prescribed reduced DOFs (labelled nodes) among the free ones
-    n_red3 = dyn.xr_eq.size
-    pres = np.zeros(n_red3, dtype=bool)
-    vp = np.zeros(n_red3)
-    dp = np.zeros(n_red3)
-    for i, r in enumerate(red_of):
-        if r >= 0:
-            pres[3 * r:3 * r + 3] = True
-            vp[3 * r:3 * r + 3] = J[:, i]
-            dp[3 * r:3 * r + 3] = dX_pos[:, i]
-    free = dyn.free
-    pf, vpf, dpf = pres[free], vp[free], dp[free]
-    K = dyn.K0
-    o = ~pf
-    Koo = K[o][:, o].tocsc()
-    Kop = K[o][:, pf]
-    solve = model.backend.factorize(Koo)
-
-    def condense(p):
-        out = np.zeros(free.sum())
-        out[pf] = p[pf]
-        if np.any(p[pf]):
-            out[o] = -solve(Kop @ p[pf])
-        return out
-
-    v0 = condense(vpf)
-    if np.any(dpf):
-        u0 = u0 + condense(dpf)
-    return u0, v0
+    def member_forces(self, x) -> dict:
+        """Tendon element forces, tendon forces and bar forces [N] at the free-DOF state x
+        (:func:`tmfem.models.mtc.post.member_state`)."""
+        from tmfem.models.mtc.post import member_state
+        return member_state(self.model, self.positions(x))
 
 
 def tendon_transverse(model, x) -> np.ndarray:

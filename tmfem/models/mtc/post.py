@@ -58,6 +58,83 @@ def membrane_stress_summary(model, x: np.ndarray) -> dict:
             "max_von_mises_element_mean": float(st.von_mises_elem.max())}
 
 
+def critical_loads(system) -> np.ndarray:
+    """Euler critical load [N] of every bar (eq. 5.31), system bar order."""
+    return np.array([system.bar.euler_critical_load(l) for l in system.l.ravel()])
+
+
+def bar_loads(system, bar_force) -> dict:
+    """Bar loads (compression positive) of bar axial forces ``bar_force`` (system bar order):
+    the largest, the smallest Euler critical load (eq. 5.31) and, for M >= 2, the largest of
+    each stage (Table 6.5)."""
+    load = -np.asarray(bar_force, dtype=float)
+    Fcrit = critical_loads(system)
+    out = {"bar_load_max": float(load.max()), "bar_critical_load": float(Fcrit.min())}
+    if system.M >= 2:
+        out["bar_load_by_stage"] = [float(v) for v in load.reshape(system.M, system.N).max(axis=1)]
+    return out
+
+
+def design_checks(system, *, sigma_p1, von_mises, tendon_stress, tendon_yield, tendon_slack,
+                  bar_force) -> list:
+    """The checks of the equilibrium design at a computed state: membrane peaks against the
+    yield stress (eqs. 5.29-5.30), tendon stresses against theirs (6.2), no slack tendon
+    (3.18), bar loads below the Euler critical load (eq. 5.31). Each a dict (check, value,
+    limit, ok, equation)."""
+    checks = []
+
+    def check(name, value, limit, ok, eq):
+        checks.append({"check": name, "value": float(value), "limit": float(limit),
+                       "ok": bool(ok), "equation": eq})
+
+    mat = system.membrane
+    if mat.yield_stress:
+        check("membrane max sigma_p1 <= yield", sigma_p1, mat.yield_stress,
+              sigma_p1 <= mat.yield_stress, "5.29")
+        check("membrane max von Mises <= yield", von_mises, mat.yield_stress,
+              von_mises <= mat.yield_stress, "5.30")
+    ty = np.asarray(tendon_yield, dtype=float)
+    if np.any(np.isfinite(ty)):
+        s = np.asarray(tendon_stress)
+        k = int(np.nanargmax(s / ty))
+        ok = np.isfinite(ty)
+        check("tendon stress <= yield", s[k], ty[k], np.all(s[ok] <= ty[ok]), "6.2")
+    slack = np.asarray(tendon_slack, dtype=bool)
+    check("no slack tendon", int(slack.sum()), 0, not slack.any(), "3.18")
+    load = -np.asarray(bar_force, dtype=float)
+    Fcrit = critical_loads(system)
+    k = int(np.argmax(load / Fcrit))
+    check("bar load <= Euler critical load", load[k], Fcrit[k], np.all(load <= Fcrit), "5.31")
+    return checks
+
+
+def check_lines(checks) -> list:
+    """One text line per check of :func:`design_checks`."""
+    return [f"check {c['check']:36s} {'ok' if c['ok'] else 'VIOLATED'}  "
+            f"({c['value']:.4g} vs {c['limit']:.4g}, eq. {c['equation']})" for c in checks]
+
+
+def printed_rows(r: dict) -> list:
+    """(quantity, ours, printed or NaN) rows of a static summary ``r`` beside the printed
+    Table 6.3/6.5 values in ``r["printed"]``: membrane peaks [MPa], the largest tendon stress
+    [MPa], bar loads (per stage for M >= 2) and the critical load [N]."""
+    pr = r.get("printed", {})
+    nan = np.nan
+    rows = [("membrane max sigma_p1 [MPa]", r["membrane_max_sigma_p1"] / 1e6,
+             pr.get("membrane_max_sigma_p1", nan) / 1e6),
+            ("membrane max von Mises [MPa]", r["membrane_max_von_mises"] / 1e6,
+             pr.get("membrane_max_von_mises", nan) / 1e6),
+            ("tendon max stress [MPa]", r["tendon_stress_max"] / 1e6,
+             pr.get("tendon_max_stress", nan) / 1e6)]
+    if "bar_load_by_stage" in r:
+        rows += [(f"bar load, stage {i + 1} [N]", v, pr.get(f"bar_load_stage{i + 1}", nan))
+                 for i, v in enumerate(r["bar_load_by_stage"])]
+    else:
+        rows.append(("bar load [N]", r["bar_load_max"], pr.get("bar_load", nan)))
+    rows.append(("bar critical load [N]", r["bar_critical_load"], pr.get("bar_critical_load", nan)))
+    return rows
+
+
 def static_summary(model, x: np.ndarray, *, result=None) -> dict:
     """JSON-able summary of an MTC equilibrium: landing vs design, forces, stresses, checks.
 
@@ -88,29 +165,10 @@ def static_summary(model, x: np.ndarray, *, result=None) -> dict:
     delta_design = np.linalg.norm(cd - cd.mean(axis=1, keepdims=True), axis=0) - r_mb
     ms = member_state(model, x)
     ss = membrane_stress_summary(model, x)
-    bar_load = -ms["bar_force"]                                   # compression positive
-    Fcrit = np.array([sysm.bar.euler_critical_load(l) for l in sysm.l.ravel()])
-    mat = sysm.membrane
-    checks = []
-
-    def check(name, value, limit, ok, eq):
-        checks.append({"check": name, "value": float(value), "limit": float(limit),
-                       "ok": bool(ok), "equation": eq})
-
-    if mat.yield_stress:
-        check("membrane max sigma_p1 <= yield", ss["max_sigma_p1"], mat.yield_stress,
-              ss["max_sigma_p1"] <= mat.yield_stress, "5.29")
-        check("membrane max von Mises <= yield", ss["max_von_mises"], mat.yield_stress,
-              ss["max_von_mises"] <= mat.yield_stress, "5.30")
-    ty = model.tendon_yield
-    if np.any(np.isfinite(ty)):
-        s = ms["tendon_stress"]
-        k = int(np.nanargmax(s / ty))
-        check("tendon stress <= yield", s[k], ty[k], np.all(s[np.isfinite(ty)] <= ty[np.isfinite(ty)]),
-              "6.2")
-    check("no slack tendon", int(ms["tendon_slack"].sum()), 0, not ms["tendon_slack"].any(), "3.18")
-    k = int(np.argmax(bar_load / Fcrit))
-    check("bar load <= Euler critical load", bar_load[k], Fcrit[k], np.all(bar_load <= Fcrit), "5.31")
+    loads = bar_loads(sysm, ms["bar_force"])
+    checks = design_checks(sysm, sigma_p1=ss["max_sigma_p1"], von_mises=ss["max_von_mises"],
+                           tendon_stress=ms["tendon_stress"], tendon_yield=model.tendon_yield,
+                           tendon_slack=ms["tendon_slack"], bar_force=ms["bar_force"])
 
     out = {
         "system": sysm.name, "mesh_n": int(topo.mesh.n), "tendon_elements": topo.tendon_elements,
@@ -123,8 +181,7 @@ def static_summary(model, x: np.ndarray, *, result=None) -> dict:
         "theta_deg": np.degrees(th).ravel().tolist(), "theta_design_deg": np.degrees(thd).ravel().tolist(),
         "psi_deg": np.degrees(ps).ravel().tolist(), "psi_design_deg": np.degrees(psd).ravel().tolist(),
         "Delta": delta.tolist(), "Delta_design": delta_design.tolist(),
-        "bar_force": ms["bar_force"].tolist(), "bar_load_max": float(bar_load.max()),
-        "bar_critical_load": float(Fcrit.min()),
+        "bar_force": ms["bar_force"].tolist(), **loads,
         "tendon_force": {t.name: float(f) for t, f in zip(sysm.tendons, ms["tendon_force"])},
         "tendon_stress_max": float(ms["tendon_stress"].max()),
         "tendon_slack": [t.name for t, s in zip(sysm.tendons, ms["tendon_slack"]) if s],
@@ -136,8 +193,6 @@ def static_summary(model, x: np.ndarray, *, result=None) -> dict:
         "membrane_max_von_mises_element_mean": ss["max_von_mises_element_mean"],
         "checks": checks, "printed": dict(sysm.printed),
     }
-    if M >= 2:
-        out["bar_load_by_stage"] = [float(bar_load.reshape(M, N)[i].max()) for i in range(M)]
     if result is not None:
         out["iterations"] = int(result.iterations)
         out["residual_history"] = [float(v) for v in result.residual_history]

@@ -46,7 +46,7 @@ SPEC = register(ModelSpec(
     name="mtc", help="membrane-truss-cable finite-element model (4.4): membrane elements, truss "
                      "bars, tension-only truss tendons",
     commands=("static", "modal", "vibrate"), build=build,
-    shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law"),
+    shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law", "rayleigh"),
     own=(
         Option("--rest-lengths", None, None, dict(help=(
             "tendon rest lengths: 'system' (default when the system has them), 'design' (eq. 3.8), "
@@ -58,7 +58,4 @@ SPEC = register(ModelSpec(
         Option("--sequence", None, STATIC, dict(type=int, help=(
             "mesh sequencing of the static solve from this coarse n, halving (default: 10 when "
             "--mesh > 20, else none; 0 disables)"))),
-        Option("--rayleigh", None, ("vibrate",), dict(type=float, nargs=2, metavar=("ALPHA", "BETA"),
-                                                      help="Rayleigh damping C = ALPHA M + BETA K_0 "
-                                                           "(default none)")),
     )))

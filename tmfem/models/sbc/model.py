@@ -168,6 +168,13 @@ class SBCModel:
         self.mtc.set_rest_lengths(rest)
         self._set_tendons()
 
+    def set_tendon_lengths(self, u) -> None:
+        """Tendon rest lengths as time-varying inputs (a plant's u), in place
+        (:meth:`MTCModel.set_tendon_lengths`)."""
+        self.mtc.set_tendon_lengths(u)
+        if not np.array_equal(self.tendons.L, self.mtc.tendons.L):
+            self.tendons.L = self.mtc.tendons.L.copy()
+
     @property
     def rest_lengths(self) -> np.ndarray:
         return self.mtc.rest_lengths
@@ -213,7 +220,8 @@ class SBCModel:
         return self.constraints.tangent(M)
 
     def member_forces(self, state: State) -> dict:
-        """Tendon axial forces [N] (per tendon, mean of its elements) and bar axial forces [N]
+        """Tendon axial forces [N] (per tendon, mean of its elements; per element
+        ``tendon_element``) and bar axial forces [N]
         (mean over each bar's Gauss points; compression negative). A bar carrying H_1j
         (1-N(D)) reports the larger compression of its two segments A-H and H-B, as
         :func:`tmfem.equilibrium.design.bar_axial_loads` does."""
@@ -222,7 +230,7 @@ class SBCModel:
         segments = 2 if self.system.deployable else 1
         Nb = self.beam.section_forces(state)["N"].reshape(
             self.numbering.bar_chain.shape[0], segments, -1).mean(axis=2).min(axis=1)
-        return {"tendon": N.reshape(-1, k).mean(axis=1), "bar": Nb}
+        return {"tendon": N.reshape(-1, k).mean(axis=1), "tendon_element": N, "bar": Nb}
 
     def _force_scale(self, state: State) -> float:
         f = self.member_forces(state)

@@ -1,19 +1,76 @@
 """Result summaries of the SBC model (6.2, 6.4): landing against the design, member forces,
-bar bending moments, frequencies beside Tables 6.6/6.7."""
+bar bending moments, membrane stress peaks, the checks of the design and Tables 6.3/6.5,
+frequencies beside Tables 6.6/6.7."""
 from __future__ import annotations
 
 import numpy as np
 
-from tmfem.models.mtc.post import q_from_positions
+from tmfem.models.mtc.post import (bar_loads, check_lines, design_checks, printed_rows,
+                                   q_from_positions)
 from tmfem.system.coordinates import q_index
 from tmfem.system.topology import label
+
+#: surfaces of :meth:`MITC4Shell.stresses` (r_3 = -1, 0, 1)
+SURFACES = ("bottom", "mid", "top")
+
+
+def shell_stresses(model, state) -> dict:
+    """Principal stresses sigma_p1 >= sigma_p2 and von Mises stress [Pa] of the shell at the
+    element centres and at the 2 x 2 Gauss points, on the bottom, middle and top surfaces.
+
+    The shell's stresses are second Piola-Kirchhoff components in the element results frame of
+    eq. 4.16 (:meth:`tmfem.fem.mitc4.MITC4Shell.stresses`); principal values and von Mises
+    (eqs. 5.29-5.30, in-plane with the transverse shear) do not depend on the in-plane frame,
+    so they are those of the floating frame O_f. Returns ``centre`` and ``gauss`` dicts of
+    arrays (3 surfaces, ne) and (3 surfaces, ne, 4).
+    """
+    sh = model.shell
+    out = {}
+    for key, pts in (("centre", [(0.5, 0.5)]), ("gauss", list(sh._gxi.T))):
+        p1, p2, vm = [], [], []
+        for xi in pts:
+            s = sh.stresses(state, xi=tuple(xi))
+            s11, s22, s12 = s["sigma"][..., 0], s["sigma"][..., 1], s["sigma"][..., 2]
+            c, r = 0.5 * (s11 + s22), np.hypot(0.5 * (s11 - s22), s12)
+            p1.append((c + r).T); p2.append((c - r).T); vm.append(s["von_mises"].T)
+        out[key] = {"sigma_p1": np.stack(p1, -1), "sigma_p2": np.stack(p2, -1),
+                    "von_mises": np.stack(vm, -1)}
+    out["centre"] = {k: v[..., 0] for k, v in out["centre"].items()}
+    return out
+
+
+def membrane_peaks(model, state) -> dict:
+    """Peak membrane stresses [Pa] of an SBC state (Tables 6.3, 6.5): the largest sigma_p1 and
+    von Mises over the 2 x 2 Gauss points on each surface and over all three
+    (``max_sigma_p1``, ``max_von_mises``), the element-centre maxima on the mid surface (the
+    counterpart of the MTC model's element means), the smallest mid-surface sigma_p2 and the
+    fractions of mid-surface Gauss points taut (sigma_p2 > 0), wrinkled (sigma_p2 <= 0 <
+    sigma_p1) and slack (sigma_p1 <= 0), the tension-field criterion of the MTC model's
+    membrane (:mod:`tmfem.fem.tension_field`) applied to the shell's stresses."""
+    st = shell_stresses(model, state)
+    g, c = st["gauss"], st["centre"]
+    out = {f"max_{k}_{s}": float(g[k][i].max()) for k in ("sigma_p1", "von_mises")
+           for i, s in enumerate(SURFACES)}
+    out["max_sigma_p1"] = max(out[f"max_sigma_p1_{s}"] for s in SURFACES)
+    out["max_von_mises"] = max(out[f"max_von_mises_{s}"] for s in SURFACES)
+    out["max_sigma_p1_element_centre"] = float(c["sigma_p1"][1].max())
+    out["max_von_mises_element_centre"] = float(c["von_mises"][1].max())
+    out["min_sigma_p2_mid"] = float(g["sigma_p2"][1].min())
+    p1, p2 = g["sigma_p1"][1], g["sigma_p2"][1]
+    out["state_fractions"] = {"taut": float(np.mean(p2 > 0)),
+                              "wrinkled": float(np.mean((p2 <= 0) & (p1 > 0))),
+                              "slack": float(np.mean(p1 <= 0))}
+    return out
 
 
 def static_summary(model, result) -> dict:
     """Summary of an SBC equilibrium ``result`` (:class:`SBCStaticResult`) of ``model``:
-    iterations, residual history, the largest distance of a labelled node from the design,
-    the corner offset Delta (mean corner radius - r_mb), tendon forces and stresses, bar axial
-    forces and the largest bar bending moment |M| [N m] at the Gauss points."""
+    iterations (MTC predictor and SBC), residual history, landing against the design (largest
+    node distance, theta, psi of the bar chords, the corner offsets Delta), tendon forces and stresses, bar axial forces and loads
+    (per stage for M >= 2) and the largest bar bending moment |M| [N m] at the Gauss points,
+    the membrane stress peaks (:func:`membrane_peaks`), the design checks
+    (:func:`tmfem.models.mtc.post.design_checks`), the printed Table 6.3/6.5 values and, for
+    1-N(D) systems, the bars' bending deflection at H_1j."""
     sysm, st = model.system, result.state
     mt = model.mtc.topology
     X = sysm.nodes()
@@ -21,6 +78,9 @@ def static_summary(model, result) -> dict:
     f = model.member_forces(st)
     sec = model.beam.section_forces(st)
     c = st.x[:, mt.mesh.corners]
+    stress = f["tendon"] / model.mtc.tendon_area
+    slack = f["tendon_element"].reshape(len(sysm.tendons), -1).min(axis=1) <= 0
+    peaks = membrane_peaks(model, st)
     out = {"system": sysm.name, "model": "sbc", "dofs": model.ndof, "mesh_n": mt.mesh.n,
            "tendon_elements": mt.tendon_elements, "bar_elements": model.numbering.bar_elements,
            "attachment": mt.attachment, "membrane_law": model.shell.law.name,
@@ -30,12 +90,20 @@ def static_summary(model, result) -> dict:
            "residual_history": [float(v) for v in result.residual_history],
            "max_deviation_from_design": float(np.linalg.norm(x - X, axis=0).max()),
            "tendon_force": f["tendon"].tolist(),
-           "tendon_stress_max": float(np.max(f["tendon"] / model.mtc.tendon_area)),
-           "bar_force": f["bar"].tolist(), "bar_load_max": float(np.max(np.abs(f["bar"]))),
+           "tendon_stress_max": float(np.max(stress)),
+           "tendon_slack": [t.name for t, s_ in zip(sysm.tendons, slack) if s_],
+           "bar_force": f["bar"].tolist(), **bar_loads(sysm, f["bar"]),
            "bar_moment_max": float(np.max(np.hypot(sec["M1"], sec["M2"]))),
+           **{f"membrane_{k}": v for k, v in peaks.items()},
+           "checks": design_checks(sysm, sigma_p1=peaks["max_sigma_p1"],
+                                   von_mises=peaks["max_von_mises"], tendon_stress=stress,
+                                   tendon_yield=model.mtc.tendon_yield, tendon_slack=slack,
+                                   bar_force=f["bar"]),
+           "printed": dict(sysm.printed),
            "monitor": {k: v.tolist() for k, v in result.monitor.items()}}
     if sysm.r_mb is not None:
         r = np.linalg.norm(c - c.mean(axis=1, keepdims=True), axis=0)
+        out["Delta"] = (r - sysm.r_mb).tolist()
         out["Delta_mean"] = float(r.mean() - sysm.r_mb)
     out["top_nodes"] = {label("B", sysm.M, j): x[:, sysm.node_index(label("B", sysm.M, j))].tolist()
                         for j in range(1, sysm.N + 1)}
@@ -80,8 +148,17 @@ def format_static(r: dict) -> str:
                                                    zip(r["theta_deg"], r["theta_design_deg"])),
              "psi   [deg] (design): " + ", ".join(f"{a:.3f} ({b:.3f})" for a, b in
                                                    zip(r["psi_deg"], r["psi_design_deg"])),
-             f"max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, max bar load "
-             f"{r['bar_load_max']:.3f} N, max bar bending moment {r['bar_moment_max']:.3e} N m"]
+             f"max bar bending moment {r['bar_moment_max']:.3e} N m; membrane peaks at the Gauss "
+             f"points [MPa], sigma_p1 bottom/mid/top "
+             + "/".join(f"{r[f'membrane_max_sigma_p1_{s}'] / 1e6:.3f}" for s in SURFACES)
+             + ", von Mises " + "/".join(f"{r[f'membrane_max_von_mises_{s}'] / 1e6:.3f}" for s in SURFACES)
+             + f"; element-centre sigma_p1 {r['membrane_max_sigma_p1_element_centre'] / 1e6:.3f}",
+             f"{'':32s} {'SBC':>12s} {'dissertation':>12s}"]
+    lines += [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
+              for a, b, c in printed_rows(r)]
+    if r["tendon_slack"]:
+        lines.append(f"SLACK tendons: {r['tendon_slack']}")
+    lines += check_lines(r["checks"])
     if "bar_bow" in r:
         lines.append("bending deflection of the bars at H_1j [mm]: "
                      + ", ".join(f"{v * 1e3:.3f}" for v in r["bar_bow"]))
@@ -94,6 +171,7 @@ def format_static(r: dict) -> str:
                 lines.append(f"{i + 1:4d} {fr:10.4f} {d['SBC'][i]:10.4f} {100 * (fr / d['SBC'][i] - 1):7.2f}%")
             else:
                 lines.append(f"{i + 1:4d} {fr:10.4f}")
+    lines += [f"wrote {r[k]}" for k in ("vtk", "png") if k in r]
     return "\n".join(lines)
 
 

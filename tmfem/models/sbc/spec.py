@@ -22,8 +22,8 @@ def build(system, options: dict, backend) -> SBCModel:
 SPEC = register(ModelSpec(
     name="sbc", help="shell-beam-cable finite-element model (4.3): MITC4 shell membrane, 4-node "
                      "beam bars, tension-only truss tendons",
-    commands=("static", "modal"), build=build,
-    shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law"),
+    commands=("static", "modal", "vibrate"), build=build,
+    shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law", "rayleigh"),
     own=(
         Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1); per bar segment A-H, H-B of a 1-N(D) system")),
         Option("--rest-lengths", None, None, dict(help=(

@@ -1,0 +1,114 @@
+"""``tmfem compare``: the SBC, MTC and COM models side by side -- natural frequencies beside
+Tables 6.6/6.7 (6.4), or with ``--vibrate`` free vibration from the same perturbation (6.5)."""
+from __future__ import annotations
+
+import sys
+
+from tmfem.cli.common import (Progress, check_time_steps, finite_float, output_file,
+                              parse_perturbation, positive_int)
+from tmfem.errors import InputError
+from tmfem.solvers.backends import backend_names
+
+NAME = "compare"
+HELP = ("the three models (SBC, MTC, COM) side by side: frequencies beside Tables 6.6/6.7, or "
+        "free vibration from one perturbation (--vibrate)")
+
+#: options of each mode, refused in the other
+FREQUENCY_ONLY = ("modes",)
+VIBRATE_ONLY = ("t_end", "dt", "perturb")
+
+
+def configure(parser) -> None:
+    parser.add_argument("--preset", required=True, help="system of Tables 6.6/6.7: 1-4 or 2-3")
+    parser.add_argument("--mesh", type=positive_int, default=10,
+                        help="FE membrane elements per side of each quadrilateral (6.4: 10; "
+                             "6.5: 10, the '20 x 20' square of 6.5.1 is 4 x 10 x 10)")
+    parser.add_argument("--tendon-elements", type=positive_int, default=3,
+                        help="truss elements per tendon of the FE models (6.4: 3)")
+    parser.add_argument("--backend", choices=backend_names(), default="scipy",
+                        help="linear-algebra backend of the FE models")
+    parser.add_argument("--modes", type=positive_int, default=None,
+                        help="frequencies per model (default 12, as Tables 6.6/6.7)")
+    parser.add_argument("--vibrate", action="store_true",
+                        help="free vibration of the three models instead of frequencies (6.5)")
+    parser.add_argument("--t-end", type=finite_float, default=None,
+                        help="--vibrate: duration [s] (default 10)")
+    parser.add_argument("--dt", type=finite_float, default=None,
+                        help="--vibrate: time step [s] (default 0.01, as 6.5)")
+    parser.add_argument("--perturb", action="append", default=None, metavar="STATE=VALUE",
+                        help="--vibrate: initial perturbation (default 6.5's: theta_12_dot=0.01 "
+                             "for 1-4, theta_11_dot=0.01 for 2-3; repeatable)")
+    parser.add_argument("--csv", help="write the table (frequencies) or the histories to this CSV")
+    parser.add_argument("--plot", help="PNG: frequencies and differences, or the overlaid histories")
+
+
+def run(args) -> dict:
+    from tmfem.reference.model_compare import paper_state
+    paper_state(args.preset)
+    mine, other = (VIBRATE_ONLY, FREQUENCY_ONLY) if args.vibrate else (FREQUENCY_ONLY, VIBRATE_ONLY)
+    wrong = [d for d in other if getattr(args, d) is not None]
+    if wrong:
+        flags = ", ".join("--" + d.replace("_", "-") for d in wrong)
+        raise InputError(f"compare{' --vibrate' if args.vibrate else ''}: option does not apply: "
+                         f"{flags} ({'without' if args.vibrate is False else 'with'} --vibrate)")
+    output_file(args.csv, option="--csv", suffixes=(".csv",))
+    output_file(args.plot, option="--plot", suffixes=(".png",))
+    return run_vibration(args) if args.vibrate else run_frequencies(args)
+
+
+def run_frequencies(args) -> dict:
+    from tmfem.reference.model_compare import compare_frequencies, write_compare_csv
+    with Progress(total=3, desc=f"compare {args.preset}") as bar:
+        r = compare_frequencies(args.preset, modes=args.modes or 12, mesh_n=args.mesh,
+                                tendon_elements=args.tendon_elements, backend=args.backend,
+                                progress=bar.step)
+    if args.csv:
+        r["csv"] = str(write_compare_csv(args.csv, r))
+    if args.plot:
+        from tmfem.post.compare import plot_model_frequencies
+        r["plot"] = str(plot_model_frequencies(args.plot, r))
+    return r
+
+
+def run_vibration(args) -> dict:
+    from tmfem.models.fe_plant import perturbation_names
+    from tmfem.reference.model_compare import fe_system
+    from tmfem.reference.vibration_compare import (format_vibration_compare, key_signals,
+                                                   three_model_vibration, write_vibration_csv)
+    t_end = 10.0 if args.t_end is None else args.t_end
+    dt = 0.01 if args.dt is None else args.dt
+    check_time_steps(t_end=t_end, dt=dt)
+    system = fe_system(args.preset)
+    pert = parse_perturbation(args.perturb, perturbation_names(system)) if args.perturb else None
+    print(f"tmfem compare --vibrate: {args.preset}, {t_end:g} s at dt = {dt:g} s, FE mesh "
+          f"{args.mesh}", file=sys.stderr)
+    with Progress(total=3, desc=f"vibrate {args.preset}") as bar:
+        def progress(model):
+            bar.step(model)
+            return bar.callback(f"{model} steps")
+        r = three_model_vibration(args.preset, t_end=t_end, dt=dt, perturb=pert, mesh_n=args.mesh,
+                                  tendon_elements=args.tendon_elements, backend=args.backend,
+                                  progress=progress)
+    out = dict(r["comparison"])
+    out["vibrate"] = True
+    out["text"] = format_vibration_compare(out, system)
+    if args.csv:
+        out["csv"] = str(write_vibration_csv(args.csv, r["t"], r["signals"]))
+    if args.plot:
+        from tmfem.post.compare import plot_vibration_overlay
+        names = key_signals(system) + ["tendon_deflection"]
+        out["plot"] = str(plot_vibration_overlay(
+            args.plot, r["t"], r["signals"], names,
+            title=f"{args.preset}: SBC, MTC and COM free vibration, "
+                  + ", ".join(f"{k} = {v:g}" for k, v in out["perturbation"].items())
+                  + f" (FE mesh {args.mesh})"))
+    return out
+
+
+def format_text(r: dict) -> str:
+    if r.get("vibrate"):
+        lines = [r["text"]]
+    else:
+        from tmfem.reference.model_compare import format_compare
+        lines = [format_compare(r)]
+    return "\n".join(lines + [f"wrote {r[k]}" for k in ("csv", "plot") if k in r])

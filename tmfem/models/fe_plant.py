@@ -1,0 +1,224 @@
+"""The equation of motion of a finite-element model of a tensegrity-membrane system (6.5).
+
+Both finite-element models (MTC, :mod:`tmfem.models.mtc`; SBC, :mod:`tmfem.models.sbc`) are
+integrated in time with Park's method (eqs. 5.34-5.35) as the plant
+
+    r(u, v, a; rest) = M a + C v + f_int(u; rest) = 0,      C = alpha M + beta K_0,
+
+on their free reduced dofs u, with the tendon rest lengths as inputs (eq. 5.19), the constant
+mass at the equilibrium, K_0 the tangent there and f_int the model's internal force. What a
+state u *is* differs -- the MTC model's independent node positions, the SBC model's
+translations and rotation vectors counted from the equilibrium -- and each model's plant says
+so through three hooks (:meth:`FEPlant.configuration`, :meth:`FEPlant.positions`,
+:attr:`FEPlant.T`); the rest is shared here:
+
+* **outputs** y (eqs. 3.1-3.2, 5.36-5.38): the bar coordinates q recovered from the bar end
+  positions (:func:`tmfem.models.mtc.post.q_from_positions`) and the membrane transverse
+  deflections w_k at the monitored material points (``system.monitor_points``), measured along
+  z_f of the floating frame of the current corners (eq. 3.3,
+  :func:`tmfem.models.mtc.topology.to_floating`), both from positions in the MTC numbering
+  (which the SBC model extends);
+* **initial state** (:func:`initial_state`): the equilibrium plus the perturbation of the
+  control-oriented model, with the labelled nodes moved rigidly with their bars and the other
+  free dofs following by static condensation of K_0.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from tmfem.equilibrium.general import node_jacobian
+from tmfem.errors import InputError
+from tmfem.fem.membrane import point_matrix
+from tmfem.models.base import split_perturbation
+from tmfem.models.mtc.post import q_from_positions
+from tmfem.models.mtc.topology import to_floating
+
+
+class FEPlant:
+    """Shared part of the finite-element plants (module docstring); a
+    :class:`tmfem.models.base.Plant`.
+
+    Subclasses set ``model`` (with ``residual``, ``backend``, ``rest_lengths``,
+    ``set_tendon_lengths``), ``mtc`` (the MTC model whose numbering, topology and membrane the
+    positions use: the model itself for MTC), ``dofmap`` and ``constraints`` (the model's
+    :class:`tmfem.fem.constraints.ConstraintMap`) and ``free``, then call :meth:`_setup`; they
+    implement :meth:`state0`, :meth:`configuration`, :meth:`positions` and
+    :meth:`strain_energy`.
+    """
+
+    model = None
+    mtc = None
+    dofmap = None
+    constraints = None
+    free = None
+
+    def _setup(self, M, *, alpha: float, beta: float, perturb, output_points) -> None:
+        """Mass ``M`` (reduced), K_0, damping, monitored points, names and the start state."""
+        if not (np.isfinite(alpha) and np.isfinite(beta) and alpha >= 0 and beta >= 0):
+            raise InputError(f"Rayleigh damping: expected alpha, beta >= 0, found {alpha}, {beta}")
+        f = self.free
+        self.M = M[f][:, f].tocsc()
+        self.K0 = self._tangent(self.state0())
+        self.alpha, self.beta = float(alpha), float(beta)
+        self.C = (self.alpha * self.M + self.beta * self.K0).tocsc() if (alpha or beta) else None
+        system = self.model.system
+        pts = system.monitor_points.T if output_points is None else np.reshape(output_points, (-1, 2))
+        self.output_points = [tuple(map(float, p)) for p in pts]
+        self._P = point_matrix(self.mtc.membrane.skmesh, np.asarray(self.output_points).T) \
+            if self.output_points else None
+        self.u0 = np.asarray(self.model.rest_lengths, dtype=float).copy()
+        self.input_names = [f"r_{t.name}" for t in system.tendons]
+        self.output_names = list(system.q_names) + [f"w_{i + 1}" for i in range(len(self.output_points))]
+        self.x0, self.v0 = initial_state(self, perturb)
+
+    # hooks -------------------------------------------------------------------------------
+    def state0(self) -> np.ndarray:
+        """The equilibrium as a free-dof state."""
+        raise NotImplementedError
+
+    def configuration(self, u):
+        """The argument of ``model.residual`` for the free-dof state u."""
+        raise NotImplementedError
+
+    def positions(self, u) -> np.ndarray:
+        """Node positions (3, n) in the MTC numbering of the free-dof state u."""
+        raise NotImplementedError
+
+    def strain_energy(self, u) -> float:
+        """Strain energy [J] of the free-dof state u."""
+        raise NotImplementedError
+
+    def translation_rows(self, nodes) -> np.ndarray:
+        """Rows (len(nodes), 3) of the constraint matrix T (all dofs x reduced dofs) that
+        carry the translations of ``nodes``."""
+        return self.dofmap.translation_dofs(np.asarray(nodes))
+
+    # Plant protocol (tmfem.models.base) ---------------------------------------------------
+    def _inputs(self, u) -> None:
+        # the plant drives its model: the tendon rest lengths are the inputs of this call
+        # (the nominal u0 when none are given), so the model is left at the last u
+        self.model.set_tendon_lengths(self.u0 if u is None else u)
+
+    def residual(self, x, v, a, t, u=None):
+        """r = M a + C v + f_int(x; u) on the free dofs (module docstring)."""
+        self._inputs(u)
+        r, _ = self.model.residual(self.configuration(x), tangent=False)
+        out = r[self.free] + self.M @ a
+        if self.C is not None:
+            out = out + self.C @ v
+        return out
+
+    def _tangent(self, x):
+        """Tangent K_T (eqs. 4.4-4.6) on the free dofs at the free-dof state x."""
+        _, K = self.model.residual(self.configuration(x))
+        return K[self.free][:, self.free].tocsc()
+
+    def jacobians(self, x, v, a, t, u=None):
+        """(dr/dx, dr/dv, dr/da) = (K_T, C, M)."""
+        self._inputs(u)
+        K = self._tangent(x)
+        C = self.C if self.C is not None else sp.csc_matrix(K.shape)
+        return K, C, self.M
+
+    def newton_matrix(self, x, v, a, t, cv, ca, u=None):
+        """K_T + cv C + ca M, the Newton matrix of Park's method (eq. 5.34)."""
+        self._inputs(u)
+        S = self._tangent(x) + ca * self.M
+        if self.C is not None:
+            S = S + cv * self.C
+        return S.tocsc()
+
+    def factorize(self, S):
+        """Solver of the Newton matrix: the model's backend."""
+        return self.model.backend.factorize(S)
+
+    def outputs(self, x, v=None, u=None) -> np.ndarray:
+        """y = [q, w_k]: bar coordinates from the bar nodes (eqs. 3.1-3.2) and membrane
+        deflections along z_f of the floating frame at the output points (eqs. 5.36-5.38)."""
+        return self.outputs_of(self.positions(x))
+
+    def outputs_of(self, xf: np.ndarray) -> np.ndarray:
+        """:meth:`outputs` of positions xf (3, n) in the MTC numbering."""
+        topo = self.mtc.topology
+        q = q_from_positions(self.model.system, xf[:, topo.system_node])
+        if self._P is None:
+            return q
+        xm = xf[:, :topo.n_mesh]
+        w = to_floating((self._P @ xm.T).T, xm[:, topo.mesh.corners])[2]
+        return np.concatenate([q, w])
+
+    def kinetic_energy(self, v) -> float:
+        """v^T M v / 2 [J] of the free-dof velocities v."""
+        return 0.5 * float(v @ (self.M @ v))
+
+
+def perturbation_names(system) -> list:
+    """Accepted perturbation names: the q of 3.2 and their rates (``theta_12_dot``)."""
+    return list(system.q_names) + [n + "_dot" for n in system.q_names]
+
+
+def initial_state(dyn: FEPlant, perturb: dict | None):
+    """Free-dof state and velocity (u0, v0) of the perturbed equilibrium.
+
+    A generalised coordinate q_k of 3.2 moves the labelled nodes rigidly: their velocity is
+    dX/dq q' (exact, :func:`tmfem.equilibrium.general.node_jacobian`, at the q recovered from
+    the equilibrium) and a displacement moves them by X(q_e + dq) - X(q_e). The remaining free
+    dofs (membrane, tendon internal nodes, and in the SBC model the rotations and bar interior
+    nodes) get the quasi-static field that follows them, v_o = -K_oo^-1 K_op v_p with K_0
+    (static condensation): for a straight prestressed tendon the linear interpolation of its
+    end velocities, for a bar the rigid rotation, for the membrane the smooth deformation its
+    prestress imposes -- the counterpart of the COM, whose membrane follows the bars through
+    its floating frame (eqs. 5.1-5.3) with the membrane modal rates at zero.
+    """
+    model, system = dyn.model, dyn.model.system
+    u0 = dyn.state0()
+    if not perturb:
+        return u0, np.zeros_like(u0)
+    dq, dqd = split_perturbation(perturb, system.q_names)
+    x_eq = dyn.positions(u0)
+    q_e = q_from_positions(system, x_eq[:, dyn.mtc.topology.system_node])
+    X_e = system.nodes(q_e)
+    dX_pos = system.nodes(q_e + dq) - X_e if np.any(dq) else np.zeros_like(X_e)
+    J = node_jacobian(system, q_e) @ dqd                       # dX/dq q' (eqs. 3.1-3.2)
+    T = sp.csr_matrix(dyn.constraints.T)
+    rows = dyn.translation_rows(dyn.mtc.topology.system_node)  # (n_labels, 3)
+    n_red = T.shape[1]
+    pres = np.zeros(n_red, dtype=bool)
+    vp = np.zeros(n_red)
+    dp = np.zeros(n_red)
+    for i, rr in enumerate(rows):
+        moved = np.any(J[:, i]) or np.any(dX_pos[:, i])
+        nnz = T.indptr[rr + 1] - T.indptr[rr]
+        if np.all(nnz == 0):                  # eliminated (fixed) node
+            continue
+        start = T.indptr[rr]
+        if not (np.all(nnz == 1) and np.all(T.data[start] == 1.0)):
+            if moved:
+                raise InputError(f"perturbation of {system.node_labels[i]}: needs "
+                                 f"attachment='point' (the bar top is a weighted patch "
+                                 f"point here)")
+            continue
+        cols = T.indices[start]
+        pres[cols] = True
+        vp[cols] = J[:, i]
+        dp[cols] = dX_pos[:, i]
+    free = dyn.free
+    pf, vpf, dpf = pres[free], vp[free], dp[free]
+    K = dyn.K0
+    o = ~pf
+    Koo = K[o][:, o].tocsc()
+    Kop = K[o][:, pf]
+    solve = model.backend.factorize(Koo)
+
+    def condense(p):
+        out = np.zeros(free.sum())
+        out[pf] = p[pf]
+        if np.any(p[pf]):
+            out[o] = -solve(Kop @ p[pf])
+        return out
+
+    v0 = condense(vpf)
+    if np.any(dpf):
+        u0 = u0 + condense(dpf)
+    return u0, v0

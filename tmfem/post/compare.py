@@ -1,0 +1,66 @@
+"""Figures of the three-model comparisons (6.4, 6.5): frequencies beside Tables 6.6/6.7 and
+free-vibration histories overlaid (:mod:`tmfem.reference.model_compare`,
+:mod:`tmfem.reference.vibration_compare`)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tmfem.post.plots import new_figure, save_figure
+
+#: colour per model (the SBC reference drawn first and thickest)
+MODEL_COLOURS = {"SBC": "black", "MTC": "tab:blue", "COM": "tab:orange"}
+
+
+def plot_model_frequencies(png, r: dict) -> Path:
+    """Top: the frequencies of the three models (ours: filled, printed: open markers) per
+    mode; bottom: each model against the SBC model [%] (ours solid, printed dashed) with the
+    bound 6.4 states."""
+    fig = new_figure(figsize=(8.0, 6.5))
+    ax, bx = fig.subplots(2, 1, sharex=True)
+    n = len(r["printed"]["SBC"])
+    k = np.arange(1, n + 1)
+    for m, c in MODEL_COLOURS.items():
+        ax.plot(k, r["ours"][m][:n], "o-", color=c, ms=5, lw=1, label=f"{m} ours")
+        ax.plot(k, r["printed"][m], "s", mfc="none", color=c, ms=8, label=f"{m} printed")
+    ax.set_ylabel("natural frequency [Hz]")
+    ax.set_title(f"{r['system']}: three models beside {r['source']}", fontsize=10)
+    ax.legend(fontsize=7, ncol=3, loc="upper left")
+    ax.grid(True, alpha=0.3)
+    for m in ("MTC", "COM"):
+        c = MODEL_COLOURS[m]
+        bx.plot(k, 100 * np.asarray(r["vs_SBC"]["ours"][m]), "o-", color=c, ms=5, lw=1,
+                label=f"{m} / SBC - 1, ours")
+        bx.plot(k, 100 * np.asarray(r["vs_SBC"]["printed"][m]), "s--", mfc="none", color=c, ms=7,
+                lw=1, label=f"{m} / SBC - 1, printed")
+    b = 100 * r["stated_bound"]
+    for s in (-b, b):
+        bx.axhline(s, color="red", lw=0.8, ls=":")
+    bx.text(1, -b, f"stated bound ({r['stated']})", color="red", fontsize=7, va="bottom")
+    bx.set_xlabel("mode number")
+    bx.set_ylabel("relative to SBC [%]")
+    bx.set_xticks(k)
+    bx.grid(True, alpha=0.3)
+    bx.legend(fontsize=7, ncol=2, loc="lower right")
+    return save_figure(fig, png)
+
+
+def plot_vibration_overlay(png, t, signals: dict, names: list, *, title: str = "") -> Path:
+    """The histories ``names`` (displacements from the start) of every model in ``signals``
+    ({model: {name: (nt,)}}) overlaid, one panel per name; angles in mrad, lengths in mm."""
+    fig = new_figure(figsize=(9.0, 1.9 * len(names) + 0.6))
+    axes = np.atleast_1d(fig.subplots(len(names), 1, sharex=True))
+    for ax, s in zip(axes, names):
+        angle = s.startswith(("theta", "psi"))
+        for m, c in MODEL_COLOURS.items():
+            if s in signals.get(m, {}):
+                ax.plot(t, 1e3 * signals[m][s], color=c, lw=1.6 if m == "SBC" else 1.0,
+                        ls="-" if m == "SBC" else "--", label=m)
+        ax.set_ylabel(f"{s} [{'mrad' if angle else 'mm'}]", fontsize=8)
+        ax.grid(True, alpha=0.3)
+    axes[0].legend(fontsize=7, loc="upper left", ncol=3)
+    axes[-1].set_xlabel("t [s]")
+    if title:
+        axes[0].set_title(title, fontsize=10)
+    return save_figure(fig, png)

@@ -1,0 +1,114 @@
+"""Fields, cells and pictures of the shell-beam-cable model's results (ParaView, PNG).
+
+The SBC model's nodes carry rotations (MITC4 shell nodes two about their directors' V_1, V_2,
+beam nodes three): the ParaView files give them as rotation vectors theta [rad] (point data,
+the spin of :meth:`tmfem.fem.element.State.advanced`: theta = a_1 V_1 + a_2 V_2 on a shell
+node). Bars are drawn as their beam elements' segments (3 per four-node element) with the
+axial force N and the bending moment |M| = (M_1^2 + M_2^2)^(1/2) of the element (mean over
+its Gauss points), tendons as lines with their axial forces, the membrane as the shell quads
+with the stresses at the element centres on the bottom, middle and top surfaces.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from tmfem.io.codes import kind_cell_data
+from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
+from tmfem.io.meshes import block_data, to_meshio
+from tmfem.io.paths import check_path
+from tmfem.io.writer import write_mesh
+from tmfem.models.mtc.topology import to_floating
+from tmfem.models.sbc.post import SURFACES, shell_stresses
+
+def rotation_vectors(model, state, d=None) -> np.ndarray:
+    """Rotation vectors (3, n_nodes) [rad]: of the nodal rotations R of ``state`` (``d`` None)
+    or of the full dof vector ``d`` (an increment or a mode shape: theta = a_1 V_1 + a_2 V_2
+    on shell nodes with the current directors, the three components on beam nodes, zero on
+    tendon nodes)."""
+    dm = model.dofmap
+    n = dm.n_nodes
+    if d is None:
+        return Rotation.from_matrix(state.R).as_rotvec().T
+    th = np.zeros((n, 3))
+    for n_rot in (2, 3):
+        nodes = np.flatnonzero(dm.counts == 3 + n_rot)
+        if nodes.size == 0:
+            continue
+        a = d[dm.rotation_dofs(nodes)]
+        if n_rot == 3:
+            th[nodes] = a
+        else:
+            V = np.einsum("nij,njk->nik", state.R[nodes], state.frames[nodes])
+            th[nodes] = a[:, 0, None] * V[:, :, 0] + a[:, 1, None] * V[:, :, 1]
+    return th.T
+
+
+def shell_field(model, state) -> MembraneField:
+    """The shell membrane of ``state`` as a :class:`MembraneField`: displacement in the floating
+    frame (eq. 3.4) and the rotation vectors as point data, element-centre stresses on the three
+    surfaces as cell data (``von_mises_top``, ``sigma_p1_mid``, ...; ``von_mises`` and
+    ``sigma_p1`` the largest over the surfaces)."""
+    topo = model.mtc.topology
+    nm = topo.n_mesh
+    xm = state.x[:, :nm]
+    xf = to_floating(xm, xm[:, topo.mesh.corners])
+    ref = np.vstack([topo.mesh.p, np.zeros(nm)])
+    c = shell_stresses(model, state)["centre"]
+    cd = {f"{k}_{s}": c[k][i] for k in c for i, s in enumerate(SURFACES)}
+    cd["von_mises"] = c["von_mises"].max(axis=0)
+    cd["sigma_p1"] = c["sigma_p1"].max(axis=0)
+    return MembraneField(mesh=topo.mesh, x=xm,
+                         point_data={DISPLACEMENT_FIELD: xf - ref,
+                                     "rotation": rotation_vectors(model, state)[:, :nm]},
+                         cell_data=cd)
+
+
+def sbc_cells(model) -> list:
+    """Cells of the whole SBC model: beam segments (lines along each bar's node chain),
+    tendon elements (lines) and shell quads."""
+    ch = model.numbering.bar_chain
+    seg = np.stack([ch[:, :-1].ravel(), ch[:, 1:].ravel()])
+    return [("line", seg), ("line", model.tendons.conn), ("quad", model.mtc.topology.mesh.t)]
+
+
+def _cell_data(model, state, cells) -> dict:
+    """Per block (beams, tendons, shells): ``kind`` (:func:`tmfem.io.codes.kind_cell_data`),
+    axial force [N], bending moment |M| [N m], shell sigma_p1 and von Mises [Pa] per surface;
+    NaN where a quantity does not exist."""
+    sec = model.beam.section_forces(state)
+    per = 3                                                  # segments per four-node element
+    Nb = np.repeat(sec["N"].mean(axis=1), per)
+    Mb = np.repeat(np.hypot(sec["M1"], sec["M2"]).mean(axis=1), per)
+    Nt = model.member_forces(state)["tendon_element"]
+    c = shell_stresses(model, state)["centre"]
+    none = [np.full(conn.shape[1], np.nan) for _, conn in cells]        # beams, tendons, shells
+    out = {**kind_cell_data(cells), "axial_force": [Nb, Nt, none[2]],
+           "bending_moment": [Mb, none[1], none[2]]}
+    for i, s in enumerate(SURFACES):
+        for k in ("von_mises", "sigma_p1"):
+            out[f"{k}_{s}"] = [none[0], none[1], c[k][i]]
+    return out
+
+
+def write_sbc_state(path, model, state) -> str:
+    """Write an SBC state for ParaView (.vtu): all nodes at their positions, the cells of
+    :func:`sbc_cells`, point data ``displacement`` [m] (from the reference) and ``rotation``
+    [rad], cell data ``kind`` (0 beam, 1 tendon, 2 shell), ``axial_force``, ``bending_moment``
+    and the shell stresses (module docstring)."""
+    path = check_path(path, suffixes=(".vtu",))
+    cells = sbc_cells(model)
+    pdata, cdata = block_data({"displacement": state.x - model.X,
+                               "rotation": rotation_vectors(model, state)},
+                              _cell_data(model, state, cells), cells, state.x.shape[1])
+    return str(write_mesh(path, to_meshio(state.x, cells, point_data=pdata, cell_data=cdata)))
+
+
+def mode_data(model, state, modes):
+    """(shapes (3 n, k) node-interleaved translations, point data ``rotation_mode_k``) of the
+    reduced mode shapes of :meth:`SBCModel.modes` for :func:`tmfem.io.writer.write_modes`."""
+    S = model.full_shapes(modes.shapes)                            # (3, n, k)
+    D = model.constraints.T @ modes.shapes
+    rot = {f"rotation_mode_{k + 1}": rotation_vectors(model, state, D[:, k])
+           for k in range(D.shape[1])}
+    return S.transpose(1, 0, 2).reshape(-1, S.shape[2]), rot
