@@ -77,7 +77,12 @@ def model_options_from_args(args, command: str):
                          "the finite-element models)")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
-        check_mesh_budget(N=system.N, n=options["mesh"])
+        check_model_budget(system, mesh=options["mesh"],
+                           tendon_elements=options.get("tendon_elements") or 1,
+                           bar_elements=options.get("bar_elements"),
+                           dofs_per_node=6 if args.model == "sbc" else 3)
+    if "attachment" in options:
+        check_attachment_options(system, attachment=options["attachment"], patch=options["patch"])
     check_outputs(args, command)
     return system, options
 
@@ -248,24 +253,26 @@ BASE_BYTES = 0.3e9
 MEMORY_FRACTION = 0.6         # of the physical memory: the machine is shared
 
 
-def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3) -> int:
+def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3,
+                      extra_dofs: int = 0, extra_text: str = "") -> int:
     """Refuse a membrane mesh whose FE model would not fit this machine.
 
     The N n x n quadrilateral patches have about N (n + 1)^2 nodes, hence
-    ``dofs_per_node`` N (n + 1)^2 unknowns; the estimated peak memory is
-    ``BASE_BYTES + BYTES_PER_DOF * dofs`` and must stay under ``MEMORY_FRACTION`` of the
-    physical memory. Returns the DOF estimate.
+    ``dofs_per_node`` N (n + 1)^2 unknowns, plus ``extra_dofs`` (members, named by
+    ``extra_text``); the estimated peak memory is ``BASE_BYTES + BYTES_PER_DOF * dofs`` and
+    must stay under ``MEMORY_FRACTION`` of the physical memory. Returns the DOF estimate.
 
     Raises
     ------
     ResourceLimit
         with the estimate and the limit.
     """
-    dofs = dofs_per_node * N * (n + 1) ** 2
+    dofs = dofs_per_node * N * (n + 1) ** 2 + int(extra_dofs)
     need = BASE_BYTES + BYTES_PER_DOF * dofs
     limit = MEMORY_FRACTION * machine_memory()
     if need > limit:
-        raise ResourceLimit(f"{option} {n}: the membrane mesh {N} x {n} x {n} gives about "
+        raise ResourceLimit(f"{option} {n}: the membrane mesh {N} x {n} x {n}"
+                            + (f" with {extra_text}" if extra_text else "") + " gives about "
                             f"{dofs:,} DOFs and needs about {need / 2**30:.1f} GiB; the limit "
                             f"is {limit / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this "
                             f"machine's {machine_memory() / 2**30:.0f} GiB)")
@@ -292,6 +299,38 @@ def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> i
             raise ResourceLimit(f"{steps:,} steps x {states:,} states need {need / 2**30:.1f} "
                                 f"GiB of history; the limit is {limit / 2**30:.1f} GiB")
     return steps
+
+
+def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
+                       bar_elements: int | None = None, modes: int | None = None,
+                       dofs_per_node: int = 3) -> int:
+    """Refuse a finite-element model of ``system`` that would not fit this machine, before
+    it is built: the membrane mesh (:func:`check_mesh_budget`, ``dofs_per_node`` 3 for the
+    membrane elements, 6 for shells) plus 3 (k - 1) DOFs per tendon of k truss elements and,
+    with ``bar_elements`` b (beam bars, 6 DOFs per node), 6 (3 b - 1) per bar; ``modes`` must
+    stay below the DOF estimate. Returns the DOF estimate."""
+    extra = 3 * len(system.tendons) * (tendon_elements - 1)
+    what = [f"{len(system.tendons)} tendons x {tendon_elements} elements"]
+    if bar_elements is not None:
+        extra += 6 * system.M * system.N * (3 * bar_elements - 1)
+        what.append(f"{system.M * system.N} bars x {bar_elements} beam elements")
+    option = "--mesh" if extra == 0 else "--mesh/--tendon-elements" + (
+        "/--bar-elements" if bar_elements is not None else "")
+    dofs = check_mesh_budget(N=system.N, n=mesh, option=option, dofs_per_node=dofs_per_node,
+                             extra_dofs=extra, extra_text=", ".join(what))
+    if modes is not None and modes >= dofs:
+        raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
+                         "DOFs")
+    return dofs
+
+
+def check_attachment_options(system: System, *, attachment: str, patch) -> None:
+    """``--patch`` applies to ``--attachment distributed`` only and must fit the membrane
+    (:func:`check_patch`)."""
+    if patch is not None and attachment != "distributed":
+        raise InputError(f"--patch: option does not apply with --attachment {attachment} "
+                         f"(expected --attachment distributed), found --patch {patch}")
+    check_patch(system, patch)
 
 
 def check_patch(system: System, patch) -> None:

@@ -27,7 +27,7 @@ import numpy as np
 
 from tmfem.cli import json_default
 from tmfem.cli.common import (Progress, add_attachment_args, add_membrane_law_arg, add_system_args,
-                              check_mesh_budget, check_patch, output_dir, positive_int,
+                              check_attachment_options, check_mesh_budget, output_dir, positive_int,
                               system_from_args)
 from tmfem.errors import InputError
 from tmfem.reference.report import explanations
@@ -63,7 +63,7 @@ def run(args) -> dict:
                          f"needs two points per axis), found {args.map_grid}")
     system = system_from_args(args)
     check_mesh_budget(N=system.N, n=args.mesh, dofs_per_node=2)
-    check_patch(system, args.patch)
+    check_attachment_options(system, attachment=args.attachment, patch=args.patch)
     out = output_dir(args.out, option="--out")
     with Progress(total=6, desc=f"study {system.name}") as bar:
         result = _study(args, system, out, bar)
