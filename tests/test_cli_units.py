@@ -23,4 +23,6 @@ def test_unit_rules():
     assert unit_of("tendon_stress_max_MPa") == "MPa" and unit_of("freq_hz") == "Hz"
     assert unit_of("system") is None
     assert column_header("t") == "t [s]" and column_header("theta_11_dot") == "theta_11_dot [rad/s]"
-    assert column_header("B_1,12_z") == "B_1,12_z [m]" and column_header("eta_1") == "eta_1"
+    assert column_header("B_1,12_z") == "B_1,12_z [m]"
+    # mass-normalised membrane modes (phi^T M phi = 1, docs/com.md): eta = w / phi in kg^0.5 m
+    assert column_header("eta_1") == "eta_1 [kg^0.5 m]" and column_header("eta_2_dot") == "eta_2_dot [kg^0.5 m/s]"

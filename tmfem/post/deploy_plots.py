@@ -21,12 +21,15 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
     ax = fig.subplots(3, 1, sharex=True)
     names = r.names["q"]
     sel = [k for k, n in enumerate(names) if n.startswith(("theta_1", "psi_1"))][:4]
-    for k in sel:
-        ln, = ax[0].plot(r.t, np.degrees(r.z[:, k]), label=names[k])
-        ax[0].plot(r.t, np.degrees(r.q_d[:, k]), "--", color=ln.get_color(), lw=1,
-                   label=f"{names[k]} reference")
+    # bars 1 and 2 of a symmetric deployment move alike: bar 1 wide and pale under bar 2
+    for i, k in enumerate(sel):
+        first = i < 2
+        ln, = ax[0].plot(r.t, np.degrees(r.z[:, k]), lw=4.0 if first else 1.4,
+                         alpha=0.45 if first else 1.0, label=names[k])
+        ax[0].plot(r.t, np.degrees(r.q_d[:, k]), ":", color="k", lw=0.9,
+                   label="references (eq. 5.68)" if i == 0 else None)
     ax[0].set_ylabel("bar attitude [deg]")
-    ax[0].legend(fontsize=7, ncol=2)
+    ax[0].legend(fontsize=7, ncol=3)
     for k, n in enumerate(r.names["w"]):
         ax[1].plot(r.t, 1e3 * r.w[:, k], label=n)
     ax[1].set_ylabel("membrane deflection w [mm]")
