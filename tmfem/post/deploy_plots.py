@@ -60,8 +60,8 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
 
 def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     """GIF of the bars (thick), tendons (thin) and the membrane polygon (flat, its corners)
-    over the run (Figures 7.5, 7.9, 7.14),
-    with matplotlib's pillow writer."""
+    over the run (Figures 7.5, 7.9, 7.14), with matplotlib's pillow writer; equal x/y scales,
+    the z axis at least 30 % of the plan size."""
     from matplotlib.animation import FuncAnimation, PillowWriter
     r = result
     nq = len(r.names["q"])
@@ -70,9 +70,17 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     Cs = [system.membrane_corners_inertial(r.z[k, :nq]) for k in idx]
     allX = np.concatenate(Xs, axis=1)
     lo, hi = allX.min(axis=1), allX.max(axis=1)
-    fig = new_figure(figsize=(5, 5))
+    box = hi - lo
+    box[2] = max(box[2], 0.3 * box[:2].max())      # a flat system keeps a readable z axis
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    fig = new_figure(figsize=(6.0, 5.5))
     ax = fig.add_subplot(projection="3d")
+    fig.subplots_adjust(left=0.0, right=0.86, bottom=0.04, top=0.92)
     bars, tends = system.bar_connectivity, system.tendon_connectivity
+    legend = [Line2D([], [], color="saddlebrown", lw=3, label="bar"),
+              Line2D([], [], color="tab:blue", lw=0.8, label="tendon"),
+              Patch(color="gold", alpha=0.4, label="membrane (corner polygon)")]
 
     def draw(i):
         ax.cla()
@@ -84,10 +92,12 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
         C = Cs[i]
         ax.plot_trisurf(C[0], C[1], C[2], color="gold", alpha=0.4)
         ax.set_xlim(lo[0], hi[0]); ax.set_ylim(lo[1], hi[1]); ax.set_zlim(lo[2], hi[2])
-        ax.set_box_aspect(hi - lo)
+        ax.set_box_aspect(box, zoom=0.85)
         ax.locator_params(axis="z", nbins=3)
         ax.set_xlabel("x [m]"); ax.set_ylabel("y [m]"); ax.set_zlabel("z [m]")
-        ax.set_title(f"t = {r.t[idx[i]]:.2f} s ({r.controller[min(idx[i], len(r.controller) - 1)]})")
+        ax.legend(handles=legend, loc="upper left", fontsize=7, frameon=False)
+        ax.set_title(f"{system.name} deployment, t = {r.t[idx[i]]:.2f} s\ncontroller: "
+                     f"{r.controller[min(idx[i], len(r.controller) - 1)]}", fontsize=10)
     anim = FuncAnimation(fig, draw, frames=len(idx))
     anim.save(str(gif), writer=PillowWriter(fps=8))
     return Path(gif)
