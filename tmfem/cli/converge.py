@@ -7,6 +7,7 @@ from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_sys
                               check_attachment_options, check_model_budget, check_outputs,
                               system_from_args)
 from tmfem.errors import InputError
+from tmfem.io.units import unit_of
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import apply_rest_lengths
 from tmfem.post.convergence import plot_convergence_study
@@ -14,6 +15,12 @@ from tmfem.solvers.backends import backend_names
 
 NAME = "converge"
 HELP = "mesh / tendon-subdivision convergence of frequencies and stresses (dissertation 6.3)"
+
+
+def _header(key: str) -> str:
+    """CSV column name with its unit (``h [m]``, ``f1 [Hz]``; counts and labels bare)."""
+    unit = unit_of(key)
+    return f"{key} [{unit}]" if unit not in (None, "-") else key
 
 
 def _ints(text: str, what: str) -> list[int]:
@@ -77,9 +84,9 @@ def run(args) -> dict:
             rows.append(row)
             if fh is not None:
                 if writer is None:
-                    writer = csv.DictWriter(fh, fieldnames=list(ROW_KEYS) + [
-                        f"f{i + 1}" for i in range(args.modes)])
-                    writer.writeheader()
+                    keys = list(ROW_KEYS) + [f"f{i + 1}" for i in range(args.modes)]
+                    writer = csv.DictWriter(fh, fieldnames=keys, lineterminator="\n")
+                    writer.writerow({k: _header(k) for k in keys})
                 writer.writerow(row)
                 fh.flush()
     finally:

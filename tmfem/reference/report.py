@@ -124,6 +124,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     """
     from tmfem.equilibrium.design import design_equilibrium
     from tmfem.io.codes import kind_cell_data
+    from tmfem.io.units import with_units
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
@@ -270,7 +271,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
                "printed_frequencies_hz": printed, "vibration": vibration,
                "deployment": deployment}
-    (out / "report.json").write_text(json.dumps(summary, indent=1))
+    (out / "report.json").write_text(json.dumps(with_units(summary), indent=1))
     add("report.json", out / "report.json")
     _index(out, system, summary, files, tables["rows"], notes, freqs, printed, statics)
     add("index.md", out / "index.md")
