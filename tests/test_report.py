@@ -62,3 +62,14 @@ def test_tables_carry_units_and_both_prestress_levels(report):
     head = next(csv.reader(open(report / "deploy-1-4D.csv")))
     assert head[0] == "t [s]" and "w_1 [m]" in head and "eta_energy [J]" in head
     assert all("[" in h for h in head[:-1]) and head[-1] == "controller"
+
+
+def test_one_membrane_displacement_field_in_every_file(report):
+    # tmfem.io.fields.DISPLACEMENT_FIELD: floating-frame displacement in the design, the MTC
+    # statics and the COM series; no other displacement name in any ParaView file
+    import meshio
+    from tmfem.io.fields import DISPLACEMENT_FIELD
+    frames = sorted((report / "vibration_com").glob("*.vtu"))[:1]
+    for f in [report / "configuration.vtu", report / "static_designed.vtu"] + frames:
+        names = {n for n in meshio.read(f).point_data if "displacement" in n}
+        assert names == {DISPLACEMENT_FIELD}, (f.name, names)
