@@ -83,6 +83,8 @@ def model_options_from_args(args, command: str):
                            dofs_per_node=6 if args.model == "sbc" else 3)
     if "attachment" in options:
         check_attachment_options(system, attachment=options["attachment"], patch=options["patch"])
+    if options.get("membrane_modes") is not None:
+        check_membrane_modes(options["membrane_modes"])
     check_outputs(args, command)
     return system, options
 
@@ -271,7 +273,8 @@ def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: 
     need = BASE_BYTES + BYTES_PER_DOF * dofs
     limit = MEMORY_FRACTION * machine_memory()
     if need > limit:
-        raise ResourceLimit(f"{option} {n}: the membrane mesh {N} x {n} x {n}"
+        given = option if " " in option else f"{option} {n}"    # "--mesh n ..." or the flag
+        raise ResourceLimit(f"{given}: the membrane mesh {N} x {n} x {n}"
                             + (f" with {extra_text}" if extra_text else "") + " gives about "
                             f"{dofs:,} DOFs and needs about {need / 2**30:.1f} GiB; the limit "
                             f"is {limit / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this "
@@ -314,14 +317,42 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
     if bar_elements is not None:
         extra += 6 * system.M * system.N * (3 * bar_elements - 1)
         what.append(f"{system.M * system.N} bars x {bar_elements} beam elements")
-    option = "--mesh" if extra == 0 else "--mesh/--tendon-elements" + (
-        "/--bar-elements" if bar_elements is not None else "")
-    dofs = check_mesh_budget(N=system.N, n=mesh, option=option, dofs_per_node=dofs_per_node,
+    given = f"--mesh {mesh} --tendon-elements {tendon_elements}" + (
+        f" --bar-elements {bar_elements}" if bar_elements is not None else "")
+    dofs = check_mesh_budget(N=system.N, n=mesh, option=given, dofs_per_node=dofs_per_node,
                              extra_dofs=extra, extra_text=", ".join(what))
     if modes is not None and modes >= dofs:
         raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
                          "DOFs")
     return dofs
+
+
+#: Largest K of the control-oriented model: its equations are built symbolically (CasADi)
+#: at a cost that grows faster than K^2 (1-4, measured under load: K = 10: 8 s, 20: 9 s,
+#: 40: 24 s; K = 1000 would run for hours).
+MAX_MEMBRANE_MODES = 40
+
+
+def check_membrane_modes(K: int) -> None:
+    """``--membrane-modes K`` of the control-oriented model: 0 <= K <= MAX_MEMBRANE_MODES."""
+    if not 0 <= K <= MAX_MEMBRANE_MODES:
+        cls = ResourceLimit if K > MAX_MEMBRANE_MODES else InputError
+        raise cls(f"--membrane-modes {K}: expected 0 <= K <= {MAX_MEMBRANE_MODES} (the model's "
+                  f"equations are built symbolically; K = 40 takes ~25 s, the cost grows faster "
+                  f"than K^2)")
+
+
+def check_com_modes(system: System, *, modes: int, membrane_modes=None) -> int:
+    """``--modes`` of the control-oriented model: at most its n_q + K coordinates. Returns K
+    (``membrane_modes`` or the system's default)."""
+    from tmfem.models.com.model import default_membrane_modes
+    K = default_membrane_modes(system) if membrane_modes is None else membrane_modes
+    states = len(system.q_names) + K
+    if modes > states:
+        raise InputError(f"--modes {modes}: the control-oriented model of {system.name} has "
+                         f"{states} coordinates (n_q + K = {len(system.q_names)} + {K}); expected "
+                         f"--modes <= {states}")
+    return K
 
 
 def check_attachment_options(system: System, *, attachment: str, patch) -> None:

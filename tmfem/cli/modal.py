@@ -5,7 +5,7 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_model_args, add_system_args, model_from_args,
+from tmfem.cli.common import (add_model_args, add_system_args, check_com_modes, model_from_args,
                               model_options_from_args)
 from tmfem.cli.static import default_monitor
 from tmfem.errors import InputError
@@ -42,13 +42,17 @@ def run(args) -> dict:
                              "finite-element mode shapes (use --model mtc)")
         from tmfem.reference.com_modal import modal_summary
         system, options = model_options_from_args(args, NAME)
-        return modal_summary(system, modes=args.modes, membrane_modes=options["membrane_modes"],
+        K = check_com_modes(system, modes=args.modes, membrane_modes=options["membrane_modes"])
+        return modal_summary(system, modes=args.modes, membrane_modes=K,
                              prestress_scale=options["prestress_scale"], mesh_n=options["mesh"],
                              membrane_law=options["membrane_law"])
     from tmfem.reference.tables import FREQUENCIES
     from tmfem.models.mtc.post import static_summary
     from tmfem.post.mtc import model_cells
     model, options = model_from_args(args, NAME)
+    if args.modes >= model.ndof:                  # before the static solve
+        raise InputError(f"--modes {args.modes}: expected fewer modes than the model's "
+                         f"{model.ndof} free DOFs")
     if args.model == "sbc":
         return sbc_modal(args, model, FREQUENCIES)
     system_name = model.system.name

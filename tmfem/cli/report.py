@@ -12,8 +12,9 @@ from __future__ import annotations
 import sys
 import textwrap
 
-from tmfem.cli.common import (Progress, add_system_args, check_model_budget, check_time_steps,
-                              output_dir, positive_float, positive_int, system_from_args)
+from tmfem.cli.common import (Progress, add_system_args, check_com_modes, check_model_budget,
+                              check_time_steps, output_dir, positive_float, positive_int,
+                              system_from_args)
 from tmfem.errors import InputError
 
 NAME = "report"
@@ -46,6 +47,7 @@ def run(args) -> dict:
 
     system = system_from_args(args)
     check_model_budget(system, mesh=args.mesh, tendon_elements=3, modes=args.modes)
+    check_com_modes(system, modes=args.modes)
     check_time_steps(t_end=args.t_end, dt=args.dt)
     deployment = REPORT_DEPLOYMENT.get(system.name)
     if deployment is None and args.no_deploy:

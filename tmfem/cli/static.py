@@ -95,9 +95,10 @@ def run(args) -> dict:
     if args.model == "sbc":
         from tmfem.errors import InputError
         from tmfem.models.sbc.post import static_summary as sbc_summary
-        if args.vtk or args.png or args.stress_plot:
-            raise InputError("static --model sbc: option does not apply yet: --vtk/--png/--stress-plot "
-                             "(field output of the shell model is not built; use --model mtc)")
+        if args.vtk or args.png or args.stress_plot or args.wrinkle_plot:
+            raise InputError("static --model sbc: option does not apply yet: --vtk/--png/"
+                             "--stress-plot/--wrinkle-plot (field output of the shell model is "
+                             "not built; use --model mtc)")
         monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
         return sbc_summary(model, model.solve_static(monitor=monitor,
                                                      progress=static_progress(args.progress)))
