@@ -67,7 +67,7 @@ def explanations(name: str, part: str) -> list[str]:
 
 #: The deployment (7.4) that the report of a system runs: the deployable variant, the
 #: controller's model error and the duration. 1-4(D) with the exact model switches to the
-#: H-infinity controller at 8.99 s; with the 7.4 choice (eq. 5.72) it does not switch within
+#: H-infinity controller within 10 s; with the 7.4 choice (eq. 5.72) it does not switch within
 #: 20 s (docs/deployment.md, "Results"), so the report shows the switch with the exact model.
 REPORT_DEPLOYMENT = {"1-4": {"preset": "1-4D", "uncertainty": "exact", "t_end": 16.0,
                              "controller": "adaptive-hinf"}}
