@@ -76,7 +76,6 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     from matplotlib.patches import Patch
     fig = new_figure(figsize=(6.0, 5.5))
     ax = fig.add_subplot(projection="3d")
-    fig.subplots_adjust(left=0.0, right=0.86, bottom=0.04, top=0.92)
     bars, tends = system.bar_connectivity, system.tendon_connectivity
     legend = [Line2D([], [], color="saddlebrown", lw=3, label="bar"),
               Line2D([], [], color="tab:blue", lw=0.8, label="tendon"),
