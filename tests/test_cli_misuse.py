@@ -72,7 +72,7 @@ def string_rest(tmp_path):
      BAD_INPUT, "half the shortest"),
     (["equilibrium", "--preset", "nope"], BAD_INPUT, "unknown preset"),
     # commands added after the first sweep (deploy, control, lpv, benchmark, --model sbc);
-    # the limits: MAX_STEPS, control.MAX_STATES, lpv.MAX_VERIFY_POINTS, MAX_MEMBRANE_MODES
+    # the limits: MAX_STEPS, control.MAX_STATES, control_lpv.MAX_VERIFY_POINTS, MAX_MEMBRANE_MODES
     (["deploy", "--preset", "1-4D", "--t-end", "nan"], BAD_INPUT, "finite"),
     (["deploy", "--preset", "1-4D", "--t-end", "abc"], BAD_INPUT, "expected a number"),
     (["deploy", "--preset", "1-4D", "--dt", "-1"], BAD_INPUT, "> 0"),
@@ -93,12 +93,12 @@ def string_rest(tmp_path):
     (["control", "hinf", "--preset", "nope"], BAD_INPUT, "unknown preset"),
     (["control", "recheck", "FILE"], BAD_INPUT, "expected an .npz"),
     (["control", "recheck", "OUT/missing.npz"], BAD_INPUT, "expected an .npz"),
-    (["lpv", "--max-iter", "-5"], BAD_INPUT, "--max-iter"),
-    (["lpv", "--refine", "100000"], TOO_LARGE, "verification grid"),
-    (["lpv", "--grid", "abc"], BAD_INPUT, "AxB"),
-    (["lpv", "--rate-bound-deg", "nan"], BAD_INPUT, "--rate-bound-deg"),
-    (["lpv", "--save", "FILE/p.npz"], BAD_INPUT, "not a directory"),
-    (["lpv", "--preset", "1-4"], BAD_INPUT, "printed LPV grid"),
+    (["control", "lpv", "--max-iter", "-5"], BAD_INPUT, "--max-iter"),
+    (["control", "lpv", "--refine", "100000"], TOO_LARGE, "verification grid"),
+    (["control", "lpv", "--grid", "abc"], BAD_INPUT, "AxB"),
+    (["control", "lpv", "--rate-bound-deg", "nan"], BAD_INPUT, "--rate-bound-deg"),
+    (["control", "lpv", "--save", "FILE/p.npz"], BAD_INPUT, "not a directory"),
+    (["control", "lpv", "--preset", "1-4"], BAD_INPUT, "printed LPV grid"),
     (["benchmark", "nope"], BAD_INPUT, "expected one of"),
     (["benchmark", "truss-arch", "--plot", "OUT/b.txt"], BAD_INPUT, "suffix"),
     (["benchmark", "--list", "--csv", "OUT/b.csv"], BAD_INPUT, "--list"),
