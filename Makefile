@@ -1,5 +1,6 @@
 # Two commands do all the set-up on a fresh Debian machine with Python >= 3.11:
-#   make demo   -- install, then the complete analysis of the 1-4 system (out/1-4/index.md)
+#   make demo   -- install, then the complete analysis of the 1-4 system with its deployment
+#                  (tmfem report; out/1-4/index.md links every file)
 #   make test   -- install, then run the test suite
 PYTHON ?= python3
 VENV   := .venv
@@ -26,7 +27,6 @@ $(STAMP): pyproject.toml $(VENV)/.syslibs
 
 demo: $(STAMP)
 	$(BIN)/tmfem report --preset 1-4 --out $(OUT)/1-4
-	$(BIN)/tmfem deploy --preset 1-4D --uncertainty exact --t-end 16 --plot $(OUT)/1-4/deploy-1-4D.png --gif $(OUT)/1-4/deploy-1-4D.gif --csv $(OUT)/1-4/deploy-1-4D.csv
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -71,6 +71,59 @@ def string_rest(tmp_path):
     (["equilibrium", "--preset", "1-4", "--attachment", "distributed", "--patch", "5"],
      BAD_INPUT, "half the shortest"),
     (["equilibrium", "--preset", "nope"], BAD_INPUT, "unknown preset"),
+    # commands added after the first sweep (deploy, control, lpv, benchmark, --model sbc);
+    # the limits: MAX_STEPS, control.MAX_STATES, control_lpv.MAX_VERIFY_POINTS, MAX_MEMBRANE_MODES
+    (["deploy", "--preset", "1-4D", "--t-end", "nan"], BAD_INPUT, "finite"),
+    (["deploy", "--preset", "1-4D", "--t-end", "abc"], BAD_INPUT, "expected a number"),
+    (["deploy", "--preset", "1-4D", "--dt", "-1"], BAD_INPUT, "> 0"),
+    (["deploy", "--preset", "1-4D", "--t-end", "1e9"], TOO_LARGE, "steps; the limit is"),
+    (["deploy", "--preset", "1-4D", "--dt", "1", "--t-end", "0.5"], BAD_INPUT, "at least one step"),
+    (["deploy", "--preset", "nope"], BAD_INPUT, "invalid choice"),
+    (["deploy", "--preset", "1-4D", "--csv", "FILE/d.csv"], BAD_INPUT, "not a directory"),
+    (["deploy", "--preset", "1-4D", "--plot", "OUT/d.txt"], BAD_INPUT, "suffix"),
+    (["deploy", "--preset", "1-4D", "--gif", "OUT/d.png"], BAD_INPUT, "suffix"),
+    (["deploy", "--preset", "1-4D", "--vtk", "FILE"], BAD_INPUT, "is a file"),
+    (["control", "hinf", "--preset", "1-4D", "--membrane-modes", "0"], BAD_INPUT, "K >= 1"),
+    (["control", "hinf", "--preset", "1-4D", "--membrane-modes", "1000"], TOO_LARGE, "states"),
+    (["control", "hinf", "--preset", "1-4D", "--save", "FILE/k.npz"], BAD_INPUT, "not a directory"),
+    (["control", "hinf", "--preset", "1-4D", "--save", "OUT/k.txt"], BAD_INPUT, "suffix"),
+    (["control", "hinf", "--preset", "1-4D", "--plot", "OUT/k.txt"], BAD_INPUT, "suffix"),
+    (["control", "hinf", "--preset", "1-4D", "--alpha", "abc"], BAD_INPUT, "invalid float"),
+    (["control", "pbh", "--preset", "1-4D", "--alpha", "1"], BAD_INPUT, "hinf` only"),
+    (["control", "hinf", "--preset", "nope"], BAD_INPUT, "unknown preset"),
+    (["control", "recheck", "FILE"], BAD_INPUT, "expected an .npz"),
+    (["control", "recheck", "OUT/missing.npz"], BAD_INPUT, "expected an .npz"),
+    (["control", "lpv", "--max-iter", "-5"], BAD_INPUT, "--max-iter"),
+    (["control", "lpv", "--refine", "100000"], TOO_LARGE, "verification grid"),
+    (["control", "lpv", "--grid", "abc"], BAD_INPUT, "AxB"),
+    (["control", "lpv", "--rate-bound-deg", "nan"], BAD_INPUT, "--rate-bound-deg"),
+    (["control", "lpv", "--save", "FILE/p.npz"], BAD_INPUT, "not a directory"),
+    (["control", "lpv", "--preset", "1-4"], BAD_INPUT, "printed LPV grid"),
+    (["benchmark", "nope"], BAD_INPUT, "expected one of"),
+    (["benchmark", "truss-arch", "--plot", "OUT/b.txt"], BAD_INPUT, "suffix"),
+    (["benchmark", "--list", "--csv", "OUT/b.csv"], BAD_INPUT, "--list"),
+    (["static", "--model", "sbc", "--preset", "1-4", "--bar-elements", "100000"], TOO_LARGE, "GiB"),
+    (["static", "--model", "sbc", "--preset", "1-4", "--tendon-elements", "100000"], TOO_LARGE, "GiB"),
+    (["static", "--model", "sbc", "--preset", "1-4", "--wrinkle-plot", "OUT/w.png"], BAD_INPUT,
+     "does not apply"),
+    (["static", "--model", "sbc", "--preset", "1-4", "--patch", "0.1"], BAD_INPUT, "does not apply"),
+    (["static", "--model", "sbc", "--preset", "1-4", "--rest-lengths", "S1=nan"], BAD_INPUT,
+     "positive rest lengths"),
+    (["static", "--model", "sbc", "--preset", "1-4", "--start", "design"], BAD_INPUT, "does not apply"),
+    (["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "3", "--modes", "100000"], BAD_INPUT,
+     "free DOFs"),
+    (["modal", "--model", "sbc", "--preset", "1-4", "--vtk", "OUT/m.vtu"], BAD_INPUT, "does not apply"),
+    (["modal", "--model", "com", "--preset", "1-4", "--membrane-modes", "1000"], TOO_LARGE, "K <= 40"),
+    (["modal", "--model", "com", "--preset", "1-4", "--modes", "100"], BAD_INPUT, "coordinates"),
+    (["modal", "--preset", "1-4", "--mesh", "3", "--modes", "100000"], BAD_INPUT, "free DOFs"),
+    (["vibrate", "--preset", "1-4", "--vtk-every", "5"], BAD_INPUT, "does not apply"),
+    (["converge", "--preset", "1-4", "--mesh", "3", "--patch", "0.2"], BAD_INPUT, "does not apply"),
+    (["converge", "--preset", "1-4", "--mesh", "3", "--attachment", "distributed", "--patch", "50"],
+     BAD_INPUT, "half the shortest"),
+    (["converge", "--preset", "1-4", "--mesh", "3", "--modes", "100000"], BAD_INPUT, "DOFs"),
+    (["static", "--preset", "1-4", "--wrinkle-plot", "FILE/w.png"], BAD_INPUT, "not a directory"),
+    (["report", "--preset", "2-3", "--out", "OUT", "--no-deploy"], BAD_INPUT, "does not apply"),
+    (["report", "--preset", "1-4", "--out", "OUT", "--modes", "20"], BAD_INPUT, "coordinates"),
 ])
 def test_misuse_one_line_and_exit_code(argv, code, needle, tmp_path, capsys):
     f = tmp_path / "a_file"
@@ -109,13 +162,16 @@ def test_failed_check_exits_1_unless_allowed(capsys):
     assert rc == REFUSED and "Traceback" not in err
 
 
-def test_ctrl_c_is_one_line_exit_130(tmp_path):
+@pytest.mark.parametrize("argv", [
+    ["vibrate", "--preset", "1-4", "--t-end", "1000", "--dt", "0.01"],
+    ["deploy", "--preset", "1-4D", "--t-end", "1000"],           # in the controller design
+])
+def test_ctrl_c_is_one_line_exit_130(argv, tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="1")
-    p = subprocess.Popen([sys.executable, "-m", "tmfem", "vibrate", "--preset", "1-4",
-                          "--t-end", "1000", "--dt", "0.01"],
+    p = subprocess.Popen([sys.executable, "-m", "tmfem"] + argv,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, text=True)
     time.sleep(6)
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=60)
     assert p.returncode == 130, err
-    assert "Traceback" not in err and err.strip().splitlines()[-1] == "tmfem vibrate: interrupted"
+    assert "Traceback" not in err and err.strip().splitlines()[-1] == f"tmfem {argv[0]}: interrupted"

@@ -56,7 +56,9 @@ def test_study_rest_lengths_are_the_6_2_design_once():
     from tmfem.reference.convergence import resolve_rest_lengths
     s = load_preset("1-4")
     assert s.rest_lengths is None
-    r = resolve_rest_lengths(s, rest_lengths=None)
+    r, rule = resolve_rest_lengths(s, rest_lengths=None)
+    assert rule == "design@10"
     assert r == pytest.approx(design_equilibrium(s, mesh_n=10).rest_lengths, rel=1e-12)
     assert r[0] == pytest.approx(1.5089, abs=1e-4)
-    assert resolve_rest_lengths(s, rest_lengths="mtc") == "mtc"
+    assert resolve_rest_lengths(s, rest_lengths="mtc") == ("mtc", "mtc")
+    assert resolve_rest_lengths(s, rest_lengths="design") == ("design", "design")   # per mesh

@@ -162,10 +162,8 @@ def render(args, mod, result) -> str:
     """The text a command prints: one JSON document (``--json``, with the units) or the
     module's ``format_text``."""
     if args.json:
-        if isinstance(result, dict) and "units" not in result:
-            from tmfem.cli.units import units_of
-            result = {**result, "units": units_of(result)}
-        return json.dumps(_finite(result), default=json_default, allow_nan=False)
+        from tmfem.io.units import with_units
+        return json.dumps(_finite(with_units(result)), default=json_default, allow_nan=False)
     return getattr(mod, "format_text", _default_text)(result)
 
 

@@ -77,7 +77,14 @@ def model_options_from_args(args, command: str):
                          "the finite-element models)")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
-        check_mesh_budget(N=system.N, n=options["mesh"])
+        check_model_budget(system, mesh=options["mesh"],
+                           tendon_elements=options.get("tendon_elements") or 1,
+                           bar_elements=options.get("bar_elements"),
+                           dofs_per_node=6 if args.model == "sbc" else 3)
+    if "attachment" in options:
+        check_attachment_options(system, attachment=options["attachment"], patch=options["patch"])
+    if options.get("membrane_modes") is not None:
+        check_membrane_modes(options["membrane_modes"])
     check_outputs(args, command)
     return system, options
 
@@ -248,24 +255,27 @@ BASE_BYTES = 0.3e9
 MEMORY_FRACTION = 0.6         # of the physical memory: the machine is shared
 
 
-def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3) -> int:
+def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3,
+                      extra_dofs: int = 0, extra_text: str = "") -> int:
     """Refuse a membrane mesh whose FE model would not fit this machine.
 
     The N n x n quadrilateral patches have about N (n + 1)^2 nodes, hence
-    ``dofs_per_node`` N (n + 1)^2 unknowns; the estimated peak memory is
-    ``BASE_BYTES + BYTES_PER_DOF * dofs`` and must stay under ``MEMORY_FRACTION`` of the
-    physical memory. Returns the DOF estimate.
+    ``dofs_per_node`` N (n + 1)^2 unknowns, plus ``extra_dofs`` (members, named by
+    ``extra_text``); the estimated peak memory is ``BASE_BYTES + BYTES_PER_DOF * dofs`` and
+    must stay under ``MEMORY_FRACTION`` of the physical memory. Returns the DOF estimate.
 
     Raises
     ------
     ResourceLimit
         with the estimate and the limit.
     """
-    dofs = dofs_per_node * N * (n + 1) ** 2
+    dofs = dofs_per_node * N * (n + 1) ** 2 + int(extra_dofs)
     need = BASE_BYTES + BYTES_PER_DOF * dofs
     limit = MEMORY_FRACTION * machine_memory()
     if need > limit:
-        raise ResourceLimit(f"{option} {n}: the membrane mesh {N} x {n} x {n} gives about "
+        given = option if " " in option else f"{option} {n}"    # "--mesh n ..." or the flag
+        raise ResourceLimit(f"{given}: the membrane mesh {N} x {n} x {n}"
+                            + (f" with {extra_text}" if extra_text else "") + " gives about "
                             f"{dofs:,} DOFs and needs about {need / 2**30:.1f} GiB; the limit "
                             f"is {limit / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this "
                             f"machine's {machine_memory() / 2**30:.0f} GiB)")
@@ -292,6 +302,66 @@ def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> i
             raise ResourceLimit(f"{steps:,} steps x {states:,} states need {need / 2**30:.1f} "
                                 f"GiB of history; the limit is {limit / 2**30:.1f} GiB")
     return steps
+
+
+def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
+                       bar_elements: int | None = None, modes: int | None = None,
+                       dofs_per_node: int = 3) -> int:
+    """Refuse a finite-element model of ``system`` that would not fit this machine, before
+    it is built: the membrane mesh (:func:`check_mesh_budget`, ``dofs_per_node`` 3 for the
+    membrane elements, 6 for shells) plus 3 (k - 1) DOFs per tendon of k truss elements and,
+    with ``bar_elements`` b (beam bars, 6 DOFs per node), 6 (3 b - 1) per bar; ``modes`` must
+    stay below the DOF estimate. Returns the DOF estimate."""
+    extra = 3 * len(system.tendons) * (tendon_elements - 1)
+    what = [f"{len(system.tendons)} tendons x {tendon_elements} elements"]
+    if bar_elements is not None:
+        extra += 6 * system.M * system.N * (3 * bar_elements - 1)
+        what.append(f"{system.M * system.N} bars x {bar_elements} beam elements")
+    given = f"--mesh {mesh} --tendon-elements {tendon_elements}" + (
+        f" --bar-elements {bar_elements}" if bar_elements is not None else "")
+    dofs = check_mesh_budget(N=system.N, n=mesh, option=given, dofs_per_node=dofs_per_node,
+                             extra_dofs=extra, extra_text=", ".join(what))
+    if modes is not None and modes >= dofs:
+        raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
+                         "DOFs")
+    return dofs
+
+
+#: Largest K of the control-oriented model: its equations are built symbolically (CasADi)
+#: at a cost that grows faster than K^2 (1-4, measured under load: K = 10: 8 s, 20: 9 s,
+#: 40: 24 s; K = 1000 would run for hours).
+MAX_MEMBRANE_MODES = 40
+
+
+def check_membrane_modes(K: int) -> None:
+    """``--membrane-modes K`` of the control-oriented model: 0 <= K <= MAX_MEMBRANE_MODES."""
+    if not 0 <= K <= MAX_MEMBRANE_MODES:
+        cls = ResourceLimit if K > MAX_MEMBRANE_MODES else InputError
+        raise cls(f"--membrane-modes {K}: expected 0 <= K <= {MAX_MEMBRANE_MODES} (the model's "
+                  f"equations are built symbolically; K = 40 takes ~25 s, the cost grows faster "
+                  f"than K^2)")
+
+
+def check_com_modes(system: System, *, modes: int, membrane_modes=None) -> int:
+    """``--modes`` of the control-oriented model: at most its n_q + K coordinates. Returns K
+    (``membrane_modes`` or the system's default)."""
+    from tmfem.models.com.model import default_membrane_modes
+    K = default_membrane_modes(system) if membrane_modes is None else membrane_modes
+    states = len(system.q_names) + K
+    if modes > states:
+        raise InputError(f"--modes {modes}: the control-oriented model of {system.name} has "
+                         f"{states} coordinates (n_q + K = {len(system.q_names)} + {K}); expected "
+                         f"--modes <= {states}")
+    return K
+
+
+def check_attachment_options(system: System, *, attachment: str, patch) -> None:
+    """``--patch`` applies to ``--attachment distributed`` only and must fit the membrane
+    (:func:`check_patch`)."""
+    if patch is not None and attachment != "distributed":
+        raise InputError(f"--patch: option does not apply with --attachment {attachment} "
+                         f"(expected --attachment distributed), found --patch {patch}")
+    check_patch(system, patch)
 
 
 def check_patch(system: System, patch) -> None:

@@ -11,8 +11,8 @@ from __future__ import annotations
 import sys
 
 from tmfem.cli import control_lpv
-from tmfem.cli.common import add_system_args, system_from_args
-from tmfem.errors import InputError
+from tmfem.cli.common import add_system_args, output_file, system_from_args
+from tmfem.errors import InputError, ResourceLimit
 
 NAME = "control"
 HELP = ("linear control: PBH tests, H-infinity LMI synthesis at a deployed configuration (7.3-7.4), "
@@ -49,6 +49,28 @@ def configure(parser) -> None:
     control_lpv.configure(parser)
 
 
+#: Largest plant of `hinf`/`pbh`: 2 (n_q + K) states. 1-4(D) with K = 3 (22 states) takes
+#: seconds; the COM is built symbolically (K = 40: ~25 s) and the LMIs grow with the square
+#: of the states (the 50-state 2-3 LMI already fails in Clarabel, docs/control.md).
+MAX_STATES = 60
+
+
+def check_control_modes(system, K) -> None:
+    """``--membrane-modes K``: 1 <= K (the membrane outputs w of eqs. 5.73-5.75 are membrane
+    deflections) and a plant of at most :data:`MAX_STATES` states."""
+    if K is None:
+        return
+    nq = len(system.q_names)
+    if K < 1:
+        raise InputError(f"--membrane-modes: expected K >= 1 (the outputs w of eqs. 5.73-5.75 "
+                         f"are membrane deflections), found {K}")
+    if 2 * (nq + K) > MAX_STATES:
+        raise ResourceLimit(f"--membrane-modes {K}: the plant of {system.name} has 2 (n_q + K) = "
+                            f"{2 * (nq + K)} states; the limit is {MAX_STATES} (K <= "
+                            f"{MAX_STATES // 2 - nq}): the symbolic model grows fast with K and "
+                            "the LMIs with the square of the states (docs/control.md)")
+
+
 def run(args) -> dict:
     if args.action == "lpv":
         given = [k for k in ("alpha", "u_m", "plot", "method", "membrane_modes", "pbh_tol")
@@ -80,7 +102,10 @@ def run(args) -> dict:
         raise InputError("--solver EIGOPT: applies to `tmfem control lpv` only")
     if args.method == "riccati" and args.solver is not None:
         raise InputError(f"--solver {args.solver}: applies to --method lmi only, found --method riccati")
+    output_file(args.save, option="--save", suffixes=(".npz",))
+    output_file(args.plot, option="--plot", suffixes=(".png",))
     system = system_from_args(args)
+    check_control_modes(system, args.membrane_modes)
     print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
                         solver=args.solver or "ARE", synthesize=args.action == "hinf",

@@ -6,7 +6,12 @@ import sys
 
 import numpy as np
 
-from tmfem.errors import InfeasibleController, InputError
+from tmfem.cli.common import output_file
+from tmfem.errors import InfeasibleController, InputError, ResourceLimit
+
+#: Largest verification grid: every point is one COM linearisation (~2 s for 2-3 on this
+#: machine under load), so 500 points is about a quarter of an hour.
+MAX_VERIFY_POINTS = 500
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
 LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma")
@@ -51,6 +56,9 @@ def run(args) -> dict:
         raise InputError(f"--refine: expected >= 4 (the issue's verification standard), found {refine}")
     if not (np.isfinite(rate) and rate >= 0):
         raise InputError(f"--rate-bound-deg: expected >= 0, found {rate}")
+    if args.max_iter is not None and args.max_iter < 1:
+        raise InputError(f"--max-iter: expected an integer >= 1, found {args.max_iter}")
+    output_file(args.save, option="--save", suffixes=(".npz",))
     if args.solver == "ARE":
         raise InputError("--solver ARE: applies to `tmfem control hinf` only; lpv takes CLARABEL or SCS")
     if args.spec is not None:
@@ -61,6 +69,11 @@ def run(args) -> dict:
     if "theta_grid_deg" not in printed or "psi_grid_deg" not in printed:
         raise InputError(f"preset {preset!r}: expected a printed LPV grid (theta_grid_deg, psi_grid_deg), found none")
     th, ps = _grid(args.grid or "6x3", printed)
+    fine_n = [(a.size - 1) * refine + 1 for a in (th, ps)]
+    if fine_n[0] * fine_n[1] > MAX_VERIFY_POINTS:
+        raise ResourceLimit(f"--grid {args.grid or '6x3'} --refine {refine}: the verification grid "
+                            f"has {fine_n[0]} x {fine_n[1]} = {fine_n[0] * fine_n[1]:,} points, one COM "
+                            f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
     rb = np.radians(rate)
     print(f"tmfem control lpv: {preset}: linearising at {th.size * ps.size} grid points", file=sys.stderr)
     with progress_bar(th.size * ps.size, 1, "LPV plant (grid points)") as bar:

@@ -4,14 +4,23 @@ from __future__ import annotations
 import csv
 
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
-                              check_mesh_budget, check_outputs, system_from_args)
+                              check_attachment_options, check_model_budget, check_outputs,
+                              system_from_args)
 from tmfem.errors import InputError
+from tmfem.io.units import unit_of
+from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import apply_rest_lengths
 from tmfem.post.convergence import plot_convergence_study
 from tmfem.solvers.backends import backend_names
 
 NAME = "converge"
 HELP = "mesh / tendon-subdivision convergence of frequencies and stresses (dissertation 6.3)"
+
+
+def _header(key: str) -> str:
+    """CSV column name with its unit (``h [m]``, ``f1 [Hz]``; counts and labels bare)."""
+    unit = unit_of(key)
+    return f"{key} [{unit}]" if unit not in (None, "-") else key
 
 
 def _ints(text: str, what: str) -> list[int]:
@@ -40,21 +49,31 @@ def configure(parser) -> None:
     add_attachment_args(parser)
     add_membrane_law_arg(parser)
     parser.add_argument("--rest-lengths", default=None,
-                        help="fixed rest lengths (system/design, evaluated once, or GROUP=VALUE "
-                             "pairs such as S1=1.5025) or the design-consistent ones recomputed "
-                             "on each mesh (mtc)")
+                        help="rest lengths held fixed on every mesh: 'system', 'design@n' (the "
+                             "ch. 3 design on the n x n mesh with point corners; default "
+                             "design@10, the design of 6.2, for a system without rest lengths) "
+                             "or GROUP=VALUE pairs such as S1=1.5025; or recomputed on each mesh: "
+                             "'design' (the ch. 3 design on that mesh, the default of `tmfem "
+                             "modal`/`static`) or 'mtc' (docs/mtc.md)")
     parser.add_argument("--csv", help="write one row per run, as it finishes")
     parser.add_argument("--plot", help="PNG: frequencies and peak stresses against h")
 
 
 def run(args) -> dict:
-    from tmfem.reference.convergence import ROW_KEYS, convergence_rows, fit_convergence
+    from tmfem.reference.convergence import (ROW_KEYS, convergence_rows, fit_convergence,
+                                             resolve_rest_lengths)
     system, rest = apply_rest_lengths(system_from_args(args), args.rest_lengths)
     meshes = _ints(args.mesh, "--mesh")
     tendons = _ints(args.tendon_elements, "--tendon-elements")
+    if not (isinstance(args.modes, int) and args.modes >= 1):
+        raise InputError(f"--modes: expected an integer >= 1, found {args.modes!r}")
+    check_attachment_options(system, attachment=args.attachment, patch=args.patch)
     for n in meshes:
-        check_mesh_budget(N=system.N, n=n, dofs_per_node=5 if args.model == "sbc" else 3)
+        for k in tendons:
+            check_model_budget(system, mesh=n, tendon_elements=k, modes=args.modes,
+                               dofs_per_node=5 if args.model == "sbc" else 3)
     check_outputs(args, NAME)
+    rest, rule = resolve_rest_lengths(system, rest_lengths=rest)
     rows = []
     writer = fh = None
     try:
@@ -67,16 +86,20 @@ def run(args) -> dict:
             rows.append(row)
             if fh is not None:
                 if writer is None:
-                    writer = csv.DictWriter(fh, fieldnames=list(ROW_KEYS) + [
-                        f"f{i + 1}" for i in range(args.modes)])
-                    writer.writeheader()
+                    keys = list(ROW_KEYS) + [f"f{i + 1}" for i in range(args.modes)]
+                    writer = csv.DictWriter(fh, fieldnames=keys, lineterminator="\n")
+                    writer.writerow({k: _header(k) for k in keys})
                 writer.writerow(row)
                 fh.flush()
     finally:
         if fh is not None:
             fh.close()
     out = {"system": system.name, "model": args.model, "attachment": args.attachment,
-           "membrane_law": args.membrane_law, "rows": rows}
+           "membrane_law": args.membrane_law, "rest_lengths_rule": rule,
+           "rest_lengths_note": describe_rule(rule, per_mesh_study=True),
+           "rest_lengths": (None if isinstance(rest, str) else
+                            {t.name: float(v) for t, v in zip(system.tendons, rest)}),
+           "rows": rows}
     if len(meshes) >= 3 and len(tendons) == 1:
         out["fit"] = fit_convergence(rows, modes=args.modes)
     elif len(tendons) >= 2 and len(meshes) == 1:
@@ -99,8 +122,12 @@ def format_text(r: dict) -> str:
     nf = sum(1 for k in rows[0] if k.startswith("f") and k[1:].isdigit())
     head = f"{'n':>3s} {'k':>2s} {'elem':>6s} {'dofs':>7s} {'Delta mm':>9s} {'sp1 MPa':>8s} {'vm MPa':>8s} " \
            + " ".join(f"{'f' + str(i + 1):>7s}" for i in range(nf))
+    fixed = r.get("rest_lengths")
     lines = [f"{r['system']} {r.get('model', 'mtc').upper()} convergence, {r['attachment']} attachment, "
-             f"{r.get('membrane_law', 'svk')} membrane", head]
+             f"{r.get('membrane_law', 'svk')} membrane",
+             f"rest lengths: {r['rest_lengths_rule']} ({r['rest_lengths_note']})"
+             + (": " + ", ".join(f"{k}={v:.5f} m" for k, v in list(fixed.items())[:4])
+                + (" ..." if len(fixed) > 4 else "") if fixed else ""), head]
     for w in rows:
         lines.append(f"{w['mesh_n']:3d} {w['tendon_elements']:2d} {w['elements']:6d} {w['dofs']:7d} "
                      f"{w['Delta_mm']:9.4f} {w['sigma_p1_max_MPa']:8.3f} {w['von_mises_max_MPa']:8.3f} "

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
-                              check_mesh_budget, check_patch, system_from_args)
+                              check_attachment_options, check_mesh_budget, system_from_args)
 from tmfem.errors import InputError
 
 NAME = "equilibrium"
@@ -35,11 +35,8 @@ def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point
 
     if mesh_n < 1:
         raise InputError(f"--mesh: expected n >= 1, found {mesh_n}")
-    if patch is not None and attachment != "distributed":
-        raise InputError(f"--patch: expected only with --attachment distributed, found "
-                         f"--attachment {attachment}")
     check_mesh_budget(N=system.N, n=mesh_n, dofs_per_node=2)
-    check_patch(system, patch)
+    check_attachment_options(system, attachment=attachment, patch=patch)
     d = design_equilibrium(system, mesh_n=mesh_n, strict=strict, attachment=attachment,
                            patch=patch, membrane_law=membrane_law)
     out = d.to_dict()

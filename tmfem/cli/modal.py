@@ -5,10 +5,11 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_model_args, add_system_args, model_from_args,
+from tmfem.cli.common import (add_model_args, add_system_args, check_com_modes, model_from_args,
                               model_options_from_args)
 from tmfem.cli.static import default_monitor
 from tmfem.errors import InputError
+from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import sequence_of
 
 NAME = "modal"
@@ -41,13 +42,17 @@ def run(args) -> dict:
                              "finite-element mode shapes (use --model mtc)")
         from tmfem.reference.com_modal import modal_summary
         system, options = model_options_from_args(args, NAME)
-        return modal_summary(system, modes=args.modes, membrane_modes=options["membrane_modes"],
+        K = check_com_modes(system, modes=args.modes, membrane_modes=options["membrane_modes"])
+        return modal_summary(system, modes=args.modes, membrane_modes=K,
                              prestress_scale=options["prestress_scale"], mesh_n=options["mesh"],
                              membrane_law=options["membrane_law"])
     from tmfem.reference.tables import FREQUENCIES
     from tmfem.models.mtc.post import static_summary
     from tmfem.post.mtc import model_cells
     model, options = model_from_args(args, NAME)
+    if args.modes >= model.ndof:                  # before the static solve
+        raise InputError(f"--modes {args.modes}: expected fewer modes than the model's "
+                         f"{model.ndof} free DOFs")
     if args.model == "sbc":
         return sbc_modal(args, model, FREQUENCIES)
     system_name = model.system.name
@@ -58,6 +63,7 @@ def run(args) -> dict:
     out = {"system": system_name, "model": "mtc", "dofs": model.ndof, "mesh_n": options["mesh"],
            "tendon_elements": options["tendon_elements"], "attachment": options["attachment"],
            "membrane_law": model.membrane_law, "rest_lengths_source": model.rest_lengths_source,
+           "rest_lengths_note": describe_rule(model.rest_lengths_source),
            "rest_lengths": st["rest_lengths"], "static_iterations": res.iterations,
            "tendon_stress_max": st["tendon_stress_max"], "bar_load_max": st["bar_load_max"],
            "Delta_mean": float(np.mean(st["Delta"])),
@@ -122,8 +128,8 @@ def format_text(r: dict) -> str:
     lines = [f"MTC modes of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
              f"membrane, {r['dofs']} free dofs",
-             f"prestress: rest lengths ({r['rest_lengths_source']}) "
-             + ", ".join(f"{k}={v:.5f}" for k, v in list(r["rest_lengths"].items())[:4])
+             f"rest lengths {r['rest_lengths_source']}: {r['rest_lengths_note']}",
+             "prestress: " + ", ".join(f"{k}={v:.5f} m" for k, v in list(r["rest_lengths"].items())[:4])
              + f"; max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, bar load "
                f"{r['bar_load_max']:.3f} N, Delta {r['Delta_mean'] * 1e3:.4f} mm"]
     d = r.get("dissertation")

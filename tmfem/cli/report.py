@@ -1,9 +1,10 @@
 """``tmfem report``: the complete analysis of one system as a report directory.
 
-Design (ch. 3), statics, modes and free vibration of the membrane-truss-cable and
-control-oriented models beside the dissertation's tables, at the designed prestress and at
-the prestress the dissertation's results imply; every table, plot and ParaView file linked
-from ``index.md`` (:func:`tmfem.reference.report.write_report`). ``make demo`` runs
+Design (ch. 3), statics, modes and free vibration of the membrane-truss-cable, shell-beam-cable
+and control-oriented models beside the dissertation's tables, at the designed prestress and at
+the prestress the dissertation's results imply, and the deployment (7.4); every table, plot,
+animation and ParaView file linked from ``index.md``
+(:func:`tmfem.reference.report.write_report`). ``make demo`` is
 ``tmfem report --preset 1-4 --out out/1-4``.
 """
 from __future__ import annotations
@@ -11,12 +12,15 @@ from __future__ import annotations
 import sys
 import textwrap
 
-from tmfem.cli.common import (Progress, add_system_args, check_mesh_budget, check_time_steps,
-                              output_dir, positive_float, positive_int, system_from_args)
+from tmfem.cli.common import (Progress, add_system_args, check_com_modes, check_model_budget,
+                              check_time_steps, output_dir, positive_float, positive_int,
+                              system_from_args)
+from tmfem.errors import InputError
 
 NAME = "report"
-HELP = ("complete analysis of a system (design, FE statics, 12 modes of the MTC and COM "
-        "models beside the dissertation, free vibration) as a report directory with index.md")
+HELP = ("complete analysis of a system (design, FE statics, 12 modes of the MTC, SBC and COM "
+        "models beside the dissertation, free vibration, deployment) as a report directory "
+        "with index.md")
 
 
 def configure(parser) -> None:
@@ -33,21 +37,32 @@ def configure(parser) -> None:
                         help="time step [s] (default 0.01, as in 6.5)")
     parser.add_argument("--no-render", action="store_true",
                         help="skip the pyvista renders (default: render)")
+    parser.add_argument("--no-deploy", action="store_true",
+                        help="skip the deployment of 7.4 (default: run it when the system has "
+                             "one, 1-4 -> 1-4D)")
 
 
 def run(args) -> dict:
-    from tmfem.reference.report import STEPS, write_report
+    from tmfem.reference.report import REPORT_DEPLOYMENT, STEPS, write_report
 
     system = system_from_args(args)
-    check_mesh_budget(N=system.N, n=args.mesh)
+    check_model_budget(system, mesh=args.mesh, tendon_elements=3, modes=args.modes)
+    check_com_modes(system, modes=args.modes)
     check_time_steps(t_end=args.t_end, dt=args.dt)
+    deployment = REPORT_DEPLOYMENT.get(system.name)
+    if deployment is None and args.no_deploy:
+        raise InputError(f"--no-deploy: option does not apply: system {system.name!r} has no "
+                         f"deployment in the report (those that have: {sorted(REPORT_DEPLOYMENT)})")
+    if deployment is not None and not args.no_deploy:
+        check_time_steps(t_end=deployment["t_end"], dt=args.dt)
     out = output_dir(args.out, option="--out")
     with Progress(total=len(STEPS), desc=f"report {system.name}") as bar:
         bar.note(STEPS[0])
         nxt = iter(STEPS[1:])
         result = write_report(system, out, mesh_n=args.mesh, modes=args.modes, t_end=args.t_end,
-                              dt=args.dt, render=not args.no_render,
-                              progress=lambda done: bar.step(next(nxt, "done")))
+                              dt=args.dt, render=not args.no_render, deploy=not args.no_deploy,
+                              progress=lambda done: bar.step(next(nxt, "done")),
+                              run_progress=lambda label: bar.callback(label))
     print(f"tmfem report: done: {out / 'index.md'}", file=sys.stderr)
     return result
 
@@ -57,12 +72,13 @@ def format_text(r: dict) -> str:
 
     f = r["frequencies_hz"]
     pr = r.get("printed_frequencies_hz") or {}
-    head = ["mode"] + [f"{k} [Hz]" for k in f] + ([f"{m} printed" for m in ("MTC", "COM")] if pr else [])
+    printed_cols = ("MTC", "SBC", "COM")
+    head = ["mode"] + [f"{k} [Hz]" for k in f] + ([f"{m} printed" for m in printed_cols] if pr else [])
     rows = []
     for i in range(r["modes"]):
         row = [i + 1] + [f"{v[i]:.4f}" if i < len(v) else "-" for v in f.values()]
         if pr:
-            row += [f"{pr[m][i]:.4f}" if i < len(pr[m]) else "-" for m in ("MTC", "COM")]
+            row += [f"{pr[m][i]:.4f}" if i < len(pr[m]) else "-" for m in printed_cols]
         rows.append(row)
     st = r["statics"]
     srows = [[k, f"{v['tendon_stress_max_MPa']:.2f}", f"{v['bar_load_max_N']:.3f}",
@@ -73,6 +89,13 @@ def format_text(r: dict) -> str:
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
              f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+    d = r.get("deployment")
+    if d:
+        lines.insert(-1, f"deployment {d['preset']} ({d['controller']}, uncertainty "
+                         f"{d['uncertainty']}): switch at {d['switch_time_s']} s, max w "
+                         f"{1e3 * d['max_membrane_deflection_m']:.2f} mm, final tracking error "
+                         f"{d['final_tracking_error']:.2g}")
+        lines.insert(-1, "")
     if r.get("notes"):
         lines += ["", "why ours and the printed values differ (docs/errata.md):"]
         lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")

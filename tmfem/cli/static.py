@@ -6,6 +6,7 @@ import sys
 import numpy as np
 
 from tmfem.cli.common import add_model_args, add_system_args, model_from_args
+from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import sequence_of
 
 NAME = "static"
@@ -132,8 +133,8 @@ def format_text(r: dict) -> str:
     lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
              f"membrane, {r['dofs']} free dofs",
-             f"rest lengths ({r['rest_lengths_source']}): "
-             + ", ".join(f"{k}={v:.5f}" for k, v in list(r["rest_lengths"].items())[:8])
+             f"rest lengths {r['rest_lengths_source']} ({describe_rule(r['rest_lengths_source'])}): "
+             + ", ".join(f"{k}={v:.5f} m" for k, v in list(r["rest_lengths"].items())[:8])
              + (" ..." if len(r["rest_lengths"]) > 8 else ""),
              f"converged in {r.get('iterations')} iterations ({r.get('static_time_s', 0):.2f} s); "
              f"residual {r['residual_history'][0]:.3e} -> {r['residual_history'][-1]:.3e} N",

@@ -27,9 +27,10 @@ import numpy as np
 
 from tmfem.cli import json_default
 from tmfem.cli.common import (Progress, add_attachment_args, add_membrane_law_arg, add_system_args,
-                              check_mesh_budget, check_patch, output_dir, positive_int,
+                              check_attachment_options, check_mesh_budget, output_dir, positive_int,
                               system_from_args)
 from tmfem.errors import InputError
+from tmfem.io.units import with_units
 from tmfem.reference.report import explanations
 from tmfem.reference.study import (plot_configuration, plot_membrane_stress, text_table,
                                    write_tables)
@@ -63,7 +64,7 @@ def run(args) -> dict:
                          f"needs two points per axis), found {args.map_grid}")
     system = system_from_args(args)
     check_mesh_budget(N=system.N, n=args.mesh, dofs_per_node=2)
-    check_patch(system, args.patch)
+    check_attachment_options(system, attachment=args.attachment, patch=args.patch)
     out = output_dir(args.out, option="--out")
     with Progress(total=6, desc=f"study {system.name}") as bar:
         result = _study(args, system, out, bar)
@@ -83,7 +84,7 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
     tables = write_tables(out, d, system, notes=explanations(system.name, "design"))
     for f in ("equilibrium.csv", "tendons.csv", "equilibrium.md"):
         files[f] = str(out / f)
-    (out / "design.json").write_text(json.dumps(result, default=json_default))
+    (out / "design.json").write_text(json.dumps(with_units(result), default=json_default))
     files["design.json"] = str(out / "design.json")
     bar.step("plots")
     files["configuration.png"] = str(plot_configuration(out / "configuration.png", d, system))
@@ -112,7 +113,7 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
         th = np.radians(np.linspace(30, 85, k))
         ps = np.radians(np.linspace(-60, 60, k))
         emap = equilibrium_map(system, theta=th, psi=ps, progress=bar.callback("map rows"))
-        (out / "equilibrium_map.json").write_text(json.dumps(emap.to_dict()))
+        (out / "equilibrium_map.json").write_text(json.dumps(with_units(emap.to_dict())))
         files["equilibrium_map.json"] = str(out / "equilibrium_map.json")
         files["equilibrium_map.png"] = str(plot_equilibrium_map(
             out / "equilibrium_map.png", emap, mark=(c.theta[0], c.psi[0] - c.sigma[0])))

@@ -6,8 +6,9 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_model_args, finite_float, add_system_args, model_from_args,
-                              check_time_steps, parse_perturbation, progress_bar)
+from tmfem.cli.common import (add_model_args, add_system_args, check_time_steps, finite_float,
+                              model_from_args, parse_perturbation, positive_int, progress_bar)
+from tmfem.errors import InputError
 from tmfem.models.mtc.spec import sequence_of
 
 NAME = "vibrate"
@@ -29,12 +30,16 @@ def configure(parser) -> None:
     parser.add_argument("--plot", help="write a plot of the monitored histories (PNG)")
     parser.add_argument("--vtk", metavar="DIR",
                         help="write a ParaView series (.pvd + .vtu frames) to this directory")
-    parser.add_argument("--vtk-every", type=int, default=10,
-                        help="steps between ParaView frames (default 10)")
+    parser.add_argument("--vtk-every", type=positive_int, default=None,
+                        help="steps between ParaView frames of --vtk (default 10)")
 
 
 def run(args) -> dict:
     check_time_steps(t_end=args.t_end, dt=args.dt)
+    if args.vtk_every is not None and args.vtk is None:
+        raise InputError("--vtk-every: option does not apply without --vtk DIR (it spaces the "
+                         "ParaView frames)")
+    args.vtk_every = args.vtk_every or 10
     model, options = model_from_args(args, NAME)
     if args.model in ("mtc", "sbc"):
         return run_fe(args, model, options)

@@ -520,7 +520,10 @@ class Structure:
 
     def to_meshio(self, st: StructureState, *, deformed: bool = False):
         """A ``meshio.Mesh`` of the shells' quads (reference or deformed points) with point data
-        ``displacement``, ``rotation`` and ``director`` and cell data per element ``N`` (membrane
+        ``displacement`` (from the reference configuration, inertial frame: a generic structure
+        has no floating frame, so this is not the tensegrity membrane's ``displacement_Of`` of
+        :data:`tmfem.io.fields.DISPLACEMENT_FIELD`), ``rotation`` and ``director`` and cell
+        data per element ``N`` (membrane
         forces N11 N22 N12 [N/m]), ``M`` (bending moments M11 M22 M12 [N m/m]), ``Q`` (shear
         forces [N/m]) and ``von_mises_bottom/mid/top`` [Pa] (local 2nd Piola-Kirchhoff
         stresses at the element centre, frame of eq. 4.11)."""

@@ -10,8 +10,9 @@ from tmfem.mesh.polygon import MembraneMesh
 
 
 #: The one name of the membrane displacement field in every output (design, MTC statics,
-#: COM series): displacement [m] from the flat reference membrane, 3 components in the
-#: floating frame O_f of the current corners (eq. 3.4).
+#: COM series, report): displacement [m] from the flat reference membrane, 3 components in
+#: the floating frame O_f of the current corners (eq. 3.4). (The element benchmarks'
+#: ``Structure.to_meshio`` writes ``displacement``: a generic shell in the inertial frame.)
 DISPLACEMENT_FIELD = "displacement_Of"
 
 

@@ -21,12 +21,15 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
     ax = fig.subplots(3, 1, sharex=True)
     names = r.names["q"]
     sel = [k for k, n in enumerate(names) if n.startswith(("theta_1", "psi_1"))][:4]
-    for k in sel:
-        ln, = ax[0].plot(r.t, np.degrees(r.z[:, k]), label=names[k])
-        ax[0].plot(r.t, np.degrees(r.q_d[:, k]), "--", color=ln.get_color(), lw=1,
-                   label=f"{names[k]} reference")
+    # bars 1 and 2 of a symmetric deployment move alike: bar 1 wide and pale under bar 2
+    for i, k in enumerate(sel):
+        first = i < 2
+        ln, = ax[0].plot(r.t, np.degrees(r.z[:, k]), lw=4.0 if first else 1.4,
+                         alpha=0.45 if first else 1.0, label=names[k])
+        ax[0].plot(r.t, np.degrees(r.q_d[:, k]), ":", color="k", lw=0.9,
+                   label="references (eq. 5.68)" if i == 0 else None)
     ax[0].set_ylabel("bar attitude [deg]")
-    ax[0].legend(fontsize=7, ncol=2)
+    ax[0].legend(fontsize=7, ncol=3)
     for k, n in enumerate(r.names["w"]):
         ax[1].plot(r.t, 1e3 * r.w[:, k], label=n)
     ax[1].set_ylabel("membrane deflection w [mm]")
@@ -57,8 +60,8 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
 
 def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     """GIF of the bars (thick), tendons (thin) and the membrane polygon (flat, its corners)
-    over the run (Figures 7.5, 7.9, 7.14),
-    with matplotlib's pillow writer."""
+    over the run (Figures 7.5, 7.9, 7.14), with matplotlib's pillow writer; equal x/y scales,
+    the z axis at least 30 % of the plan size."""
     from matplotlib.animation import FuncAnimation, PillowWriter
     r = result
     nq = len(r.names["q"])
@@ -67,9 +70,16 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
     Cs = [system.membrane_corners_inertial(r.z[k, :nq]) for k in idx]
     allX = np.concatenate(Xs, axis=1)
     lo, hi = allX.min(axis=1), allX.max(axis=1)
-    fig = new_figure(figsize=(5, 5))
+    box = hi - lo
+    box[2] = max(box[2], 0.3 * box[:2].max())      # a flat system keeps a readable z axis
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    fig = new_figure(figsize=(6.0, 5.5))
     ax = fig.add_subplot(projection="3d")
     bars, tends = system.bar_connectivity, system.tendon_connectivity
+    legend = [Line2D([], [], color="saddlebrown", lw=3, label="bar"),
+              Line2D([], [], color="tab:blue", lw=0.8, label="tendon"),
+              Patch(color="gold", alpha=0.4, label="membrane (corner polygon)")]
 
     def draw(i):
         ax.cla()
@@ -81,10 +91,12 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
         C = Cs[i]
         ax.plot_trisurf(C[0], C[1], C[2], color="gold", alpha=0.4)
         ax.set_xlim(lo[0], hi[0]); ax.set_ylim(lo[1], hi[1]); ax.set_zlim(lo[2], hi[2])
-        ax.set_box_aspect(hi - lo)
+        ax.set_box_aspect(box, zoom=0.85)
         ax.locator_params(axis="z", nbins=3)
         ax.set_xlabel("x [m]"); ax.set_ylabel("y [m]"); ax.set_zlabel("z [m]")
-        ax.set_title(f"t = {r.t[idx[i]]:.2f} s ({r.controller[min(idx[i], len(r.controller) - 1)]})")
+        ax.legend(handles=legend, loc="upper left", fontsize=7, frameon=False)
+        ax.set_title(f"{system.name} deployment, t = {r.t[idx[i]]:.2f} s\ncontroller: "
+                     f"{r.controller[min(idx[i], len(r.controller) - 1)]}", fontsize=10)
     anim = FuncAnimation(fig, draw, frames=len(idx))
     anim.save(str(gif), writer=PillowWriter(fps=8))
     return Path(gif)

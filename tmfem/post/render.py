@@ -267,10 +267,12 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
         p.add_mesh(base, color="#bbbbbb", style="wireframe", line_width=1)
         p.add_mesh(g, scalars=name, cmap="plasma", clim=[0.0, 1.0], line_width=3,
                    show_edges=False,
-                   scalar_bar_args={"title": "|u| / max|u|", "color": "black", "fmt": "%.1f",
-                                    "vertical": True, "position_x": 0.86, "position_y": 0.15,
-                                    "width": 0.06, "height": 0.6, "n_labels": 3,
-                                    "title_font_size": 10, "label_font_size": 9})
+                   # one bar (pyvista keeps one per title): every panel has the same scale
+                   scalar_bar_args={"title": "displacement / its maximum (every panel)",
+                                    "color": "black", "fmt": "%.1f", "vertical": False,
+                                    "position_x": 0.2, "position_y": 0.02, "width": 0.6,
+                                    "height": 0.07, "n_labels": 3, "title_font_size": 13,
+                                    "label_font_size": 11})
         p.add_text(f"mode {m + 1}: {f[m]:.4g} Hz", position="upper_edge", font_size=10,
                    color="black")
         _set_view(p, X)
@@ -278,5 +280,5 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
     if title:
         p.subplot(rows - 1, 0)
         p.add_text(title + " (grey: prestressed state; shapes scaled)", position="lower_left",
-                   font_size=8, color="black")
+                   font_size=12, color="black")
     return _screenshot(p, png_path)

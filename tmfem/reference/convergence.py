@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.models.mtc.design import design_mesh_of, design_rest_lengths_at
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.mtc.post import static_summary
 
@@ -26,23 +27,30 @@ ROW_KEYS = ("mesh_n", "tendon_elements", "attachment", "elements", "h", "dofs", 
             "model")
 
 
-def resolve_rest_lengths(system, *, rest_lengths):
-    """Rest lengths held fixed over a study: an array, or ``"mtc"`` (recomputed per mesh).
+#: Rest-length rule of a study of a system without rest lengths: the ch. 3 design of 6.2
+#: (point corners, mesh n = 10), held fixed on every mesh.
+DEFAULT_RULE = "design@10"
 
-    ``None``/``"system"``/``"design"`` are evaluated once, so every mesh analyses the same
-    physical structure; ``"design"`` (the default without system rest lengths) is the ch. 3
-    design of 6.2 (eqs. 3.8-3.9; point corners on the membrane mesh n = 10,
-    :func:`tmfem.equilibrium.design.design_equilibrium`).
+
+def resolve_rest_lengths(system, *, rest_lengths):
+    """(rest lengths, rule) of a study: an array held fixed on every mesh, or a rule
+    recomputed per mesh (``"design"``, ``"mtc"``), and the name of the rule.
+
+    ``None`` is ``"system"`` for a system with rest lengths, else :data:`DEFAULT_RULE`;
+    ``"system"``, ``"design@n"`` (:func:`tmfem.models.mtc.design.design_rest_lengths_at`)
+    and values are evaluated once, so every mesh analyses the same physical structure.
+    ``"design"`` designs on each analysis mesh (as ``tmfem modal``/``static`` do by default),
+    so the structure changes with the mesh.
     """
-    if isinstance(rest_lengths, str) and rest_lengths == "mtc":
-        return "mtc"
     if rest_lengths is None:
-        rest_lengths = "system" if system.rest_lengths is not None else "design"
-    if isinstance(rest_lengths, str) and rest_lengths == "design":
-        from tmfem.equilibrium.design import design_equilibrium
-        return np.asarray(design_equilibrium(system).rest_lengths, dtype=float)
+        rest_lengths = "system" if system.rest_lengths is not None else DEFAULT_RULE
+    if isinstance(rest_lengths, str) and rest_lengths in ("mtc", "design"):
+        return rest_lengths, rest_lengths
+    n = design_mesh_of(rest_lengths)
+    if n is not None:
+        return design_rest_lengths_at(system, n), rest_lengths
     m = MTCModel(system, mesh_n=2, tendon_elements=1, rest_lengths=rest_lengths)   # checks
-    return m.rest_lengths.copy()
+    return m.rest_lengths.copy(), rest_lengths if isinstance(rest_lengths, str) else "given"
 
 
 def _mtc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_law):
@@ -107,7 +115,7 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
     """
     if model not in ROWS:
         raise InputError(f"convergence: expected model one of {sorted(ROWS)}, found {model!r}")
-    rest = resolve_rest_lengths(system, rest_lengths=rest_lengths)
+    rest, _ = resolve_rest_lengths(system, rest_lengths=rest_lengths)
     for n in meshes:
         for k in tendon_elements:
             t0 = time.perf_counter()

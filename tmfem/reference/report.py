@@ -6,9 +6,11 @@
 2. the static equilibrium of the membrane-truss-cable (MTC) FE model (4.4, 6.2) for the
    designed rest lengths *and* for the prestress the dissertation's own results imply
    (:data:`IMPLIED_PRESTRESS`, docs/errata.md);
-3. the 12 lowest modes of the MTC model and of the control-oriented model (COM, ch. 5) at
-   both prestress levels, beside Table 6.6 (eq. 5.32);
+3. the 12 lowest modes of the MTC model, the shell-beam-cable (SBC) model and the
+   control-oriented model (COM, ch. 5) at both prestress levels, beside Table 6.6 (eq. 5.32);
 4. free vibration of both models after the perturbation of 6.5 (Park's method, eq. 5.34-5.35);
+5. the closed-loop deployment of its deployable variant (7.4, :data:`REPORT_DEPLOYMENT`:
+   1-4 -> 1-4(D)), with its plot, animation and ParaView series;
 
 and writes every table (CSV with units in the headers, Markdown), plot (PNG), ParaView file
 (VTU/PVD) and an ``index.md`` that links them and explains where and why the numbers differ
@@ -63,9 +65,17 @@ def explanations(name: str, part: str) -> list[str]:
     """The notes of :data:`EXPLANATIONS` for system ``name`` (``part``: design or models)."""
     return list(EXPLANATIONS.get(name, {}).get(part, []))
 
+#: The deployment (7.4) that the report of a system runs: the deployable variant, the
+#: controller's model error and the duration. 1-4(D) with the exact model switches to the
+#: H-infinity controller within 10 s; with the 7.4 choice (eq. 5.72) it does not switch within
+#: 20 s (docs/deployment.md, "Results"), so the report shows the switch with the exact model.
+REPORT_DEPLOYMENT = {"1-4": {"preset": "1-4D", "uncertainty": "exact", "t_end": 16.0,
+                             "controller": "adaptive-hinf"}}
+
 #: Steps of :func:`write_report`, for a progress bar.
 STEPS = ("equilibrium design", "MTC statics (designed)", "MTC statics (implied)",
-         "MTC modes", "COM modes", "COM free vibration", "MTC free vibration", "index")
+         "MTC modes", "SBC modes", "COM modes", "COM free vibration", "MTC free vibration",
+         "deployment", "index")
 
 
 def _csv(path: Path, header: list, rows: list) -> Path:
@@ -83,7 +93,8 @@ def _num(v, nd=5):
 
 
 def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float = 10.0,
-                 dt: float = 0.01, render: bool = True, progress=None) -> dict:
+                 dt: float = 0.01, render: bool = True, deploy: bool = True, progress=None,
+                 run_progress=None) -> dict:
     """Run the complete analysis of ``system`` and write it to the directory ``out``.
 
     Parameters
@@ -100,8 +111,12 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         Free-vibration duration and time step [s] (6.5: dt = 0.01 s).
     render : bool
         Draw the pyvista renders.
+    deploy : bool
+        Run the deployment of :data:`REPORT_DEPLOYMENT` (when the system has one).
     progress : callable, optional
         ``progress(step_name)`` after each entry of :data:`STEPS`.
+    run_progress : callable, optional
+        ``run_progress(label)`` -> a ``progress(step, n_steps)`` callback for the time runs.
 
     Returns
     -------
@@ -109,6 +124,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     """
     from tmfem.equilibrium.design import design_equilibrium
     from tmfem.io.codes import kind_cell_data
+    from tmfem.io.units import with_units
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
@@ -200,6 +216,12 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                                               k=min(modes, 12),
                                               title=f"{name} MTC modes, designed prestress"))
     step(STEPS[3])
+    if not system.deployable:
+        from tmfem.models.sbc.model import SBCModel
+        for label, (rest, sys_k) in cases.items():
+            sbc = SBCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
+            freqs[f"SBC {label}"] = sbc.modes(sbc.solve_static().state, k=modes).freq_hz
+    step(STEPS[4])
     K = default_membrane_modes(system)
     com_design = modal_summary(system, modes=modes, membrane_modes=K)
     freqs["COM designed"] = np.array(com_design["freq_hz"])
@@ -207,7 +229,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     if scale is not None:
         com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale)
         freqs[f"COM x{scale:.4f}"] = np.array(com_implied["freq_hz"])
-    step(STEPS[4])
+    step(STEPS[5])
     printed = FREQUENCIES.get(name)
     add("frequencies.csv", _frequency_table(out / "frequencies.csv", freqs, printed, modes))
     add("frequencies.png", _frequency_plot(out / "frequencies.png", freqs, printed, modes, name))
@@ -217,21 +239,28 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     vdir = out / "vibration_com"
     r_com = free_vibration(com, t_end=t_end, dt=dt, perturb=perturb,
                            csv_path=out / "vibration_com.csv", jacobian="reuse",
-                           vtk_dir=vdir, vtk_every=max(1, int(round(0.1 / dt))))
+                           vtk_dir=vdir, vtk_every=max(1, int(round(0.1 / dt))),
+                           progress=_run_progress(run_progress, "COM free vibration"))
     add("vibration_com.csv", out / "vibration_com.csv")
     add("vibration_com.pvd", Path(r_com.stats["pvd"]))
     add("vibration_com.png", plot_free_vibration(
         r_com, out / "vibration_com.png",
         title=f"{name} COM free vibration, K = {K}, " + _perturbation_text(perturb)))
-    step(STEPS[5])
+    step(STEPS[6])
     model, res = mtc["designed"]
     r_mtc = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
-                               csv_path=out / "vibration_mtc.csv")
+                               csv_path=out / "vibration_mtc.csv",
+                               progress=_run_progress(run_progress, "MTC free vibration"))
     add("vibration_mtc.csv", out / "vibration_mtc.csv")
     add("vibration_mtc.png", plot_free_vibration(
         r_mtc, out / "vibration_mtc.png",
         title=f"{name} MTC free vibration, mesh {mesh_n}, " + _perturbation_text(perturb)))
-    step(STEPS[6])
+    step(STEPS[7])
+    deployment = None
+    if deploy and name in REPORT_DEPLOYMENT:
+        deployment = _deployment(out, REPORT_DEPLOYMENT[name], dt=dt, add=add,
+                                 progress=_run_progress(run_progress, "deployment"))
+    step(STEPS[8])
 
     vibration = {"COM": _vibration_summary(r_com), "MTC": _vibration_summary(r_mtc)}
     summary = {"system": name, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
@@ -240,17 +269,46 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                "implied_prestress": implied,
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
-               "printed_frequencies_hz": printed, "vibration": vibration}
-    (out / "report.json").write_text(json.dumps(summary, indent=1))
+               "printed_frequencies_hz": printed, "vibration": vibration,
+               "deployment": deployment}
+    (out / "report.json").write_text(json.dumps(with_units(summary), indent=1))
     add("report.json", out / "report.json")
     _index(out, system, summary, files, tables["rows"], notes, freqs, printed, statics)
     add("index.md", out / "index.md")
-    step(STEPS[7])
+    step(STEPS[9])
     summary["files"] = files
     summary["notes"] = notes
     summary["out"] = str(out)
     summary["ok"] = bool(d.ok)
     return summary
+
+
+def _run_progress(factory, label):
+    return None if factory is None else factory(label)
+
+
+def _deployment(out: Path, spec: dict, *, dt: float, add, progress) -> dict:
+    """Run the deployment ``spec`` (:data:`REPORT_DEPLOYMENT`) and write its CSV, plot, GIF and
+    ParaView series into ``out`` (:func:`tmfem.reference.deployments.write_outputs`)."""
+    from tmfem.control.deploy import run_deployment
+    from tmfem.reference.deployments import setup, write_outputs
+
+    p = spec["preset"]
+    s = setup(p, controller=spec["controller"], uncertainty=spec["uncertainty"])
+    r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+                       t_end=spec["t_end"], dt=dt, progress=progress)
+    files = write_outputs(s, r, preset=p, csv_path=out / f"deploy-{p}.csv",
+                          plot=out / f"deploy-{p}.png", gif=out / f"deploy-{p}.gif",
+                          vtk=out / f"deploy-{p}",
+                          title=f"{p} deployment: {spec['controller']}, uncertainty "
+                                f"{s.adaptive.uncertainty}")
+    suffix = {"csv": "csv", "plot": "png", "gif": "gif", "pvd": "pvd"}
+    for kind, path in files.items():
+        add(f"deploy-{p}.{suffix[kind]}", path)
+    scalars = {k: float(v) for k, v in s.info.items() if np.isscalar(v)}
+    ys = [s.model.system.tendon_section(t).yield_stress for t in s.model.system.tendons]
+    yield_mpa = min(ys) / 1e6 if all(ys) else None
+    return {**spec, "dt_s": dt, **r.summary(), **scalars, "tendon_yield_MPa": yield_mpa}
 
 
 def _perturbation_text(perturb: dict) -> str:
@@ -324,24 +382,36 @@ def _frequency_table(path: Path, freqs: dict, printed, modes: int) -> Path:
 
 
 def _frequency_plot(png: Path, freqs: dict, printed, modes: int, name: str) -> Path:
+    """Two panels: our frequencies with the printed ones (black open markers), and the
+    relative difference of each of our columns to the printed column of its model."""
     from tmfem.post.plots import mode_styles, new_figure, save_figure
 
-    fig = new_figure(figsize=(7.5, 4.8))
-    ax = fig.subplots()
+    fig = new_figure(figsize=(7.5, 7.2))
+    ax, dx = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
     k = np.arange(1, modes + 1)
-    series = dict(freqs)
-    if printed:
-        series.update({f"{m} printed ({printed['source'].split('dissertation ')[-1]})":
-                       np.asarray(printed[m]) for m in ("MTC", "COM")})
-    for (label, f), style in zip(series.items(), mode_styles(len(series))):
+    styles = mode_styles(len(freqs))
+    for (label, f), style in zip(freqs.items(), styles):
         n = min(modes, len(f))
-        ax.plot(k[:n], f[:n], label=label, ms=5, lw=1.0, **style)
-    ax.set_xlabel("mode number")
+        ax.plot(k[:n], f[:n], label=label, ms=4, lw=1.0, **style)
+        ref = np.asarray((printed or {}).get(label.split()[0], []), dtype=float)
+        m = min(n, ref.size)
+        if m:
+            dx.plot(k[:m], 100 * (np.asarray(f[:m]) / ref[:m] - 1), ms=4, lw=1.0, label=label, **style)
+    if printed:
+        src = printed["source"].split("dissertation ")[-1]
+        for m, mk in (("MTC", "o"), ("SBC", "s"), ("COM", "^")):
+            ref = np.asarray(printed.get(m, []), dtype=float)[:modes]
+            ax.plot(k[:ref.size], ref, mk, mfc="none", mec="k", ms=8, mew=0.8,
+                    label=f"{m} printed ({src})")
     ax.set_ylabel("natural frequency [Hz]")
-    ax.set_xticks(k)
     ax.set_title(f"{name}: natural frequencies (eq. 5.32) beside the printed table", fontsize=10)
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=7, loc="upper left")
+    ax.legend(fontsize=7, loc="upper left", ncol=2)
+    dx.axhline(0.0, color="k", lw=0.6)
+    dx.set_ylabel("difference to the printed\ncolumn of the model [%]")
+    dx.set_xlabel("mode number")
+    dx.set_xticks(k)
+    for a in (ax, dx):
+        a.grid(True, alpha=0.3)
     return save_figure(fig, png)
 
 
@@ -350,6 +420,58 @@ def _vibration_summary(r) -> dict:
             "min_tendon_force_N": float(r.stats["min_tendon_force"]),
             "min_tendon_force_tendon": r.stats["min_tendon_force_tendon"],
             "peak_to_peak_mm": {k: (1e3 * np.ptp(v, axis=0)).tolist() for k, v in r.nodes.items()}}
+
+
+def _largest_differences(freqs: dict, printed) -> str:
+    """One line: the largest relative difference of each of our columns to the printed
+    column of its model (MTC, SBC, COM)."""
+    if not printed:
+        return ""
+    parts = []
+    for label, f in freqs.items():
+        ref = np.asarray(printed.get(label.split()[0], []), dtype=float)
+        n = min(len(ref), len(f))
+        if n:
+            parts.append(f"{label} {100 * np.max(np.abs(np.asarray(f[:n]) / ref[:n] - 1)):.2f} %")
+    return "Largest difference to the printed column of the same model: " + ", ".join(parts) + "."
+
+
+def _deployment_section(d, link, img) -> list[str]:
+    """Section 5 of the index: the deployment run of :data:`REPORT_DEPLOYMENT`."""
+    if not d:
+        return []
+    p = d["preset"]
+    rows = [("switching time to the linear controller", "s", d["switch_time_s"]),
+            ("largest membrane deflection w", "mm", 1e3 * d["max_membrane_deflection_m"]),
+            ("peak bar compression", "N", d["peak_bar_compression_N"]),
+            ("bar Euler load (eq. 5.31)", "N", d["bar_critical_load_N"]),
+            ("largest membrane von Mises stress", "MPa", 1e-6 * d["max_von_mises_Pa"]),
+            ("largest tendon stress", "MPa", 1e-6 * d["max_tendon_stress_Pa"]),
+            ("tendon yield stress (7.4.1)", "MPa", d.get("tendon_yield_MPa")),
+            ("rest lengths at a limit", "s", d["limits_active_s"]),
+            ("relative tracking error at the end", "-", d["final_tracking_error"]),
+            ("wall time", "s", d["wall_time_s"])]
+    return ["## 5. Deployment (7.4)", "",
+            f"`{p}` from its packaged configuration (Table 7.3) to the deployed one: adaptive "
+            "partial feedback linearisation (Table 7.1 gains, eq. 5.68 reference), then the "
+            f"switch to the linear controller of `--controller {d['controller']}` (adaptive-hinf: "
+            "the LMI H-infinity controller of 7.3), "
+            f"{d['t_end']:g} s at dt = {d['dt_s']:g} s. The controller's model has no error "
+            f"(`--uncertainty {d['uncertainty']}`): with the 7.4 model error (eq. 5.72) it does "
+            "not switch within 20 s (docs/deployment.md, 'Results'). Same run: `tmfem deploy "
+            f"--preset {p} --uncertainty {d['uncertainty']} --t-end {d['t_end']:g}`.", "",
+            f"Files: {link(f'deploy-{p}.csv')} (every signal, units in the header), "
+            f"{link(f'deploy-{p}.png')}, {link(f'deploy-{p}.gif')} (animation), "
+            f"{link(f'deploy-{p}.pvd')} (ParaView series).", "",
+            tabulate([[q, u, _num(v)] for q, u, v in rows], headers=["quantity", "unit", "value"],
+                     tablefmt="github", disable_numparse=True), "",
+            *([("The largest tendon stress exceeds the yield stress: a start-up transient of "
+                "the rest-length commands (the printed 83 MPa is not reproduced; "
+                "docs/reproduction.md, 'Deployment (7.4)')."), ""]
+              if d.get("tendon_yield_MPa") and 1e-6 * d["max_tendon_stress_Pa"] > d["tendon_yield_MPa"]
+              else []),
+            img(f"deploy-{p}.png", "deployment"), "", img(f"deploy-{p}.gif", "deployment animation"),
+            ""]
 
 
 def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, freqs, printed,
@@ -411,13 +533,16 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
             row += [_num(printed[m][i], 5) if i < len(printed[m]) else "-" for m in ("MTC", "SBC", "COM")]
         body.append(row)
     L += [tabulate(body, headers=head, tablefmt="github", disable_numparse=True), "",
-          f"Printed: {printed['source'] if printed else 'none'}. SBC (shell-beam-cable) is not "
-          "implemented yet; its column is the dissertation's.", "",
+          f"Printed: {printed['source'] if printed else 'none'}. MTC: membrane-truss-cable "
+          "(4.4), SBC: shell-beam-cable (4.3, MITC4 shell and beam bars), both on the mesh "
+          "above; COM: control-oriented model (ch. 5) with K membrane modes; 'x1.29' scales "
+          "the designed membrane prestress (docs/errata.md, 'COM frequencies').", "",
+          _largest_differences(freqs, printed), "",
           img("frequencies.png", "frequencies"), "", img("modes.png", "mode shapes"), ""]
     v = summary["vibration"]
     L += ["## 4. Free vibration (6.5)", "",
-          "Perturbation " + ", ".join(f"`{k} = {x:g}`" for k, x in summary["perturbation"].items())
-          + f", Park's method, dt = {summary['dt_s']:g} s.", "",
+          f"Perturbation `{_perturbation_text(summary['perturbation'])}`, Park's method, "
+          f"dt = {summary['dt_s']:g} s, designed prestress.", "",
           f"Files: {link('vibration_com.csv')}, {link('vibration_com.pvd')} (ParaView series), "
           f"{link('vibration_mtc.csv')}.", ""]
     body = [[m, s["steps"], f"{s['wall_time_s']:.1f}", f"{s['min_tendon_force_N']:.4g} "
@@ -428,6 +553,7 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
                                   "peak-to-peak x, y, z [mm]"], tablefmt="github",
                    disable_numparse=True), "",
           img("vibration_com.png", "COM free vibration"), "",
-          img("vibration_mtc.png", "MTC free vibration"), "",
-          "## All files", ""] + [f"- [{k}]({p})" for k, p in sorted(files.items())]
+          img("vibration_mtc.png", "MTC free vibration"), ""]
+    L += _deployment_section(summary.get("deployment"), link, img)
+    L += ["## All files", ""] + [f"- [{k}]({p})" for k, p in sorted(files.items())]
     (out / "index.md").write_text("\n".join(L) + "\n")

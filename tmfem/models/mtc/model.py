@@ -35,7 +35,7 @@ from tmfem.errors import InputError
 from tmfem.fem.element import State, assemble
 from tmfem.fem.membrane import MembraneElement, MembraneTL
 from tmfem.fem.truss import TrussElement, TrussSet, truss_internal
-from tmfem.models.mtc.design import consistent_rest_lengths
+from tmfem.models.mtc.design import consistent_rest_lengths, design_mesh_of, design_rest_lengths_at
 from tmfem.fem.tension_field import check_law_name
 from tmfem.models.mtc.topology import MTCTopology, build_topology, membrane_placement
 from tmfem.solvers.backends import get_backend
@@ -92,10 +92,14 @@ class MTCModel:
         How the bar tops hold the membrane corners.
     patch : float, optional
         Radius of the distributed attachment patch [m] (default 10 % of r_mb).
-    rest_lengths : ndarray or {"system", "design", "mtc"}, optional
+    rest_lengths : ndarray or {"system", "design", "design@n", "mtc"}, optional
         Tendon rest lengths. Default: ``system.rest_lengths`` when set, else ``"design"``:
-        the design of ``tmfem.equilibrium.design_equilibrium`` (eq. 3.8). ``"mtc"``: the
-        rest lengths for which the design configuration is an exact equilibrium of this model
+        the ch. 3 design (``tmfem.equilibrium.design_equilibrium``, eq. 3.8) *on this model's
+        membrane mesh and corner attachment*, so it changes with ``mesh_n``. ``"design@n"``
+        (e.g. ``"design@10"``): the ch. 3 design on the N x n x n mesh with point corners
+        (6.2 designs on n = 10), the same rest lengths whatever this model's mesh
+        (:func:`tmfem.models.mtc.design.design_rest_lengths_at`). ``"mtc"``: the rest lengths
+        for which the design configuration is an exact equilibrium of this model
         (:meth:`consistent_rest_lengths`).
     lumped_tendon_mass : bool
         Lumped instead of consistent truss mass for the tendons (bars always consistent: it
@@ -160,7 +164,7 @@ class MTCModel:
     # ------------------------------------------------------------------ set-up
     def set_rest_lengths(self, rest) -> None:
         """Set the tendon rest lengths: an array (one per tendon) or ``"system"``,
-        ``"design"`` or ``"mtc"`` (see the class docstring)."""
+        ``"design"``, ``"design@n"`` or ``"mtc"`` (see the class docstring)."""
         n_t = len(self.system.tendons)
         if isinstance(rest, str):
             source = rest
@@ -177,9 +181,11 @@ class MTCModel:
                                      "consistent rest lengths balance truss bars without points "
                                      "H_1j); expected 'design' (eq. 3.8), 'system' or values")
                 r = self.consistent_rest_lengths()["rest_lengths"]
+            elif design_mesh_of(rest) is not None:
+                r = design_rest_lengths_at(self.system, design_mesh_of(rest))
             else:
                 raise InputError(f"rest_lengths: expected an array or one of 'system', 'design', "
-                                 f"'mtc', found {rest!r}")
+                                 f"'design@n' (n >= 1), 'mtc', found {rest!r}")
         else:
             source = "given"
             r = np.asarray(rest, dtype=float)

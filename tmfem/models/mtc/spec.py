@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from tmfem.errors import InputError
 from tmfem.models.base import ModelSpec, Option, register
+from tmfem.models.mtc.design import design_mesh_of
 from tmfem.models.mtc.model import MTCModel
 
 STATIC = ("static", "modal", "vibrate")
@@ -10,8 +11,8 @@ STATIC = ("static", "modal", "vibrate")
 
 def apply_rest_lengths(system, text):
     """The system and the ``rest_lengths`` argument of :class:`MTCModel` for a
-    ``--rest-lengths`` text: ``system``/``design``/``mtc`` or ``GROUP=VALUE[,...]``."""
-    if text is None or text in ("system", "design", "mtc"):
+    ``--rest-lengths`` text: ``system``/``design``/``design@n``/``mtc`` or ``GROUP=VALUE[,...]``."""
+    if text is None or text in ("system", "design", "mtc") or design_mesh_of(text) is not None:
         return system, text
     values = {}
     for item in text.split(","):
@@ -21,7 +22,8 @@ def apply_rest_lengths(system, text):
         except ValueError:
             sep = ""
         if not sep:
-            raise InputError(f"--rest-lengths: expected system, design, mtc or GROUP=VALUE[,...] "
+            raise InputError(f"--rest-lengths: expected system, design, design@n, mtc or "
+                             f"GROUP=VALUE[,...] "
                              f"(e.g. S1=1.5025), found {text!r}")
     return system.with_rest_lengths(values), "system"
 
@@ -49,9 +51,12 @@ SPEC = register(ModelSpec(
     shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law", "rayleigh"),
     own=(
         Option("--rest-lengths", None, None, dict(help=(
-            "tendon rest lengths: 'system' (default when the system has them), 'design' (eq. 3.8), "
-            "'mtc' (those that make the design an exact equilibrium of this model) or values per "
-            "group/tendon, e.g. 'S1=1.5025'"))),
+            "tendon rest lengths: 'system' (default when the system has them), 'design' (default "
+            "otherwise: the ch. 3 design, eq. 3.8, on this model's mesh and attachment, so it "
+            "changes with --mesh), 'design@n' (the ch. 3 design on the n x n mesh with point "
+            "corners, e.g. design@10 as in 6.2: the same rest lengths on every mesh; the default "
+            "of `tmfem converge`), 'mtc' (those that make the design an exact equilibrium of this "
+            "model) or values per group/tendon, e.g. 'S1=1.5025'"))),
         Option("--start", "undeformed", ("static", "modal"), dict(
             choices=("undeformed", "design"),
             help="start of the static iteration (the undeformed membrane, as in 6.2)")),

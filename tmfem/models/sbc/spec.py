@@ -1,7 +1,6 @@
 """The SBC model in the model registry: its command-line options and how they build it."""
 from __future__ import annotations
 
-from tmfem.errors import InputError
 from tmfem.models.base import ModelSpec, Option, register
 from tmfem.models.mtc.spec import apply_rest_lengths
 from tmfem.models.sbc.model import SBCModel
@@ -9,9 +8,6 @@ from tmfem.models.sbc.model import SBCModel
 
 def build(system, options: dict, backend) -> SBCModel:
     """The SBC model of ``system`` with the registry's option values."""
-    if options["patch"] is not None and options["attachment"] != "distributed":
-        raise InputError(f"--patch: option does not apply with --attachment {options['attachment']} "
-                         f"(expected --attachment distributed), found --patch {options['patch']}")
     system, rest = apply_rest_lengths(system, options["rest_lengths"])
     return SBCModel(system, mesh_n=options["mesh"], tendon_elements=options["tendon_elements"],
                     bar_elements=options["bar_elements"], attachment=options["attachment"],
@@ -27,6 +23,7 @@ SPEC = register(ModelSpec(
     own=(
         Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1); per bar segment A-H, H-B of a 1-N(D) system")),
         Option("--rest-lengths", None, None, dict(help=(
-            "tendon rest lengths: 'system', 'design' (eq. 3.8), 'mtc' (the MTC model's consistent "
-            "ones) or values per group/tendon, e.g. 'S1=1.5025'"))),
+            "tendon rest lengths: 'system', 'design' (eq. 3.8 on this model's mesh), 'design@n' "
+            "(eq. 3.8 on the n x n mesh, e.g. design@10), 'mtc' (the MTC model's consistent ones) "
+            "or values per group/tendon, e.g. 'S1=1.5025'"))),
     )))

@@ -22,20 +22,38 @@ _EXACT = {
     "corner_radial_displacement": "m", "max_tendon_deflection_m": "m", "mesh_n": "-",
     "dofs": "-", "steps": "-", "relative_difference": "-", "relative_difference_to_MTC": "-",
     "energy_drift_J": "J", "initial_kinetic_energy_J": "J", "static_time_s": "s",
+    "bar_moment_max": "N m", "top_nodes": "m", "residual_history": "N", "bar_load": "N",
+    "tendon_max_stress": "Pa", "h": "m", "membrane_mass": "kg", "q": "rad", "q_range": "rad",
+    "prestress_scale": "-", "printed_stress_prestress_scale": "-",
+    "printed_bar_load_prestress_scale": "-", "B_q_condition_max": "-",
+    "final_tracking_error": "-", "rbf_sigma": "rad", "margin": "-", "tol": "-",
+    "min_controllability_margin": "-", "min_observability_margin": "-", "eigenvalue": "1/s",
+    "rayleigh": "[1/s, s] (alpha, beta of C = alpha M + beta K_0)",
+    "w_bar": "bound of the RBF weights, unit of the learnt uncertainty (eq. 5.70)",
+    "symmetric_null": "- (null vector of eq. 3.16 per unit F_Delta)",
+    "checks": "value and limit in the SI unit of the checked quantity (Pa, N, m)",
+    "closed_form": "S1, delta, delta_3_36, r1_equilibrium, r_mb in m; A, det, ratio -",
+    "final": "per state: rad, rad/s (theta, psi), kg^0.5 m, kg^0.5 m/s (eta_k), m (positions)",
 }
 _SUFFIX = [(r".*_deg$", "deg"), (r".*_hz$", "Hz"), (r".*_MPa$", "MPa"), (r".*_mm$", "mm"),
            (r".*_m$", "m"), (r".*_N$", "N"), (r".*_s$", "s"), (r".*_J$", "J"),
-           (r".*_Pa$", "Pa"), (r".*_N_per_m$", "N/m")]
+           (r".*_Pa$", "Pa"), (r".*_N_per_m$", "N/m"), (r"f\d+$", "Hz"),
+           (r".*_fractions?$", "-")]
 
 
 def unit_of(key: str) -> str | None:
-    """The unit of a JSON key, or None when the key is not a physical quantity."""
+    """The unit of a JSON key, or None when the key is not a physical quantity. A dict under
+    a key with a unit (e.g. ``rest_lengths``: {tendon: value}) carries that unit; the names of
+    states and signals (``theta_11``, ``eta_2_dot``) have the units of the run histories
+    (:func:`tmfem.io.run.column_header`)."""
+    from tmfem.io.run import column_header
     if key in _EXACT:
         return _EXACT[key]
     for pattern, unit in _SUFFIX:
         if re.match(pattern, key):
             return unit
-    return None
+    head = column_header(key)
+    return head[len(key) + 2:-1] if head != key else None
 
 
 def units_of(doc) -> dict:
@@ -54,3 +72,11 @@ def units_of(doc) -> dict:
                 walk(v)
     walk(doc)
     return dict(sorted(out.items()))
+
+
+def with_units(doc):
+    """``doc`` with its ``units`` table (:func:`units_of`) when it is a dict without one:
+    every JSON document tmfem writes (``--json``, ``report.json``, ``design.json``)."""
+    if isinstance(doc, dict) and "units" not in doc:
+        return {**doc, "units": units_of(doc)}
+    return doc

@@ -1,0 +1,135 @@
+"""The deployments of dissertation 7.4 and what a deployment run writes.
+
+The dissertation's parameters per deployment (7.4): omega_r of eq. 5.68, the gains of
+Table 7.1 (eq. 5.69), the uncertainty model of the controller (eq. 5.72 for 1-4(D), M G
+ignored for 1-6(D) and 2-3) and the monitored membrane points of eqs. 5.73-5.75. The
+printed points lie on the membrane edges (mid-edge points of the polygon); they are moved
+1 mm toward the centroid so that they fall inside the mesh (docs/errata.md).
+``tmfem deploy`` and ``tmfem report`` run them (:func:`setup`, :func:`write_outputs`).
+"""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from tmfem.errors import InputError
+
+#: 7.4: omega_r (eq. 5.68), Table 7.1 (omega_0, omega_e, tau, d_c), uncertainty, points (5.73-5.75)
+DEPLOYMENTS = {
+    "1-4D": {"omega_r": 0.7, "table_7_1": (15.0, 150.0, 20.0, 1.5), "uncertainty": "initial",
+             "points": [(1.0, 1.0), (2.0, 1.0), (1.0, 2.0)], "u_m": 0.01, "path": "delta"},
+    "1-6D": {"omega_r": 0.35, "table_7_1": (4.0, 10.0, 20.0, 0.7), "uncertainty": "no-MG",
+             "points": [(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], "u_m": 0.02, "path": "delta"},
+    "2-3-deploy": {"omega_r": 0.5, "table_7_1": (1.0, 24.0, 5.0, 0.9), "uncertainty": "no-MG",
+                   "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01,
+                   "path": "table-7-7-bases"},
+}
+CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
+               "adaptive": "none"}
+UNCERTAINTIES = ("initial", "no-MG", "exact")
+
+#: ParaView frames of a deployment: one every this many samples.
+VTK_EVERY = 10
+
+
+def inside_points(system, points, *, inset: float = 1e-3):
+    """The points moved ``inset`` metres toward the membrane centroid (see module docstring)."""
+    c = system.membrane_corners.mean(axis=1)
+    out = []
+    for p in points:
+        p = np.asarray(p, dtype=float)
+        d = c - p
+        out.append(tuple(p + inset * d / np.linalg.norm(d)))
+    return out
+
+
+def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
+          allocation: str = "bounded", path: str | None = None):
+    """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`).
+    ``path`` (default the preset's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
+    membrane stretch Delta linear in s), ``"table-7-7-bases"`` (2-3: the stage-2 base on the
+    reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
+    ``"linear"`` (every symmetric parameter linear in s)."""
+    from tmfem.control.adaptive import Gains
+    from tmfem.control.deploy import build_deployment
+    from tmfem.reference.tables import deployment_bases
+    from tmfem.system.presets import load_preset
+    check_choices(preset, controller=controller, uncertainty=uncertainty, path=path)
+    p = DEPLOYMENTS[preset]
+    path = path or p["path"]
+    final, initial = load_preset(preset), load_preset(preset + "-initial")
+    w0, we, tau, dc = p["table_7_1"]
+    return build_deployment(final=final, initial=initial, omega_r=p["omega_r"],
+                            gains=Gains(omega_0=w0, omega_e=we, tau=tau, d_c=dc),
+                            uncertainty=uncertainty or p["uncertainty"],
+                            output_points=inside_points(final, p["points"]),
+                            linear=CONTROLLERS[controller], u_m=p["u_m"],
+                            bases=deployment_bases(final) if path == "table-7-7-bases" else None,
+                            delta_path=path == "delta", allocation=allocation)
+
+
+def check_choices(preset: str, *, controller: str = "adaptive-hinf", uncertainty=None,
+                  path=None) -> None:
+    """Refuse an unknown deployment preset, controller, uncertainty model or path (before
+    any work: ``tmfem deploy`` calls it first)."""
+    if preset not in DEPLOYMENTS:
+        raise InputError(f"deploy: expected a preset among {sorted(DEPLOYMENTS)}, found {preset!r}")
+    own = DEPLOYMENTS[preset]["path"]
+    if path is not None and path not in ("linear", own):
+        raise InputError(f"--path for {preset}: expected 'linear' or {own!r}, found {path!r}")
+    if controller not in CONTROLLERS:
+        raise InputError(f"--controller: expected one of {sorted(CONTROLLERS)}, found {controller!r}")
+    if uncertainty is not None and uncertainty not in UNCERTAINTIES:
+        raise InputError(f"--uncertainty: expected one of {list(UNCERTAINTIES)}, found {uncertainty!r}")
+
+
+def csv_columns(r) -> list[str]:
+    """Header of the deployment CSV: one column per named signal, with its unit
+    (:func:`tmfem.io.run.column_header`): time, q, the references q_d, w, rest lengths u,
+    tendon lengths L, the zero-dynamics energy and the active controller (a label)."""
+    from tmfem.io.run import column_header
+    n = r.names
+    names = (["t"] + n["q"] + [f"{q}_ref" for q in n["q"]] + n["w"] + n["u"]
+             + [f"L_{t}" for t in n["tendons"]] + ["eta_energy"])
+    return [column_header(c) for c in names] + ["controller"]
+
+
+def write_csv(path, r) -> str:
+    """The deployment CSV (:func:`csv_columns`), ``\\n`` line endings."""
+    nq = len(r.names["q"])
+    with open(path, "w", newline="") as fh:
+        wr = csv.writer(fh, lineterminator="\n")
+        wr.writerow(csv_columns(r))
+        for k in range(r.t.size):
+            wr.writerow([f"{r.t[k]:.6g}"] + [f"{v:.10g}" for v in r.z[k, :nq]]
+                        + [f"{v:.10g}" for v in r.q_d[k]] + [f"{v:.10g}" for v in r.w[k]]
+                        + [f"{v:.10g}" for v in r.u[k]] + [f"{v:.10g}" for v in r.lengths[k]]
+                        + [f"{r.eta_energy[k]:.6g}", r.controller[min(k, len(r.controller) - 1)]])
+    return str(path)
+
+
+def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gif=None,
+                  vtk=None) -> dict:
+    """Write the files of deployment run ``r`` of set-up ``s``: CSV, plot (Figures 7.2-7.4),
+    GIF (Figure 7.5) and ParaView series (a frame every :data:`VTK_EVERY` samples); returns
+    {kind: path} of those written."""
+    out = {}
+    if csv_path:
+        out["csv"] = write_csv(csv_path, r)
+    if plot:
+        from tmfem.post.deploy_plots import plot_deployment
+        out["plot"] = str(plot_deployment(plot, r, title=title))
+    if gif:
+        from tmfem.post.deploy_plots import animate_deployment
+        out["gif"] = str(animate_deployment(gif, s.model.system, r))
+    if vtk:
+        from tmfem.io.codes import configuration_cells
+        from tmfem.io.series import write_series
+        sysm = s.model.system
+        cells = configuration_cells(sysm)
+        idx = range(0, r.t.size, VTK_EVERY)
+        out["pvd"] = str(write_series(Path(vtk), ((float(r.t[k]), sysm.nodes(r.z[k, :s.model.nq]),
+                                                   cells) for k in idx), name=preset))
+    return out
