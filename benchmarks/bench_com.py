@@ -19,6 +19,7 @@ from tmfem.models.com.model import default_membrane_modes
 from tmfem.models.com.model import ControlOrientedModel
 from tmfem.simulation.vibration import free_vibration
 from tmfem.system import load_preset
+from timing import print_breakdown
 
 PERTURB = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}
 
@@ -92,12 +93,7 @@ def bench(name: str, t_end: float) -> None:
           f" (load average {load:.1f} on {os.cpu_count()} cores: wall > CPU means other processes)")
     print(f"  {res.stats['steps']} steps, {res.stats['newton_iterations']} Newton iterations, "
           f"{res.stats['jacobian_evaluations']} Jacobian evaluations")
-    for k in tm.t:
-        if tm.n[k]:
-            print(f"  {k:<14} {tm.n[k]:6d} calls  {tm.t[k]:6.2f} s  ({1e6 * tm.t[k] / tm.n[k]:7.1f} us/call, "
-                  f"{100 * tm.t[k] / wall:4.1f} %)")
-    rest = wall - sum(tm.t.values())
-    print(f"  {'rest (Park loop, LU solves, Python)':<14} {rest:6.2f} s ({100 * rest / wall:4.1f} %)")
+    print_breakdown(tm.t, tm.n, wall, "Park loop, LU solves, Python")
 
 
 def main():

@@ -22,6 +22,7 @@ from tmfem.models.mtc.dynamics import MTCDynamics
 from tmfem.models.mtc.model import MTCModel
 from tmfem.simulation.driver import simulate
 from tmfem.system import load_preset
+from timing import print_breakdown
 
 
 class Timed:
@@ -77,12 +78,7 @@ def main():
           f"on {os.cpu_count()} cores")
     print(f"  {steps} steps, {sim.stats['newton_iterations']} Newton iterations, "
           f"{sim.stats['jacobian_evaluations']} Newton matrices")
-    for k in Timed.KEYS:
-        if plant.n[k]:
-            print(f"  {k:<14} {plant.n[k]:6d} calls {plant.t[k]:7.2f} s "
-                  f"({1e3 * plant.t[k] / plant.n[k]:6.2f} ms/call, {100 * plant.t[k] / wall:4.1f} %)")
-    rest = wall - sum(plant.t.values())
-    print(f"  {'rest (Park loop, solves, controller)':<14} {rest:6.2f} s ({100 * rest / wall:4.1f} %)")
+    print_breakdown(plant.t, plant.n, wall, "Park loop, solves, controller")
 
 
 if __name__ == "__main__":

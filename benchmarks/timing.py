@@ -1,0 +1,17 @@
+"""Shared print-out of the benchmark scripts: where the time of a run went, by timed call.
+
+Run as ``python benchmarks/<script>.py``; the scripts import this module from their own
+directory (it is on ``sys.path[0]`` when a script runs).
+"""
+from __future__ import annotations
+
+
+def print_breakdown(times: dict, counts: dict, wall: float, rest: str) -> None:
+    """One line per timed call (count, seconds, per call, share of ``wall``) and the rest,
+    labelled ``rest``."""
+    for k, t in times.items():
+        if counts[k]:
+            print(f"  {k:<14} {counts[k]:6d} calls {t:7.2f} s ({1e3 * t / counts[k]:7.3f} ms/call, "
+                  f"{100 * t / wall:4.1f} %)")
+    left = wall - sum(times.values())
+    print(f"  {'rest (' + rest + ')':<14} {left:6.2f} s ({100 * left / wall:4.1f} %)")
