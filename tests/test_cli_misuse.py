@@ -112,7 +112,6 @@ def string_rest(tmp_path):
     (["static", "--model", "sbc", "--preset", "1-4", "--start", "design"], BAD_INPUT, "does not apply"),
     (["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "3", "--modes", "100000"], BAD_INPUT,
      "free DOFs"),
-    (["modal", "--model", "sbc", "--preset", "1-4", "--vtk", "OUT/m.vtu"], BAD_INPUT, "does not apply"),
     (["modal", "--model", "com", "--preset", "1-4", "--membrane-modes", "1000"], TOO_LARGE, "K <= 40"),
     (["modal", "--model", "com", "--preset", "1-4", "--modes", "100"], BAD_INPUT, "coordinates"),
     (["modal", "--preset", "1-4", "--mesh", "3", "--modes", "100000"], BAD_INPUT, "free DOFs"),

@@ -38,7 +38,7 @@ _EXACT = {
 _SUFFIX = [(r".*_deg$", "deg"), (r".*_hz$", "Hz"), (r".*_MPa$", "MPa"), (r".*_mm$", "mm"),
            (r".*_m$", "m"), (r".*_N$", "N"), (r".*_s$", "s"), (r".*_J$", "J"),
            (r".*_Pa$", "Pa"), (r".*_N_per_m$", "N/m"), (r"f\d+$", "Hz"),
-           (r".*_fractions?$", "-")]
+           (r".*_fractions?$", "-"), (r"membrane_m(ax|in)_", "Pa")]
 
 
 def unit_of(key: str) -> str | None:
