@@ -399,17 +399,25 @@ def verify(plant: GeneralizedPlant, controller, *, gamma: float, alpha: float,
     InfeasibleController
         when either check fails (poles first: ``control.norm`` does not check stability).
     """
-    import control
     T = closed_loop(plant, controller)
+    nrm, re = check_loop(T, gamma=gamma, alpha=alpha, rtol=rtol, what="closed loop")
+    return T, nrm, re
+
+
+def check_loop(T, *, gamma: float, alpha: float, rtol: float, what: str) -> tuple:
+    """(||T||_inf, max Re of its poles) of a closed loop T, or :class:`InfeasibleController`
+    when a pole lies right of -alpha (within ``rtol`` alpha + 1e-9) or the norm exceeds
+    gamma (1 + rtol); poles first: ``control.norm`` does not check stability."""
+    import control
     re = float(np.max(np.real(T.poles())))
     if not re < -alpha + rtol * max(alpha, 1e-6) + 1e-9:
-        raise InfeasibleController(f"closed loop: expected all poles with Re < -alpha_1 = "
+        raise InfeasibleController(f"{what}: expected all poles with Re < -alpha_1 = "
                                    f"{-alpha:g}, found max Re = {re:.6g}")
     nrm = float(control.norm(T, p="inf"))
     if not nrm <= gamma * (1 + rtol):
-        raise InfeasibleController(f"closed loop: expected ||T_pw||_inf <= gamma = {gamma:.6g}, "
+        raise InfeasibleController(f"{what}: expected ||T_pw||_inf <= gamma = {gamma:.6g}, "
                                    f"found {nrm:.6g}")
-    return T, nrm, re
+    return nrm, re
 
 
 def _minimise_gamma(plant, *, alpha, solver, eps, regularization, scale, residual_tol):
@@ -643,14 +651,7 @@ def hinf_state_feedback(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: 
     Acl = plant.A + plant.B2 @ Kx
     T = control.ss(Acl, plant.B1, plant.C1 + plant.D12 @ Kx, plant.D11,
                    inputs=list(plant.w_names), outputs=list(plant.p_names), name="T_pw")
-    re = float(np.max(np.linalg.eigvals(Acl).real))
-    if not re < -alpha + verify_rtol * max(alpha, 1e-6) + 1e-9:
-        raise InfeasibleController(f"state feedback: expected closed-loop poles with Re < "
-                                   f"{-alpha:g}, found max Re = {re:.6g}")
-    nrm = float(control.norm(T, p="inf"))
-    if not nrm <= gamma * (1 + verify_rtol):
-        raise InfeasibleController(f"state feedback: expected ||T_pw||_inf <= {gamma:.6g}, "
-                                   f"found {nrm:.6g}")
+    nrm, re = check_loop(T, gamma=gamma, alpha=alpha, rtol=verify_rtol, what="state feedback")
     return HinfDesign(controller=Kss, gamma=gamma, alpha=float(alpha), closed_loop=T,
                       closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep, plant=plant,
                       kind="state feedback", operating_point=dict(operating_point or {}),
