@@ -24,6 +24,8 @@ so through three hooks (:meth:`FEPlant.configuration`, :meth:`FEPlant.positions`
 """
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -35,7 +37,7 @@ from tmfem.models.mtc.post import q_from_positions
 from tmfem.models.mtc.topology import to_floating
 
 
-class FEPlant:
+class FEPlant(ABC):
     """Shared part of the finite-element plants (module docstring); a
     :class:`tmfem.models.base.Plant`.
 
@@ -73,21 +75,21 @@ class FEPlant:
         self.x0, self.v0 = initial_state(self, perturb)
 
     # hooks -------------------------------------------------------------------------------
+    @abstractmethod
     def state0(self) -> np.ndarray:
         """The equilibrium as a free-dof state."""
-        raise NotImplementedError
 
+    @abstractmethod
     def configuration(self, u):
         """The argument of ``model.residual`` for the free-dof state u."""
-        raise NotImplementedError
 
+    @abstractmethod
     def positions(self, u) -> np.ndarray:
         """Node positions (3, n) in the MTC numbering of the free-dof state u."""
-        raise NotImplementedError
 
+    @abstractmethod
     def strain_energy(self, u) -> float:
         """Strain energy [J] of the free-dof state u."""
-        raise NotImplementedError
 
     def translation_rows(self, nodes) -> np.ndarray:
         """Rows (len(nodes), 3) of the constraint matrix T (all dofs x reduced dofs) that
