@@ -16,14 +16,7 @@ import time
 
 import numpy as np
 
-
-def best(fn, repeat=3):
-    t = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        t.append(time.perf_counter() - t0)
-    return min(t)
+from timing import best
 
 
 def main(argv=None):

@@ -14,17 +14,10 @@ import sys
 import time
 
 import numpy as np
+
+from timing import best
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-
-
-def best(fn, repeat=3):
-    t = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        t.append(time.perf_counter() - t0)
-    return min(t)
 
 
 def main(argv=None):

@@ -1,9 +1,22 @@
-"""Shared print-out of the benchmark scripts: where the time of a run went, by timed call.
+"""Shared timing helpers of the benchmark scripts: best-of-n timing and where the time of a run
+went, by timed call.
 
 Run as ``python benchmarks/<script>.py``; the scripts import this module from their own
 directory (it is on ``sys.path[0]`` when a script runs).
 """
 from __future__ import annotations
+
+import time
+
+
+def best(fn, repeat: int = 3) -> float:
+    """The shortest wall time of ``repeat`` calls of ``fn`` [s]."""
+    t = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        t.append(time.perf_counter() - t0)
+    return min(t)
 
 
 def print_breakdown(times: dict, counts: dict, wall: float, rest: str) -> None:
