@@ -18,7 +18,8 @@ def _bar_signals(names) -> list:
 def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "") -> Path:
     """Five panels over time: the bar attitudes of both runs against the reference, their
     tracking errors q - q_ref, the membrane deflections w_k, the commanded rest lengths (one tendon of each family) and the
-    deviation between the plants (bars [mrad], left axis; w [mm], right axis). Run A solid,
+    deviation between the plants (bars [mrad], left axis; w [mm], right axis; both
+    logarithmic). Run A solid,
     run B dashed; a run that stopped early is marked."""
     fig = new_figure(figsize=(8.5, 14))
     ax = fig.subplots(5, 1, sharex=True)
@@ -52,10 +53,16 @@ def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "")
     l1, = ax[4].plot(dev["t"], 1e3 * dev["q"], "-", color="C0",
                      label=f"bars: max |q ({labels[1]}) - q ({labels[0]})| [mrad]")
     ax[4].set_ylabel("bar deviation [mrad]", color="C0")
+    ax[4].set_yscale("log")
     tw = ax[4].twinx()
     l2, = tw.plot(dev["t"], 1e3 * dev["w"], "-", color="C3",
                   label=f"membrane: max |w ({labels[1]}) - w ({labels[0]})| [mm]")
     tw.set_ylabel("membrane deflection deviation [mm]", color="C3")
+    tw.set_yscale("log")
+    for x, d in ((ax[4], 1e3 * dev["q"]), (tw, 1e3 * dev["w"])):
+        top = float(np.max(d)) if d.size else 0.0
+        if top > 0:           # three decades below the largest deviation: the start is exact
+            x.set_ylim(1e-3 * top, 2.0 * top)
     ax[4].legend(handles=[l1, l2], fontsize=7, loc="upper left")
     ax[4].set_xlabel("time [s]")
     for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--")):
@@ -67,8 +74,11 @@ def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "")
         if r.failure:
             for x in ax:
                 x.axvline(r.t[-1], color="r", ls=ls, lw=0.9)
-            ax[0].annotate(f"{lab} stopped at {r.t[-1]:.2f} s (Newton failed)", (r.t[-1], 0.9),
-                           xycoords=("data", "axes fraction"), fontsize=7, color="r", ha="right")
+            early = r.t[-1] < 0.5 * max(a.t[-1], b.t[-1])
+            ax[0].annotate(f" {lab} stopped at {r.t[-1]:.2f} s (Newton failed) ", (r.t[-1], 0.5),
+                           xycoords=("data", "axes fraction"), fontsize=7, color="r",
+                           ha="left" if early else "right",
+                           bbox={"fc": "white", "ec": "none", "alpha": 0.8})
     for x in ax[:4]:
         x.legend(fontsize=6, ncol=3)
     for x in ax:
