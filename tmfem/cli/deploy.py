@@ -161,11 +161,12 @@ def check_plant(args) -> int | None:
                          f"found {args.compare_plant}")
     fe = [p for p in plants if p != "com"]
     if not fe:
-        for opt, val in (("--plant-mesh", args.plant_mesh), ("--plant-tendons", args.plant_tendons)):
+        for opt, val, fe_kinds in (("--plant-mesh", args.plant_mesh, "mtc|sbc"),
+                                   ("--plant-tendons", args.plant_tendons, "mtc")):
             if val is not None:
-                raise InputError(f"{opt} belongs to an FE plant (--plant or --compare-plant mtc|sbc; "
-                                 f"the COM plant has neither a membrane mesh nor FE tendons), "
-                                 f"found {opt} {val} with --plant com")
+                raise InputError(f"{opt} belongs to --plant {fe_kinds} or --compare-plant "
+                                 f"{fe_kinds} (the COM plant has neither a membrane mesh nor FE "
+                                 f"tendons), found {opt} {val} with --plant com")
         return None
     if args.plant_tendons is not None and "mtc" not in fe:
         raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "
