@@ -63,7 +63,7 @@ def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "")
         top = float(np.max(d)) if d.size else 0.0
         if top > 0:           # three decades below the largest deviation: the start is exact
             x.set_ylim(1e-3 * top, 2.0 * top)
-    ax[4].legend(handles=[l1, l2], fontsize=7, loc="upper left")
+    tw.legend(handles=[l1, l2], fontsize=7, loc="lower right")   # drawn above both axes
     ax[4].set_xlabel("time [s]")
     for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--")):
         if r.switch_time is not None:
@@ -78,7 +78,7 @@ def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "")
             ax[0].annotate(f" {lab} stopped at {r.t[-1]:.2f} s (Newton failed) ", (r.t[-1], 0.5),
                            xycoords=("data", "axes fraction"), fontsize=7, color="r",
                            ha="left" if early else "right",
-                           bbox={"fc": "white", "ec": "none", "alpha": 0.8})
+                           bbox={"fc": "white", "ec": "none", "alpha": 0.8}, zorder=10)
     for x in ax[:4]:
         x.legend(fontsize=6, ncol=3)
     for x in ax:
