@@ -10,8 +10,8 @@ FE state as sensors would give it:
   SBC bars are beams whose chords A_ij-B_ij give q, their bending and the rotations of their
   nodes do not enter);
 * eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
-  nodes (the SBC shell's mid-surface nodes) are taken into the floating frame of the current corners (eq. 3.3), interpolated at
-  the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
+  nodes (the SBC shell's mid-surface nodes) are taken into the floating frame of the current
+  corners (eq. 3.3), interpolated at the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
   corner constraints, eqs. 3.5, 5.14) is subtracted and the rest is projected on the
   relative modes in the mass inner product (:meth:`MembraneBasis.modal_coordinates`) -- a
   full-field measurement of the membrane (photogrammetry), the best case of the "projection
@@ -29,8 +29,10 @@ model's :class:`~tmfem.models.mtc.dynamics.MTCDynamics` or the SBC model's
 M a + C v + f_int(x; u) = 0) whose outputs are that estimate
 y = [z, z'], so every controller built for the COM plant (the adaptive PFL, the switch, the
 linear controllers) runs on it unchanged. :func:`fe_state_of` places the FE model in the
-configuration of a COM state (bars at q, membrane on the COM's field, tendons straight), the
-start of a deployment.
+configuration of a COM state (bars at q, membrane on the COM's field, tendons straight);
+:func:`mtc_deployment_plant` and :func:`sbc_deployment_plant` (:func:`deployment_plant` by
+name) build the plant of a deployment, started at rest in its own equilibrium of the
+packaged design.
 """
 from __future__ import annotations
 
