@@ -1,13 +1,17 @@
-"""Speed of a COM-designed controller on the MTC finite-element plant (issue 15).
+"""Speed of a COM-designed controller on a finite-element plant (issue 15).
 
-The deployed 2-3 system (preset 2-3-deploy, Table 7.7) on the MTC model with N x n x n
+The deployed 2-3 system (preset 2-3-deploy, Table 7.7) or 1-4(D) (``--preset 1-4D``, SBC
+only) on the MTC (``--plant mtc``, default) or SBC model (``--plant sbc``) with N x n x n
 membrane elements, in closed loop with the LQR state feedback of the COM linearisation
 (:func:`tmfem.control.deploy.lqr_state_feedback`) through the COM-state estimate
 (:class:`tmfem.control.state_estimate.FEStatePlant`), from theta_11' = 0.02 rad/s, dt = 0.01 s.
 Target (issue 15): a 20 s 2-3 deployment on the 3x10x10 MTC model in under 10 minutes, i.e.
-under 0.3 s per step. Prints the time per step and where it goes.
+under 0.3 s per step. Prints the time per step and where it goes (for the SBC plant also
+inside its Newton matrix: element assembly, the exponential map's tangent operator, the
+constraint products T^T K dexp T).
 
-    .venv/bin/python benchmarks/bench_fe_plant.py [--mesh 10] [--t-end 2] [--jacobian step]
+    .venv/bin/python benchmarks/bench_fe_plant.py [--plant mtc|sbc] [--preset 2-3-deploy|1-4D]
+        [--mesh 10] [--t-end 2] [--jacobian step]
 """
 from __future__ import annotations
 
@@ -20,6 +24,8 @@ from tmfem.control.state_estimate import FEStatePlant
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.models.mtc.dynamics import MTCDynamics
 from tmfem.models.mtc.model import MTCModel
+from tmfem.models.sbc import dynamics as sbc_dynamics
+from tmfem.models.sbc.model import SBCModel
 from tmfem.simulation.driver import simulate
 from tmfem.system import load_preset
 from timing import print_breakdown
@@ -28,7 +34,7 @@ from timing import print_breakdown
 class Timed:
     """Proxy that times the plant calls the driver and the integrator make."""
 
-    KEYS = ("residual", "newton_matrix", "factorize", "outputs")
+    KEYS = ("residual", "newton_matrix", "jacobians", "factorize", "outputs")
 
     def __init__(self, plant):
         self.plant = plant
@@ -49,25 +55,54 @@ class Timed:
         return timed
 
 
+class TimedFunction:
+    """A module attribute (function) replaced by a timed wrapper for the rest of the run."""
+
+    def __init__(self, owner, name):
+        self.owner, self.name, self.fn = owner, name, getattr(owner, name)
+        self.t, self.n = 0.0, 0
+
+        def timed(*a, **kw):
+            t0 = time.perf_counter()
+            out = self.fn(*a, **kw)
+            self.t += time.perf_counter() - t0
+            self.n += 1
+            return out
+        setattr(owner, name, timed)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--plant", default="mtc", choices=["mtc", "sbc"])
+    ap.add_argument("--preset", default="2-3-deploy", choices=["2-3-deploy", "1-4D"])
     ap.add_argument("--mesh", type=int, default=10)
     ap.add_argument("--t-end", type=float, default=2.0)
     ap.add_argument("--jacobian", default="step", choices=["iteration", "step", "reuse"])
     a = ap.parse_args()
-    s = load_preset("2-3-deploy")
+    if a.plant == "mtc" and a.preset == "1-4D":
+        ap.error("--plant mtc: 1-4D has H_1j nodes along the bars (the SBC model only)")
+    s = load_preset(a.preset)
     t0 = time.perf_counter()
     com = ControlOrientedModel(s, membrane_modes=default_membrane_modes(s), rest_lengths="system")
     z_e = com.equilibrium(com.u0, z0=com.z0)
     ctrl, _ = lqr_state_feedback(com, u_e=com.u0, z_e=z_e, u_m=0.01)
     t_com = time.perf_counter() - t0
     t0 = time.perf_counter()
-    fe = MTCModel(s, mesh_n=a.mesh, rest_lengths="system")
-    x_eq = fe.solve_static().x
-    plant = Timed(FEStatePlant(MTCDynamics(fe, x_eq, perturb={"theta_11_dot": 0.02}), com))
+    perturb = {"theta_11_dot": 0.02}
+    if a.plant == "mtc":
+        fe = MTCModel(s, mesh_n=a.mesh, rest_lengths="system")
+        dyn = MTCDynamics(fe, fe.solve_static().x, perturb=perturb)
+    else:
+        fe = SBCModel(s, mesh_n=a.mesh, rest_lengths="system")
+        dyn = sbc_dynamics.SBCDynamics(fe, fe.solve_static().state, perturb=perturb)
+    plant = Timed(FEStatePlant(dyn, com))
     t_fe = time.perf_counter() - t0
-    print(f"2-3 on MTC {s.N}x{a.mesh}x{a.mesh}: {plant.x0.size} free DOFs; COM + LQR {t_com:.2f} s, "
-          f"MTC build + static {t_fe:.2f} s")
+    inner = []
+    if a.plant == "sbc":
+        inner = [TimedFunction(sbc_dynamics, "assemble"),
+                 TimedFunction(sbc_dynamics.SBCDynamics, "_rotation_jacobian")]
+    print(f"{a.preset} on {a.plant.upper()} {s.N}x{a.mesh}x{a.mesh}: {plant.x0.size} free DOFs; "
+          f"COM + LQR {t_com:.2f} s, FE build + static {t_fe:.2f} s")
     c0, w0 = time.process_time(), time.perf_counter()
     sim = simulate(plant, t_end=a.t_end, dt=0.01, controller=ctrl, jacobian=a.jacobian)
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
@@ -79,6 +114,12 @@ def main():
     print(f"  {steps} steps, {sim.stats['newton_iterations']} Newton iterations, "
           f"{sim.stats['jacobian_evaluations']} Newton matrices")
     print_breakdown(plant.t, plant.n, wall, "Park loop, solves, controller")
+    if inner:
+        print("  inside the SBC tangents (newton_matrix, and jacobians for the starting "
+              "accelerations):")
+        print_breakdown({f.name: f.t for f in inner}, {f.name: f.n for f in inner},
+                        plant.t["newton_matrix"] + plant.t["jacobians"],
+                        "products T^T K dexp T, slicing")
 
 
 if __name__ == "__main__":

@@ -9,7 +9,7 @@ import time
 
 from tmfem.cli.common import (check_time_steps, output_dir, output_file, positive_float,
                               progress_bar)
-from tmfem.errors import ConvergenceError, InputError
+from tmfem.errors import InputError
 from tmfem.reference.deployments import (CONTROLLERS, DEPLOYMENTS, UNCERTAINTIES, check_choices,
                                          setup, write_outputs)
 
@@ -32,17 +32,27 @@ def configure(parser) -> None:
                         help="rest-length limits in the PFL: bounded (the admissible rest lengths "
                              "closest in acceleration, default) or clip (eq. 5.58 as is, saturated "
                              "by the plant)")
-    parser.add_argument("--plant", choices=["com", "mtc"], default="com",
+    parser.add_argument("--plant", choices=["com", "mtc", "sbc"], default="com",
                         help="the model the controller drives: com (the control-oriented model it "
-                             "is designed on, default) or mtc (the membrane-truss-cable FE model, "
-                             "read through the COM-state estimate; systems without H_1j nodes)")
+                             "is designed on, default), mtc (the membrane-truss-cable FE model; "
+                             "systems without H_1j nodes) or sbc (the shell-beam-cable FE model, "
+                             "any system), the FE plants read through the COM-state estimate")
     parser.add_argument("--plant-mesh", type=int, metavar="N",
                         help="membrane elements per side of each of the FE plant's N "
-                             "quadrilaterals (--plant mtc; default 10, the paper's mesh)")
+                             "quadrilaterals (--plant or --compare-plant mtc|sbc; default 10, the "
+                             "paper's mesh)")
     parser.add_argument("--plant-tendons", choices=["cable", "fixed-rate"],
-                        help="tendon law of the FE plant (--plant mtc): cable (EA fixed, the rate "
-                             "EA/r of eq. 3.9 follows the rest length; default) or fixed-rate (the "
-                             "rate frozen at the final rest lengths, as eq. 5.19 and the COM)")
+                        help="tendon law of the MTC plant (--plant or --compare-plant mtc): cable "
+                             "(EA fixed, the rate EA/r of eq. 3.9 follows the rest length; "
+                             "default) or fixed-rate (the rate frozen at the final rest lengths, as "
+                             "eq. 5.19 and the COM); the SBC model has the cable law only")
+    parser.add_argument("--compare-plant", choices=["com", "mtc", "sbc"],
+                        help="run the same deployment on this plant too and compare (JSON "
+                             "'compare': its figures and the deviation between the plants)")
+    parser.add_argument("--compare-plot", help="PNG: both runs overlaid and their deviation over "
+                                               "time (--compare-plant)")
+    parser.add_argument("--compare-csv", help="the CSV of the --compare-plant run (the same "
+                                              "columns as --csv)")
     parser.add_argument("--t-end", type=positive_float, default=20.0, help="duration [s]")
     parser.add_argument("--dt", type=positive_float, default=0.01, help="sample time [s]")
     parser.add_argument("--csv", help="write every named signal (one column each, units in the header)")
@@ -60,58 +70,113 @@ def run(args) -> dict:
     output_dir(args.vtk, option="--vtk")
     check_choices(args.preset, controller=args.controller, uncertainty=args.uncertainty,
                   path=args.path)
+    output_file(args.compare_plot, option="--compare-plot", suffixes=(".png",))
+    output_file(args.compare_csv, option="--compare-csv", suffixes=(".csv",))
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path)
-    from tmfem.control.deploy import run_deployment
-    plant = None
-    if args.plant == "mtc":
-        from tmfem.control.state_estimate import mtc_deployment_plant
-        from tmfem.system.presets import load_preset
-        plant = mtc_deployment_plant(s.model, load_preset(args.preset + "-initial"),
-                                     mesh_n=mesh_n, tendon_law=args.plant_tendons or "cable")
-    with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {args.plant}") as bar:
-        try:
-            r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
-                               z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,
-                               jacobian="reuse" if plant is None else "step")
-        except ConvergenceError as exc:
-            if plant is None:
-                raise
-            raise ConvergenceError(f"the closed loop on the {args.plant} plant diverged: {exc} "
-                                   "(docs/fe-plant.md)") from None
+    r = _run_on(args, s, args.plant, mesh_n)
     out = {"preset": args.preset, "controller": args.controller, "plant": args.plant,
-           **({"plant_tendons": args.plant_tendons or "cable", "plant_mesh": mesh_n}
-              if args.plant == "mtc" else {}),
+           **_plant_options(args, args.plant, mesh_n),
            "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
            "path": args.path or DEPLOYMENTS[args.preset]["path"],
-           **r.summary(), **s.info,
-           "total_wall_time_s": time.perf_counter() - t0}
+           **r.summary(), **s.info}
+    title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
+             f"uncertainty {s.adaptive.uncertainty}")
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
-                             gif=args.gif, vtk=args.vtk,
-                             title=f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
-                                   f"uncertainty {s.adaptive.uncertainty}"))
+                             gif=args.gif, vtk=args.vtk, title=title))
+    if args.compare_plant:
+        out["compare"] = _compare(args, mesh_n, r)
+    out["total_wall_time_s"] = time.perf_counter() - t0
+    # a diverged closed loop is a failed check: the result and the files of the record up
+    # to the failure are written, the exit code is 1 (docs/cli.md, docs/fe-plant.md)
+    out["failed_checks"] = [f"closed loop on the {p} plant diverged at t = {v['t_end_s']:.4g} s"
+                            for p, v in ((args.plant, out), (args.compare_plant,
+                                                             out.get("compare", {})))
+                            if v.get("failure")]
+    return out
+
+
+def _plant_options(args, plant: str, mesh_n) -> dict:
+    if plant == "com":
+        return {}
+    return {"plant_mesh": mesh_n, **({"plant_tendons": args.plant_tendons or "cable"}
+                                     if plant == "mtc" else {})}
+
+
+def _run_on(args, s, plant_kind: str, mesh_n):
+    """The deployment of set-up ``s`` on ``plant_kind``; an FE-plant run that diverges returns
+    its record up to the failure (``failure``)."""
+    from tmfem.control.deploy import run_deployment
+    from tmfem.control.state_estimate import deployment_plant
+    from tmfem.system.presets import load_preset
+    plant = deployment_plant(plant_kind, s.model, load_preset(args.preset + "-initial"),
+                             mesh_n=mesh_n or 10,
+                             tendon_law=args.plant_tendons if plant_kind == "mtc" else None)
+    with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
+        return run_deployment(model=s.model, reference=s.reference, controller=s.controller,
+                              z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,
+                              jacobian="reuse" if plant is None else "step",
+                              partial=plant is not None)
+
+
+def _compare(args, mesh_n, r) -> dict:
+    """The same deployment on ``--compare-plant`` (a fresh controller: the adaptive PFL and
+    the switch carry state) and its deviation from run ``r``."""
+    from tmfem.control.plant_compare import deviation_summary, plant_deviation
+    from tmfem.reference.deployments import write_csv
+    s2 = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+               allocation=args.allocation, path=args.path)
+    r2 = _run_on(args, s2, args.compare_plant, mesh_n)
+    dev = plant_deviation(r, r2)
+    out = {"plant": args.compare_plant, **_plant_options(args, args.compare_plant, mesh_n),
+           **r2.summary(), "deviation": deviation_summary(dev)}
+    if args.compare_csv:
+        out["csv"] = write_csv(args.compare_csv, r2)
+    if args.compare_plot:
+        from tmfem.post.plant_compare_plot import plot_plant_comparison
+        out["plot"] = str(plot_plant_comparison(
+            args.compare_plot, r, r2, dev, labels=(args.plant, args.compare_plant),
+            title=f"{args.preset} deployment ({args.controller}) on the {args.plant} plant "
+                  f"(solid) and the {args.compare_plant} plant (dashed)"))
     return out
 
 
 def check_plant(args) -> int | None:
-    """The FE plant's options, checked before any work: ``--plant-mesh`` belongs to
-    ``--plant mtc``; the MTC model has no nodes along the bars, so no 1-N(D) system; the
-    mesh within the machine's budget. Returns the plant mesh (None for the COM plant)."""
+    """The FE plants' options, checked before any work: ``--plant-mesh`` belongs to an FE
+    plant, ``--plant-tendons`` to an MTC plant (the SBC model has the cable law only); the
+    MTC model has no nodes along the bars, so no 1-N(D) system; ``--compare-plant`` differs
+    from ``--plant`` and ``--compare-plot``/``--compare-csv`` need it; the mesh within the
+    machine's budget. Returns the plant mesh (None without an FE plant)."""
     from tmfem.cli.common import check_mesh_budget
     from tmfem.system.presets import load_preset
-    if args.plant == "com":
-        for opt, val in (("--plant-mesh", args.plant_mesh), ("--plant-tendons", args.plant_tendons)):
+    plants = [args.plant] + ([args.compare_plant] if args.compare_plant else [])
+    for opt in ("--compare-plot", "--compare-csv"):
+        if getattr(args, opt[2:].replace("-", "_")) and not args.compare_plant:
+            raise InputError(f"{opt} belongs to --compare-plant (the second plant of the same "
+                             f"deployment), found {opt} without it")
+    if args.compare_plant == args.plant:
+        raise InputError(f"--compare-plant: expected a plant other than --plant {args.plant}, "
+                         f"found {args.compare_plant}")
+    fe = [p for p in plants if p != "com"]
+    if not fe:
+        for opt, val, fe_kinds in (("--plant-mesh", args.plant_mesh, "mtc|sbc"),
+                                   ("--plant-tendons", args.plant_tendons, "mtc")):
             if val is not None:
-                raise InputError(f"{opt} belongs to --plant mtc (the COM plant has neither a "
-                                 f"membrane mesh nor FE tendons), found {opt} {val} with --plant com")
+                raise InputError(f"{opt} belongs to --plant {fe_kinds} or --compare-plant "
+                                 f"{fe_kinds} (the COM plant has neither a membrane mesh nor FE "
+                                 f"tendons), found {opt} {val} with --plant com")
         return None
+    if args.plant_tendons is not None and "mtc" not in fe:
+        raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "
+                         f"law only (EA fixed, k = EA / r); expected no --plant-tendons with "
+                         f"--plant sbc, found --plant-tendons {args.plant_tendons}")
     system = load_preset(args.preset)
-    if system.deployable:
+    if system.deployable and "mtc" in fe:
         raise InputError(f"--plant mtc: {args.preset} is a 1-N(D) system (tendons attached at "
                          "H_1j along the bars), which the MTC model cannot represent; expected a "
-                         "system without H_1j nodes (2-3-deploy), or --plant com")
+                         "system without H_1j nodes (2-3-deploy), --plant sbc or --plant com")
     n = 10 if args.plant_mesh is None else args.plant_mesh
     if n < 2:
         raise InputError(f"--plant-mesh: expected an integer >= 2, found {n}")
@@ -124,8 +189,14 @@ def format_text(r: dict) -> str:
             "bar_critical_load_N", "max_von_mises_Pa", "max_tendon_stress_Pa",
             "min_rest_length_margin_m", "final_tracking_error", "limits_active_s",
             "max_eta_energy_J", "B_q_condition_max", "wall_time_s"]
-    keys += [k for k in r if k.startswith("plant_")]
+    keys += [k for k in r if k.startswith("plant_")] + ["failure"]
     lines = [f"deployment {r['preset']} on the {r['plant']} plant ({r['controller']}, "
              f"uncertainty {r['uncertainty']})"]
     lines += [f"  {k}: {r[k]:.6g}" if isinstance(r[k], float) else f"  {k}: {r[k]}" for k in keys]
+    if "compare" in r:
+        c = r["compare"]
+        lines.append(f"  on the {c['plant']} plant: switch_time_s {c['switch_time_s']}, "
+                     f"final_tracking_error {c['final_tracking_error']:.6g}, failure {c['failure']}")
+        lines += [f"  deviation {k}: {v}" for k, v in c["deviation"].items()]
+        lines += [f"compare {k}: {c[k]}" for k in ("csv", "plot") if k in c]
     return "\n".join(lines + [f"{k}: {r[k]}" for k in ("csv", "plot", "gif", "pvd") if k in r])

@@ -29,7 +29,7 @@ import numpy as np
 
 from tmfem.control.limits import RestLengthLimits
 from tmfem.control.switching import relative_error
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.plant import COMPlant
 from tmfem.simulation.controllers import LinearController
@@ -154,6 +154,7 @@ class DeploymentResult:
     allocation_active: np.ndarray = field(default_factory=lambda: np.zeros(0))
     plant_report: dict | None = None
     names: dict = field(default_factory=dict)
+    failure: str | None = None
 
     def summary(self) -> dict:
         """The JSON figures of issue 13."""
@@ -173,13 +174,14 @@ class DeploymentResult:
                 "max_eta_energy_J": float(np.max(self.eta_energy)),
                 "B_q_condition_max": float(np.max(self.condition_numbers))
                 if self.condition_numbers.size else None,
-                "wall_time_s": self.wall_time,
+                "wall_time_s": self.wall_time, "failure": self.failure,
                 **{f"plant_{k}": v for k, v in (self.plant_report or {}).items()}}
 
 
 def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float = 0.01,
                    r_min: float = 1e-3, stress_every: int = 10, progress=None,
-                   mesh_n: int = 10, jacobian: str = "reuse", plant=None) -> DeploymentResult:
+                   mesh_n: int = 10, jacobian: str = "reuse", plant=None,
+                   partial: bool = False) -> DeploymentResult:
     """Deploy: the COM plant (:class:`StatePlant`) from z0 under ``controller`` (reading
     y = [z, z']) saturated by :class:`RestLengthLimits`, integrated by Park's method
     (eqs. 5.34-5.35) at step dt. The run records the state and the inputs only; outputs,
@@ -192,27 +194,40 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     outputs are the COM state y = [z, z'] serves (a finite-element plant through its state
     estimate, :class:`tmfem.control.state_estimate.FEStatePlant`): the run records that y as
     z, z', and a plant with a ``recover(states)`` method adds what only it knows (the FE
-    tendon forces and slack, the membrane deflections its sensors measure) as ``plant_report``."""
+    tendon forces and slack, the membrane deflections its sensors measure) as ``plant_report``.
+
+    ``partial``: a run whose integration fails (:class:`ConvergenceError`, a diverging closed
+    loop) returns what it recorded up to the failure, with the message in ``failure``,
+    instead of raising (the record of a failing FE-plant run, docs/fe-plant.md)."""
     from tmfem.control.recovery import StressRecovery
     if stress_every < 1:
         raise InputError(f"stress_every: expected >= 1, found {stress_every}")
     plant = StatePlant(model, z0=z0) if plant is None else plant
     lim = RestLengthLimits(controller, model=model, r_min=r_min)
     nq, nz = model.nq, model.nz
-    X, V, U, S = [], [], [], []
+    T, C, X, V, U, S = [], [], [], [], [], []
     recover = getattr(plant, "recover", None)
 
     def record(t, x, v, a, u, y):
         y = plant.outputs(x, v, u) if y is None else y
+        T.append(t); C.append(lim.name)
         X.append(y[:nz].copy()); V.append(y[nz:].copy()); U.append(u.copy())
         if recover is not None:
             S.append(x.copy())
         return False
 
     t0 = time.perf_counter()
-    sim = simulate(plant, t_end=t_end, dt=dt, controller=lim, record=record, progress=progress,
-                   outputs=False, jacobian=jacobian)
+    failure = None
+    try:
+        simulate(plant, t_end=t_end, dt=dt, controller=lim, record=record, progress=progress,
+                 outputs=False, jacobian=jacobian)
+    except ConvergenceError as exc:
+        if not partial or len(T) < 2:
+            raise
+        failure = str(exc)
+        log.warning("deployment stopped at t = %.4g s: %s", T[-1], exc)
     wall = time.perf_counter() - t0
+    t_rec = np.array(T)
     z, zd, u = np.array(X), np.array(V), np.array(U)
     out = [model.fast_outputs(zk, with_lengths=True) for zk in z]
     w = np.array([o[0] for o in out])
@@ -220,32 +235,35 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     report = recover(np.array(S), u) if recover is not None else None
     if report is not None:
         w = report.pop("w")
-    q_d = np.array([reference(tk)[0] for tk in sim.t])
+        slack = report.pop("slack", None)
+        if slack is not None:
+            report["first_slack_s"] = float(t_rec[np.argmax(slack > 0)]) if np.any(slack) else None
+    q_d = np.array([reference(tk)[0] for tk in t_rec])
     eta, etad = z[:, nq:], zd[:, nq:]
     E = 0.5 * np.sum(etad**2, axis=1) + 0.5 * np.sum(model.membrane.omega**2 * eta**2, axis=1)
     q_e = getattr(reference, "q_e", None)
-    rel = relative_error(z[:, :nq], q_e) if q_e is not None else np.full(sim.t.size, np.nan)
+    rel = relative_error(z[:, :nq], q_e) if q_e is not None else np.full(t_rec.size, np.nan)
     rc = StressRecovery(model.system, mesh_n=mesh_n)
     sigma_t = rc.tendon_stress(model.k, L, u)
-    idx = np.arange(0, sim.t.size, stress_every)
+    idx = np.arange(0, t_rec.size, stress_every)
     bar, vm = rc.bars_and_membrane(z[idx, :nq], model.k * (L[idx] - u[idx]))
-    act = np.array([a for _, a in lim.active])
+    act = np.array([a for _, a in lim.active])[:t_rec.size]
     cond, alloc = [], []
     for c in (controller, getattr(controller, "first", None)):
         if c is not None and hasattr(c, "condition_numbers"):
             cond, alloc = c.condition_numbers, getattr(c, "allocation_active", [])
     return DeploymentResult(
-        t=sim.t, z=z, zd=zd, u=u, u_commanded=u, lengths=L, w=w, q_d=q_d,
-        controller=list(sim.controller), eta_energy=E, relative_error=rel,
+        t=t_rec, z=z, zd=zd, u=u, u_commanded=u, lengths=L, w=w, q_d=q_d,
+        controller=C, eta_energy=E, relative_error=rel,
         switch_time=getattr(controller, "switch_time", None), limits_active=act,
         min_margin=float(np.min(lim.margins)),
         stress={"peak_bar_compression_N": float(np.max(bar)),
                 "bar_critical_load_N": rc.critical_load,
                 "max_von_mises_Pa": float(np.max(vm)),
                 "max_tendon_stress_Pa": float(np.max(sigma_t)),
-                "bar_t": sim.t[idx], "bar": bar, "von_mises": vm, "tendon": sigma_t},
+                "bar_t": t_rec[idx], "bar": bar, "von_mises": vm, "tendon": sigma_t},
         condition_numbers=np.asarray(cond, dtype=float), wall_time=wall,
-        allocation_active=np.asarray(alloc, dtype=float), plant_report=report,
+        allocation_active=np.asarray(alloc, dtype=float), plant_report=report, failure=failure,
         names={"q": list(model.system.q_names), "u": model.input_names,
                "tendons": [t.name for t in model.system.tendons],
                "w": [f"w_{i + 1}" for i in range(len(model.output_points))]})

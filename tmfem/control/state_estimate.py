@@ -1,4 +1,4 @@
-"""The membrane-truss-cable finite-element model as the plant of the deployment controllers.
+"""The finite-element models (MTC, SBC) as the plant of the deployment controllers.
 
 The controllers of chapters 7-8 are designed on the control-oriented model (COM, eq. 5.27)
 and read its state z = [q, eta] (bar coordinates and membrane modal coordinates, or the
@@ -6,10 +6,12 @@ membrane point coordinates of eqs. 5.17-5.18) with its rates. On a finite-elemen
 state does not exist: it has to be measured. :class:`COMStateEstimator` computes it from the
 FE state as sensors would give it:
 
-* q from the bar nodes (eqs. 3.1-3.2, :func:`tmfem.models.mtc.post.q_from_positions`);
+* q from the bar end nodes (eqs. 3.1-3.2, :func:`tmfem.models.mtc.post.q_from_positions`; the
+  SBC bars are beams whose chords A_ij-B_ij give q, their bending and the rotations of their
+  nodes do not enter);
 * eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
-  nodes are taken into the floating frame of the current corners (eq. 3.3), interpolated at
-  the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
+  nodes (the SBC shell's mid-surface nodes) are taken into the floating frame of the current
+  corners (eq. 3.3), interpolated at the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
   corner constraints, eqs. 3.5, 5.14) is subtracted and the rest is projected on the
   relative modes in the mass inner product (:meth:`MembraneBasis.modal_coordinates`) -- a
   full-field measurement of the membrane (photogrammetry), the best case of the "projection
@@ -21,12 +23,16 @@ Where the FE membrane moves exactly as the COM's field (eqs. 5.1, 5.3) the estim
 (test); otherwise it is the COM state closest in the kinetic-energy norm, and what it leaves
 out (modes above K, tendon vibration) is what the controller does not see.
 
-:class:`FEStatePlant` is an FE plant (:class:`tmfem.models.mtc.dynamics.MTCDynamics`: the
-tendon rest lengths as inputs, M a + C v + f_int(x; u) = 0) whose outputs are that estimate
+:class:`FEStatePlant` is an FE plant (any :class:`tmfem.models.fe_plant.FEPlant`: the MTC
+model's :class:`~tmfem.models.mtc.dynamics.MTCDynamics` or the SBC model's
+:class:`~tmfem.models.sbc.dynamics.SBCDynamics`, the tendon rest lengths as inputs,
+M a + C v + f_int(x; u) = 0) whose outputs are that estimate
 y = [z, z'], so every controller built for the COM plant (the adaptive PFL, the switch, the
 linear controllers) runs on it unchanged. :func:`fe_state_of` places the FE model in the
-configuration of a COM state (bars at q, membrane on the COM's field, tendons straight), the
-start of a deployment.
+configuration of a COM state (bars at q, membrane on the COM's field, tendons straight);
+:func:`mtc_deployment_plant` and :func:`sbc_deployment_plant` (:func:`deployment_plant` by
+name) build the plant of a deployment, started at rest in its own equilibrium of the
+packaged design.
 """
 from __future__ import annotations
 
@@ -60,12 +66,13 @@ class COMStateEstimator:
     ----------
     com : ControlOrientedModel
         The controllers' design model, of the same system as the FE model.
-    dyn : MTCDynamics
-        The FE plant: ``positions(x)`` gives all node positions of a free-DOF state.
+    dyn : FEPlant
+        The FE plant: ``positions(x)`` gives the node positions of a free-DOF state in the
+        numbering of its MTC model ``dyn.mtc`` (membrane, system labels, tendon internals).
     """
 
     def __init__(self, com, dyn):
-        fe = dyn.model
+        fe = dyn.mtc
         if fe.system is not com.system:
             raise InputError("FE plant: expected the FE model and the control-oriented model of "
                              f"the same System, found {fe.system.name!r} and {com.system.name!r}")
@@ -113,7 +120,7 @@ class FEStatePlant:
 
     Parameters
     ----------
-    dyn : MTCDynamics
+    dyn : FEPlant
     com : ControlOrientedModel
     x0, v0 : ndarray, optional
         Start state (free DOFs); default the plant's own (its equilibrium and perturbation).
@@ -126,6 +133,7 @@ class FEStatePlant:
             raise InputError(f"FE plant: expected the COM's inputs {com.input_names}, found "
                              f"{self.input_names}")
         self.output_names = list(com.state_names)
+        self.predictor = getattr(dyn, "predictor", "acceleration")
         self.u0 = dyn.u0
         self.x0 = dyn.x0 if x0 is None else np.asarray(x0, dtype=float)
         self.v0 = dyn.v0 if v0 is None else np.asarray(v0, dtype=float)
@@ -150,50 +158,66 @@ class FEStatePlant:
         z, zd = self.estimator.state(x, np.zeros_like(x) if v is None else v)
         return np.concatenate([z, zd])
 
-    def recover(self, states, inputs) -> dict:
+    def recover(self, states, inputs, *, stress_every: int = 10) -> dict:
         """What the FE model alone knows over a run, from its recorded states (n, n_free) and
         inputs (n, n_t): the membrane deflections w_k its sensors measure at the plant's
-        output points (eqs. 5.36-5.38, :meth:`MTCDynamics.outputs`), the tendon forces of its
-        tension-only truss elements and how often one went slack (the COM's tendons cannot).
+        output points (eqs. 5.36-5.38, :meth:`FEPlant.outputs`), the forces of its
+        tension-only tendon elements and how often one went slack (the COM's tendons
+        cannot), its bar compression (the SBC model: the larger of the two segments of a bar
+        carrying H_1j) and, every ``stress_every`` samples, its membrane's peak stresses
+        (``dyn.membrane_stress``: the MTC membrane's Gauss points, the SBC shell's three
+        surfaces). ``slack``: the number of slack tendon elements per sample.
         """
         dyn = self.dyn
-        fe = dyn.model
-        nq = len(fe.system.q_names)
-        w, T, slack = [], [], []
-        for x, u in zip(states, inputs):
+        nq = len(dyn.model.system.q_names)
+        w, T, Te, bar, vm, p1 = [], [], [], [], [], []
+        for k, (x, u) in enumerate(zip(states, inputs)):
             w.append(dyn.outputs(x)[nq:])
-            fe.set_tendon_lengths(u)
-            m = member_state(fe, dyn.positions(x))
-            T.append(m["tendon_force"]); slack.append(int(np.sum(m["tendon_slack"])))
-        fe.set_tendon_lengths(dyn.u0)
-        T, slack = np.array(T), np.array(slack)
-        return {"w": np.array(w), "model": "mtc", "free_dofs": int(dyn.x0.size),
-                "max_tendon_stress_Pa": float(np.max(T / fe.tendon_area)),
+            dyn.model.set_tendon_lengths(u)
+            m = dyn.member_forces(x)
+            T.append(m["tendon_force"]); Te.append(m["element_force"]); bar.append(m["bar_force"])
+            if k % stress_every == 0:
+                st = dyn.membrane_stress(x)
+                vm.append(st["max_von_mises"]); p1.append(st["max_sigma_p1"])
+        dyn.model.set_tendon_lengths(dyn.u0)
+        T, Te, bar = np.array(T), np.array(Te), np.array(bar)
+        slack = np.sum(Te <= 0.0, axis=1)
+        return {"w": np.array(w), "model": dyn.name, "free_dofs": int(dyn.x0.size),
+                "max_tendon_stress_Pa": float(np.max(T / dyn.mtc.tendon_area)),
                 "min_tendon_force_N": float(np.min(T)),
-                "tendon_slack_samples": int(np.sum(slack > 0))}
+                "tendon_slack_samples": int(np.sum(slack > 0)),
+                "tendon_slack_elements_max": int(np.max(slack)),
+                "peak_bar_compression_N": float(max(0.0, -np.min(bar))),
+                "max_von_mises_Pa": float(np.max(vm)), "max_sigma_p1_Pa": float(np.max(p1)),
+                "slack": slack}
+
+
+def com_positions(com, mtc, z) -> np.ndarray:
+    """Node positions (3, n_nodes) of the MTC model ``mtc`` (of the COM's system) in the
+    configuration of the COM state z: labelled nodes at q (eqs. 3.1-3.2), membrane nodes on
+    the COM's field (eqs. 5.1, 5.3, interpolated from the COM basis nodes at the FE reference
+    nodes), dependent nodes from their masters, tendon internal nodes on the chords."""
+    if mtc.system is not com.system:
+        raise InputError("FE start state: expected the FE model and the control-oriented model of "
+                         "the same System")
+    topo = mtc.topology
+    zm = com.P @ np.asarray(z, dtype=float)
+    x = np.zeros((3, topo.n_nodes))
+    x[:, topo.system_node] = com.system.nodes(zm[:com.nq])
+    xm, _ = com.membrane_positions(z)
+    x[:, :topo.n_mesh] = (_probe(com.membrane.scalar_basis.mesh, topo.mesh.p) @ xm.T).T
+    return mtc.with_straight_tendons(mtc.full(mtc.reduce(x)))
 
 
 def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
-    """Free-DOF positions and velocities of the FE model in the configuration of the COM
-    state (z, z'): labelled nodes at q (eqs. 3.1-3.2), membrane nodes on the COM's field
-    (eqs. 5.1, 5.3, interpolated from the COM basis nodes at the FE reference nodes), tendon
-    internal nodes on the chords; velocities by a central difference of that placement along
-    z' (``step`` in the coordinates).
+    """Free-DOF state and velocity of the FE plant ``dyn`` in the configuration of the COM
+    state (z, z'): :func:`com_positions` on the numbering of ``dyn.mtc``, then
+    ``dyn.state_of`` (the SBC model's bars straight, its rotations those of ``dyn``'s
+    reference state); velocities by a central difference of that placement along z'
+    (``step`` in the coordinates).
     """
-    fe = dyn.model
-    if fe.system is not com.system:
-        raise InputError("FE start state: expected the FE model and the control-oriented model of "
-                         "the same System")
-    topo = fe.topology
-    interp = _probe(com.membrane.scalar_basis.mesh, topo.mesh.p)
-
     def place(zz):
-        zm = com.P @ zz
-        x = np.zeros((3, topo.n_nodes))
-        x[:, topo.system_node] = com.system.nodes(zm[:com.nq])
-        xm, _ = com.membrane_positions(zz)
-        x[:, :topo.n_mesh] = (interp @ xm.T).T
-        return fe.reduce(fe.with_straight_tendons(fe.full(fe.reduce(x))))[fe.free]
+        return dyn.state_of(com_positions(com, dyn.mtc, zz))
 
     z = np.asarray(z, dtype=float)
     x = place(z)
@@ -201,6 +225,13 @@ def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray
         return x, np.zeros_like(x)
     zd = np.asarray(zd, dtype=float)
     return x, (place(z + step * zd) - place(z - step * zd)) / (2 * step)
+
+
+def packaged_state(com, initial) -> np.ndarray:
+    """The COM state z (eq. 5.18's coordinates) of the packaged design ``initial``: its bars
+    at q, eta = 0."""
+    return np.linalg.solve(com.P, np.concatenate([np.asarray(initial.q, dtype=float),
+                                                  np.zeros(com.K)]))
 
 
 def start_rest_lengths(initial, tendon_law: str, nominal) -> np.ndarray:
@@ -228,7 +259,7 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     of a deployment, its sensors at the COM's output points.
 
     The start is the plant's own equilibrium at rest in the packaged configuration: from the
-    placement of the COM configuration of ``initial`` (:func:`fe_state_of`, bars at its q, eta
+    placement of the COM configuration of ``initial`` (:func:`com_positions`, bars at its q, eta
     = 0) the FE statics are solved under :func:`start_rest_lengths` -- the bars take their
     axial strain, the membrane and tendons their FE shapes -- so that the run starts without
     the transient of an FE state out of equilibrium."""
@@ -237,10 +268,58 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                   rest_lengths=com.u0, tendon_law=tendon_law)
     dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points)
-    z0 = np.linalg.solve(com.P, np.concatenate([np.asarray(initial.q, dtype=float),
-                                                np.zeros(com.K)]))
-    x_place, _ = fe_state_of(com, dyn, z0)
     fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
-    st = fe.solve_static(x0=dyn.positions(x_place))
+    st = fe.solve_static(x0=com_positions(com, fe, packaged_state(com, initial)))
     fe.set_tendon_lengths(com.u0)
     return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free])
+
+
+def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
+                         bar_elements: int = 1) -> FEStatePlant:
+    """The SBC model of the COM's system (MITC4 shell membrane, four-node beam bars -- with
+    H_1j a node of the bar for a 1-N(D) system --, tension-only tendons of the cable law
+    k = EA / r, its sensors at the COM's output points) as the plant of a deployment.
+
+    The plant's reference state (rotation vectors counted from it, mass at its directors,
+    :class:`SBCDynamics`) is its own equilibrium at rest in the packaged configuration, so
+    the run starts at u = 0: the COM configuration of ``initial`` (bars at its q, eta = 0) is
+    placed on the SBC model's MTC numbering (:func:`com_positions`), solved there
+    with the MTC model of rigid bar points (the SBC statics' predictor) under the packaged
+    design's rest lengths (:func:`start_rest_lengths`, ``"cable"``), mapped onto the SBC
+    unknowns (:meth:`SBCModel.state_from_mtc`: shell directors on the membrane normals, bar
+    triads turned with the chords) and Newton's method finishes on the SBC model, whose bars
+    then bend under the tendons at H_1j."""
+    from tmfem.models.sbc.dynamics import SBCDynamics
+    from tmfem.models.sbc.model import SBCModel
+    sbc = SBCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
+                   bar_elements=bar_elements, rest_lengths=com.u0)
+    mtc = sbc.mtc
+    sbc.set_tendon_lengths(start_rest_lengths(initial, "cable", com.u0))
+    pre = mtc.solve_static(x0=com_positions(com, mtc, packaged_state(com, initial)))
+    st = sbc.solve_static(start=sbc.state_from_mtc(pre.x))
+    sbc.set_tendon_lengths(com.u0)
+    dyn = SBCDynamics(sbc, st.state, output_points=com.output_points)
+    return FEStatePlant(dyn, com)
+
+
+#: the plants a deployment can run on: the COM it is designed on and the two FE models
+PLANTS = ("com", "mtc", "sbc")
+
+
+def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
+                     tendon_law: str | None = None):
+    """The plant ``kind`` of a deployment of the COM's system from the packaged design
+    ``initial``: None for ``"com"`` (:func:`tmfem.control.deploy.run_deployment` builds the
+    COM plant), :func:`mtc_deployment_plant` (``tendon_law`` default ``"cable"``) or
+    :func:`sbc_deployment_plant` (the SBC model has the cable law only: ``"fixed-rate"`` is
+    refused)."""
+    if kind not in PLANTS:
+        raise InputError(f"plant: expected one of {list(PLANTS)}, found {kind!r}")
+    if kind == "com":
+        return None
+    if kind == "sbc":
+        if tendon_law not in (None, "cable"):
+            raise InputError(f"SBC plant tendons: the SBC model has the cable law only (EA fixed, "
+                             f"k = EA / r); expected 'cable', found {tendon_law!r}")
+        return sbc_deployment_plant(com, initial, mesh_n=mesh_n)
+    return mtc_deployment_plant(com, initial, mesh_n=mesh_n, tendon_law=tendon_law or "cable")

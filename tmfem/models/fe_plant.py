@@ -45,10 +45,12 @@ class FEPlant(ABC):
     ``set_tendon_lengths``), ``mtc`` (the MTC model whose numbering, topology and membrane the
     positions use: the model itself for MTC), ``dofmap`` and ``constraints`` (the model's
     :class:`tmfem.fem.constraints.ConstraintMap`) and ``free``, then call :meth:`_setup`; they
-    implement :meth:`state0`, :meth:`configuration`, :meth:`positions` and
-    :meth:`strain_energy`.
+    implement :meth:`state0`, :meth:`configuration`, :meth:`positions`,
+    :meth:`strain_energy`, :meth:`state_of`, :meth:`member_forces` and
+    :meth:`membrane_stress`, and name themselves (``name``: ``"mtc"``, ``"sbc"``).
     """
 
+    name = None
     model = None
     mtc = None
     dofmap = None
@@ -90,6 +92,19 @@ class FEPlant(ABC):
     @abstractmethod
     def strain_energy(self, u) -> float:
         """Strain energy [J] of the free-dof state u."""
+
+    @abstractmethod
+    def state_of(self, xf: np.ndarray) -> np.ndarray:
+        """The free-dof state whose node positions (MTC numbering) are xf (3, n)."""
+
+    @abstractmethod
+    def member_forces(self, u) -> dict:
+        """Tendon element forces ``element_force``, tendon forces ``tendon_force`` and bar
+        axial forces ``bar_force`` [N] at the free-dof state u."""
+
+    @abstractmethod
+    def membrane_stress(self, u) -> dict:
+        """Peak membrane stresses [Pa] ``max_von_mises``, ``max_sigma_p1`` at u."""
 
     def translation_rows(self, nodes) -> np.ndarray:
         """Rows (len(nodes), 3) of the constraint matrix T (all dofs x reduced dofs) that

@@ -95,7 +95,8 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
         the two starting steps of ``"park"``), so the zero-order-hold steps of u are
         integrated to second order there and the first step starts from the acceleration of
         the first input u_0 (not of the plant's nominal ``u0``); Park's multistep formula is
-        first order across the steps of u.
+        first order across the steps of u. The Newton predictor is the plant's
+        ``predictor`` attribute when it has one (default constant acceleration).
     record : callable, optional
         ``record(t, x, v, a, u, y)`` at every time (the start included); a true return
         value stops the run.
@@ -135,7 +136,7 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
     t0 = time.perf_counter()
     res = park_integrate(loop, x0=x0, v0=v0, dt=dt, n_steps=n_steps, scheme=scheme, tol=tol,
                          jacobian=jacobian, callback=step, store=False, progress=progress,
-                         sampled=True)
+                         sampled=True, predictor=getattr(plant, "predictor", "acceleration"))
     return Simulation(t=np.array(T), y=np.array(Y), u=np.array(U), controller=C, x=res.x[-1],
                       v=res.v[-1], wall_time=time.perf_counter() - t0,
                       stats={"steps": res.steps, "newton_iterations": res.newton_iterations,

@@ -92,7 +92,8 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                    a0=None, scheme: str = "park", tol: float = 1e-10,
                    max_iter: int = 25, jacobian: str = "iteration", reuse_iter: int = 4,
                    callback: Callable | None = None, store: bool = True,
-                   progress: Callable | None = None, sampled: bool = False) -> ParkResult:
+                   progress: Callable | None = None, sampled: bool = False,
+                   predictor: str = "acceleration") -> ParkResult:
     """Integrate r(x, v, a, t) = 0 with Park's method started by the trapezoidal rule.
 
     Parameters
@@ -135,6 +136,14 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         callback. Park's multistep formula does not use the acceleration: it sees the input
         steps through its history and is first order across them.
 
+    predictor : {"acceleration", "velocity"}
+        Start of each step's Newton iteration: x_n + dt v_n + dt^2 a_n / 2 (constant
+        acceleration) or x_n + dt v_n. The second is for systems with dofs of almost no
+        inertia (the SBC shell's nodal rotations, rotary inertia rho h^3 / 12): the
+        acceleration re-solved after an input step is the residual moment divided by that
+        inertia, and extrapolating it puts the predictor at rotations of radians, from where
+        Newton diverges (docs/fe-plant.md).
+
     Returns
     -------
     ParkResult
@@ -147,6 +156,8 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         raise InputError(f"time step: expected dt > 0, found {dt!r}")
     if not (isinstance(n_steps, (int, np.integer)) and n_steps >= 0):
         raise InputError(f"number of steps: expected an integer >= 0, found {n_steps!r}")
+    if predictor not in ("acceleration", "velocity"):
+        raise InputError(f"predictor: expected 'acceleration' or 'velocity', found {predictor!r}")
     x = np.array(x0, dtype=float)
     v = np.array(v0, dtype=float)
     if x.shape != v.shape or x.ndim != 1:
@@ -183,8 +194,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                 vnew = 2.0 * (xnew - xn) / dt - vn
                 return vnew, 2.0 * (vnew - vn) / dt - an
             cv, ca = 2.0 / dt, 4.0 / dt**2
-        # predictor: constant acceleration
-        xk = xn + dt * vn + 0.5 * dt**2 * an
+        xk = xn + dt * vn + (0.5 * dt**2 * an if predictor == "acceleration" else 0.0)
         if jacobian != "reuse" or kept_coef != (cv, ca):
             solve = None
         fresh = False

@@ -67,6 +67,8 @@ class MTCDynamics(FEPlant):
         Default ``system.monitor_points``.
     """
 
+    name = "mtc"
+
     def __init__(self, model, x_eq, *, alpha: float = 0.0, beta: float = 0.0,
                  perturb: dict | None = None, output_points=None):
         self.model = self.mtc = model
@@ -101,6 +103,17 @@ class MTCDynamics(FEPlant):
         (:func:`tmfem.models.mtc.post.member_state`)."""
         from tmfem.models.mtc.post import member_state
         return member_state(self.model, self.positions(x))
+
+    def state_of(self, xf: np.ndarray) -> np.ndarray:
+        """The free-DOF state of full node positions xf (3, n_nodes)."""
+        return self.model.reduce(xf)[self.free]
+
+    def membrane_stress(self, x) -> dict:
+        """Peak membrane stresses [Pa] (``max_von_mises``, ``max_sigma_p1``) at the Gauss
+        points of the free-DOF state x (:func:`tmfem.models.mtc.post.membrane_stress_summary`)."""
+        from tmfem.models.mtc.post import membrane_stress_summary
+        m = membrane_stress_summary(self.model, self.positions(x))
+        return {"max_von_mises": m["max_von_mises"], "max_sigma_p1": m["max_sigma_p1"]}
 
 
 def tendon_transverse(model, x) -> np.ndarray:

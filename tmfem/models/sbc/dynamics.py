@@ -62,6 +62,11 @@ class SBCDynamics(FEPlant):
         :class:`tmfem.models.mtc.dynamics.MTCDynamics`.
     """
 
+    name = "sbc"
+    #: Park's Newton predictor (:func:`tmfem.solvers.park.park_integrate`): the shell's nodal
+    #: rotations carry almost no inertia, so the acceleration is not extrapolated
+    predictor = "velocity"
+
     def __init__(self, model, state_eq, *, alpha: float = 0.0, beta: float = 0.0,
                  perturb: dict | None = None, output_points=None):
         self.model, self.mtc = model, model.mtc
@@ -141,3 +146,23 @@ class SBCDynamics(FEPlant):
         f = self.model.member_forces(self.configuration(u))
         return {"element_force": f["tendon_element"], "tendon_force": f["tendon"],
                 "bar_force": f["bar"]}
+
+    def state_of(self, xf: np.ndarray) -> np.ndarray:
+        """The free-dof state whose positions (MTC numbering) are xf (3, n_mtc_nodes), the bars
+        straight (their interior nodes on the chords of xf) and the nodal rotations those of
+        the reference state (zero rotation vectors)."""
+        x = self.state_eq.x.copy()
+        x[:, :self._n_mtc] = xf
+        ch = self.model.numbering.bar_chain
+        x[:, ch] = self.model.along_bars(x)
+        d = np.zeros(self.dofmap.ndof)
+        tr = self.dofmap.translation_dofs(np.arange(x.shape[1]))
+        d[tr] = (x - self.state_eq.x).T
+        return self.constraints.reduce(d)[self.free]
+
+    def membrane_stress(self, u) -> dict:
+        """Peak shell stresses [Pa] (``max_von_mises``, ``max_sigma_p1``: Gauss points of the
+        bottom, middle and top surfaces, :func:`tmfem.models.sbc.post.membrane_peaks`) at u."""
+        from tmfem.models.sbc.post import membrane_peaks
+        m = membrane_peaks(self.model, self.configuration(u))
+        return {"max_von_mises": m["max_von_mises"], "max_sigma_p1": m["max_sigma_p1"]}

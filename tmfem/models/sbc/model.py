@@ -124,7 +124,7 @@ class SBCModel:
         X = np.zeros((3, dm.n_nodes))
         X[:, :num.n_mtc_nodes] = x_start
         X[:, mt.system_node] = system.nodes()
-        X[:, num.bar_chain] = self._along_bars(X)
+        X[:, num.bar_chain] = self.along_bars(X)
         self.X = X
         mem = system.membrane
         self.shell = MITC4Shell(X=X, conn=mt.mesh.t, dofmap=dm,
@@ -143,12 +143,12 @@ class SBCModel:
         # start: the MTC start (bar tops on the corners), bar interiors on the chords
         x0 = X.copy()
         x0[:, :num.n_mtc_nodes] = x_start
-        x0[:, num.bar_chain] = self._along_bars(x0)
+        x0[:, num.bar_chain] = self.along_bars(x0)
         self._start = State(x=x0, R=np.broadcast_to(np.eye(3), (dm.n_nodes, 3, 3)).copy(),
                             frames=self.shell.frames)
 
     # ------------------------------------------------------------------ set-up
-    def _along_bars(self, x: np.ndarray) -> np.ndarray:
+    def along_bars(self, x: np.ndarray) -> np.ndarray:
         """Positions (3, n_bars, 3 e + 1) of the bar chain nodes on the chord of each bar's
         ends in x (at the fractions ``numbering.chain_s``)."""
         ch = self.numbering.bar_chain
@@ -246,7 +246,7 @@ class SBCModel:
         num = self.numbering
         x = self.X.copy()
         x[:, :num.n_mtc_nodes] = x_mtc
-        x[:, num.bar_chain] = self._along_bars(x)
+        x[:, num.bar_chain] = self.along_bars(x)
         R = np.broadcast_to(np.eye(3), (self.dofmap.n_nodes, 3, 3)).copy()
         mesh = self.mtc.topology.mesh
         nodes = np.arange(mesh.p.shape[1])
