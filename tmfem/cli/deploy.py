@@ -43,6 +43,12 @@ def configure(parser) -> None:
                         help="tendon law of the FE plant (--plant mtc): cable (EA fixed, the rate "
                              "EA/r of eq. 3.9 follows the rest length; default) or fixed-rate (the "
                              "rate frozen at the final rest lengths, as eq. 5.19 and the COM)")
+    parser.add_argument("--pfl-at", choices=["state", "reference"],
+                        help="where the adaptive PFL evaluates its model terms: state (the "
+                             "measured state, eq. 5.58; default on --plant com) or reference (the "
+                             "reference q_d, q_d' with the measured membrane coordinates: the "
+                             "plant's own stiffness stays in the loop; default on --plant mtc, "
+                             "where the law at the state diverges, docs/fe-plant.md)")
     parser.add_argument("--t-end", type=positive_float, default=20.0, help="duration [s]")
     parser.add_argument("--dt", type=positive_float, default=0.01, help="sample time [s]")
     parser.add_argument("--csv", help="write every named signal (one column each, units in the header)")
@@ -62,15 +68,19 @@ def run(args) -> dict:
                   path=args.path)
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
+    pfl_at = args.pfl_at or ("state" if args.plant == "com" else "reference")
+    # the PFL's tendon model is the plant's tendon law (docs/fe-plant.md)
+    tendons = "fixed-rate" if args.plant == "com" else args.plant_tendons or "cable"
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
-              allocation=args.allocation, path=args.path)
+              allocation=args.allocation, path=args.path, evaluation=pfl_at,
+              tendon_law=tendons)
     from tmfem.control.deploy import run_deployment
     plant = None
     if args.plant == "mtc":
         from tmfem.control.state_estimate import mtc_deployment_plant
         from tmfem.system.presets import load_preset
         plant = mtc_deployment_plant(s.model, load_preset(args.preset + "-initial"),
-                                     mesh_n=mesh_n, tendon_law=args.plant_tendons or "cable")
+                                     mesh_n=mesh_n, tendon_law=tendons)
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {args.plant}") as bar:
         try:
             r = run_deployment(model=s.model, reference=s.reference, controller=s.controller,
@@ -82,9 +92,10 @@ def run(args) -> dict:
             raise ConvergenceError(f"the closed loop on the {args.plant} plant diverged: {exc} "
                                    "(docs/fe-plant.md)") from None
     out = {"preset": args.preset, "controller": args.controller, "plant": args.plant,
-           **({"plant_tendons": args.plant_tendons or "cable", "plant_mesh": mesh_n}
+           **({"plant_tendons": tendons, "plant_mesh": mesh_n}
               if args.plant == "mtc" else {}),
            "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
+           "pfl_at": pfl_at,
            "path": args.path or DEPLOYMENTS[args.preset]["path"],
            **r.summary(), **s.info,
            "total_wall_time_s": time.perf_counter() - t0}

@@ -154,7 +154,8 @@ class FEStatePlant:
         """What the FE model alone knows over a run, from its recorded states (n, n_free) and
         inputs (n, n_t): the membrane deflections w_k its sensors measure at the plant's
         output points (eqs. 5.36-5.38, :meth:`MTCDynamics.outputs`), the tendon forces of its
-        tension-only truss elements and how often one went slack (the COM's tendons cannot).
+        tension-only truss elements, how often one went slack and which (the COM's tendons
+        cannot).
         """
         dyn = self.dyn
         fe = dyn.model
@@ -164,13 +165,15 @@ class FEStatePlant:
             w.append(dyn.outputs(x)[nq:])
             fe.set_tendon_lengths(u)
             m = member_state(fe, dyn.positions(x))
-            T.append(m["tendon_force"]); slack.append(int(np.sum(m["tendon_slack"])))
+            T.append(m["tendon_force"]); slack.append(m["tendon_slack"])
         fe.set_tendon_lengths(dyn.u0)
-        T, slack = np.array(T), np.array(slack)
+        T, slack = np.array(T), np.array(slack, dtype=bool)
         return {"w": np.array(w), "model": "mtc", "free_dofs": int(dyn.x0.size),
                 "max_tendon_stress_Pa": float(np.max(T / fe.tendon_area)),
                 "min_tendon_force_N": float(np.min(T)),
-                "tendon_slack_samples": int(np.sum(slack > 0))}
+                "tendon_slack_samples": int(np.sum(slack.any(axis=1))),
+                "slack_tendons": [t.name for t, s in zip(fe.system.tendons, slack.any(axis=0))
+                                  if s]}
 
 
 def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
