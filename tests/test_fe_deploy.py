@@ -124,3 +124,21 @@ def test_2_3_deployment_on_the_mtc_plant():
     if not REDUCED:
         assert fe.switch_time == pytest.approx(com.switch_time, abs=0.5)
         assert fe.relative_error[-1] < 0.01
+
+
+def test_cli_defaults_of_the_fe_plant(capsys):
+    """`tmfem deploy --plant mtc` runs the PFL at the reference with the plant's tendon law
+    (cable by default), and names the FE tendons that went slack; `--pfl-at state` is
+    accepted on either plant (docs/cli.md: exit 0)."""
+    import json
+    from tmfem.cli import main
+    rc = main(["deploy", "--preset", "2-3-deploy", "--controller", "adaptive", "--plant", "mtc",
+               "--plant-mesh", "3", "--t-end", "0.1", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert rc in (0, None)
+    assert out["pfl_at"] == "reference" and out["plant_tendons"] == "cable"
+    assert isinstance(out["plant_slack_tendons"], list)
+    assert out["min_rest_length_margin_m"] >= 0
+    rc = main(["deploy", "--preset", "2-3-deploy", "--controller", "adaptive", "--t-end", "0.05",
+               "--pfl-at", "reference", "--json"])
+    assert rc in (0, None) and json.loads(capsys.readouterr().out)["pfl_at"] == "reference"
