@@ -54,7 +54,8 @@ def main():
     dev_a = np.max(np.abs(np.column_stack([f[h][:n] - c[h][:n] for h in ang])), axis=1)
     dev_p = np.max(np.abs(np.column_stack([f[h][:n] - c[h][:n] for h in pos])), axis=1)
     for name, run in ((a.com_csv, c), (a.fe_csv, f)):
-        err = np.max(np.abs(np.column_stack([run[h][:n] - run[h + "_ref"][:n] for h in ang])), axis=1)
+        err = np.max(np.abs(np.column_stack([run[h][:n] - run[h + "_ref"][:n] for h in ang])),
+                     axis=1)
         pfl = run["controller"][:n] == "adaptive-pfl"
         tendons = [h[2:] for h in run if h.startswith("r_")]
         margin = np.min(np.column_stack([run["L_" + k][:n] - run["r_" + k][:n] for k in tendons]))

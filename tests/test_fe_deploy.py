@@ -68,7 +68,8 @@ def test_pfl_at_the_state_diverges_at_the_reference_tracks():
     fixed-rate tendons over the first 1.5 s: the law of eq. 5.58 with its terms at the
     measured state cancels the structure's stiffness (up to omega^2 = 3.2e3 s^-2) against
     k_q <= 60 s^-2 and the closed loop diverges (Park's Newton fails at 1.4 s); with the
-    terms at the reference the bars stay within 10 mrad of it (the COM plant: 9.4 mrad)."""
+    terms at the reference the bars stay within 10 mrad (angles) and 10 mm (bases) of it (the
+    COM plant under eq. 5.58: 9.4 mrad, 9.4 mm)."""
     initial = load_preset("2-3-deploy-initial")
     errors = {}
     for ev in ("state", "reference"):

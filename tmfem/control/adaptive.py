@@ -29,15 +29,16 @@ treats an active limit; the two differ only while one is active.
 Where the model terms are evaluated (``evaluation``): ``"state"`` (eq. 5.58 as printed) takes
 M_hat, F_hat, B_hat (eq. 5.28) at the measured state (q, q', eta, eta'); the law then cancels
 the structure's own stiffness and puts k_q in its place, so a plant whose stiffness differs
-from the model's by more than k_q / omega_i^2 in a stiff direction i (the membrane stretch of
-the 2-3 system: omega_i^2 up to 3.2e3 s^-2 against k_q = 1-47 s^-2 over the first 1.4 s,
-a tolerance of 0.03-1.5 %) is unstable in closed loop (docs/fe-plant.md). ``"reference"`` takes them at the reference (q_d, q_d') with the measured
-membrane coordinates (eta, eta'): a feedforward along the reference plus the feedback
-D_q e' + K_q e (the "PD+" of robot control); the linearised closed loop keeps the plant's own
-tangent stiffness, K_p + M_q (k_q I), so an error of the model's stiffness changes the
-tracking error, not the stability (at stable equilibria K_p is positive definite). The
-terms of eq. 5.41 then depend on t and eta only through the reference: the same
-controller on the control-oriented model (eq. 5.27) and on a finite-element plant.
+from the model's by more than k_q / omega_i^2 in a stiff direction i is unstable in closed
+loop (the 2-3 stage-2 bars moving in the membrane's plane: omega_i^2 up to 3.2e3 s^-2
+against k_q = 1-47 s^-2 over the first 1.4 s, a tolerance of 0.03-1.5 %; docs/fe-plant.md).
+``"reference"`` takes them at the reference (q_d, q_d') with the measured membrane
+coordinates (eta, eta'): a feedforward along the reference plus the feedback
+D_q e' + K_q e (the "PD+" of robot control). The linearised closed loop then keeps the
+plant's own tangent stiffness, q'' = -M_q^-1 K_p e - k_q e - d_q e', so an error of the
+model's stiffness changes the tracking error, not the stability (K_p is positive definite at
+the stable equilibria of the path). The error e, the rates and the RBF input v_q stay the
+measured ones.
 
 The tendon model (``tendon_law``): the control-oriented model writes the tendon forces as
 B(x) u (eq. 5.19) with the rates k = EA / u_0 of the final rest lengths. For a plant whose
