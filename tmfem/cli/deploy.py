@@ -42,7 +42,8 @@ def configure(parser) -> None:
     parser.add_argument("--plant-tendons", choices=["cable", "fixed-rate"],
                         help="tendon law of the FE plant (--plant mtc): cable (EA fixed, the rate "
                              "EA/r of eq. 3.9 follows the rest length; default) or fixed-rate (the "
-                             "rate frozen at the final rest lengths, as eq. 5.19 and the COM)")
+                             "rate frozen at the final rest lengths, as eq. 5.19 and the COM); the "
+                             "adaptive PFL's tendon model follows it")
     parser.add_argument("--pfl-at", choices=["state", "reference"],
                         help="where the adaptive PFL evaluates its model terms: state (the "
                              "measured state, eq. 5.58; default on --plant com) or reference (the "
