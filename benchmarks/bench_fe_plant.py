@@ -10,8 +10,12 @@ under 0.3 s per step. Prints the time per step and where it goes (for the SBC pl
 inside its Newton matrix: element assembly, the exponential map's tangent operator, the
 constraint products T^T K dexp T).
 
+``--deploy cable|fixed-rate``: instead, the 2-3 deployment itself (the adaptive PFL of 7.4 at
+the reference with the plant's tendon law, docs/fe-plant.md) on the MTC plant with that
+tendon law, from its packaged equilibrium, through :func:`run_deployment`.
+
     .venv/bin/python benchmarks/bench_fe_plant.py [--plant mtc|sbc] [--preset 2-3-deploy|1-4D]
-        [--mesh 10] [--t-end 2] [--jacobian step]
+        [--mesh 10] [--t-end 2] [--jacobian step] [--deploy cable|fixed-rate]
 """
 from __future__ import annotations
 
@@ -78,9 +82,14 @@ def main():
     ap.add_argument("--mesh", type=int, default=10)
     ap.add_argument("--t-end", type=float, default=2.0)
     ap.add_argument("--jacobian", default="step", choices=["iteration", "step", "reuse"])
+    ap.add_argument("--deploy", choices=["cable", "fixed-rate"])
     a = ap.parse_args()
     if a.plant == "mtc" and a.preset == "1-4D":
         ap.error("--plant mtc: 1-4D has H_1j nodes along the bars (the SBC model only)")
+    if a.deploy:
+        if (a.plant, a.preset) != ("mtc", "2-3-deploy"):
+            ap.error("--deploy: the 2-3 deployment on the MTC plant (--plant mtc --preset 2-3-deploy)")
+        return deployment(a)
     s = load_preset(a.preset)
     t0 = time.perf_counter()
     com = ControlOrientedModel(s, membrane_modes=default_membrane_modes(s), rest_lengths="system")
@@ -120,6 +129,29 @@ def main():
         print_breakdown({f.name: f.t for f in inner}, {f.name: f.n for f in inner},
                         plant.t["newton_matrix"] + plant.t["jacobians"],
                         "products T^T K dexp T, slicing")
+
+
+def deployment(a):
+    """The 2-3 deployment on the MTC plant (``--deploy``), timed as :func:`main`."""
+    from tmfem.control.deploy import run_deployment
+    from tmfem.control.state_estimate import mtc_deployment_plant
+    from tmfem.reference.deployments import setup
+    t0 = time.perf_counter()
+    s = setup("2-3-deploy", controller="adaptive", evaluation="reference", tendon_law=a.deploy)
+    plant = Timed(mtc_deployment_plant(s.model, load_preset("2-3-deploy-initial"),
+                                       mesh_n=a.mesh, tendon_law=a.deploy))
+    print(f"2-3 deployment on MTC 3x{a.mesh}x{a.mesh} ({a.deploy} tendons): {plant.x0.size} free "
+          f"DOFs; set-up (COM, PFL, FE start equilibrium) {time.perf_counter() - t0:.2f} s")
+    c0, w0 = time.process_time(), time.perf_counter()
+    r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+                       t_end=a.t_end, dt=0.01, plant=plant, jacobian=a.jacobian)
+    cpu, wall = time.process_time() - c0, time.perf_counter() - w0
+    steps = r.t.size - 1
+    print(f"{a.t_end:g} s deployment (and its recovery), dt = 0.01 s: wall {wall:.2f} s, CPU "
+          f"{cpu:.2f} s, {cpu / steps * 1e3:.1f} ms CPU per step (target < 300 ms: "
+          f"{'met' if cpu / steps < 0.3 else 'NOT met'}); load average {os.getloadavg()[0]:.1f} "
+          f"on {os.cpu_count()} cores")
+    print_breakdown(plant.t, plant.n, wall, "PFL, Park loop, solves, recovery")
 
 
 if __name__ == "__main__":

@@ -45,7 +45,9 @@ def configure(parser) -> None:
                         help="tendon law of the MTC plant (--plant or --compare-plant mtc): cable "
                              "(EA fixed, the rate EA/r of eq. 3.9 follows the rest length; "
                              "default) or fixed-rate (the rate frozen at the final rest lengths, as "
-                             "eq. 5.19 and the COM); the SBC model has the cable law only")
+                             "eq. 5.19 and the COM); the SBC model has the cable law only; the "
+                             "adaptive PFL's tendon model follows the plant's law (fixed rates under "
+                             "uncertainty 'initial', eq. 5.72)")
     parser.add_argument("--compare-plant", choices=["com", "mtc", "sbc"],
                         help="run the same deployment on this plant too and compare (JSON "
                              "'compare': its figures and the deviation between the plants)")
@@ -53,6 +55,13 @@ def configure(parser) -> None:
                                                "time (--compare-plant)")
     parser.add_argument("--compare-csv", help="the CSV of the --compare-plant run (the same "
                                               "columns as --csv)")
+    parser.add_argument("--pfl-at", choices=["state", "reference"],
+                        help="where the adaptive PFL evaluates its model terms: state (the "
+                             "measured state, eq. 5.58; default without an FE plant) or reference (the "
+                             "reference q_d, q_d' with the measured membrane coordinates: the "
+                             "plant's own stiffness stays in the loop; default with an FE "
+                             "plant, where the law at the state diverges, docs/fe-plant.md); "
+                             "a --compare-plant run uses the same controller")
     parser.add_argument("--t-end", type=positive_float, default=20.0, help="duration [s]")
     parser.add_argument("--dt", type=positive_float, default=0.01, help="sample time [s]")
     parser.add_argument("--csv", help="write every named signal (one column each, units in the header)")
@@ -74,12 +83,21 @@ def run(args) -> dict:
     output_file(args.compare_csv, option="--compare-csv", suffixes=(".csv",))
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
+    # one controller for both plants of a comparison: with an FE plant among them, the PFL
+    # at the reference and its tendon model the FE plant's tendon law (docs/fe-plant.md),
+    # except under eq. 5.72, whose F_q is frozen with the fixed rates of eq. 5.19
+    fe = args.plant != "com" or args.compare_plant not in (None, "com")
+    pfl_at = args.pfl_at or ("reference" if fe else "state")
+    frozen = (args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"]) == "initial"
+    tendons = (args.plant_tendons or "cable") if fe and not frozen else "fixed-rate"
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
-              allocation=args.allocation, path=args.path)
+              allocation=args.allocation, path=args.path, evaluation=pfl_at,
+              tendon_law=tendons)
     r = _run_on(args, s, args.plant, mesh_n)
     out = {"preset": args.preset, "controller": args.controller, "plant": args.plant,
            **_plant_options(args, args.plant, mesh_n),
            "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
+           "pfl_at": pfl_at,
            "path": args.path or DEPLOYMENTS[args.preset]["path"],
            **r.summary(), **s.info}
     title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
@@ -87,7 +105,7 @@ def run(args) -> dict:
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
                              gif=args.gif, vtk=args.vtk, title=title))
     if args.compare_plant:
-        out["compare"] = _compare(args, mesh_n, r)
+        out["compare"] = _compare(args, mesh_n, r, pfl_at, tendons)
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
     # to the failure are written, the exit code is 1 (docs/cli.md, docs/fe-plant.md)
@@ -121,13 +139,13 @@ def _run_on(args, s, plant_kind: str, mesh_n):
                               partial=plant is not None)
 
 
-def _compare(args, mesh_n, r) -> dict:
-    """The same deployment on ``--compare-plant`` (a fresh controller: the adaptive PFL and
-    the switch carry state) and its deviation from run ``r``."""
+def _compare(args, mesh_n, r, pfl_at: str, tendons: str) -> dict:
+    """The same deployment on ``--compare-plant`` (a fresh controller of the same options: the
+    adaptive PFL and the switch carry state) and its deviation from run ``r``."""
     from tmfem.control.plant_compare import deviation_summary, plant_deviation
     from tmfem.reference.deployments import write_csv
     s2 = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
-               allocation=args.allocation, path=args.path)
+               allocation=args.allocation, path=args.path, evaluation=pfl_at, tendon_law=tendons)
     r2 = _run_on(args, s2, args.compare_plant, mesh_n)
     dev = plant_deviation(r, r2)
     out = {"plant": args.compare_plant, **_plant_options(args, args.compare_plant, mesh_n),

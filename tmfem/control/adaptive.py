@@ -25,10 +25,30 @@ inversion of eq. 5.58 honours r_min <= u <= |tendon|(q) by
 ``"clip"`` returns eq. 5.58 unchanged and leaves the limits to the plant-side saturation
 (:class:`tmfem.control.deploy.RestLengthLimits`). The dissertation does not say how it
 treats an active limit; the two differ only while one is active.
+
+Where the model terms are evaluated (``evaluation``): ``"state"`` (eq. 5.58 as printed) takes
+M_hat, F_hat, B_hat (eq. 5.28) at the measured state (q, q', eta, eta'); the law then cancels
+the structure's own stiffness and puts k_q in its place, so a plant whose stiffness differs
+from the model's by more than k_q / omega_i^2 in a stiff direction i is unstable in closed
+loop (the 2-3 stage-2 bars moving in the membrane's plane: omega_i^2 up to 3.2e3 s^-2
+against k_q = 1-47 s^-2 over the first 1.4 s, a tolerance of 0.03-1.5 %; docs/fe-plant.md).
+``"reference"`` takes them at the reference (q_d, q_d') with the measured membrane
+coordinates (eta, eta'): a feedforward along the reference plus the feedback
+D_q e' + K_q e (the "PD+" of robot control). The linearised closed loop then keeps the
+plant's own tangent stiffness, q'' = -M_q^-1 K_p e - k_q e - d_q e', so an error of the
+model's stiffness changes the tracking error, not the stability (K_p is positive definite at
+the stable equilibria of the path). The error e, the rates and the RBF input v_q stay the
+measured ones.
+
+The tendon model (``tendon_law``): the control-oriented model writes the tendon forces as
+B(x) u (eq. 5.19) with the rates k = EA / u_0 of the final rest lengths. For a plant whose
+tendons keep their EA while their rest length changes (k = EA / u, eq. 3.9; the MTC plant's
+``"cable"`` law) the tendon force T = EA (|d| / u - 1) is affine in w = 1/u, and eq. 5.46 is
+solved for w with B_q' = -B_q diag(u_0 |d|) (:meth:`AdaptivePFL._cable`).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -39,6 +59,8 @@ from tmfem.errors import InputError, SingularInputMatrix
 
 UNCERTAINTY = ("initial", "no-MG", "exact")
 ALLOCATION = ("bounded", "clip")
+EVALUATION = ("state", "reference")
+TENDON_LAWS = ("fixed-rate", "cable")
 
 
 @dataclass
@@ -82,6 +104,13 @@ class AdaptivePFL:
     cond_every : int
         The condition number of B_q (eq. 5.46) is computed and checked every ``cond_every``
         samples (an exactly singular B_q fails its solve at any sample and is named then).
+    evaluation : {"state", "reference"}
+        Where M_hat, F_hat, B_hat are evaluated (module docstring): at the measured state
+        (eq. 5.58) or at the reference (q_d, q_d') with the measured membrane coordinates.
+    tendon_law : {"fixed-rate", "cable"}
+        The controller's tendon model (module docstring): the model's rates k = EA / u_0
+        (eq. 5.19, the COM) or k = EA / u (eq. 3.9 at the commanded rest length, a cable of
+        fixed EA), for which eq. 5.46 is solved in 1/u.
     """
 
     name = "adaptive-pfl"
@@ -89,7 +118,18 @@ class AdaptivePFL:
     def __init__(self, *, model, reference, gains: Gains, rbf: GaussianRBF, w_bar: float,
                  gamma: float = 0.01, alpha: float = 1.0, beta: float = 1.0,
                  uncertainty: str = "initial", z_initial=None, allocation: str = "bounded",
-                 r_min: float = 1e-3, cond_every: int = 10):
+                 r_min: float = 1e-3, cond_every: int = 10, evaluation: str = "state",
+                 tendon_law: str = "fixed-rate"):
+        if tendon_law not in TENDON_LAWS:
+            raise InputError(f"tendon_law: expected one of {TENDON_LAWS}, found {tendon_law!r}")
+        if tendon_law == "cable" and uncertainty == "initial":
+            raise InputError("tendon_law='cable': expected uncertainty 'no-MG' or 'exact' (the "
+                             "'initial' model freezes F_q with the fixed rates of eq. 5.19), "
+                             "found 'initial'")
+        self.tendon_law = tendon_law
+        if evaluation not in EVALUATION:
+            raise InputError(f"evaluation: expected one of {EVALUATION}, found {evaluation!r}")
+        self.evaluation = evaluation
         if uncertainty not in UNCERTAINTY:
             raise InputError(f"uncertainty: expected one of {UNCERTAINTY}, found {uncertainty!r}")
         if allocation not in ALLOCATION:
@@ -142,6 +182,9 @@ class AdaptivePFL:
         y = np.asarray(y, dtype=float)
         z, zd = y[:nz], y[nz:2 * nz]
         q, qd = z[:nq], zd[:nq]
+        if self.evaluation == "reference":
+            z, zd = z.copy(), zd.copy()
+            z[:nq], zd[:nq] = self.reference(t)[:2]
         M, F, B = self.model.matrices(z, zd)
         try:
             if self.uncertainty == "no-MG":
@@ -156,13 +199,14 @@ class AdaptivePFL:
                 self.condition_numbers.append(check_input_matrix(exact.B_q,
                                                                  where=f" at t = {t:.4g} s"))
             self._samples += 1
-            return self._law(t, q, qd, xc, exact, F_q, key)
+            return self._law(t, q, qd, xc, exact, F_q, key, z[:nq])
         except np.linalg.LinAlgError as exc:
             raise SingularInputMatrix(f"eq. 5.46 at t = {t:.4g} s: expected invertible M_q and "
                                       f"B_q, found a singular matrix ({exc})") from None
 
-    def _law(self, t, q, qd, xc, exact, F_q, key):
-        """Eq. 5.58 and the adaptation term Y of eq. 5.51 from the PFL terms."""
+    def _law(self, t, q, qd, xc, exact, F_q, key, q_model):
+        """Eq. 5.58 and the adaptation term Y of eq. 5.51 from the PFL terms (evaluated at
+        the configuration ``q_model``)."""
         nq = self.nq
         q_d, qd_d, qdd_d = self.reference(t)
         e, ed = q - q_d, qd - qd_d
@@ -170,17 +214,35 @@ class AdaptivePFL:
         W = xc.reshape(self.rbf.m, nq, order="F")
         phi = self.rbf(np.concatenate([q, qd]))
         v = -F_q - W.T @ phi - qdd_d + d_q * ed + k_q * e
+        L = tendon_lengths(self.model.system, q).copy()
+        if self.tendon_law == "cable":
+            terms, v, lower, upper = self._cable(exact, v, q_model, L)
+        else:
+            terms, lower, upper = exact, self.r_min, L
         if self.allocation == "bounded":
-            u, active = bounded_inversion(exact, v, lower=self.r_min,
-                                          upper=tendon_lengths(self.model.system, q))
+            u, active = bounded_inversion(terms, v, lower=lower, upper=upper)
             if active:
                 self.allocation_active.append(float(t))
         else:
-            u = np.linalg.solve(exact.B_q, v)
+            u = np.linalg.solve(terms.B_q, v)
+        if self.tendon_law == "cable":
+            u = 1.0 / u
         Y = -self.gamma * np.outer(phi, self.alpha * e + self.beta * ed)        # eq. 5.51
         out = (u, Y, W, e)
         self._cache = (key, out)
         return out
+
+    def _cable(self, terms, v, q_model, L):
+        """Eq. 5.46 in w = 1/u for tendons of fixed EA (module docstring): the tendon part
+        -B_q (L - u) of the model's rate k = EA / u_0 becomes -B_q diag(u_0 L) w + B_q u_0,
+        so B_q' = -B_q diag(u_0 L) and v' = v - B_q (L + u_0) (L at ``q_model``, where the
+        terms are evaluated); the limits r_min <= u <= |tendon|(q) become 1/|tendon| <= w <=
+        1/r_min. Returns (terms with B_q', v', lower, upper) of w."""
+        u0 = self.model.u0
+        Lm = tendon_lengths(self.model.system, q_model).copy()
+        Bw = -terms.B_q * (u0 * Lm)[None, :]
+        vw = v - terms.B_q @ (Lm + u0)
+        return replace(terms, B_q=Bw), vw, 1.0 / L, 1.0 / self.r_min
 
     def output(self, t, y, xc):
         return self._terms(t, y, xc)[0]

@@ -289,7 +289,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      u_m: float = 0.01, membrane_modes: int | None = None,
                      check_path: bool = True, bases=None, allocation: str = "bounded",
                      hinf_method: str = "lmi", r_min: float = 1e-3,
-                     delta_path: bool = False) -> DeploymentSetup:
+                     delta_path: bool = False, evaluation: str = "state",
+                     tendon_law: str = "fixed-rate") -> DeploymentSetup:
     """The model (built at the final configuration with its printed rest lengths), the
     reference from ``initial`` to ``final`` (:class:`DeploymentReference`, stage bases from
     ``bases`` when given, psi_r from eq. 3.22 with Delta linear in s when ``delta_path``,
@@ -298,7 +299,9 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     equilibrium: ``"lmi"`` (issue 12's H-infinity output feedback of 7.3 with alpha-stability,
     :func:`lmi_hinf_controller`, synthesised by ``hinf_method``), ``"lqr"``
     (:func:`lqr_state_feedback`) or ``"hinf"`` (:func:`hinf_output_feedback`, python-control
-    Riccati on [q, w])."""
+    Riccati on [q, w]). ``evaluation``: where the PFL evaluates its model terms, at the
+    measured state (eq. 5.58) or at the reference; ``tendon_law``: the PFL's tendon model,
+    the rates of eq. 5.19 or k = EA / u (:mod:`tmfem.control.adaptive`)."""
     from tmfem.control.adaptive import AdaptivePFL, reference_centres
     from tmfem.control.reference_trajectory import DeploymentReference
     from tmfem.control.rbf import GaussianRBF
@@ -322,7 +325,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     C, sig = reference_centres(ref, t_end=t_settle, m=n_centres)
     ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centres=C, sigma=sig),
                      w_bar=w_bar, gamma=gamma, uncertainty=uncertainty, allocation=allocation,
-                     r_min=r_min)
+                     r_min=r_min, evaluation=evaluation, tendon_law=tendon_law)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
     z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)]))
     info = {"rbf_centres": n_centres, "rbf_sigma": sig, "w_bar": w_bar, "K": K}

@@ -162,7 +162,7 @@ class FEStatePlant:
         """What the FE model alone knows over a run, from its recorded states (n, n_free) and
         inputs (n, n_t): the membrane deflections w_k its sensors measure at the plant's
         output points (eqs. 5.36-5.38, :meth:`FEPlant.outputs`), the forces of its
-        tension-only tendon elements and how often one went slack (the COM's tendons
+        tension-only tendon elements, how often one went slack and which (the COM's tendons
         cannot), its bar compression (the SBC model: the larger of the two segments of a bar
         carrying H_1j) and, every ``stress_every`` samples, its membrane's peak stresses
         (``dyn.membrane_stress``: the MTC membrane's Gauss points, the SBC shell's three
@@ -170,12 +170,13 @@ class FEStatePlant:
         """
         dyn = self.dyn
         nq = len(dyn.model.system.q_names)
-        w, T, Te, bar, vm, p1 = [], [], [], [], [], []
+        w, T, Te, bar, vm, p1, slack_t = [], [], [], [], [], [], []
         for k, (x, u) in enumerate(zip(states, inputs)):
             w.append(dyn.outputs(x)[nq:])
             dyn.model.set_tendon_lengths(u)
             m = dyn.member_forces(x)
             T.append(m["tendon_force"]); Te.append(m["element_force"]); bar.append(m["bar_force"])
+            slack_t.append(m["tendon_slack"])
             if k % stress_every == 0:
                 st = dyn.membrane_stress(x)
                 vm.append(st["max_von_mises"]); p1.append(st["max_sigma_p1"])
@@ -189,6 +190,8 @@ class FEStatePlant:
                 "tendon_slack_elements_max": int(np.max(slack)),
                 "peak_bar_compression_N": float(max(0.0, -np.min(bar))),
                 "max_von_mises_Pa": float(np.max(vm)), "max_sigma_p1_Pa": float(np.max(p1)),
+                "slack_tendons": [t.name for t, s in zip(dyn.model.system.tendons,
+                                                         np.any(slack_t, axis=0)) if s],
                 "slack": slack}
 
 

@@ -100,7 +100,8 @@ class FEPlant(ABC):
     @abstractmethod
     def member_forces(self, u) -> dict:
         """Tendon element forces ``element_force``, tendon forces ``tendon_force`` and bar
-        axial forces ``bar_force`` [N] at the free-dof state u."""
+        axial forces ``bar_force`` [N] at the free-dof state u, and per tendon whether one of
+        its elements is slack (``tendon_slack``)."""
 
     @abstractmethod
     def membrane_stress(self, u) -> dict:

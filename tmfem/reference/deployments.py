@@ -46,12 +46,15 @@ def inside_points(system, points, *, inset: float = 1e-3):
 
 
 def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
-          allocation: str = "bounded", path: str | None = None):
+          allocation: str = "bounded", path: str | None = None, evaluation: str = "state",
+          tendon_law: str = "fixed-rate"):
     """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`).
     ``path`` (default the preset's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
     membrane stretch Delta linear in s), ``"table-7-7-bases"`` (2-3: the stage-2 base on the
     reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
-    ``"linear"`` (every symmetric parameter linear in s)."""
+    ``"linear"`` (every symmetric parameter linear in s). ``evaluation``: where the PFL
+    evaluates its model terms (``"state"``, eq. 5.58, or ``"reference"``); ``tendon_law``: its
+    tendon model (``"fixed-rate"``, eq. 5.19, or ``"cable"``, :mod:`tmfem.control.adaptive`)."""
     from tmfem.control.adaptive import Gains
     from tmfem.control.deploy import build_deployment
     from tmfem.reference.tables import deployment_bases
@@ -67,7 +70,8 @@ def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | 
                             output_points=inside_points(final, p["points"]),
                             linear=CONTROLLERS[controller], u_m=p["u_m"],
                             bases=deployment_bases(final) if path == "table-7-7-bases" else None,
-                            delta_path=path == "delta", allocation=allocation)
+                            delta_path=path == "delta", allocation=allocation,
+                            evaluation=evaluation, tendon_law=tendon_law)
 
 
 def check_choices(preset: str, *, controller: str = "adaptive-hinf", uncertainty=None,

@@ -142,10 +142,11 @@ class SBCDynamics(FEPlant):
 
     def member_forces(self, u) -> dict:
         """Tendon element forces, tendon forces and bar axial forces [N] at the state u
-        (:meth:`SBCModel.member_forces`)."""
+        (:meth:`SBCModel.member_forces`); a tendon is slack where one of its elements is."""
         f = self.model.member_forces(self.configuration(u))
+        slack = np.any(f["tendon_element"].reshape(f["tendon"].size, -1) <= 0.0, axis=1)
         return {"element_force": f["tendon_element"], "tendon_force": f["tendon"],
-                "bar_force": f["bar"]}
+                "bar_force": f["bar"], "tendon_slack": slack}
 
     def state_of(self, xf: np.ndarray) -> np.ndarray:
         """The free-dof state whose positions (MTC numbering) are xf (3, n_mtc_nodes), the bars
