@@ -179,6 +179,48 @@ def test_switching_bumpless():
     assert u[0] == pytest.approx(0.3) and sw.switch_jump == pytest.approx(0.0, abs=1e-12)
 
 
+def test_switching_estimate_start():
+    # start="estimate": an observer's state starts at the measured perturbation y - y_e
+    # (the central H-infinity controller, tmfem.control.hinf_central); the input then jumps
+    # to the controller's own, and the jump is reported
+    import control
+
+    class Const:
+        name = "first"
+
+        def reset(self, t0, y0, dt):
+            return np.zeros(0)
+
+        def output(self, t, y, xc):
+            return np.array([0.3])
+
+        def update(self, t, y, xc):
+            return xc
+    q_e = np.array([1.0, 2.0])
+    lin = LinearController(control.ss(-np.eye(2), np.eye(2), [[1.0, 0.5]], [[0.0, 0.0]]),
+                           u_e=[0.1], y_e=q_e, name="lin")
+    sw = SwitchingController(first=Const(), second=lin, q_of_y=lambda y: y, q_e=q_e,
+                             measure=lambda y: y, R_c=0.01, start="estimate")
+    xc = sw.reset(0.0, np.array([1.5, 2.0]), 0.01)
+    assert sw.output(0.0, np.array([1.5, 2.0]), xc)[0] == 0.3
+    xc = sw.update(0.0, np.array([1.5, 2.0]), xc)
+    y = np.array([1.005, 2.004])
+    u = sw.output(0.01, y, xc)
+    assert sw.switch_time == 0.01
+    assert u[0] == pytest.approx(0.1 + 0.005 + 0.5 * 0.004)           # u_e + C_k (y - y_e)
+    assert sw.switch_jump == pytest.approx(0.3 - u[0])
+    with pytest.raises(InputError, match="start"):
+        SwitchingController(first=Const(), second=lin, q_of_y=lambda y: y, q_e=q_e,
+                            measure=lambda y: y, start="zero")
+    small = LinearController(control.ss([[-1.0]], [[1.0, 0.0]], [[2.0]], [[0.0, 0.0]]),
+                             u_e=[0.1], y_e=q_e, name="lin")
+    sw = SwitchingController(first=Const(), second=small, q_of_y=lambda y: y, q_e=q_e,
+                             measure=lambda y: y, start="estimate")
+    xc = sw.reset(0.0, y, 0.01)
+    with pytest.raises(InputError, match="order 2"):
+        sw.output(0.0, y, xc)
+
+
 def test_bounded_inversion_kkt_and_exact_inside():
     # eq. 5.46 with rest-length limits: inside the limits the exact B_q^-1 v; outside, the
     # minimiser of (B_q u - v)^T M_q (B_q u - v) over the box, checked by its KKT
