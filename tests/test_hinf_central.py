@@ -91,14 +91,15 @@ def plant14():
     from tmfem.control.design import deployed_hinf
     from tmfem.control.plant import DEPLOYED
     from tmfem.system import load_preset
-    d = deployed_hinf(load_preset("1-4D"), synthesize=False)
+    d = deployed_hinf(load_preset("1-4D"), method="central")
     return d, DEPLOYED["1-4D"]["alpha"]
 
 
 def test_1_4D_central_design(plant14):
     d, alpha = plant14
     P = d.generalized
-    c = hinf_central(P, alpha=alpha)
+    c = d.design
+    assert c.kind == "output feedback (central, minimum entropy)" and c.alpha == alpha
     # gamma_opt = ||D11|| = W_e = 0.5 (7.4), gamma = 1.01 gamma_opt
     assert c.gamma_lmi == pytest.approx(0.5, rel=1e-5) and c.gamma == pytest.approx(1.01 * c.gamma_lmi)
     # python-control's own norms and poles on the closed loop
@@ -134,7 +135,7 @@ def test_1_4D_central_h2_not_above_the_lmi_route(plant14):
     from tmfem.control.hinf import hinf_lmi
     d, alpha = plant14
     P = d.generalized
-    c = hinf_central(P, alpha=alpha)
+    c = d.design
     lmi = hinf_lmi(P, alpha=alpha, solver="ARE")
     assert lmi.gamma == pytest.approx(c.gamma, rel=1e-9)
     assert _noise_to_ed_h2(P, c.controller) <= _noise_to_ed_h2(P, lmi.controller)
