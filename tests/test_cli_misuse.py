@@ -90,6 +90,8 @@ def string_rest(tmp_path):
     (["control", "hinf", "--preset", "1-4D", "--plot", "OUT/k.txt"], BAD_INPUT, "suffix"),
     (["control", "hinf", "--preset", "1-4D", "--alpha", "abc"], BAD_INPUT, "invalid float"),
     (["control", "pbh", "--preset", "1-4D", "--alpha", "1"], BAD_INPUT, "hinf` only"),
+    (["control", "hinf", "--preset", "1-4D", "--method", "central", "--solver", "CLARABEL"],
+     BAD_INPUT, "--method lmi only"),
     (["control", "hinf", "--preset", "nope"], BAD_INPUT, "unknown preset"),
     (["control", "recheck", "FILE"], BAD_INPUT, "expected an .npz"),
     (["control", "recheck", "OUT/missing.npz"], BAD_INPUT, "expected an .npz"),

@@ -147,27 +147,31 @@ def test_rest_length_saturation(model14):
     assert lim.active == [(0.0, 8)] and lim.margins[0] == pytest.approx(0.0)
 
 
+class _Const:
+    """A deployment controller with the constant input 0.3 (no state)."""
+
+    name = "first"
+
+    def reset(self, t0, y0, dt):
+        return np.zeros(0)
+
+    def output(self, t, y, xc):
+        return np.array([0.3])
+
+    def update(self, t, y, xc):
+        return xc
+
+
 def test_switching_bumpless():
     # eq. 5.70 with q_e = (1, 2): switch at the first sample within R_c; a dynamic linear
     # controller then starts from a state giving the deployment controller's last input
     import control
 
-    class Const:
-        name = "first"
-
-        def reset(self, t0, y0, dt):
-            return np.zeros(0)
-
-        def output(self, t, y, xc):
-            return np.array([0.3])
-
-        def update(self, t, y, xc):
-            return xc
     q_e = np.array([1.0, 2.0])
     assert relative_error([1.01, 2.0], q_e) == pytest.approx(0.01)
     lin = LinearController(control.ss([[-1.0]], [[1.0, 0.0]], [[2.0]], [[0.0, 0.0]]),
                            u_e=[0.1], y_e=q_e, name="lin")
-    sw = SwitchingController(first=Const(), second=lin, q_of_y=lambda y: y, q_e=q_e,
+    sw = SwitchingController(first=_Const(), second=lin, q_of_y=lambda y: y, q_e=q_e,
                              measure=lambda y: y, R_c=0.01)
     xc = sw.reset(0.0, np.array([1.5, 2.0]), 0.01)
     u = sw.output(0.0, np.array([1.5, 2.0]), xc)
@@ -177,6 +181,37 @@ def test_switching_bumpless():
     u = sw.output(0.01, y, xc)
     assert sw.switch_time == 0.01 and sw.name == "lin"
     assert u[0] == pytest.approx(0.3) and sw.switch_jump == pytest.approx(0.0, abs=1e-12)
+
+
+def test_switching_estimate_start():
+    # start="estimate": an observer's state starts at the measured perturbation y - y_e
+    # (the central H-infinity controller, tmfem.control.hinf_central); the input then jumps
+    # to the controller's own, and the jump is reported
+    import control
+
+    q_e = np.array([1.0, 2.0])
+    lin = LinearController(control.ss(-np.eye(2), np.eye(2), [[1.0, 0.5]], [[0.0, 0.0]]),
+                           u_e=[0.1], y_e=q_e, name="lin")
+    sw = SwitchingController(first=_Const(), second=lin, q_of_y=lambda y: y, q_e=q_e,
+                             measure=lambda y: y, R_c=0.01, start="estimate")
+    xc = sw.reset(0.0, np.array([1.5, 2.0]), 0.01)
+    assert sw.output(0.0, np.array([1.5, 2.0]), xc)[0] == 0.3
+    xc = sw.update(0.0, np.array([1.5, 2.0]), xc)
+    y = np.array([1.005, 2.004])
+    u = sw.output(0.01, y, xc)
+    assert sw.switch_time == 0.01
+    assert u[0] == pytest.approx(0.1 + 0.005 + 0.5 * 0.004)           # u_e + C_k (y - y_e)
+    assert sw.switch_jump == pytest.approx(0.3 - u[0])
+    with pytest.raises(InputError, match="start"):
+        SwitchingController(first=_Const(), second=lin, q_of_y=lambda y: y, q_e=q_e,
+                            measure=lambda y: y, start="zero")
+    small = LinearController(control.ss([[-1.0]], [[1.0, 0.0]], [[2.0]], [[0.0, 0.0]]),
+                             u_e=[0.1], y_e=q_e, name="lin")
+    sw = SwitchingController(first=_Const(), second=small, q_of_y=lambda y: y, q_e=q_e,
+                             measure=lambda y: y, start="estimate")
+    xc = sw.reset(0.0, y, 0.01)
+    with pytest.raises(InputError, match="order 2"):
+        sw.output(0.0, y, xc)
 
 
 def test_bounded_inversion_kkt_and_exact_inside():

@@ -39,9 +39,11 @@ def configure(parser) -> None:
                              "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
                              "docs/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (a feasible "
                              "point at --gamma, docs/lpv.md)")
-    parser.add_argument("--method", choices=("lmi", "riccati"), default=None,
+    parser.add_argument("--method", choices=("lmi", "riccati", "central"), default=None,
                         help="lmi (default): eliminated LMIs of eq. 5.65; riccati: python-control "
-                             "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant")
+                             "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant; central: the "
+                             "central (minimum-entropy) controller at 1.01 gamma_opt, solver-"
+                             "independent, the one `tmfem deploy` uses (docs/control.md)")
     parser.add_argument("--pbh-tol", type=float, default=None,
                         help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
     parser.add_argument("--save", help="write plant and controller to this .npz")
@@ -100,8 +102,9 @@ def run(args) -> dict:
                              "`tmfem control hinf` only")
     if args.solver == "EIGOPT":
         raise InputError("--solver EIGOPT: applies to `tmfem control lpv` only")
-    if args.method == "riccati" and args.solver is not None:
-        raise InputError(f"--solver {args.solver}: applies to --method lmi only, found --method riccati")
+    if args.method in ("riccati", "central") and args.solver is not None:
+        raise InputError(f"--solver {args.solver}: applies to --method lmi only, found --method "
+                         f"{args.method}")
     output_file(args.save, option="--save", suffixes=(".npz",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
     system = system_from_args(args)

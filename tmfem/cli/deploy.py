@@ -20,7 +20,8 @@ def configure(parser) -> None:
     parser.add_argument("--preset", required=True, choices=sorted(DEPLOYMENTS))
     parser.add_argument("--controller", default="adaptive-hinf", choices=sorted(CONTROLLERS),
                         help="adaptive PFL then a linear controller about the final equilibrium: "
-                             "adaptive-hinf (the LMI H-infinity controller of 7.3, tmfem control), "
+                             "adaptive-hinf (the H-infinity controller of 7.3: the central one at 1.01 "
+                             "gamma_opt, tmfem control hinf --method central), "
                              "adaptive-hinf-riccati (python-control hinfsyn), adaptive-lqr (LQR "
                              "state feedback) or adaptive (no switch)")
     parser.add_argument("--uncertainty", choices=list(UNCERTAINTIES),

@@ -5,6 +5,8 @@
 * :mod:`tmfem.control.pbh`: PBH eigenvector tests with margins (eq. 5.71);
 * :mod:`tmfem.control.hinf`: H-infinity output feedback by eliminated LMIs with
   alpha-stability, controller recovery (eqs. 5.63-5.67), state feedback;
+* :mod:`tmfem.control.hinf_central`: the central (minimum-entropy) controller at
+  (1 + tol) gamma_opt, one well-defined member of a degenerate optimum's family;
 * :mod:`tmfem.control.design`: the end-to-end design, saving and re-checking;
 * :mod:`tmfem.control.analysis`: closed-loop plots;
 * deployment (7.2, 7.4, 7.6; docs/deployment.md): :mod:`tmfem.control.reference_trajectory`

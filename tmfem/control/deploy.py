@@ -98,14 +98,19 @@ def hinf_output_feedback(model, *, u_e, z_e=None, w_e: float = 0.5, w_n: float =
 
 
 #: names of the H-infinity controllers of 7.3 by synthesis method
-HINF_NAMES = {"lmi": "hinf-lmi", "riccati": "hinf-shifted-riccati"}
+HINF_NAMES = {"central": "hinf-central", "lmi": "hinf-lmi", "riccati": "hinf-shifted-riccati"}
+#: the linear controller's state at the switch (:class:`SwitchingController`) by method:
+#: the central controller is an observer of the measured state (its state starts at it)
+HINF_STARTS = {"central": "estimate", "lmi": "bumpless", "riccati": "bumpless"}
 
 
-def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "lmi"):
+def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central"):
     """The H-infinity controller of 7.3 (eqs. 5.62-5.67, :func:`tmfem.control.design.
-    deployed_hinf` with the 7.4 weights and alpha_1: eliminated LMIs, or ``method=
-    "riccati"``, python-control ``hinfsyn`` on the alpha-shifted plant where the LMI does not
-    solve, the 2-3 system) as a :class:`LinearController`, with ``measure`` mapping the
+    deployed_hinf` with the 7.4 weights and alpha_1: the central controller at 1.01
+    gamma_opt (default, solver-independent, :mod:`tmfem.control.hinf_central`), the
+    eliminated LMIs (``"lmi"``, one solver-dependent member of the degenerate optimum's
+    family) or ``method="riccati"``, python-control ``hinfsyn`` on the alpha-shifted
+    plant) as a :class:`LinearController`, with ``measure`` mapping the
     modal state y = [z, z'] of :class:`StatePlant` onto the design's measured signals
     [q, v, q', v'] (membrane point coordinates of eq. 5.18: z_points = P^-1 z_modal, the
     same linear map for the rates).
@@ -288,7 +293,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      n_centres: int = 10, w_bar: float = 100.0, gamma: float = 0.01,
                      u_m: float = 0.01, membrane_modes: int | None = None,
                      check_path: bool = True, bases=None, allocation: str = "bounded",
-                     hinf_method: str = "lmi", r_min: float = 1e-3,
+                     hinf_method: str = "central", r_min: float = 1e-3,
                      delta_path: bool = False, evaluation: str = "state",
                      tendon_law: str = "fixed-rate") -> DeploymentSetup:
     """The model (built at the final configuration with its printed rest lengths), the
@@ -297,7 +302,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     one-stage systems), the adaptive PFL (eq. 5.58, limits treated by ``allocation``) and,
     unless ``linear="none"``, the switch (eq. 5.70) to a linear controller about the final
     equilibrium: ``"lmi"`` (issue 12's H-infinity output feedback of 7.3 with alpha-stability,
-    :func:`lmi_hinf_controller`, synthesised by ``hinf_method``), ``"lqr"``
+    :func:`lmi_hinf_controller`, synthesised by ``hinf_method``, its state at the switch by
+    :data:`HINF_STARTS`), ``"lqr"``
     (:func:`lqr_state_feedback`) or ``"hinf"`` (:func:`hinf_output_feedback`, python-control
     Riccati on [q, w]). ``evaluation``: where the PFL evaluates its model terms, at the
     measured state (eq. 5.58) or at the reference; ``tendon_law``: the PFL's tendon model,
@@ -331,10 +337,12 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     info = {"rbf_centres": n_centres, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
     lin_ctrl = None
     ctrl = ad
+    start = "bumpless"
     if linear != "none":
         if linear == "lmi":
             lin_ctrl, measure, g = lmi_hinf_controller(final, membrane_modes=K, method=hinf_method)
             info["hinf_gamma"] = g
+            start = HINF_STARTS[hinf_method]
         elif linear == "lqr":
             lin_ctrl, _ = lqr_state_feedback(model, u_e=model.u0, z_e=z_e, u_m=u_m)
             measure = lambda y: np.asarray(y)                               # noqa: E731
@@ -343,7 +351,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
             measure = output_measure(model)
             info["hinf_gamma"] = g
         ctrl = SwitchingController(first=ad, second=lin_ctrl, q_of_y=lambda y: y[: model.nq],
-                                   q_e=ref.q_e, measure=measure, R_c=R_c)
+                                   q_e=ref.q_e, measure=measure, R_c=R_c, start=start)
     return DeploymentSetup(model=model, reference=ref, adaptive=ad, controller=ctrl,
                            linear=lin_ctrl, z0=z0, z_e=z_e, info=info)
 

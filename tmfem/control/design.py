@@ -15,11 +15,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.control.hinf import GeneralizedPlant, HinfDesign, hinf_lmi, hinf_riccati, verify
+from tmfem.control.hinf_central import hinf_central
 from tmfem.control.pbh import PBHResult, pbh_ss
 from tmfem.control.plant import DEPLOYED, DeployedPlant, deployed_plant, generalized_plant
 from tmfem.errors import InputError
 
 log = logging.getLogger(__name__)
+
+#: synthesis methods of :func:`deployed_hinf`
+METHODS = ("lmi", "riccati", "central")
 
 
 @dataclass
@@ -67,12 +71,15 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         failure with Clarabel (docs/control.md).
     synthesize : bool
         False: plant and PBH only (``tmfem control pbh``).
-    method : {"lmi", "riccati"}
-        Eliminated LMIs (:func:`~tmfem.control.hinf.hinf_lmi`) or the Riccati route on the
-        alpha-shifted plant (:func:`~tmfem.control.hinf.hinf_riccati`).
+    method : {"lmi", "riccati", "central"}
+        Eliminated LMIs (:func:`~tmfem.control.hinf.hinf_lmi`), the Riccati route on the
+        alpha-shifted plant (:func:`~tmfem.control.hinf.hinf_riccati`) or the central
+        (minimum-entropy) controller at 1.01 gamma_opt
+        (:func:`~tmfem.control.hinf_central.hinf_central`: solver-independent; the default
+        of the deployments, docs/control.md).
     """
-    if method not in ("lmi", "riccati"):
-        raise InputError(f"method: expected 'lmi' or 'riccati', found {method!r}")
+    if method not in METHODS:
+        raise InputError(f"method: expected one of {METHODS}, found {method!r}")
     d = DEPLOYED.get(system.name, {})
     alpha = d.get("alpha") if alpha is None else alpha
     u_m = d.get("u_m") if u_m is None else u_m
@@ -87,6 +94,8 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     if synthesize:
         if method == "lmi":
             design = hinf_lmi(gen, alpha=alpha, solver=solver, operating_point=plant.operating_point)
+        elif method == "central":
+            design = hinf_central(gen, alpha=alpha, operating_point=plant.operating_point)
         else:
             design = hinf_riccati(gen, alpha=alpha, operating_point=plant.operating_point)
     return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design,

@@ -11,16 +11,27 @@ time-varying reference the condition would hold at t = 0, where q = q_d(0) (docs
 The linear controller is any :class:`tmfem.simulation.controllers.LinearController` from
 y_lin - y_e to u - u_e (an H-infinity controller of issue 12, an LQR state feedback, ...);
 ``measure(y)`` maps the plant outputs seen by the switching controller onto its inputs
-y_lin. Bumpless start: at the switch the linear controller is reset and its state x_c is
-chosen, in the least-squares sense, so that its first output equals the last input of the
-deployment controller (C_k x_c = u_prev - u_e - D_k (y_lin - y_e)); a static gain has no
-state and the jump in u at the switch is reported (``switch_jump``).
+y_lin. The linear controller's state x_c at the switch (``start``):
+
+* ``"bumpless"``: chosen, in the least-squares sense, so that its first output equals the
+  last input of the deployment controller (C_k x_c = u_prev - u_e - D_k (y_lin - y_e)). The
+  minimum-norm solution depends on the controller's state coordinates (two realisations of
+  one transfer function start differently).
+* ``"estimate"``: x_c = y_lin - y_e, for a controller whose state estimates the measured
+  state perturbation in the coordinates of y_lin (an observer, such as the central
+  H-infinity controller, :mod:`tmfem.control.hinf_central`): it starts with zero estimation
+  error; the input then jumps to the controller's own.
+
+A static gain has no state. The jump in u at the switch is reported (``switch_jump``).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from tmfem.errors import InputError
+
+#: initialisations of the linear controller's state at the switch
+STARTS = ("bumpless", "estimate")
 
 
 def relative_error(q, q_e):
@@ -50,11 +61,17 @@ class SwitchingController:
         y -> inputs of ``second``.
     R_c : float
         Switching radius (7.4: 0.01).
+    start : {"bumpless", "estimate"}
+        The linear controller's state at the switch (module docstring).
     """
 
-    def __init__(self, *, first, second, q_of_y, q_e, measure, R_c: float = 0.01):
+    def __init__(self, *, first, second, q_of_y, q_e, measure, R_c: float = 0.01,
+                 start: str = "bumpless"):
         if not R_c > 0:
             raise InputError(f"R_c: expected > 0, found {R_c!r}")
+        if start not in STARTS:
+            raise InputError(f"start: expected one of {STARTS}, found {start!r}")
+        self.start = start
         self.first, self.second = first, second
         self.q_of_y, self.q_e, self.measure, self.R_c = q_of_y, np.asarray(q_e, float), measure, R_c
         relative_error(self.q_e, self.q_e)                   # refuses zero entries of q_e
@@ -84,6 +101,11 @@ class SwitchingController:
         yl = np.asarray(self.measure(y), dtype=float)
         x2 = np.asarray(self.second.reset(t, yl, self.dt), dtype=float)
         _, _, C, D = self.second.discrete
+        if x2.size and self.start == "estimate":
+            if x2.size != yl.size:
+                raise InputError(f"start 'estimate': expected a controller of order "
+                                 f"{yl.size} (its state estimates y - y_e), found {x2.size}")
+            return yl - self.second.y_e
         if x2.size and self._u_prev is not None:
             rhs = self._u_prev - self.second.u_e - D @ (yl - self.second.y_e)
             x2 = np.linalg.lstsq(C, rhs, rcond=None)[0]

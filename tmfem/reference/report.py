@@ -455,7 +455,7 @@ def _deployment_section(d, link, img) -> list[str]:
             f"`{p}` from its packaged configuration (Table 7.3) to the deployed one: adaptive "
             "partial feedback linearisation (Table 7.1 gains, eq. 5.68 reference), then the "
             f"switch to the linear controller of `--controller {d['controller']}` (adaptive-hinf: "
-            "the LMI H-infinity controller of 7.3), "
+            "the H-infinity controller of 7.3: the central one at 1.01 gamma_opt), "
             f"{d['t_end']:g} s at dt = {d['dt_s']:g} s. The controller's model has no error "
             f"(`--uncertainty {d['uncertainty']}`): with the 7.4 model error (eq. 5.72) it does "
             "not switch within 20 s (docs/deployment.md, 'Results'). Same run: `tmfem deploy "
