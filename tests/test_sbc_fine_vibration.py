@@ -41,13 +41,14 @@ def test_fine_mesh_1_4_vibration_runs_past_the_old_failure():
     r = three_model_vibration("1-4", t_end=t_end, dt=0.01, mesh_n=20)
     c = r["comparison"]
     assert c["t_end"] == pytest.approx(t_end)
-    # undamped: Park's method only dissipates (the unresolved shell modes); measured
-    # -2.8e-2 (SBC) over 10 s on 4 x 10 x 10
+    # undamped: Park's method only dissipates (the unresolved high modes); measured on
+    # 4 x 10 x 10 over 10 s 2.8e-2 (SBC), 2.3e-2 (MTC); here 3.0e-2, 4.9e-2 (5 s: 8.6e-3, 1.1e-2)
     for m in ("SBC", "MTC"):
-        assert c["energy_drift_over_initial_kinetic"][m] < 0.05, m
+        assert c["energy_drift_over_initial_kinetic"][m] < 0.08, m
     # the two FE models against each other, within the bounds of the 4 x 10 x 10 run
     # (docs/sbc.md: first 2 s rms differences 1.0 % theta_12, 1.0 % B_12 z, 7.4 % w_1;
-    # amplitudes of the perturbed bar within 0.4 %)
+    # amplitudes of the perturbed bar within 0.4 %); measured here 0.78 %, 0.78 %, 6.3 %,
+    # 0.2 % (10 s) and 0.4 % (5 s), frequencies 0.3078 / 0.3079 Hz
     early = c["rms_difference_vs_SBC_early"]["MTC"]
     assert early["theta_12"] < 0.03 and early["B_12_z"] < 0.03
     assert early["w_1"] < 0.15
