@@ -132,3 +132,38 @@ def test_kept_matrix_restarts_with_full_newton_and_lands_on_the_same_solution():
     np.testing.assert_allclose(reuse.x, full.x, atol=1e-8)
     np.testing.assert_allclose(step.x, full.x, atol=1e-8)
     assert reuse.jacobian_evaluations < full.jacobian_evaluations / 2
+
+
+class _QuasiStaticArctan:
+    """m x'' + arctan(x - A sin t) = 0 with m -> 0: a quasi-static dof, x = A sin t - tan(m a)
+    (closed form), whose Newton matrix (K = 1 / (1 + (x - A sin t)^2), the mass term ~1e-8)
+    makes plain Newton overshoot and diverge once the predictor misses by |z| > 1.39 (Newton
+    on arctan), as the SBC shell's soft rotations do (docs/sbc.md, "Free vibration on the
+    fine mesh")."""
+
+    m, A = 1e-9, 100.0
+
+    def residual(self, x, v, a, t):
+        return self.m * a + np.arctan(x - self.A * np.sin(t))
+
+    def jacobians(self, x, v, a, t):
+        z = x - self.A * np.sin(t)
+        return np.diag(1.0 / (1.0 + z**2)), np.zeros((1, 1)), self.m * np.eye(1)
+
+
+def test_line_search_converges_where_plain_newton_diverges():
+    kw = dict(x0=[0.0], v0=[_QuasiStaticArctan.A], dt=0.5, n_steps=30)
+    # the predictor misses x(t) by ~A dt^3 / 6 = 2.1 > 1.39: plain Newton diverges, named so
+    with pytest.raises(ConvergenceError, match=r"Park step \d+ \(t = .* s, dt = 0.5 s\): "
+                                               r"Newton diverged .* at the predictor"):
+        park_integrate(_QuasiStaticArctan(), **kw)
+    res = park_integrate(_QuasiStaticArctan(), line_search=True, **kw)
+    exact = _QuasiStaticArctan.A * np.sin(res.t)
+    assert res.steps == 30
+    assert np.max(np.abs(res.x[:, 0] - exact)) < 1e-5       # tan(m a) with |a| <~ A / dt^2
+    # where plain Newton converges, the line search takes every correction whole
+    smooth = dict(x0=[0.0], v0=[_QuasiStaticArctan.A], dt=0.05, n_steps=100)
+    a = park_integrate(_QuasiStaticArctan(), **smooth)
+    b = park_integrate(_QuasiStaticArctan(), line_search=True, **smooth)
+    np.testing.assert_array_equal(a.x, b.x)
+    assert a.newton_iterations == b.newton_iterations

@@ -229,6 +229,7 @@ class _Points:
         e1 /= np.linalg.norm(e1, axis=-1, keepdims=True)
         e2 = np.cross(e3, e1)
         Ev = np.stack([e1, e2, e3], axis=-2)                         # rows e_m
+        self.frame = Ev
         Ginv = np.linalg.inv(J)                                      # columns G^i
         T = np.einsum("...mj,...ji->...mi", Ev, Ginv)                # T_mi = e_m . G^i
         basis = np.zeros((5, 3, 3))
@@ -586,13 +587,19 @@ class MITC4Shell:
         thickness Gauss points: :func:`tmfem.fem.tension_field.element_wrinkling` of the local
         in-plane strains in the results frame of :meth:`stresses` (``direction``: the tension
         direction in that frame, [e_1, e_2, 0]). With the SVK law these are the states the
-        lamina would take if it could wrinkle."""
+        lamina would take if it could wrinkle. ``direction_xyz`` (3, ne): the same tension
+        direction in the global axes, d = n_1 e_1 + n_2 e_2 with the results frame of the
+        reference geometry (one frame per element: e_1, e_2 do not vary through the
+        thickness), a material direction of the reference surface as the Green-Lagrange
+        strain it comes from."""
         u, d, w, _ = self._nodal(state)
         pts = _Points(self, np.asarray(xi, dtype=float).reshape(2, 1), np.ones(1),
                       *np.polynomial.legendre.leggauss(2), output_frame=True)
         c = self._strains(pts, u, d, w)[0]
         eps = np.einsum("...ap,...p->...a", pts.Q, c).reshape(self.ne, -1, 5)
-        return element_wrinkling(self.law, _in_plane(eps))
+        out = element_wrinkling(self.law, _in_plane(eps))
+        out["direction_xyz"] = np.einsum("emi,me->ie", pts.frame[:, 0, 0, :2], out["direction"][:2])
+        return out
 
 
 class ShellPressure:

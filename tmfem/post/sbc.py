@@ -6,7 +6,8 @@ the spin of :meth:`tmfem.fem.element.State.advanced`: theta = a_1 V_1 + a_2 V_2 
 node). Bars are drawn as their beam elements' segments (3 per four-node element) with the
 axial force N and the bending moment |M| = (M_1^2 + M_2^2)^(1/2) of the element (mean over
 its Gauss points), tendons as lines with their axial forces, the membrane as the shell quads
-with the stresses at the element centres on the bottom, middle and top surfaces.
+with the stresses at the element centres on the bottom, middle and top surfaces and the
+lamina law's state there (taut / wrinkled / slack, docs/wrinkling.md).
 """
 from __future__ import annotations
 
@@ -44,11 +45,23 @@ def rotation_vectors(model, state, d=None) -> np.ndarray:
     return th.T
 
 
+def shell_wrinkling(model, state) -> dict:
+    """Cell data of the shell lamina law's states (docs/wrinkling.md): ``membrane_state``
+    (ne,) int32, 0 taut, 1 wrinkled, 2 slack, of the element centre's two thickness Gauss
+    points, and ``wrinkle_direction`` (3, ne), the tension (wrinkle-crest) direction in the
+    global axes of the reference surface, zero where the element is not wrinkled
+    (:meth:`tmfem.fem.mitc4.MITC4Shell.wrinkling`; the MTC model's
+    :func:`tmfem.post.mtc.membrane_field` writes the same two fields)."""
+    wr = model.shell.wrinkling(state)
+    return {"membrane_state": wr["state"].astype(np.int32), "wrinkle_direction": wr["direction_xyz"]}
+
+
 def shell_field(model, state) -> MembraneField:
     """The shell membrane of ``state`` as a :class:`MembraneField`: displacement in the floating
     frame (eq. 3.4) and the rotation vectors as point data, element-centre stresses on the three
     surfaces as cell data (``von_mises_top``, ``sigma_p1_mid``, ...; ``von_mises`` and
-    ``sigma_p1`` the largest over the surfaces)."""
+    ``sigma_p1`` the largest over the surfaces) with the lamina states of
+    :func:`shell_wrinkling`."""
     topo = model.mtc.topology
     nm = topo.n_mesh
     xm = state.x[:, :nm]
@@ -58,6 +71,7 @@ def shell_field(model, state) -> MembraneField:
     cd = {f"{k}_{s}": c[k][i] for k in c for i, s in enumerate(SURFACES)}
     cd["von_mises"] = c["von_mises"].max(axis=0)
     cd["sigma_p1"] = c["sigma_p1"].max(axis=0)
+    cd.update(shell_wrinkling(model, state))
     return MembraneField(mesh=topo.mesh, x=xm,
                          point_data={DISPLACEMENT_FIELD: xf - ref,
                                      "rotation": rotation_vectors(model, state)[:, :nm]},
@@ -74,8 +88,9 @@ def sbc_cells(model) -> list:
 
 def _cell_data(model, state, cells) -> dict:
     """Per block (beams, tendons, shells): ``kind`` (:func:`tmfem.io.codes.kind_cell_data`),
-    axial force [N], bending moment |M| [N m], shell sigma_p1 and von Mises [Pa] per surface;
-    NaN where a quantity does not exist."""
+    axial force [N], bending moment |M| [N m], shell sigma_p1 and von Mises [Pa] per surface,
+    the shell states ``membrane_state`` and ``wrinkle_direction`` (:func:`shell_wrinkling`);
+    NaN where a quantity does not exist (-1 for the integer state)."""
     sec = model.beam.section_forces(state)
     per = 3                                                  # segments per four-node element
     Nb = np.repeat(sec["N"].mean(axis=1), per)
@@ -88,14 +103,20 @@ def _cell_data(model, state, cells) -> dict:
     for i, s in enumerate(SURFACES):
         for k in ("von_mises", "sigma_p1"):
             out[f"{k}_{s}"] = [none[0], none[1], c[k][i]]
+    wr = shell_wrinkling(model, state)
+    out["membrane_state"] = [np.full(n.size, -1, dtype=np.int32) for n in none[:2]] \
+        + [wr["membrane_state"]]
+    out["wrinkle_direction"] = [np.full((3, n.size), np.nan) for n in none[:2]] \
+        + [wr["wrinkle_direction"]]
     return out
 
 
 def write_sbc_state(path, model, state) -> str:
     """Write an SBC state for ParaView (.vtu): all nodes at their positions, the cells of
     :func:`sbc_cells`, point data ``displacement`` [m] (from the reference) and ``rotation``
-    [rad], cell data ``kind`` (0 beam, 1 tendon, 2 shell), ``axial_force``, ``bending_moment``
-    and the shell stresses (module docstring)."""
+    [rad], cell data ``kind`` (0 beam, 1 tendon, 2 shell), ``axial_force``, ``bending_moment``,
+    the shell stresses (module docstring) and the shell states ``membrane_state``,
+    ``wrinkle_direction`` (:func:`shell_wrinkling`)."""
     path = check_path(path, suffixes=(".vtu",))
     cells = sbc_cells(model)
     pdata, cdata = block_data({"displacement": state.x - model.X,

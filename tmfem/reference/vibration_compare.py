@@ -21,11 +21,12 @@ from __future__ import annotations
 
 import csv
 import logging
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError
 from tmfem.models.mtc.dynamics import fit_frequency
 from tmfem.reference.model_compare import MODELS, com_model, fe_models, paper_state
 
@@ -88,14 +89,16 @@ def three_model_vibration(name: str, *, t_end: float, dt: float = 0.01, perturb=
     results, static = {}, {}
     for key, run in (("SBC", sbc_free_vibration), ("MTC", mtc_free_vibration)):
         steps = progress(key) if progress else None
-        st = fe[key].solve_static()
-        static[key] = st.time
-        results[key] = run(fe[key], st.state if key == "SBC" else st.x, t_end=t_end, dt=dt,
-                           perturb=pert, progress=steps)
+        with named_model(key, name, mesh_n):
+            st = fe[key].solve_static()
+            static[key] = st.time
+            results[key] = run(fe[key], st.state if key == "SBC" else st.x, t_end=t_end, dt=dt,
+                               perturb=pert, progress=steps)
     steps = progress("COM") if progress else None
-    com = com_model(name, mesh_n=mesh_n)
-    results["COM"] = free_vibration(com, t_end=t_end, dt=dt, perturb=pert, jacobian="reuse",
-                                    progress=steps)
+    with named_model("COM", name, mesh_n):
+        com = com_model(name, mesh_n=mesh_n)
+        results["COM"] = free_vibration(com, t_end=t_end, dt=dt, perturb=pert, jacobian="reuse",
+                                        progress=steps)
     t = results["SBC"].t
     for k, r in results.items():
         if r.t.shape != t.shape:
@@ -105,6 +108,16 @@ def three_model_vibration(name: str, *, t_end: float, dt: float = 0.01, perturb=
             "comparison": compare_histories(name, t, signals, system=system, perturb=pert,
                                             results=results, static=static, mesh_n=mesh_n,
                                             tendon_elements=tendon_elements)}
+
+
+@contextmanager
+def named_model(model: str, name: str, mesh_n: int):
+    """Re-raise a :class:`~tmfem.errors.ConvergenceError` of one model's run with the model,
+    system and mesh in front (which of the three failed)."""
+    try:
+        yield
+    except ConvergenceError as exc:
+        raise ConvergenceError(f"{model} model of {name} (FE mesh {mesh_n}): {exc}") from exc
 
 
 def compare_histories(name, t, signals, *, system, perturb, results, static, mesh_n,

@@ -74,7 +74,7 @@ def check_time_grid(t_end: float, dt: float) -> int:
 def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=None,
              scheme: str = "park", jacobian: str = "step", tol: float = 1e-10,
              record: Callable | None = None, progress: Callable | None = None,
-             outputs: bool = True) -> Simulation:
+             outputs: bool = True, line_search: bool = False) -> Simulation:
     """Integrate ``plant`` over [0, t_end] with inputs from ``controller`` (module docstring).
 
     Parameters
@@ -107,6 +107,8 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
         the controller does not read them (an open loop); False skips them there (``record``
         then gets ``y = None`` and ``Simulation.y`` is empty) -- a free vibration that
         records its own quantities.
+    line_search : bool
+        Backtracking on the Newton corrections of every step (:func:`park_integrate`).
     """
     n_steps = check_time_grid(t_end, dt)
     ctrl = as_controller(controller, plant.u0)
@@ -136,7 +138,8 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
     t0 = time.perf_counter()
     res = park_integrate(loop, x0=x0, v0=v0, dt=dt, n_steps=n_steps, scheme=scheme, tol=tol,
                          jacobian=jacobian, callback=step, store=False, progress=progress,
-                         sampled=True, predictor=getattr(plant, "predictor", "acceleration"))
+                         sampled=True, predictor=getattr(plant, "predictor", "acceleration"),
+                         line_search=line_search)
     return Simulation(t=np.array(T), y=np.array(Y), u=np.array(U), controller=C, x=res.x[-1],
                       v=res.v[-1], wall_time=time.perf_counter() - t0,
                       stats={"steps": res.steps, "newton_iterations": res.newton_iterations,

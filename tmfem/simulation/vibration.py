@@ -173,7 +173,7 @@ def sbc_free_vibration(model, state_eq, *, alpha: float = 0.0, beta: float = 0.0
 def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_path=None,
                       scheme: str = "park", jacobian: str = "step", monitor_nodes=None,
                       progress=None, vtk_dir=None, vtk_every: int = 10, tol: float = 1e-10,
-                      membrane=None) -> FEVibration:
+                      membrane=None, line_search: bool = True) -> FEVibration:
     """Free vibration of a finite-element plant ``dyn`` (:class:`tmfem.models.fe_plant.FEPlant`)
     from its perturbed equilibrium (6.5, eqs. 5.34-5.35).
 
@@ -198,6 +198,11 @@ def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_pat
         ``membrane(u) -> MembraneField`` of a free-dof state, for the ParaView frames.
     progress : callable, optional
         ``progress(step, n_steps)``.
+    line_search : bool
+        Backtracking on the Newton corrections (:func:`tmfem.solvers.park.park_integrate`;
+        default on: a correction that reduces the residual is taken whole, so it changes
+        nothing where plain Newton converges; the SBC shell's soft rotations on fine meshes
+        need it, docs/sbc.md "Free vibration on the fine mesh").
 
     Outputs per step: q, w_k (eqs. 5.36, 5.38), the monitored bar ends, the largest tendon
     transverse deflection (eq. 5.37, relative to the equilibrium), kinetic and strain energy.
@@ -245,7 +250,7 @@ def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_pat
 
     try:
         sim = simulate(dyn, t_end=t_end, dt=dt, scheme=scheme, jacobian=jacobian, tol=tol,
-                       record=record, progress=progress)
+                       record=record, progress=progress, line_search=line_search)
     finally:
         out.close()
     Xa = np.array(XS)

@@ -93,7 +93,8 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                    max_iter: int = 25, jacobian: str = "iteration", reuse_iter: int = 4,
                    callback: Callable | None = None, store: bool = True,
                    progress: Callable | None = None, sampled: bool = False,
-                   predictor: str = "acceleration") -> ParkResult:
+                   predictor: str = "acceleration",
+                   line_search: bool = False) -> ParkResult:
     """Integrate r(x, v, a, t) = 0 with Park's method started by the trapezoidal rule.
 
     Parameters
@@ -135,7 +136,17 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         acceleration of the first input, not of the system's inputs before the first
         callback. Park's multistep formula does not use the acceleration: it sees the input
         steps through its history and is first order across them.
-
+    line_search : bool
+        Backtracking on the Newton correction of a step (:func:`_line_search`): a correction
+        dx larger than 1e3 x the tolerance (not in the quadratic, round-off-limited end of the
+        iteration) is scaled by the first alpha = 1, 1/2, ..., 1/64 with
+        ||r(x + alpha dx)||_2 <= (1 - 1e-4 alpha) ||r(x)||_2 (Armijo), taken whole when none
+        decreases. The Newton direction is a descent direction of ||r||^2, so this only
+        shortens corrections that overshoot: a system whose Newton matrix has
+        near-singular, strongly nonlinear directions (the thin shell's rotations in the SBC
+        model, docs/sbc.md "Free vibration on the fine mesh"). Convergence is still judged on
+        the full correction |dx|; a kept (modified-Newton) matrix whose direction does not
+        decrease the residual is replaced by a fresh one.
     predictor : {"acceleration", "velocity"}
         Start of each step's Newton iteration: x_n + dt v_n + dt^2 a_n / 2 (constant
         acceleration) or x_n + dt v_n. The second is for systems with dofs of almost no
@@ -201,9 +212,15 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         full = jacobian == "iteration"
         x_pred = xk.copy()
         dx_prev = np.inf
+        r_next = None          # the residual at xk when the line search has evaluated it
+        r_first = dx_first = None
         for it in range(1, max_iter + 1):
             vk, ak = kin(xk)
-            r = system.residual(xk, vk, ak, t)
+            r = system.residual(xk, vk, ak, t) if r_next is None else r_next
+            factored = False
+            r_next = None
+            if r_first is None:
+                r_first = float(np.max(np.abs(r)))
             # a kept (modified-Newton) matrix that has not converged in 2 reuse_iter
             # iterations gives way to full Newton for the step
             full = full or it > 2 * reuse_iter
@@ -212,9 +229,11 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                 solve = _solver(_newton_matrix(system, xk, vk, ak, t, cv, ca), system)
                 kept_coef = (cv, ca)
                 fresh = True
+                factored = True
                 res.jacobian_evaluations += 1
             dx = -solve(r)
             dx_norm = np.max(np.abs(dx))
+            dx_first = dx_norm if dx_first is None else dx_first
             if dx_norm > dx_prev and not full and dx_norm > 1e3 * tol * (1.0 + np.max(np.abs(xk))):
                 # growing corrections of a kept matrix: restart the step from the predictor
                 # with full Newton
@@ -223,17 +242,29 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                 res.restarts += 1
                 continue
             dx_prev = dx_norm
+            if line_search and dx_norm > 1e3 * tol * (1.0 + np.max(np.abs(xk))):
+                alpha, r_next, decreased = _line_search(
+                    lambda y: system.residual(y, *kin(y), t), xk, dx, r)
+                if not decreased and not factored:
+                    full, r_next = True, r     # a kept matrix's direction: refresh, no step
+                    continue
+                dx = alpha * dx
             xk = xk + dx
             res.newton_iterations += 1
             if not np.all(np.isfinite(xk)):
                 raise ConvergenceError(f"Park step {k} (t = {t:.6g}): Newton produced non-finite "
                                        f"values at iteration {it}")
-            if np.max(np.abs(dx)) <= tol * (1.0 + np.max(np.abs(xk))):
+            if dx_norm <= tol * (1.0 + np.max(np.abs(xk))):
                 break
         else:
-            raise ConvergenceError(f"Park step {k} (t = {t:.6g}): Newton did not converge in "
-                                   f"{max_iter} iterations; last |dx| = {np.max(np.abs(dx)):.3e}, "
-                                   f"|r| = {np.max(np.abs(r)):.3e}; try a smaller dt")
+            r_last = float(np.max(np.abs(r)))
+            # growing residuals or corrections: divergence, not slow convergence
+            grew = r_last > 10.0 * r_first or dx_norm > 10.0 * dx_first
+            how = "diverged" if grew else "did not converge"
+            raise ConvergenceError(f"Park step {k} (t = {t:.6g} s, dt = {dt:g} s): Newton {how} in "
+                                   f"{max_iter} iterations: |r| = {r_first:.3e} at the predictor, "
+                                   f"{r_last:.3e} at the last iterate (max norm), last |dx| = "
+                                   f"{dx_norm:.3e} (tolerance {tol:g} (1 + |x|))")
         x = xk
         v, a = kin(x)
         hx.append(x.copy()); hv.append(v.copy())
@@ -256,6 +287,23 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         res.x, res.v, res.a = x[None], v[None], a[None]
         res.t = T[last: last + 1]
     return res
+
+
+def _line_search(residual, x, dx, r, *, min_alpha: float = 1.0 / 64):
+    """Backtracking on a Newton correction (``line_search`` of :func:`park_integrate`):
+    ``(alpha, r(x + alpha dx), True)`` for the first alpha = 1, 1/2, ... >= min_alpha with
+    ||r(x + alpha dx)||_2 <= (1 - 1e-4 alpha) ||r(x)||_2, else ``(1, r(x + dx), False)``:
+    the full correction, as plain Newton takes it."""
+    r0 = float(np.linalg.norm(r))
+    alpha, full = 1.0, None
+    while alpha >= min_alpha:
+        rt = residual(x + alpha * dx)
+        full = rt if full is None else full
+        rn = float(np.linalg.norm(rt))
+        if np.isfinite(rn) and rn <= (1.0 - 1e-4 * alpha) * r0:
+            return alpha, rt, True
+        alpha *= 0.5
+    return 1.0, full, False
 
 
 class LinearSecondOrder:
