@@ -16,7 +16,7 @@ MAX_VERIFY_POINTS = 500
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
 LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma", "gamma_rtol",
-            "time_budget", "fixed_gamma", "sample_time")
+            "time_budget", "fixed_gamma", "sample_time", "start")
 
 #: EIGOPT defaults: relative bracket width of the gamma bisection, its time budget [s]
 GAMMA_RTOL, TIME_BUDGET = 0.05, 300.0
@@ -36,6 +36,9 @@ def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
                         help=prefix + f"EIGOPT: seconds for the gamma bisection (default {TIME_BUDGET:g})")
     parser.add_argument("--fixed-gamma", action="store_true", default=None,
                         help=prefix + "EIGOPT: a feasible point at --gamma only (no bisection)")
+    parser.add_argument("--start", metavar="FILE.npz", default=None,
+                        help=prefix + "EIGOPT bisection: start the first level from this saved design (e.g. "
+                             "one on a sub-grid: continuation in the grid) instead of the Riccati fit")
 
 
 def configure(parser) -> None:
@@ -58,7 +61,10 @@ def _grid(spec: str, printed: dict):
     th, ps = np.radians(printed["theta_grid_deg"]), np.radians(printed["psi_grid_deg"])
     if not (1 <= nt <= th.size and 1 <= nps <= ps.size):
         raise InputError(f"--grid: expected at most {th.size}x{ps.size} points of the printed grid, found {spec}")
-    pick = lambda a, k: a[np.round(np.linspace(0, a.size - 1, k)).astype(int)]   # noqa: E731
+    # k evenly spread points including both ends; one point: the middle one (psi_0 = 8.36 deg of
+    # eq. 5.100 on the printed psi axis, so a reduced grid still holds the 8.4 reference)
+    pick = lambda a, k: a[np.round(np.linspace(0, a.size - 1, k)).astype(int)] if k > 1 \
+        else a[[a.size // 2]]                                                    # noqa: E731
     return pick(th, nt), pick(ps, nps)
 
 
@@ -71,7 +77,7 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
         raise InputError(f"--refine: expected >= 4 (the issue's verification standard), found {refine}")
     if solver not in ("CLARABEL", "SCS", "EIGOPT"):
         raise InputError(f"--solver {solver}: applies to `tmfem control hinf` only; lpv takes CLARABEL, SCS or EIGOPT")
-    eig = {k: getattr(args, k, None) for k in ("gamma_rtol", "time_budget", "fixed_gamma")}
+    eig = {k: getattr(args, k, None) for k in ("gamma_rtol", "time_budget", "fixed_gamma", "start")}
     if solver != "EIGOPT":
         given = [k for k, v in {**eig, "gamma": args.gamma, "sample_time": getattr(args, "sample_time", None)}.items()
                  if v is not None]
@@ -79,9 +85,17 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
             raise InputError(f"options {['--' + k.replace('_', '-') for k in given]} apply to --solver EIGOPT "
                              f"only, found --solver {solver}")
     elif args.fixed_gamma:
-        if args.gamma is None or eig["gamma_rtol"] is not None or eig["time_budget"] is not None:
-            raise InputError("--fixed-gamma: expected --gamma G and neither --gamma-rtol nor --time-budget "
+        if args.gamma is None or any(eig[k] is not None for k in ("gamma_rtol", "time_budget", "start")):
+            raise InputError("--fixed-gamma: expected --gamma G and none of --gamma-rtol, --time-budget, --start "
                              "(one level, no bisection)")
+    start = None
+    if eig["start"] is not None:
+        from pathlib import Path
+        from tmfem.control.lpv_synthesis import LPVStateFeedback
+        if not Path(eig["start"]).is_file():
+            raise InputError(f"--start: expected a design saved by `tmfem control lpv --save`, found no file "
+                             f"{eig['start']!r}")
+        start = LPVStateFeedback.load(eig["start"])
     rtol = GAMMA_RTOL if eig["gamma_rtol"] is None else eig["gamma_rtol"]
     budget = TIME_BUDGET if eig["time_budget"] is None else eig["time_budget"]
     if not (0 < rtol < 1):
@@ -101,7 +115,7 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
                             f"has {fine_n[0]} x {fine_n[1]} = {fine_n[0] * fine_n[1]:,} points, one COM "
                             f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
     return {"system": s, "preset": preset, "theta": th, "psi": ps, "refine": refine, "solver": solver,
-            "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget}
+            "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget, "start": start}
 
 
 def design_plant(cfg: dict, *, rate_deg: float):
@@ -141,8 +155,8 @@ def synthesise(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
                 t0 = time.perf_counter()
                 ctrl, br = bisect_gamma(gp, lower=bound.lower_bound, upper=upper, rtol=cfg["rtol"],
                                         time_budget=cfg["budget"], max_iter=max_iter or 150,
-                                        sample_time=sample_time,
-                                        progress=lambda w: bar(min(time.perf_counter() - t0, cfg["budget"]),
+                                        sample_time=sample_time, start=cfg["start"],
+                                        progress=lambda w: bar(int(min(time.perf_counter() - t0, cfg["budget"])),
                                                                cfg["budget"]))
             extra = br.to_dict()
         else:

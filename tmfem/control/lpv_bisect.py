@@ -52,9 +52,9 @@ class GammaBracket:
 
 
 def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float = 0.02,
-                 time_budget: float = 300.0, max_iter: int = 150, margin: float = 1e-3,
+                 time_budget: float = 300.0, max_iter: int = 150, margin: float = 1e-8,
                  t_schedule=(1e-2, 1e-3, 1e-4), sample_time: float | None = None,
-                 progress=None) -> tuple[LPVStateFeedback, GammaBracket]:
+                 start: LPVStateFeedback | None = None, progress=None) -> tuple[LPVStateFeedback, GammaBracket]:
     """Minimise gamma of eqs. 5.95-5.96 on the grid of ``gp`` (module docstring).
 
     Parameters
@@ -76,6 +76,10 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     sample_time : float, optional
         Also the sampled-loop stability LMI at this zero-order-hold step
         (:class:`~tmfem.control.lpv_eigopt.EigOpt`).
+    start : LPVStateFeedback, optional
+        The first level starts from this design's P(rho), Q(rho) instead of the Riccati fit:
+        a design on a sub-grid (continuation in the grid; coefficients of parameters it does
+        not vary are zero) or an earlier run.
     progress : callable, optional
         Called with (hi - lo) / hi after each level.
 
@@ -95,13 +99,14 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     co = Coordinates.of(gp)
     e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=upper, sample_time=sample_time)
     levels, best, not_found = [], None, None
-    lo, hi, z_start, gamma, stopped = lower, upper, e.riccati_start(upper), upper, "tolerance"
+    z_start = e.riccati_start(upper) if start is None else e.start_from(*_coefficients(start, co, gp))
+    lo, hi, gamma, stopped = lower, upper, upper, "tolerance"
     while True:
         t1, n1 = time.perf_counter(), e.evaluations
         z, worst, reason = e.solve(gamma, z_start, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
                                    deadline=deadline)
         row = {"gamma": gamma, "evaluations": e.evaluations - n1, "time_s": time.perf_counter() - t1,
-               "largest_scaled_eig": worst, "start": "riccati" if best is None else "continuation"}
+               "largest_scaled_eig": worst, "start": ("riccati" if start is None else "given design") if best is None else "continuation"}
         if reason == "time":
             levels.append({**row, "result": "unfinished (time budget)"})
             stopped = "time budget"
@@ -141,3 +146,26 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     best.solve_time = total
     log.info("gamma bisection: %s", best.status)
     return best, br
+
+
+def _coefficients(design: LPVStateFeedback, co: Coordinates, gp):
+    """P_k, Q_k of ``design`` in the scaled coordinates (P = T P_s T, Q = Q_s T) and the
+    normalised parameters of ``co``: P(rho) is affine, so they are P at the centre and its
+    change over each half-width (zero along a parameter the design does not vary)."""
+    import numpy as np
+    T = co.T
+    if list(design.state_names) != list(gp.state_names):
+        raise InputError("gamma bisection start: expected a design over the same states, found "
+                         f"{len(design.state_names)} states against {len(gp.state_names)}")
+
+    def at(rho):
+        return design.P_of(rho) / T[:, None] / T[None, :], design.Q_of(rho) / T[None, :]
+    P0, Q0 = at(co.centre)
+    Ps, Qs = [P0], [Q0]
+    for k in co.varying:
+        d = np.zeros_like(co.centre)
+        d[k] = co.half[k]
+        P1, Q1 = at(co.centre + d)
+        Ps.append(P1 - P0)
+        Qs.append(Q1 - Q0)
+    return Ps, Qs

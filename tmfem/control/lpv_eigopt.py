@@ -28,7 +28,7 @@ import numpy as np
 import scipy.optimize as so
 
 from tmfem.control.hinf_are import game_riccati, state_feedback_gain
-from tmfem.errors import InfeasibleController
+from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
 
@@ -137,6 +137,17 @@ class EigOpt:
         Pi, Qi = (self._Pi, self._Qi) if gamma == self.gamma0 else self._riccati(gamma)
         P0, Q0 = self._fit(Pi, Qi)
         return np.concatenate([P0.ravel(), Q0.ravel()]) / self.sig
+
+    def start_from(self, P, Q) -> np.ndarray:
+        """z of given coefficients P_k, Q_k in the coordinates x = T x_s of the synthesis
+        (e.g. a design on a sub-grid, its missing coefficients zero: continuation in the grid)."""
+        Li = np.linalg.inv(self.L)
+        Pb = np.array([Li @ Pk @ Li.T for Pk in P])
+        Qb = np.array([Qk @ Li.T for Qk in Q])
+        if Pb.shape != (self.nb, self.n, self.n) or Qb.shape != (self.nb, self.nu, self.n):
+            raise InputError(f"EIGOPT start: expected {self.nb} coefficients P_k ({self.n} x {self.n}) and "
+                             f"Q_k ({self.nu} x {self.n}), found shapes {Pb.shape} and {Qb.shape}")
+        return np.concatenate([Pb.ravel(), Qb.ravel()]) / self.sig
 
     # ------------------------------------------------------------------ the LMIs
     def unpack(self, z):
