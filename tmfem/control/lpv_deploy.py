@@ -73,6 +73,12 @@ class LPVDeployment:
         """Names of y_lpv: the design plant's states, then its parameters."""
         return list(self.plant.state_names) + list(self.plant.parameter_names)
 
+    def reference_rho(self, t) -> np.ndarray:
+        """rho_r(t) = [theta_13, psi_13] of the reference q_d(t) (eq. 5.100: theta_r, psi_0)."""
+        r = np.asarray(self.reference(t)[0], dtype=float)[self.rho_q].copy()
+        r[1] = wrap_angle(r[1])
+        return r
+
     def measure(self, y) -> np.ndarray:
         """y_lpv = [q, v, q', v', rho] from the plant outputs y = [z, z'] (modal)."""
         y = np.asarray(y, dtype=float)
@@ -138,7 +144,8 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
 
 def state_feedback_controller(dep: LPVDeployment, design):
     """The scheduled state feedback of 8.3 (:class:`tmfem.control.lpv_controller.LPVController`)
-    of ``design`` on y_lpv, tracking q_d of eq. 5.100.
+    of ``design`` on y_lpv, tracking q_d of eq. 5.100, gains at the measured rho, equilibria
+    x_e, u_e at the reference's rho_r(t).
 
     Raises
     ------
@@ -160,4 +167,5 @@ def state_feedback_controller(dep: LPVDeployment, design):
                              f"found {[np.degrees(x).round(2).tolist() for x in design.axes]} deg")
     n = pl.nx
     return LPVController(design, pl, state_index=np.arange(n), q_index=np.arange(nq),
-                         rho_index=[n, n + 1], reference=lambda t: dep.reference(t)[0])
+                         rho_index=[n, n + 1], reference=lambda t: dep.reference(t)[0],
+                         reference_rho=dep.reference_rho)
