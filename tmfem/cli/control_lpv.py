@@ -53,7 +53,8 @@ def configure(parser) -> None:
                         help="lpv: only the pointwise state-feedback lower bound of gamma (no SDP)")
 
 
-def _grid(spec: str, printed: dict):
+def printed_grid(spec: str, printed: dict):
+    """The --grid AxB points of the printed LPV grid (evenly spread, both ends; one point: the middle)."""
     try:
         nt, nps = (int(v) for v in spec.lower().split("x"))
     except ValueError:
@@ -108,7 +109,7 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
     printed = dict(s.printed or {})
     if "theta_grid_deg" not in printed or "psi_grid_deg" not in printed:
         raise InputError(f"preset {preset!r}: expected a printed LPV grid (theta_grid_deg, psi_grid_deg), found none")
-    th, ps = _grid(args.grid or "6x3", printed)
+    th, ps = printed_grid(args.grid or "6x3", printed)
     fine_n = [(a.size - 1) * refine + 1 for a in (th, ps)]
     if fine_n[0] * fine_n[1] > MAX_VERIFY_POINTS:
         raise ResourceLimit(f"--grid {args.grid or '6x3'} --refine {refine}: the verification grid "
