@@ -19,6 +19,8 @@ import logging
 import time
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from tmfem.control.lpv_eigopt import EigOpt
 from tmfem.control.lpv_synthesis import Coordinates, GeneralisedLPV, LPVStateFeedback
 from tmfem.errors import InfeasibleController, InputError
@@ -105,8 +107,9 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
         t1, n1 = time.perf_counter(), e.evaluations
         z, worst, reason = e.solve(gamma, z_start, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
                                    deadline=deadline)
+        first = "riccati" if start is None else "given design"
         row = {"gamma": gamma, "evaluations": e.evaluations - n1, "time_s": time.perf_counter() - t1,
-               "largest_scaled_eig": worst, "start": ("riccati" if start is None else "given design") if best is None else "continuation"}
+               "largest_scaled_eig": worst, "start": first if best is None else "continuation"}
         if reason == "time":
             levels.append({**row, "result": "unfinished (time budget)"})
             stopped = "time budget"
@@ -115,7 +118,7 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
         if worst < 0:
             try:
                 ctrl = co.accepted(gp, *e.coefficients(z), gamma, solver="EIGOPT", status="",
-                                   solve=0.0, build=0.0)
+                                   solve=0.0, build=0.0, sample_time=sample_time)
             except InfeasibleController as exc:
                 log.info("gamma bisection: level %.5g rejected on re-computation: %s", gamma, exc)
         levels.append({**row, "result": "feasible" if ctrl else "not found"})
@@ -152,7 +155,6 @@ def _coefficients(design: LPVStateFeedback, co: Coordinates, gp):
     """P_k, Q_k of ``design`` in the scaled coordinates (P = T P_s T, Q = Q_s T) and the
     normalised parameters of ``co``: P(rho) is affine, so they are P at the centre and its
     change over each half-width (zero along a parameter the design does not vary)."""
-    import numpy as np
     T = co.T
     if list(design.state_names) != list(gp.state_names):
         raise InputError("gamma bisection start: expected a design over the same states, found "

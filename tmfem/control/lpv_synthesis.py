@@ -335,7 +335,7 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
         Ps, Qs, _, nev = feasible_point(gp, gamma, T=T, c_of=co.c_of, dvs=co.dvs, max_iter=max_iter or 150,
                                         sample_time=sample_time)
         return co.accepted(gp, Ps, Qs, gamma, solver="EIGOPT", status=f"feasible point ({nev} evaluations)",
-                           solve=time.perf_counter() - t1, build=t1 - t0)
+                           solve=time.perf_counter() - t1, build=t1 - t0, sample_time=sample_time)
 
     def pcol(k):
         return k * (ms + mq)
@@ -460,12 +460,22 @@ class Coordinates:
         """The coefficients of P_k in dP/dt at each rate vertex."""
         return [np.concatenate([[0.0], (v / self.half)[self.varying]]) for v in self.verts]
 
-    def accepted(self, gp, Ps, Qs, gamma, *, solver, status, solve, build) -> "LPVStateFeedback":
-        """:func:`_accepted` (strictly negative LMIs) of P_k, Q_k given in the scaled coordinates."""
+    def accepted(self, gp, Ps, Qs, gamma, *, solver, status, solve, build,
+                 sample_time: float | None = None) -> "LPVStateFeedback":
+        """:func:`_accepted` (strictly negative LMIs) of P_k, Q_k given in the scaled coordinates;
+        with ``sample_time`` also every frozen sampled loop of the grid stable
+        (:func:`tmfem.control.lpv_verify.verify`)."""
         T = self.T
-        return _accepted(gp, [Tm_back(P, T) for P in Ps], [Q * T[None, :] for Q in Qs], gamma, T, self.verts,
+        ctrl = _accepted(gp, [Tm_back(P, T) for P in Ps], [Q * T[None, :] for Q in Qs], gamma, T, self.verts,
                          self.centre, self.half, self.varying, solver=solver, status=status, solve=solve,
                          build=build, sizes=self.sizes, tol=-1e-300)
+        if sample_time is not None:
+            from tmfem.control.lpv_verify import verify
+            r = verify(ctrl, gp, sample_time=sample_time, allow_failure=True).max_sampled_radius
+            if not r < 1:
+                raise InfeasibleController(f"the frozen loops sampled at {sample_time} s have spectral radius "
+                                           f"{r:.6f} (expected < 1)")
+        return ctrl
 
 
 def _accepted(gp, Pv, Qv, g, T, verts, centre, half, varying, *, solver, status, solve, build, sizes,
