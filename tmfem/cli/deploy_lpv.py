@@ -6,7 +6,9 @@ its design plant rebuilt on its grid) or synthesised on the fly with the options
 ``tmfem control lpv`` (EIGOPT by default, with the sampled-loop constraint at --dt), then
 verified on the finer grid. A controller built elsewhere (any object with the reset/output/
 update/name protocol of :mod:`tmfem.simulation.controllers` reading the measured LPV
-signals, :class:`tmfem.control.lpv_deploy.LPVDeployment`) deploys through :data:`BUILDERS`.
+signals, :class:`tmfem.control.lpv_deploy.LPVDeployment`) deploys through :data:`DESIGNS`
+and :data:`BUILDERS` (a new ``--controller`` name adds an entry to each and to
+:data:`tmfem.reference.deployments.LPV_CONTROLLERS`).
 """
 from __future__ import annotations
 
@@ -67,10 +69,6 @@ def lpv_state_feedback(dep, design):
     return state_feedback_controller(dep, design)
 
 
-#: --controller name -> builder(deployment, design) of a controller on the LPV signals
-BUILDERS = {"lpv": lpv_state_feedback}
-
-
 def design(args, preset: str):
     """(design plant, state-feedback design, JSON entries): loaded and checked on its grid
     (sampled at --dt), or synthesised and verified on the finer grid."""
@@ -103,6 +101,12 @@ def design(args, preset: str):
     return plant, ctrl, {**out, **syn, **v.to_dict()}
 
 
+#: --controller name -> design(args, preset) -> (design plant, design with ``gamma``, JSON entries)
+DESIGNS = {"lpv": design}
+#: --controller name -> builder(deployment, design) of a controller on the LPV signals y_lpv
+BUILDERS = {"lpv": lpv_state_feedback}
+
+
 def run(args) -> dict:
     """The LPV deployment (module docstring); the JSON keys of the 7.4 deployments plus the
     design's."""
@@ -111,7 +115,7 @@ def run(args) -> dict:
     from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, run_summary, write_outputs
     check(args)
     t0 = time.perf_counter()
-    plant, d, info = design(args, args.preset)
+    plant, d, info = DESIGNS[args.controller](args, args.preset)
     dep = lpv_setup(args.preset, plant)
     s = dep.setup(BUILDERS[args.controller](dep, d))
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller})") as bar:
