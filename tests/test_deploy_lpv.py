@@ -20,6 +20,8 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"
     (["--preset", "2-3-lpv", "--allocation", "clip"], "do not apply to the LPV deployment"),
     (["--preset", "2-3-lpv", "--plant", "mtc"], "do not apply to the LPV deployment"),
     (["--preset", "2-3-lpv", "--path", "linear"], "do not apply to the LPV deployment"),
+    (["--preset", "2-3-lpv", "--pfl-at", "reference"], "do not apply to the LPV deployment"),
+    (["--preset", "2-3-lpv", "--compare-plant", "mtc"], "do not apply to the LPV deployment"),
     (["--preset", "2-3-lpv", "--lpv-controller", "missing.npz"], "expected an existing .npz"),
     (["--preset", "2-3-lpv", "--lpv-controller", "x.npz", "--gamma", "5"], "belong to a synthesis on the fly"),
     (["--preset", "2-3-deploy", "--gamma", "5"], "apply to --controller lpv only"),

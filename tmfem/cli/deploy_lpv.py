@@ -23,7 +23,8 @@ from tmfem.errors import InfeasibleController, InputError
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
 SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
 #: options of the 7.4 deployments that do not apply to the LPV one (None or False: not given)
-NOT_LPV = ("uncertainty", "allocation", "plant_mesh", "plant_tendons")
+NOT_LPV = ("uncertainty", "allocation", "plant_mesh", "plant_tendons", "compare_plant", "compare_plot",
+           "compare_csv", "pfl_at")
 
 
 def configure(parser) -> None:
@@ -112,7 +113,7 @@ def run(args) -> dict:
     design's."""
     from tmfem.cli.common import progress_bar
     from tmfem.control.deploy import run_deployment
-    from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, run_summary, write_outputs
+    from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
     check(args)
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
@@ -122,14 +123,17 @@ def run(args) -> dict:
         r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
                            t_end=args.t_end, dt=args.dt, progress=bar, jacobian="reuse")
     q_err = np.abs(r.z[:, :len(r.names["q"])] - r.q_d)
-    out = run_summary(r, preset=args.preset, controller=args.controller, plant="com", uncertainty=None,
-                      allocation=None, path=LPV_DEPLOYMENTS[args.preset]["path"],
-                      info={**s.info, "max_tracking_error": float(q_err.max()),
-                            "rest_length_above_tendon_length_max_m": float(np.max(r.u - r.lengths)), **info})
-    out["total_wall_time_s"] = time.perf_counter() - t0
+    # the keys of the 7.4 deployments (tmfem.cli.deploy.run; no PFL: uncertainty, allocation and
+    # pfl_at None), then the design's
+    out = {"preset": args.preset, "controller": args.controller, "plant": "com", "uncertainty": None,
+           "allocation": None, "pfl_at": None, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(),
+           **s.info, "max_tracking_error": float(q_err.max()),
+           "rest_length_above_tendon_length_max_m": float(np.max(r.u - r.lengths)), **info}
     if not np.all(np.isfinite(r.z)):
         raise InfeasibleController(f"the LPV deployment of {args.preset} diverged (non-finite states)")
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
                              vtk=args.vtk, title=f"{args.preset} deployment on the com plant: {args.controller} "
                                                  f"(gamma = {d.gamma:.4g}), eq. 5.100"))
+    out["total_wall_time_s"] = time.perf_counter() - t0
+    out["failed_checks"] = []
     return out

@@ -114,15 +114,6 @@ def write_csv(path, r) -> str:
     return str(path)
 
 
-def run_summary(r, *, preset: str, controller: str, plant: str, uncertainty, allocation, path: str,
-                info: dict) -> dict:
-    """The JSON keys every ``tmfem deploy`` run reports (7.4 and 8.4 alike): what ran, the
-    figures of :meth:`tmfem.control.deploy.DeploymentResult.summary`, then the set-up's
-    ``info`` (the output paths and the total time are added by the command)."""
-    return {"preset": preset, "controller": controller, "plant": plant, "uncertainty": uncertainty,
-            "allocation": allocation, "path": path, **r.summary(), **info}
-
-
 def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gif=None,
                   vtk=None) -> dict:
     """Write the files of deployment run ``r`` of set-up ``s``: CSV, plot (Figures 7.2-7.4, or
