@@ -188,13 +188,17 @@ class LPVStateFeedback:
                 "solve_time_s": self.solve_time, "build_time_s": self.build_time,
                 "sizes": self.sizes, "max_lmi_eig": self.max_lmi_eig, "min_P_eig": self.min_P_eig}
 
+    def arrays(self) -> dict:
+        """The coefficients, gamma and grid as arrays (the contents of :meth:`save`)."""
+        return dict(gamma=self.gamma, P=np.array(self.P), Q=np.array(self.Q), centre=self.centre,
+                    half_width=self.half_width, varying=np.isin(np.arange(len(self.centre)), self.varying),
+                    rate_bounds=self.rate_bounds, parameter_names=np.array(self.parameter_names),
+                    state_names=np.array(self.state_names),
+                    **{f"axis_{k}": a for k, a in enumerate(self.axes)})
+
     def save(self, path) -> None:
         """Write the coefficients, gamma and grid to an ``.npz`` file."""
-        np.savez(path, gamma=self.gamma, P=np.array(self.P), Q=np.array(self.Q), centre=self.centre,
-                 half_width=self.half_width, varying=np.isin(np.arange(len(self.centre)), self.varying),
-                 rate_bounds=self.rate_bounds, parameter_names=np.array(self.parameter_names),
-                 state_names=np.array(self.state_names),
-                 **{f"axis_{k}": a for k, a in enumerate(self.axes)})
+        np.savez(path, **self.arrays())
 
     @classmethod
     def load(cls, path) -> "LPVStateFeedback":
