@@ -16,7 +16,7 @@ MAX_VERIFY_POINTS = 500
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
 LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma", "gamma_rtol",
-            "time_budget", "fixed_gamma", "sample_time", "start")
+            "time_budget", "fixed_gamma", "sample_time", "start", "output_feedback", "noise")
 
 #: EIGOPT defaults: relative bracket width of the gamma bisection, its time budget [s]
 GAMMA_RTOL, TIME_BUDGET = 0.05, 300.0
@@ -51,6 +51,13 @@ def configure(parser) -> None:
                              "step [s] to be stable (8.4 runs at 0.01 s; docs/lpv.md)")
     parser.add_argument("--bound-only", action="store_true", default=None,
                         help="lpv: only the pointwise state-feedback lower bound of gamma (no SDP)")
+    parser.add_argument("--output-feedback", action="store_true", default=None,
+                        help="lpv: observer-based output feedback on the measured q and membrane points "
+                             "(K(rho) with a gridded Kalman estimator; frozen-parameter verification on the "
+                             "finer grid, sampled at --sample-time when given; docs/lpv.md)")
+    parser.add_argument("--noise", type=float, default=None,
+                        help="lpv --output-feedback: measurement-noise weight W_n of the estimator design "
+                             "and of the verified norm [rad, m] (default 0.001)")
 
 
 def printed_grid(spec: str, printed: dict):
@@ -171,20 +178,46 @@ def synthesise(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
                   "solve_time_s": ctrl.solve_time, "sample_time_s": sample_time, **extra}
 
 
-def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None):
-    """:func:`tmfem.control.lpv_verify.verify` on the grid ``refine`` times finer (new COM
-    linearisations); refuses a controller that fails there."""
+def fine_plant(cfg: dict, plant):
+    """The plant on the grid ``refine`` times finer (new COM linearisations, the design's
+    membrane points)."""
     from tmfem.cli.common import progress_bar
     from tmfem.control.lpv_plant import com_lpv_plant
-    from tmfem.control.lpv_synthesis import interconnection_8_1
-    from tmfem.control.lpv_verify import verify
     from tmfem.reference.tables import deployment_bases
     s = cfg["system"]
     fine_axes = plant.refined(cfg["refine"])
     with progress_bar(fine_axes[0].size * fine_axes[1].size, 1, "verification plant (grid points)") as bar:
-        fine = com_lpv_plant(s, theta=fine_axes[0], psi=fine_axes[1], bases=deployment_bases(s),
+        return com_lpv_plant(s, theta=fine_axes[0], psi=fine_axes[1], bases=deployment_bases(s),
                              rate_bounds=plant.rate_bounds, membrane_points=plant.membrane_points, progress=bar)
-    return verify(ctrl, interconnection_8_1(fine, tracked=s.q_names), sample_time=sample_time)
+
+
+def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
+    """:func:`tmfem.control.lpv_verify.verify` on the grid ``refine`` times finer
+    (:func:`fine_plant`, or ``fine`` when given); refuses a controller that fails there."""
+    from tmfem.control.lpv_synthesis import interconnection_8_1
+    from tmfem.control.lpv_verify import verify
+    fine = fine_plant(cfg, plant) if fine is None else fine
+    return verify(ctrl, interconnection_8_1(fine, tracked=cfg["system"].q_names), sample_time=sample_time)
+
+
+def output_feedback(ctrl, plant, fine, s, noise, dt):
+    """The observer-based output feedback on q and the membrane point coordinates, verified
+    frozen on the fine grid (sampled at ``dt`` when given). JSON: ``gamma`` becomes the
+    largest frozen closed-loop norm from [q_d, n_d, n] to p over the fine grid
+    (``state_feedback_gamma`` the certified level of K(rho)); ``verification_max_eig`` stays
+    the LMI of K(rho) re-checked there."""
+    from tmfem.cli.common import progress_bar
+    from tmfem.control.lpv_output import design_output_feedback, verify_output_feedback
+    nz = plant.nx // 2
+    measured = list(plant.state_names[:nz])          # q and the K point coordinates (eq. 5.17)
+    t0 = time.perf_counter()
+    d = design_output_feedback(ctrl, plant, tracked=s.q_names, measured=measured, W_n=noise)
+    with progress_bar(int(np.prod(fine.grid_shape)), 1, "output-feedback verification (points)") as bar:
+        vo = verify_output_feedback(d, fine, W_e=0.5, W_u=0.05, dt=dt, progress=bar)
+    return d, {"output_feedback": True, "measured": measured, "noise_weight": noise, "W_d": d.W_d,
+               "state_feedback_gamma": ctrl.gamma, "gamma": vo.max_hinf,
+               "guarantee": "frozen-parameter (fine grid) only; K(rho) alone is rate-bounded on the design grid",
+               "output_feedback_time_s": time.perf_counter() - t0, **vo.to_dict()}
 
 
 def run(args) -> dict:
@@ -196,6 +229,13 @@ def run(args) -> dict:
     if args.sample_time is not None and not (np.isfinite(args.sample_time) and args.sample_time > 0):
         raise InputError(f"--sample-time: expected seconds > 0, found {args.sample_time}")
     output_file(args.save, option="--save", suffixes=(".npz",))
+    if args.noise is not None and not args.output_feedback:
+        raise InputError("lpv: option --noise applies with --output-feedback only")
+    if args.output_feedback and args.bound_only:
+        raise InputError("lpv: --bound-only computes no controller; it does not apply with --output-feedback")
+    noise = 1e-3 if args.noise is None else args.noise
+    if not (np.isfinite(noise) and noise > 0):
+        raise InputError(f"--noise: expected a weight > 0, found {noise}")
     if args.spec is not None:
         raise InputError(f"lpv: expected --preset (a preset with a printed LPV grid), found the file {args.spec!r}")
     cfg = check_synthesis(args, solver=args.solver or "SCS", preset=args.preset or "2-3-lpv")
@@ -204,11 +244,17 @@ def run(args) -> dict:
     if args.bound_only:
         return out
     ctrl, syn = synthesise(cfg, gp, bound, max_iter=args.max_iter, sample_time=args.sample_time)
-    v = verify_finer(cfg, plant, ctrl, sample_time=args.sample_time)
+    fine = fine_plant(cfg, plant)
+    v = verify_finer(cfg, plant, ctrl, sample_time=args.sample_time, fine=fine)
+    out = {**out, **syn, **v.to_dict()}
+    saved = ctrl
+    if args.output_feedback:
+        saved, extra = output_feedback(ctrl, plant, fine, cfg["system"], noise, args.sample_time)
+        out = {**out, **extra}
     if args.save:
-        ctrl.save(args.save)
+        saved.save(args.save)
         out["saved"] = args.save
-    return {**out, **syn, **v.to_dict()}
+    return out
 
 
 def format_text(r: dict) -> str:
@@ -220,6 +266,14 @@ def format_text(r: dict) -> str:
         lines += [f"gamma = {r['gamma']:.5g} ({r['solver']}, {r['status']}, {r['solve_time_s']:.1f} s, sizes {r['sizes']})",
                   f"verification on {r['verification_grid']}: max LMI eigenvalue {r['verification_max_eig']:.3e}, "
                   f"max closed-loop Re {r['closed_loop_max_real']:.3e}"]
+    if r.get("output_feedback"):
+        lines += [f"output feedback on {len(r['measured'])} measured signals (W_n = {r['noise_weight']:g}): "
+                  f"frozen max closed-loop Re {r['output_feedback_closed_loop_max_real']:.3e}, "
+                  f"max ||T_pw|| {r['output_feedback_hinf_max']:.4g} ({r['guarantee']})"]
+        if r["output_feedback_sampled_max_radius"] is not None:
+            lines.append(f"sampled-data loops at dt = {r['sample_time_s']:g} s: max spectral radius "
+                         f"{r['output_feedback_sampled_max_radius']:.6g} (state feedback alone "
+                         f"{r['state_feedback_sampled_max_radius']:.6g})")
     if r.get("gamma_levels"):
         nf = r["gamma_not_found"]
         lines.append(f"EIGOPT bisection ({len(r['gamma_levels'])} levels, {r['gamma_search_time_s']:.0f} s, stopped on "

@@ -143,10 +143,10 @@ class LPVOutputFeedback:
         """(Phi, Gamma_u, Gamma_y) of the estimator over one sample dt at frozen rho: the exact
         zero-order-hold solution e(t + dt) = Phi e + Gamma_u (u - u_e) + Gamma_y (y_m - y_e)
         of e' = (A - L C_m) e + B (u - u_e) + L (y_m - y_e)."""
-        A, B, C, L, _, _ = self.model(rho)
-        n, m = A.shape[0], B.shape[1] + L.shape[1]
-        E = sla.expm(np.block([[A - L @ C, B, L], [np.zeros((m, n + m))]]) * dt)
-        return E[:n, :n], E[:n, n:n + B.shape[1]], E[:n, n + B.shape[1]:]
+        A, BL, C, _ = self.estimator.at(rho)
+        n, m, nu = A.shape[0], BL.shape[1], self.nu
+        E = sla.expm(np.block([[A - BL[:, nu:] @ C, BL], [np.zeros((m, n + m))]]) * dt)
+        return E[:n, :n], E[:n, n:n + nu], E[:n, n + nu:]
 
     def save(self, path) -> None:
         """The state-feedback coefficients (``LPVStateFeedback.save``) with the gridded gains
@@ -370,35 +370,42 @@ class LPVOutputController:
         self.reference = reference
         self._lo = np.array([a[0] for a in est.axes])
         self._hi = np.array([a[-1] for a in est.axes])
-        self._dt = None
+        self._dt, self._last = None, None
 
     def _read(self, y, xc):
+        key = (np.asarray(y, dtype=float).tobytes(), np.asarray(xc, dtype=float).tobytes())
+        if self._last is not None and self._last[0] == key:        # output, then update, of one step
+            return self._last[1]
+        self._last = (key, self._evaluate(y, xc))
+        return self._last[1]
+
+    def _evaluate(self, y, xc):
         y = np.asarray(y, dtype=float)
         ym = y[self.measured_index]
         rho = np.clip(y[self.rho_index], self._lo, self._hi)
         n = self.design.nx
-        e = xc[:n] - self.design.estimator.interpolate("x_e", rho)
+        x_e = self.design.estimator.interpolate("x_e", rho)
+        e = xc[:n] - x_e
         ue = self.design.estimator.interpolate("u_e", rho)[:self.design.nu]
         u = ue + self.design.state_feedback.gain(rho) @ np.concatenate([e, xc[n:]])
-        return ym, rho, e, ue, u
+        return ym, rho, e, ue, u, x_e
 
     def reset(self, t0, y0, dt):
         """x^ starts at the equilibrium of the measured rho (bumpless from an equilibrium), xi = 0."""
         if not (np.isfinite(dt) and dt > 0):
             raise InputError(f"LPV output controller: expected a sample time dt > 0, found {dt!r}")
-        self._dt = float(dt)
+        self._dt, self._last = float(dt), None
         rho = np.clip(np.asarray(y0, dtype=float)[self.rho_index], self._lo, self._hi)
         return np.concatenate([self.design.estimator.interpolate("x_e", rho),
                                np.zeros(self.design.tracked_rows.size)])
 
     def output(self, t, y, xc):
-        return self._read(y, xc)[-1]
+        return self._read(y, xc)[4]
 
     def update(self, t, y, xc):
-        ym, rho, e, ue, u = self._read(y, xc)
+        ym, rho, e, ue, u, x_e = self._read(y, xc)
         Phi, Gu, Gy = self.design.step_matrices(rho, self._dt)
         ye = self.design.estimator.interpolate("y_e", rho)
-        x_e = self.design.estimator.interpolate("x_e", rho)
         n = self.design.nx
         xi = xc[n:] + self._dt * (np.asarray(self.reference(t), dtype=float) - ym[self.design.tracked_rows])
         return np.concatenate([x_e + Phi @ e + Gu @ (u - ue) + Gy @ (ym - ye), xi])
