@@ -23,7 +23,40 @@ from tmfem.control.lpv_synthesis import LPVStateFeedback
 from tmfem.errors import InputError
 
 
-class LPVController:
+class Scheduled:
+    """What the scheduled controllers share: the reference q_d(t), the parameters read from y
+    at ``rho_index`` and held inside the design grid ``axes``, the operating point rho_r(t)
+    (``reference_rho``, optional) and the sample time."""
+
+    def _schedule(self, axes, rho_index, reference, what: str, reference_rho=None) -> None:
+        self.rho_index = np.asarray(rho_index, dtype=int)
+        if not callable(reference):
+            raise InputError(f"{what}: expected the reference q_d(t) as a callable")
+        if reference_rho is not None and not callable(reference_rho):
+            raise InputError(f"{what}: expected the reference parameters rho_r(t) as a callable")
+        self.reference, self.reference_rho = reference, reference_rho
+        self._lo = np.array([a[0] for a in axes])
+        self._hi = np.array([a[-1] for a in axes])
+        self._what, self._dt = what, None
+
+    def rho(self, y) -> np.ndarray:
+        """Scheduling parameters from y, held inside the design grid."""
+        return np.clip(np.asarray(y, dtype=float)[self.rho_index], self._lo, self._hi)
+
+    def operating_rho(self, t, rho) -> np.ndarray:
+        """Where x_e, u_e of the control law are taken: rho_r(t) (held inside the grid) when
+        ``reference_rho`` is given, else ``rho``."""
+        if self.reference_rho is None:
+            return rho
+        return np.clip(np.asarray(self.reference_rho(t), dtype=float), self._lo, self._hi)
+
+    def _sample_time(self, dt) -> None:
+        if not (np.isfinite(dt) and dt > 0):
+            raise InputError(f"{self._what}: expected a sample time dt > 0, found {dt!r}")
+        self._dt = float(dt)
+
+
+class LPVController(Scheduled):
     """Scheduled state feedback with integral action (module docstring).
 
     Parameters
@@ -48,37 +81,27 @@ class LPVController:
         self.design, self.plant, self.name = design, plant, name
         self.state_index = np.asarray(state_index, dtype=int)
         self.q_index = np.asarray(q_index, dtype=int)
-        self.rho_index = np.asarray(rho_index, dtype=int)
+        self._schedule(plant.axes, rho_index, reference, "LPV controller", reference_rho)
         n, nq = plant.nx, self.q_index.size
         nk = design.P[0].shape[0]
         if self.state_index.size != n or nk != n + nq or self.rho_index.size != len(plant.axes):
             raise InputError(f"LPV controller: expected {n} state, {nk - n} tracked and {len(plant.axes)} "
                              f"scheduling indices, found {self.state_index.size}, {nq} and "
                              f"{self.rho_index.size}")
-        if not callable(reference):
-            raise InputError("LPV controller: expected the reference q_d(t) as a callable")
-        if reference_rho is not None and not callable(reference_rho):
-            raise InputError("LPV controller: expected the reference parameters rho_r(t) as a callable")
-        self.reference, self.reference_rho = reference, reference_rho
-        self._lo = np.array([a[0] for a in plant.axes])
-        self._hi = np.array([a[-1] for a in plant.axes])
-        self._dt = None
 
-    def rho(self, y) -> np.ndarray:
-        """Scheduling parameters from y, held inside the design grid."""
-        return np.clip(np.asarray(y, dtype=float)[self.rho_index], self._lo, self._hi)
+    @property
+    def read_index(self) -> np.ndarray:
+        """The entries of y the controller reads (x_z and rho)."""
+        return np.concatenate([self.state_index, self.rho_index])
 
     def reset(self, t0, y0, dt):
-        if not (np.isfinite(dt) and dt > 0):
-            raise InputError(f"LPV controller: expected a sample time dt > 0, found {dt!r}")
-        self._dt = float(dt)
+        self._sample_time(dt)
         return np.zeros(self.q_index.size)
 
     def output(self, t, y, xc):
         y = np.asarray(y, dtype=float)
         r = self.rho(y)
-        re = r if self.reference_rho is None else np.clip(np.asarray(self.reference_rho(t), dtype=float),
-                                                           self._lo, self._hi)
+        re = self.operating_rho(t, r)
         x = np.concatenate([y[self.state_index] - self.plant.interpolate("x_e", re), xc])
         return self.plant.interpolate("u_e", re) + self.design.gain(r) @ x
 

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from tmfem.control.lpv_controller import Scheduled
 from tmfem.control.lpv_plant import GriddedLPV
 from tmfem.control.lpv_synthesis import LPVStateFeedback, _state_scaling
 from tmfem.errors import InfeasibleController, InputError
@@ -331,7 +332,7 @@ def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e:
     return res
 
 
-class LPVOutputController:
+class LPVOutputController(Scheduled):
     """The observer-based scheduled controller of the module docstring as a simulation
     controller (protocol of :mod:`tmfem.simulation.controllers`).
 
@@ -359,18 +360,13 @@ class LPVOutputController:
                  name: str = "lpv-output"):
         self.design, self.name = design, name
         self.measured_index = np.asarray(measured_index, dtype=int)
-        self.rho_index = np.asarray(rho_index, dtype=int)
         est = design.estimator
+        self._schedule(est.axes, rho_index, reference, "LPV output controller")
         if self.measured_index.size != len(design.measured) or self.rho_index.size != len(est.axes):
             raise InputError(f"LPV output controller: expected {len(design.measured)} measured and "
                              f"{len(est.axes)} scheduling indices, found {self.measured_index.size} and "
                              f"{self.rho_index.size}")
-        if not callable(reference):
-            raise InputError("LPV output controller: expected the reference q_d(t) as a callable")
-        self.reference = reference
-        self._lo = np.array([a[0] for a in est.axes])
-        self._hi = np.array([a[-1] for a in est.axes])
-        self._dt, self._last = None, None
+        self._last = None
 
     def _read(self, y, xc):
         key = (np.asarray(y, dtype=float).tobytes(), np.asarray(xc, dtype=float).tobytes())
@@ -380,9 +376,8 @@ class LPVOutputController:
         return self._last[1]
 
     def _evaluate(self, y, xc):
-        y = np.asarray(y, dtype=float)
-        ym = y[self.measured_index]
-        rho = np.clip(y[self.rho_index], self._lo, self._hi)
+        ym = np.asarray(y, dtype=float)[self.measured_index]
+        rho = self.rho(y)
         n = self.design.nx
         x_e = self.design.estimator.interpolate("x_e", rho)
         e = xc[:n] - x_e
@@ -392,10 +387,9 @@ class LPVOutputController:
 
     def reset(self, t0, y0, dt):
         """x^ starts at the equilibrium of the measured rho (bumpless from an equilibrium), xi = 0."""
-        if not (np.isfinite(dt) and dt > 0):
-            raise InputError(f"LPV output controller: expected a sample time dt > 0, found {dt!r}")
-        self._dt, self._last = float(dt), None
-        rho = np.clip(np.asarray(y0, dtype=float)[self.rho_index], self._lo, self._hi)
+        self._sample_time(dt)
+        self._last = None
+        rho = self.rho(y0)
         return np.concatenate([self.design.estimator.interpolate("x_e", rho),
                                np.zeros(self.design.tracked_rows.size)])
 
