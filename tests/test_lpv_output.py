@@ -157,3 +157,27 @@ def test_measurement_noise_is_one_seeded_sample_per_step():
     assert c.name == base.name
     with pytest.raises(InputError, match="sigma >= 0"):
         MeasurementNoise(base, sigma=-1.0)
+
+
+def test_reference_rho_and_scheduling_on_the_estimate(design):
+    pl, d = design
+    xc = np.array([X0 + 0.02, 0.1, 0.3])                     # [x^, v^, xi]
+    y = [X0 + 0.01, 1.3]
+    base = LPVOutputController(d, measured_index=[0], rho_index=[1], reference=lambda t: [X0])
+    base.reset(0.0, y, 0.01)
+    # about rho_r: x_e = X0 at every grid point, so only the feed-forward u_e(rho_r) changes:
+    # u(rho_r) - u(rho) = (rho_r - rho) X0 (u_e = (1 + rho) X0, interpolated exactly)
+    ref = LPVOutputController(d, measured_index=[0], rho_index=[1], reference=lambda t: [X0],
+                              reference_rho=lambda t: [0.4])
+    ref.reset(0.0, y, 0.01)
+    assert ref.output(0.0, y, xc) - base.output(0.0, y, xc) == pytest.approx([(0.4 - 1.3) * X0], abs=1e-12)
+    # scheduling on the estimate: the parameters read from x^ by name ("x" here, rho = x^ = 0.52)
+    ax = GriddedLPV(**{**{k: getattr(pl, k) for k in ("axes", "A", "B", "C", "D", "rate_bounds", "state_names",
+                                                     "input_names", "output_names", "x_e", "u_e", "y_e")},
+                       "parameter_names": ["x"]})
+    dx = design_output_feedback(d.state_feedback, ax, tracked=["y"], measured=["y"], W_d=0.3, W_n=0.01)
+    est = LPVOutputController(dx, measured_index=[0], rho_index=[1], reference=lambda t: [X0], schedule="estimate")
+    est.reset(0.0, y, 0.01)
+    assert est.output(0.0, y, xc) == pytest.approx(base.output(0.0, [y[0], xc[0]], xc), abs=1e-12)
+    with pytest.raises(InputError, match="among the plant states"):
+        LPVOutputController(d, measured_index=[0], rho_index=[1], reference=lambda t: [X0], schedule="estimate")

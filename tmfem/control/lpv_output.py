@@ -1,5 +1,5 @@
 """Output-feedback LPV control: the scheduled state feedback of eqs. 5.95-5.99 with a gridded
-Kalman estimator (the output feedback that 8.5 names as future work).
+Kalman estimator (the output feedback that 9.2 names as future work).
 
 Formulation (observer-based, frozen-parameter verified; docs/lpv.md). The plant of
 :func:`~tmfem.control.lpv_synthesis.interconnection_8_1` is measured through
@@ -337,7 +337,10 @@ class LPVOutputController(Scheduled):
     controller (protocol of :mod:`tmfem.simulation.controllers`).
 
     Controller state [x^, xi] (the absolute state estimate and the integrators). Per sample
-    dt, rho is read from the measured signals and held inside the design grid; the estimate
+    dt, rho is read from the measured signals (``schedule="measured"``, as 8.4 schedules the
+    state feedback) or from the estimate x^ (``"estimate"``: the parameters are states of the
+    plant, theta_13 and psi_13 for 2-3; the estimate filters the measurement noise out of
+    x_e(rho), u_e(rho) and K(rho)) and held inside the design grid; the estimate
     advances by the exact zero-order-hold solution of the frozen estimator
     (:meth:`LPVOutputFeedback.step_matrices`, rho and the commanded u held over the step),
     the integrators by forward Euler (as :class:`~tmfem.control.lpv_controller.LPVController`).
@@ -351,13 +354,20 @@ class LPVOutputController(Scheduled):
         Positions in the plant's output vector y of the measured signals (``design.measured``).
     rho_index : sequence of int
         Positions in y of the scheduling parameters (measured: for 2-3 theta_13 and psi_13,
-        which are also among the measured signals).
+        which are also among the measured signals); with ``schedule="estimate"`` used at
+        :meth:`reset` only.
+    schedule : {"measured", "estimate"}
+    reference_rho : callable, optional
+        t -> rho_r(t), the parameters of the reference: the control law is then taken about
+        the equilibrium the reference passes through, u = u_e(rho_r) + K(rho) [x^ - x_e(rho_r);
+        xi] (as :class:`~tmfem.control.lpv_controller.LPVController` with ``reference_rho``);
+        the estimator keeps its model about the scheduling rho.
     reference : callable
         t -> q_d(t) (absolute values, as the measured q).
     """
 
     def __init__(self, design: LPVOutputFeedback, *, measured_index, rho_index, reference,
-                 name: str = "lpv-output"):
+                 schedule: str = "measured", reference_rho=None, name: str = "lpv-output"):
         self.design, self.name = design, name
         self.measured_index = np.asarray(measured_index, dtype=int)
         est = design.estimator
@@ -366,24 +376,43 @@ class LPVOutputController(Scheduled):
             raise InputError(f"LPV output controller: expected {len(design.measured)} measured and "
                              f"{len(est.axes)} scheduling indices, found {self.measured_index.size} and "
                              f"{self.rho_index.size}")
+        if schedule not in ("measured", "estimate"):
+            raise InputError(f"LPV output controller: schedule expected 'measured' or 'estimate', found "
+                             f"{schedule!r}")
+        self._from_estimate = None
+        if schedule == "estimate":
+            missing = [p for p in est.parameter_names if p not in est.state_names]
+            if missing:
+                raise InputError(f"LPV output controller: schedule='estimate' needs the parameters among the "
+                                 f"plant states, found {missing} not in them")
+            self._from_estimate = np.array([est.state_names.index(p) for p in est.parameter_names])
+        if reference_rho is not None and not callable(reference_rho):
+            raise InputError("LPV output controller: expected reference_rho as a callable t -> rho_r(t)")
+        self.reference_rho = reference_rho
         self._last = None
 
-    def _read(self, y, xc):
-        key = (np.asarray(y, dtype=float).tobytes(), np.asarray(xc, dtype=float).tobytes())
+    def _read(self, t, y, xc):
+        key = (t, np.asarray(y, dtype=float).tobytes(), np.asarray(xc, dtype=float).tobytes())
         if self._last is not None and self._last[0] == key:        # output, then update, of one step
             return self._last[1]
-        self._last = (key, self._evaluate(y, xc))
+        self._last = (key, self._evaluate(t, y, xc))
         return self._last[1]
 
-    def _evaluate(self, y, xc):
+    def _evaluate(self, t, y, xc):
+        """Measured signals, scheduling rho, estimator deviation e = x^ - x_e(rho) with u_e(rho),
+        and the input u."""
+        est, n = self.design.estimator, self.design.nx
         ym = np.asarray(y, dtype=float)[self.measured_index]
-        rho = self.rho(y)
-        n = self.design.nx
-        x_e = self.design.estimator.interpolate("x_e", rho)
-        e = xc[:n] - x_e
-        ue = self.design.estimator.interpolate("u_e", rho)[:self.design.nu]
-        u = ue + self.design.state_feedback.gain(rho) @ np.concatenate([e, xc[n:]])
-        return ym, rho, e, ue, u, x_e
+        rho = self.rho(y) if self._from_estimate is None else \
+            np.clip(xc[self._from_estimate], self._lo, self._hi)
+        x_e = est.interpolate("x_e", rho)
+        ue = est.interpolate("u_e", rho)[:self.design.nu]
+        x_c, u_c = x_e, ue
+        if self.reference_rho is not None:
+            r = np.clip(np.asarray(self.reference_rho(t), dtype=float), self._lo, self._hi)
+            x_c, u_c = est.interpolate("x_e", r), est.interpolate("u_e", r)[:self.design.nu]
+        u = u_c + self.design.state_feedback.gain(rho) @ np.concatenate([xc[:n] - x_c, xc[n:]])
+        return ym, rho, xc[:n] - x_e, ue, u, x_e
 
     def reset(self, t0, y0, dt):
         """x^ starts at the equilibrium of the measured rho (bumpless from an equilibrium), xi = 0."""
@@ -394,10 +423,10 @@ class LPVOutputController(Scheduled):
                                np.zeros(self.design.tracked_rows.size)])
 
     def output(self, t, y, xc):
-        return self._read(y, xc)[4]
+        return self._read(t, y, xc)[4]
 
     def update(self, t, y, xc):
-        ym, rho, e, ue, u, x_e = self._read(y, xc)
+        ym, rho, e, ue, u, x_e = self._read(t, y, xc)
         Phi, Gu, Gy = self.design.step_matrices(rho, self._dt)
         ye = self.design.estimator.interpolate("y_e", rho)
         n = self.design.nx
