@@ -24,7 +24,8 @@ def configure(parser) -> None:
                              "adaptive-hinf (default; the LMI H-infinity controller of 7.3, tmfem control), "
                              "adaptive-hinf-riccati (python-control hinfsyn), adaptive-lqr (LQR "
                              "state feedback) or adaptive (no switch); LPV presets (8.4): lpv (default; "
-                             "the scheduled state feedback of 8.3)")
+                             "the scheduled state feedback of 8.3) or lpv-output (its observer-based output feedback on the "
+                             "measured q and membrane points, docs/lpv.md)")
     parser.add_argument("--uncertainty", choices=list(UNCERTAINTIES),
                         help="controller model error (default: the 7.4 choice of the preset)")
     parser.add_argument("--path", choices=["delta", "table-7-7-bases", "linear"],
@@ -88,7 +89,7 @@ def run(args) -> dict:
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
         return deploy_lpv.run(args)
-    lpv_opts = deploy_lpv.given(args, ("lpv_controller",) + deploy_lpv.SYNTHESIS)
+    lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise") + deploy_lpv.SYNTHESIS)
     if lpv_opts:
         raise InputError(f"options {lpv_opts} apply to --controller lpv only, found --controller {args.controller}")
     args.allocation = args.allocation or "bounded"

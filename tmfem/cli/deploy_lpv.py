@@ -34,6 +34,10 @@ def configure(parser) -> None:
     parser.add_argument("--solver", choices=("EIGOPT", "CLARABEL", "SCS"), default=None,
                         help="--controller lpv: synthesis solver (default EIGOPT, docs/lpv.md)")
     control_lpv.configure_synthesis(parser, prefix="--controller lpv: ")
+    parser.add_argument("--noise", type=float, default=None, metavar="SIGMA",
+                        help="LPV deployment: measurement noise, seeded Gaussian samples of this standard "
+                             "deviation [rad, m; rad/s, m/s] per step on every signal the controller reads "
+                             "(lpv: all states and rho; lpv-output: q, the membrane points and rho)")
 
 
 def given(args, names) -> list:
@@ -70,6 +74,19 @@ def lpv_state_feedback(dep, design):
     return state_feedback_controller(dep, design)
 
 
+def lpv_output_feedback(dep, design):
+    """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv_output`
+    with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
+    reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17) and rho;
+    the control law about rho_r(t) as the state feedback's."""
+    from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
+    pl = dep.plant
+    nz, n = pl.nx // 2, pl.nx
+    of = design_output_feedback(design, pl, tracked=dep.model.system.q_names, measured=pl.state_names[:nz])
+    return LPVOutputController(of, measured_index=np.arange(nz), rho_index=[n, n + 1],
+                               reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho)
+
+
 def design(args, preset: str):
     """(design plant, state-feedback design, JSON entries): loaded and checked on its grid
     (sampled at --dt), or synthesised and verified on the finer grid."""
@@ -103,9 +120,9 @@ def design(args, preset: str):
 
 
 #: --controller name -> design(args, preset) -> (design plant, design with ``gamma``, JSON entries)
-DESIGNS = {"lpv": design}
+DESIGNS = {"lpv": design, "lpv-output": design}
 #: --controller name -> builder(deployment, design) of a controller on the LPV signals y_lpv
-BUILDERS = {"lpv": lpv_state_feedback}
+BUILDERS = {"lpv": lpv_state_feedback, "lpv-output": lpv_output_feedback}
 
 
 def run(args) -> dict:
@@ -115,10 +132,17 @@ def run(args) -> dict:
     from tmfem.control.deploy import run_deployment
     from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
     check(args)
+    if args.noise is not None and not (np.isfinite(args.noise) and args.noise >= 0):
+        raise InputError(f"--noise: expected a standard deviation >= 0, found {args.noise}")
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
     dep = lpv_setup(args.preset, plant)
-    s = dep.setup(BUILDERS[args.controller](dep, d))
+    c = BUILDERS[args.controller](dep, d)
+    if args.noise:
+        from tmfem.simulation.controllers import MeasurementNoise
+        c = MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
+        info["measurement_noise_sigma"] = args.noise
+    s = dep.setup(c)
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller})") as bar:
         r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
                            t_end=args.t_end, dt=args.dt, progress=bar, jacobian="reuse")

@@ -371,7 +371,7 @@ class LPVOutputController(Scheduled):
         self.design, self.name = design, name
         self.measured_index = np.asarray(measured_index, dtype=int)
         est = design.estimator
-        self._schedule(est.axes, rho_index, reference, "LPV output controller")
+        self._schedule(est.axes, rho_index, reference, "LPV output controller", reference_rho)
         if self.measured_index.size != len(design.measured) or self.rho_index.size != len(est.axes):
             raise InputError(f"LPV output controller: expected {len(design.measured)} measured and "
                              f"{len(est.axes)} scheduling indices, found {self.measured_index.size} and "
@@ -386,10 +386,12 @@ class LPVOutputController(Scheduled):
                 raise InputError(f"LPV output controller: schedule='estimate' needs the parameters among the "
                                  f"plant states, found {missing} not in them")
             self._from_estimate = np.array([est.state_names.index(p) for p in est.parameter_names])
-        if reference_rho is not None and not callable(reference_rho):
-            raise InputError("LPV output controller: expected reference_rho as a callable t -> rho_r(t)")
-        self.reference_rho = reference_rho
         self._last = None
+
+    @property
+    def read_index(self) -> np.ndarray:
+        """The entries of y the controller reads (the measured signals and rho)."""
+        return np.concatenate([self.measured_index, self.rho_index])
 
     def _read(self, t, y, xc):
         key = (t, np.asarray(y, dtype=float).tobytes(), np.asarray(xc, dtype=float).tobytes())
@@ -409,7 +411,7 @@ class LPVOutputController(Scheduled):
         ue = est.interpolate("u_e", rho)[:self.design.nu]
         x_c, u_c = x_e, ue
         if self.reference_rho is not None:
-            r = np.clip(np.asarray(self.reference_rho(t), dtype=float), self._lo, self._hi)
+            r = self.operating_rho(t, rho)
             x_c, u_c = est.interpolate("x_e", r), est.interpolate("u_e", r)[:self.design.nu]
         u = u_c + self.design.state_feedback.gain(rho) @ np.concatenate([xc[:n] - x_c, xc[n:]])
         return ym, rho, xc[:n] - x_e, ue, u, x_e

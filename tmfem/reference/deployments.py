@@ -147,7 +147,7 @@ LPV_DEPLOYMENTS = {
                 "membrane_modes": 4, "path": "table-7-7-bases"},
 }
 #: controllers of an LPV deployment (``tmfem deploy --controller``)
-LPV_CONTROLLERS = ("lpv",)
+LPV_CONTROLLERS = ("lpv", "lpv-output")
 
 
 def lpv_setup(preset: str, plant, *, model_at: str = "final"):
