@@ -181,3 +181,20 @@ def test_reference_rho_and_scheduling_on_the_estimate(design):
     assert est.output(0.0, y, xc) == pytest.approx(base.output(0.0, [y[0], xc[0]], xc), abs=1e-12)
     with pytest.raises(InputError, match="among the plant states"):
         LPVOutputController(d, measured_index=[0], rho_index=[1], reference=lambda t: [X0], schedule="estimate")
+
+
+def test_estimator_is_driven_by_the_saturated_input(design):
+    # with input_limits the estimate advances with the input the plant receives:
+    # x^+ differs by Gamma_u (u_sat - u) (the zero-order-hold step of step_matrices)
+    pl, d = design
+    rho, dt = 1.3, 0.01
+    y, xc = [X0 + 0.01, rho], np.array([X0 + 0.02, 0.1, 0.3])
+    kw = dict(measured_index=[0], rho_index=[1], reference=lambda t: [X0])
+    free = LPVOutputController(d, **kw)
+    lim = LPVOutputController(d, **kw, input_limits=lambda u, ym: np.minimum(u, 0.5))
+    free.reset(0.0, y, dt), lim.reset(0.0, y, dt)
+    u = free.output(0.0, y, xc)
+    assert lim.output(0.0, y, xc) == pytest.approx(u)            # the command itself is unchanged
+    assert u[0] > 0.5
+    Gu = d.step_matrices([rho], dt)[1]
+    np.testing.assert_allclose(lim.update(0.0, y, xc)[:2] - free.update(0.0, y, xc)[:2], Gu @ (0.5 - u), atol=1e-14)

@@ -78,13 +78,16 @@ def lpv_output_feedback(dep, design):
     """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv_output`
     with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
     reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17) and rho;
-    the control law about rho_r(t) as the state feedback's."""
+    the control law about rho_r(t) as the state feedback's; the estimator is driven by the input
+    saturated to the rest-length limits [1 mm, |tendon|(q_m)] of the run at the measured q."""
+    from tmfem.control.limits import tendon_lengths
     from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
-    pl = dep.plant
-    nz, n = pl.nx // 2, pl.nx
-    of = design_output_feedback(design, pl, tracked=dep.model.system.q_names, measured=pl.state_names[:nz])
+    pl, system = dep.plant, dep.model.system
+    nz, n, nq = pl.nx // 2, pl.nx, dep.model.nq
+    of = design_output_feedback(design, pl, tracked=system.q_names, measured=pl.state_names[:nz])
     return LPVOutputController(of, measured_index=np.arange(nz), rho_index=[n, n + 1],
-                               reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho)
+                               reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho,
+                               input_limits=lambda u, ym: np.clip(u, 1e-3, tendon_lengths(system, ym[:nq])))
 
 
 def design(args, preset: str):

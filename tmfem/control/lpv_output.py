@@ -344,8 +344,9 @@ class LPVOutputController(Scheduled):
     advances by the exact zero-order-hold solution of the frozen estimator
     (:meth:`LPVOutputFeedback.step_matrices`, rho and the commanded u held over the step),
     the integrators by forward Euler (as :class:`~tmfem.control.lpv_controller.LPVController`).
-    The estimator sees the commanded input: a saturation downstream (rest-length limits) is
-    not known to it.
+    The estimator is driven by the commanded input, or with ``input_limits`` by the input the
+    plant is expected to receive after a saturation downstream (the rest-length limits of
+    7.4: the estimate otherwise drifts from the plant while a limit acts).
 
     Parameters
     ----------
@@ -362,12 +363,15 @@ class LPVOutputController(Scheduled):
         the equilibrium the reference passes through, u = u_e(rho_r) + K(rho) [x^ - x_e(rho_r);
         xi] (as :class:`~tmfem.control.lpv_controller.LPVController` with ``reference_rho``);
         the estimator keeps its model about the scheduling rho.
+    input_limits : callable, optional
+        (u, y_m) -> the saturated input, e.g. u clipped to [r_min, |tendon|(q_m)] with the
+        measured q (:func:`tmfem.control.limits.tendon_lengths`).
     reference : callable
         t -> q_d(t) (absolute values, as the measured q).
     """
 
     def __init__(self, design: LPVOutputFeedback, *, measured_index, rho_index, reference,
-                 schedule: str = "measured", reference_rho=None, name: str = "lpv-output"):
+                 schedule: str = "measured", reference_rho=None, input_limits=None, name: str = "lpv-output"):
         self.design, self.name = design, name
         self.measured_index = np.asarray(measured_index, dtype=int)
         est = design.estimator
@@ -386,6 +390,9 @@ class LPVOutputController(Scheduled):
                 raise InputError(f"LPV output controller: schedule='estimate' needs the parameters among the "
                                  f"plant states, found {missing} not in them")
             self._from_estimate = np.array([est.state_names.index(p) for p in est.parameter_names])
+        if input_limits is not None and not callable(input_limits):
+            raise InputError("LPV output controller: expected input_limits as a callable (u, y_m) -> u")
+        self.input_limits = input_limits
         self._last = None
 
     @property
@@ -429,6 +436,8 @@ class LPVOutputController(Scheduled):
 
     def update(self, t, y, xc):
         ym, rho, e, ue, u, x_e = self._read(t, y, xc)
+        if self.input_limits is not None:
+            u = np.asarray(self.input_limits(u, ym), dtype=float)
         Phi, Gu, Gy = self.design.step_matrices(rho, self._dt)
         ye = self.design.estimator.interpolate("y_e", rho)
         n = self.design.nx
