@@ -77,9 +77,11 @@ def lpv_state_feedback(dep, design):
 def lpv_output_feedback(dep, design):
     """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv_output`
     with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
-    reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17) and rho;
-    the control law about rho_r(t) as the state feedback's; the estimator is driven by the input
-    saturated to the rest-length limits [1 mm, |tendon|(q_m)] of the run at the measured q."""
+    reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
+    the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
+    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/lpv.md); the control law about rho_r(t)
+    as the state feedback's; the estimator is driven by the input saturated to the rest-length
+    limits [1 mm, |tendon|(q_m)] of the run at the measured q."""
     from tmfem.control.limits import tendon_lengths
     from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
     pl, system = dep.plant, dep.model.system
@@ -87,6 +89,7 @@ def lpv_output_feedback(dep, design):
     of = design_output_feedback(design, pl, tracked=system.q_names, measured=pl.state_names[:nz])
     return LPVOutputController(of, measured_index=np.arange(nz), rho_index=[n, n + 1],
                                reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho,
+                               schedule="estimate",
                                input_limits=lambda u, ym: np.clip(u, 1e-3, tendon_lengths(system, ym[:nq])))
 
 
