@@ -2,7 +2,7 @@
 through the library (tmfem.control.deploy.run_deployment; docs/lpv.md, output feedback).
 
 Run: .venv/bin/python benchmarks/lpv_output_deploy.py [--gamma 20] [--t-end 20] [--dt 2e-4]
-         [--sigma 0 1e-3] [--plot docs/figures/lpv_output_deploy.png]
+         [--sigma 0 1e-3] [--schedule measured|estimate] [--plot out.png]
 
 Builds the 6 x 3 plant of P_D, K(rho) by EIGOPT at --gamma, the Kalman estimator (W_d = W_n =
 0.001), then deploys theta_13 from 77.32 to 63 deg (eq. 5.100: xi_r = 1, omega_r = 0.3,
@@ -21,7 +21,7 @@ import numpy as np
 from tmfem.control.deploy import run_deployment
 from tmfem.control.lpv_controller import LPVController
 from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
-from tmfem.control.lpv_plant import choose_membrane_points, com_lpv_plant
+from tmfem.control.lpv_plant import com_lpv_plant
 from tmfem.control.lpv_synthesis import interconnection_8_1, synthesize_state_feedback
 from tmfem.control.reference_trajectory import DeploymentReference
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
@@ -37,6 +37,8 @@ def main():
     ap.add_argument("--t-end", type=float, default=20.0)
     ap.add_argument("--dt", type=float, default=2e-4)
     ap.add_argument("--sigma", type=float, nargs="+", default=[0.0, 1e-3])
+    ap.add_argument("--schedule", choices=["measured", "estimate"], default="measured",
+                    help="where the output feedback reads rho (the state feedback: measured)")
     ap.add_argument("--plot", default=None)
     a = ap.parse_args()
     s = load_preset("2-3-lpv")
@@ -52,9 +54,8 @@ def main():
     def cfg(theta, psi):
         return with_configuration(s, configuration_5_97(s, theta, psi, **bases(theta, psi)))
     th0, th1, ps0 = np.radians(77.32), np.radians(63.0), np.radians(8.36)
-    pts = choose_membrane_points(ControlOrientedModel(cfg(th[0], ps[0]), membrane_modes=4))  # as com_lpv_plant
     s0 = cfg(th0, ps0)
-    model = ControlOrientedModel(s0, membrane_modes=4, membrane_points=pts)
+    model = ControlOrientedModel(s0, membrane_modes=4, membrane_points=pl.membrane_points)
     ref = DeploymentReference(initial=s0.symmetric, final=cfg(th1, ps0).symmetric, N=s.N,
                               q_names=list(s.q_names), omega_r=0.3, bases=bases)
     rho_index = [s.q_names.index("theta_13"), s.q_names.index("psi_13")]
@@ -68,7 +69,7 @@ def main():
                                   reference=lambda tk: ref(tk)[0])
             else:
                 c = LPVOutputController(of, measured_index=range(nz), rho_index=rho_index,
-                                        reference=lambda tk: ref(tk)[0])
+                                        reference=lambda tk: ref(tk)[0], schedule=a.schedule)
             if sigma > 0:
                 c = MeasurementNoise(c, sigma=sigma, index=range(2 * nz if kind == "lpv" else nz), seed=1)
             r = run_deployment(model=model, reference=ref, controller=c, z0=z0, t_end=a.t_end, dt=a.dt,
