@@ -263,7 +263,8 @@ def format_text(r: dict) -> str:
              f"pointwise state-feedback lower bound of gamma: {r['lpv_gamma_lower_bound']:.4g} at "
              f"(theta_13, psi_13) = ({', '.join(deg)}) (printed ||G_pw|| < {r['printed_gamma_bound']})"]
     if "gamma" in r:
-        lines += [f"gamma = {r['gamma']:.5g} ({r['solver']}, {r['status']}, {r['solve_time_s']:.1f} s, sizes {r['sizes']})",
+        lines += [f"{'K(rho): ' if r.get('output_feedback') else ''}gamma = "
+                  f"{r.get('state_feedback_gamma', r['gamma']):.5g} ({r['solver']}, {r['status']}, {r['solve_time_s']:.1f} s, sizes {r['sizes']})",
                   f"verification on {r['verification_grid']}: max LMI eigenvalue {r['verification_max_eig']:.3e}, "
                   f"max closed-loop Re {r['closed_loop_max_real']:.3e}"]
     if r.get("output_feedback"):
@@ -272,8 +273,8 @@ def format_text(r: dict) -> str:
                   f"max ||T_pw|| {r['output_feedback_hinf_max']:.4g} ({r['guarantee']})"]
         if r["output_feedback_sampled_max_radius"] is not None:
             lines.append(f"sampled-data loops at dt = {r['sample_time_s']:g} s: max spectral radius "
-                         f"{r['output_feedback_sampled_max_radius']:.6g} (state feedback alone "
-                         f"{r['state_feedback_sampled_max_radius']:.6g})")
+                         f"{r['output_feedback_sampled_max_radius']:.9f} (state feedback alone "
+                         f"{r['state_feedback_sampled_max_radius']:.9f})")
     if r.get("gamma_levels"):
         nf = r["gamma_not_found"]
         lines.append(f"EIGOPT bisection ({len(r['gamma_levels'])} levels, {r['gamma_search_time_s']:.0f} s, stopped on "
