@@ -148,3 +148,77 @@ def test_eigenvalue_optimisation_finds_a_feasible_point_above_the_optimum_only()
         synthesize_state_feedback(gp_of(pl), solver="EIGOPT", gamma=0.97 * g_opt)
     with pytest.raises(InputError, match="fixed level"):
         synthesize_state_feedback(gp_of(pl), solver="EIGOPT")
+
+
+def test_gamma_bisection_reaches_the_conic_optimum():
+    # the oscillator of docs/lpv.md: Clarabel's optimum is the reference. The bisection between
+    # the pointwise lower bound and 2 x it (continuation in gamma) stops when hi - lo <= 1e-3 hi:
+    # its gamma is feasible (>= the optimum) and within 1e-3 (+ the 5e-4 by which the proven bound
+    # lies below the optimum) of it, and passes the 4x finer check
+    from tmfem.control.lpv_bisect import bisect_gamma
+    from tmfem.control.lpv_bounds import pointwise_state_feedback_bound
+    pl = oscillator_plant()
+    gp = gp_of(pl)
+    g_opt = synthesize_state_feedback(gp).gamma
+    lb = pointwise_state_feedback_bound(gp).lower_bound
+    assert lb <= g_opt * (1 + 1e-5)
+    ctrl, br = bisect_gamma(gp, lower=lb, upper=2 * lb, rtol=1e-3)
+    assert br.converged and br.stopped == "tolerance"
+    assert g_opt * (1 - 1e-5) <= ctrl.gamma <= g_opt * (1 + 1.5e-3)
+    assert verify(ctrl, gp_of(pl.resampled(pl.refined(4)))).passed
+    # the bracket as reported: every feasible level at or above the returned one, every level not
+    # found below it (a level not found is not a proof: the proven bound is lb)
+    assert br.feasible == ctrl.gamma and br.lower_bound == lb
+    assert min(lv["gamma"] for lv in br.levels if lv["result"] == "feasible") == ctrl.gamma
+    assert all(lv["gamma"] < ctrl.gamma for lv in br.levels if lv["result"] == "not found")
+    assert [lv["start"] for lv in br.levels][:2] == ["riccati", "continuation"]
+    assert "does not prove" in br.to_dict()["gamma_note"]
+    # a given start (continuation from an earlier design): that design is feasible at 1.01 x its
+    # gamma, so the first level needs no iteration (the coordinates are carried over exactly)
+    _, br2 = bisect_gamma(gp, lower=lb, upper=1.01 * ctrl.gamma, rtol=1e-2, start=ctrl)
+    assert br2.levels[0]["start"] == "given design" and br2.levels[0]["result"] == "feasible"
+    assert br2.levels[0]["evaluations"] == 0
+
+
+def test_gamma_bisection_refusals():
+    from tmfem.control.lpv_bisect import bisect_gamma
+    gp = gp_of(oscillator_plant())
+    with pytest.raises(InputError, match="lower < upper"):
+        bisect_gamma(gp, lower=1.0, upper=0.5)
+    with pytest.raises(InputError, match="rtol"):
+        bisect_gamma(gp, lower=0.1, upper=1.0, rtol=0.0)
+    # an upper level below the optimum (0.3): no feasible point to bisect from
+    with pytest.raises(InfeasibleController):
+        bisect_gamma(gp, lower=0.1, upper=0.25)
+    # no time for the first level
+    with pytest.raises(InfeasibleController, match="time budget"):
+        bisect_gamma(gp, lower=0.1, upper=1.0, time_budget=1e-9)
+
+
+def sampled_radius(ctrl, plant, dt):
+    """Largest spectral radius of the zero-order-hold loop A_d + B_d K(rho) over the grid of
+    ``plant`` (python-control sample_system for the discretisation)."""
+    import control
+    out = 0.0
+    for idx, rho in plant.points():
+        sd = control.sample_system(control.ss(plant.A[idx], plant.B[idx], np.eye(2), 0), dt, method="zoh")
+        out = max(out, np.abs(np.linalg.eigvals(sd.A + sd.B @ ctrl.gain(rho))).max())
+    return out
+
+
+def test_sampled_loop_constraint_makes_the_controller_stable_when_sampled():
+    # the H-infinity state feedback does not bound the gain: the oscillator's Clarabel optimum
+    # (gains ~1e5) and EIGOPT's point at 1.3 x it are unstable when sampled with a zero-order
+    # hold at dt = 0.2 s; with the discrete Lyapunov LMI at that step (sample_time) every frozen
+    # sampled loop of the 4x finer grid is stable, the continuous LMIs still hold there
+    pl = oscillator_plant()
+    fine = pl.resampled(pl.refined(4))
+    g_opt = synthesize_state_feedback(gp_of(pl)).gamma
+    free = synthesize_state_feedback(gp_of(pl), solver="EIGOPT", gamma=1.3 * g_opt)
+    assert sampled_radius(free, fine, 0.2) > 1
+    r = synthesize_state_feedback(gp_of(pl), solver="EIGOPT", gamma=1.3 * g_opt, sample_time=0.2)
+    assert sampled_radius(r, fine, 0.2) < 1
+    v = verify(r, gp_of(fine), sample_time=0.2)
+    assert v.passed and v.max_sampled_radius == pytest.approx(sampled_radius(r, fine, 0.2), rel=1e-9)
+    with pytest.raises(InputError, match="EIGOPT only"):
+        synthesize_state_feedback(gp_of(pl), sample_time=0.2)

@@ -25,13 +25,13 @@ def test_lpv_cli_refuses_bad_input(argv, msg, capsys):
 
 
 def test_lpv_cli_bound_only_on_one_point(capsys):
-    # one grid point (the corner theta = 63 deg, psi = 7.5 deg of P_D): the pointwise
+    # one grid point (theta = 71.59 deg, psi = 8.36 deg of P_D: one point of an axis is its middle): the pointwise
     # state-feedback optimum (Riccati test) is tight: a static gain designed at 1.01 x it has a
     # closed-loop H-infinity norm (SLICOT ab13dd via python-control) between the two
     assert main(["control", "lpv", "--grid", "1x1", "--bound-only", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["grid"] == [1, 1] and out["printed_gamma_bound"] == 4.18
-    assert np.degrees(out["lpv_gamma_lower_bound_at"]) == pytest.approx([63.0, 7.5])
+    assert np.degrees(out["lpv_gamma_lower_bound_at"]) == pytest.approx([71.59, 8.36])
     g, nrm = out["lpv_gamma_lower_bound"], out["lpv_gamma_lower_bound_achieved_norm"]
     assert g * (1 - 1e-4) <= nrm <= 1.01 * g * (1 + 1e-6)
     assert "gamma" not in out

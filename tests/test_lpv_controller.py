@@ -62,6 +62,14 @@ def test_scheduled_controller_holds_rho_in_the_grid_and_refuses_bad_indices():
         LPVController(design, pl, state_index=[0], q_index=[0], rho_index=[2], reference=lambda t: [X0])
     with pytest.raises(InputError, match="dt > 0"):
         c.reset(0.0, np.zeros(3), 0.0)
+    # equilibria at the reference's parameters: at the equilibrium state with zero integrators
+    # the output is u_e(rho_r) = (1 + rho_r) X0 (rho_r = 0.5), not u_e of the measured 1.3
+    cr = LPVController(design, pl, state_index=[0, 1], q_index=[0], rho_index=[2], reference=lambda t: [X0],
+                       reference_rho=lambda t: [0.5])
+    assert cr.output(0.0, [X0, 0.0, 1.3], np.zeros(1)) == pytest.approx([1.5 * X0], rel=1e-12)
+    with pytest.raises(InputError, match="rho_r"):
+        LPVController(design, pl, state_index=[0, 1], q_index=[0], rho_index=[2], reference=lambda t: [X0],
+                      reference_rho=[0.5])
 
 
 def test_state_feedback_riccati_test_matches_the_lmi():

@@ -37,8 +37,8 @@ def configure(parser) -> None:
                         help="hinf: how the eliminated LMIs are solved: ARE (default; their Riccati "
                              "characterisation, bisection on gamma, LMIs re-checked), or the SDP "
                              "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
-                             "docs/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (a feasible "
-                             "point at --gamma, docs/lpv.md)")
+                             "docs/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (eigenvalue "
+                             "optimisation: bisection on gamma, or one level with --fixed-gamma; docs/lpv.md)")
     parser.add_argument("--method", choices=("lmi", "riccati", "central"), default=None,
                         help="lmi (default): eliminated LMIs of eq. 5.65; riccati: python-control "
                              "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant; central: the "

@@ -7,29 +7,32 @@ from __future__ import annotations
 
 import time
 
+from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_time_steps, output_dir, output_file, positive_float,
                               progress_bar)
 from tmfem.errors import InputError
-from tmfem.reference.deployments import (CONTROLLERS, DEPLOYMENTS, UNCERTAINTIES, check_choices,
-                                         setup, write_outputs)
+from tmfem.reference.deployments import (CONTROLLERS, DEPLOYMENTS, LPV_CONTROLLERS, LPV_DEPLOYMENTS,
+                                         UNCERTAINTIES, check_choices, setup, write_outputs)
 
 NAME = "deploy"
 HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
 
 def configure(parser) -> None:
-    parser.add_argument("--preset", required=True, choices=sorted(DEPLOYMENTS))
-    parser.add_argument("--controller", default="adaptive-hinf", choices=sorted(CONTROLLERS),
-                        help="adaptive PFL then a linear controller about the final equilibrium: "
-                             "adaptive-hinf (the H-infinity controller of 7.3: the central one at 1.01 "
-                             "gamma_opt, tmfem control hinf --method central), "
+    parser.add_argument("--preset", required=True, choices=sorted(DEPLOYMENTS) + sorted(LPV_DEPLOYMENTS))
+    parser.add_argument("--controller", default=None, choices=sorted(CONTROLLERS) + list(LPV_CONTROLLERS),
+                        help="7.4 presets: adaptive PFL then a linear controller about the final equilibrium: "
+                             "adaptive-hinf (default; the H-infinity controller of 7.3: the central one at "
+                             "1.01 gamma_opt, tmfem control hinf --method central), "
                              "adaptive-hinf-riccati (python-control hinfsyn), adaptive-lqr (LQR "
-                             "state feedback) or adaptive (no switch)")
+                             "state feedback) or adaptive (no switch); LPV presets (8.4): lpv (default; "
+                             "the scheduled state feedback of 8.3) or lpv-output (its observer-based output feedback on the "
+                             "measured q and membrane points, docs/lpv.md)")
     parser.add_argument("--uncertainty", choices=list(UNCERTAINTIES),
                         help="controller model error (default: the 7.4 choice of the preset)")
     parser.add_argument("--path", choices=["delta", "table-7-7-bases", "linear"],
                         help="deployment path (default: delta for 1-N(D), table-7-7-bases for 2-3; "
                              "linear: every symmetric parameter linear in the progress)")
-    parser.add_argument("--allocation", choices=["bounded", "clip"], default="bounded",
+    parser.add_argument("--allocation", choices=["bounded", "clip"], default=None,
                         help="rest-length limits in the PFL: bounded (the admissible rest lengths "
                              "closest in acceleration, default) or clip (eq. 5.58 as is, saturated "
                              "by the plant)")
@@ -69,6 +72,7 @@ def configure(parser) -> None:
     parser.add_argument("--plot", help="PNG as Figures 7.2-7.4")
     parser.add_argument("--gif", help="animation of the deployment (GIF)")
     parser.add_argument("--vtk", metavar="DIR", help="ParaView series of the configuration")
+    deploy_lpv.configure(parser)
 
 
 def run(args) -> dict:
@@ -78,6 +82,18 @@ def run(args) -> dict:
     output_file(args.plot, option="--plot", suffixes=(".png",))
     output_file(args.gif, option="--gif", suffixes=(".gif",))
     output_dir(args.vtk, option="--vtk")
+    lpv = args.preset in LPV_DEPLOYMENTS
+    args.controller = args.controller or ("lpv" if lpv else "adaptive-hinf")
+    if lpv != (args.controller in LPV_CONTROLLERS):
+        raise InputError(f"--controller {args.controller}: expected one of "
+                         f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
+                         f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
+    if lpv:
+        return deploy_lpv.run(args)
+    lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise") + deploy_lpv.SYNTHESIS)
+    if lpv_opts:
+        raise InputError(f"options {lpv_opts} apply to --controller lpv only, found --controller {args.controller}")
+    args.allocation = args.allocation or "bounded"
     check_choices(args.preset, controller=args.controller, uncertainty=args.uncertainty,
                   path=args.path)
     output_file(args.compare_plot, option="--compare-plot", suffixes=(".png",))
@@ -209,6 +225,7 @@ def format_text(r: dict) -> str:
             "min_rest_length_margin_m", "final_tracking_error", "limits_active_s",
             "max_eta_energy_J", "B_q_condition_max", "wall_time_s"]
     keys += [k for k in r if k.startswith("plant_")] + ["failure"]
+    keys += [k for k in ("gamma", "max_tracking_error") if k in r]
     lines = [f"deployment {r['preset']} on the {r['plant']} plant ({r['controller']}, "
              f"uncertainty {r['uncertainty']})"]
     lines += [f"  {k}: {r[k]:.6g}" if isinstance(r[k], float) else f"  {k}: {r[k]}" for k in keys]

@@ -44,6 +44,8 @@ class GriddedLPV:
     x_e, u_e, y_e : arrays of shape ``grid_shape + (n,)``, optional
         Equilibrium state, input and output at each grid point (the linearisations are
         about them); zeros when not given.
+    membrane_points : list of (component, x_f, y_f), optional
+        The membrane point coordinates of eq. 5.17 among the states (:func:`com_lpv_plant`).
     """
 
     axes: list
@@ -59,6 +61,7 @@ class GriddedLPV:
     x_e: np.ndarray | None = None
     u_e: np.ndarray | None = None
     y_e: np.ndarray | None = None
+    membrane_points: list | None = None
     _interp: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
@@ -269,4 +272,4 @@ def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int = 4,
                 progress(a * psi.size + b + 1, total)
     return GriddedLPV(axes=[theta, psi], parameter_names=["theta_13", "psi_13"],
                       rate_bounds=np.asarray(rate_bounds, dtype=float), state_names=names[0],
-                      input_names=names[1], output_names=names[2], **mats)
+                      input_names=names[1], output_names=names[2], membrane_points=list(pts), **mats)

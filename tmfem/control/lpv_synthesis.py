@@ -188,13 +188,48 @@ class LPVStateFeedback:
                 "solve_time_s": self.solve_time, "build_time_s": self.build_time,
                 "sizes": self.sizes, "max_lmi_eig": self.max_lmi_eig, "min_P_eig": self.min_P_eig}
 
+    def arrays(self) -> dict:
+        """The coefficients, gamma and grid as arrays (the contents of :meth:`save`)."""
+        return dict(gamma=self.gamma, P=np.array(self.P), Q=np.array(self.Q), centre=self.centre,
+                    half_width=self.half_width, varying=np.isin(np.arange(len(self.centre)), self.varying),
+                    rate_bounds=self.rate_bounds, parameter_names=np.array(self.parameter_names),
+                    state_names=np.array(self.state_names),
+                    **{f"axis_{k}": a for k, a in enumerate(self.axes)})
+
     def save(self, path) -> None:
         """Write the coefficients, gamma and grid to an ``.npz`` file."""
-        np.savez(path, gamma=self.gamma, P=np.array(self.P), Q=np.array(self.Q), centre=self.centre,
-                 half_width=self.half_width, varying=np.array(self.varying, dtype=bool),
-                 rate_bounds=self.rate_bounds, parameter_names=np.array(self.parameter_names),
-                 state_names=np.array(self.state_names),
-                 **{f"axis_{k}": a for k, a in enumerate(self.axes)})
+        np.savez(path, **self.arrays())
+
+    @classmethod
+    def load(cls, path) -> "LPVStateFeedback":
+        """The coefficients, gamma and grid written by :meth:`save` (sizes and residuals are
+        re-computed by whoever uses it: :func:`tmfem.control.lpv_verify.verify`).
+
+        Raises
+        ------
+        InputError
+            Not a file written by :meth:`save`.
+        """
+        try:
+            d = np.load(path, allow_pickle=False)
+            keys = ("gamma", "P", "Q", "centre", "half_width", "varying", "rate_bounds",
+                    "parameter_names", "state_names")
+            f = {k: d[k] for k in keys}
+        except (OSError, KeyError, ValueError) as exc:
+            raise InputError(f"LPV controller file {str(path)!r}: expected an .npz written by "
+                             f"`tmfem control lpv --save` (keys gamma, P, Q, ...), found {exc}") from None
+        axes = [d[f"axis_{k}"] for k in range(len(f["parameter_names"]))]
+        P, Q = list(f["P"]), list(f["Q"])
+        varying = [k for k, a in enumerate(axes) if a.size > 1]      # as in the synthesis
+        if len(P) != 1 + len(varying) or len(Q) != len(P):
+            raise InputError(f"LPV controller file {str(path)!r}: expected {1 + len(varying)} coefficients "
+                             f"P_k, Q_k (eq. 5.99 on its grid), found {len(P)} and {len(Q)}")
+        return cls(gamma=float(f["gamma"]), P=P, Q=Q, centre=f["centre"], half_width=f["half_width"],
+                   varying=varying, axes=axes,
+                   parameter_names=[str(v) for v in f["parameter_names"]], rate_bounds=f["rate_bounds"],
+                   state_names=[str(v) for v in f["state_names"]], solver="loaded", status=f"from {path}",
+                   solve_time=0.0, build_time=0.0, sizes={"n_x": P[0].shape[0], "coefficients": len(P)},
+                   max_lmi_eig=float("nan"), min_P_eig=float("nan"))
 
 
 def lmi_matrix(*, A, B1, B2, C1, D11, D12, P, Q, dP, gamma) -> np.ndarray:
@@ -242,7 +277,8 @@ def _sym_basis(n: int) -> sp.csr_matrix:
 
 def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", margin: float = 1e-6,
                               scale: bool = True, accuracy: float = 1e-5,
-                              max_iter: int | None = None, gamma: float | None = None) -> LPVStateFeedback:
+                              max_iter: int | None = None, gamma: float | None = None,
+                              sample_time: float | None = None) -> LPVStateFeedback:
     """Minimise gamma subject to eqs. 5.95-5.96 at every grid point and rate vertex (8.3).
 
     The LMIs are written directly as a sparse conic program (vec(M) = vec(M_0) + G x with
@@ -260,6 +296,9 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
         accepted only when every re-computed LMI is negative.
     gamma : float, optional
         The fixed level of "EIGOPT" (required there, refused by the other solvers).
+    sample_time : float, optional
+        "EIGOPT" only: also the stability of the frozen loops sampled at this zero-order-hold
+        step (:class:`tmfem.control.lpv_eigopt.EigOpt`).
     margin : float
         Strictness: LMI <= -margin I and P >= margin I (in the scaled coordinates).
     scale : bool
@@ -278,35 +317,29 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
     if (gamma is None) == (solver == "EIGOPT"):
         raise InputError(f"gamma: expected a fixed level with solver EIGOPT only, found gamma = {gamma!r} "
                          f"with solver {solver}")
+    if sample_time is not None and (solver != "EIGOPT" or not (np.isfinite(sample_time) and sample_time > 0)):
+        raise InputError(f"sample_time: expected a step > 0 with solver EIGOPT only, found {sample_time!r} "
+                         f"with solver {solver}")
     t0 = time.perf_counter()
-    shp = gp.grid_shape
+    co = Coordinates.of(gp, scale=scale)
+    shp, T, centre, half, varying, verts, sizes = (co.grid_shape, co.T, co.centre, co.half, co.varying,
+                                                    co.verts, co.sizes)
     n, nw, nu, npp = (gp.sizes[k] for k in ("n_x", "n_w", "n_u", "n_p"))
     N = n + nw + npp
-    lo = np.array([a[0] for a in gp.axes]); hi = np.array([a[-1] for a in gp.axes])
-    centre = (lo + hi) / 2
-    half = np.where(hi > lo, (hi - lo) / 2, 1.0)
-    varying = [k for k in range(len(shp)) if shp[k] > 1]
-    T = _state_scaling(gp.A[tuple(s // 2 for s in shp)]) if scale else np.ones(n)
     Ti = 1.0 / T
     nb = 1 + len(varying)
     S = _sym_basis(n)
     ms, mq = S.shape[1], nu * n
-    nvar = nb * (ms + mq) + 1
+    nvar = sizes["decision_variables"]
     In = sp.identity(n, format="csr")
-    verts = gp.rate_vertices()
-    sizes = {"grid_points": int(np.prod(shp)), "rate_vertices": len(verts),
-             "lmis": int(np.prod(shp)) * len(verts), "lmi_size": N, "n_x": n, "n_w": nw,
-             "n_u": nu, "n_p": npp, "decision_variables": nvar}
     log.info("LPV synthesis: %s", sizes)
     if solver == "EIGOPT":
         from tmfem.control.lpv_eigopt import feasible_point
         t1 = time.perf_counter()
-        Ps, Qs, _, nev = feasible_point(
-            gp, gamma, T=T, c_of=lambda r: np.concatenate([[1.0], ((r - centre) / half)[varying]]),
-            dvs=[np.concatenate([[0.0], (v / half)[varying]]) for v in verts], max_iter=max_iter or 150)
-        return _accepted(gp, [Tm_back(P, T) for P in Ps], [Q * T[None, :] for Q in Qs], gamma, T, verts,
-                         centre, half, varying, solver="EIGOPT", status=f"feasible point ({nev} evaluations)",
-                         solve=time.perf_counter() - t1, build=t1 - t0, sizes=sizes, tol=-1e-300)
+        Ps, Qs, _, nev = feasible_point(gp, gamma, T=T, c_of=co.c_of, dvs=co.dvs, max_iter=max_iter or 150,
+                                        sample_time=sample_time)
+        return co.accepted(gp, Ps, Qs, gamma, solver="EIGOPT", status=f"feasible point ({nev} evaluations)",
+                           solve=time.perf_counter() - t1, build=t1 - t0, sample_time=sample_time)
 
     def pcol(k):
         return k * (ms + mq)
@@ -391,6 +424,62 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
     raise InfeasibleController(f"LPV state-feedback synthesis (eqs. 5.95-5.96) on a {shp} grid with "
                                f"{len(verts)} rate vertices failed: {last}; expected an optimal, "
                                "accurate solution")
+
+
+@dataclass
+class Coordinates:
+    """The synthesis coordinates of a generalised plant (module docstring): parameters
+    normalised to [-1, 1] over the grid (``centre``, ``half``; ``varying``: the parameters
+    with more than one grid value), states x = T x_s, the rate vertices and the LMI sizes."""
+
+    grid_shape: tuple
+    T: np.ndarray
+    centre: np.ndarray
+    half: np.ndarray
+    varying: list
+    verts: np.ndarray
+    sizes: dict
+
+    @classmethod
+    def of(cls, gp: GeneralisedLPV, *, scale: bool = True) -> "Coordinates":
+        shp = gp.grid_shape
+        n, nw, nu, npp = (gp.sizes[k] for k in ("n_x", "n_w", "n_u", "n_p"))
+        lo = np.array([a[0] for a in gp.axes]); hi = np.array([a[-1] for a in gp.axes])
+        varying = [k for k in range(len(shp)) if shp[k] > 1]
+        verts = gp.rate_vertices()
+        nvar = (1 + len(varying)) * (n * (n + 1) // 2 + nu * n) + 1
+        sizes = {"grid_points": int(np.prod(shp)), "rate_vertices": len(verts),
+                 "lmis": int(np.prod(shp)) * len(verts), "lmi_size": n + nw + npp, "n_x": n, "n_w": nw,
+                 "n_u": nu, "n_p": npp, "decision_variables": nvar}
+        return cls(grid_shape=shp, T=_state_scaling(gp.A[tuple(s // 2 for s in shp)]) if scale else np.ones(n),
+                   centre=(lo + hi) / 2, half=np.where(hi > lo, (hi - lo) / 2, 1.0), varying=varying,
+                   verts=verts, sizes=sizes)
+
+    def c_of(self, rho) -> np.ndarray:
+        """The coefficients [1, rho_n...] of P_k in P(rho) (eq. 5.99, normalised rho)."""
+        return np.concatenate([[1.0], ((np.asarray(rho) - self.centre) / self.half)[self.varying]])
+
+    @property
+    def dvs(self) -> list:
+        """The coefficients of P_k in dP/dt at each rate vertex."""
+        return [np.concatenate([[0.0], (v / self.half)[self.varying]]) for v in self.verts]
+
+    def accepted(self, gp, Ps, Qs, gamma, *, solver, status, solve, build,
+                 sample_time: float | None = None) -> "LPVStateFeedback":
+        """:func:`_accepted` (strictly negative LMIs) of P_k, Q_k given in the scaled coordinates;
+        with ``sample_time`` also every frozen sampled loop of the grid stable
+        (:func:`tmfem.control.lpv_verify.verify`)."""
+        T = self.T
+        ctrl = _accepted(gp, [Tm_back(P, T) for P in Ps], [Q * T[None, :] for Q in Qs], gamma, T, self.verts,
+                         self.centre, self.half, self.varying, solver=solver, status=status, solve=solve,
+                         build=build, sizes=self.sizes, tol=-1e-300)
+        if sample_time is not None:
+            from tmfem.control.lpv_verify import verify
+            r = verify(ctrl, gp, sample_time=sample_time, allow_failure=True).max_sampled_radius
+            if not r < 1:
+                raise InfeasibleController(f"the frozen loops sampled at {sample_time} s have spectral radius "
+                                           f"{r:.6f} (expected < 1)")
+        return ctrl
 
 
 def _accepted(gp, Pv, Qv, g, T, verts, centre, half, varying, *, solver, status, solve, build, sizes,

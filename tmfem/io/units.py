@@ -34,6 +34,13 @@ _EXACT = {
     "checks": "value and limit in the SI unit of the checked quantity (Pa, N, m)",
     "closed_form": "S1, delta, delta_3_36, r1_equilibrium, r_mb in m; A, det, ratio -",
     "final": "per state: rad, rad/s (theta, psi), kg^0.5 m, kg^0.5 m/s (eta_k), m (positions)",
+    # LPV synthesis and deployment (docs/lpv.md)
+    "gamma": "-", "gamma_feasible": "-", "gamma_not_found": "-", "gamma_lower_bound_proven": "-",
+    "gamma_rtol": "-", "lpv_gamma_lower_bound": "-", "pointwise_gamma": "-", "printed_gamma_bound": "-",
+    "verification_max_eig": "- (relative)", "verification_max_eig_at": "rad",
+    "closed_loop_max_real": "1/s", "closed_loop_max_real_at": "rad", "sampled_max_radius": "-",
+    "sampled_max_radius_at": "rad", "lpv_gamma_lower_bound_at": "rad", "omega_r": "rad/s", "xi_r": "-",
+    "max_tracking_error": "rad (angles), m (positions)", "largest_scaled_eig": "- (scaled)",
 }
 _SUFFIX = [(r".*_deg$", "deg"), (r".*_hz$", "Hz"), (r".*_MPa$", "MPa"), (r".*_mm$", "mm"),
            (r".*_m$", "m"), (r".*_N$", "N"), (r".*_s$", "s"), (r".*_J$", "J"),
@@ -47,6 +54,8 @@ def unit_of(key: str) -> str | None:
     states and signals (``theta_11``, ``eta_2_dot``) have the units of the run histories
     (:func:`tmfem.io.run.column_header`)."""
     from tmfem.io.run import column_header
+    if key.startswith("design_grid_"):                 # an LPV design's check on its own grid
+        key = key[len("design_grid_"):]
     if key in _EXACT:
         return _EXACT[key]
     for pattern, unit in _SUFFIX:

@@ -30,27 +30,62 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
                    label="references (eq. 5.68)" if i == 0 else None)
     ax[0].set_ylabel("bar attitude [deg]")
     ax[0].legend(fontsize=7, ncol=3)
-    for k, n in enumerate(r.names["w"]):
-        ax[1].plot(r.t, 1e3 * r.w[:, k], label=n)
-    ax[1].set_ylabel("membrane deflection w [mm]")
-    ax[1].legend(fontsize=8)
-    tn = r.names["tendons"]
-    seen = set()
-    for k, n in enumerate(tn):
-        fam = n.rsplit("_", 1)[0]
-        if fam in seen:
-            continue
-        seen.add(fam)
-        ln, = ax[2].plot(r.t, r.u[:, k], label=f"rest length {n}")
-        ax[2].plot(r.t, r.lengths[:, k], ":", color=ln.get_color(), label=f"limit |{n}|")
-    ax[2].set_ylabel("length [m]")
-    ax[2].set_xlabel("time [s]")
-    ax[2].legend(fontsize=7, ncol=2)
+    _deflections(ax[1], r)
+    _rest_lengths(ax[2], r)
     if r.switch_time is not None:
         for a in ax:
             a.axvline(r.switch_time, color="k", ls="--", lw=0.8)
         ax[0].annotate(f"switch {r.switch_time:.2f} s", (r.switch_time, ax[0].get_ylim()[1]),
                        fontsize=8, va="top")
+    for a in ax:
+        a.grid(alpha=0.3)
+    if title:
+        ax[0].set_title(title)
+    return save_figure(fig, Path(png))
+
+
+def _deflections(ax, r) -> None:
+    """w_1..w_3 [mm] against time (Figures 7.3, 8.3)."""
+    for k, n in enumerate(r.names["w"]):
+        ax.plot(r.t, 1e3 * r.w[:, k], label=n)
+    ax.set_ylabel("membrane deflection w [mm]")
+    ax.legend(fontsize=8)
+
+
+def _rest_lengths(ax, r) -> None:
+    """One tendon of each family: rest length and its limit, the tendon length (Figures 7.4, 8.4)."""
+    seen = set()
+    for k, n in enumerate(r.names["tendons"]):
+        fam = n.rsplit("_", 1)[0]
+        if fam in seen:
+            continue
+        seen.add(fam)
+        ln, = ax.plot(r.t, r.u[:, k], label=f"rest length {n}")
+        ax.plot(r.t, r.lengths[:, k], ":", color=ln.get_color(), label=f"limit |{n}|")
+    ax.set_ylabel("length [m]")
+    ax.set_xlabel("time [s]")
+    ax.legend(fontsize=7, ncol=2)
+
+
+def plot_lpv_deployment(png, result, *, title: str = "") -> Path:
+    """Figures 8.2-8.4: the attitudes (theta, psi) of bars b_11 and b_21 and the position
+    (x, y, z) of b_21's lower end A_21 against their references (eq. 5.100), the membrane
+    deflections w_1..w_3, rest lengths against their limits (the tendon lengths)."""
+    r = result
+    fig = new_figure(figsize=(8, 12))
+    ax = fig.subplots(4, 1, sharex=True)
+    names = r.names["q"]
+    for a, keys, scale, unit in ((ax[0], ("theta_11", "psi_11", "theta_21", "psi_21"), np.degrees, "deg"),
+                                 (ax[1], ("x_21", "y_21", "z_21"), lambda v: v, "m")):
+        for i, n in enumerate(keys):
+            k = names.index(n)
+            a.plot(r.t, scale(r.z[:, k]), label=n)
+            a.plot(r.t, scale(r.q_d[:, k]), ":", color="k", lw=0.9,
+                   label="references (eq. 5.100)" if i == 0 else None)
+        a.set_ylabel(f"bars b_11, b_21 [{unit}]")
+        a.legend(fontsize=7, ncol=3)
+    _deflections(ax[2], r)
+    _rest_lengths(ax[3], r)
     for a in ax:
         a.grid(alpha=0.3)
     if title:

@@ -116,15 +116,16 @@ def write_csv(path, r) -> str:
 
 def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gif=None,
                   vtk=None) -> dict:
-    """Write the files of deployment run ``r`` of set-up ``s``: CSV, plot (Figures 7.2-7.4),
-    GIF (Figure 7.5) and ParaView series (a frame every :data:`VTK_EVERY` samples); returns
-    {kind: path} of those written."""
+    """Write the files of deployment run ``r`` of set-up ``s``: CSV, plot (Figures 7.2-7.4, or
+    8.2-8.4 for an LPV preset), GIF (Figures 7.5, 8.5) and ParaView series (a frame every
+    :data:`VTK_EVERY` samples); returns {kind: path} of those written."""
     out = {}
     if csv_path:
         out["csv"] = write_csv(csv_path, r)
     if plot:
-        from tmfem.post.deploy_plots import plot_deployment
-        out["plot"] = str(plot_deployment(plot, r, title=title))
+        from tmfem.post.deploy_plots import plot_deployment, plot_lpv_deployment
+        draw = plot_lpv_deployment if preset in LPV_DEPLOYMENTS else plot_deployment
+        out["plot"] = str(draw(plot, r, title=title))
     if gif:
         from tmfem.post.deploy_plots import animate_deployment
         out["gif"] = str(animate_deployment(gif, s.model.system, r))
@@ -137,3 +138,32 @@ def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gi
         out["pvd"] = str(write_series(Path(vtk), ((float(r.t[k]), sysm.nodes(r.z[k, :s.model.nq]),
                                                    cells) for k in idx), name=preset))
     return out
+
+
+#: 8.4: eq. 5.100 (xi_r = 1, omega_r; theta_0, theta_e, psi_0 from the preset's printed
+#: section) and the monitored points of eq. 5.101 (moved 1 mm inside as the 7.4 points)
+LPV_DEPLOYMENTS = {
+    "2-3-lpv": {"omega_r": 0.3, "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)],
+                "membrane_modes": 4, "path": "table-7-7-bases"},
+}
+#: controllers of an LPV deployment (``tmfem deploy --controller``)
+LPV_CONTROLLERS = ("lpv", "lpv-output")
+
+
+def lpv_setup(preset: str, plant, *, model_at: str = "final"):
+    """The deployment of 8.4 of ``preset`` for the design plant ``plant`` (its grid built with
+    :func:`tmfem.reference.tables.deployment_bases`, as ``tmfem control lpv``):
+    :func:`tmfem.control.lpv_deploy.lpv_deployment` with the parameters of
+    :data:`LPV_DEPLOYMENTS`."""
+    from tmfem.control.lpv_deploy import lpv_deployment
+    from tmfem.reference.tables import deployment_bases
+    from tmfem.system.presets import load_preset
+    if preset not in LPV_DEPLOYMENTS:
+        raise InputError(f"LPV deployment: expected a preset among {sorted(LPV_DEPLOYMENTS)}, found {preset!r}")
+    p = LPV_DEPLOYMENTS[preset]
+    s = load_preset(preset)
+    pr = s.printed
+    return lpv_deployment(s, plant, theta_0=np.radians(pr["theta0_deg"]), theta_e=np.radians(pr["theta_e_deg"]),
+                          psi_0=np.radians(pr["psi0_deg"]), omega_r=p["omega_r"], bases=deployment_bases(s),
+                          output_points=inside_points(s, p["points"]), membrane_modes=p["membrane_modes"],
+                          model_at=model_at)

@@ -109,6 +109,45 @@ class LinearController:
         return A @ xc + B @ (np.asarray(y) - self.y_e)
 
 
+class MeasurementNoise:
+    """``controller`` reading y + sigma * n_k: independent zero-mean Gaussian samples of
+    standard deviation ``sigma`` (scalar or one per entry of ``index``) added to the entries
+    ``index`` of y (all by default), one sample per time step (the same at ``output`` and
+    ``update`` of a step), seeded for reproducibility. Sampled white noise: its intensity
+    over dt is sigma^2 dt."""
+
+    def __init__(self, controller, *, sigma, index=None, seed: int = 0):
+        self.controller = controller
+        self.sigma = np.asarray(sigma, dtype=float)
+        if not np.all(np.isfinite(self.sigma)) or np.any(self.sigma < 0):
+            raise InputError(f"measurement noise: expected sigma >= 0, found {sigma!r}")
+        self.index = None if index is None else np.asarray(index, dtype=int)
+        self._rng = np.random.default_rng(seed)
+        self._t, self._n = None, None
+
+    @property
+    def name(self) -> str:
+        return self.controller.name
+
+    def _noisy(self, t, y):
+        y = np.array(y, dtype=float)
+        idx = np.arange(y.size) if self.index is None else self.index
+        if t != self._t:
+            self._t, self._n = t, self.sigma * self._rng.standard_normal(idx.size)
+        y[idx] += self._n
+        return y
+
+    def reset(self, t0, y0, dt):
+        self._t = None
+        return self.controller.reset(t0, self._noisy(t0, y0), dt)
+
+    def output(self, t, y, xc):
+        return self.controller.output(t, self._noisy(t, y), xc)
+
+    def update(self, t, y, xc):
+        return self.controller.update(t, self._noisy(t, y), xc)
+
+
 def as_controller(controller, u0) -> Controller:
     """``controller`` itself (it has reset/output/update), an open loop at the plant's nominal
     input ``u0`` when None, or an open loop at the given array or schedule ``u(t)``."""

@@ -1,0 +1,169 @@
+"""``tmfem deploy --preset 2-3-lpv --controller lpv``: the LPV deployment of 8.4 (called by
+:mod:`tmfem.cli.deploy`).
+
+The controller is loaded (``--lpv-controller saved.npz`` from ``tmfem control lpv --save``,
+its design plant rebuilt on its grid) or synthesised on the fly with the options of
+``tmfem control lpv`` (EIGOPT by default, with the sampled-loop constraint at --dt), then
+verified on the finer grid. A controller built elsewhere (any object with the reset/output/
+update/name protocol of :mod:`tmfem.simulation.controllers` reading the measured LPV
+signals, :class:`tmfem.control.lpv_deploy.LPVDeployment`) deploys through :data:`DESIGNS`
+and :data:`BUILDERS` (a new ``--controller`` name adds an entry to each and to
+:data:`tmfem.reference.deployments.LPV_CONTROLLERS`).
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from tmfem.cli import control_lpv
+from tmfem.errors import InfeasibleController, InputError
+
+#: the synthesis options of an on-the-fly design (refused with --lpv-controller)
+SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
+#: options of the 7.4 deployments that do not apply to the LPV one (None or False: not given)
+NOT_LPV = ("uncertainty", "allocation", "plant_mesh", "plant_tendons", "compare_plant", "compare_plot",
+           "compare_csv", "pfl_at")
+
+
+def configure(parser) -> None:
+    parser.add_argument("--lpv-controller", metavar="FILE.npz",
+                        help="--controller lpv: a design saved by `tmfem control lpv --save` (else one "
+                             "is synthesised with the options below)")
+    parser.add_argument("--solver", choices=("EIGOPT", "CLARABEL", "SCS"), default=None,
+                        help="--controller lpv: synthesis solver (default EIGOPT, docs/lpv.md)")
+    control_lpv.configure_synthesis(parser, prefix="--controller lpv: ")
+    parser.add_argument("--noise", type=float, default=None, metavar="SIGMA",
+                        help="LPV deployment: measurement noise, seeded Gaussian samples of this standard "
+                             "deviation [rad, m; rad/s, m/s] per step on every signal the controller reads "
+                             "(lpv: all states and rho; lpv-output: q, the membrane points and rho)")
+
+
+def given(args, names) -> list:
+    """The options among ``names`` given on the command line (not None / not False)."""
+    return ["--" + k.replace("_", "-") for k in names if getattr(args, k, None) not in (None, False)]
+
+
+def check(args) -> None:
+    """Refusals before any work: options of the 7.4 deployments, the FE plant, the paths."""
+    from tmfem.reference.deployments import LPV_DEPLOYMENTS
+    bad = given(args, NOT_LPV)
+    if args.plant != "com":
+        bad.append(f"--plant {args.plant}")
+    own = LPV_DEPLOYMENTS[args.preset]["path"]
+    if args.path not in (None, own):
+        bad.append(f"--path {args.path}")
+    if bad:
+        raise InputError(f"--controller {args.controller}: options {bad} do not apply to the LPV deployment "
+                         f"of {args.preset} (COM plant, reference of eq. 5.100 on the {own} path, no PFL)")
+    if args.lpv_controller is not None:
+        syn = given(args, SYNTHESIS)
+        if syn:
+            raise InputError(f"--lpv-controller: options {syn} belong to a synthesis on the fly, found them "
+                             "with a saved design")
+        from pathlib import Path
+        if not (args.lpv_controller.endswith(".npz") and Path(args.lpv_controller).is_file()):
+            raise InputError(f"--lpv-controller: expected an existing .npz file (tmfem control lpv --save), "
+                             f"found {args.lpv_controller!r}")
+
+
+def lpv_state_feedback(dep, design):
+    """--controller lpv: the scheduled state feedback of 8.3 on the measured LPV signals."""
+    from tmfem.control.lpv_deploy import state_feedback_controller
+    return state_feedback_controller(dep, design)
+
+
+def lpv_output_feedback(dep, design):
+    """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv_output`
+    with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
+    reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
+    the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
+    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/lpv.md); the control law about rho_r(t)
+    as the state feedback's; the estimator is driven by the input saturated to the rest-length
+    limits [1 mm, |tendon|(q_m)] of the run at the measured q."""
+    from tmfem.control.limits import tendon_lengths
+    from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
+    pl, system = dep.plant, dep.model.system
+    nz, n, nq = pl.nx // 2, pl.nx, dep.model.nq
+    of = design_output_feedback(design, pl, tracked=system.q_names, measured=pl.state_names[:nz])
+    return LPVOutputController(of, measured_index=np.arange(nz), rho_index=[n, n + 1],
+                               reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho,
+                               schedule="estimate",
+                               input_limits=lambda u, ym: np.clip(u, 1e-3, tendon_lengths(system, ym[:nq])))
+
+
+def design(args, preset: str):
+    """(design plant, state-feedback design, JSON entries): loaded and checked on its grid
+    (sampled at --dt), or synthesised and verified on the finer grid."""
+    from tmfem.control.lpv_synthesis import LPVStateFeedback, interconnection_8_1
+    from tmfem.control.lpv_verify import verify
+    if args.lpv_controller is not None:
+        from tmfem.cli.common import progress_bar
+        from tmfem.control.lpv_plant import com_lpv_plant
+        from tmfem.reference.tables import deployment_bases
+        from tmfem.system import load_preset
+        d = LPVStateFeedback.load(args.lpv_controller)
+        s = load_preset(preset)
+        if d.parameter_names != ["theta_13", "psi_13"] or len(d.axes) != 2:
+            raise InputError(f"--lpv-controller {args.lpv_controller}: expected a design scheduled on "
+                             f"['theta_13', 'psi_13'], found {d.parameter_names}")
+        n = d.axes[0].size * d.axes[1].size
+        print(f"tmfem deploy: {preset}: rebuilding the design plant at its {n} grid points", file=sys.stderr)
+        with progress_bar(n, 1, "LPV plant (grid points)") as bar:
+            plant = com_lpv_plant(s, theta=d.axes[0], psi=d.axes[1], bases=deployment_bases(s),
+                                  rate_bounds=d.rate_bounds, progress=bar)
+        v = verify(d, interconnection_8_1(plant, tracked=s.q_names), sample_time=args.dt)
+        return plant, d, {"lpv_controller": args.lpv_controller, "gamma": d.gamma,
+                          **{f"design_grid_{k}": x for k, x in v.to_dict().items()}}
+    cfg = control_lpv.check_synthesis(args, solver=args.solver or "EIGOPT", preset=preset)
+    plant, gp, bound, out = control_lpv.design_plant(cfg, rate_deg=10.0)
+    sample = args.dt if cfg["solver"] == "EIGOPT" else None
+    ctrl, syn = control_lpv.synthesise(cfg, gp, bound, sample_time=sample)
+    v = control_lpv.verify_finer(cfg, plant, ctrl, sample_time=args.dt)
+    out.pop("preset")
+    return plant, ctrl, {**out, **syn, **v.to_dict()}
+
+
+#: --controller name -> design(args, preset) -> (design plant, design with ``gamma``, JSON entries)
+DESIGNS = {"lpv": design, "lpv-output": design}
+#: --controller name -> builder(deployment, design) of a controller on the LPV signals y_lpv
+BUILDERS = {"lpv": lpv_state_feedback, "lpv-output": lpv_output_feedback}
+
+
+def run(args) -> dict:
+    """The LPV deployment (module docstring); the JSON keys of the 7.4 deployments plus the
+    design's."""
+    from tmfem.cli.common import progress_bar
+    from tmfem.control.deploy import run_deployment
+    from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
+    check(args)
+    if args.noise is not None and not (np.isfinite(args.noise) and args.noise >= 0):
+        raise InputError(f"--noise: expected a standard deviation >= 0, found {args.noise}")
+    t0 = time.perf_counter()
+    plant, d, info = DESIGNS[args.controller](args, args.preset)
+    dep = lpv_setup(args.preset, plant)
+    c = BUILDERS[args.controller](dep, d)
+    if args.noise:
+        from tmfem.simulation.controllers import MeasurementNoise
+        c = MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
+        info["measurement_noise_sigma"] = args.noise
+    s = dep.setup(c)
+    with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller})") as bar:
+        r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+                           t_end=args.t_end, dt=args.dt, progress=bar, jacobian="reuse")
+    q_err = np.abs(r.z[:, :len(r.names["q"])] - r.q_d)
+    # the keys of the 7.4 deployments (tmfem.cli.deploy.run; no PFL: uncertainty, allocation and
+    # pfl_at None), then the design's
+    out = {"preset": args.preset, "controller": args.controller, "plant": "com", "uncertainty": None,
+           "allocation": None, "pfl_at": None, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(),
+           **s.info, "max_tracking_error": float(q_err.max()),
+           "rest_length_above_tendon_length_max_m": float(np.max(r.u - r.lengths)), **info}
+    if not np.all(np.isfinite(r.z)):
+        raise InfeasibleController(f"the LPV deployment of {args.preset} diverged (non-finite states)")
+    out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
+                             vtk=args.vtk, title=f"{args.preset} deployment on the com plant: {args.controller} "
+                                                 f"(gamma = {d.gamma:.4g}), eq. 5.100"))
+    out["total_wall_time_s"] = time.perf_counter() - t0
+    out["failed_checks"] = []
+    return out
