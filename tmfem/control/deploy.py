@@ -26,6 +26,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from tmfem.control.limits import RestLengthLimits
 from tmfem.control.switching import relative_error
@@ -203,7 +204,12 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
 
     ``partial``: a run whose integration fails (:class:`ConvergenceError`, a diverging closed
     loop) returns what it recorded up to the failure, with the message in ``failure``,
-    instead of raising (the record of a failing FE-plant run, docs/fe-plant.md)."""
+    instead of raising (the record of a failing FE-plant run, docs/fe-plant.md).
+
+    The loop runs with one BLAS thread: its dense algebra is small (the LPV gain's 71 x 71
+    solve, the COM's Newton matrices), where OpenBLAS threads cost more than they give (a
+    71 x 71 solve: 0.16 ms on one thread, 1.2-9 ms on two threads of a loaded 2-core
+    machine)."""
     from tmfem.control.recovery import StressRecovery
     if stress_every < 1:
         raise InputError(f"stress_every: expected >= 1, found {stress_every}")
@@ -224,8 +230,9 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     t0 = time.perf_counter()
     failure = None
     try:
-        simulate(plant, t_end=t_end, dt=dt, controller=lim, record=record, progress=progress,
-                 outputs=False, jacobian=jacobian)
+        with threadpool_limits(limits=1, user_api="blas"):
+            simulate(plant, t_end=t_end, dt=dt, controller=lim, record=record,
+                     progress=progress, outputs=False, jacobian=jacobian)
     except ConvergenceError as exc:
         if not partial or len(T) < 2:
             raise
