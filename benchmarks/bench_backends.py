@@ -121,12 +121,13 @@ def main(argv=None) -> int:
     ap.add_argument("--json", action="store_true", help="one JSON document of all rows")
     args = ap.parse_args(argv)
     if args.run:
+        from tmfem.cli import rank_report
         from tmfem.solvers.distributed import mpi_main
         if args.run[1] == "scipy":
             print(json.dumps(run_one(int(args.run[0]), "scipy", args.rest_length, args.sequence)))
             return 0
         return mpi_main(lambda: json.dumps(run_one(int(args.run[0]), args.run[1], args.rest_length,
-                                                   args.sequence)))
+                                                   args.sequence)), report=rank_report())
     rows = []
     if not args.json:
         print(f"# 1-4 MTC, static from the undeformed membrane + 12 modes; {os.cpu_count()} cpus, "

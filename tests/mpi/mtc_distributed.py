@@ -15,6 +15,7 @@ import sys
 
 import numpy as np
 
+from tmfem.cli import rank_report
 from tmfem.solvers.distributed import comm_world, mpi_main
 
 
@@ -49,4 +50,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(mpi_main(main))
+    sys.exit(mpi_main(main, report=rank_report()))

@@ -18,20 +18,22 @@ the structure they come from.
   all ranks (with the failing rank's message), so no rank waits in a collective call for a
   rank that has died (the assemblers check their element arrays so).
 * :func:`mpi_main` runs a program: output on rank 0 only, one error message, a non-zero
-  exit code on every rank, never a hang.
+  exit code on every rank, never a hang (the caller prints what it is handed: library
+  code writes nothing).
 
 Vectors are replicated (O(n) per rank), matrices and factorisations distributed.
 """
 from __future__ import annotations
 
-import sys
-import traceback
+import logging
 
 import numpy as np
 import scipy.sparse as sp
 
 from tmfem import errors
 from tmfem.errors import InputError, TmfemError
+
+log = logging.getLogger(__name__)
 
 
 def comm_world():
@@ -94,16 +96,19 @@ def _find_tmfem_error(name: str):
     return TmfemError
 
 
-def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
+def mpi_main(main, *, report, comm=None, grace: float = 5.0) -> int:
     """Run ``main()`` on every rank; return its exit code (0, or the error's ``exit_code``).
 
-    ``main`` returns the text to print (or None); rank 0 prints it. When ``main`` raises,
-    the ranks agree by a non-blocking barrier: if every rank reaches it within ``grace``
-    seconds (the error was raised on all ranks, or the others finished), rank 0 prints the
-    lowest failing rank's message once as ``error: ...`` and every rank returns the code.
-    If not (the other ranks wait in a collective call for the failed one), the failing rank
-    prints its message and aborts the MPI job with the code: a non-zero exit, never a hang.
-    ``label`` prefixes the error line (the CLI's ``"tmfem static: "``).
+    ``main`` returns the text to show (or None); ``report(text, error=False)`` receives it
+    on rank 0 (the caller prints it: this module writes nothing). When ``main`` raises, the
+    ranks agree by a non-blocking barrier: if every rank reaches it within ``grace``
+    seconds (the error was raised on all ranks, or the others finished), rank 0 receives
+    the lowest failing rank's message once, ``report(message, error=True)`` (prefixed
+    ``rank r of P: `` when not every rank failed), and every rank returns the code. If not
+    (the other ranks wait in a collective call for the failed one), the failing rank
+    receives ``report("rank r of P: message", error=True)`` and aborts the MPI job with the
+    code: a non-zero exit, never a hang. An unexpected exception (not a
+    :class:`TmfemError`) is logged with its traceback.
     """
     import time
     comm = comm_world() if comm is None else comm
@@ -113,15 +118,14 @@ def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
     except TmfemError as exc:
         failure = (exc.exit_code, str(exc))
     except Exception as exc:
-        traceback.print_exc()
+        log.error("rank %d of %d: unexpected error", comm.rank, comm.size, exc_info=True)
         failure = (1, f"{type(exc).__name__}: {exc}")
     if comm.size > 1:
         req = comm.Ibarrier()
         t0 = time.monotonic()
         while not req.Test():
             if failure is not None and time.monotonic() - t0 > grace:
-                print(f"{label}error: rank {comm.rank} of {comm.size}: {failure[1]}", file=sys.stderr,
-                      flush=True)
+                report(f"rank {comm.rank} of {comm.size}: {failure[1]}", error=True)
                 comm.Abort(failure[0])
             time.sleep(0.01)
         failures = comm.allgather(failure)
@@ -132,10 +136,10 @@ def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
         r, (code, msg) = bad[0]
         if comm.rank == 0:
             where = f"rank {r} of {comm.size}: " if comm.size > 1 and len(bad) < comm.size else ""
-            print(f"{label}error: {where}{msg}", file=sys.stderr, flush=True)
+            report(f"{where}{msg}", error=True)
         return code
     if comm.rank == 0 and text:
-        print(text, flush=True)
+        report(text, error=False)
     return 0
 
 

@@ -136,7 +136,9 @@ class PetscBackend:
         self.options = parse_options(options)
         self.eig_tol = float(eig_tol)
         self.comm = self.PETSc.COMM_WORLD
-        self._cache = {}          # sparsity pattern -> [Mat, KSP, generation]
+        self._cache = {}          # sparsity pattern -> [Mat, KSP, generation, symmetric, serial]
+        self._dead = []           # retired cache entries, destroyed by _reap
+        self._serial = 0          # creation count of cache entries (the same on every rank)
 
     # ------------------------------------------------------------------ matrices
     def ownership(self, n: int) -> tuple[int, int]:
@@ -212,11 +214,37 @@ class PetscBackend:
         return M, key
 
     def _drop(self, key) -> None:
-        """Free the cached Mat and KSP (MUMPS factors) of ``key``."""
+        """Retire the cached Mat and KSP (MUMPS factors) of ``key`` (its pattern is gone).
+
+        A finalizer: it runs wherever the pattern dies, which need not be the same point on
+        every rank (an exception unwinding on one rank, the cyclic garbage collector), and
+        destroying MUMPS factors is collective. So the entry leaves the cache at once and
+        is destroyed later by :meth:`_reap`, at a call every rank makes."""
         entry = self._cache.pop(key, None)
         if entry is not None:
-            entry[1].destroy()
-            entry[0].destroy()
+            self._dead.append(entry)
+
+    def _reap(self) -> None:
+        """Destroy the retired entries that every rank has retired, in the order they were
+        created (collective: called where every rank enters, at each factorisation and
+        eigen solve)."""
+        serials = sorted(e[4] for e in self._dead)
+        if self.comm.size > 1:
+            common = set(serials)
+            for other in self.comm.tompi4py().allgather(serials):
+                common &= set(other)
+            serials = sorted(common)
+        for serial in serials:
+            entry = next(e for e in self._dead if e[4] == serial)
+            self._dead.remove(entry)
+            self._destroy(entry)
+
+    @staticmethod
+    def _destroy(entry) -> None:
+        """Free the Mat and KSP of a cache entry (collective); its solves are stale."""
+        entry[2] = -1
+        entry[1].destroy()
+        entry[0].destroy()
 
     def _symmetric(self, A, M) -> bool:
         """Whether A (scipy, the same on every rank) or its PETSc Mat M equals its transpose
@@ -282,6 +310,7 @@ class PetscBackend:
         """
         from tmfem.solvers.backends import SingularMatrix
         PETSc = self.PETSc
+        self._reap()
         M, key = self._mat(A)
         n = M.getSize()[0]
         sym = self._symmetric(A, M)
@@ -291,9 +320,14 @@ class PetscBackend:
             M.setOption(PETSc.Mat.Option.SYMMETRIC, sym)
             ksp.setOperators(M)
             self._configure(ksp, sym)
-            entry = [M, ksp, 0, sym]
+            if entry is not None:          # the same pattern (and Mat M), the other symmetry
+                old = self._cache.pop(key)
+                old[2] = -1                # its solves are stale
+                old[1].destroy()
+            self._serial += 1
+            entry = [M, ksp, 0, sym, self._serial]
             if len(self._cache) >= 4:
-                self._drop(next(iter(self._cache)))
+                self._destroy(self._cache.pop(next(iter(self._cache))))
             self._cache[key] = entry
         else:
             ksp = entry[1]
@@ -389,6 +423,7 @@ class PetscBackend:
         SLEPc Krylov-Schur with shift-and-invert (module docstring); V (n, k) M-orthonormal."""
         import scipy.linalg as la
         PETSc, SLEPc = self.PETSc, self.SLEPc
+        self._reap()
         Kp, _ = self._mat(K, cache=False)
         Mp, _ = self._mat(M, cache=False)
         n = Kp.getSize()[0]
