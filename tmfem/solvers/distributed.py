@@ -176,10 +176,18 @@ class DistributedMatrix:
     def __init__(self, mat, pattern, shape):
         self.mat, self.pattern, self.shape = mat, pattern, shape
         self.version = 0
+        self._vecs = None
+
+    def vecs(self):
+        """Work vectors (x, y) of the matrix' layout, created once (creating a parallel Vec
+        is collective)."""
+        if self._vecs is None:
+            self._vecs = self.mat.createVecs()
+        return self._vecs
 
     def diagonal(self) -> np.ndarray:
         """The diagonal (N,) on every rank."""
-        d, _ = self.mat.createVecs()
+        d, _ = self.vecs()
         self.mat.getDiagonal(d)
         return gather(d)
 
@@ -189,7 +197,7 @@ class DistributedMatrix:
         if x.shape[0] != n or x.ndim > 2:
             raise InputError(f"distributed matrix: expected x of {n} rows, found shape {x.shape}")
         lo, hi = self.mat.getOwnershipRange()
-        xv, yv = self.mat.createVecs()
+        xv, yv = self.vecs()
         cols = x.reshape(n, -1)
         out = np.empty_like(cols)
         for j in range(cols.shape[1]):
@@ -288,17 +296,20 @@ class DistributedAssembler:
         np.cumsum(np.bincount(orow, minlength=self.hi - self.lo), out=self._indptr[1:])
         self._pattern = Pattern()
 
-    def _check(self, Xe, g, what):
-        """Every rank agrees that the local arrays are finite and of the right shape."""
+    def _check(self, values, what):
+        """Every rank agrees (one collective call) that the local arrays of all groups are
+        finite and of the right shapes; the arrays as float."""
         with collective(self.comm, what):
-            Xe = np.asarray(Xe, dtype=float)
-            if Xe.shape != g.value_shape:
-                raise InputError(f"{what}: expected arrays of shape {g.value_shape}, found {Xe.shape}")
-            bad = int(np.sum(~np.isfinite(Xe)))
+            values = [np.asarray(v, dtype=float) for v in values]
+            for Xe, g in zip(values, self._groups):
+                if Xe.shape != g.value_shape:
+                    raise InputError(f"{what}: expected arrays of shape {g.value_shape}, found "
+                                     f"{Xe.shape}")
+            bad = sum(int(np.sum(~np.isfinite(Xe))) for Xe in values)
             if bad:
                 raise errors.ConvergenceError(f"{what}: expected finite element arrays, found {bad} "
                                               "non-finite entries")
-        return Xe
+        return values
 
     def matrix(self, *values, out: DistributedMatrix | None = None) -> DistributedMatrix:
         """Sum over all ranks of this rank's element matrices / entries, one array per group
@@ -308,8 +319,7 @@ class DistributedAssembler:
         if len(values) != len(self._groups):
             raise InputError(f"distributed matrix: expected {len(self._groups)} arrays (one per "
                              f"group), found {len(values)}")
-        parts = [g.weighted(self._check(v, g, "distributed matrix"))
-                 for g, v in zip(self._groups, values)]
+        parts = [g.weighted(v) for g, v in zip(self._groups, self._check(values, "distributed matrix"))]
         vals = np.bincount(self._inverse, weights=np.concatenate(parts) if parts else None,
                            minlength=self._nu)
         del parts
