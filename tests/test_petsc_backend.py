@@ -209,7 +209,7 @@ def _mpirun(n, *args, timeout=120, program=None):
     # into os.environ: a child mpiexec that sees them thinks it is nested and exits
     env = {k: v for k, v in os.environ.items()
            if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
-    program = program or [sys.executable, str(ROOT / "tests" / "mpi" / "mtc_distributed.py")]
+    program = program or [sys.executable, str(ROOT / "tests" / "mpi" / "fe_distributed.py")]
     cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", str(n), *program, *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env)
 
@@ -432,8 +432,7 @@ def test_sbc_one_and_two_ranks_agree_with_scipy(sbc_scipy):
     runs = {1: {"ranks": 1, "distributed": m1.distributed is not None, "iterations": s1.iterations,
                 "predictor_iterations": s1.predictor_iterations, "x": s1.state.x, "R": s1.state.R,
                 "omega2": m1.modes(s1.state, k=12).omega2}}
-    p = _mpirun(2, "1-4", "6", program=[sys.executable, str(ROOT / "tests" / "mpi" /
-                                                            "sbc_distributed.py")])
+    p = _mpirun(2, "1-4", "6", "--model", "sbc")
     assert p.returncode == 0, p.stderr
     lines = p.stdout.strip().splitlines()
     assert len(lines) == 1                             # one document, from rank 0 only
@@ -454,16 +453,15 @@ def test_sbc_one_and_two_ranks_agree_with_scipy(sbc_scipy):
 
 @needs_mpi
 def test_sbc_failure_on_one_rank_one_error_nonzero_exit():
-    script = [sys.executable, str(ROOT / "tests" / "mpi" / "sbc_distributed.py")]
     # non-finite shell matrices on rank 1 only: caught collectively, one message from rank 0
-    p = _mpirun(2, "1-4", "4", "--nan-rank", "1", program=script)
+    p = _mpirun(2, "1-4", "4", "--model", "sbc", "--nan-rank", "1")
     assert p.returncode != 0
     assert p.stderr.count("error: ") == 1 and "non-finite entries" in p.stderr
     assert p.stdout.strip() == ""
     # the shell kernel of rank 1 raises while rank 0 waits in a collective call: one error,
     # the job aborted (the MTC predictor's MUMPS factors, freed while rank 1 unwinds, are
     # destroyed collectively later, not on the failing rank alone: no hang)
-    p = _mpirun(2, "1-4", "4", "--fail-rank", "1", timeout=60, program=script)
+    p = _mpirun(2, "1-4", "4", "--model", "sbc", "--fail-rank", "1", timeout=60)
     assert p.returncode != 0
     assert p.stderr.count("error: rank 1 of 2: FloatingPointError") == 1
     assert p.stdout.strip() == ""
