@@ -13,7 +13,9 @@ Columns: free DOFs, iterations of the static solve on the finest mesh, time per 
 time, time inside the backend's factorisations (incl. MUMPS/SuperLU analysis; their number)
 and solves, CPU time of rank 0 (static + eigen: the wall times of a shared machine grow with
 its load, printed in the header and per row), peak resident memory per rank (max over
-ranks), first frequency.
+ranks), first frequency. A second table splits rank 0's static time by phase
+(:class:`PhaseTimer`: element kernels and assembly, pattern set-up, interpolation, model
+builds, factorisations, solves, the rest: trust-region algebra, MPI waits).
 OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
 Targets (issue 11, 2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
 scipy time of 4x80x80; 1.2 M DOF < 5 min and < 16 GB.
@@ -39,18 +41,21 @@ class TimedBackend:
         self.inner, self.name = inner, inner.name
         self.distributed_assembly = getattr(inner, "distributed_assembly", False)
         self.t_factor = self.t_solve = self.t_eig = 0.0
+        self.c_factor = self.c_solve = 0.0          # CPU time of this process
         self.n_factor = 0
 
     def factorize(self, A):
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         solve = self.inner.factorize(A)
         self.t_factor += time.perf_counter() - t
+        self.c_factor += time.process_time() - c
         self.n_factor += 1
 
         def timed(b):
-            t = time.perf_counter()
+            t, c = time.perf_counter(), time.process_time()
             x = solve(b)
             self.t_solve += time.perf_counter() - t
+            self.c_solve += time.process_time() - c
             return x
         return timed
 
@@ -59,6 +64,47 @@ class TimedBackend:
         out = self.inner.eigsh(K, M, k, sigma)
         self.t_eig += time.perf_counter() - t
         return out
+
+
+#: the columns of the second table (rank 0's static time by phase)
+PHASES = ("model", "patterns", "interp", "build", "factor", "solve", "rest")
+
+
+class PhaseTimer:
+    """CPU and wall time of this process inside the model-side calls of a run, by phase
+    (wrapped methods; the calls of a phase do not nest): ``model`` the residual, tangent
+    and energy evaluations (element kernels and assembly), ``patterns`` the set-up of the
+    assemblers' sparsity patterns (once per mesh, and the mass), ``interp`` the mesh
+    sequencing's interpolation, ``build`` the models of the sequencing levels."""
+
+    def __init__(self):
+        from tmfem.fem.distributed import DistributedElements
+        from tmfem.models.mtc.model import MTCModel
+        from tmfem.solvers.distributed import DistributedAssembler
+        self.cpu, self.wall = {}, {}
+        self._saved = []
+        for phase, targets in {"model": [(DistributedElements, "residual"),
+                                         (DistributedElements, "energy"),
+                                         (MTCModel, "residual"), (MTCModel, "energy")],
+                               "patterns": [(DistributedAssembler, "__init__")],
+                               "interp": [(MTCModel, "interpolate_from")],
+                               "build": [(MTCModel, "__init__")]}.items():
+            self.cpu[phase] = self.wall[phase] = 0.0
+            for cls, name in targets:
+                self._wrap(phase, cls, name)
+
+    def _wrap(self, phase, cls, name):
+        inner = getattr(cls, name)
+        self._saved.append((cls, name, inner))
+
+        def timed(*a, **k):
+            c, t = time.process_time(), time.perf_counter()
+            try:
+                return inner(*a, **k)
+            finally:
+                self.cpu[phase] += time.process_time() - c
+                self.wall[phase] += time.perf_counter() - t
+        setattr(cls, name, timed)
 
 
 def system_1_4(rest_length: float):
@@ -80,9 +126,10 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     system = system_1_4(rest_length)
     t0 = time.perf_counter()
     m = MTCModel(system, mesh_n=mesh, tendon_elements=3, backend=be)
+    phases = PhaseTimer()
     t1, c1 = time.perf_counter(), time.process_time()
     res = m.solve_static(sequence=sequence or None)
-    t2 = time.perf_counter()
+    t2, c2 = time.perf_counter(), time.process_time()
     modes = m.modes(res.x, k=12)
     t3, c3 = time.perf_counter(), time.process_time()
     its = (res.newton_iterations_tangent or [res.iterations])[-1]
@@ -92,8 +139,9 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     return dict(config=config, ranks=size, mesh=f"4x{mesh}x{mesh}", dofs=m.ndof, build_s=t1 - t0,
                 iterations=its, total_iterations=res.iterations, s_per_it=(t2 - t1) / res.iterations,
                 static_s=t2 - t1, eigen_s=t3 - t2, factor_s=be.t_factor, n_factor=be.n_factor,
-                solve_s=be.t_solve, cpu_s=c3 - c1, rss_mb=rss, f1_hz=float(modes.freq_hz[0]),
-                load=os.getloadavg()[0])
+                solve_s=be.t_solve, cpu_factor_s=be.c_factor, cpu_solve_s=be.c_solve, cpu_s=c3 - c1, cpu_static_s=c2 - c1, cpu_eigen_s=c3 - c2,
+                cpu_phases=phases.cpu, wall_phases=phases.wall, rss_mb=rss,
+                f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0])
 
 
 def launch(mesh: int, config: str, args) -> dict:
@@ -121,12 +169,13 @@ def main(argv=None) -> int:
     ap.add_argument("--json", action="store_true", help="one JSON document of all rows")
     args = ap.parse_args(argv)
     if args.run:
+        from tmfem.cli import rank_report
         from tmfem.solvers.distributed import mpi_main
         if args.run[1] == "scipy":
             print(json.dumps(run_one(int(args.run[0]), "scipy", args.rest_length, args.sequence)))
             return 0
         return mpi_main(lambda: json.dumps(run_one(int(args.run[0]), args.run[1], args.rest_length,
-                                                   args.sequence)))
+                                                   args.sequence)), report=rank_report())
     rows = []
     if not args.json:
         print(f"# 1-4 MTC, static from the undeformed membrane + 12 modes; {os.cpu_count()} cpus, "
@@ -150,6 +199,22 @@ def main(argv=None) -> int:
                   f"{row['load']:.1f}", flush=True)
     if args.json:
         print(json.dumps(rows))
+        return 0
+    print("\n# where rank 0's time went (wall s; CPU s in brackets): static = model (kernels,"
+          " assembly) + patterns + interp + build + factor + solve + rest; eigen")
+    print(f"{'config':>7s} {'mesh':>11s} {'static':>16s} "
+          + " ".join(f"{p:>15s}" for p in PHASES) + f" {'eigen':>16s}")
+    for row in rows:
+        if "error" in row:
+            continue
+        w, c = row["wall_phases"], row["cpu_phases"]
+        w = dict(w, factor=row["factor_s"], solve=row["solve_s"])
+        c = dict(c, factor=row["cpu_factor_s"], solve=row["cpu_solve_s"])
+        w["rest"] = row["static_s"] - sum(w.values())
+        c["rest"] = row["cpu_static_s"] - sum(c.values())
+        print(f"{row['config']:>7s} {row['mesh']:>11s} {row['static_s']:7.2f} ({row['cpu_static_s']:6.2f}) "
+              + " ".join(f"{w[p]:6.2f} ({c[p]:6.2f})" for p in PHASES)
+              + f" {row['eigen_s']:7.2f} ({row['cpu_eigen_s']:6.2f})")
     return 0
 
 

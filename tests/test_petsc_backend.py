@@ -209,7 +209,7 @@ def _mpirun(n, *args, timeout=120, program=None):
     # into os.environ: a child mpiexec that sees them thinks it is nested and exits
     env = {k: v for k, v in os.environ.items()
            if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
-    program = program or [sys.executable, str(ROOT / "tests" / "mpi" / "mtc_distributed.py")]
+    program = program or [sys.executable, str(ROOT / "tests" / "mpi" / "fe_distributed.py")]
     cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", str(n), *program, *args]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env)
 
@@ -381,3 +381,104 @@ def test_distributed_tangent_held_by_a_caller_is_not_overwritten(models):
     del held
     d.residual(State(x=x0))
     assert len(d._K) == n_before                            # a dropped one is refilled
+
+
+# ---------------------------------------------------------------- SBC on distributed assembly
+@pytest.fixture(scope="module")
+def sbc_scipy():
+    # 1-4 SBC at 4 x 6 x 6: 937 free dofs, so that scipy's modes come from ARPACK
+    # shift-invert (its dense path below 600 dofs has an error ~ eps lambda_max, 1e-7 on the
+    # lowest SBC mode with the shells' stiff rotations: docs/backends.md)
+    from tmfem.models.sbc.model import SBCModel
+    from tmfem.system import load_preset
+    m = SBCModel(load_preset("1-4"), mesh_n=6)
+    st = m.solve_static()
+    return m, st, m.modes(st.state, k=12, tangent=st.tangent)
+
+
+@needs_petsc
+def test_sbc_distributed_tangent_and_its_symmetric_part_are_the_scipy_ones(sbc_scipy):
+    # source: the scipy assembly of the same state (T^T K T restricted to the free dofs)
+    from tmfem.models.sbc.model import SBCModel
+    m, st, _ = sbc_scipy
+    mp = SBCModel(m.system, mesh_n=6, backend="petsc")
+    d = mp.distributed
+    assert d is not None and d._shares[0] is not None          # the shells by elements
+    r, K = m.residual(st.state)
+    K = K.tocsr()[m.free][:, m.free]
+    rd, Kd = d.residual(st.state)
+    Kd = d.assembler.scipy(Kd)
+    assert np.abs(rd - r[m.free]).max() <= 1e-12 * np.abs(r).max() + 1e-9
+    assert abs(Kd - K).max() <= 1e-12 * abs(K).max()
+    Ks = d.assembler.scipy(d.residual(st.state, symmetric=True)[1])
+    assert abs(Ks - 0.5 * (K + K.T)).max() <= 1e-12 * abs(K).max()
+    assert abs(Ks - Ks.T).max() <= 1e-15 * abs(K).max()     # summation order only
+    Md = d.assembler.scipy(d.mass(mp._full_mass(st.state)))
+    Ms = m.mass(st.state).tocsr()[m.free][:, m.free]
+    assert abs(Md - Ms).max() <= 1e-14 * abs(Ms).max()
+    assert d.energy(st.state) == pytest.approx(m.energy(st.state), rel=1e-12)
+
+
+@needs_mpi
+def test_sbc_one_and_two_ranks_agree_with_scipy(sbc_scipy):
+    # source: the scipy SBC model's static solve from the undeformed membrane (MTC
+    # predictor, then the SBC trust region) and its 12 modes; the PETSc runs assemble the
+    # shells rank by rank (1 rank: in this process)
+    from tmfem.models.sbc.model import SBCModel
+    m, st, md = sbc_scipy
+    u = st.state.x - m.start_state().x
+    m1 = SBCModel(m.system, mesh_n=6, backend="petsc")
+    s1 = m1.solve_static()
+    runs = {1: {"ranks": 1, "distributed": m1.distributed is not None, "iterations": s1.iterations,
+                "predictor_iterations": s1.predictor_iterations, "x": s1.state.x, "R": s1.state.R,
+                "omega2": m1.modes(s1.state, k=12).omega2}}
+    p = _mpirun(2, "1-4", "6", "--model", "sbc")
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.strip().splitlines()
+    assert len(lines) == 1                             # one document, from rank 0 only
+    runs[2] = json.loads(lines[0])
+    for n, run in runs.items():
+        assert run["ranks"] == n and run["distributed"]
+        assert run["predictor_iterations"] == st.predictor_iterations
+        # the SBC stage starts on the round-off floor of its 1e-9 test (|r| ~ 1e-7 N against
+        # 9e-8 N: the thin shells' stiff rotations), so round-off decides between 1 and 2
+        # steps; the equilibrium is the same (below)
+        assert abs(run["iterations"] - st.iterations) <= 1
+        x = np.array(run["x"])
+        assert np.linalg.norm(x - st.state.x) <= 1e-9 * np.linalg.norm(u)
+        assert np.abs(np.array(run["R"]) - st.state.R).max() <= 1e-9
+        f = np.sqrt(np.array(run["omega2"])) / (2 * np.pi)
+        assert np.allclose(f, md.freq_hz, rtol=1e-8, atol=0)
+
+
+@needs_mpi
+def test_sbc_failure_on_one_rank_one_error_nonzero_exit():
+    # non-finite shell matrices on rank 1 only: caught collectively, one message from rank 0
+    p = _mpirun(2, "1-4", "4", "--model", "sbc", "--nan-rank", "1")
+    assert p.returncode != 0
+    assert p.stderr.count("error: ") == 1 and "non-finite entries" in p.stderr
+    assert p.stdout.strip() == ""
+    # the shell kernel of rank 1 raises while rank 0 waits in a collective call: one error,
+    # the job aborted (the MTC predictor's MUMPS factors, freed while rank 1 unwinds, are
+    # destroyed collectively later, not on the failing rank alone: no hang)
+    p = _mpirun(2, "1-4", "4", "--model", "sbc", "--fail-rank", "1", timeout=60)
+    assert p.returncode != 0
+    assert p.stderr.count("error: rank 1 of 2: FloatingPointError") == 1
+    assert p.stdout.strip() == ""
+
+
+@needs_mpi
+def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
+    # source: the same command on 1 process with scipy (frequencies to 1e-8, static
+    # iterations equal); the VTK file written once, by rank 0
+    argv = ["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "6", "--modes", "6",
+            "--json"]
+    p = _cli_in_rank_dirs(tmp_path, 2, *argv, "--backend", "petsc", "--vtk", "m.vtu")
+    assert p.returncode == 0, p.stderr
+    assert _written(tmp_path, 0) == ["m.vtu"] and _written(tmp_path, 1) == []
+    d2 = json.loads(p.stdout)                      # exactly one document on stdout
+    p1 = subprocess.run([sys.executable, "-m", "tmfem", *argv], capture_output=True, text=True,
+                        cwd=tmp_path)
+    d1 = json.loads(p1.stdout)
+    assert abs(d2["iterations"] - d1["iterations"]) <= 1          # round-off floor (above)
+    assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)

@@ -99,9 +99,10 @@ def test_prestressed_thin_membrane_modes_by_displacement_control():
     assert m.freq_hz[1] == pytest.approx(f11 * np.sqrt(5 / 2), rel=0.03)
 
 
-def _pressed_plate(follower):
+def _pressed_plate(follower, backend="scipy"):
     xs = np.linspace(0, 1, 5)
-    s = Structure.shell(MeshQuad.init_tensor(xs, xs), section=ShellSection(E=1e6, nu=0.3, thickness=0.01))
+    s = Structure.shell(MeshQuad.init_tensor(xs, xs), section=ShellSection(E=1e6, nu=0.3, thickness=0.01),
+                        backend=backend)
     s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0) | np.isclose(x, 1) | np.isclose(y, 0) | np.isclose(y, 1)),
           ["ux", "uy", "uz"])
     s.pressure(0.5, follower=follower)
@@ -207,3 +208,42 @@ def test_point_moment_does_not_depend_on_the_order_of_symmetry_and_load():
     EI = 1e4 * 0.5 * 0.02**3 / 12
     np.testing.assert_allclose(tips[0], tips[1], rtol=1e-12)
     np.testing.assert_allclose(np.abs(tips[0]), 1e-4 * 2.0 / EI, rtol=1e-8)
+
+
+class _CountingBackend:
+    """The scipy backend, counting the calls that reach it."""
+
+    name = "counting"
+
+    def __init__(self):
+        from tmfem.solvers.backends import ScipyBackend
+        self.inner, self.calls = ScipyBackend(), {"factorize": 0, "eigsh": 0}
+
+    def factorize(self, A):
+        self.calls["factorize"] += 1
+        return self.inner.factorize(A)
+
+    def eigsh(self, K, M, k, sigma, v0=None):
+        self.calls["eigsh"] += 1
+        return self.inner.eigsh(K, M, k, sigma, v0=v0)
+
+
+def test_every_solve_of_a_structure_goes_through_its_backend():
+    # source: the same solves on the default backend (results equal), and the call counts
+    be = _CountingBackend()
+    s, c = _pressed_plate(False, backend=be)
+    ref, _ = _pressed_plate(False)
+    w = s.displacements(s.solve_linear())[2, c]
+    assert be.calls["factorize"] == 1
+    assert w == ref.displacements(ref.solve_linear())[2, c]
+    s.solve(steps=2)
+    s.solve_arc_length(dl=0.05, n_steps=2)
+    assert be.calls["factorize"] > 3
+    xs = np.linspace(0, 1, 4)
+    plates = [Structure.shell(MeshQuad.init_tensor(xs, xs), backend=b,
+                              section=ShellSection(E=1e6, nu=0.3, thickness=0.01, rho=1e3))
+              for b in (be, "scipy")]
+    for p in plates:
+        p.fix(p.nodes_where(lambda x, y, z: np.isclose(x, 0)), "all")
+    assert np.array_equal(plates[0].modes(k=3).omega2, plates[1].modes(k=3).omega2)
+    assert be.calls["eigsh"] == 1

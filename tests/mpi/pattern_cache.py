@@ -8,6 +8,7 @@ import sys
 import numpy as np
 import scipy.sparse as sp
 
+from tmfem.cli import rank_report
 from tmfem.solvers.distributed import mpi_main
 
 
@@ -29,4 +30,4 @@ def main():
 
 
 if __name__ == "__main__":
-    sys.exit(mpi_main(main))
+    sys.exit(mpi_main(main, report=rank_report()))

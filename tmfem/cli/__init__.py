@@ -229,10 +229,21 @@ def _main_mpi(args, mod) -> int:
             except MemoryError:
                 raise ResourceLimit(_OUT_OF_MEMORY) from None
         return render(args, mod, result["value"])
-    code = mpi_main(body, label=f"tmfem {args.command}: ")
+    code = mpi_main(body, report=rank_report(f"tmfem {args.command}: "))
     if code == 0:
         code = _checks_exit(args, result["value"], printing=rank == 0)
     return code
+
+
+def rank_report(label: str = ""):
+    """The ``report`` of :func:`tmfem.solvers.distributed.mpi_main` that prints: the text
+    on stdout, an error as ``LABELerror: ...`` on stderr."""
+    def report(text: str, *, error: bool) -> None:
+        if error:
+            print(f"{label}error: {text}", file=sys.stderr, flush=True)
+        else:
+            print(text, flush=True)
+    return report
 
 
 def _finite(obj):

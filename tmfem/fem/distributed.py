@@ -29,11 +29,21 @@ while it evaluates trial points (two or three matrices in all).
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 
 import numpy as np
 import scipy.sparse as sp
 
 from tmfem.solvers.distributed import DistributedAssembler, comm_world, element_share
+
+
+def for_backend(backend, elements, state0, T, free):
+    """The :class:`DistributedElements` of a model's element sets when ``backend``
+    assembles distributed matrices (``backend.distributed_assembly``: PETSc, on one rank
+    or under ``mpiexec``), else None (the model assembles scipy matrices)."""
+    if not getattr(backend, "distributed_assembly", False):
+        return None
+    return DistributedElements(elements, state0, T, free)
 
 
 def _shares(e) -> bool:
@@ -72,8 +82,7 @@ class DistributedElements:
                 self._shares.append(share)
                 self._entries.append(None)
             else:
-                K0 = sp.csr_matrix(e.internal(state0, tangent=True)[1])
-                K0.sort_indices()
+                K0 = _structure(e.internal(state0, tangent=True)[1])
                 share = element_share(K0.nnz, self.comm)
                 rows = np.repeat(np.arange(self.n), np.diff(K0.indptr))
                 groups.append((np.stack([rows[share], K0.indices[share]], axis=1), "entry"))
@@ -89,10 +98,14 @@ class DistributedElements:
         """Number of unknowns (free dofs)."""
         return self.assembler.N
 
-    def residual(self, state, *, tangent: bool = True):
+    def residual(self, state, *, tangent: bool = True, symmetric: bool = False):
         """``(r, K)``: the internal force on the free dofs (N,), the same on every rank, and
         the tangent (a :class:`~tmfem.solvers.distributed.DistributedMatrix`, refilled in a
-        later call only once the caller has dropped it), eqs. 4.4-4.6."""
+        later call only once the caller has dropped it), eqs. 4.4-4.6. ``symmetric``: the
+        symmetric part (K + K^T) / 2 of the tangent instead (assembled from the symmetric
+        parts of the element matrices: T^T K T commutes with the transposition), for the
+        modes about a state of a tangent that is symmetric only at equilibrium (finite
+        rotations)."""
         f = np.zeros(self.n)
         values = []
         for e, share, entries in zip(self.elements, self._shares, self._entries):
@@ -100,6 +113,8 @@ class DistributedElements:
                 fe, Ke = e.element_arrays(state, tangent=tangent, elements=share)
                 f += np.bincount(np.asarray(e.element_dofs)[share].ravel(), weights=fe.ravel(),
                                  minlength=self.n)
+                if tangent and symmetric:
+                    Ke = 0.5 * (Ke + np.swapaxes(Ke, 1, 2))
                 values.append(Ke)
             else:
                 fs, Ks = e.internal(state, tangent=tangent)
@@ -107,6 +122,8 @@ class DistributedElements:
                     f += fs
                 if tangent:
                     Ks = sp.csr_matrix(Ks)
+                    if symmetric:
+                        Ks = sp.csr_matrix(0.5 * (Ks + Ks.T))
                     Ks.sort_indices()
                     if not (np.array_equal(Ks.indptr, entries[0])
                             and np.array_equal(Ks.indices, entries[1])):
@@ -134,18 +151,46 @@ class DistributedElements:
                 local += e.energy(state)
         return float(self.comm.allreduce(local))
 
-    def mass(self):
-        """Mass matrix (T^T M T)[free][:, free] (a DistributedMatrix), assembled once from the
-        sets' mass matrices (entries shared out over the ranks)."""
-        if self._M is None:
-            M = sp.csr_matrix(sum(e.mass() for e in self.elements))
-            M.sort_indices()
-            rows = np.repeat(np.arange(self.n), np.diff(M.indptr))
-            share = element_share(M.nnz, self.comm)
-            asm = DistributedAssembler([(np.stack([rows[share], M.indices[share]], axis=1), "entry")],
-                                       self.n, T=self.T, keep=self.free, comm=self.comm)
-            self._M = asm.matrix(M.data[share])
-        return self._M
+    def mass(self, M=None):
+        """Mass matrix (T^T M T)[free][:, free] (a DistributedMatrix) of the full mass M
+        (n, n), the same on every rank, its entries shared out over the ranks; by default
+        the sum of the sets' masses, assembled once and kept (pass M for a mass that
+        depends on the state: the rotary inertia of shells and beams at the current
+        directors)."""
+        if M is None and self._M is not None:
+            return self._M
+        keep = M is None
+        M = sp.csr_matrix(sum(e.mass() for e in self.elements) if keep else M)
+        M.sort_indices()
+        rows = np.repeat(np.arange(self.n), np.diff(M.indptr))
+        share = element_share(M.nnz, self.comm)
+        asm = DistributedAssembler([(np.stack([rows[share], M.indices[share]], axis=1), "entry")],
+                                   self.n, T=self.T, keep=self.free, comm=self.comm)
+        Md = asm.matrix(M.data[share])
+        if keep:
+            self._M = Md
+        return Md
+
+
+    def modes(self, K, M, *, k: int, sigma: float, backend):
+        """The k lowest modes of (M omega^2 - K) phi = 0 (eq. 5.32) of a distributed tangent
+        K and mass M on the free dofs (:func:`tmfem.solvers.eigen.lowest_modes`), the
+        shapes on all reduced dofs (n_r, k), zero at the fixed ones."""
+        from tmfem.solvers.eigen import lowest_modes
+        modes = lowest_modes(K, M, k=k, sigma=sigma, backend=backend)
+        shapes = np.zeros((self.free.size, modes.shapes.shape[1]))
+        shapes[self.free] = modes.shapes
+        return replace(modes, shapes=shapes)
+
+
+def _structure(K) -> sp.csr_matrix:
+    """A CSR matrix on the union of the patterns of K and K^T (sorted; the values do not
+    matter): the fixed pattern of a set's tangent and of its symmetric part."""
+    K = sp.csr_matrix(K)
+    B = sp.csr_matrix((np.ones(K.nnz), K.indices, K.indptr), shape=K.shape)
+    S = sp.csr_matrix(B + B.T)
+    S.sort_indices()
+    return S
 
 
 def _on_pattern(K: sp.csr_matrix, indptr, indices) -> sp.csr_matrix:

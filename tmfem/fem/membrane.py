@@ -306,17 +306,25 @@ class MembraneTL:
         fe = np.einsum("ibeq,kbeq,eq->eki", P, dN, dx).reshape(-1, 12)
         if not tangent:
             return fe, None
-        B = np.empty((4, 3, 3) + dx.shape)
-        B[:, :, 0] = F[None, :, 0] * dN[:, None, 0]
-        B[:, :, 1] = F[None, :, 1] * dN[:, None, 1]
-        B[:, :, 2] = F[None, :, 0] * dN[:, None, 1] + F[None, :, 1] * dN[:, None, 0]
-        hdx = h * dx
-        DB = np.einsum("vweq,kiweq->kiveq", D, B)
-        Km = np.einsum("kiveq,ljveq,eq->ekilj", B, DB, hdx, optimize=True)
+        ne, nq = dx.shape
+        # B (ne, nq, 3 Voigt, 12 = (node k, component i)), element-major for batched matmuls
+        Ft = np.transpose(F, (2, 3, 1, 0))                            # (ne, nq, a, i)
+        dNt = np.transpose(dN, (2, 3, 1, 0))                          # (ne, nq, a, k)
+        B = np.empty((ne, nq, 3, 4, 3))
+        B[:, :, 0] = dNt[:, :, 0, :, None] * Ft[:, :, 0, None, :]
+        B[:, :, 1] = dNt[:, :, 1, :, None] * Ft[:, :, 1, None, :]
+        B[:, :, 2] = dNt[:, :, 1, :, None] * Ft[:, :, 0, None, :] + dNt[:, :, 0, :, None] * Ft[:, :, 1, None, :]
+        B = B.reshape(ne, nq, 3, 12)
+        hdx = (h * dx)[:, :, None, None]
+        DB = np.matmul(np.transpose(D, (2, 3, 0, 1)) * hdx, B)        # (ne, nq, 3, 12)
+        Km = np.matmul(np.swapaxes(B.reshape(ne, nq * 3, 12), 1, 2), DB.reshape(ne, nq * 3, 12))
         # initial-stress part: delta_ij N_k,a S_ab N_l,b
-        g = np.einsum("kaeq,abeq,lbeq,eq->ekl", dN, S, dN, hdx, optimize=True)
-        Km += g[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
-        return fe, Km.reshape(-1, 12, 12)
+        SdN = np.matmul(np.transpose(S, (2, 3, 0, 1)) * hdx, dNt)      # (ne, nq, b, l)
+        g = np.matmul(np.swapaxes(dNt.reshape(ne, nq * 2, 4), 1, 2), SdN.reshape(ne, nq * 2, 4))
+        K4 = Km.reshape(ne, 4, 3, 4, 3)
+        for i in range(3):
+            K4[:, :, i, :, i] += g
+        return fe, Km
 
     def internal_forms(self, x, *, tangent: bool = True):
         """Same as :meth:`internal`, assembled with the scikit-fem forms (reference)."""

@@ -61,6 +61,8 @@ mapped to the rotational dofs by d(d_k)/d(alpha, beta) = (a/2) [-V_2, V_1].
 """
 from __future__ import annotations
 
+import copy
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -244,6 +246,16 @@ class _Points:
         D = shell.section.lamina_matrix()
         self.C = np.einsum("...ba,bc,...cd->...ad", self.Q, D, self.Q)   # C~ = Q^T D Q
 
+    #: the per-element arrays (leading axis: elements)
+    _PER_ELEMENT = ("Ga", "Gb", "G3", "detJ", "dV", "Q", "C")
+
+    def take(self, elements: slice) -> "_Points":
+        """The same points on the ``elements`` (a slice) only (views of the arrays)."""
+        out = copy.copy(self)
+        for name in self._PER_ELEMENT:
+            setattr(out, name, getattr(self, name)[elements])
+        return out
+
 
 class MITC4Shell:
     """A set of MITC4 shell elements on the 5-dof nodes of a :class:`DofMap` (module docstring).
@@ -329,6 +341,7 @@ class MITC4Shell:
         self._gauss = _Points(self, xq, wq, rz, wz)
         self._asm = Assembler(dofmap.element_dofs(conn, rotations=True), dofmap.ndof)
         self._M = None
+        self._part_cache = None
 
     # ------------------------------------------------------------------ kinematics
     def _tie_weights(self, xi):
@@ -390,11 +403,41 @@ class MITC4Shell:
         g3t = self._tie_G3 + u3
         return c, g, gt, g3t
 
+    # ------------------------------------------------------------------ share protocol
+    @property
+    def element_dofs(self) -> np.ndarray:
+        """(ne, 20) global dofs of each element, node by node [u_x, u_y, u_z, alpha, beta]
+        (the share protocol of :class:`tmfem.fem.distributed.DistributedElements`)."""
+        return self._asm.dofs
+
+    def _part(self, elements: slice) -> "MITC4Shell":
+        """This element set restricted to the ``elements`` (a slice): a shallow copy with
+        the per-element reference arrays sliced (kept for the next call with that slice:
+        a rank of a distributed assembly asks for the same block every time)."""
+        if elements == slice(None):
+            return self
+        key = elements.indices(self.ne)
+        if self._part_cache is not None and self._part_cache[0] == key:
+            return self._part_cache[1]
+        part = copy.copy(self)
+        part.conn = self.conn[:, elements]
+        part.ne = part.conn.shape[1]
+        for name in ("_Xe", "_De", "_tie_G", "_tie_G3"):
+            setattr(part, name, getattr(self, name)[elements])
+        part._gauss = self._gauss.take(elements)
+        part._part_cache = None
+        self._part_cache = (key, part)
+        return part
+
     # ------------------------------------------------------------------ element arrays
-    def element_arrays(self, state, *, tangent: bool = True):
-        """Element internal forces fe (ne, 20) and tangents Ke (ne, 20, 20) (or None), local
-        dofs node by node [u_x, u_y, u_z, alpha, beta] (eqs. 4.4-4.6 with the MITC shear of
-        eqs. 4.17-4.18)."""
+    def element_arrays(self, state, *, tangent: bool = True, elements: slice = slice(None)):
+        """Element internal forces fe (ne, 20) and tangents Ke (ne, 20, 20) (or None) of the
+        ``elements`` (a slice; default all), local dofs node by node [u_x, u_y, u_z, alpha,
+        beta] (eqs. 4.4-4.6 with the MITC shear of eqs. 4.17-4.18)."""
+        return self._part(elements)._element_arrays(state, tangent=tangent)
+
+    def _element_arrays(self, state, *, tangent: bool = True):
+        """:meth:`element_arrays` of all elements of this set."""
         u, d, w, V = self._nodal(state)
         pts = self._gauss
         c, g, gt, g3t = self._strains(pts, u, d, w)
@@ -508,9 +551,14 @@ class MITC4Shell:
         fe, Ke = self.element_arrays(state, tangent=tangent)
         return self._asm.vector(fe), (self._asm.matrix(Ke) if tangent else None)
 
-    def energy(self, state) -> float:
-        """Strain energy [J]: int c . C~ c / 2 dV (SVK, eq. 4.9), or
-        int W(E_loc) + k G ((2 e_13)^2 + (2 e_23)^2) / 2 dV (tension-field lamina)."""
+    def energy(self, state, *, elements: slice = slice(None)) -> float:
+        """Strain energy [J] of the ``elements`` (a slice; default all): int c . C~ c / 2 dV
+        (SVK, eq. 4.9), or int W(E_loc) + k G ((2 e_13)^2 + (2 e_23)^2) / 2 dV (tension-field
+        lamina)."""
+        return self._part(elements)._energy(state)
+
+    def _energy(self, state) -> float:
+        """:meth:`energy` of all elements of this set."""
         u, d, w, _ = self._nodal(state)
         pts = self._gauss
         c = self._strains(pts, u, d, w)[0]

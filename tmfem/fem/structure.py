@@ -115,9 +115,14 @@ class Structure:
         Reference positions [m].
     dofs : int or array_like (n_nodes,)
         Dofs per node: 3 (translations), 5 (shell) or 6 (beam).
+    backend : str or Backend
+        Linear-algebra backend of every solve (linear, Newton, arc length, modes; ``"scipy"``
+        default, :func:`tmfem.solvers.get_backend`); its matrices are assembled as scipy
+        matrices on every rank.
     """
 
-    def __init__(self, *, points, dofs):
+    def __init__(self, *, points, dofs, backend="scipy"):
+        self.backend = get_backend(backend)
         self.X = np.asarray(points, dtype=float)
         if self.X.ndim != 2 or self.X.shape[0] != 3:
             raise InputError(f"structure: expected points of shape (3, n), found {self.X.shape}")
@@ -139,13 +144,14 @@ class Structure:
     # ------------------------------------------------------------------ building
     @classmethod
     def shell(cls, mesh, *, section: ShellSection, normals=None, shear: str = "mitc",
-              law="svk") -> "Structure":
+              law="svk", backend="scipy") -> "Structure":
         """A shell structure from a quad mesh (scikit-fem ``MeshQuad``, ``meshio.Mesh``,
         meshio-readable path or ``(points, quads)``; flat or curved in 3-D): every node a 5-dof
         shell node, one MITC4 element set. ``normals`` (3, n): reference directors; ``shear``
-        and ``law`` (in-plane lamina law, "svk" or "tension-field"): see :class:`MITC4Shell`."""
+        and ``law`` (in-plane lamina law, "svk" or "tension-field"): see :class:`MITC4Shell`;
+        ``backend``: see :class:`Structure`."""
         p, t = read_quad_mesh(mesh)
-        s = cls(points=p, dofs=5)
+        s = cls(points=p, dofs=5, backend=backend)
         s.add_shell(t, section=section, normals=normals, shear=shear, law=law)
         return s
 
@@ -409,7 +415,7 @@ class Structure:
         up = cm.reduce(self._prescribed) if np.any(self._prescribed) else np.zeros(cm.n_reduced)
         rhs = rhs - K @ up
         u = up.copy()
-        u[idx] = factorize(K[idx][:, idx], get_backend(), equilibrate=True)(rhs[idx])
+        u[idx] = factorize(K[idx][:, idx], self.backend, equilibrate=True)(rhs[idx])
         return StructureState(state=s0.advanced(cm.full(u), self.dofmap), lam=1.0, iterations=1)
 
     def solve(self, *, steps: int = 10, lam_end: float = 1.0, tol: float = 1e-8, max_iter: int = 30,
@@ -441,7 +447,8 @@ class Structure:
             try:
                 res = newton(lambda s: self.residual(s, target), s_try, free=self.constraints.free,
                              tol=tol, scale=scale, max_iter=max_iter, line_search=line_search,
-                             load_factor=target, update=self.advance, equilibrate=equilibrate)
+                             load_factor=target, update=self.advance, equilibrate=equilibrate,
+                             backend=self.backend)
             except ConvergenceError as exc:
                 dlam = 0.5 * d
                 log.info("structure: step to lam = %g failed (%s); halving", target, exc)
@@ -479,7 +486,7 @@ class Structure:
             return cm.residual(f - fb), cm.tangent(K if Kb is None else K - Kb)
         s0 = self.reference_state() if start is None else start.state
         path = arc_length(internal, q, s0, free=cm.free, dl=dl, n_steps=n_steps,
-                          lam_max=lam_max, tol=tol, update=self.advance,
+                          lam_max=lam_max, tol=tol, update=self.advance, backend=self.backend,
                           stop=None if stop is None else (lambda s, lam: stop(StructureState(s, lam))))
         its = [0] + list(path.iterations)
         return [StructureState(state=s, lam=float(lam), iterations=i) for s, lam, i in zip(path.u, path.lam, its)]
@@ -502,7 +509,7 @@ class Structure:
         K = 0.5 * (K + K.T).tocsr()
         cm = self.constraints
         M = cm.tangent(self.mass(st.state))
-        m = lowest_modes(K, M, k=k, free=cm.free)
+        m = lowest_modes(K, M, k=k, free=cm.free, backend=self.backend)
         m.shapes = np.asarray(cm.T @ m.shapes)
         return m
 

@@ -18,20 +18,22 @@ the structure they come from.
   all ranks (with the failing rank's message), so no rank waits in a collective call for a
   rank that has died (the assemblers check their element arrays so).
 * :func:`mpi_main` runs a program: output on rank 0 only, one error message, a non-zero
-  exit code on every rank, never a hang.
+  exit code on every rank, never a hang (the caller prints what it is handed: library
+  code writes nothing).
 
 Vectors are replicated (O(n) per rank), matrices and factorisations distributed.
 """
 from __future__ import annotations
 
-import sys
-import traceback
+import logging
 
 import numpy as np
 import scipy.sparse as sp
 
 from tmfem import errors
 from tmfem.errors import InputError, TmfemError
+
+log = logging.getLogger(__name__)
 
 
 def comm_world():
@@ -94,16 +96,19 @@ def _find_tmfem_error(name: str):
     return TmfemError
 
 
-def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
+def mpi_main(main, *, report, comm=None, grace: float = 5.0) -> int:
     """Run ``main()`` on every rank; return its exit code (0, or the error's ``exit_code``).
 
-    ``main`` returns the text to print (or None); rank 0 prints it. When ``main`` raises,
-    the ranks agree by a non-blocking barrier: if every rank reaches it within ``grace``
-    seconds (the error was raised on all ranks, or the others finished), rank 0 prints the
-    lowest failing rank's message once as ``error: ...`` and every rank returns the code.
-    If not (the other ranks wait in a collective call for the failed one), the failing rank
-    prints its message and aborts the MPI job with the code: a non-zero exit, never a hang.
-    ``label`` prefixes the error line (the CLI's ``"tmfem static: "``).
+    ``main`` returns the text to show (or None); ``report(text, error=False)`` receives it
+    on rank 0 (the caller prints it: this module writes nothing). When ``main`` raises, the
+    ranks agree by a non-blocking barrier: if every rank reaches it within ``grace``
+    seconds (the error was raised on all ranks, or the others finished), rank 0 receives
+    the lowest failing rank's message once, ``report(message, error=True)`` (prefixed
+    ``rank r of P: `` when not every rank failed), and every rank returns the code. If not
+    (the other ranks wait in a collective call for the failed one), the failing rank
+    receives ``report("rank r of P: message", error=True)`` and aborts the MPI job with the
+    code: a non-zero exit, never a hang. An unexpected exception (not a
+    :class:`TmfemError`) is logged with its traceback.
     """
     import time
     comm = comm_world() if comm is None else comm
@@ -113,15 +118,14 @@ def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
     except TmfemError as exc:
         failure = (exc.exit_code, str(exc))
     except Exception as exc:
-        traceback.print_exc()
+        log.error("rank %d of %d: unexpected error", comm.rank, comm.size, exc_info=True)
         failure = (1, f"{type(exc).__name__}: {exc}")
     if comm.size > 1:
         req = comm.Ibarrier()
         t0 = time.monotonic()
         while not req.Test():
             if failure is not None and time.monotonic() - t0 > grace:
-                print(f"{label}error: rank {comm.rank} of {comm.size}: {failure[1]}", file=sys.stderr,
-                      flush=True)
+                report(f"rank {comm.rank} of {comm.size}: {failure[1]}", error=True)
                 comm.Abort(failure[0])
             time.sleep(0.01)
         failures = comm.allgather(failure)
@@ -132,10 +136,10 @@ def mpi_main(main, *, comm=None, grace: float = 5.0, label: str = "") -> int:
         r, (code, msg) = bad[0]
         if comm.rank == 0:
             where = f"rank {r} of {comm.size}: " if comm.size > 1 and len(bad) < comm.size else ""
-            print(f"{label}error: {where}{msg}", file=sys.stderr, flush=True)
+            report(f"{where}{msg}", error=True)
         return code
     if comm.rank == 0 and text:
-        print(text, flush=True)
+        report(text, error=False)
     return 0
 
 
@@ -172,10 +176,18 @@ class DistributedMatrix:
     def __init__(self, mat, pattern, shape):
         self.mat, self.pattern, self.shape = mat, pattern, shape
         self.version = 0
+        self._vecs = None
+
+    def vecs(self):
+        """Work vectors (x, y) of the matrix' layout, created once (creating a parallel Vec
+        is collective)."""
+        if self._vecs is None:
+            self._vecs = self.mat.createVecs()
+        return self._vecs
 
     def diagonal(self) -> np.ndarray:
         """The diagonal (N,) on every rank."""
-        d, _ = self.mat.createVecs()
+        d, _ = self.vecs()
         self.mat.getDiagonal(d)
         return gather(d)
 
@@ -185,7 +197,7 @@ class DistributedMatrix:
         if x.shape[0] != n or x.ndim > 2:
             raise InputError(f"distributed matrix: expected x of {n} rows, found shape {x.shape}")
         lo, hi = self.mat.getOwnershipRange()
-        xv, yv = self.mat.createVecs()
+        xv, yv = self.vecs()
         cols = x.reshape(n, -1)
         out = np.empty_like(cols)
         for j in range(cols.shape[1]):
@@ -284,17 +296,20 @@ class DistributedAssembler:
         np.cumsum(np.bincount(orow, minlength=self.hi - self.lo), out=self._indptr[1:])
         self._pattern = Pattern()
 
-    def _check(self, Xe, g, what):
-        """Every rank agrees that the local arrays are finite and of the right shape."""
+    def _check(self, values, what):
+        """Every rank agrees (one collective call) that the local arrays of all groups are
+        finite and of the right shapes; the arrays as float."""
         with collective(self.comm, what):
-            Xe = np.asarray(Xe, dtype=float)
-            if Xe.shape != g.value_shape:
-                raise InputError(f"{what}: expected arrays of shape {g.value_shape}, found {Xe.shape}")
-            bad = int(np.sum(~np.isfinite(Xe)))
+            values = [np.asarray(v, dtype=float) for v in values]
+            for Xe, g in zip(values, self._groups):
+                if Xe.shape != g.value_shape:
+                    raise InputError(f"{what}: expected arrays of shape {g.value_shape}, found "
+                                     f"{Xe.shape}")
+            bad = sum(int(np.sum(~np.isfinite(Xe))) for Xe in values)
             if bad:
                 raise errors.ConvergenceError(f"{what}: expected finite element arrays, found {bad} "
                                               "non-finite entries")
-        return Xe
+        return values
 
     def matrix(self, *values, out: DistributedMatrix | None = None) -> DistributedMatrix:
         """Sum over all ranks of this rank's element matrices / entries, one array per group
@@ -304,8 +319,7 @@ class DistributedAssembler:
         if len(values) != len(self._groups):
             raise InputError(f"distributed matrix: expected {len(self._groups)} arrays (one per "
                              f"group), found {len(values)}")
-        parts = [g.weighted(self._check(v, g, "distributed matrix"))
-                 for g, v in zip(self._groups, values)]
+        parts = [g.weighted(v) for g, v in zip(self._groups, self._check(values, "distributed matrix"))]
         vals = np.bincount(self._inverse, weights=np.concatenate(parts) if parts else None,
                            minlength=self._nu)
         del parts

@@ -56,10 +56,12 @@ class ParkResult:
 
 
 def _solver(S, system=None):
+    """``solve(b)`` of the Newton (or mass) matrix S: the system's own ``factorize``, else
+    sparse S by the system's ``backend`` (scipy when it names none), dense S by LU."""
     if system is not None and hasattr(system, "factorize"):
         return system.factorize(S)
     if sp.issparse(S):
-        return get_backend().factorize(S)
+        return get_backend(getattr(system, "backend", None)).factorize(S)
     S = np.asarray(S, dtype=float)
     import scipy.linalg as sla
     lu = sla.lu_factor(S, check_finite=False)
@@ -80,7 +82,7 @@ def initial_acceleration(system, x0, v0, t0=0.0, *, a0=None, tol=1e-12, max_iter
     for it in range(max_iter):
         r = system.residual(x0, v0, a, t0)
         _, _, M = system.jacobians(x0, v0, a, t0)
-        da = -_solver(M)(r)
+        da = -_solver(M, system)(r)
         a = a + da
         if np.linalg.norm(da) <= tol * (1.0 + np.linalg.norm(a)):
             return a

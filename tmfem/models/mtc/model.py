@@ -337,12 +337,11 @@ class MTCModel:
         distributed matrices (PETSc, on one rank or under ``mpiexec``), else None. The
         static solve and the modes then work on it: each rank evaluates and assembles its
         share of the membrane elements."""
-        if not getattr(self.backend, "distributed_assembly", False):
-            return None
         if self._dist is None:
-            from tmfem.fem.distributed import DistributedElements
-            self._dist = DistributedElements(self.elements, State(x=self.initial_positions("design")),
-                                             self.topology.T, self.free)
+            from tmfem.fem.distributed import for_backend
+            self._dist = for_backend(self.backend, self.elements,
+                                     State(x=self.initial_positions("design")),
+                                     self.topology.T, self.free)
         return self._dist
 
     def mass(self) -> sp.csr_matrix:
@@ -488,10 +487,7 @@ class MTCModel:
             _, K = self.residual(self.reduce(x))
             return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma, backend=self.backend)
         _, K = dist.residual(State(x=self.full(self.reduce(x))))
-        modes = lowest_modes(K, dist.mass(), k=k, sigma=sigma, backend=self.backend)
-        shapes = np.zeros((self.free.size, modes.shapes.shape[1]))
-        shapes[self.free] = modes.shapes
-        return replace(modes, shapes=shapes)
+        return dist.modes(K, dist.mass(), k=k, sigma=sigma, backend=self.backend)
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
         """Mode shapes (3, n_nodes, k) from reduced vectors (3 n_red, k)."""

@@ -162,6 +162,7 @@ class SBCModel:
                                 tension_only=t.tension_only)
         self.tendon_element = TrussElement(self.tendons, self.dofmap)
         self._M = None
+        self._dist = None
 
     def set_rest_lengths(self, rest) -> None:
         """Tendon rest lengths, as :meth:`MTCModel.set_rest_lengths`."""
@@ -208,6 +209,26 @@ class SBCModel:
         """Strain energy [J] of shells, beams and tendons (eq. 4.9)."""
         return sum(e.energy(state) for e in self.elements)
 
+    @property
+    def distributed(self):
+        """The element sets assembled rank by rank on the free dofs
+        (:class:`tmfem.fem.distributed.DistributedElements`: each rank evaluates its share
+        of the MITC4 shells, the beams and tendons are shared by matrix entries) when the
+        backend assembles distributed matrices (PETSc, on one rank or under ``mpiexec``),
+        else None. The static solve and the modes then work on it."""
+        if self._dist is None:
+            from tmfem.fem.distributed import for_backend
+            self._dist = for_backend(self.backend, self.elements, self.start_state(),
+                                     self.constraints.T, self.free)
+        return self._dist
+
+    def _on_free(self, du: np.ndarray) -> np.ndarray:
+        """The reduced increment (n_red,) of an increment du of the free dofs (zeros at the
+        fixed ones)."""
+        full = np.zeros(self.free.size)
+        full[self.free] = du
+        return full
+
     def advance(self, state: State, du: np.ndarray) -> State:
         """State after the reduced increment du: translations added, rotations by the
         exponential map (the ``update=`` of the trust-region solver)."""
@@ -216,8 +237,11 @@ class SBCModel:
     def mass(self, state: State | None = None) -> sp.csr_matrix:
         """Reduced mass T^T M T: shell (with rotary inertia) and beams at the directors of
         ``state`` (reference by default), consistent tendon mass."""
-        M = self.shell.mass(state) + self.beam.mass(state) + self.tendon_element.mass()
-        return self.constraints.tangent(M)
+        return self.constraints.tangent(self._full_mass(state))
+
+    def _full_mass(self, state: State | None = None) -> sp.csr_matrix:
+        """The mass of :meth:`mass` on all dofs (before the constraint map)."""
+        return self.shell.mass(state) + self.beam.mass(state) + self.tendon_element.mass()
 
     def member_forces(self, state: State) -> dict:
         """Tendon axial forces [N] (per tendon, mean of its elements; per element
@@ -297,10 +321,18 @@ class SBCModel:
             if callable(progress):
                 progress(it, rn, mu, rho)
 
+        dist = self.distributed
+        if dist is None:                   # unknowns: the reduced dofs, scipy matrices
+            residual, energy, advance, unknowns = self.residual, self.energy, self.advance, self.free
+        else:                              # unknowns: the free dofs, assembled rank by rank
+            residual, energy, unknowns = dist.residual, dist.energy, np.ones(dist.N, bool)
+
+            def advance(s, du):
+                return self.advance(s, self._on_free(du))
         res = trust_region_newton(
-            self.residual, self.energy, s0, free=self.free, scale=np.maximum(Md, 1e-9 * Md.max()),
+            residual, energy, s0, free=unknowns, scale=np.maximum(Md, 1e-9 * Md.max()),
             force_scale=self._force_scale, tol=tol, max_iter=max_iter, backend=self.backend,
-            callback=record, newton_first=start is not None or pre is not None, update=self.advance,
+            callback=record, newton_first=start is not None or pre is not None, update=advance,
             describe=lambda s: self.mtc.state_note(self.mtc.reduce(s.x[:, :self.numbering.n_mtc_nodes])),
             what="SBC static solve")
         mon = {k: np.array(v) for k, v in hist.items()}
@@ -319,11 +351,17 @@ class SBCModel:
         """Lowest ``k`` modes about the prestressed ``state`` (eq. 5.32): symmetric part of
         the reduced tangent, mass at the current directors. ``tangent``: the reduced tangent
         at ``state`` when already assembled (``SBCStaticResult.tangent``). Shapes are reduced
-        vectors (:meth:`full_shapes`)."""
-        K = self.residual(state)[1] if tangent is None else tangent
-        K = 0.5 * (K + K.T)
-        return lowest_modes(K.tocsr(), self.mass(state), k=k, free=self.free, sigma=sigma,
-                            backend=self.backend)
+        vectors (:meth:`full_shapes`). With distributed assembly the symmetric part is
+        assembled from the element matrices (``tangent`` is not needed)."""
+        dist = self.distributed
+        if dist is None:
+            K = self.residual(state)[1] if tangent is None else tangent
+            K = 0.5 * (K + K.T)
+            return lowest_modes(K.tocsr(), self.mass(state), k=k, free=self.free, sigma=sigma,
+                                backend=self.backend)
+        _, K = dist.residual(state, symmetric=True)
+        return dist.modes(K, dist.mass(self._full_mass(state)), k=k, sigma=sigma,
+                          backend=self.backend)
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
         """Translations (3, n_nodes, k) of the mode shapes from reduced vectors (n_red, k)."""
