@@ -12,7 +12,8 @@ closed form and path of :class:`tmfem.control.reference_trajectory.DeploymentRef
 Plant: the control-oriented model (eq. 5.27) built at the final configuration with its
 designed rest lengths, in modal membrane coordinates, started at rest in the initial
 configuration (as the 7.4 deployments, :func:`tmfem.control.deploy.run_deployment`: Park's
-method, rest-length limits).
+method, rest-length limits), or an FE plant through its COM-state estimate started in its own
+equilibrium of :meth:`LPVDeployment.packaged` (docs/fe-plant.md).
 
 Measurement (:meth:`LPVDeployment.measure`): the plant's y = [z, z'] (modal) mapped onto the
 signals of the LPV design, y_lpv = [x_z, rho] with x_z = [q, v, q', v'] (v = T_v_eta eta, the
@@ -67,6 +68,14 @@ class LPVDeployment:
     z_e: np.ndarray
     rho_q: list
     info: dict
+    initial: object = None
+
+    def packaged(self):
+        """The initial (packaged) configuration as a designed System: its rest lengths those
+        the run starts with, u_e of the design grid at rho_r(0) (the controller's first
+        output at rest on the reference) -- the start of an FE plant
+        (:func:`tmfem.control.state_estimate.deployment_plant`)."""
+        return self.initial.replace(rest_lengths=self.plant.interpolate("u_e", self.reference_rho(0.0)))
 
     @property
     def signal_names(self) -> list:
@@ -139,7 +148,8 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
             "theta_e_deg": float(np.degrees(theta_e)), "psi_0_deg": float(np.degrees(psi_0)), "K": model.K,
             "lpv_grid": list(plant.grid_shape)}
     return LPVDeployment(model=model, reference=ref, plant=plant, T_veta=T_veta, z0=z0, z_e=z_e,
-                         rho_q=[list(final.q_names).index(n) for n in plant.parameter_names], info=info)
+                         rho_q=[list(final.q_names).index(n) for n in plant.parameter_names], info=info,
+                         initial=initial)
 
 
 def state_feedback_controller(dep: LPVDeployment, design):
