@@ -35,9 +35,14 @@ def test_compare_names_the_model_whose_integration_fails(monkeypatch, capsys):
 @pytest.mark.slow
 def test_fine_mesh_1_4_vibration_runs_past_the_old_failure():
     # 6.5.1 on the 4 x 20 x 20 mesh: plain Newton diverged at Park step 494 (t = 4.94 s) in
-    # the SBC model; with the line search it runs through (reduced: to 5 s, just past it)
+    # the SBC model; with the line search it runs through. No reduced size can reach the old
+    # failure: the SBC part alone takes about an hour of wall time here (3488 s for 10 s).
+    # CI covers the line search by tests/test_park.py (closed form) and the named failure
+    # by test_compare_names_the_model_whose_integration_fails.
+    if REDUCED:
+        pytest.skip("4 x 20 x 20 SBC vibration to t = 4.94 s: about 30 min, full scale only")
     from tmfem.reference.vibration_compare import three_model_vibration
-    t_end = 5.0 if REDUCED else 10.0
+    t_end = 10.0
     r = three_model_vibration("1-4", t_end=t_end, dt=0.01, mesh_n=20)
     c = r["comparison"]
     assert c["t_end"] == pytest.approx(t_end)
