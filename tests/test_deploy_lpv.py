@@ -18,7 +18,7 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"
     (["--preset", "2-3-lpv", "--controller", "adaptive-lqr"], "for the LPV deployment (8.4)"),
     (["--preset", "2-3-lpv", "--uncertainty", "exact"], "do not apply to the LPV deployment"),
     (["--preset", "2-3-lpv", "--allocation", "clip"], "do not apply to the LPV deployment"),
-    (["--preset", "2-3-lpv", "--plant-mesh", "5"], "with an FE --plant only"),
+    (["--preset", "2-3-lpv", "--plant-mesh", "5"], "belongs to --plant mtc|sbc"),
     (["--preset", "2-3-lpv", "--plant", "sbc", "--plant-tendons", "fixed-rate"], "cable law only"),
     (["--preset", "2-3-lpv", "--path", "linear"], "do not apply to the LPV deployment"),
     (["--preset", "2-3-lpv", "--pfl-at", "reference"], "do not apply to the LPV deployment"),

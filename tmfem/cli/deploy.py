@@ -112,7 +112,7 @@ def run(args) -> dict:
               tendon_law=tendons)
     r = _run_on(args, s, args.plant, mesh_n)
     out = {"preset": args.preset, "controller": args.controller, "plant": args.plant,
-           **_plant_options(args, args.plant, mesh_n),
+           **plant_options(args, args.plant, mesh_n),
            "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
            "pfl_at": pfl_at,
            "path": args.path or DEPLOYMENTS[args.preset]["path"],
@@ -126,14 +126,18 @@ def run(args) -> dict:
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
     # to the failure are written, the exit code is 1 (docs/cli.md, docs/fe-plant.md)
-    out["failed_checks"] = [f"closed loop on the {p} plant diverged at t = {v['t_end_s']:.4g} s"
-                            for p, v in ((args.plant, out), (args.compare_plant,
-                                                             out.get("compare", {})))
-                            if v.get("failure")]
+    out["failed_checks"] = diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out
 
 
-def _plant_options(args, plant: str, mesh_n) -> dict:
+def diverged(runs) -> list:
+    """The failed checks of (plant, result) pairs: a closed loop that diverged (``failure``)."""
+    return [f"closed loop on the {p} plant diverged at t = {v['t_end_s']:.4g} s" for p, v in runs
+            if v.get("failure")]
+
+
+def plant_options(args, plant: str, mesh_n) -> dict:
+    """The FE plant's options of a run on ``plant`` for the JSON (none for the COM plant)."""
     if plant == "com":
         return {}
     return {"plant_mesh": mesh_n, **({"plant_tendons": args.plant_tendons or "cable"}
@@ -165,7 +169,7 @@ def _compare(args, mesh_n, r, pfl_at: str, tendons: str) -> dict:
                allocation=args.allocation, path=args.path, evaluation=pfl_at, tendon_law=tendons)
     r2 = _run_on(args, s2, args.compare_plant, mesh_n)
     dev = plant_deviation(r, r2)
-    out = {"plant": args.compare_plant, **_plant_options(args, args.compare_plant, mesh_n),
+    out = {"plant": args.compare_plant, **plant_options(args, args.compare_plant, mesh_n),
            **r2.summary(), "deviation": deviation_summary(dev)}
     if args.compare_csv:
         out["csv"] = write_csv(args.compare_csv, r2)

@@ -44,21 +44,18 @@ def given(args, names) -> list:
     return ["--" + k.replace("_", "-") for k in names if getattr(args, k, None) not in (None, False)]
 
 
-def check(args) -> None:
-    """Refusals before any work: options of the 7.4 deployments, the FE plant, the paths."""
+def check(args) -> int | None:
+    """Refusals before any work: options of the 7.4 deployments, the FE plant's options (those
+    of the 7.4 deployments, :func:`tmfem.cli.deploy.check_plant`), the paths. Returns the FE
+    plant's mesh (None on the COM plant)."""
     from tmfem.reference.deployments import LPV_DEPLOYMENTS
     bad = given(args, NOT_LPV)
-    if args.plant == "com":
-        bad += given(args, ("plant_mesh", "plant_tendons"))
-    elif args.plant == "sbc" and args.plant_tendons not in (None, "cable"):
-        bad.append(f"--plant-tendons {args.plant_tendons} (the SBC model has the cable law only)")
     own = LPV_DEPLOYMENTS[args.preset]["path"]
     if args.path not in (None, own):
         bad.append(f"--path {args.path}")
     if bad:
         raise InputError(f"--controller {args.controller}: options {bad} do not apply to the LPV deployment "
-                         f"of {args.preset} (reference of eq. 5.100 on the {own} path, no PFL; --plant-mesh and "
-                         f"--plant-tendons with an FE --plant only)")
+                         f"of {args.preset} (reference of eq. 5.100 on the {own} path, no PFL)")
     if args.lpv_controller is not None:
         syn = given(args, SYNTHESIS)
         if syn:
@@ -68,6 +65,8 @@ def check(args) -> None:
         if not (args.lpv_controller.endswith(".npz") and Path(args.lpv_controller).is_file()):
             raise InputError(f"--lpv-controller: expected an existing .npz file (tmfem control lpv --save), "
                              f"found {args.lpv_controller!r}")
+    from tmfem.cli.deploy import check_plant
+    return check_plant(args)
 
 
 def lpv_state_feedback(dep, design):
@@ -139,7 +138,7 @@ def run(args) -> dict:
     from tmfem.cli.common import progress_bar
     from tmfem.control.deploy import run_deployment
     from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
-    check(args)
+    mesh_n = check(args)
     if args.noise is not None and not (np.isfinite(args.noise) and args.noise >= 0):
         raise InputError(f"--noise: expected a standard deviation >= 0, found {args.noise}")
     t0 = time.perf_counter()
@@ -156,10 +155,10 @@ def run(args) -> dict:
         # the FE plant starts in its own equilibrium of the packaged configuration under the
         # rest lengths the controller starts with (docs/fe-plant.md)
         from tmfem.control.state_estimate import deployment_plant
-        fe = deployment_plant(args.plant, s.model, dep.packaged(), mesh_n=args.plant_mesh or 10,
+        fe = deployment_plant(args.plant, s.model, dep.packaged(), mesh_n=mesh_n,
                               tendon_law=args.plant_tendons)
-        info.update(plant_mesh=args.plant_mesh or 10,
-                    **({"plant_tendons": args.plant_tendons or "cable"} if args.plant == "mtc" else {}))
+    from tmfem.cli.deploy import diverged, plant_options
+    info.update(plant_options(args, args.plant, mesh_n))
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller}) on {args.plant}") as bar:
         r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
                            t_end=args.t_end, dt=args.dt, progress=bar, plant=fe,
@@ -177,6 +176,5 @@ def run(args) -> dict:
                              vtk=args.vtk, title=f"{args.preset} deployment on the {args.plant} plant: {args.controller} "
                                                  f"(gamma = {d.gamma:.4g}), eq. 5.100"))
     out["total_wall_time_s"] = time.perf_counter() - t0
-    out["failed_checks"] = ([f"closed loop on the {args.plant} plant diverged at t = {out['t_end_s']:.4g} s"]
-                            if out.get("failure") else [])
+    out["failed_checks"] = diverged([(args.plant, out)])
     return out
