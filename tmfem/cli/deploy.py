@@ -52,6 +52,16 @@ def configure(parser) -> None:
                              "eq. 5.19 and the COM); the SBC model has the cable law only; the "
                              "adaptive PFL's tendon model follows the plant's law (fixed rates under "
                              "uncertainty 'initial', eq. 5.72)")
+    parser.add_argument("--plant-bars", choices=["chord", "rigid"],
+                        help="how the SBC plant's state estimate measures the bar coordinates q "
+                             "(--plant or --compare-plant sbc): chord (the bar end nodes, "
+                             "default) or rigid (the rigid bars closest to the beam nodes in the "
+                             "kinetic-energy norm: the bending modes do not move them, "
+                             "docs/fe-plant.md)")
+    parser.add_argument("--plant-damping", type=positive_float, metavar="BETA",
+                        help="stiffness-proportional Rayleigh damping C = BETA K_0 [s] of the FE "
+                             "plant (--plant or --compare-plant mtc|sbc; default none: the "
+                             "undamped plant)")
     parser.add_argument("--compare-plant", choices=["com", "mtc", "sbc"],
                         help="run the same deployment on this plant too and compare (JSON "
                              "'compare': its figures and the deviation between the plants)")
@@ -89,6 +99,11 @@ def run(args) -> dict:
                          f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
+        given = [o for o, v in (("--plant-bars", args.plant_bars),
+                                ("--plant-damping", args.plant_damping)) if v is not None]
+        if given:
+            raise InputError(f"options {given} apply to the 7.4 deployments only, found the LPV "
+                             f"preset {args.preset}")
         return deploy_lpv.run(args)
     lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise") + deploy_lpv.SYNTHESIS)
     if lpv_opts:
@@ -141,7 +156,10 @@ def plant_options(args, plant: str, mesh_n) -> dict:
     if plant == "com":
         return {}
     return {"plant_mesh": mesh_n, **({"plant_tendons": args.plant_tendons or "cable"}
-                                     if plant == "mtc" else {})}
+                                     if plant == "mtc" else {}),
+            **({"plant_bars": getattr(args, "plant_bars", None) or "chord"}
+               if plant == "sbc" else {}),
+            "plant_damping_s": getattr(args, "plant_damping", None) or 0.0}
 
 
 def _run_on(args, s, plant_kind: str, mesh_n):
@@ -152,7 +170,9 @@ def _run_on(args, s, plant_kind: str, mesh_n):
     from tmfem.system.presets import load_preset
     plant = deployment_plant(plant_kind, s.model, load_preset(args.preset + "-initial"),
                              mesh_n=mesh_n or 10,
-                             tendon_law=args.plant_tendons if plant_kind == "mtc" else None)
+                             tendon_law=args.plant_tendons if plant_kind == "mtc" else None,
+                             bars=(args.plant_bars or "chord") if plant_kind == "sbc" else "chord",
+                             beta=(args.plant_damping or 0.0) if plant_kind != "com" else 0.0)
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
         return run_deployment(model=s.model, reference=s.reference, controller=s.controller,
                               z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,
@@ -183,8 +203,9 @@ def _compare(args, mesh_n, r, pfl_at: str, tendons: str) -> dict:
 
 
 def check_plant(args) -> int | None:
-    """The FE plants' options, checked before any work: ``--plant-mesh`` belongs to an FE
-    plant, ``--plant-tendons`` to an MTC plant (the SBC model has the cable law only); the
+    """The FE plants' options, checked before any work: ``--plant-mesh`` and
+    ``--plant-damping`` belong to an FE plant, ``--plant-tendons`` to an MTC plant (the SBC
+    model has the cable law only), ``--plant-bars`` to an SBC plant; the
     MTC model has no nodes along the bars, so no 1-N(D) system; ``--compare-plant`` differs
     from ``--plant`` and ``--compare-plot``/``--compare-csv`` need it; the mesh within the
     machine's budget. Returns the plant mesh (None without an FE plant)."""
@@ -199,13 +220,19 @@ def check_plant(args) -> int | None:
         raise InputError(f"--compare-plant: expected a plant other than --plant {args.plant}, "
                          f"found {args.compare_plant}")
     fe = [p for p in plants if p != "com"]
+    if args.plant_bars is not None and "sbc" not in fe:
+        raise InputError(f"--plant-bars belongs to an SBC plant (beam bars with nodes along them; "
+                         f"the MTC bars are straight trusses), expected --plant sbc or "
+                         f"--compare-plant sbc, found --plant-bars {args.plant_bars} with "
+                         f"{' and '.join(plants)}")
     if not fe:
         for opt, val, fe_kinds in (("--plant-mesh", args.plant_mesh, "mtc|sbc"),
-                                   ("--plant-tendons", args.plant_tendons, "mtc")):
+                                   ("--plant-tendons", args.plant_tendons, "mtc"),
+                                   ("--plant-damping", args.plant_damping, "mtc|sbc")):
             if val is not None:
                 raise InputError(f"{opt} belongs to --plant {fe_kinds} or --compare-plant "
-                                 f"{fe_kinds} (the COM plant has neither a membrane mesh nor FE "
-                                 f"tendons), found {opt} {val} with --plant com")
+                                 f"{fe_kinds} (the COM plant has no membrane mesh, FE tendons or FE "
+                                 f"damping), found {opt} {val} with --plant com")
         return None
     if args.plant_tendons is not None and "mtc" not in fe:
         raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "

@@ -45,6 +45,17 @@ B(x) u (eq. 5.19) with the rates k = EA / u_0 of the final rest lengths. For a p
 tendons keep their EA while their rest length changes (k = EA / u, eq. 3.9; the MTC plant's
 ``"cable"`` law) the tendon force T = EA (|d| / u - 1) is affine in w = 1/u, and eq. 5.46 is
 solved for w with B_q' = -B_q diag(u_0 |d|) (:meth:`AdaptivePFL._cable`).
+
+Damped feedback inversion (``feedback_damping`` = mu > 0, our option): the bracket of
+eq. 5.58 splits into the feedforward v_ff = -F_q - W_F^T Phi_F - q_d'' (its value at
+e = e' = 0) and the feedback v_fb = D_q e' + K_q e; the rest lengths are
+u = B_q^-1 v_ff + du with du the damped least-squares solution of B_q du = v_fb (Tikhonov
+factor mu s_1 in the metric of M_q, :func:`tmfem.control.pfl.bounded_inversion`; the limits
+on u + du). The COM's B_q of a 1-N(D) system is ill-conditioned (1-4(D): condition number
+~220): in its weak directions -- combinations of SL and SU whose bar accelerations almost
+cancel on the rigid bars -- eq. 5.46 commands large tendon-force changes that an elastic
+structure answers differently (docs/fe-plant.md); the damping leaves the strong
+directions inverted and bounds the gain of the weak ones at 1 / (2 mu s_1).
 """
 from __future__ import annotations
 
@@ -111,6 +122,11 @@ class AdaptivePFL:
         The controller's tendon model (module docstring): the model's rates k = EA / u_0
         (eq. 5.19, the COM) or k = EA / u (eq. 3.9 at the commanded rest length, a cable of
         fixed EA), for which eq. 5.46 is solved in 1/u.
+    feedback_damping : float
+        mu >= 0 (module docstring, "Damped feedback inversion"): 0 inverts eq. 5.58 as
+        printed; mu > 0 inverts the feedforward part exactly and the feedback part
+        D_q e' + K_q e by the damped least squares of
+        :func:`tmfem.control.pfl.bounded_inversion`.
     """
 
     name = "adaptive-pfl"
@@ -119,7 +135,10 @@ class AdaptivePFL:
                  gamma: float = 0.01, alpha: float = 1.0, beta: float = 1.0,
                  uncertainty: str = "initial", z_initial=None, allocation: str = "bounded",
                  r_min: float = 1e-3, cond_every: int = 10, evaluation: str = "state",
-                 tendon_law: str = "fixed-rate"):
+                 tendon_law: str = "fixed-rate", feedback_damping: float = 0.0):
+        if not (np.isfinite(feedback_damping) and feedback_damping >= 0):
+            raise InputError(f"feedback_damping: expected a number >= 0, found {feedback_damping!r}")
+        self.feedback_damping = float(feedback_damping)
         if tendon_law not in TENDON_LAWS:
             raise InputError(f"tendon_law: expected one of {TENDON_LAWS}, found {tendon_law!r}")
         if tendon_law == "cable" and uncertainty == "initial":
@@ -213,18 +232,25 @@ class AdaptivePFL:
         d_q, k_q = self.gains(t)
         W = xc.reshape(self.rbf.m, nq, order="F")
         phi = self.rbf(np.concatenate([q, qd]))
-        v = -F_q - W.T @ phi - qdd_d + d_q * ed + k_q * e
+        v_fb = d_q * ed + k_q * e
+        v = -F_q - W.T @ phi - qdd_d + v_fb
         L = tendon_lengths(self.model.system, q).copy()
         if self.tendon_law == "cable":
             terms, v, lower, upper = self._cable(exact, v, q_model, L)
         else:
             terms, lower, upper = exact, self.r_min, L
+        # the feedforward (v at e = e' = 0) inverted exactly, the feedback part damped
+        u_ff = np.linalg.solve(terms.B_q, v - v_fb) if self.feedback_damping else 0.0
+        v_inv = v_fb if self.feedback_damping else v
         if self.allocation == "bounded":
-            u, active = bounded_inversion(terms, v, lower=lower, upper=upper)
+            u, active = bounded_inversion(terms, v_inv, lower=lower - u_ff, upper=upper - u_ff,
+                                          damping=self.feedback_damping)
             if active:
                 self.allocation_active.append(float(t))
         else:
-            u = np.linalg.solve(terms.B_q, v)
+            u = bounded_inversion(terms, v_inv, lower=-np.inf, upper=np.inf,
+                                  damping=self.feedback_damping)[0]
+        u = u + u_ff
         if self.tendon_law == "cable":
             u = 1.0 / u
         Y = -self.gamma * np.outer(phi, self.alpha * e + self.beta * ed)        # eq. 5.51

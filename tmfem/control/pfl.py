@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.errors import SingularInputMatrix
+from tmfem.errors import InputError, SingularInputMatrix
 
 #: condition number of B_q above which eq. 5.46 is refused
 COND_LIMIT = 1e10
@@ -82,7 +82,8 @@ def check_input_matrix(B_q, *, where: str = "", cond_limit: float = COND_LIMIT) 
     return c
 
 
-def bounded_inversion(terms: PFLTerms, v, *, lower, upper) -> tuple[np.ndarray, bool]:
+def bounded_inversion(terms: PFLTerms, v, *, lower, upper,
+                      damping: float = 0.0) -> tuple[np.ndarray, bool]:
     """Rest lengths u with B_q u = v (eq. 5.46, ``v`` = the bracket of eq. 5.58) inside the
     limits [lower, upper]; where the exact solution leaves them, the admissible u whose
     acceleration q'' = -F_q* - B_q u is closest to the commanded one in the kinetic-energy
@@ -94,16 +95,36 @@ def bounded_inversion(terms: PFLTerms, v, *, lower, upper) -> tuple[np.ndarray, 
     M_q = R^T R). Clipping each rest length instead would leave the other tendons
     compensating a force the clipped one does not give.
 
+    ``damping`` = mu > 0 replaces the inverse by the damped least-squares one (Tikhonov),
+
+        min_u |R (B_q u - v)|^2 + (mu s_1)^2 |u|^2,   s_1 the largest singular value of R B_q,
+
+    u = sum_i s_i / (s_i^2 + mu^2 s_1^2) (U_i^T R v) V_i with R B_q = U S V^T: directions of
+    R B_q with s_i >> mu s_1 are inverted as before, weaker ones (which eq. 5.46 amplifies by
+    1 / s_i) are not driven beyond gain 1 / (2 mu s_1).
+
     Returns
     -------
     u : ndarray
     active : bool
         True when the limits changed the solution of eq. 5.46.
     """
-    u = np.linalg.solve(terms.B_q, v)
+    if damping < 0:
+        raise InputError(f"inversion damping: expected >= 0, found {damping!r}")
+    R = np.linalg.cholesky(0.5 * (terms.M_q + terms.M_q.T)).T if damping else None
+    if damping:
+        U, s, Vt = np.linalg.svd(R @ terms.B_q)
+        lam = damping * s[0]
+        u = Vt.T @ (s / (s**2 + lam**2) * (U.T @ (R @ v)))
+    else:
+        u = np.linalg.solve(terms.B_q, v)
     if np.all(u >= lower) and np.all(u <= upper):
         return u, False
     from scipy.optimize import lsq_linear
-    R = np.linalg.cholesky(0.5 * (terms.M_q + terms.M_q.T)).T
-    sol = lsq_linear(R @ terms.B_q, R @ v, bounds=(lower, upper), method="bvls")
+    R = np.linalg.cholesky(0.5 * (terms.M_q + terms.M_q.T)).T if R is None else R
+    A, b = R @ terms.B_q, R @ v
+    if damping:
+        A = np.vstack([A, lam * np.eye(A.shape[1])])
+        b = np.concatenate([b, np.zeros(A.shape[1])])
+    sol = lsq_linear(A, b, bounds=(lower, upper), method="bvls")
     return np.clip(sol.x, lower, upper), True

@@ -8,7 +8,10 @@ FE state as sensors would give it:
 
 * q from the bar end nodes (eqs. 3.1-3.2, :func:`tmfem.models.mtc.post.q_from_positions`; the
   SBC bars are beams whose chords A_ij-B_ij give q, their bending and the rotations of their
-  nodes do not enter);
+  nodes do not enter), or (``bars="rigid"``, SBC plant) from the rigid placement of each bar
+  closest to its beam-chain nodes in the kinetic-energy norm (:func:`rigid_bar_fit`): the
+  bar's rigid-body coordinates, which the bending modes (mass-orthogonal to them) do not
+  move;
 * eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
   nodes (the SBC shell's mid-surface nodes) are taken into the floating frame of the current
   corners (eq. 3.3), interpolated at the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
@@ -42,10 +45,55 @@ from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
 from tmfem.models.mtc.post import member_state, q_from_positions
 from tmfem.models.mtc.topology import to_floating
-from tmfem.system.coordinates import q_index
+from tmfem.system.coordinates import join_q, q_index
+from tmfem.system.geometry import wrap_angle
 
 #: displacement step [m] of the central difference along the FE velocity (module docstring)
 RATE_STEP = 1e-5
+#: how the estimate measures the bar coordinates q (:class:`COMStateEstimator`)
+BAR_MEASURES = ("chord", "rigid")
+
+
+def rigid_bar_fit(system, X: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """q (eqs. 3.1-3.2) of the rigid bars closest to the chain-node positions X (3, n_bars,
+    n_chain) of elastic bars in the kinetic-energy norm of their translations.
+
+    Node i of a bar sits at the fraction s_i of the bar in the reference (A_ij at 0, B_ij at
+    1) and carries the lumped mass m_i of a uniform bar (trapezoidal weights of the chain
+    spacing). A rigid bar places it at a + s_i l b (unit b); minimising
+    sum_i m_i |x_i - a - s_i l b|^2 gives
+
+    * a bar on a fixed base A (stage 1, a = A): b ~ sum_i m_i s_i (x_i - A),
+    * a bar of free base: b ~ sum_i m_i (s_i - s_m)(x_i - c), l = |sum_i m_i (s_i - s_m)
+      (x_i - c)| / sum_i m_i (s_i - s_m)^2, a = c - s_m l b, with c and s_m the mass-weighted
+      means of x_i and s_i,
+
+    and theta = arccos(b_z), psi = atan2(b_y, b_x) (3.2). These are the coordinates of the
+    bar's rigid-body modes: the bending modes are mass-orthogonal to them, so a force at an
+    interior node (H_1j) moves them at once as it turns a rigid bar, where the chord A-B
+    moves only as the bending reaches the ends (docs/fe-plant.md). Straight bars give the
+    chord."""
+    s = np.asarray(s, dtype=float)
+    m = np.zeros_like(s)
+    m[:-1] += 0.5 * np.diff(s)
+    m[1:] += 0.5 * np.diff(s)
+    M, N = system.M, system.N
+    a = X[:, :, 0].copy()
+    fixed = np.arange(M * N) < N                      # stage-1 bars: A_1j on the base
+    b = np.einsum("c,knc->kn", m * s, X - a[:, :, None])
+    if not np.all(fixed):
+        sm = np.sum(m * s) / np.sum(m)
+        c = np.einsum("c,knc->kn", m, X) / np.sum(m)
+        bf = np.einsum("c,knc->kn", m * (s - sm), X - c[:, :, None])
+        length = np.linalg.norm(bf, axis=0) / np.sum(m * (s - sm) ** 2)
+        free = ~fixed
+        b[:, free] = bf[:, free]
+        a[:, free] = (c - sm * length * bf / np.linalg.norm(bf, axis=0))[:, free]
+    A = a.reshape(3, M, N)
+    bn = b / np.linalg.norm(b, axis=0)
+    theta = np.arccos(np.clip(bn[2], -1.0, 1.0)).reshape(M, N)
+    psi = wrap_angle(np.arctan2(bn[1], bn[0])).reshape(M, N)
+    return join_q(A, theta, psi)
 
 
 def _probe(skmesh, p: np.ndarray):
@@ -69,9 +117,20 @@ class COMStateEstimator:
     dyn : FEPlant
         The FE plant: ``positions(x)`` gives the node positions of a free-DOF state in the
         numbering of its MTC model ``dyn.mtc`` (membrane, system labels, tendon internals).
+    bars : {"chord", "rigid"}
+        q from the bar end nodes, or from the rigid fit of the bar's chain nodes
+        (:func:`rigid_bar_fit`; a plant with nodes along its bars, ``dyn.bar_chain_positions``:
+        the SBC model).
     """
 
-    def __init__(self, com, dyn):
+    def __init__(self, com, dyn, *, bars: str = "chord"):
+        if bars not in BAR_MEASURES:
+            raise InputError(f"bar measurement: expected one of {BAR_MEASURES}, found {bars!r}")
+        if bars == "rigid" and not hasattr(dyn, "bar_chain_positions"):
+            raise InputError(f"bar measurement 'rigid': expected an FE plant with nodes along "
+                             f"its bars (the SBC model), found the {dyn.name} plant, whose bars "
+                             f"are straight trusses (their chord is their rigid fit)")
+        self.bars = bars
         fe = dyn.mtc
         if fe.system is not com.system:
             raise InputError("FE plant: expected the FE model and the control-oriented model of "
@@ -92,7 +151,10 @@ class COMStateEstimator:
     def modal(self, x) -> np.ndarray:
         """[q, eta] (modal coordinates) of the free-DOF FE positions x."""
         xf = self.dyn.positions(x)
-        q = q_from_positions(self.com.system, xf[:, self._system_node])
+        if self.bars == "rigid":
+            q = rigid_bar_fit(self.com.system, *self.dyn.bar_chain_positions(x))
+        else:
+            q = q_from_positions(self.com.system, xf[:, self._system_node])
         xm = xf[:, :self._n_mesh]
         r = to_floating((self._I @ xm.T).T, xm[:, self._corners])
         delta = self.com.zeta(q)[:self._nd]
@@ -124,10 +186,12 @@ class FEStatePlant:
     com : ControlOrientedModel
     x0, v0 : ndarray, optional
         Start state (free DOFs); default the plant's own (its equilibrium and perturbation).
+    bars : {"chord", "rigid"}
+        How the estimate measures q (:class:`COMStateEstimator`).
     """
 
-    def __init__(self, dyn, com, *, x0=None, v0=None):
-        self.dyn, self.estimator = dyn, COMStateEstimator(com, dyn)
+    def __init__(self, dyn, com, *, x0=None, v0=None, bars: str = "chord"):
+        self.dyn, self.estimator = dyn, COMStateEstimator(com, dyn, bars=bars)
         self.input_names = list(dyn.input_names)
         if self.input_names != list(com.input_names):
             raise InputError(f"FE plant: expected the COM's inputs {com.input_names}, found "
@@ -256,7 +320,7 @@ def start_rest_lengths(initial, tendon_law: str, nominal) -> np.ndarray:
 
 
 def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
-                         tendon_law: str = "cable") -> FEStatePlant:
+                         tendon_law: str = "cable", beta: float = 0.0) -> FEStatePlant:
     """The MTC model of the COM's system (its rest lengths, N x mesh_n x mesh_n membrane,
     ``tendon_elements`` trusses per tendon, the tendon law of :class:`MTCModel`) as the plant
     of a deployment, its sensors at the COM's output points.
@@ -265,12 +329,13 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     placement of the COM configuration of ``initial`` (:func:`com_positions`, bars at its q, eta
     = 0) the FE statics are solved under :func:`start_rest_lengths` -- the bars take their
     axial strain, the membrane and tendons their FE shapes -- so that the run starts without
-    the transient of an FE state out of equilibrium."""
+    the transient of an FE state out of equilibrium. ``beta``: stiffness-proportional
+    Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe_plant.FEPlant`)."""
     from tmfem.models.mtc.dynamics import MTCDynamics
     from tmfem.models.mtc.model import MTCModel
     fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                   rest_lengths=com.u0, tendon_law=tendon_law)
-    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points)
+    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points, beta=beta)
     fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
     st = fe.solve_static(x0=com_positions(com, fe, packaged_state(com, initial)))
     fe.set_tendon_lengths(com.u0)
@@ -278,7 +343,8 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
 
 
 def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
-                         bar_elements: int = 1) -> FEStatePlant:
+                         bar_elements: int = 1, bars: str = "chord",
+                         beta: float = 0.0) -> FEStatePlant:
     """The SBC model of the COM's system (MITC4 shell membrane, four-node beam bars -- with
     H_1j a node of the bar for a 1-N(D) system --, tension-only tendons of the cable law
     k = EA / r, its sensors at the COM's output points) as the plant of a deployment.
@@ -291,7 +357,11 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     design's rest lengths (:func:`start_rest_lengths`, ``"cable"``), mapped onto the SBC
     unknowns (:meth:`SBCModel.state_from_mtc`: shell directors on the membrane normals, bar
     triads turned with the chords) and Newton's method finishes on the SBC model, whose bars
-    then bend under the tendons at H_1j."""
+    then bend under the tendons at H_1j. ``bars``: how the estimate measures q (the bar
+    chords or their rigid fit, :class:`COMStateEstimator`); ``beta``: stiffness-proportional
+    Rayleigh damping C = beta K_0 (K_0 at that equilibrium; docs/fe-plant.md: without it the
+    undamped SBC plant's Park integration diverges during the 1-4(D) deployment even under
+    the COM run's smooth rest lengths)."""
     from tmfem.models.sbc.dynamics import SBCDynamics
     from tmfem.models.sbc.model import SBCModel
     sbc = SBCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
@@ -301,8 +371,8 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     pre = mtc.solve_static(x0=com_positions(com, mtc, packaged_state(com, initial)))
     st = sbc.solve_static(start=sbc.state_from_mtc(pre.x))
     sbc.set_tendon_lengths(com.u0)
-    dyn = SBCDynamics(sbc, st.state, output_points=com.output_points)
-    return FEStatePlant(dyn, com)
+    dyn = SBCDynamics(sbc, st.state, output_points=com.output_points, beta=beta)
+    return FEStatePlant(dyn, com, bars=bars)
 
 
 #: the plants a deployment can run on: the COM it is designed on and the two FE models
@@ -310,19 +380,27 @@ PLANTS = ("com", "mtc", "sbc")
 
 
 def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
-                     tendon_law: str | None = None):
+                     tendon_law: str | None = None, bars: str = "chord", beta: float = 0.0):
     """The plant ``kind`` of a deployment of the COM's system from the packaged design
     ``initial``: None for ``"com"`` (:func:`tmfem.control.deploy.run_deployment` builds the
     COM plant), :func:`mtc_deployment_plant` (``tendon_law`` default ``"cable"``) or
     :func:`sbc_deployment_plant` (the SBC model has the cable law only: ``"fixed-rate"`` is
-    refused)."""
+    refused; ``bars``: its bar measurement, ``"rigid"`` refused on the other plants);
+    ``beta``: the FE plant's Rayleigh damping C = beta K_0 (refused for the COM)."""
     if kind not in PLANTS:
         raise InputError(f"plant: expected one of {list(PLANTS)}, found {kind!r}")
+    if bars != "chord" and kind != "sbc":
+        raise InputError(f"bar measurement {bars!r}: expected the SBC plant (beam bars with "
+                         f"nodes along them), found the {kind} plant")
+    if beta and kind == "com":
+        raise InputError(f"plant damping beta = {beta}: expected an FE plant (mtc, sbc), found "
+                         "the COM plant (its damping is the design model's)")
     if kind == "com":
         return None
     if kind == "sbc":
         if tendon_law not in (None, "cable"):
             raise InputError(f"SBC plant tendons: the SBC model has the cable law only (EA fixed, "
                              f"k = EA / r); expected 'cable', found {tendon_law!r}")
-        return sbc_deployment_plant(com, initial, mesh_n=mesh_n)
-    return mtc_deployment_plant(com, initial, mesh_n=mesh_n, tendon_law=tendon_law or "cable")
+        return sbc_deployment_plant(com, initial, mesh_n=mesh_n, bars=bars, beta=beta)
+    return mtc_deployment_plant(com, initial, mesh_n=mesh_n, tendon_law=tendon_law or "cable",
+                                beta=beta)

@@ -136,6 +136,16 @@ class SBCDynamics(FEPlant):
         d = self.constraints.full(self._reduced(u))
         return self.state_eq.x[:, :self._n_mtc] + d[self._tr].T
 
+    def bar_chain_positions(self, u) -> tuple[np.ndarray, np.ndarray]:
+        """Positions (3, n_bars, n_chain) of every bar's beam-chain nodes, A_ij first and
+        B_ij last (H_1j among them for a 1-N(D) system), at the free-dof state u, and their
+        reference fractions s along the bar (``numbering.chain_s``)."""
+        ch = self.model.numbering.bar_chain
+        d = self.constraints.full(self._reduced(u))
+        tr = self.dofmap.translation_dofs(ch.ravel())                          # (n, 3)
+        x = self.state_eq.x[:, ch.ravel()] + d[tr].T
+        return x.reshape(3, *ch.shape), self.model.numbering.chain_s
+
     def strain_energy(self, u) -> float:
         """Strain energy [J] of shells, beams and tendons (:meth:`SBCModel.energy`)."""
         return self.model.energy(self.configuration(u))

@@ -1,0 +1,103 @@
+"""The 1-4(D) deployment (7.4, adaptive PFL without the switch, dt = 0.01 s) on the SBC plant:
+the experiments of docs/fe-plant.md, "What was tried". Prints one line per experiment.
+
+    .venv/bin/python demos/sbc_1_4d_diagnosis.py [--mesh 4] [--t-end 3] [--only response,open-loop,closed]
+
+``response``: psi_11 after a 1 mm step of the four SL rest lengths, COM and the SBC measured
+at the chords and by the rigid fit of the bars. ``open-loop``: the rest lengths of the COM's
+own closed-loop run (uncertainty ``exact``) applied to the SBC plant, undamped and with
+Rayleigh damping. ``closed``: the closed loop for combinations of the uncertainty model, the
+bar measurement, the PFL's feedback damping mu and the plant damping beta: where it stopped,
+its largest bar error, its deviation from the COM run of the same controller, the smallest
+rest-length margin and the tendon forces of SL_1, SU_1 at the end of the record.
+"""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from tmfem.control.deploy import StatePlant, run_deployment
+from tmfem.control.state_estimate import FEStatePlant, sbc_deployment_plant, start_rest_lengths
+from tmfem.reference.deployments import setup
+from tmfem.simulation.controllers import OpenLoop
+from tmfem.simulation.driver import simulate
+from tmfem.system import load_preset
+
+INITIAL = load_preset("1-4D-initial")
+#: (uncertainty, bars, feedback damping mu, plant damping beta [s]); the PFL at the reference
+CLOSED = [("initial", "chord", 0.0, 0.0), ("initial", "rigid", 0.0, 0.0),
+          ("initial", "rigid", 0.0, 1e-3), ("initial", "rigid", 1 / 30, 0.0),
+          ("exact", "rigid", 0.0, 0.0), ("exact", "rigid", 1 / 30, 0.0),
+          ("exact", "rigid", 1 / 30, 1e-3)]
+
+
+def response(mesh):
+    s = setup("1-4D", controller="adaptive")
+    r0 = start_rest_lengths(INITIAL, "cable", s.model.u0)
+    sbc = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh)
+    u = r0.copy()
+    u[:4] += 1e-3
+    for name, p in (("COM", StatePlant(s.model, z0=s.z0)), ("SBC chord", sbc),
+                    ("SBC rigid", FEStatePlant(sbc.dyn, s.model, bars="rigid"))):
+        d = [simulate(p, t_end=0.1, dt=0.01, controller=c, jacobian="step").y[:, 1]
+             for c in (r0, u)]
+        print(f"response {name:10s} psi_11 at 10, 20, 50, 100 ms [mrad]:",
+              np.round(1e3 * (d[1] - d[0])[[1, 2, 5, 10]], 3), flush=True)
+
+
+def open_loop(mesh, t_end):
+    s = setup("1-4D", controller="adaptive", uncertainty="exact")
+    U = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+                       t_end=t_end).u
+    for beta in (0.0, 1e-4, 1e-3):
+        p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, beta=beta)
+        r = run_deployment(model=s.model, reference=s.reference, partial=True, plant=p,
+                           controller=OpenLoop(lambda t: U[min(int(t / 0.01 + 1e-9), len(U) - 1)]),
+                           z0=s.z0, t_end=t_end, jacobian="step")
+        print(f"open-loop COM inputs, beta = {beta:g} s: reached {r.t[-1]:.2f} s, min tendon force "
+              f"{r.plant_report['min_tendon_force_N']:.2f} N, failure: {r.failure}", flush=True)
+
+
+def closed(mesh, t_end):
+    for unc, bars, mu, beta in CLOSED:
+        runs = []
+        for plant in ("sbc", "com"):
+            s = setup("1-4D", controller="adaptive", uncertainty=unc, evaluation="reference")
+            s.adaptive.feedback_damping = mu
+            p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, bars=bars, beta=beta) \
+                if plant == "sbc" else None
+            runs.append(run_deployment(model=s.model, reference=s.reference, controller=s.controller,
+                                       z0=s.z0, t_end=t_end, plant=p, partial=True,
+                                       jacobian="step" if p else "reuse"))
+        r, rc = runs
+        n, nq = r.t.size, s.model.nq
+        err = np.max(np.abs(r.z[:, :nq] - r.q_d))
+        dev = np.max(np.abs(r.z[:, :nq] - rc.z[:n, :nq]), axis=1)
+        k = s.model.k
+        T = k * (r.lengths[-1] - r.u[-1])
+        print(f"closed {unc:7s} bars={bars:5s} mu={mu:.3g} beta={beta:g}: reached {r.t[-1]:.2f} s, "
+              f"bar error max {1e3 * err:.2f} mrad (COM {1e3 * np.max(np.abs(rc.z[:n, :nq] - rc.q_d[:n])):.2f}), "
+              f"deviation from COM max {1e3 * dev.max():.2f} mrad at {r.t[np.argmax(dev)]:.2f} s, "
+              f"margin {1e3 * r.min_margin:.2f} mm, model tendon forces SL_1, SU_1 at the end "
+              f"{T[0]:.2f}, {T[4]:.2f} N (COM run {(k * (rc.lengths[n - 1] - rc.u[n - 1]))[[0, 4]].round(2)})",
+              flush=True)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--mesh", type=int, default=4)
+    ap.add_argument("--t-end", type=float, default=3.0)
+    ap.add_argument("--only", default="response,open-loop,closed")
+    a = ap.parse_args()
+    only = a.only.split(",")
+    if "response" in only:
+        response(a.mesh)
+    if "open-loop" in only:
+        open_loop(a.mesh, a.t_end)
+    if "closed" in only:
+        closed(a.mesh, a.t_end)
+
+
+if __name__ == "__main__":
+    main()
