@@ -110,7 +110,7 @@ def test_bar_measurement_and_damping_refused_where_they_do_not_apply(dep, capsys
                          (["--preset", "2-3-deploy", "--plant", "mtc", "--plant-bars", "rigid"],
                           "belongs to an SBC plant"),
                          (["--preset", "1-4D", "--plant-damping", "1e-3"], "--plant-damping belongs"),
-                         (["--preset", "2-3-lpv", "--plant-bars", "rigid"], "7.4 deployments only")):
+                         (["--preset", "2-3-lpv", "--plant-bars", "rigid"], "belongs to an SBC plant")):
         assert main(["deploy", *argv, "--t-end", "0.05"]) == 2
         assert needle in capsys.readouterr().err
 

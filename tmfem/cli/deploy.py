@@ -99,11 +99,6 @@ def run(args) -> dict:
                          f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
-        given = [o for o, v in (("--plant-bars", args.plant_bars),
-                                ("--plant-damping", args.plant_damping)) if v is not None]
-        if given:
-            raise InputError(f"options {given} apply to the 7.4 deployments only, found the LPV "
-                             f"preset {args.preset}")
         return deploy_lpv.run(args)
     lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise") + deploy_lpv.SYNTHESIS)
     if lpv_opts:
@@ -162,6 +157,14 @@ def plant_options(args, plant: str, mesh_n) -> dict:
             "plant_damping_s": getattr(args, "plant_damping", None) or 0.0}
 
 
+def plant_arguments(args, plant: str) -> dict:
+    """The FE plant's options of a run on ``plant`` as the keyword arguments of
+    :func:`tmfem.control.state_estimate.deployment_plant` (both deployment kinds)."""
+    return {"tendon_law": args.plant_tendons if plant == "mtc" else None,
+            "bars": (args.plant_bars or "chord") if plant == "sbc" else "chord",
+            "beta": (args.plant_damping or 0.0) if plant != "com" else 0.0}
+
+
 def _run_on(args, s, plant_kind: str, mesh_n):
     """The deployment of set-up ``s`` on ``plant_kind``; an FE-plant run that diverges returns
     its record up to the failure (``failure``)."""
@@ -169,10 +172,7 @@ def _run_on(args, s, plant_kind: str, mesh_n):
     from tmfem.control.state_estimate import deployment_plant
     from tmfem.system.presets import load_preset
     plant = deployment_plant(plant_kind, s.model, load_preset(args.preset + "-initial"),
-                             mesh_n=mesh_n or 10,
-                             tendon_law=args.plant_tendons if plant_kind == "mtc" else None,
-                             bars=(args.plant_bars or "chord") if plant_kind == "sbc" else "chord",
-                             beta=(args.plant_damping or 0.0) if plant_kind != "com" else 0.0)
+                             mesh_n=mesh_n or 10, **plant_arguments(args, plant_kind))
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
         return run_deployment(model=s.model, reference=s.reference, controller=s.controller,
                               z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,

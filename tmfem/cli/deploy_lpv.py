@@ -154,9 +154,10 @@ def run(args) -> dict:
     if args.plant != "com":
         # the FE plant starts in its own equilibrium of the packaged configuration under the
         # rest lengths the controller starts with (docs/fe-plant.md)
+        from tmfem.cli.deploy import plant_arguments
         from tmfem.control.state_estimate import deployment_plant
         fe = deployment_plant(args.plant, s.model, dep.packaged(), mesh_n=mesh_n,
-                              tendon_law=args.plant_tendons)
+                              **plant_arguments(args, args.plant))
     from tmfem.cli.deploy import diverged, plant_options
     info.update(plant_options(args, args.plant, mesh_n))
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller}) on {args.plant}") as bar:

@@ -150,18 +150,19 @@ LPV_DEPLOYMENTS = {
 LPV_CONTROLLERS = ("lpv", "lpv-output")
 
 
-def lpv_setup(preset: str, plant, *, model_at: str = "final"):
+def lpv_setup(preset: str, plant, *, model_at: str = "final", system=None):
     """The deployment of 8.4 of ``preset`` for the design plant ``plant`` (its grid built with
     :func:`tmfem.reference.tables.deployment_bases`, as ``tmfem control lpv``):
     :func:`tmfem.control.lpv_deploy.lpv_deployment` with the parameters of
-    :data:`LPV_DEPLOYMENTS`."""
+    :data:`LPV_DEPLOYMENTS`; ``system``: the System deployed, default the preset's (another
+    one, e.g. with stiffer bars, for a perturbation study of an FE plant)."""
     from tmfem.control.lpv_deploy import lpv_deployment
     from tmfem.reference.tables import deployment_bases
     from tmfem.system.presets import load_preset
     if preset not in LPV_DEPLOYMENTS:
         raise InputError(f"LPV deployment: expected a preset among {sorted(LPV_DEPLOYMENTS)}, found {preset!r}")
     p = LPV_DEPLOYMENTS[preset]
-    s = load_preset(preset)
+    s = load_preset(preset) if system is None else system
     pr = s.printed
     return lpv_deployment(s, plant, theta_0=np.radians(pr["theta0_deg"]), theta_e=np.radians(pr["theta_e_deg"]),
                           psi_0=np.radians(pr["psi0_deg"]), omega_r=p["omega_r"], bases=deployment_bases(s),
