@@ -6,6 +6,13 @@ square grid, lambda_ij = (4 / h^2) (sin^2(i pi h / 2) + sin^2(j pi h / 2)), h = 
 (repeated for i != j: the pairs of a symmetric structure); LAPACK's dense eigh; SLEPc's
 Krylov-Schur on the same model.
 """
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.linalg as la
@@ -14,6 +21,8 @@ import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.block_krylov import block_krylov_schur, start_block
+
+ROOT = Path(__file__).resolve().parents[1]
 
 try:
     import petsc4py  # noqa: F401
@@ -98,10 +107,35 @@ def test_petsc_block_and_slepc_agree_on_the_mtc_modes():
 
 
 @needs_petsc
-def test_slepc_options_need_the_slepc_solver():
+def test_slepc_options_choose_slepc_and_are_refused_by_the_block_solver():
     from tmfem.solvers.petsc import PetscBackend
+    assert PetscBackend().eig_solver == "block"                  # one rank
+    assert PetscBackend(options="-eps_ncv 40").eig_solver == "slepc"
     with pytest.raises(InputError, match="expected eig_solver='slepc'"):
-        PetscBackend(options="-eps_ncv 40")
-    assert PetscBackend(options="-eps_ncv 40", eig_solver="slepc").eig_solver == "slepc"
-    with pytest.raises(InputError, match="expected eig_solver 'block' or 'slepc'"):
+        PetscBackend(options="-eps_ncv 40", eig_solver="block")
+    with pytest.raises(InputError, match="expected eig_solver 'auto', 'block' or 'slepc'"):
         PetscBackend(eig_solver="arpack")
+
+
+MPIEXEC = shutil.which("mpiexec")
+
+
+@pytest.mark.skipif(not (HAVE_PETSC and MPIEXEC), reason="petsc4py or mpiexec missing")
+def test_block_solver_under_two_ranks_agrees_with_scipy():
+    # source: the scipy model's 12 modes at its own equilibrium from the design; under 2
+    # ranks the default is SLEPc, the block solver is asked for (rows of the basis
+    # distributed, inner products summed over the ranks)
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
+    cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable,
+           str(ROOT / "tests" / "mpi" / "fe_distributed.py"), "1-4", "6", "--start", "design",
+           "--eig-solver", "block"]
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=120, cwd=ROOT, env=env)
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip())
+    m = MTCModel(load_preset("1-4"), mesh_n=6)
+    assert m.free.sum() >= 400                                   # the block solver's size
+    ref = m.modes(m.solve_static(start="design").x, k=12)
+    assert np.allclose(run["omega2"], ref.omega2, rtol=2e-8, atol=0)
