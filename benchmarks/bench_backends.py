@@ -155,7 +155,8 @@ def launch(mesh: int, config: str, args) -> dict:
     cmd = [sys.executable, HERE, "--run", str(mesh), config, "--rest-length", str(args.rest_length),
            "--sequence", str(args.sequence)]
     if config == "petsc2":
-        cmd = [shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"] + cmd
+        cmd = ([shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"]
+               + (["--mca", "mpi_yield_when_idle", "1"] if args.mpi_yield else []) + cmd)
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
         return dict(config=config, mesh=f"4x{mesh}x{mesh}", error=p.stderr.strip().splitlines()[-1:])
@@ -169,6 +170,9 @@ def main(argv=None) -> int:
     ap.add_argument("--rest-length", type=float, default=1.5025,
                     help="rest length of the S tendons [m] (the value Tables 6.3/6.6 imply)")
     ap.add_argument("--sequence", type=int, default=10, help="coarsest mesh of the mesh sequencing")
+    ap.add_argument("--mpi-yield", action="store_true",
+                    help="petsc2: Open MPI's waiting ranks yield the core (--mca mpi_yield_when_idle 1) "
+                         "instead of busy-waiting")
     ap.add_argument("--run", nargs=2, metavar=("MESH", "CONFIG"), help=argparse.SUPPRESS)
     ap.add_argument("--json", action="store_true", help="one JSON document of all rows")
     args = ap.parse_args(argv)
