@@ -17,6 +17,8 @@ ranks), first frequency. A second table splits rank 0's static time by phase
 (:class:`PhaseTimer`: element kernels and assembly, pattern set-up, interpolation, model
 builds, factorisations, solves, the rest: trust-region algebra, MPI waits).
 OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
+--mpi-yield: petsc2's waiting ranks yield the core (Open MPI ``--mca mpi_yield_when_idle 1``;
+helps on a loaded machine: busy-waiting takes the core from the working rank and other jobs).
 Targets (issue 11, 2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
 scipy time of 4x80x80; 1.2 M DOF < 5 min and < 16 GB.
 """
@@ -187,7 +189,11 @@ def main(argv=None) -> int:
     rows = []
     if not args.json:
         print(f"# 1-4 MTC, static from the undeformed membrane + 12 modes; {os.cpu_count()} cpus, "
-              f"load average {os.getloadavg()[0]:.2f}")
+              f"load average {os.getloadavg()[0]:.2f} (wall times grow with it; CPU s is rank 0's)")
+        print("# eigen: scipy ARPACK shift-invert; petsc (1 rank) the block Krylov-Schur on MUMPS "
+              "solves of 8 right-hand sides; petsc2 SLEPc Krylov-Schur (PetscBackend "
+              "eig_solver='auto'); petsc2 MPI waiting: "
+              + ("yield (--mca mpi_yield_when_idle 1)" if args.mpi_yield else "busy (Open MPI default)"))
         print(f"{'config':>7s} {'mesh':>11s} {'dofs':>8s} {'its':>4s} {'s/it':>7s} {'static s':>9s} "
               f"{'eigen s':>8s} {'factor s':>9s} {'n':>3s} {'solve s':>8s} {'CPU s':>7s} "
               f"{'RSS MB/rank':>11s} {'f1 [Hz]':>9s} load")
