@@ -103,6 +103,14 @@ def _is_number(tok: str) -> bool:
         return False
 
 
+def _shift_invert_failure(sigma: float, exc):
+    """The :class:`SingularMatrix` of a failing factorisation of K - sigma M (PETSc error
+    ``exc``) in an eigen solve."""
+    from tmfem.solvers.backends import SingularMatrix
+    return SingularMatrix(f"eigen (petsc): expected K - sigma M non-singular for sigma={sigma:g}, "
+                          f"found the shift-invert factorisation failing (PETSc error {exc.ierr})")
+
+
 class PetscBackend:
     """PETSc/SLEPc backend (module docstring).
 
@@ -549,10 +557,7 @@ class PetscBackend:
             try:
                 ksp.setUp()
             except PETSc.Error as exc:
-                from tmfem.solvers.backends import SingularMatrix
-                raise SingularMatrix(f"eigen (petsc): expected K - sigma M non-singular for sigma="
-                                     f"{sigma:g}, found the shift-invert factorisation failing "
-                                     f"(PETSc error {exc.ierr})") from None
+                raise _shift_invert_failure(sigma, exc) from None
             F = ksp.getPC().getFactorMatrix()
 
             def solve(X):
@@ -613,10 +618,7 @@ class PetscBackend:
             try:
                 E.solve()
             except PETSc.Error as exc:
-                from tmfem.solvers.backends import SingularMatrix
-                raise SingularMatrix(f"eigen (petsc): expected K - sigma M non-singular for sigma="
-                                     f"{sigma:g}, found the shift-invert factorisation failing "
-                                     f"(PETSc error {exc.ierr})") from None
+                raise _shift_invert_failure(sigma, exc) from None
             nconv = E.getConverged()
             if nconv < k:
                 raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "
