@@ -9,9 +9,11 @@ Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py
     ||b - A x|| <= rtol ||b|| (PETSc's default preconditioned norm stops 10-100x short of
     the requested accuracy).
 ``eigsh(K, M, k, sigma) -> (w, V)``
-    SLEPc EPS Krylov-Schur for the generalised Hermitian problem K v = w M v (eq. 5.32)
-    with shift-and-invert about ``sigma`` (the factorisation of K - sigma M by the same
-    MUMPS Cholesky); the k eigenvalues nearest to sigma, vectors M-orthonormal (SLEPc's
+    The generalised Hermitian problem K v = w M v (eq. 5.32) by shift-and-invert about
+    ``sigma`` (the factorisation of K - sigma M by the same MUMPS Cholesky): on one rank
+    the block Krylov-Schur of :mod:`tmfem.solvers.block_krylov` (MUMPS solves of 8
+    right-hand sides at once), under ``mpiexec -n P > 1`` SLEPc EPS Krylov-Schur
+    (``eig_solver``); the k eigenvalues nearest to sigma, vectors M-orthonormal (the
     B-inner product, then a Rayleigh-Ritz step in their span, so that repeated eigenvalues
     come out as full M-orthonormal pairs).
 
