@@ -17,6 +17,8 @@ ranks), first frequency. A second table splits rank 0's static time by phase
 (:class:`PhaseTimer`: element kernels and assembly, pattern set-up, interpolation, model
 builds, factorisations, solves, the rest: trust-region algebra, MPI waits).
 OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
+--mpi-yield: petsc2's waiting ranks yield the core (Open MPI ``--mca mpi_yield_when_idle 1``;
+helps on a loaded machine: busy-waiting takes the core from the working rank and other jobs).
 Targets (issue 11, 2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
 scipy time of 4x80x80; 1.2 M DOF < 5 min and < 16 GB.
 """
@@ -130,6 +132,8 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     t1, c1 = time.perf_counter(), time.process_time()
     res = m.solve_static(sequence=sequence or None)
     t2, c2 = time.perf_counter(), time.process_time()
+    cpu_phases, wall_phases = dict(phases.cpu), dict(phases.wall)     # of the static solve
+    f_static, c_static, s_static, cs_static = be.t_factor, be.c_factor, be.t_solve, be.c_solve
     modes = m.modes(res.x, k=12)
     t3, c3 = time.perf_counter(), time.process_time()
     its = (res.newton_iterations_tangent or [res.iterations])[-1]
@@ -139,8 +143,10 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     return dict(config=config, ranks=size, mesh=f"4x{mesh}x{mesh}", dofs=m.ndof, build_s=t1 - t0,
                 iterations=its, total_iterations=res.iterations, s_per_it=(t2 - t1) / res.iterations,
                 static_s=t2 - t1, eigen_s=t3 - t2, factor_s=be.t_factor, n_factor=be.n_factor,
-                solve_s=be.t_solve, cpu_factor_s=be.c_factor, cpu_solve_s=be.c_solve, cpu_s=c3 - c1, cpu_static_s=c2 - c1, cpu_eigen_s=c3 - c2,
-                cpu_phases=phases.cpu, wall_phases=phases.wall, rss_mb=rss,
+                solve_s=be.t_solve, cpu_factor_s=be.c_factor, cpu_solve_s=be.c_solve,
+                static_factor_s=f_static, static_cpu_factor_s=c_static, static_solve_s=s_static,
+                static_cpu_solve_s=cs_static, cpu_s=c3 - c1, cpu_static_s=c2 - c1,
+                cpu_eigen_s=c3 - c2, cpu_phases=cpu_phases, wall_phases=wall_phases, rss_mb=rss,
                 f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0])
 
 
@@ -151,7 +157,8 @@ def launch(mesh: int, config: str, args) -> dict:
     cmd = [sys.executable, HERE, "--run", str(mesh), config, "--rest-length", str(args.rest_length),
            "--sequence", str(args.sequence)]
     if config == "petsc2":
-        cmd = [shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"] + cmd
+        cmd = ([shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"]
+               + (["--mca", "mpi_yield_when_idle", "1"] if args.mpi_yield else []) + cmd)
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:
         return dict(config=config, mesh=f"4x{mesh}x{mesh}", error=p.stderr.strip().splitlines()[-1:])
@@ -165,6 +172,9 @@ def main(argv=None) -> int:
     ap.add_argument("--rest-length", type=float, default=1.5025,
                     help="rest length of the S tendons [m] (the value Tables 6.3/6.6 imply)")
     ap.add_argument("--sequence", type=int, default=10, help="coarsest mesh of the mesh sequencing")
+    ap.add_argument("--mpi-yield", action="store_true",
+                    help="petsc2: Open MPI's waiting ranks yield the core (--mca mpi_yield_when_idle 1) "
+                         "instead of busy-waiting")
     ap.add_argument("--run", nargs=2, metavar=("MESH", "CONFIG"), help=argparse.SUPPRESS)
     ap.add_argument("--json", action="store_true", help="one JSON document of all rows")
     args = ap.parse_args(argv)
@@ -179,7 +189,11 @@ def main(argv=None) -> int:
     rows = []
     if not args.json:
         print(f"# 1-4 MTC, static from the undeformed membrane + 12 modes; {os.cpu_count()} cpus, "
-              f"load average {os.getloadavg()[0]:.2f}")
+              f"load average {os.getloadavg()[0]:.2f} (wall times grow with it; CPU s is rank 0's)")
+        print("# eigen: scipy ARPACK shift-invert; petsc (1 rank) the block Krylov-Schur on MUMPS "
+              "solves of 8 right-hand sides; petsc2 SLEPc Krylov-Schur (PetscBackend "
+              "eig_solver='auto'); petsc2 MPI waiting: "
+              + ("yield (--mca mpi_yield_when_idle 1)" if args.mpi_yield else "busy (Open MPI default)"))
         print(f"{'config':>7s} {'mesh':>11s} {'dofs':>8s} {'its':>4s} {'s/it':>7s} {'static s':>9s} "
               f"{'eigen s':>8s} {'factor s':>9s} {'n':>3s} {'solve s':>8s} {'CPU s':>7s} "
               f"{'RSS MB/rank':>11s} {'f1 [Hz]':>9s} load")
@@ -208,8 +222,8 @@ def main(argv=None) -> int:
         if "error" in row:
             continue
         w, c = row["wall_phases"], row["cpu_phases"]
-        w = dict(w, factor=row["factor_s"], solve=row["solve_s"])
-        c = dict(c, factor=row["cpu_factor_s"], solve=row["cpu_solve_s"])
+        w = dict(w, factor=row["static_factor_s"], solve=row["static_solve_s"])
+        c = dict(c, factor=row["static_cpu_factor_s"], solve=row["static_cpu_solve_s"])
         w["rest"] = row["static_s"] - sum(w.values())
         c["rest"] = row["cpu_static_s"] - sum(c.values())
         print(f"{row['config']:>7s} {row['mesh']:>11s} {row['static_s']:7.2f} ({row['cpu_static_s']:6.2f}) "

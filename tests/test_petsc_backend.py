@@ -482,3 +482,45 @@ def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
     d1 = json.loads(p1.stdout)
     assert abs(d2["iterations"] - d1["iterations"]) <= 1          # round-off floor (above)
     assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
+
+
+@needs_petsc
+def test_petsc_block_and_slepc_agree_on_the_mtc_modes():
+    # source: SLEPc's Krylov-Schur on the same model; the 1-4 MTC model at its equilibrium
+    # (531 free dofs: the block solver's path; tmfem.solvers.block_krylov)
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import EIG_BLOCK_MIN_N, PetscBackend
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
+    assert m.distributed.N >= EIG_BLOCK_MIN_N
+    st = m.solve_static(start="design")
+    block = m.modes(st.x, k=12)
+    m.backend = PetscBackend(eig_solver="slepc")
+    slepc = m.modes(st.x, k=12)
+    assert np.allclose(block.freq_hz, slepc.freq_hz, rtol=1e-10, atol=0)
+
+
+@needs_petsc
+def test_slepc_options_choose_slepc_and_are_refused_by_the_block_solver():
+    from tmfem.solvers.petsc import PetscBackend
+    assert PetscBackend().eig_solver == "block"                  # one rank
+    assert PetscBackend(options="-eps_ncv 40").eig_solver == "slepc"
+    with pytest.raises(InputError, match="expected eig_solver='slepc'"):
+        PetscBackend(options="-eps_ncv 40", eig_solver="block")
+    with pytest.raises(InputError, match="expected eig_solver 'auto', 'block' or 'slepc'"):
+        PetscBackend(eig_solver="arpack")
+
+
+@needs_mpi
+def test_block_solver_under_two_ranks_agrees_with_scipy(models, equilibria):
+    # source: the scipy model's 12 modes at its own equilibrium from the design; under 2
+    # ranks the default is SLEPc, the block solver is asked for (rows of the basis
+    # distributed, inner products summed over the ranks)
+    from tmfem.solvers.petsc import EIG_BLOCK_MIN_N
+    p = _mpirun(2, "1-4", "6", "--start", "design", "--eig-solver", "block")
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip())
+    m = models["1-4"]
+    assert m.free.sum() >= EIG_BLOCK_MIN_N                       # the block solver's size
+    ref = m.modes(equilibria["1-4"].x, k=12)
+    assert np.allclose(run["omega2"], ref.omega2, rtol=2e-8, atol=0)

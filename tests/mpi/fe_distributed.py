@@ -5,12 +5,13 @@ rank 0 prints one JSON document.
 
 usage: python tests/mpi/fe_distributed.py PRESET MESH_N [--model mtc|sbc]
                                           [--start design|undeformed] [--fail-rank R] [--nan-rank R]
+                                          [--eig-solver auto|block|slepc]
 --model: the MTC model (membrane, bars, tendons; default) or the SBC model (MITC4 shells,
 beams, cables; static from the undeformed membrane through the MTC predictor);
 --start: the MTC model's start; --fail-rank R: the membrane/shell kernel of rank R raises
 (a failure on one rank: the other ranks wait in a collective call, mpi_main aborts the
 job); --nan-rank R: rank R's element matrices are not finite (caught collectively by the
-assembler: one clean error).
+assembler: one clean error); --eig-solver: the PETSc backend's eigen solver.
 """
 import argparse
 import json
@@ -30,16 +31,19 @@ def main():
     ap.add_argument("--start", default="undeformed")
     ap.add_argument("--fail-rank", type=int, default=None)
     ap.add_argument("--nan-rank", type=int, default=None)
+    ap.add_argument("--eig-solver", choices=("auto", "block", "slepc"), default="auto")
     args = ap.parse_args()
+    from tmfem.solvers.petsc import PetscBackend
     from tmfem.system import load_preset
     comm = comm_world()
+    backend = PetscBackend(eig_solver=args.eig_solver)
     if args.model == "mtc":
         from tmfem.models.mtc.model import MTCModel
-        model = MTCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend="petsc")
+        model = MTCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend=backend)
         element = model.membrane_element
     else:
         from tmfem.models.sbc.model import SBCModel
-        model = SBCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend="petsc")
+        model = SBCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend=backend)
         element = model.shell
     kernel = element.element_arrays
     if args.fail_rank is not None and comm.rank == args.fail_rank:

@@ -401,29 +401,32 @@ class _EntryMap:
             W[has, i] = T.data[pos[has]]
         W[C < 0] = 0.0
         self.p, self.C, self.W = p, C, W
+        self.unit = p == 1 and bool(np.all(W == 1.0))     # plain dofs: the values as they are
 
     def _rows_cols(self):
-        C, p = self.C, self.p
-        ne, nd = C.shape[:2]
+        """Row and column indices of the entries, broadcast views ((ne, nd, p, nd, p) for
+        element groups, (m, p, p) for entry groups)."""
+        C = self.C
         if self.kind == "element":
-            rows = np.broadcast_to(C[:, :, :, None, None], (ne, nd, p, nd, p)).ravel()
-            cols = np.broadcast_to(C[:, None, None, :, :], (ne, nd, p, nd, p)).ravel()
-        else:
-            rows = np.broadcast_to(C[:, 0, :, None], (ne, p, p)).ravel()
-            cols = np.broadcast_to(C[:, 1, None, :], (ne, p, p)).ravel()
-        return rows, cols
+            return C[:, :, :, None, None], C[:, None, None, :, :]
+        return C[:, 0, :, None], C[:, 1, None, :]
 
     def keys(self, N: int) -> np.ndarray:
         """Linear keys row * N + column of the valid (unknown, unknown) entries."""
         rows, cols = self._rows_cols()
-        self.valid = (rows >= 0) & (cols >= 0)
-        self.all_valid = bool(self.valid.all())
-        return rows[self.valid] * N + cols[self.valid]
+        keys = (rows * N + cols).ravel()
+        self.all_valid = bool((self.C >= 0).all())
+        if self.all_valid:
+            return keys
+        self.valid = ((rows >= 0) & (cols >= 0)).ravel()
+        return keys[self.valid]
 
     def weighted(self, X) -> np.ndarray:
         """Values of the valid entries: T_ia T_jb X_ij, flattened like :meth:`keys`."""
         W = self.W
-        if self.kind == "element":
+        if self.unit:
+            v = X.ravel()
+        elif self.kind == "element":
             if self.p == 1:
                 v = (X * W[:, :, 0, None] * W[:, None, :, 0]).ravel()
             else:
