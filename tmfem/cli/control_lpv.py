@@ -38,7 +38,9 @@ def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
                         help=prefix + "EIGOPT: a feasible point at --gamma only (no bisection)")
     parser.add_argument("--start", metavar="FILE.npz", default=None,
                         help=prefix + "EIGOPT bisection: start the first level from this saved design (e.g. "
-                             "one on a sub-grid: continuation in the grid) instead of the Riccati fit")
+                             "one on a sub-grid: continuation in the grid) instead of the Riccati fit (with "
+                             "--sample-time and no --start, the bisection first runs on the grid with psi "
+                             "at its middle value and starts from that design)")
 
 
 def configure(parser) -> None:
@@ -281,6 +283,11 @@ def format_text(r: dict) -> str:
                      f"{r['gamma_stopped']}): feasible at {r['gamma_feasible']:.5g}, not found at "
                      f"{'-' if nf is None else f'{nf:.5g}'}; the optimum is in [{r['gamma_lower_bound_proven']:.5g}, "
                      f"{r['gamma_feasible']:.5g}] (a level not found is not proven infeasible)")
+        if r.get("gamma_start_grid"):
+            ok = [lv["gamma"] for lv in r["gamma_start_levels"] if lv["result"] == "feasible"]
+            lines.append(f"continuation in the grid: started from the {'x'.join(map(str, r['gamma_start_grid']))} "
+                         f"grid's design ({len(r['gamma_start_levels'])} levels there, lowest feasible "
+                         f"{min(ok):.5g})")
     if "saved" in r:
         lines.append(f"saved {r['saved']}")
     return "\n".join(lines)

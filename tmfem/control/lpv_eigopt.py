@@ -107,7 +107,7 @@ class EigOpt:
         P0, Q0 = self._fit(self._Pi, self._Qi)
         self.nP = P0.size
         self.sig = np.concatenate([np.full(P0.size, max(np.abs(P0).max(), 1e-300)),
-                                   np.full(Q0.size, max(np.abs(Q0).max(), 1e-300))])
+                                   np.full(Q0.size, max(np.abs(Q0).max(initial=0.0), 1e-300))])
         self.evaluations = 0
 
     # ------------------------------------------------------------------ start points
@@ -123,14 +123,15 @@ class EigOpt:
             Y = gamma * np.linalg.inv(X)
             Y = (Y + Y.T) / 2
             Pi.append(Y)
-            Qi.append(state_feedback_gain(*args, gamma, eps=self.eps) @ Y)
+            Qi.append(state_feedback_gain(*args, gamma, eps=self.eps) @ Y if args[2].shape[1]
+                      else np.zeros((0, Y.shape[0])))        # no input: the analysis LMI of a loop
         return np.array(Pi), np.array(Qi)
 
     def _fit(self, Pi, Qi):
         m = self.c.shape[0]
         P0 = np.linalg.lstsq(self.c, Pi.reshape(m, -1), rcond=None)[0]
         Q0 = np.linalg.lstsq(self.c, Qi.reshape(m, -1), rcond=None)[0]
-        return P0.reshape(-1, *Pi.shape[1:]), Q0.reshape(-1, *Qi.shape[1:])
+        return P0.reshape(-1, *Pi.shape[1:]), Q0.reshape(len(P0), *Qi.shape[1:])
 
     def riccati_start(self, gamma) -> np.ndarray:
         """z of the affine fit of the pointwise Riccati solutions at ``gamma`` (balanced)."""
