@@ -1,6 +1,6 @@
 """Rate-bounded certificate of the output-feedback LPV loop (tmfem.control.lpv_certificate) on
 the oscillator of docs/lpv.md (not a tensegrity): against the bounded real lemma solved by
-cvxpy/Clarabel and assembled independently of the transposition."""
+cvxpy/Clarabel and assembled here from the frozen loops."""
 import itertools
 
 import cvxpy as cp
@@ -26,16 +26,14 @@ def loops(d, plant):
 
 
 def brl(X, dX, A, B, C, D, g):
-    """The primal bounded real lemma matrix of the module docstring (numpy or cvxpy)."""
-    H = A.T @ X + X @ A + dX
-    if isinstance(X, np.ndarray):
-        return np.block([[H, X @ B, C.T], [B.T @ X, -g * np.eye(B.shape[1]), D.T],
-                         [C, D, -g * np.eye(C.shape[0])]])
-    return cp.bmat([[H, X @ B, C.T], [B.T @ X, -g * np.eye(B.shape[1]), D.T], [C, D, -g * np.eye(C.shape[0])]])
+    """The bounded real lemma matrix of the module docstring, eq. 5.95 on the loop (numpy or cvxpy)."""
+    H = A @ X + X @ A.T - dX
+    blocks = [[H, B, X @ C.T], [B.T, -g * np.eye(B.shape[1]), D.T], [C @ X, D, -g * np.eye(C.shape[0])]]
+    return np.block(blocks) if isinstance(X, np.ndarray) else cp.bmat(blocks)
 
 
 def conic_optimum(d, plant):
-    """min gamma of the primal LMI with X(rho) = X0 + rho_n X1 (rho_n = rho - 1 on [0, 2]) at
+    """min gamma of the LMI with X(rho) = X0 + rho_n X1 (rho_n = rho - 1 on [0, 2]) at
     every grid point and both rate vertices, by cvxpy (Clarabel)."""
     n = d.nx + 1 + d.nx
     X0, X1 = cp.Variable((n, n), symmetric=True), cp.Variable((n, n), symmetric=True)
@@ -62,11 +60,15 @@ def test_certificate_holds_the_primal_lmi_and_is_near_the_conic_optimum(design):
     pl, d = design
     c = rate_bounded_certificate(d, pl, W_e=W_E, W_u=W_U, rtol=1e-2)
     assert c.found and c.bracket.converged
+    # the separation start (the state feedback's P with a rate-bounded Z of the estimation error)
+    # already holds the LMI at the upper level: no iteration there
+    assert c.start["start_max_eig"] < 0 and c.start["estimator_error_gamma"] > 0
+    assert c.bracket.levels[0]["start"] == "given design" and c.bracket.levels[0]["evaluations"] == 0
     # the proven lower bound is the largest frozen-loop norm of the grid (python-control norm)
     import control
     frozen = max(control.norm(control.ss(*lp[1:]), p="inf") for lp in loops(d, pl))
     assert c.lower_bound == pytest.approx(frozen, rel=1e-6)
-    # X(rho) of the certificate in the primal LMI, assembled here from the frozen loops: negative
+    # X(rho) of the certificate in the LMI, assembled here from the frozen loops: negative
     # at every grid point and rate vertex, X > 0
     X = c.lyapunov
     for (rho, A, B, C, D), v in itertools.product(loops(d, pl), (-0.2, 0.2)):

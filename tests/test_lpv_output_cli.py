@@ -13,6 +13,8 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"
 @pytest.mark.parametrize("argv, msg", [
     (["control", "lpv", "--noise", "0.01"], "applies with --output-feedback only"),
     (["control", "lpv", "--output-feedback", "--bound-only"], "does not apply with --output-feedback"),
+    (["control", "lpv", "--rate-certificate"], "applies with --output-feedback only"),
+    (["control", "hinf", "--preset", "1-4D", "--rate-certificate"], "apply to `tmfem control lpv` only"),
     (["control", "lpv", "--output-feedback", "--noise", "0"], "expected a weight > 0"),
     (["control", "lpv", "--output-feedback", "--solver", "EIGOPT", "--sample-time", "-1"], "expected seconds > 0"),
     (["deploy", "--preset", "2-3-deploy", "--noise", "0.001"], "apply to --controller lpv only"),

@@ -104,6 +104,10 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     progress : callable, optional
         Called with (hi - lo) / hi after each level.
 
+    A ``gp`` without control input (B2 with no column: the analysis LMI of a closed loop,
+    :mod:`tmfem.control.lpv_certificate`) given a ``start`` is balanced on it instead of on the
+    pointwise Riccati solutions.
+
     Raises
     ------
     InfeasibleController
@@ -134,9 +138,12 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
                                      max_iter=max_iter, margin=margin, t_schedule=t_schedule,
                                      sample_time=sample_time)
         first = f"sub-grid design {'x'.join(map(str, sub.grid_shape))} (gamma {start.gamma:.5g})"
-    e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=upper, sample_time=sample_time)
+    analysis = gp.sizes["n_u"] == 0
+    given = None if start is None else _coefficients(start, co, gp)
+    e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=upper, sample_time=sample_time,
+               balance_on=given if analysis else None)
     levels, best, not_found = [], None, None
-    z_start = e.riccati_start(upper) if start is None else e.start_from(*_coefficients(start, co, gp))
+    z_start = e.riccati_start(upper) if start is None else e.start_from(*given)
     lo, hi, gamma, stopped = lower, upper, upper, "tolerance"
     while True:
         t1, n1 = time.perf_counter(), e.evaluations

@@ -75,10 +75,15 @@ class EigOpt:
         (A_d = e^(A dt), B_d = int_0^dt e^(A s) ds B2): the frozen sampled loop
         A_d + B_d K has spectral radius < r (a controller sampled at dt must be stable there;
         the continuous LMI of eq. 5.95 does not bound the gain).
+    balance_on : (P_k, Q_k), optional
+        Coefficients (coordinates x = T x_s) whose values at the grid points replace the
+        pointwise Riccati solutions at ``gamma`` for the balancing and the variable scale (a
+        given start; the analysis LMI of a loop without control input, whose Riccati equation
+        fails numerically for the lightly damped 121-state 2-3 loop: :mod:`tmfem.control.lpv_certificate`).
     """
 
     def __init__(self, gp, *, T, c_of, dvs, gamma: float, eps: float = 1e-4, sample_time: float | None = None,
-                 radius: float = 1.0):
+                 radius: float = 1.0, balance_on=None):
         Ti = 1.0 / T
         self.eps, self.gamma0 = eps, gamma
         idx = list(np.ndindex(*gp.grid_shape))
@@ -91,7 +96,10 @@ class EigOpt:
         self.D12 = np.array([gp.D12[k] for k in idx])
         self.dvs = np.array(dvs, dtype=float)
         shp = gp.grid_shape
-        Pi, Qi = self._riccati(gamma)
+        if balance_on is None:
+            Pi, Qi = self._riccati(gamma)
+        else:
+            Pi, Qi = (np.einsum("ik,kab->iab", self.c, np.asarray(X, dtype=float)) for X in balance_on)
         L = np.linalg.cholesky(Pi[int(np.ravel_multi_index(tuple(k // 2 for k in shp), shp))])
         Li = np.linalg.inv(L)
         self.L = L

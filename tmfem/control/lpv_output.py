@@ -333,9 +333,9 @@ def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e:
             progress(k + 1, int(np.prod(plant.grid_shape)))
     chk = None
     if certificate is not None and certificate.found:
-        from tmfem.control.lpv_certificate import transposed_loop
+        from tmfem.control.lpv_certificate import closed_loop_lpv
         from tmfem.control.lpv_verify import verify
-        chk = verify(certificate.lyapunov, transposed_loop(design, plant, W_e=W_e, W_u=W_u), allow_failure=True)
+        chk = verify(certificate.lyapunov, closed_loop_lpv(design, plant, W_e=W_e, W_u=W_u), allow_failure=True)
     ok = cl < 0 and (not dt or sr < 1) and (chk is None or chk.max_lmi_eig < 0)
     res = OutputFeedbackVerification(grid=plant.grid_shape, max_cl_real=cl, max_cl_real_at=cl_at, max_hinf=hn,
                                      max_hinf_at=hn_at, dt=dt, max_sampled_radius=sr, max_sampled_radius_at=sr_at,
