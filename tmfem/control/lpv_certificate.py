@@ -180,7 +180,8 @@ def rate_bounded_certificate(design, plant: GriddedLPV, *, W_e: float, W_u: floa
                              progress=None) -> RateBoundedCertificate:
     """X(rho) and the lowest gamma found for the analysis LMI of the module docstring on the
     design grid of ``plant`` (the plants ``design`` was made for), by the EIGOPT bisection
-    between the largest frozen norm and ``upper`` (default 2 x it), from
+    between the largest frozen norm and ``upper`` (default 2 x the larger of it and the state
+    feedback's gamma: the separation start holds P(rho) of that level), from
     :func:`separation_start` at ``upper``.
 
     Returns a certificate with ``found`` False (and the reason) when no point is found at the
@@ -197,7 +198,7 @@ def rate_bounded_certificate(design, plant: GriddedLPV, *, W_e: float, W_u: floa
     t0 = time.perf_counter()
     gp = closed_loop_lpv(design, plant, W_e=W_e, W_u=W_u)
     lo, lo_at = _frozen_norms(gp)
-    hi = 2.0 * lo if upper is None else upper
+    hi = 2.0 * max(lo, design.state_feedback.gamma) if upper is None else upper
     if not hi > lo:
         raise InputError(f"rate-bounded certificate: expected an upper level above the largest frozen norm "
                          f"{lo:.6g} (no certificate below it), found {hi!r}")
