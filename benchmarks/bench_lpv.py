@@ -2,11 +2,10 @@
 
 Run: .venv/bin/python benchmarks/bench_lpv.py [--grid 2x2] [--solver SCS] [--max-iter N]
      .venv/bin/python benchmarks/bench_lpv.py --grid 6x3 --solver EIGOPT [--sample-time 0.01]
-         [--gamma-upper G] [--rtol 0.05] [--budget 300] [--grid-continuation]
+         [--gamma-upper G] [--rtol 0.05] [--budget 300]
 Prints the plant build time, the LMI sizes, the solve times (wall and CPU: the machine may be
 shared) and gamma for the 2-3 system of ch. 8 (preset 2-3-lpv) on a sub-grid of P_D (8.3);
-EIGOPT: the gamma bisection (docs/lpv.md) from --gamma-upper (default 2 x the pointwise bound);
---grid-continuation forces the sub-grid stage (psi collapsed) also without --sample-time.
+EIGOPT: the gamma bisection (docs/lpv.md) from --gamma-upper (default 2 x the pointwise bound).
 """
 import argparse
 import time
@@ -29,7 +28,6 @@ def main():
     ap.add_argument("--gamma-upper", type=float, default=None)
     ap.add_argument("--rtol", type=float, default=0.05)
     ap.add_argument("--budget", type=float, default=300.0)
-    ap.add_argument("--grid-continuation", action="store_true", default=None)
     a = ap.parse_args()
     th, ps = printed_grid(a.grid, PRINTED["8.1"])
     s = load_preset("2-3-lpv")
@@ -43,10 +41,7 @@ def main():
             from tmfem.control.lpv_bisect import bisect_gamma
             lb = pointwise_state_feedback_bound(gp).lower_bound
             r, br = bisect_gamma(gp, lower=lb, upper=a.gamma_upper or 2 * lb, rtol=a.rtol, time_budget=a.budget,
-                                 max_iter=150, sample_time=a.sample_time, grid_continuation=a.grid_continuation)
-            for lv in br.start_levels:
-                print(f"  sub-grid {br.start_grid} level {lv['gamma']:.4f}: {lv['result']} ({lv['evaluations']} "
-                      f"evaluations, {lv['time_s']:.1f} s, start {lv['start']})")
+                                 max_iter=150, sample_time=a.sample_time)
             for lv in br.levels:
                 print(f"  level {lv['gamma']:.4f}: {lv['result']} ({lv['evaluations']} evaluations, "
                       f"{lv['time_s']:.1f} s, start {lv['start']})")

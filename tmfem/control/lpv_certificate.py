@@ -127,9 +127,12 @@ def separation_start(design, plant: GriddedLPV, gp: GeneralisedLPV, gamma: float
     M[:n + nq, :n + nq] = np.eye(n + nq)
     M[n + nq:, :n] = np.eye(n)
     M[n + nq:, n + nq:] = -np.eye(n)
+    c0 = np.asarray(sf.centre, dtype=float)
+    steps = [c0 + np.eye(c0.size)[k] * sf.half_width[k] for k in sf.varying]
+    Zs = [Z.P_of(c0)] + [Z.P_of(r) - Z.P_of(c0) for r in steps]       # Z(rho) in the basis of P(rho)
     best = None
     for beta in betas:
-        Xk = [M @ sla.block_diag(Pk, beta * Zk) @ M.T for Pk, Zk in zip(sf.P, Z.P)]
+        Xk = [M @ sla.block_diag(Pk, beta * Zk) @ M.T for Pk, Zk in zip(sf.P, Zs)]
         X = LPVStateFeedback(gamma=gamma, P=Xk, Q=[np.zeros((0, 2 * n + nq))] * len(Xk), centre=sf.centre,
                              half_width=sf.half_width, varying=sf.varying, axes=sf.axes,
                              parameter_names=sf.parameter_names, rate_bounds=sf.rate_bounds,
