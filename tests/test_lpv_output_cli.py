@@ -13,6 +13,8 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"
 @pytest.mark.parametrize("argv, msg", [
     (["control", "lpv", "--noise", "0.01"], "applies with --output-feedback only"),
     (["control", "lpv", "--output-feedback", "--bound-only"], "does not apply with --output-feedback"),
+    (["control", "lpv", "--rate-certificate"], "applies with --output-feedback only"),
+    (["control", "hinf", "--preset", "1-4D", "--rate-certificate"], "apply to `tmfem control lpv` only"),
     (["control", "lpv", "--output-feedback", "--noise", "0"], "expected a weight > 0"),
     (["control", "lpv", "--output-feedback", "--solver", "EIGOPT", "--sample-time", "-1"], "expected seconds > 0"),
     (["deploy", "--preset", "2-3-deploy", "--noise", "0.001"], "apply to --controller lpv only"),
@@ -35,7 +37,7 @@ def test_output_feedback_on_one_point_of_the_2_3_plant(capsys, tmp_path):
     # pointwise bound, Riccati test: output feedback cannot beat state feedback on [q_d, n_d])
     f = tmp_path / "of.npz"
     assert main(["control", "lpv", "--grid", "1x1", "--solver", "EIGOPT", "--gamma", "20", "--fixed-gamma",
-                 "--output-feedback",
+                 "--output-feedback", "--rate-certificate",
                  "--sample-time", "2e-4", "--save", str(f), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["output_feedback"] and out["output_feedback_passed"] and out["passed"]
@@ -44,6 +46,13 @@ def test_output_feedback_on_one_point_of_the_2_3_plant(capsys, tmp_path):
     assert out["output_feedback_closed_loop_max_real"] < 0 and out["output_feedback_sampled_max_radius"] < 1
     assert out["gamma"] >= out["lpv_gamma_lower_bound"] * (1 - 1e-4)
     assert out["state_feedback_gamma"] == 20.0 and out["verification_max_eig"] < 0
+    # --rate-certificate: on one point (no parameter varies) the certificate is the bounded real
+    # lemma of the frozen 121-state loop: found between its norm (the proven bound) and 2 x it,
+    # re-checked on the 4x finer grid (the same point)
+    assert out["rate_bounded_certificate"] and out["guarantee"].startswith("rate-bounded")
+    assert out["rate_bounded_frozen_norm_max"] == pytest.approx(out["gamma"], rel=1e-6)
+    assert out["rate_bounded_frozen_norm_max"] <= out["rate_bounded_gamma"] <= 2 * out["rate_bounded_frozen_norm_max"]
+    assert out["rate_bounded_verification_max_eig"] < 0
     saved = np.load(f)
     assert saved["L"].shape == (1, 1, 50, 25) and float(saved["W_n"]) == 1e-3
 

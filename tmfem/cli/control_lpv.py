@@ -16,7 +16,7 @@ MAX_VERIFY_POINTS = 500
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
 LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma", "gamma_rtol",
-            "time_budget", "fixed_gamma", "sample_time", "start", "output_feedback", "noise")
+            "time_budget", "fixed_gamma", "sample_time", "start", "output_feedback", "noise", "rate_certificate")
 
 #: EIGOPT defaults: relative bracket width of the gamma bisection, its time budget [s]
 GAMMA_RTOL, TIME_BUDGET = 0.05, 300.0
@@ -38,7 +38,9 @@ def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
                         help=prefix + "EIGOPT: a feasible point at --gamma only (no bisection)")
     parser.add_argument("--start", metavar="FILE.npz", default=None,
                         help=prefix + "EIGOPT bisection: start the first level from this saved design (e.g. "
-                             "one on a sub-grid: continuation in the grid) instead of the Riccati fit")
+                             "one on a sub-grid: continuation in the grid) instead of the Riccati fit (with "
+                             "--sample-time and no --start, the bisection first runs on the grid with psi "
+                             "at its middle value and starts from that design)")
 
 
 def configure(parser) -> None:
@@ -55,6 +57,10 @@ def configure(parser) -> None:
                         help="lpv: observer-based output feedback on the measured q and membrane points "
                              "(K(rho) with a gridded Kalman estimator; frozen-parameter verification on the "
                              "finer grid, sampled at --sample-time when given; docs/lpv.md)")
+    parser.add_argument("--rate-certificate", action="store_true", default=None,
+                        help="lpv --output-feedback: also the rate-bounded certificate of the output-feedback "
+                             "loop (analysis LMI with X(rho) affine, EIGOPT bisection on gamma with the "
+                             "--gamma-rtol and --time-budget of the synthesis), re-checked on the finer grid")
     parser.add_argument("--noise", type=float, default=None,
                         help="lpv --output-feedback: measurement-noise weight W_n of the estimator design "
                              "and of the verified norm [rad, m] (default 0.001)")
@@ -200,23 +206,36 @@ def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
     return verify(ctrl, interconnection_8_1(fine, tracked=cfg["system"].q_names), sample_time=sample_time)
 
 
-def output_feedback(ctrl, plant, fine, s, noise, dt):
+def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None):
     """The observer-based output feedback on q and the membrane point coordinates, verified
     frozen on the fine grid (sampled at ``dt`` when given). JSON: ``gamma`` becomes the
     largest frozen closed-loop norm from [q_d, n_d, n] to p over the fine grid
     (``state_feedback_gamma`` the certified level of K(rho)); ``verification_max_eig`` stays
-    the LMI of K(rho) re-checked there."""
+    the LMI of K(rho) re-checked there. ``certificate``: (rtol, time budget) of the rate-bounded
+    certificate of the loop (:mod:`tmfem.control.lpv_certificate`) on the design grid, re-checked
+    on the fine grid (keys ``rate_bounded_*``), or None."""
     from tmfem.cli.common import progress_bar
     from tmfem.control.lpv_output import design_output_feedback, verify_output_feedback
     nz = plant.nx // 2
     measured = list(plant.state_names[:nz])          # q and the K point coordinates (eq. 5.17)
     t0 = time.perf_counter()
     d = design_output_feedback(ctrl, plant, tracked=s.q_names, measured=measured, W_n=noise)
+    cert = None
+    if certificate is not None:
+        from tmfem.control.lpv_certificate import rate_bounded_certificate
+        rtol, budget = certificate
+        with progress_bar(budget, 1, "rate-bounded certificate (s of budget)") as bar:
+            t1 = time.perf_counter()
+            cert = rate_bounded_certificate(d, plant, W_e=0.5, W_u=0.05, rtol=rtol, time_budget=budget,
+                                            progress=lambda w: bar(int(min(time.perf_counter() - t1, budget)),
+                                                                   budget))
     with progress_bar(int(np.prod(fine.grid_shape)), 1, "output-feedback verification (points)") as bar:
-        vo = verify_output_feedback(d, fine, W_e=0.5, W_u=0.05, dt=dt, progress=bar)
+        vo = verify_output_feedback(d, fine, W_e=0.5, W_u=0.05, dt=dt, certificate=cert, progress=bar)
     return d, {"output_feedback": True, "measured": measured, "noise_weight": noise, "W_d": d.W_d,
                "state_feedback_gamma": ctrl.gamma, "gamma": vo.max_hinf,
-               "guarantee": "frozen-parameter (fine grid) only; K(rho) alone is rate-bounded on the design grid",
+               "guarantee": ("rate-bounded (X(rho) of the loop on the design grid, re-checked on the fine grid)"
+                             if cert is not None and cert.found else
+                             "frozen-parameter (fine grid) only; K(rho) alone is rate-bounded on the design grid"),
                "output_feedback_time_s": time.perf_counter() - t0, **vo.to_dict()}
 
 
@@ -231,6 +250,8 @@ def run(args) -> dict:
     output_file(args.save, option="--save", suffixes=(".npz",))
     if args.noise is not None and not args.output_feedback:
         raise InputError("lpv: option --noise applies with --output-feedback only")
+    if args.rate_certificate and not args.output_feedback:
+        raise InputError("lpv: option --rate-certificate applies with --output-feedback only")
     if args.output_feedback and args.bound_only:
         raise InputError("lpv: --bound-only computes no controller; it does not apply with --output-feedback")
     noise = 1e-3 if args.noise is None else args.noise
@@ -249,7 +270,8 @@ def run(args) -> dict:
     out = {**out, **syn, **v.to_dict()}
     saved = ctrl
     if args.output_feedback:
-        saved, extra = output_feedback(ctrl, plant, fine, cfg["system"], noise, args.sample_time)
+        saved, extra = output_feedback(ctrl, plant, fine, cfg["system"], noise, args.sample_time,
+                                       certificate=(cfg["rtol"], cfg["budget"]) if args.rate_certificate else None)
         out = {**out, **extra}
     if args.save:
         saved.save(args.save)
@@ -275,12 +297,23 @@ def format_text(r: dict) -> str:
             lines.append(f"sampled-data loops at dt = {r['sample_time_s']:g} s: max spectral radius "
                          f"{r['output_feedback_sampled_max_radius']:.9f} (state feedback alone "
                          f"{r['state_feedback_sampled_max_radius']:.9f})")
+        if "rate_bounded_certificate" in r:
+            lines.append("rate-bounded certificate of the loop (X(rho) affine): "
+                         + (f"gamma = {r['rate_bounded_gamma']:.5g} (frozen norms up to "
+                            f"{r['rate_bounded_frozen_norm_max']:.5g}), re-checked on the fine grid: max LMI "
+                            f"eigenvalue {r['rate_bounded_verification_max_eig']:.3e}"
+                            if r["rate_bounded_certificate"] else f"not found ({r['rate_bounded_message']})"))
     if r.get("gamma_levels"):
         nf = r["gamma_not_found"]
         lines.append(f"EIGOPT bisection ({len(r['gamma_levels'])} levels, {r['gamma_search_time_s']:.0f} s, stopped on "
                      f"{r['gamma_stopped']}): feasible at {r['gamma_feasible']:.5g}, not found at "
                      f"{'-' if nf is None else f'{nf:.5g}'}; the optimum is in [{r['gamma_lower_bound_proven']:.5g}, "
                      f"{r['gamma_feasible']:.5g}] (a level not found is not proven infeasible)")
+        if r.get("gamma_start_grid"):
+            ok = [lv["gamma"] for lv in r["gamma_start_levels"] if lv["result"] == "feasible"]
+            lines.append(f"continuation in the grid: started from the {'x'.join(map(str, r['gamma_start_grid']))} "
+                         f"grid's design ({len(r['gamma_start_levels'])} levels there, lowest feasible "
+                         f"{min(ok):.5g})")
     if "saved" in r:
         lines.append(f"saved {r['saved']}")
     return "\n".join(lines)

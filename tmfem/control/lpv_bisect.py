@@ -12,6 +12,15 @@ stops after a fixed number of iterations): the bracket it returns is
 [highest level not found, lowest level found] next to the proven lower bound. Stops when
 hi - lo <= rtol hi or when the time budget is spent; the controller is that of the lowest
 feasible level, accepted only after the LMIs are re-computed in floating point.
+
+Continuation in the grid (automatic with the sampled-loop LMI and no given start, on a grid
+where more than one parameter varies): the pointwise Riccati start knows nothing of the
+sample time, and on the 2-3 plant at 6 x 3 with dt = 0.01 s the first level was not found
+from it (docs/lpv.md, run D). So the last varying parameter is first collapsed to its middle
+grid value (:func:`collapsed`; for 2-3 the 6 x 1 grid at psi_13 = 8.36 deg), the gamma
+bisection runs there (recursively: a further parameter is collapsed the same way) within half
+of the time budget, and its design, extended constant along the collapsed parameter
+(P(rho) = P_0 + rho_1 P_1 with P_2 = 0, Q likewise), starts the first level on the full grid.
 """
 from __future__ import annotations
 
@@ -33,7 +42,9 @@ class GammaBracket:
     """Where the gamma minimisation ended. ``lower_bound``: proven (no controller below it);
     ``not_found``: the highest level where no point was found (None: none failed; not a
     proof of infeasibility); ``feasible``: the lowest level with a verified point (the
-    controller's gamma); ``levels``: one dict per level tried, in order."""
+    controller's gamma); ``levels``: one dict per level tried, in order; ``start_grid``,
+    ``start_levels``: the collapsed grid of the continuation in the grid and the levels tried
+    there (None and empty without it)."""
 
     lower_bound: float
     feasible: float
@@ -43,12 +54,15 @@ class GammaBracket:
     stopped: str
     time_s: float
     levels: list = field(default_factory=list)
+    start_grid: list | None = None
+    start_levels: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"gamma_lower_bound_proven": self.lower_bound, "gamma_not_found": self.not_found,
                 "gamma_feasible": self.feasible, "gamma_rtol": self.rtol, "gamma_converged": self.converged,
                 "gamma_stopped": self.stopped, "gamma_search_time_s": self.time_s,
-                "gamma_levels": self.levels,
+                "gamma_levels": self.levels, "gamma_start_grid": self.start_grid,
+                "gamma_start_levels": self.start_levels,
                 "gamma_note": "EIGOPT failing at a level does not prove that level infeasible: the "
                               "optimum lies in [gamma_lower_bound_proven, gamma_feasible]"}
 
@@ -56,7 +70,8 @@ class GammaBracket:
 def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float = 0.02,
                  time_budget: float = 300.0, max_iter: int = 150, margin: float = 1e-8,
                  t_schedule=(1e-2, 1e-3, 1e-4), sample_time: float | None = None,
-                 start: LPVStateFeedback | None = None, progress=None) -> tuple[LPVStateFeedback, GammaBracket]:
+                 start: LPVStateFeedback | None = None, grid_continuation: bool | None = None,
+                 progress=None) -> tuple[LPVStateFeedback, GammaBracket]:
     """Minimise gamma of eqs. 5.95-5.96 on the grid of ``gp`` (module docstring).
 
     Parameters
@@ -82,8 +97,16 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
         The first level starts from this design's P(rho), Q(rho) instead of the Riccati fit:
         a design on a sub-grid (continuation in the grid; coefficients of parameters it does
         not vary are zero) or an earlier run.
+    grid_continuation : bool, optional
+        Start from the design of the bisection on the :func:`collapsed` grid (module
+        docstring). Default: with ``sample_time``, no ``start`` and more than one varying
+        parameter. The sub-grid stage's levels are ``GammaBracket.start_levels``.
     progress : callable, optional
         Called with (hi - lo) / hi after each level.
+
+    A ``gp`` without control input (B2 with no column: the analysis LMI of a closed loop,
+    :mod:`tmfem.control.lpv_certificate`) given a ``start`` is balanced on it instead of on the
+    pointwise Riccati solutions.
 
     Raises
     ------
@@ -99,15 +122,33 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     t0 = time.perf_counter()
     deadline = t0 + time_budget
     co = Coordinates.of(gp)
-    e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=upper, sample_time=sample_time)
+    if grid_continuation is None:
+        grid_continuation = sample_time is not None and start is None and len(co.varying) > 1
+    if grid_continuation and start is not None:
+        raise InputError("gamma bisection: grid_continuation starts from its own sub-grid design; expected no "
+                         "given start with it")
+    first, sub = ("riccati" if start is None else "given design"), None
+    if grid_continuation:
+        if len(co.varying) < 2:
+            raise InputError(f"gamma bisection: grid continuation needs a grid where at least two parameters "
+                             f"vary, found grid {gp.grid_shape}")
+        sub = collapsed(gp, co.varying[-1])
+        log.info("gamma bisection: continuation in the grid, first on the %s grid", sub.grid_shape)
+        start, sub_br = bisect_gamma(sub, lower=lower, upper=upper, rtol=rtol, time_budget=time_budget / 2,
+                                     max_iter=max_iter, margin=margin, t_schedule=t_schedule,
+                                     sample_time=sample_time)
+        first = f"sub-grid design {'x'.join(map(str, sub.grid_shape))} (gamma {start.gamma:.5g})"
+    analysis = gp.sizes["n_u"] == 0
+    given = None if start is None else _coefficients(start, co, gp)
+    e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=upper, sample_time=sample_time,
+               balance_on=given if analysis else None)
     levels, best, not_found = [], None, None
-    z_start = e.riccati_start(upper) if start is None else e.start_from(*_coefficients(start, co, gp))
+    z_start = e.riccati_start(upper) if start is None else e.start_from(*given)
     lo, hi, gamma, stopped = lower, upper, upper, "tolerance"
     while True:
         t1, n1 = time.perf_counter(), e.evaluations
         z, worst, reason = e.solve(gamma, z_start, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
                                    deadline=deadline)
-        first = "riccati" if start is None else "given design"
         row = {"gamma": gamma, "evaluations": e.evaluations - n1, "time_s": time.perf_counter() - t1,
                "largest_scaled_eig": worst, "start": first if best is None else "continuation"}
         if reason == "time":
@@ -142,13 +183,29 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
                                    f"feasible point at gamma = {upper:.5g}")
     total = time.perf_counter() - t0
     br = GammaBracket(lower_bound=lower, feasible=hi, not_found=not_found, rtol=rtol,
-                      converged=hi - lo <= rtol * hi, stopped=stopped, time_s=total, levels=levels)
+                      converged=hi - lo <= rtol * hi, stopped=stopped, time_s=total, levels=levels,
+                      start_grid=None if sub is None else list(sub.grid_shape),
+                      start_levels=[] if sub is None else sub_br.start_levels + sub_br.levels)
     best.status = (f"bisection: feasible at {hi:.5g}, not found at "
                    f"{'-' if not_found is None else f'{not_found:.5g}'}, proven lower bound {lower:.5g} "
                    f"({len(levels)} levels, {e.evaluations} evaluations, stopped on {stopped})")
     best.solve_time = total
     log.info("gamma bisection: %s", best.status)
     return best, br
+
+
+def collapsed(gp: GeneralisedLPV, k: int) -> GeneralisedLPV:
+    """``gp`` on the sub-grid where parameter ``k`` takes only its middle grid value (index
+    size // 2; for the 2-3 grid of P_D, psi_13 = 8.36 deg), the other axes and every rate bound
+    unchanged."""
+    mid = gp.grid_shape[k] // 2
+    cut = lambda X: np.take(X, [mid], axis=k)               # noqa: E731
+    sub = GeneralisedLPV.from_matrices(
+        axes=[a if j != k else a[[mid]] for j, a in enumerate(gp.axes)], parameter_names=gp.parameter_names,
+        rate_bounds=gp.rate_bounds, A=cut(gp.A), B1=cut(gp.B1), B2=cut(gp.B2), C1=cut(gp.C1),
+        D11=cut(gp.D11), D12=cut(gp.D12))
+    sub.state_names = list(gp.state_names)
+    return sub
 
 
 def _coefficients(design: LPVStateFeedback, co: Coordinates, gp):

@@ -75,10 +75,15 @@ class EigOpt:
         (A_d = e^(A dt), B_d = int_0^dt e^(A s) ds B2): the frozen sampled loop
         A_d + B_d K has spectral radius < r (a controller sampled at dt must be stable there;
         the continuous LMI of eq. 5.95 does not bound the gain).
+    balance_on : (P_k, Q_k), optional
+        Coefficients (coordinates x = T x_s) whose values at the grid points replace the
+        pointwise Riccati solutions at ``gamma`` for the balancing and the variable scale (a
+        given start; the analysis LMI of a loop without control input, whose Riccati equation
+        fails numerically for the lightly damped 121-state 2-3 loop: :mod:`tmfem.control.lpv_certificate`).
     """
 
     def __init__(self, gp, *, T, c_of, dvs, gamma: float, eps: float = 1e-4, sample_time: float | None = None,
-                 radius: float = 1.0):
+                 radius: float = 1.0, balance_on=None):
         Ti = 1.0 / T
         self.eps, self.gamma0 = eps, gamma
         idx = list(np.ndindex(*gp.grid_shape))
@@ -91,7 +96,10 @@ class EigOpt:
         self.D12 = np.array([gp.D12[k] for k in idx])
         self.dvs = np.array(dvs, dtype=float)
         shp = gp.grid_shape
-        Pi, Qi = self._riccati(gamma)
+        if balance_on is None:
+            Pi, Qi = self._riccati(gamma)
+        else:
+            Pi, Qi = (np.einsum("ik,kab->iab", self.c, np.asarray(X, dtype=float)) for X in balance_on)
         L = np.linalg.cholesky(Pi[int(np.ravel_multi_index(tuple(k // 2 for k in shp), shp))])
         Li = np.linalg.inv(L)
         self.L = L
@@ -107,7 +115,7 @@ class EigOpt:
         P0, Q0 = self._fit(self._Pi, self._Qi)
         self.nP = P0.size
         self.sig = np.concatenate([np.full(P0.size, max(np.abs(P0).max(), 1e-300)),
-                                   np.full(Q0.size, max(np.abs(Q0).max(), 1e-300))])
+                                   np.full(Q0.size, max(np.abs(Q0).max(initial=0.0), 1e-300))])
         self.evaluations = 0
 
     # ------------------------------------------------------------------ start points
@@ -123,14 +131,15 @@ class EigOpt:
             Y = gamma * np.linalg.inv(X)
             Y = (Y + Y.T) / 2
             Pi.append(Y)
-            Qi.append(state_feedback_gain(*args, gamma, eps=self.eps) @ Y)
+            Qi.append(state_feedback_gain(*args, gamma, eps=self.eps) @ Y if args[2].shape[1]
+                      else np.zeros((0, Y.shape[0])))        # no input: the analysis LMI of a loop
         return np.array(Pi), np.array(Qi)
 
     def _fit(self, Pi, Qi):
         m = self.c.shape[0]
         P0 = np.linalg.lstsq(self.c, Pi.reshape(m, -1), rcond=None)[0]
         Q0 = np.linalg.lstsq(self.c, Qi.reshape(m, -1), rcond=None)[0]
-        return P0.reshape(-1, *Pi.shape[1:]), Q0.reshape(-1, *Qi.shape[1:])
+        return P0.reshape(-1, *Pi.shape[1:]), Q0.reshape(len(P0), *Qi.shape[1:])
 
     def riccati_start(self, gamma) -> np.ndarray:
         """z of the affine fit of the pointwise Riccati solutions at ``gamma`` (balanced)."""

@@ -236,7 +236,10 @@ class OutputFeedbackVerification:
     w = [q_d, n_d, n] to p (python-control ``norm``, SLICOT ab13dd) and, with a sample time,
     the largest spectral radius of the sampled-data loops of the output feedback and of the
     state feedback alone (:class:`~tmfem.control.lpv_controller.LPVController`'s discretisation),
-    each with the parameter values where it occurs."""
+    each with the parameter values where it occurs. With a rate-bounded certificate
+    (:mod:`tmfem.control.lpv_certificate`) also its analysis LMI with the certificate's X(rho)
+    and gamma re-checked on this grid (``certificate_check``, a
+    :class:`~tmfem.control.lpv_verify.Verification`; None when no certificate was found)."""
 
     grid: tuple
     max_cl_real: float
@@ -248,9 +251,17 @@ class OutputFeedbackVerification:
     max_sampled_radius_at: list | None
     state_feedback_sampled_radius: float | None
     passed: bool
+    certificate: object = None
+    certificate_check: object = None
 
     def to_dict(self) -> dict:
-        return {"verification_grid": list(self.grid), "output_feedback_closed_loop_max_real": self.max_cl_real,
+        cert = {}
+        if self.certificate is not None:
+            cert = self.certificate.to_dict()
+            chk = self.certificate_check
+            cert.update({"rate_bounded_verification_max_eig": None if chk is None else chk.max_lmi_eig,
+                         "rate_bounded_verification_max_eig_at": None if chk is None else chk.max_lmi_eig_at})
+        return {**cert, "verification_grid": list(self.grid), "output_feedback_closed_loop_max_real": self.max_cl_real,
                 "output_feedback_closed_loop_max_real_at": self.max_cl_real_at,
                 "output_feedback_hinf_max": self.max_hinf, "output_feedback_hinf_max_at": self.max_hinf_at,
                 "sample_time_s": self.dt, "output_feedback_sampled_max_radius": self.max_sampled_radius,
@@ -283,13 +294,16 @@ def sampled_closed_loops(design: LPVOutputFeedback, A, B, C_m, rho, dt: float):
 
 
 def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e: float, W_u: float,
-                           dt: float | None = None, allow_failure: bool = False,
+                           dt: float | None = None, allow_failure: bool = False, certificate=None,
                            progress=None) -> OutputFeedbackVerification:
     """Check ``design`` on the frozen plants of ``plant`` (e.g. COM linearisations on a grid
     4x finer than the design's; :meth:`LPVOutputFeedback.frozen_closed_loop` with the
     weights W_e, W_u of Fig. 8.1). Passes when every frozen loop is stable and, with ``dt``,
     every sampled-data loop of the output feedback has spectral radius < 1. The H-infinity
-    norms are reported, not judged (there is no synthesised bound for them).
+    norms are reported, not judged (there is no synthesised bound for them). With ``certificate``
+    (a found :class:`~tmfem.control.lpv_certificate.RateBoundedCertificate` of the design grid)
+    its analysis LMI must also hold at every point and rate vertex of ``plant``: then the loop is
+    stable for rho varying within the rate bounds and its L2 gain is below the certificate's gamma.
 
     Raises
     ------
@@ -317,10 +331,16 @@ def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e:
             sf = max(sf, float(np.abs(np.linalg.eigvals(M_sf)).max()))
         if progress is not None:
             progress(k + 1, int(np.prod(plant.grid_shape)))
-    ok = cl < 0 and (not dt or sr < 1)
+    chk = None
+    if certificate is not None and certificate.found:
+        from tmfem.control.lpv_certificate import closed_loop_lpv
+        from tmfem.control.lpv_verify import verify
+        chk = verify(certificate.lyapunov, closed_loop_lpv(design, plant, W_e=W_e, W_u=W_u), allow_failure=True)
+    ok = cl < 0 and (not dt or sr < 1) and (chk is None or chk.max_lmi_eig < 0)
     res = OutputFeedbackVerification(grid=plant.grid_shape, max_cl_real=cl, max_cl_real_at=cl_at, max_hinf=hn,
                                      max_hinf_at=hn_at, dt=dt, max_sampled_radius=sr, max_sampled_radius_at=sr_at,
-                                     state_feedback_sampled_radius=sf, passed=bool(ok))
+                                     state_feedback_sampled_radius=sf, passed=bool(ok), certificate=certificate,
+                                     certificate_check=chk)
     log.info("LPV output feedback on %s: max closed-loop Re %.3e at %s, max ||T_pw|| %.4g at %s, "
              "sampled radius %s at %s", plant.grid_shape, cl, cl_at, hn, hn_at, sr, sr_at)
     if not ok and not allow_failure:
@@ -328,6 +348,8 @@ def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e:
             f"LPV output feedback fails its frozen-parameter verification on a {plant.grid_shape} grid: "
             f"largest closed-loop real part {cl:.3e} at rho = {cl_at}"
             + (f", largest sampled-data spectral radius {sr:.6f} at rho = {sr_at} (dt = {dt} s)" if dt else "")
+            + (f", rate-bounded LMI (gamma = {certificate.gamma:.5g}) largest relative eigenvalue "
+               f"{chk.max_lmi_eig:.3e} at rho = {chk.max_lmi_eig_at}" if chk is not None else "")
             + "; expected < 0" + (" and < 1" if dt else ""))
     return res
 
