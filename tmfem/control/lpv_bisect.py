@@ -146,10 +146,11 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     z_start = e.riccati_start(upper) if start is None else e.start_from(*given)
     lo, hi, gamma, stopped = lower, upper, upper, "tolerance"
     while True:
-        t1, n1 = time.perf_counter(), e.evaluations
+        t1, c1, n1 = time.perf_counter(), time.process_time(), e.evaluations
         z, worst, reason = e.solve(gamma, z_start, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
                                    deadline=deadline)
         row = {"gamma": gamma, "evaluations": e.evaluations - n1, "time_s": time.perf_counter() - t1,
+               "cpu_s": time.process_time() - c1,
                "largest_scaled_eig": worst, "start": first if best is None else "continuation"}
         if reason == "time":
             levels.append({**row, "result": "unfinished (time budget)"})
