@@ -2,10 +2,12 @@
 
 Run: .venv/bin/python benchmarks/bench_lpv.py [--grid 2x2] [--solver SCS] [--max-iter N]
      .venv/bin/python benchmarks/bench_lpv.py --grid 6x3 --solver EIGOPT [--sample-time 0.01]
-         [--gamma-upper G] [--rtol 0.05] [--budget 300]
+         [--gamma-upper G] [--rtol 0.05] [--budget 300] [--grid-continuation auto|on|off]
 Prints the plant build time, the LMI sizes, the solve times (wall and CPU: the machine may be
 shared) and gamma for the 2-3 system of ch. 8 (preset 2-3-lpv) on a sub-grid of P_D (8.3);
-EIGOPT: the gamma bisection (docs/lpv.md) from --gamma-upper (default 2 x the pointwise bound).
+EIGOPT: the gamma bisection (docs/lpv.md) from --gamma-upper (default 2 x the pointwise bound),
+with the continuation in the grid (6 x 1 first) as bisect_gamma decides (auto) or forced on/off;
+prints every level (also the sub-grid's), the bracket and the CPU time.
 """
 import argparse
 import time
@@ -28,6 +30,7 @@ def main():
     ap.add_argument("--gamma-upper", type=float, default=None)
     ap.add_argument("--rtol", type=float, default=0.05)
     ap.add_argument("--budget", type=float, default=300.0)
+    ap.add_argument("--grid-continuation", default="auto", choices=["auto", "on", "off"])
     a = ap.parse_args()
     th, ps = printed_grid(a.grid, PRINTED["8.1"])
     s = load_preset("2-3-lpv")
@@ -40,11 +43,15 @@ def main():
         if a.solver == "EIGOPT":
             from tmfem.control.lpv_bisect import bisect_gamma
             lb = pointwise_state_feedback_bound(gp).lower_bound
+            print(f"pointwise bound {lb:.4f}: {time.perf_counter() - t:.1f} s wall, {time.process_time() - c:.1f} s CPU")
+            gc = {"auto": None, "on": True, "off": False}[a.grid_continuation]
             r, br = bisect_gamma(gp, lower=lb, upper=a.gamma_upper or 2 * lb, rtol=a.rtol, time_budget=a.budget,
-                                 max_iter=150, sample_time=a.sample_time)
-            for lv in br.levels:
-                print(f"  level {lv['gamma']:.4f}: {lv['result']} ({lv['evaluations']} evaluations, "
-                      f"{lv['time_s']:.1f} s, start {lv['start']})")
+                                 max_iter=150, sample_time=a.sample_time, grid_continuation=gc)
+            for name, rows in (("sub-grid " + "x".join(map(str, br.start_grid or [])), br.start_levels),
+                               ("grid " + a.grid, br.levels)):
+                for lv in rows:
+                    print(f"  {name} level {lv['gamma']:.4f}: {lv['result']} ({lv['evaluations']} evaluations, "
+                          f"{lv['time_s']:.1f} s wall, {lv.get('cpu_s', float('nan')):.1f} s CPU, start {lv['start']})")
             print(f"bracket [{br.lower_bound:.4f} proven, {br.feasible:.4f} feasible], not found at "
                   f"{br.not_found}, stopped on {br.stopped}")
         else:

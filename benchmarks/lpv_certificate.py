@@ -2,14 +2,19 @@
 docs/lpv.md, output feedback) for a saved state-feedback design.
 
 Run: .venv/bin/python benchmarks/lpv_certificate.py --design F.npz [--budget 900] [--rtol 0.05]
-         [--upper G] [--fine] [--cache DIR]
+         [--upper G] [--fine] [--cache DIR] [--save-certificate X.npz | --certificate X.npz]
+         [--refine [--per-round 4] [--rounds 8] [--refine-budget 1200]]
 
 Builds the design plant on the design's grid (COM linearisations at the symmetric equilibria
 of eq. 5.97), the gridded Kalman estimator (W_d = W_n = 0.001) on q and the membrane points,
 the 121-state loops and the EIGOPT bisection of the analysis LMI (X(rho) affine, +-10 deg/s)
 between the largest frozen norm and --upper (default 2 x it). With --fine, a found certificate
 is re-checked on the 4x finer grid (new linearisations) with the frozen checks of
-verify_output_feedback. --cache keeps the plants as pickles. Prints one JSON object.
+verify_output_feedback. --cache keeps the plants as pickles. --save-certificate writes the
+certificate's X(rho) (LPVStateFeedback.save, no gain rows), --certificate reads one instead of
+solving. --refine (implies --fine): the cutting-plane refinement of refine_certificate on the 4x
+finer grid (the worst --per-round failing points per round, at most --rounds re-solves within
+--refine-budget s), then the re-check. Prints one JSON object (times wall and CPU).
 """
 import argparse
 import json
@@ -20,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.control.lpv_certificate import rate_bounded_certificate
+from tmfem.control.lpv_certificate import (RateBoundedCertificate, _frozen_norms, closed_loop_lpv,
+                                           rate_bounded_certificate, refine_certificate)
 from tmfem.control.lpv_output import design_output_feedback, verify_output_feedback
 from tmfem.control.lpv_plant import com_lpv_plant
 from tmfem.control.lpv_synthesis import LPVStateFeedback
@@ -47,7 +53,17 @@ def main():
     ap.add_argument("--upper", type=float, default=None)
     ap.add_argument("--fine", action="store_true")
     ap.add_argument("--cache", default=None)
+    ap.add_argument("--save-certificate", default=None)
+    ap.add_argument("--certificate", default=None)
+    ap.add_argument("--refine", action="store_true")
+    ap.add_argument("--per-round", type=int, default=4)
+    ap.add_argument("--rounds", type=int, default=8)
+    ap.add_argument("--refine-budget", type=float, default=1200.0)
     a = ap.parse_args()
+    if (a.per_round != 4 or a.rounds != 8 or a.refine_budget != 1200.0) and not a.refine:
+        ap.error("--per-round, --rounds and --refine-budget apply with --refine only")
+    if a.certificate and (a.save_certificate or a.upper is not None):
+        ap.error("--certificate reads a saved X(rho): --save-certificate and --upper do not apply")
     logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(name)s: %(message)s")
     logging.getLogger("tmfem").setLevel(logging.INFO)
     s = load_preset("2-3-lpv")
@@ -57,13 +73,29 @@ def main():
     pl = plant_on(s, sf.axes[0], sf.axes[1], sf.rate_bounds, a.cache, f"plant_{shape}")
     t_plant = time.perf_counter() - t
     of = design_output_feedback(sf, pl, tracked=s.q_names, measured=pl.state_names[:pl.nx // 2])
-    c = rate_bounded_certificate(of, pl, W_e=0.5, W_u=0.05, upper=a.upper, rtol=a.rtol, time_budget=a.budget)
+    t, cpu = time.perf_counter(), time.process_time()
+    if a.certificate:
+        X = LPVStateFeedback.load(a.certificate)
+        lo, lo_at = _frozen_norms(closed_loop_lpv(of, pl, W_e=0.5, W_u=0.05))
+        c = RateBoundedCertificate(lyapunov=X, gamma=X.gamma, lower_bound=lo, lower_bound_at=lo_at, bracket=None,
+                                   time_s=time.perf_counter() - t, message=f"loaded from {a.certificate}")
+    else:
+        c = rate_bounded_certificate(of, pl, W_e=0.5, W_u=0.05, upper=a.upper, rtol=a.rtol, time_budget=a.budget)
+        if a.save_certificate and c.found:
+            c.lyapunov.save(a.save_certificate)
     out = {"design": a.design, "design_gamma": sf.gamma, "grid": list(pl.grid_shape), "plant_s": t_plant,
-           "loop_states": of.nx + len(of.tracked_rows) + of.nx, **c.to_dict()}
-    if a.fine and c.found:
+           "loop_states": of.nx + len(of.tracked_rows) + of.nx, "certificate_cpu_s": time.process_time() - cpu,
+           **c.to_dict()}
+    if (a.fine or a.refine) and c.found:
         t = time.perf_counter()
         fa = pl.refined(4)
         fine = plant_on(s, fa[0], fa[1], pl.rate_bounds, a.cache, f"fine_{shape}", membrane_points=pl.membrane_points)
+        out["fine_plant_s"] = time.perf_counter() - t
+        if a.refine:
+            c = refine_certificate(c, of, fine, W_e=0.5, W_u=0.05, per_round=a.per_round, max_rounds=a.rounds,
+                                   time_budget=a.refine_budget)
+            out.update({k: val for k, val in c.to_dict().items() if k.startswith("rate_bounded_refinement")})
+        t = time.perf_counter()
         v = verify_output_feedback(of, fine, W_e=0.5, W_u=0.05, dt=0.01, certificate=c, allow_failure=True)
         out.update({k: val for k, val in v.to_dict().items() if k not in out}, fine_s=time.perf_counter() - t)
     print(json.dumps(out, default=lambda o: o.tolist() if isinstance(o, np.ndarray) else str(o)))

@@ -112,3 +112,83 @@ def test_certificate_not_found_and_refusals(design):
     # the controller on a destabilised plant: a frozen loop is unstable, no certificate can exist
     with pytest.raises(InfeasibleController, match="unstable"):
         rate_bounded_certificate(d, oscillator(shift=3.0), W_e=W_E, W_u=W_U)
+
+
+# --------------------------------------------------------------------- cutting-plane refinement
+def nonlinear_oscillator(rho):
+    """x'' + 0.1 x' + (1 + rho^2) x = u about x_e = 0.5 (stiffness nonlinear in rho: between grid
+    points the multilinear interpolation of the design plant is not the true plant)."""
+    from tmfem.control.lpv_plant import GriddedLPV
+    rho = np.asarray(rho, dtype=float)
+    k = rho.size
+    return GriddedLPV(axes=[rho], parameter_names=["rho"], A=np.array([[[0, 1], [-(1 + r * r), -0.1]] for r in rho]),
+                      B=np.broadcast_to([[0.0], [1.0]], (k, 2, 1)), C=np.broadcast_to([[1.0, 0.0]], (k, 1, 2)),
+                      D=np.zeros((k, 1, 1)), rate_bounds=[[-0.2, 0.2]], state_names=["x", "v"], input_names=["u"],
+                      output_names=["y"], x_e=np.array([[0.5, 0.0]] * k),
+                      u_e=np.array([[(1 + r * r) * 0.5] for r in rho]), y_e=np.array([[0.5]] * k))
+
+
+@pytest.fixture(scope="module")
+def nonlinear():
+    pl = nonlinear_oscillator([0.0, 2.0])
+    d = make_design(pl)
+    return pl, d, rate_bounded_certificate(d, pl, W_e=W_E, W_u=W_U, rtol=1e-2), nonlinear_oscillator(np.linspace(0, 2, 5))
+
+
+def largest_brl(X, gamma, d, plant):
+    """Largest eigenvalue of the LMI assembled here (``brl``) with X(rho) over the frozen loops of
+    ``plant``'s grid and both rate vertices, and the smallest eigenvalue of X(rho) there."""
+    lmi, minX = -np.inf, np.inf
+    for (rho, A, B, C, D), v in itertools.product(loops(d, plant), (-0.2, 0.2)):
+        lmi = max(lmi, np.linalg.eigvalsh(brl(X.P_of(rho), v / X.half_width[0] * X.P[1], A, B, C, D, gamma)).max())
+        minX = min(minX, np.linalg.eigvalsh(X.P_of(rho)).min())
+    return lmi, minX
+
+
+def test_refinement_makes_a_design_grid_certificate_hold_on_the_finer_grid(nonlinear):
+    from tmfem.control.lpv_certificate import refine_certificate
+    pl, d, c, fine = nonlinear
+    assert c.found
+    # the estimator's model at rho = 1 interpolates stiffness 3; the true plant has 2
+    assert pl.at([1.0])[0][1, 0] == pytest.approx(-3.0) and fine.A[2][1, 0] == pytest.approx(-2.0)
+    # the design-grid certificate fails between the grid points (the LMI assembled here, and the
+    # re-check of verify_output_feedback, which refuses it), although every frozen loop is stable
+    before, _ = largest_brl(c.lyapunov, c.gamma, d, fine)
+    assert before > 0
+    v = verify_output_feedback(d, fine, W_e=W_E, W_u=W_U, certificate=c, allow_failure=True)
+    assert not v.passed and v.max_cl_real < 0 and v.certificate_check.max_lmi_eig_at == [1.0]
+    # a certificate at this gamma exists on the fine grid: cvxpy/Clarabel's optimum there is below it
+    assert conic_optimum(d, fine) <= c.gamma
+    # one cut (the worst point, rho = 1) is enough: the other failing points (0.5, 1.5) pass after it
+    r = refine_certificate(c, d, fine, W_e=W_E, W_u=W_U, per_round=1)
+    ref = r.refinement
+    assert ref["passed"] and ref["stopped"] == "passed" and ref["points_added"] == 1
+    assert ref["rounds"][0]["added_at"] == [[1.0]] and ref["rounds"][0]["failing"] == 3
+    assert r.gamma == c.gamma and r.lower_bound == c.lower_bound
+    after, minX = largest_brl(r.lyapunov, r.gamma, d, fine)
+    assert after < 0 and minX > 0
+    v = verify_output_feedback(d, fine, W_e=W_E, W_u=W_U, certificate=r)
+    assert v.passed and v.to_dict()["rate_bounded_refinement_passed"] is True
+    assert v.to_dict()["rate_bounded_verification_max_eig"] < 0
+
+
+def test_refinement_budgets_and_refusals(nonlinear):
+    from tmfem.control.lpv_certificate import refine_certificate
+    pl, d, c, fine = nonlinear
+    # no round allowed: the certificate is returned as it was, with the failing points counted
+    r = refine_certificate(c, d, fine, W_e=W_E, W_u=W_U, max_rounds=0)
+    assert not r.refinement["passed"] and r.refinement["stopped"] == "rounds"
+    assert r.refinement["rounds"][0]["failing"] == 3 and r.lyapunov is c.lyapunov
+    # a certificate that already holds on the fine grid: no round, nothing added
+    lin = oscillator()
+    dl = make_design(lin)
+    cl = rate_bounded_certificate(dl, lin, W_e=W_E, W_u=W_U, rtol=1e-2)
+    rl = refine_certificate(cl, dl, oscillator(np.linspace(0, 2, 9)), W_e=W_E, W_u=W_U)
+    assert rl.refinement["passed"] and rl.refinement["points_added"] == 0 and rl.lyapunov is cl.lyapunov
+    with pytest.raises(InputError, match="contain every design point"):
+        refine_certificate(c, d, nonlinear_oscillator(np.linspace(0, 1.9, 5)), W_e=W_E, W_u=W_U)
+    with pytest.raises(InputError, match="per_round"):
+        refine_certificate(c, d, fine, W_e=W_E, W_u=W_U, per_round=0)
+    none = rate_bounded_certificate(d, pl, W_e=W_E, W_u=W_U, time_budget=1e-9)
+    with pytest.raises(InputError, match="found none"):
+        refine_certificate(none, d, fine, W_e=W_E, W_u=W_U)

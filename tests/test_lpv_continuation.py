@@ -57,8 +57,17 @@ def test_sampled_bisection_starts_from_the_collapsed_grid_design():
     ctrl, br = bisect_gamma(gp, lower=lb, upper=2 * lb, rtol=0.05, sample_time=dt)
     assert br.start_grid == [3, 1] and br.start_levels and br.start_levels[0]["start"] == "riccati"
     sub_gamma = min(lv["gamma"] for lv in br.start_levels if lv["result"] == "feasible")
-    assert br.levels[0]["start"] == f"sub-grid design 3x1 (gamma {sub_gamma:.5g})"
-    assert br.levels[0]["result"] == "feasible" and lb <= ctrl.gamma <= 2 * lb
+    sub_nf = [lv["gamma"] for lv in br.start_levels if lv["result"] == "not found"]
+    run = [lv for lv in br.levels if "carried" not in lv["result"]]
+    assert run[0]["start"] == f"sub-grid design 3x1 (gamma {sub_gamma:.5g})"
+    # the first full level: the lowest where the extended sub-grid design holds as it is, or
+    # (here: it holds nowhere below the upper level) the upper level
+    assert run[0]["result"] == "feasible" and (run[0]["gamma"] == 2 * lb or run[0]["evaluations"] == 0)
+    assert lb <= ctrl.gamma <= 2 * lb
+    # the highest sub-grid level not found is carried as the full grid's lo
+    if sub_nf and max(sub_nf) > lb:
+        assert br.levels[0]["result"] == "not found on the 3x1 sub-grid (carried)"
+        assert br.levels[0]["gamma"] == max(sub_nf) <= br.not_found < ctrl.gamma
     assert br.to_dict()["gamma_start_grid"] == [3, 1]
     fine = two_parameter_oscillator(9, 9)
     v = verify(ctrl, fine, sample_time=dt)
@@ -88,3 +97,41 @@ def test_grid_continuation_only_where_it_applies():
     ctrl, _ = bisect_gamma(gp, lower=lb, upper=2 * lb, rtol=0.2)
     with pytest.raises(InputError, match="no given start"):
         bisect_gamma(gp, lower=lb, upper=2 * lb, sample_time=0.5, start=ctrl, grid_continuation=True)
+
+
+def test_a_full_grid_design_restricted_to_the_line_is_a_sub_grid_design():
+    # why a level not found on the collapsed grid is carried into the full grid's bracket: the
+    # full grid's P(rho), Q(rho) on the line b = 0.5 (normalised b = 0) hold the sub-grid's LMIs
+    # at the same gamma (its points are full-grid points; the rate vertices +-v_b average out)
+    from tmfem.control.lpv_synthesis import LPVStateFeedback
+    gp = two_parameter_oscillator()
+    lb = pointwise_state_feedback_bound(gp).lower_bound
+    ctrl, _ = bisect_gamma(gp, lower=lb, upper=2 * lb, rtol=0.05)
+    assert ctrl.varying == [0, 1]
+    sub = collapsed(gp, 1)
+    line = LPVStateFeedback(gamma=ctrl.gamma, P=ctrl.P[:2], Q=ctrl.Q[:2], centre=ctrl.centre,
+                            half_width=ctrl.half_width, varying=[0], axes=sub.axes, parameter_names=["a", "b"],
+                            rate_bounds=ctrl.rate_bounds, state_names=ctrl.state_names, solver="restricted",
+                            status="", solve_time=0.0, build_time=0.0, sizes={}, max_lmi_eig=np.nan, min_P_eig=np.nan)
+    for a in gp.axes[0]:
+        np.testing.assert_allclose(line.gain([a, 0.5]), ctrl.gain([a, 0.5]), rtol=1e-12, atol=1e-12)
+    assert verify(line, sub).passed
+
+
+def test_first_level_of_a_given_start_is_its_lowest_free_level():
+    # a design feasible at g1 given as the start with the upper level 4 x the bound: the first
+    # level is the lowest gamma where it holds as it is (to rtol / 4), found without iterating;
+    # 2 % below it the same P, Q fail the LMI (verify), so the level is the design's own
+    import dataclasses
+    gp = two_parameter_oscillator()
+    lb = pointwise_state_feedback_bound(gp).lower_bound
+    d1, _ = bisect_gamma(gp, lower=lb, upper=2 * lb, rtol=0.3)
+    ctrl, br = bisect_gamma(gp, lower=lb, upper=4 * lb, rtol=0.05, start=d1)
+    first = br.levels[0]
+    assert first["start"] == "given design" and first["result"] == "feasible" and first["evaluations"] == 0
+    assert first["gamma"] <= d1.gamma * (1 + 0.05 / 4) and first["gamma"] < 4 * lb
+    assert verify(dataclasses.replace(d1, gamma=first["gamma"]), gp).passed
+    assert not verify(dataclasses.replace(d1, gamma=0.98 * first["gamma"]), gp, allow_failure=True).passed
+    # without it the first level is the upper one, as before
+    _, br0 = bisect_gamma(gp, lower=lb, upper=4 * lb, rtol=0.05, start=d1, first_free=False)
+    assert br0.levels[0]["gamma"] == 4 * lb

@@ -14,6 +14,10 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"
     (["control", "lpv", "--noise", "0.01"], "applies with --output-feedback only"),
     (["control", "lpv", "--output-feedback", "--bound-only"], "does not apply with --output-feedback"),
     (["control", "lpv", "--rate-certificate"], "applies with --output-feedback only"),
+    (["control", "lpv", "--output-feedback", "--certificate-rounds", "2"], "applies with --rate-certificate only"),
+    (["control", "lpv", "--output-feedback", "--rate-certificate", "--certificate-rounds", "-1"],
+     "expected an integer >= 0"),
+    (["control", "hinf", "--preset", "1-4D", "--certificate-rounds", "2"], "apply to `tmfem control lpv` only"),
     (["control", "hinf", "--preset", "1-4D", "--rate-certificate"], "apply to `tmfem control lpv` only"),
     (["control", "lpv", "--output-feedback", "--noise", "0"], "expected a weight > 0"),
     (["control", "lpv", "--output-feedback", "--solver", "EIGOPT", "--sample-time", "-1"], "expected seconds > 0"),
@@ -53,6 +57,8 @@ def test_output_feedback_on_one_point_of_the_2_3_plant(capsys, tmp_path):
     assert out["rate_bounded_frozen_norm_max"] == pytest.approx(out["gamma"], rel=1e-6)
     assert out["rate_bounded_frozen_norm_max"] <= out["rate_bounded_gamma"] <= 2 * out["rate_bounded_frozen_norm_max"]
     assert out["rate_bounded_verification_max_eig"] < 0
+    # the fine grid is that one point: the cutting-plane refinement checks it and adds nothing
+    assert out["rate_bounded_refinement_passed"] and out["rate_bounded_refinement_points_added"] == 0
     saved = np.load(f)
     assert saved["L"].shape == (1, 1, 50, 25) and float(saved["W_n"]) == 1e-3
 

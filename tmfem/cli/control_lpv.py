@@ -16,10 +16,14 @@ MAX_VERIFY_POINTS = 500
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
 LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma", "gamma_rtol",
-            "time_budget", "fixed_gamma", "sample_time", "start", "output_feedback", "noise", "rate_certificate")
+            "time_budget", "fixed_gamma", "sample_time", "start", "output_feedback", "noise", "rate_certificate",
+            "certificate_rounds")
 
 #: EIGOPT defaults: relative bracket width of the gamma bisection, its time budget [s]
 GAMMA_RTOL, TIME_BUDGET = 0.05, 300.0
+
+#: cutting-plane rounds of the rate-bounded certificate on the finer grid, points added per round
+CERTIFICATE_ROUNDS, CERTIFICATE_PER_ROUND = 8, 4
 
 
 def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
@@ -60,7 +64,13 @@ def configure(parser) -> None:
     parser.add_argument("--rate-certificate", action="store_true", default=None,
                         help="lpv --output-feedback: also the rate-bounded certificate of the output-feedback "
                              "loop (analysis LMI with X(rho) affine, EIGOPT bisection on gamma with the "
-                             "--gamma-rtol and --time-budget of the synthesis), re-checked on the finer grid")
+                             "--gamma-rtol and --time-budget of the synthesis), re-checked on the finer grid; "
+                             "where it fails there, refined by cutting planes (--certificate-rounds)")
+    parser.add_argument("--certificate-rounds", type=int, default=None,
+                        help="lpv --rate-certificate: at most this many cutting-plane rounds when the design-grid "
+                             "certificate fails on the finer grid (each imposes the 4 worst failing points of "
+                             "that grid and re-solves at the same gamma, within another --time-budget; default "
+                             f"{CERTIFICATE_ROUNDS}, 0: none; docs/lpv.md)")
     parser.add_argument("--noise", type=float, default=None,
                         help="lpv --output-feedback: measurement-noise weight W_n of the estimator design "
                              "and of the verified norm [rad, m] (default 0.001)")
@@ -211,9 +221,10 @@ def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None):
     frozen on the fine grid (sampled at ``dt`` when given). JSON: ``gamma`` becomes the
     largest frozen closed-loop norm from [q_d, n_d, n] to p over the fine grid
     (``state_feedback_gamma`` the certified level of K(rho)); ``verification_max_eig`` stays
-    the LMI of K(rho) re-checked there. ``certificate``: (rtol, time budget) of the rate-bounded
-    certificate of the loop (:mod:`tmfem.control.lpv_certificate`) on the design grid, re-checked
-    on the fine grid (keys ``rate_bounded_*``), or None."""
+    the LMI of K(rho) re-checked there. ``certificate``: (rtol, time budget, rounds) of the
+    rate-bounded certificate of the loop (:mod:`tmfem.control.lpv_certificate`) on the design grid,
+    refined by cutting planes on the fine grid (at most ``rounds`` re-solves within another time
+    budget) and re-checked there (keys ``rate_bounded_*``), or None."""
     from tmfem.cli.common import progress_bar
     from tmfem.control.lpv_output import design_output_feedback, verify_output_feedback
     nz = plant.nx // 2
@@ -222,13 +233,18 @@ def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None):
     d = design_output_feedback(ctrl, plant, tracked=s.q_names, measured=measured, W_n=noise)
     cert = None
     if certificate is not None:
-        from tmfem.control.lpv_certificate import rate_bounded_certificate
-        rtol, budget = certificate
+        from tmfem.control.lpv_certificate import rate_bounded_certificate, refine_certificate
+        rtol, budget, rounds = certificate
         with progress_bar(budget, 1, "rate-bounded certificate (s of budget)") as bar:
             t1 = time.perf_counter()
             cert = rate_bounded_certificate(d, plant, W_e=0.5, W_u=0.05, rtol=rtol, time_budget=budget,
                                             progress=lambda w: bar(int(min(time.perf_counter() - t1, budget)),
                                                                    budget))
+        if cert.found and rounds > 0:
+            with progress_bar(rounds, 1, "certificate refinement (rounds)") as bar:
+                cert = refine_certificate(cert, d, fine, W_e=0.5, W_u=0.05, per_round=CERTIFICATE_PER_ROUND,
+                                          max_rounds=rounds, time_budget=budget,
+                                          progress=lambda k: bar(min(k, rounds), rounds))
     with progress_bar(int(np.prod(fine.grid_shape)), 1, "output-feedback verification (points)") as bar:
         vo = verify_output_feedback(d, fine, W_e=0.5, W_u=0.05, dt=dt, certificate=cert, progress=bar)
     return d, {"output_feedback": True, "measured": measured, "noise_weight": noise, "W_d": d.W_d,
@@ -252,6 +268,11 @@ def run(args) -> dict:
         raise InputError("lpv: option --noise applies with --output-feedback only")
     if args.rate_certificate and not args.output_feedback:
         raise InputError("lpv: option --rate-certificate applies with --output-feedback only")
+    if args.certificate_rounds is not None and not args.rate_certificate:
+        raise InputError("lpv: option --certificate-rounds applies with --rate-certificate only")
+    rounds = CERTIFICATE_ROUNDS if args.certificate_rounds is None else args.certificate_rounds
+    if rounds < 0:
+        raise InputError(f"--certificate-rounds: expected an integer >= 0, found {rounds}")
     if args.output_feedback and args.bound_only:
         raise InputError("lpv: --bound-only computes no controller; it does not apply with --output-feedback")
     noise = 1e-3 if args.noise is None else args.noise
@@ -271,7 +292,7 @@ def run(args) -> dict:
     saved = ctrl
     if args.output_feedback:
         saved, extra = output_feedback(ctrl, plant, fine, cfg["system"], noise, args.sample_time,
-                                       certificate=(cfg["rtol"], cfg["budget"]) if args.rate_certificate else None)
+                                       certificate=(cfg["rtol"], cfg["budget"], rounds) if args.rate_certificate else None)
         out = {**out, **extra}
     if args.save:
         saved.save(args.save)
@@ -303,6 +324,11 @@ def format_text(r: dict) -> str:
                             f"{r['rate_bounded_frozen_norm_max']:.5g}), re-checked on the fine grid: max LMI "
                             f"eigenvalue {r['rate_bounded_verification_max_eig']:.3e}"
                             if r["rate_bounded_certificate"] else f"not found ({r['rate_bounded_message']})"))
+        if "rate_bounded_refinement_passed" in r:
+            lines.append(f"  cutting-plane refinement on {r['rate_bounded_refinement_fine_grid']}: "
+                         f"{r['rate_bounded_refinement_stopped']} after {len(r['rate_bounded_refinement_rounds'])} "
+                         f"checks, {r['rate_bounded_refinement_points_added']} points added "
+                         f"({r['rate_bounded_refinement_time_s']:.0f} s)")
     if r.get("gamma_levels"):
         nf = r["gamma_not_found"]
         lines.append(f"EIGOPT bisection ({len(r['gamma_levels'])} levels, {r['gamma_search_time_s']:.0f} s, stopped on "

@@ -71,6 +71,7 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
                  time_budget: float = 300.0, max_iter: int = 150, margin: float = 1e-8,
                  t_schedule=(1e-2, 1e-3, 1e-4), sample_time: float | None = None,
                  start: LPVStateFeedback | None = None, grid_continuation: bool | None = None,
+                 carry_not_found: bool = True, first_free: bool = True,
                  progress=None) -> tuple[LPVStateFeedback, GammaBracket]:
     """Minimise gamma of eqs. 5.95-5.96 on the grid of ``gp`` (module docstring).
 
@@ -101,6 +102,16 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
         Start from the design of the bisection on the :func:`collapsed` grid (module
         docstring). Default: with ``sample_time``, no ``start`` and more than one varying
         parameter. The sub-grid stage's levels are ``GammaBracket.start_levels``.
+    carry_not_found : bool
+        With the continuation in the grid, the highest level not found on the sub-grid becomes
+        the full grid's lo (and ``not_found``): a full-grid design restricted to the sub-grid's
+        line is a sub-grid design at the same gamma (the LMIs of the line are among the full
+        grid's; the rate vertices +-v of the collapsed parameter average to its zero rate), so
+        that level is "not found" for the full grid in the same local sense (docs/lpv.md).
+    first_free : bool
+        From a given start (or the sub-grid design), the first level is the lowest gamma at
+        which the start holds every LMI as it is (a bisection on the sign of the largest
+        eigenvalue, which decreases with gamma; no iteration) when that is below ``upper``.
     progress : callable, optional
         Called with (hi - lo) / hi after each level.
 
@@ -145,11 +156,19 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     levels, best, not_found = [], None, None
     z_start = e.riccati_start(upper) if start is None else e.start_from(*given)
     lo, hi, gamma, stopped = lower, upper, upper, "tolerance"
+    if sub is not None and carry_not_found and sub_br.not_found is not None and sub_br.not_found > lo:
+        lo = not_found = sub_br.not_found
+        levels.append({"gamma": lo, "evaluations": 0, "time_s": 0.0, "cpu_s": 0.0, "largest_scaled_eig": None,
+                       "start": first, "result": f"not found on the {'x'.join(map(str, sub.grid_shape))} "
+                                                 "sub-grid (carried)"})
+    if start is not None and first_free:
+        gamma = _lowest_free_level(e, z_start, lo, upper, margin=margin, rtol=rtol / 4)
     while True:
-        t1, n1 = time.perf_counter(), e.evaluations
+        t1, c1, n1 = time.perf_counter(), time.process_time(), e.evaluations
         z, worst, reason = e.solve(gamma, z_start, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
                                    deadline=deadline)
         row = {"gamma": gamma, "evaluations": e.evaluations - n1, "time_s": time.perf_counter() - t1,
+               "cpu_s": time.process_time() - c1,
                "largest_scaled_eig": worst, "start": first if best is None else "continuation"}
         if reason == "time":
             levels.append({**row, "result": "unfinished (time budget)"})
@@ -167,6 +186,9 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
                  row["evaluations"], row["time_s"])
         if ctrl is not None:
             best, hi, z_start = ctrl, gamma, z
+        elif best is None and gamma < upper:      # a free first level refused on re-computation
+            gamma = upper
+            continue
         elif best is None:
             raise InfeasibleController(f"gamma bisection: expected a feasible point at the upper level "
                                        f"gamma = {upper:.5g}, found none (largest scaled LMI eigenvalue "
@@ -192,6 +214,25 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
     best.solve_time = total
     log.info("gamma bisection: %s", best.status)
     return best, br
+
+
+def _lowest_free_level(e: EigOpt, z, lo: float, hi: float, *, margin: float, rtol: float) -> float:
+    """The lowest level in (lo, hi] (to ``rtol``) where ``z`` holds every LMI of ``e`` as it is
+    (largest scaled eigenvalue < -margin, the test of :meth:`EigOpt.solve` before iterating); the
+    LMIs of eq. 5.95 decrease with gamma (-gamma I blocks), so the sign test is monotone. ``hi``
+    when ``z`` fails there too."""
+    def holds(g):
+        scale = tuple(None if X is None else np.maximum(np.abs(X).max(axis=(-2, -1)), 1e-300)
+                      for X in e.matrices(z, g))
+        return e.largest(z, g, scale) < -margin
+    if not holds(hi):
+        return hi
+    a, b = lo, hi
+    while b - a > rtol * b:
+        m = (a + b) / 2
+        a, b = (a, m) if holds(m) else (m, b)
+    log.info("gamma bisection: the start holds every LMI as it is from gamma = %.5g", b)
+    return b
 
 
 def collapsed(gp: GeneralisedLPV, k: int) -> GeneralisedLPV:

@@ -37,6 +37,7 @@ sampled loops are checked frozen only (:func:`~tmfem.control.lpv_output.verify_o
 """
 from __future__ import annotations
 
+import itertools
 import logging
 import time
 from dataclasses import dataclass, field
@@ -153,7 +154,8 @@ class RateBoundedCertificate:
     no level was found; ``gamma``: its certified L2-gain bound; ``lower_bound``: the largest
     frozen-loop norm of the design grid (proven: no certificate below it); ``bracket``: the
     :class:`~tmfem.control.lpv_bisect.GammaBracket`, or None; ``message``: why none was found;
-    ``start``: the separation start's gamma of Z, beta and largest relative LMI eigenvalue."""
+    ``start``: the separation start's gamma of Z, beta and largest relative LMI eigenvalue;
+    ``refinement``: the rounds of :func:`refine_certificate` (empty without it)."""
 
     lyapunov: LPVStateFeedback | None
     gamma: float | None
@@ -163,6 +165,7 @@ class RateBoundedCertificate:
     time_s: float
     message: str = ""
     start: dict = field(default_factory=dict)
+    refinement: dict = field(default_factory=dict)
 
     @property
     def found(self) -> bool:
@@ -175,6 +178,7 @@ class RateBoundedCertificate:
              **{f"rate_bounded_start_{k}": v for k, v in self.start.items()}}
         if self.bracket is not None:
             d["rate_bounded_levels"] = self.bracket.levels
+        d.update({f"rate_bounded_refinement_{k}": v for k, v in self.refinement.items()})
         return d
 
 
@@ -218,3 +222,135 @@ def rate_bounded_certificate(design, plant: GriddedLPV, *, W_e: float, W_u: floa
                                       bracket=None, time_s=time.perf_counter() - t0, message=str(exc), start=info)
     return RateBoundedCertificate(lyapunov=X, gamma=X.gamma, lower_bound=lo, lower_bound_at=lo_at, bracket=br,
                                   time_s=time.perf_counter() - t0, message=X.status, start=info)
+
+
+def pointwise_lmi_eigs(lyapunov: LPVStateFeedback, gp: GeneralisedLPV, gamma: float | None = None):
+    """The largest relative eigenvalue of the analysis LMI (module docstring; over the rate
+    vertices, divided by the matrix's largest |entry| as in :func:`tmfem.control.lpv_verify.verify`)
+    and the smallest eigenvalue of X(rho), at every point of ``gp``'s grid (arrays of the grid's
+    shape), with X(rho) = ``lyapunov.P_of`` and ``gamma`` (default the Lyapunov matrix's)."""
+    from tmfem.control.lpv_synthesis import lmi_matrix
+    g = lyapunov.gamma if gamma is None else gamma
+    dXs = [sum((v[k] / lyapunov.half_width[k]) * lyapunov.P[1 + j] for j, k in enumerate(lyapunov.varying))
+           if lyapunov.varying else 0.0 * lyapunov.P[0] for v in gp.rate_vertices()]
+    lmi, minX = np.full(gp.grid_shape, -np.inf), np.full(gp.grid_shape, np.inf)
+    for idx in np.ndindex(*gp.grid_shape):
+        rho = np.array([a[i] for a, i in zip(gp.axes, idx)])
+        X = lyapunov.P_of(rho)
+        minX[idx] = np.linalg.eigvalsh((X + X.T) / 2).min()
+        for dX in dXs:
+            M = lmi_matrix(A=gp.A[idx], B1=gp.B1[idx], B2=gp.B2[idx], C1=gp.C1[idx], D11=gp.D11[idx],
+                           D12=gp.D12[idx], P=X, Q=np.zeros((0, X.shape[0])), dP=dX, gamma=g)
+            lmi[idx] = max(lmi[idx], float(np.linalg.eigvalsh((M + M.T) / 2).max() / np.abs(M).max()))
+    return lmi, minX
+
+
+def refine_certificate(certificate: RateBoundedCertificate, design, fine: GriddedLPV, *, W_e: float, W_u: float,
+                       per_round: int = 4, max_rounds: int = 8, time_budget: float = 600.0, max_iter: int = 150,
+                       margin: float = 1e-8, t_schedule=(1e-4, 1e-5, 1e-6), progress=None) -> RateBoundedCertificate:
+    """Cutting-plane refinement of a design-grid certificate until its LMI holds on ``fine``.
+
+    The certificate's LMI is imposed at the design grid points only; between them the loop of
+    the true plant and the controller's interpolated model (:func:`closed_loop_lpv` on ``fine``,
+    as :func:`~tmfem.control.lpv_output.verify_output_feedback` builds it) may violate it. Each
+    round re-checks X(rho) at every point and rate vertex of ``fine`` (:func:`pointwise_lmi_eigs`);
+    if some fail, the ``per_round`` worst of them join the imposed points (with all rate vertices)
+    and EIGOPT (:class:`~tmfem.control.lpv_eigopt.EigOpt` on the imposed points, balanced on the
+    current X) re-solves the LMI at the certificate's gamma from the current X(rho), which is
+    already nearly feasible; X(rho) stays affine in rho. Ends when the fine grid passes
+    (``refinement["passed"]``), after ``max_rounds`` re-solves, when ``time_budget`` seconds are
+    spent, or when a re-solve finds no point (reported, not a proof: EIGOPT is local).
+
+    ``fine`` must contain the design grid (e.g. ``plant.resampled(plant.refined(4))`` or the
+    COM linearisations on ``plant.refined(4)``): the imposed points are points of ``fine``.
+    Returns a new certificate: X(rho) the last one found (the input's when no round found one),
+    ``refinement`` the rounds (points added, largest fine-grid eigenvalue before each round,
+    evaluations, times) and ``passed``.
+
+    Raises
+    ------
+    InputError
+        No found certificate, bad options, or a ``fine`` grid that misses a design point.
+    """
+    from tmfem.control.lpv_bisect import _coefficients
+    from tmfem.control.lpv_eigopt import EigOpt
+    from tmfem.control.lpv_synthesis import Coordinates, Tm_back
+    if not certificate.found:
+        raise InputError("certificate refinement: expected a found rate-bounded certificate, found none "
+                         f"({certificate.message})")
+    if not (int(per_round) == per_round >= 1 and int(max_rounds) == max_rounds >= 0 and time_budget > 0):
+        raise InputError(f"certificate refinement: expected per_round >= 1, max_rounds >= 0 (integers) and a "
+                         f"time budget > 0, found {per_round!r}, {max_rounds!r}, {time_budget!r}")
+    X = certificate.lyapunov
+    design_idx = []
+    for rho in itertools.product(*X.axes):
+        hit = [np.flatnonzero(np.isclose(a, r, rtol=0, atol=1e-12 * max(1.0, np.abs(a).max())))
+               for a, r in zip(fine.axes, rho)]
+        if any(h.size == 0 for h in hit):
+            raise InputError(f"certificate refinement: expected the fine grid to contain every design point, "
+                             f"found none at rho = {list(rho)}")
+        design_idx.append(tuple(int(h[0]) for h in hit))
+    t0, c0 = time.perf_counter(), time.process_time()
+    deadline = t0 + time_budget
+    gp = closed_loop_lpv(design, fine, W_e=W_e, W_u=W_u)
+    co = Coordinates.of(gp)
+    gamma, imposed, rounds = X.gamma, list(design_idx), []
+    passed, stopped = False, "rounds"
+    while True:
+        t1, c1 = time.perf_counter(), time.process_time()
+        lmi, minX = pointwise_lmi_eigs(X, gp)
+        worst = float(lmi.max())
+        at = [float(a[i]) for a, i in zip(gp.axes, np.unravel_index(int(np.argmax(lmi)), lmi.shape))]
+        check_s = time.perf_counter() - t1
+        fail = [tuple(int(i) for i in k) for k in np.argwhere((lmi >= 0) | (minX <= 0))]
+        log.info("certificate refinement: %d imposed points, fine grid %s: %d failing, largest relative LMI "
+                 "eigenvalue %.3e at %s (%.1f s)", len(imposed), gp.grid_shape, len(fail), worst, at, check_s)
+        if not fail:
+            passed, stopped = True, "passed"
+            rounds.append({"round": len(rounds), "fine_max_eig": worst, "fine_max_eig_at": at, "failing": 0,
+                           "check_s": check_s})
+            break
+        new = [k for k in sorted(fail, key=lambda k: -lmi[k]) if k not in imposed][:per_round]
+        row = {"round": len(rounds), "fine_max_eig": worst, "fine_max_eig_at": at, "failing": len(fail),
+               "check_s": check_s,
+               "added_at": [[float(a[i]) for a, i in zip(gp.axes, k)] for k in new]}
+        if not new:                             # an imposed point fails its re-computation
+            rounds.append(row)
+            stopped = "an imposed point fails"
+            break
+        if len(rounds) >= max_rounds or time.perf_counter() > deadline:
+            rounds.append(row)
+            stopped = "rounds" if len(rounds) > max_rounds else "time budget"
+            break
+        imposed += new
+        e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=gamma, points=imposed,
+                   balance_on=_coefficients(X, co, gp))
+        z, top, reason = e.solve(gamma, e.start_from(*_coefficients(X, co, gp)), t_schedule=t_schedule,
+                                 max_iter=max_iter, margin=margin, deadline=deadline)
+        row.update(imposed=len(imposed), evaluations=e.evaluations, largest_scaled_eig=top,
+                   result="found" if top < 0 else ("unfinished (time budget)" if reason == "time" else "not found"),
+                   time_s=time.perf_counter() - t1, cpu_s=time.process_time() - c1)
+        rounds.append(row)
+        log.info("certificate refinement: round %d, %d points imposed: %s (%d evaluations, largest scaled "
+                 "eigenvalue %.3e, %.1f s)", row["round"], len(imposed), row["result"], e.evaluations, top,
+                 row["time_s"])
+        if progress is not None:
+            progress(len(rounds))
+        if top >= 0:
+            stopped = "time budget" if reason == "time" else "not found"
+            break
+        Ps, _ = e.coefficients(z)
+        X = LPVStateFeedback(gamma=gamma, P=[Tm_back(P, co.T) for P in Ps], Q=[np.zeros((0, gp.A.shape[-1]))] * len(Ps),
+                             centre=co.centre, half_width=co.half, varying=co.varying,
+                             axes=[a.copy() for a in X.axes], parameter_names=list(X.parameter_names),
+                             rate_bounds=X.rate_bounds.copy(), state_names=list(X.state_names), solver="EIGOPT",
+                             status=f"refined: {len(imposed)} points imposed", solve_time=0.0, build_time=0.0,
+                             sizes={}, max_lmi_eig=top, min_P_eig=np.nan)
+    ref = {"passed": passed, "stopped": stopped, "rounds": rounds, "points_added": len(imposed) - len(design_idx),
+           "points_imposed": len(imposed), "fine_grid": list(gp.grid_shape), "time_s": time.perf_counter() - t0,
+           "cpu_s": time.process_time() - c0}
+    log.info("certificate refinement: %s after %d rounds, %d points added (%.1f s)", stopped, len(rounds),
+             ref["points_added"], ref["time_s"])
+    from dataclasses import replace
+    return replace(certificate, lyapunov=X, refinement=ref,
+                   message=certificate.message + f"; refined on {list(gp.grid_shape)}: {stopped}")

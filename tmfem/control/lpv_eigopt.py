@@ -80,13 +80,21 @@ class EigOpt:
         pointwise Riccati solutions at ``gamma`` for the balancing and the variable scale (a
         given start; the analysis LMI of a loop without control input, whose Riccati equation
         fails numerically for the lightly damped 121-state 2-3 loop: :mod:`tmfem.control.lpv_certificate`).
+    points : list of index tuples, optional
+        Impose the LMIs at these points of the grid of ``gp`` only (default: every point; the
+        cutting-plane refinement of :mod:`tmfem.control.lpv_certificate` imposes the design
+        points and the failing points of a finer grid). The balancing uses the listed point
+        nearest to the grid centre.
     """
 
     def __init__(self, gp, *, T, c_of, dvs, gamma: float, eps: float = 1e-4, sample_time: float | None = None,
-                 radius: float = 1.0, balance_on=None):
+                 radius: float = 1.0, balance_on=None, points=None):
         Ti = 1.0 / T
         self.eps, self.gamma0 = eps, gamma
-        idx = list(np.ndindex(*gp.grid_shape))
+        shp = gp.grid_shape
+        idx = list(np.ndindex(*shp)) if points is None else [tuple(int(i) for i in k) for k in points]
+        if not idx or any(len(k) != len(shp) or not all(0 <= i < s for i, s in zip(k, shp)) for k in idx):
+            raise InputError(f"EIGOPT: expected points as index tuples of the {shp} grid, found {points!r}")
         self.c = np.array([c_of(np.array([a[i] for a, i in zip(gp.axes, k)])) for k in idx])
         self.A = np.array([Ti[:, None] * gp.A[k] * T[None, :] for k in idx])
         self.B1 = np.array([Ti[:, None] * gp.B1[k] for k in idx])
@@ -95,12 +103,12 @@ class EigOpt:
         self.D11 = np.array([gp.D11[k] for k in idx])
         self.D12 = np.array([gp.D12[k] for k in idx])
         self.dvs = np.array(dvs, dtype=float)
-        shp = gp.grid_shape
         if balance_on is None:
             Pi, Qi = self._riccati(gamma)
         else:
             Pi, Qi = (np.einsum("ik,kab->iab", self.c, np.asarray(X, dtype=float)) for X in balance_on)
-        L = np.linalg.cholesky(Pi[int(np.ravel_multi_index(tuple(k // 2 for k in shp), shp))])
+        mid = np.array([k // 2 for k in shp])
+        L = np.linalg.cholesky(Pi[int(np.argmin([np.abs(np.array(k) - mid).sum() for k in idx]))])
         Li = np.linalg.inv(L)
         self.L = L
         self.A, self.B1, self.B2 = Li @ self.A @ L, Li @ self.B1, Li @ self.B2
