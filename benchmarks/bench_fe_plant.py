@@ -104,7 +104,7 @@ def main():
     else:
         fe = SBCModel(s, mesh_n=a.mesh, rest_lengths="system")
         dyn = sbc_dynamics.SBCDynamics(fe, fe.solve_static().state, perturb=perturb)
-    plant = Timed(FEStatePlant(dyn, com))
+    plant = Timed(FEStatePlant(dyn, com, bars="chord"))      # as measured in docs/fe-plant.md
     t_fe = time.perf_counter() - t0
     inner = []
     if a.plant == "sbc":

@@ -35,7 +35,7 @@ CLOSED = [("initial", "chord", 0.0, 0.0), ("initial", "rigid", 0.0, 0.0),
 def response(mesh):
     s = setup("1-4D", controller="adaptive")
     r0 = start_rest_lengths(INITIAL, "cable", s.model.u0)
-    sbc = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh)
+    sbc = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, bars="chord")
     u = r0.copy()
     u[:4] += 1e-3
     for name, p in (("COM", StatePlant(s.model, z0=s.z0)), ("SBC chord", sbc),

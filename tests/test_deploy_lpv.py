@@ -22,7 +22,8 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"
     (["--preset", "2-3-lpv", "--plant", "sbc", "--plant-tendons", "fixed-rate"], "cable law only"),
     (["--preset", "2-3-lpv", "--path", "linear"], "do not apply to the LPV deployment"),
     (["--preset", "2-3-lpv", "--pfl-at", "reference"], "do not apply to the LPV deployment"),
-    (["--preset", "2-3-lpv", "--compare-plant", "mtc"], "do not apply to the LPV deployment"),
+    (["--preset", "2-3-lpv", "--compare-plot", "x.png"], "--compare-plot belongs to --compare-plant"),
+    (["--preset", "2-3-lpv", "--compare-plant", "com"], "expected a plant other than --plant com"),
     (["--preset", "2-3-lpv", "--lpv-controller", "missing.npz"], "expected an existing .npz"),
     (["--preset", "2-3-lpv", "--lpv-controller", "x.npz", "--gamma", "5"], "belong to a synthesis on the fly"),
     (["--preset", "2-3-deploy", "--gamma", "5"], "apply to --controller lpv only"),
@@ -143,6 +144,39 @@ def _check_follows_the_com_run(runs, plant, bound):
     dev = max(np.max(np.abs(col[n] - com[n])) for n in q)
     assert dev < bound, dev
     return out
+
+
+def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
+    """`tmfem deploy --preset 2-3-lpv --plant mtc --compare-plant com --compare-plot`: the same
+    design (a fresh controller) on the 3 x 2 x 2 MTC and the COM plant over 0.3 s; the JSON's
+    bar deviation is the largest |q_mtc - q_com| of the two CSVs (computed here from the files),
+    both runs name the same controller (design, gamma) and their own plant's tendon law."""
+    import csv as _csv
+    pl, d, path = design21
+    png, a, b = tmp_path / "cmp.png", tmp_path / "mtc.csv", tmp_path / "com.csv"
+    assert main(["deploy", "--preset", "2-3-lpv", "--lpv-controller", str(path), "--plant", "mtc",
+                 "--plant-mesh", "2", "--compare-plant", "com", "--t-end", "0.3", "--csv", str(a),
+                 "--compare-csv", str(b), "--compare-plot", str(png), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    c = out["compare"]
+    assert png.stat().st_size > 10_000 and c["plot"] == str(png)
+    assert c["plant"] == "com" and c["failure"] is None and out["failure"] is None
+    for k in ("controller", "gamma", "lpv_controller"):
+        assert c[k] == out[k]
+    assert c["gamma"] == pytest.approx(d.gamma)
+    assert (out["plant_tendons"], c["plant_tendons"]) == ("cable", "fixed-rate")
+    assert c["rest_length_above_tendon_length_max_m"] <= 0 and c["max_tracking_error"] < 0.02
+    cols = []
+    for f in (a, b):
+        rows = list(_csv.reader(open(f)))
+        head = [h.split(" [")[0] for h in rows[0]]
+        cols.append({h: np.array([float(r[k]) for r in rows[1:]]) for k, h in enumerate(head[:-1])})
+    assert cols[0].keys() == cols[1].keys()
+    q = [n for n in cols[0] if n + "_ref" in cols[0]]
+    dq = max(np.max(np.abs(cols[0][n] - cols[1][n])) for n in q)
+    assert dq > 0
+    assert np.radians(c["deviation"]["max_bar_deviation_deg"]) == pytest.approx(dq, rel=1e-6)
+    assert c["deviation"]["common_record_s"] == pytest.approx(0.3)
 
 
 @pytest.mark.slow

@@ -49,10 +49,11 @@ def test_park_loop_refuses_bad_shapes():
         park_loop(lin, F_x=np.zeros((1, 2)), F_v=np.zeros((1, 2)), dt=0.0)
 
 
-def _start_radius(design, plant_kind, bar_factor=None):
+def _start_radius(design, plant_kind, bar_factor=None, bars=None):
     """Spectral radius and dominant frequency of the LPV deployment's sampled loop at its start
-    on the 3 x 2 x 2 FE plant ``plant_kind`` (the plant built as `tmfem deploy` builds it), the
-    bars' Young's modulus x ``bar_factor`` (the COM's bars are rigid either way)."""
+    on the 3 x 2 x 2 FE plant ``plant_kind`` (the plant built as `tmfem deploy` builds it; the
+    SBC plant's q measured by ``bars``), the bars' Young's modulus x ``bar_factor`` (the COM's
+    bars are rigid either way)."""
     from tmfem.control.state_estimate import deployment_plant
     from tmfem.reference.deployments import lpv_setup
     from tmfem.system import load_preset
@@ -61,7 +62,7 @@ def _start_radius(design, plant_kind, bar_factor=None):
         s = s.replace(bar=dataclasses.replace(s.bar, E=s.bar.E * bar_factor))
     pl, d, _ = design
     dep = lpv_setup("2-3-lpv", pl, system=s)
-    plant = deployment_plant(plant_kind, dep.model, dep.packaged(), mesh_n=2)
+    plant = deployment_plant(plant_kind, dep.model, dep.packaged(), mesh_n=2, bars=bars)
     return dominant_eigenvalues(lpv_start_loop(dep, d, plant, dt=0.01), 0.01, k=1)[0]
 
 
@@ -76,7 +77,7 @@ def test_lpv_start_loop_on_the_sbc_plant_is_unstable_near_nyquist(design21, mtc_
     # which the gain designed on rigid bars drives: the sampled loop grows by ~1.5 per sample
     # at 45.6 Hz (measured 1.4998); on the MTC plant (truss bars) 1.0095 at 5.8 Hz, whose
     # closed loop runs (tests/test_deploy_lpv.py)
-    r_sbc, f_sbc = _start_radius(design21, "sbc")
+    r_sbc, f_sbc = _start_radius(design21, "sbc", bars="chord")
     r_mtc, _ = mtc_start
     assert r_sbc > 1.3 and f_sbc > 40.0, (r_sbc, f_sbc)
     assert r_mtc < 1.02, r_mtc
@@ -86,22 +87,26 @@ def test_lpv_start_loop_on_the_sbc_plant_is_unstable_near_nyquist(design21, mtc_
 def test_lpv_start_loop_with_stiff_bars_is_the_mtc_one(design21, mtc_start):  # noqa: F811
     # the bars' bending is the cause: with E x 10 (bending modes x 3.2 in frequency, x 10 less
     # compliance) the SBC loop at the start is the MTC one (measured 1.00943 against 1.00953)
-    r, _ = _start_radius(design21, "sbc", bar_factor=10.0)
+    r, _ = _start_radius(design21, "sbc", bar_factor=10.0, bars="chord")
     assert r == pytest.approx(mtc_start[0], abs=1e-3)
 
 
-def test_2_3_adaptive_deployment_on_the_sbc_plant_is_the_mtc_one(capsys):
+@pytest.mark.parametrize("bars", [None, "chord"])
+def test_2_3_adaptive_deployment_on_the_sbc_plant_is_the_mtc_one(bars, capsys):
     # the 7.4 deployment of the 2-3 system (adaptive PFL at the reference, cable tendons) runs
-    # on the SBC plant with the bar chords as measured q: its gains are low enough that the
-    # bars' bending modes stay out of the loop; over the first 2 s on 3 x 4 x 4 its bars stay
-    # within 0.5 mrad of the same deployment on the MTC plant (measured 0.047 mrad; 3 x 10 x
-    # 10 over 20 s with the switch: 0.20 mrad, docs/fe-plant.md), no rest length above its
+    # on the SBC plant with q measured as the bars' rigid fit (the default) and as their
+    # chords: its gains are low enough that the bars' bending modes stay out of the loop; over
+    # the first 2 s on 3 x 4 x 4 its bars stay within 0.5 mrad of the same deployment on the
+    # MTC plant (measured 0.047 mrad with the chords, 0.057 mrad with the rigid fit; 3 x 10 x 10
+    # over 20 s with the switch: 0.20 mrad, docs/fe-plant.md), no rest length above its
     # tendon, and the FE tendons slack only where the allocation holds the P_2j at zero tension
     import json
     from tmfem.cli import main
     assert main(["deploy", "--preset", "2-3-deploy", "--controller", "adaptive", "--plant", "sbc",
-                 "--plant-mesh", "4", "--compare-plant", "mtc", "--t-end", "2", "--json"]) == 0
+                 "--plant-mesh", "4", "--compare-plant", "mtc", "--t-end", "2", "--json",
+                 *(["--plant-bars", bars] if bars else [])]) == 0
     out = json.loads(capsys.readouterr().out)
+    assert out["plant_bars"] == (bars or "rigid")
     assert out["failure"] is None and out["compare"]["failure"] is None
     assert np.radians(out["compare"]["deviation"]["max_bar_deviation_deg"]) < 5e-4
     assert out["min_rest_length_margin_m"] >= 0.0

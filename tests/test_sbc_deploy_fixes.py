@@ -42,6 +42,37 @@ def test_rigid_fit_of_straight_bars_is_their_chord(preset):
     assert np.max(np.abs(got - ref)) < 1e-12
 
 
+@pytest.mark.parametrize("preset", ["1-4D", "2-3-deploy"])
+def test_rigid_fit_of_two_node_bars_is_their_chord(preset):
+    """A bar of two nodes (the MTC model's truss bars) is its chord whatever the positions:
+    with the nodes moved at random by up to 5 mm (the bar stretched and turned, a free base
+    moved), the rigid fit (lumped masses 1/2, 1/2) returns the q of the end nodes (eqs.
+    3.1-3.2) to round-off -- so the MTC plant's chord measurement is the SBC plant's default
+    rigid fit."""
+    system = load_preset(preset)
+    q = np.asarray(system.q, dtype=float)
+    s = np.array([0.0, 1.0])
+    X = _chains(system, q, s)
+    X[:, :, 1:] += 5e-3 * np.random.default_rng(3).uniform(-1, 1, X[:, :, 1:].shape)
+    free = np.arange(system.M * system.N) >= system.N        # stage 2: the base moves too
+    X[:, free, 0] += 5e-3 * np.random.default_rng(4).uniform(-1, 1, X[:, free, 0].shape)
+    got = rigid_bar_fit(system, X, s)
+    ends = q_from_positions(system, np.concatenate([X[:, :, 0], X[:, :, 1]], axis=1))
+    assert np.max(np.abs(got - ends)) < 1e-12
+
+
+def test_sbc_plant_measures_the_rigid_fit_by_default(dep):
+    """The SBC plant's bar measurement defaults to the rigid fit (the chords see the beams'
+    bending modes, docs/fe-plant.md), on the library's plant as on the CLI's."""
+    from tmfem.cli.deploy import plant_arguments
+    from tmfem.cli import build_parser
+    s, init, plant, _ = dep
+    assert plant.estimator.bars == "rigid"
+    args = build_parser().parse_args(["deploy", "--preset", "1-4D", "--plant", "sbc"])
+    assert plant_arguments(args, "sbc")["bars"] == "rigid"
+    assert FEStatePlant(plant.dyn, s.model, bars="chord").estimator.bars == "chord"
+
+
 def test_rigid_fit_ignores_a_bending_shape_orthogonal_to_the_rotation():
     """A bar on a fixed base bent by a shape phi(s) = s^2 (s - c) normal to it, with c such
     that sum_i m_i s_i phi_i = 0 (mass-orthogonal to the rigid rotation about A): the fit

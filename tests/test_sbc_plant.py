@@ -20,17 +20,20 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"
 
 @pytest.fixture(scope="module")
 def dep():
-    """The 1-4(D) deployment of 7.4 (adaptive PFL) and its SBC plant on a 4 x 4 x 4 mesh."""
+    """The 1-4(D) deployment of 7.4 (adaptive PFL) and its SBC plant on a 4 x 4 x 4 mesh, q
+    measured as the bar chords (the tests below are about what the chords see; the default
+    rigid fit: tests/test_sbc_deploy_fixes.py)."""
     s = setup("1-4D", controller="adaptive")
     init = load_preset("1-4D-initial")
-    plant = sbc_deployment_plant(s.model, init, mesh_n=4)
+    plant = sbc_deployment_plant(s.model, init, mesh_n=4, bars="chord")
     return s, init, plant, start_rest_lengths(init, "cable", s.model.u0)
 
 
 def test_sbc_estimate_inverts_the_com_placement(dep):
-    """An SBC state placed on the COM's own field (eqs. 5.1, 5.3: bar chords at q, shell
-    mid-surface at P_0 + Psi Delta(q) + Phi eta) is estimated back exactly, rates included:
-    the beam rotations and the H_1j nodes of the bars do not enter the estimate (4 x 10 x 10,
+    """An SBC state placed on the COM's own field (eqs. 5.1, 5.3: straight bars at q, shell
+    mid-surface at P_0 + Psi Delta(q) + Phi eta) is estimated back exactly, rates included,
+    by the default rigid fit of the bars (of straight bars: their chord): the beam rotations
+    and the H_1j nodes of the bars do not enter the estimate (4 x 10 x 10,
     the mesh of the COM's membrane basis, so that the interpolations are exact)."""
     s, init, _, _ = dep
     plant = sbc_deployment_plant(s.model, init, mesh_n=10)
@@ -176,17 +179,39 @@ def test_compare_mtc_with_com_2_3(tmp_path, capsys):
     assert dev["common_record_s"] == pytest.approx(0.3)
     assert np.radians(dev["max_bar_deviation_deg"]) < 7e-3
     assert out["units"]["max_bar_deviation_deg"] == "deg"
+    # one controller on both plants, its tendon model the plants' fixed rates: no warning
+    for k in ("controller", "uncertainty", "allocation", "pfl_at", "pfl_tendon_model"):
+        assert out["compare"][k] == out[k]
+    assert out["pfl_tendon_model"] == out["compare"]["plant_tendons"] == "fixed-rate"
+    assert out["warnings"] == []
+
+
+def test_compare_warns_where_the_pfl_tendon_model_is_not_the_plants(capsys):
+    """With cable tendons on the MTC plant the PFL's tendon model is the cable law (the
+    FE-plant default), which the COM plant (fixed rates of eq. 5.19) does not have: the same
+    controller runs on both, and the JSON and stderr say so for the COM run only."""
+    from tmfem.cli import main
+    rc = main(["deploy", "--preset", "2-3-deploy", "--controller", "adaptive", "--plant", "mtc",
+               "--plant-mesh", "2", "--compare-plant", "com", "--t-end", "0.05", "--json"])
+    cap = capsys.readouterr()
+    out = json.loads(cap.out)
+    assert rc == 0
+    assert out["pfl_tendon_model"] == out["compare"]["pfl_tendon_model"] == "cable"
+    assert (out["plant_tendons"], out["compare"]["plant_tendons"]) == ("cable", "fixed-rate")
+    assert len(out["warnings"]) == 1 and "com plant's tendon law (fixed-rate)" in out["warnings"][0]
+    assert "warning: the PFL's tendon model (cable)" in cap.err
 
 
 @pytest.mark.slow
 def test_1_4d_sbc_deployment_fails_and_keeps_its_record(tmp_path, capsys):
-    """The 1-4(D) deployment (7.4, adaptive + H-infinity) on the SBC plant diverges within
-    0.2 s (docs/fe-plant.md: 0.11 s on 4 x 4 x 4 and 4 x 10 x 10): the CLI exits 1 naming
+    """The 1-4(D) deployment (7.4, adaptive + H-infinity) on the SBC plant measured through
+    the bar chords diverges within 0.2 s (docs/fe-plant.md: 0.11 s on 4 x 4 x 4 and 4 x 10 x
+    10; 0.41 s with the default rigid fit): the CLI exits 1 naming
     the failed check, with the record up to the failure in the CSV and the comparison with
     the COM run (4 x 10 x 10; reduced: 4 x 4 x 4)."""
     from tmfem.cli import main
     csv = tmp_path / "sbc.csv"
-    rc = main(["deploy", "--preset", "1-4D", "--plant", "sbc", "--plant-mesh",
+    rc = main(["deploy", "--preset", "1-4D", "--plant", "sbc", "--plant-bars", "chord", "--plant-mesh",
                "4" if REDUCED else "10", "--compare-plant", "com", "--t-end", "0.3",
                "--csv", str(csv), "--json"])
     cap = capsys.readouterr()
@@ -216,7 +241,7 @@ def test_lqr_designed_on_the_com_damps_the_sbc_plant():
                                  u_m=0.01)
     fe = SBCModel(s, mesh_n=4, rest_lengths="system")
     plant = FEStatePlant(SBCDynamics(fe, fe.solve_static().state,
-                                     perturb={"theta_11_dot": 0.02}), com)
+                                     perturb={"theta_11_dot": 0.02}), com, bars="chord")
     iq = list(s.q_names).index("theta_11")
     d = simulate(plant, t_end=3.0, dt=0.01, controller=ctrl, jacobian="step").y[:, iq]
     d = d - d[0]

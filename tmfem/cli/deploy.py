@@ -54,9 +54,10 @@ def configure(parser) -> None:
                              "uncertainty 'initial', eq. 5.72)")
     parser.add_argument("--plant-bars", choices=["chord", "rigid"],
                         help="how the SBC plant's state estimate measures the bar coordinates q "
-                             "(--plant or --compare-plant sbc): chord (the bar end nodes, "
-                             "default) or rigid (the rigid bars closest to the beam nodes in the "
-                             "kinetic-energy norm: the bending modes do not move them, "
+                             "(--plant or --compare-plant sbc): rigid (the rigid bars closest to "
+                             "the beam nodes in the kinetic-energy norm: the bending modes do not "
+                             "move them; default) or chord (the bar end nodes, which see the "
+                             "beams' bending modes: the LPV loop diverges with them, "
                              "docs/fe-plant.md)")
     parser.add_argument("--plant-damping", type=positive_float, metavar="BETA",
                         help="stiffness-proportional Rayleigh damping C = BETA K_0 [s] of the FE "
@@ -92,6 +93,8 @@ def run(args) -> dict:
     output_file(args.plot, option="--plot", suffixes=(".png",))
     output_file(args.gif, option="--gif", suffixes=(".gif",))
     output_dir(args.vtk, option="--vtk")
+    output_file(args.compare_plot, option="--compare-plot", suffixes=(".png",))
+    output_file(args.compare_csv, option="--compare-csv", suffixes=(".csv",))
     lpv = args.preset in LPV_DEPLOYMENTS
     args.controller = args.controller or ("lpv" if lpv else "adaptive-hinf")
     if lpv != (args.controller in LPV_CONTROLLERS):
@@ -106,8 +109,6 @@ def run(args) -> dict:
     args.allocation = args.allocation or "bounded"
     check_choices(args.preset, controller=args.controller, uncertainty=args.uncertainty,
                   path=args.path)
-    output_file(args.compare_plot, option="--compare-plot", suffixes=(".png",))
-    output_file(args.compare_csv, option="--compare-csv", suffixes=(".csv",))
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
     # one controller for both plants of a comparison: with an FE plant among them, the PFL
@@ -120,19 +121,29 @@ def run(args) -> dict:
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path, evaluation=pfl_at,
               tendon_law=tendons)
+    warnings = tendon_model_warnings(args, tendons)
     r = _run_on(args, s, args.plant, mesh_n)
-    out = {"preset": args.preset, "controller": args.controller, "plant": args.plant,
-           **plant_options(args, args.plant, mesh_n),
-           "uncertainty": s.adaptive.uncertainty, "allocation": s.adaptive.allocation,
-           "pfl_at": pfl_at,
-           "path": args.path or DEPLOYMENTS[args.preset]["path"],
+    # the controller's options, the same on both plants of a comparison (docs/fe-plant.md)
+    ctrl = {"controller": args.controller, "uncertainty": s.adaptive.uncertainty,
+            "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons}
+    out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
+           **ctrl, "path": args.path or DEPLOYMENTS[args.preset]["path"],
            **r.summary(), **s.info}
     title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
              f"uncertainty {s.adaptive.uncertainty}")
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
                              gif=args.gif, vtk=args.vtk, title=title))
+    out["warnings"] = warnings
     if args.compare_plant:
-        out["compare"] = _compare(args, mesh_n, r, pfl_at, tendons)
+        def rerun(kind):
+            s2 = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+                       allocation=args.allocation, path=args.path, evaluation=pfl_at,
+                       tendon_law=tendons)
+            return _run_on(args, s2, kind, mesh_n), {}
+        out["compare"] = compare_plants(
+            args, r, rerun, mesh_n=mesh_n, controller=ctrl,
+            about=f"PFL at the {pfl_at}, its tendon model {tendons}, uncertainty "
+                  f"{s.adaptive.uncertainty}, allocation {s.adaptive.allocation}")
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
     # to the failure are written, the exit code is 1 (docs/cli.md, docs/fe-plant.md)
@@ -146,22 +157,49 @@ def diverged(runs) -> list:
             if v.get("failure")]
 
 
+def plant_tendons(args, plant: str) -> str:
+    """The tendon law of the plant ``plant`` of a run: the COM's fixed rates of eq. 5.19, the
+    SBC model's cable law k = EA / r, the MTC model's ``--plant-tendons`` (default cable)."""
+    return {"com": "fixed-rate", "sbc": "cable"}.get(plant) or args.plant_tendons or "cable"
+
+
+def tendon_model_warnings(args, tendons: str) -> list:
+    """Where the adaptive PFL's tendon model ``tendons`` is not the tendon law of a plant it
+    drives (the same controller on both plants of a comparison, docs/fe-plant.md): one line
+    each, also on stderr."""
+    import sys
+    out = []
+    for p in [args.plant] + ([args.compare_plant] if args.compare_plant else []):
+        law = plant_tendons(args, p)
+        if law != tendons:
+            out.append(f"the PFL's tendon model ({tendons}) is not the {p} plant's tendon law "
+                       f"({law}): the run on the {p} plant has this model error too")
+    for w in out:
+        print(f"tmfem deploy: warning: {w}", file=sys.stderr)
+    return out
+
+
 def plant_options(args, plant: str, mesh_n) -> dict:
-    """The FE plant's options of a run on ``plant`` for the JSON (none for the COM plant)."""
+    """The plant's options of a run on ``plant`` for the JSON (the COM plant: its tendon law
+    only)."""
     if plant == "com":
-        return {}
-    return {"plant_mesh": mesh_n, **({"plant_tendons": args.plant_tendons or "cable"}
-                                     if plant == "mtc" else {}),
-            **({"plant_bars": getattr(args, "plant_bars", None) or "chord"}
-               if plant == "sbc" else {}),
+        return {"plant_tendons": plant_tendons(args, plant)}
+    return {"plant_mesh": mesh_n, "plant_tendons": plant_tendons(args, plant),
+            **({"plant_bars": sbc_bars(args)} if plant == "sbc" else {}),
             "plant_damping_s": getattr(args, "plant_damping", None) or 0.0}
+
+
+def sbc_bars(args) -> str:
+    """The SBC plant's bar measurement: ``--plant-bars``, default the rigid fit (the chords see
+    the beams' bending modes, docs/fe-plant.md)."""
+    return getattr(args, "plant_bars", None) or "rigid"
 
 
 def plant_arguments(args, plant: str) -> dict:
     """The FE plant's options of a run on ``plant`` as the keyword arguments of
     :func:`tmfem.control.state_estimate.deployment_plant` (both deployment kinds)."""
     return {"tendon_law": args.plant_tendons if plant == "mtc" else None,
-            "bars": (args.plant_bars or "chord") if plant == "sbc" else "chord",
+            "bars": sbc_bars(args) if plant == "sbc" else None,
             "beta": (args.plant_damping or 0.0) if plant != "com" else 0.0}
 
 
@@ -180,25 +218,30 @@ def _run_on(args, s, plant_kind: str, mesh_n):
                               partial=plant is not None)
 
 
-def _compare(args, mesh_n, r, pfl_at: str, tendons: str) -> dict:
-    """The same deployment on ``--compare-plant`` (a fresh controller of the same options: the
-    adaptive PFL and the switch carry state) and its deviation from run ``r``."""
+def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str) -> dict:
+    """The same deployment on ``--compare-plant`` and its deviation from run ``r`` (both
+    deployment kinds): ``rerun(plant)`` runs it there with a fresh controller of the same
+    options (the adaptive PFL, the switch and the LPV observer carry state) and returns the
+    result and its extra JSON entries; ``controller``: those options (JSON of both runs),
+    ``about``: their summary for the plot's title. The CSV and the plot if asked for."""
     from tmfem.control.plant_compare import deviation_summary, plant_deviation
     from tmfem.reference.deployments import write_csv
-    s2 = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
-               allocation=args.allocation, path=args.path, evaluation=pfl_at, tendon_law=tendons)
-    r2 = _run_on(args, s2, args.compare_plant, mesh_n)
+    r2, extra = rerun(args.compare_plant)
     dev = plant_deviation(r, r2)
     out = {"plant": args.compare_plant, **plant_options(args, args.compare_plant, mesh_n),
-           **r2.summary(), "deviation": deviation_summary(dev)}
+           **controller, **r2.summary(), **extra, "deviation": deviation_summary(dev)}
     if args.compare_csv:
         out["csv"] = write_csv(args.compare_csv, r2)
     if args.compare_plot:
         from tmfem.post.plant_compare_plot import plot_plant_comparison
+        runs = [(p, plant_options(args, p, mesh_n)) for p in (args.plant, args.compare_plant)]
+        title = (f"{args.preset} deployment, the same controller on both plants: "
+                 f"{controller['controller']} ({about})\n" +
+                 "; ".join(f"{p} plant ({ls}): " + (", ".join(
+                     f"{k[6:]} {v}" for k, v in o.items() if k != "plant_damping_s" or v))
+                     for (p, o), ls in zip(runs, ("solid", "dashed"))))
         out["plot"] = str(plot_plant_comparison(
-            args.compare_plot, r, r2, dev, labels=(args.plant, args.compare_plant),
-            title=f"{args.preset} deployment ({args.controller}) on the {args.plant} plant "
-                  f"(solid) and the {args.compare_plant} plant (dashed)"))
+            args.compare_plot, r, r2, dev, labels=(args.plant, args.compare_plant), title=title))
     return out
 
 

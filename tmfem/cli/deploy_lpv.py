@@ -23,7 +23,7 @@ from tmfem.errors import InfeasibleController, InputError
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
 SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
 #: options of the 7.4 deployments that do not apply to the LPV one (None or False: not given)
-NOT_LPV = ("uncertainty", "allocation", "compare_plant", "compare_plot", "compare_csv", "pfl_at")
+NOT_LPV = ("uncertainty", "allocation", "pfl_at")
 
 
 def configure(parser) -> None:
@@ -132,11 +132,45 @@ DESIGNS = {"lpv": design, "lpv-output": design}
 BUILDERS = {"lpv": lpv_state_feedback, "lpv-output": lpv_output_feedback}
 
 
+def _run_on(args, dep, d, kind: str, mesh_n):
+    """(set-up, result) of the LPV deployment with a fresh controller of ``d`` (the
+    ``--controller`` builder, with ``--noise`` its seeded measurement noise) on the plant
+    ``kind``: an FE plant starts in its own equilibrium of the packaged configuration under
+    the rest lengths the controller starts with (docs/fe-plant.md)."""
+    from tmfem.cli.common import progress_bar
+    from tmfem.cli.deploy import plant_arguments
+    from tmfem.control.deploy import run_deployment
+    from tmfem.control.state_estimate import deployment_plant
+    c = BUILDERS[args.controller](dep, d)
+    if args.noise:
+        from tmfem.simulation.controllers import MeasurementNoise
+        c = MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
+    s = dep.setup(c)
+    fe = deployment_plant(kind, s.model, dep.packaged(), mesh_n=mesh_n or 10,
+                          **plant_arguments(args, kind))
+    with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller}) on {kind}") as bar:
+        r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+                           t_end=args.t_end, dt=args.dt, progress=bar, plant=fe,
+                           jacobian="reuse" if fe is None else "step", partial=fe is not None)
+    if not np.all(np.isfinite(r.z)):
+        raise InfeasibleController(f"the LPV deployment of {args.preset} on the {kind} plant diverged "
+                                   "(non-finite states)")
+    return s, r
+
+
+def _figures(r) -> dict:
+    """The LPV run's own JSON figures: the largest tracking error of q (eq. 5.100) and of the
+    commanded rest lengths above the tendon lengths."""
+    q_err = np.abs(r.z[:, :len(r.names["q"])] - r.q_d)
+    return {"max_tracking_error": float(q_err.max()),
+            "rest_length_above_tendon_length_max_m": float(np.max(r.u - r.lengths))}
+
+
 def run(args) -> dict:
     """The LPV deployment (module docstring); the JSON keys of the 7.4 deployments plus the
-    design's."""
-    from tmfem.cli.common import progress_bar
-    from tmfem.control.deploy import run_deployment
+    design's; with ``--compare-plant`` the same design (a fresh controller) on the second
+    plant (:func:`tmfem.cli.deploy.compare_plants`)."""
+    from tmfem.cli.deploy import compare_plants, diverged, plant_options
     from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
     mesh_n = check(args)
     if args.noise is not None and not (np.isfinite(args.noise) and args.noise >= 0):
@@ -144,38 +178,26 @@ def run(args) -> dict:
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
     dep = lpv_setup(args.preset, plant)
-    c = BUILDERS[args.controller](dep, d)
-    if args.noise:
-        from tmfem.simulation.controllers import MeasurementNoise
-        c = MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
-        info["measurement_noise_sigma"] = args.noise
-    s = dep.setup(c)
-    fe = None
-    if args.plant != "com":
-        # the FE plant starts in its own equilibrium of the packaged configuration under the
-        # rest lengths the controller starts with (docs/fe-plant.md)
-        from tmfem.cli.deploy import plant_arguments
-        from tmfem.control.state_estimate import deployment_plant
-        fe = deployment_plant(args.plant, s.model, dep.packaged(), mesh_n=mesh_n,
-                              **plant_arguments(args, args.plant))
-    from tmfem.cli.deploy import diverged, plant_options
-    info.update(plant_options(args, args.plant, mesh_n))
-    with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller}) on {args.plant}") as bar:
-        r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
-                           t_end=args.t_end, dt=args.dt, progress=bar, plant=fe,
-                           jacobian="reuse" if fe is None else "step", partial=fe is not None)
-    q_err = np.abs(r.z[:, :len(r.names["q"])] - r.q_d)
+    s, r = _run_on(args, dep, d, args.plant, mesh_n)
     # the keys of the 7.4 deployments (tmfem.cli.deploy.run; no PFL: uncertainty, allocation and
     # pfl_at None), then the design's
-    out = {"preset": args.preset, "controller": args.controller, "plant": args.plant, "uncertainty": None,
-           "allocation": None, "pfl_at": None, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(),
-           **s.info, "max_tracking_error": float(q_err.max()),
-           "rest_length_above_tendon_length_max_m": float(np.max(r.u - r.lengths)), **info}
-    if not np.all(np.isfinite(r.z)):
-        raise InfeasibleController(f"the LPV deployment of {args.preset} diverged (non-finite states)")
+    ctrl = {"controller": args.controller, "uncertainty": None, "allocation": None, "pfl_at": None,
+            "gamma": d.gamma, "lpv_controller": args.lpv_controller,
+            "measurement_noise_sigma": args.noise or 0.0}
+    out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
+           **ctrl, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(), **s.info,
+           **_figures(r), **info}
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
                              vtk=args.vtk, title=f"{args.preset} deployment on the {args.plant} plant: {args.controller} "
                                                  f"(gamma = {d.gamma:.4g}), eq. 5.100"))
+    if args.compare_plant:
+        def rerun(kind):
+            _, r2 = _run_on(args, dep, d, kind, mesh_n)
+            return r2, _figures(r2)
+        src = args.lpv_controller or "synthesised here"
+        out["compare"] = compare_plants(
+            args, r, rerun, mesh_n=mesh_n, controller=ctrl,
+            about=f"gamma = {d.gamma:.4g}, {src}" + (f", noise {args.noise:g}" if args.noise else ""))
     out["total_wall_time_s"] = time.perf_counter() - t0
-    out["failed_checks"] = diverged([(args.plant, out)])
+    out["failed_checks"] = diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out

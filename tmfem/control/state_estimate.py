@@ -6,12 +6,13 @@ membrane point coordinates of eqs. 5.17-5.18) with its rates. On a finite-elemen
 state does not exist: it has to be measured. :class:`COMStateEstimator` computes it from the
 FE state as sensors would give it:
 
-* q from the bar end nodes (eqs. 3.1-3.2, :func:`tmfem.models.mtc.post.q_from_positions`; the
-  SBC bars are beams whose chords A_ij-B_ij give q, their bending and the rotations of their
-  nodes do not enter), or (``bars="rigid"``, SBC plant) from the rigid placement of each bar
-  closest to its beam-chain nodes in the kinetic-energy norm (:func:`rigid_bar_fit`): the
-  bar's rigid-body coordinates, which the bending modes (mass-orthogonal to them) do not
-  move;
+* q from the rigid placement of each bar closest to its nodes in the kinetic-energy norm
+  (:func:`rigid_bar_fit`, ``bars="rigid"``, the default on the SBC plant): the bar's
+  rigid-body coordinates, which the bending modes of the SBC's beams (mass-orthogonal to
+  them) do not move; or from the bar end nodes (``bars="chord"``, eqs. 3.1-3.2,
+  :func:`tmfem.models.mtc.post.q_from_positions`: the MTC plant's truss bars, whose chord is
+  their rigid fit; on the SBC plant the chords A_ij-B_ij of the beams, which see their
+  bending, docs/fe-plant.md);
 * eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
   nodes (the SBC shell's mid-surface nodes) are taken into the floating frame of the current
   corners (eq. 3.3), interpolated at the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
@@ -52,6 +53,15 @@ from tmfem.system.geometry import wrap_angle
 RATE_STEP = 1e-5
 #: how the estimate measures the bar coordinates q (:class:`COMStateEstimator`)
 BAR_MEASURES = ("chord", "rigid")
+
+
+def default_bar_measure(dyn) -> str:
+    """The bar measurement of an FE plant when none is asked for: the rigid fit
+    (:func:`rigid_bar_fit`) of a plant with nodes along its bars (``bar_chain_positions``: the
+    SBC model's beams, whose chords see their bending modes -- the LPV loop measured through
+    them is unstable, docs/fe-plant.md), the chord of one with straight truss bars (the MTC
+    model: there the chord is the rigid fit, the two end nodes being the whole bar)."""
+    return "rigid" if hasattr(dyn, "bar_chain_positions") else "chord"
 
 
 def rigid_bar_fit(system, X: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -117,13 +127,15 @@ class COMStateEstimator:
     dyn : FEPlant
         The FE plant: ``positions(x)`` gives the node positions of a free-DOF state in the
         numbering of its MTC model ``dyn.mtc`` (membrane, system labels, tendon internals).
-    bars : {"chord", "rigid"}
+    bars : {"chord", "rigid"}, optional
         q from the bar end nodes, or from the rigid fit of the bar's chain nodes
         (:func:`rigid_bar_fit`; a plant with nodes along its bars, ``dyn.bar_chain_positions``:
-        the SBC model).
+        the SBC model); default :func:`default_bar_measure` (rigid on the SBC plant, chord on
+        the MTC plant).
     """
 
-    def __init__(self, com, dyn, *, bars: str = "chord"):
+    def __init__(self, com, dyn, *, bars: str | None = None):
+        bars = default_bar_measure(dyn) if bars is None else bars
         if bars not in BAR_MEASURES:
             raise InputError(f"bar measurement: expected one of {BAR_MEASURES}, found {bars!r}")
         if bars == "rigid" and not hasattr(dyn, "bar_chain_positions"):
@@ -186,11 +198,12 @@ class FEStatePlant:
     com : ControlOrientedModel
     x0, v0 : ndarray, optional
         Start state (free DOFs); default the plant's own (its equilibrium and perturbation).
-    bars : {"chord", "rigid"}
-        How the estimate measures q (:class:`COMStateEstimator`).
+    bars : {"chord", "rigid"}, optional
+        How the estimate measures q (:class:`COMStateEstimator`; default
+        :func:`default_bar_measure`: rigid on the SBC plant, chord on the MTC plant).
     """
 
-    def __init__(self, dyn, com, *, x0=None, v0=None, bars: str = "chord"):
+    def __init__(self, dyn, com, *, x0=None, v0=None, bars: str | None = None):
         self.dyn, self.estimator = dyn, COMStateEstimator(com, dyn, bars=bars)
         self.input_names = list(dyn.input_names)
         if self.input_names != list(com.input_names):
@@ -343,7 +356,7 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
 
 
 def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
-                         bar_elements: int = 1, bars: str = "chord",
+                         bar_elements: int = 1, bars: str = "rigid",
                          beta: float = 0.0) -> FEStatePlant:
     """The SBC model of the COM's system (MITC4 shell membrane, four-node beam bars -- with
     H_1j a node of the bar for a 1-N(D) system --, tension-only tendons of the cable law
@@ -357,8 +370,9 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     design's rest lengths (:func:`start_rest_lengths`, ``"cable"``), mapped onto the SBC
     unknowns (:meth:`SBCModel.state_from_mtc`: shell directors on the membrane normals, bar
     triads turned with the chords) and Newton's method finishes on the SBC model, whose bars
-    then bend under the tendons at H_1j. ``bars``: how the estimate measures q (the bar
-    chords or their rigid fit, :class:`COMStateEstimator`); ``beta``: stiffness-proportional
+    then bend under the tendons at H_1j. ``bars``: how the estimate measures q (the rigid fit
+    of the beam nodes, default, or the bar chords, which see the bending modes,
+    :class:`COMStateEstimator`); ``beta``: stiffness-proportional
     Rayleigh damping C = beta K_0 (K_0 at that equilibrium; docs/fe-plant.md: without it the
     undamped SBC plant's Park integration diverges during the 1-4(D) deployment even under
     the COM run's smooth rest lengths)."""
@@ -380,16 +394,16 @@ PLANTS = ("com", "mtc", "sbc")
 
 
 def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
-                     tendon_law: str | None = None, bars: str = "chord", beta: float = 0.0):
+                     tendon_law: str | None = None, bars: str | None = None, beta: float = 0.0):
     """The plant ``kind`` of a deployment of the COM's system from the packaged design
     ``initial``: None for ``"com"`` (:func:`tmfem.control.deploy.run_deployment` builds the
     COM plant), :func:`mtc_deployment_plant` (``tendon_law`` default ``"cable"``) or
     :func:`sbc_deployment_plant` (the SBC model has the cable law only: ``"fixed-rate"`` is
-    refused; ``bars``: its bar measurement, ``"rigid"`` refused on the other plants);
+    refused; ``bars``: its bar measurement, default ``"rigid"``, refused on the other plants);
     ``beta``: the FE plant's Rayleigh damping C = beta K_0 (refused for the COM)."""
     if kind not in PLANTS:
         raise InputError(f"plant: expected one of {list(PLANTS)}, found {kind!r}")
-    if bars != "chord" and kind != "sbc":
+    if bars is not None and kind != "sbc":
         raise InputError(f"bar measurement {bars!r}: expected the SBC plant (beam bars with "
                          f"nodes along them), found the {kind} plant")
     if beta and kind == "com":
@@ -401,6 +415,6 @@ def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
         if tendon_law not in (None, "cable"):
             raise InputError(f"SBC plant tendons: the SBC model has the cable law only (EA fixed, "
                              f"k = EA / r); expected 'cable', found {tendon_law!r}")
-        return sbc_deployment_plant(com, initial, mesh_n=mesh_n, bars=bars, beta=beta)
+        return sbc_deployment_plant(com, initial, mesh_n=mesh_n, bars=bars or "rigid", beta=beta)
     return mtc_deployment_plant(com, initial, mesh_n=mesh_n, tendon_law=tendon_law or "cable",
                                 beta=beta)

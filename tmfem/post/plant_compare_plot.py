@@ -2,6 +2,7 @@
 :func:`tmfem.control.plant_compare.plant_deviation`)."""
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,27 @@ def _bar_signals(names) -> list:
     return [k for k, n in enumerate(names) if n.startswith(("theta_", "psi_")) and n.endswith("1")]
 
 
+def switch_label_places(times, t_span: float, *, close: float = 0.2) -> list:
+    """(height in axes fraction, horizontal alignment) of the labels of the switch times
+    ``times`` on an axis from 0 to ``t_span``: a label reads to the left of its line in the
+    right half of the axis (and to the right in the left half), so that it stays inside the
+    axes; labels of switches less than ``close`` x the span apart go one above the other (two
+    switches 0.1 s apart over 20 s would otherwise print over each other)."""
+    places, used = [], []
+    for t in times:
+        ha = "right" if t > 0.5 * t_span else "left"
+        level = sum(1 for tu, hu in used if hu == ha and abs(tu - t) < close * t_span)
+        places.append((0.02 + 0.09 * level, ha))
+        used.append((t, ha))
+    return places
+
+
 def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "") -> Path:
+    """:func:`comparison_figure` written to ``png``."""
+    return save_figure(comparison_figure(a, b, dev, labels=labels, title=title), Path(png))
+
+
+def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
     """Five panels over time: the bar attitudes of both runs against the reference, their
     tracking errors q - q_ref, the membrane deflections w_k, the commanded rest lengths (one tendon of each family) and the
     deviation between the plants (bars [mrad], left axis; w [mm], right axis; both
@@ -65,12 +86,17 @@ def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "")
             x.set_ylim(1e-3 * top, 2.0 * top)
     tw.legend(handles=[l1, l2], fontsize=7, loc="lower right")   # drawn above both axes
     ax[4].set_xlabel("time [s]")
+    t_span = max(a.t[-1], b.t[-1])
+    switches = [(r.switch_time, lab, ls) for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--"))
+                if r.switch_time is not None]
+    for (t_s, lab, ls), (y, ha) in zip(switches, switch_label_places([t for t, _, _ in switches], t_span)):
+        for x in ax:
+            x.axvline(t_s, color="k", ls=ls, lw=0.7)
+        ax[0].annotate(f"switch {lab} {t_s:.2f} s", (t_s, y), xycoords=("data", "axes fraction"),
+                       xytext=(-3 if ha == "right" else 3, 0), textcoords="offset points",
+                       fontsize=7, ha=ha, va="bottom",
+                       bbox={"fc": "white", "ec": "none", "alpha": 0.8, "pad": 0.5})
     for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--")):
-        if r.switch_time is not None:
-            for x in ax:
-                x.axvline(r.switch_time, color="k", ls=ls, lw=0.7)
-            ax[0].annotate(f"switch {lab} {r.switch_time:.2f} s", (r.switch_time, 0.02),
-                           xycoords=("data", "axes fraction"), fontsize=7)
         if r.failure:
             for x in ax:
                 x.axvline(r.t[-1], color="r", ls=ls, lw=0.9)
@@ -83,6 +109,7 @@ def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "")
         x.legend(fontsize=6, ncol=3)
     for x in ax:
         x.grid(alpha=0.3)
-    if title:
-        ax[0].set_title(title, fontsize=9)
-    return save_figure(fig, Path(png))
+    if title:                 # wrapped to the figure's width: a long title is not cropped
+        ax[0].set_title("\n".join(textwrap.fill(line, 105) for line in title.split("\n")),
+                        fontsize=9)
+    return fig
