@@ -71,6 +71,31 @@ def test_forms_and_kernel_agree(mem):
     assert abs(K1 - K2).max() <= 1e-12 * abs(K1).max()
 
 
+@pytest.mark.parametrize("elements", [slice(None), slice(5, 31)])
+def test_kernel_in_chunks_agrees_with_the_forms(mem, monkeypatch, elements):
+    # source: independent formulation -- scikit-fem forms; the kernel runs in chunks of 7
+    # elements (a partial last chunk; all elements, and a share starting inside a chunk)
+    import scipy.sparse as sp
+    import tmfem.fem.membrane as membrane
+    monkeypatch.setattr(membrane, "KERNEL_CHUNK", 7)
+    rng = np.random.default_rng(2)
+    x = 1.02 * mem.X + 0.02 * rng.normal(size=mem.X.shape)
+    fe, Ke = mem.element_arrays(x, elements=elements)
+    f2, K2 = mem.internal_forms(x)
+    dofs = mem._asm.dofs[elements]
+    assert fe.shape == (dofs.shape[0], 12) and Ke.shape == (dofs.shape[0], 12, 12)
+    if elements == slice(None):
+        f1 = np.bincount(dofs.ravel(), weights=fe.ravel(), minlength=mem.ndof)
+        r = np.repeat(dofs, 12, axis=1).ravel()
+        c = np.tile(dofs, (1, 12)).ravel()
+        K1 = sp.csr_matrix((Ke.ravel(), (r, c)), shape=K2.shape)
+        np.testing.assert_allclose(f1, f2, atol=1e-12 * abs(f1).max())
+        assert abs(K1 - K2).max() <= 1e-12 * abs(K1).max()
+    else:                          # the share's arrays are those of the whole set's
+        fa, Ka = mem.element_arrays(x)
+        assert np.array_equal(fe, fa[elements]) and np.array_equal(Ke, Ka[elements])
+
+
 def test_tangent_matches_finite_differences(mem):
     # source: central differences of the residual; the state has tension and compression so
     # both the material (K_L) and initial-stress (K_NL) parts are exercised

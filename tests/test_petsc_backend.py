@@ -524,3 +524,43 @@ def test_block_solver_under_two_ranks_agrees_with_scipy(models, equilibria):
     assert m.free.sum() >= EIG_BLOCK_MIN_N                       # the block solver's size
     ref = m.modes(equilibria["1-4"].x, k=12)
     assert np.allclose(run["omega2"], ref.omega2, rtol=2e-8, atol=0)
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [1, 2, 3])
+def test_block_pair_pattern_is_scipys_pattern_and_matrix(ranks):
+    # source: scipy's T^T K T of the same element matrices and entries (its structure from
+    # unit values and |T|, so no cancellation); the 4-node group is keyed per block pair
+    # (block size 3), the group of permuted local dofs and the entries per entry
+    p = _mpirun(ranks, program=[sys.executable, str(ROOT / "tests" / "mpi" / "assembler_pattern.py")])
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["block_sizes"] == [3, 1, 1]
+    assert out["pattern_equal"]
+    assert out["max_rel"] <= 1e-14
+
+
+@needs_petsc
+@pytest.mark.parametrize("eig_solver", ["block", "slepc"])
+def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria, eig_solver):
+    # source: the scipy model's 12 modes at its equilibrium from the design; PETSc's log of
+    # MUMPS' symbolic (MatCholFctrSym) and numeric factorisations: K - sigma M has the
+    # tangent's pattern (the mass lies within it), so the eigen solve factorises it
+    # numerically in the static solve's analysed pattern; an st_ option gives the eigen
+    # solve its own KSP, and with it its own analysis
+    from petsc4py import PETSc
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    PETSc.Log.begin()
+    sym, num = PETSc.Log.Event("MatCholFctrSym"), PETSc.Log.Event("MatCholFctrNum")
+    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    for options, analyses in ((None, 0), ("-st_mat_mumps_icntl_14 40", 1)):
+        m = MTCModel(load_preset("1-4"), mesh_n=6,
+                     backend=PetscBackend(eig_solver=eig_solver, options=options))
+        st = m.solve_static(start="design")
+        s0, n0 = sym.getPerfInfo()["count"], num.getPerfInfo()["count"]
+        modes = m.modes(st.x, k=12)
+        assert sym.getPerfInfo()["count"] - s0 == analyses
+        assert num.getPerfInfo()["count"] - n0 == 1
+        assert np.allclose(modes.omega2, ref.omega2, rtol=2e-8, atol=0)

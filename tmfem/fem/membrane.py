@@ -156,6 +156,10 @@ def point_matrix(skmesh, points) -> sp.csr_matrix:
                          f"({exc})") from None
 
 
+#: elements per chunk of the membrane kernel (:meth:`MembraneTL.element_arrays`)
+KERNEL_CHUNK = 4096
+
+
 class MembraneTL:
     """Total-Lagrangian membrane on a flat reference mesh (eqs. 4.25-4.28).
 
@@ -231,8 +235,11 @@ class MembraneTL:
         """Deformation gradient F (3, 2, ne, nqp) and Green-Lagrange strain E (2, 2, ...) at
         the Gauss points (eq. 4.7) of the ``elements`` (a slice; default all):
         F_ia = delta_ia + sum_k u_i(node k) N_k,a, u = x - X (X = (x_f, y_f, 0))."""
-        x = self._check_x(x)
-        ue = (x - self.X)[:, self.skmesh.t[:, elements]]                # (3, 4, ne)
+        return self._strain_u(self._check_x(x) - self.X, elements)
+
+    def _strain_u(self, u, elements: slice):
+        """:meth:`strain` from the displacements u = x - X (3, nn)."""
+        ue = u[:, self.skmesh.t[:, elements]]                           # (3, 4, ne)
         F = np.einsum("ike,kaeq->iaeq", ue, self._dN[:, :, elements], optimize=True)
         F[0, 0] += 1.0
         F[1, 1] += 1.0
@@ -297,8 +304,27 @@ class MembraneTL:
 
         Vectorised B-matrix kernel of eqs. 4.4-4.6: the variation of the Green-Lagrange strain
         of node k, component i is (Voigt) B = [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1].
+        Evaluated in chunks of :data:`KERNEL_CHUNK` elements into the output arrays, so that
+        the kernel's temporaries (~7 kB per element) stay chunk-sized.
         """
-        F, Eg = self.strain(x, elements=elements)
+        u = self._check_x(x) - self.X
+        lo, hi, step = elements.indices(self.skmesh.t.shape[1])
+        ne = max(hi - lo, 0)
+        if ne <= KERNEL_CHUNK or step != 1:
+            return self._element_arrays(u, tangent, elements)
+        fe = np.empty((ne, 12))
+        Ke = np.empty((ne, 12, 12)) if tangent else None
+        for a in range(0, ne, KERNEL_CHUNK):
+            b = min(a + KERNEL_CHUNK, ne)
+            f, K = self._element_arrays(u, tangent, slice(lo + a, lo + b))
+            fe[a:b] = f
+            if tangent:
+                Ke[a:b] = K
+        return fe, Ke
+
+    def _element_arrays(self, u, tangent: bool, elements: slice):
+        """:meth:`element_arrays` of one chunk of elements, from u = x - X."""
+        F, Eg = self._strain_u(u, elements)
         S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
         dN, dx = self._dN[:, :, elements], self._dx[elements]

@@ -155,6 +155,35 @@ def gather(vec) -> np.ndarray:
     return out
 
 
+def unique_inverse(keys: np.ndarray):
+    """``(u, inverse)`` with u the sorted distinct values of the int64 array ``keys`` and
+    ``u[inverse] == keys`` (``inverse`` int32 when it fits): ``np.unique(keys,
+    return_inverse=True)``, but on a *stable* sort (timsort), which is linear on data
+    made of a few sorted runs -- the received pattern keys (one sorted run per sending
+    rank), the node-pair expansion of :meth:`_EntryMap.pattern` -- where np.unique's
+    quicksort is n log n; already sorted keys skip the sort."""
+    keys = np.asarray(keys, dtype=np.int64)
+    n = keys.size
+    idx = np.int32 if n < 2**31 else np.int64
+    if n == 0:
+        return keys.copy(), np.zeros(0, idx)
+    perm = None
+    if not bool(np.all(keys[1:] >= keys[:-1])):
+        perm = np.argsort(keys, kind="stable")
+        keys = keys[perm]
+    first = np.empty(n, bool)
+    first[0] = True
+    np.not_equal(keys[1:], keys[:-1], out=first[1:])
+    u = keys[first]
+    rank = np.cumsum(first, dtype=idx)
+    rank -= 1
+    if perm is None:
+        return u, rank
+    inverse = np.empty(n, idx)
+    inverse[perm] = rank
+    return u, inverse
+
+
 class Pattern:
     """Identity of a sparsity pattern (one per :class:`DistributedAssembler`); the backend
     keys its factorisations by it and frees them when the pattern is gone."""
@@ -263,15 +292,24 @@ class DistributedAssembler:
         number[keep] = np.arange(int(keep.sum()))
         self.N = int(keep.sum())
         self.T, self.keep, self.n = T, keep, int(n)
-        self._groups, keys = [], []
+        self._groups, keys, local = [], [], []
+        offset = 0
         for dofs, kind in groups:
             g = _EntryMap(np.asarray(dofs, dtype=np.int64), kind, n, T, number)
             self._groups.append(g)
-            keys.append(g.keys(self.N))
+            gkeys, ginv = g.pattern(self.N)
+            keys.append(gkeys)
+            local.append((offset, gkeys.size, ginv))
+            offset += gkeys.size
         keys = np.concatenate(keys) if keys else np.zeros(0, np.int64)
-        ukeys, inverse = np.unique(keys, return_inverse=True)
-        idx = np.int32 if ukeys.size < 2**31 else np.int64
-        self._inverse = inverse.astype(idx)
+        ukeys, inverse = unique_inverse(keys)
+        del keys
+        # each valid entry of each group -> its key (through the group's own candidate keys)
+        parts = [inverse[off:off + size] if ginv is None else inverse[off + ginv]
+                 for off, size, ginv in local]
+        del local
+        self._inverse = np.concatenate(parts) if parts else inverse[:0]
+        del parts, inverse
         self._nu = ukeys.size
         # owners of the rows (PETSc's default split) and the exchange of the pattern
         P = self.comm.size
@@ -286,9 +324,9 @@ class DistributedAssembler:
         else:
             recv = np.empty(int(self._recvcounts.sum()), np.int64)
             self.comm.Alltoallv([ukeys, self._sendcounts], [recv, self._recvcounts])
-            okeys, rinv = np.unique(recv, return_inverse=True)
-            self._recv_inverse = rinv.astype(idx)
-        del ukeys, keys
+            okeys, self._recv_inverse = unique_inverse(recv)      # P sorted runs: a merge
+            del recv
+        del ukeys
         self._nnz = okeys.size
         orow = okeys // self.N - self.lo if self.N else okeys
         self._indices = (okeys % self.N if self.N else okeys).astype(self.PETSc.IntType)
@@ -392,15 +430,18 @@ class _EntryMap:
         self.value_shape = (ne, nd, nd) if kind == "element" else (ne,)
         counts = np.diff(T.indptr)
         p = max(1, int(counts[dofs].max())) if dofs.size else 1
-        C = np.full((ne, nd, p), -1, np.int64)
-        W = np.zeros((ne, nd, p))
+        # the unknowns (-1: none, fixed) and weights of the p entries of each full dof's row of T
+        Cd = np.full((n, p), -1, np.int64)
+        Wd = np.zeros((n, p))
         for i in range(p):                      # p is small (1 for plain dofs)
-            has = counts[dofs] > i
-            pos = T.indptr[dofs] + i
-            C[has, i] = number[T.indices[pos[has]]]
-            W[has, i] = T.data[pos[has]]
-        W[C < 0] = 0.0
-        self.p, self.C, self.W = p, C, W
+            has = np.flatnonzero(counts > i)
+            pos = T.indptr[has] + i
+            Cd[has, i] = number[T.indices[pos]]
+            Wd[has, i] = T.data[pos]
+        Wd[Cd < 0] = 0.0
+        C, W = Cd[dofs], Wd[dofs]
+        self.p, self.C, self.W, self.Cd, self.dofs, self.n = p, C, W, Cd, dofs, n
+        self.block_size = _block_size(dofs) if kind == "element" else 1
         self.unit = p == 1 and bool(np.all(W == 1.0))     # plain dofs: the values as they are
 
     def _rows_cols(self):
@@ -415,11 +456,71 @@ class _EntryMap:
         """Linear keys row * N + column of the valid (unknown, unknown) entries."""
         rows, cols = self._rows_cols()
         keys = (rows * N + cols).ravel()
+        self._set_valid(rows, cols)
+        return keys if self.all_valid else keys[self.valid]
+
+    def _set_valid(self, rows, cols) -> None:
+        """Which entries (flattened like :meth:`weighted`) land on two unknowns."""
         self.all_valid = bool((self.C >= 0).all())
-        if self.all_valid:
-            return keys
-        self.valid = ((rows >= 0) & (cols >= 0)).ravel()
-        return keys[self.valid]
+        if not self.all_valid:
+            self.valid = ((rows >= 0) & (cols >= 0)).ravel()
+
+    def pattern(self, N: int):
+        """``(keys, inverse)``: candidate keys row * N + column of this group and, for each
+        valid entry (flattened like :meth:`weighted`), the index of its key in them
+        (``None``: the keys are the entries themselves, :meth:`keys`).
+
+        Element groups whose local dofs come in blocks of b consecutive full dofs (the 3
+        translations of a membrane node, the 5 or 6 dofs of a shell node: ``block_size``)
+        are keyed per *block pair* (16 per 4-node membrane element instead of 144): the
+        distinct block pairs (one sort of ne nb^2 keys), then each expanded to its
+        (b p) x (b p) entries through T, laid out row by row (for unknowns numbered in
+        the order of the full dofs the expansion is one sorted run, which
+        :func:`unique_inverse` merges with the other groups in linear time). Two block
+        pairs may share entries (dofs tied by T): the assembler's unique merges them."""
+        bs = self.block_size
+        if bs == 1:
+            return self.keys(N), None
+        ne, nd, p = self.C.shape
+        nb, bp = nd // bs, bs * p
+        first = self.dofs[:, ::bs]                                    # (ne, nb) block ids
+        pairs, pinv = np.unique((first[:, :, None] * self.n + first[:, None, :]).ravel(),
+                                return_inverse=True)
+        # the entries of each distinct block pair (a, c): rows C[a .. a+b-1], cols C[c ..]
+        Cd = self.Cd
+        rows = Cd[(pairs // self.n)[:, None] + np.arange(bs)].reshape(-1, bp)     # (npairs, bp)
+        cols = Cd[(pairs % self.n)[:, None] + np.arange(bs)].reshape(-1, bp)
+        npairs = pairs.size
+        # row-by-row layout: the pairs of one row block a (contiguous: pairs are sorted
+        # by a) expand to  for ii: for pair: for jj  (position dest)
+        a = pairs // self.n
+        start = np.ones(npairs, bool)
+        start[1:] = a[1:] != a[:-1]
+        gstart = np.flatnonzero(start)
+        grp = np.cumsum(start) - 1
+        s0, cnt = gstart[grp], np.diff(np.append(gstart, npairs))[grp]
+        ii, jj = np.arange(bp)[:, None], np.arange(bp)[None, :]
+        dest = (s0[:, None, None] * (bp * bp) + ii * (cnt[:, None, None] * bp)
+                + (np.arange(npairs) - s0)[:, None, None] * bp + jj)              # (npairs, bp, bp)
+        full = np.empty(npairs * bp * bp, np.int64)
+        full[dest.ravel()] = (rows[:, :, None] * N + cols[:, None, :]).ravel()
+        ok = np.zeros(full.size, bool)
+        ok[dest.ravel()] = ((rows[:, :, None] >= 0) & (cols[:, None, :] >= 0)).ravel()
+        del rows, cols
+        idx = np.int32 if full.size < 2**31 else np.int64
+        where = np.cumsum(ok, dtype=idx) - 1                           # key index of a slot
+        where = where[dest.ravel()]                                    # ... of (pair, ii, jj)
+        keys = full[ok]
+        del full, ok, dest
+        # each element entry (e, k, i, q, l, j, r) -> slot (pair of (k, l), (i, q), (j, r))
+        pinv = pinv.reshape(ne, nb, nb).astype(idx) * idx(bp * bp)
+        off = (np.arange(bp)[:, None] * bp + np.arange(bp)).astype(idx).reshape(bs, p, bs, p)
+        slot = pinv[:, :, None, None, :, None, None] + off[None, None, :, :, None, :, :]
+        inverse = where[slot.ravel()]
+        del slot
+        R, Cc = self._rows_cols()
+        self._set_valid(R, Cc)
+        return keys, (inverse if self.all_valid else inverse[self.valid])
 
     def weighted(self, X) -> np.ndarray:
         """Values of the valid entries: T_ia T_jb X_ij, flattened like :meth:`keys`."""
@@ -434,3 +535,18 @@ class _EntryMap:
         else:
             v = (X[:, None, None] * W[:, 0, :, None] * W[:, 1, None, :]).ravel()
         return v if self.all_valid else v[self.valid]
+
+
+def _block_size(dofs: np.ndarray) -> int:
+    """The largest b <= 6 dividing nd such that every element's local dofs (ne, nd) come
+    in blocks of b consecutive full dofs (a node's translations: 3); 1 when none (or no
+    elements)."""
+    ne, nd = dofs.shape
+    if ne == 0:
+        return 1
+    for b in range(min(6, nd), 1, -1):
+        if nd % b == 0:
+            D = dofs.reshape(ne, nd // b, b)
+            if np.array_equal(D, D[:, :, :1] + np.arange(b)):
+                return b
+    return 1

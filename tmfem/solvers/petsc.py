@@ -500,10 +500,11 @@ class PetscBackend:
         if not 1 <= k < n:
             raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
         sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
+        reuse = self._analysed(K, M) if sym else None
         if self.eig_solver == "block" and sym and n >= EIG_BLOCK_MIN_N:
-            w, V = self._block_eigsh(Kp, Mp, k, float(sigma))
+            w, V = self._block_eigsh(Kp, Mp, k, float(sigma), reuse)
         else:
-            w, V = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym)
+            w, V = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym, reuse)
         order = np.argsort(np.abs(w - sigma), kind="stable")[:k]
         w, V = w[order], V[:, order]
         # Rayleigh-Ritz in span(V) (scipy operators on the full arrays): exactly M-orthonormal,
@@ -517,7 +518,66 @@ class PetscBackend:
         o = np.argsort(w)
         return w[o], V[:, o]
 
-    def _block_eigsh(self, Kp, Mp, k: int, sigma: float):
+    def _analysed(self, K, M):
+        """The cache entry (Mat, KSP: MUMPS' analysis done) of the tangent K's pattern when
+        the eigen solve can factorise K - sigma M in it, else None.
+
+        The static solve has factorised tangents of K's pattern in that entry (a Cholesky
+        KSP whose symbolic analysis every later numeric factorisation of the pattern
+        reuses); when the mass M has no entry outside K's pattern (the MTC mass: the
+        membrane's and the trusses' node blocks), K - sigma M has K's pattern and needs
+        only a numeric factorisation there (one MUMPS analysis less per eigen solve:
+        PETSc's PCSetUp redoes the symbolic factorisation only when the nonzero pattern
+        changes). Not with ``st_`` options (they configure the eigen solve's own KSP), an
+        iterative solver or a matrix of another kind. Collective (the subset check)."""
+        from tmfem.solvers.distributed import DistributedMatrix
+        if not (self.solver == "direct" and type(K) is DistributedMatrix
+                and type(M) is DistributedMatrix):
+            return None
+        entry = self._cache.get(("dist", id(K.pattern)))
+        if entry is None or not entry[3] or any(key.startswith("st_") for key in self.options) \
+                or any(key.startswith("st_") for key in self.PETSc.Options().getAll()):
+            return None
+        if len(entry) < 6:
+            import weakref
+            entry.append(weakref.WeakKeyDictionary())    # M's pattern -> within K's?
+        subset = entry[5].get(M.pattern)
+        if subset is None:
+            subset = entry[5][M.pattern] = self._subset(M.mat, K.mat)
+        return entry if subset else None
+
+    def _subset(self, B, A) -> bool:
+        """Whether the nonzero pattern of B lies within that of A (the same row layout);
+        the same answer on every rank."""
+        ia, ja, _ = A.getValuesCSR()
+        ib, jb, _ = B.getValuesCSR()
+        n = A.getSize()[1]
+        ka = np.repeat(np.arange(ia.size - 1, dtype=np.int64), np.diff(ia)) * n + ja
+        kb = np.repeat(np.arange(ib.size - 1, dtype=np.int64), np.diff(ib)) * n + jb
+        ka.sort()
+        pos = np.minimum(np.searchsorted(ka, kb), max(ka.size - 1, 0))
+        mine = bool(kb.size == 0 or (ka.size > 0 and np.array_equal(ka[pos], kb)))
+        if self.comm.size == 1:
+            return mine
+        return all(self.comm.tompi4py().allgather(mine))
+
+    def _shifted_in(self, entry, Kp, Mp, sigma: float):
+        """K - sigma M in the cached Mat of ``entry`` (its pattern: see :meth:`_analysed`),
+        numerically factorised by the entry's KSP (the analysis reused); the KSP. Earlier
+        solves of the entry are stale from here on."""
+        PETSc = self.PETSc
+        A, ksp = entry[0], entry[1]
+        entry[2] += 1
+        Kp.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        ksp.setOperators(A)
+        try:
+            ksp.setUp()
+        except PETSc.Error as exc:
+            raise _shift_invert_failure(sigma, exc) from None
+        return ksp
+
+    def _block_eigsh(self, Kp, Mp, k: int, sigma: float, reuse=None):
         """(w, V) of K v = w M v, the k eigenvalues nearest to sigma and their M-orthonormal
         vectors (full arrays on every rank), by :func:`block_krylov_schur` on the MUMPS
         Cholesky factors of K - sigma M (the ``st_`` options apply to its KSP, as to
@@ -525,17 +585,20 @@ class PetscBackend:
         from tmfem.solvers.block_krylov import block_krylov_schur, start_block
         PETSc = self.PETSc
         n = Kp.getSize()[0]
-        A = Kp.duplicate(copy=True)
-        A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        ksp = PETSc.KSP().create(comm=self.comm)
-        ksp.setOptionsPrefix("st_")
-        ksp.setOperators(A)
-        ksp.setType("preonly")
-        ksp.getPC().setType("cholesky")
-        ksp.getPC().setFactorSolverType("mumps")
-        with self._database({key: v for key, v in self.options.items() if key.startswith("st_")}):
-            ksp.setFromOptions()
+        if reuse is None:
+            A = Kp.duplicate(copy=True)
+            A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+            A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+            ksp = PETSc.KSP().create(comm=self.comm)
+            ksp.setOptionsPrefix("st_")
+            ksp.setOperators(A)
+            ksp.setType("preonly")
+            ksp.getPC().setType("cholesky")
+            ksp.getPC().setFactorSolverType("mumps")
+            with self._database({key: v for key, v in self.options.items() if key.startswith("st_")}):
+                ksp.setFromOptions()
+        else:
+            A = reuse[0]
         b = EIG_BLOCK
         lo, hi = A.getOwnershipRange()
         comm = self.comm.tompi4py()
@@ -556,10 +619,13 @@ class PetscBackend:
             return Bm
 
         try:
-            try:
-                ksp.setUp()
-            except PETSc.Error as exc:
-                raise _shift_invert_failure(sigma, exc) from None
+            if reuse is None:
+                try:
+                    ksp.setUp()
+                except PETSc.Error as exc:
+                    raise _shift_invert_failure(sigma, exc) from None
+            else:
+                ksp = self._shifted_in(reuse, Kp, Mp, sigma)
             F = ksp.getPC().getFactorMatrix()
 
             def solve(X):
@@ -582,18 +648,26 @@ class PetscBackend:
         finally:
             for Bm in dense.values():
                 Bm.destroy()
-            ksp.destroy()
-            A.destroy()
+            if reuse is None:
+                ksp.destroy()
+                A.destroy()
         log.debug("eigen (petsc, block): %d modes, %d restarts", k, restarts)
         V = X if comm.size == 1 else np.concatenate(comm.allgather(X), axis=0)
         return sigma + 1.0 / theta, V
 
-    def _slepc_eigsh(self, Kp, Mp, k: int, sigma: float, sym: bool):
+    def _slepc_eigsh(self, Kp, Mp, k: int, sigma: float, sym: bool, reuse=None):
         """(w, V) of K v = w M v, the converged eigenvalues nearest to sigma (at least k) and
-        their vectors (full arrays on every rank), by SLEPc (module docstring)."""
+        their vectors (full arrays on every rank), by SLEPc (module docstring). With
+        ``reuse`` (:meth:`_analysed`) K - sigma M is formed in place in that entry's Mat
+        and factorised by its KSP (SLEPc's ``ST`` mat mode ``inplace``, subset pattern):
+        MUMPS' analysis of the static solve is reused."""
         PETSc, SLEPc = self.PETSc, self.SLEPc
         n = Kp.getSize()[0]
         E = SLEPc.EPS().create(comm=self.comm)
+        if reuse is not None:
+            reuse[2] += 1                      # its Mat becomes K - sigma M: solves are stale
+            Kp.copy(reuse[0], structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            Kp = reuse[0]
         try:
             E.setOperators(Kp, Mp)
             E.setProblemType(SLEPc.EPS.ProblemType.GHEP if sym else SLEPc.EPS.ProblemType.GNHEP)
@@ -617,6 +691,10 @@ class PetscBackend:
             with self._database({key: v for key, v in self.options.items()
                                  if key.startswith(("eps_", "st_"))}):
                 E.setFromOptions()
+            if reuse is not None:
+                st.setMatMode(SLEPc.ST.MatMode.INPLACE)
+                st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+                st.setKSP(reuse[1])
             try:
                 E.solve()
             except PETSc.Error as exc:
