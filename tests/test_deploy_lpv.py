@@ -86,9 +86,10 @@ def test_cli_lpv_deployment_tracks_without_slack(design21, tmp_path, capsys):
                  "--csv", str(csv), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     # the JSON keys of the 7.4 deployments (a 0.05 s adaptive 1-4(D) run), but the adaptive
-    # PFL's own set-up (its RBF network)
+    # PFL's own set-up (its RBF network, its tendon model and the warnings about that model)
     assert main(["deploy", "--preset", "1-4D", "--controller", "adaptive", "--t-end", "0.05", "--json"]) == 0
-    keys74 = set(json.loads(capsys.readouterr().out)) - {"rbf_centres", "rbf_sigma", "w_bar"}
+    keys74 = set(json.loads(capsys.readouterr().out)) - {"rbf_centres", "rbf_sigma", "w_bar",
+                                                             "pfl_tendon_model", "warnings"}
     assert keys74 - {"csv"} <= set(out), keys74 - set(out)
     assert out["controller"] == "lpv" and out["gamma"] == 20.0 and out["design_grid_passed"]
     assert out["uncertainty"] is None and out["path"] == "table-7-7-bases"
