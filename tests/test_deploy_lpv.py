@@ -4,6 +4,7 @@ psi = 8.36 deg; the full 6 x 3 runs are in docs/lpv.md). Sources: eq. 5.100 (ref
 (rest lengths never above the tendon lengths), 8.4 (Euler load 1332.3 N)."""
 import json
 import os
+import re
 
 import numpy as np
 import pytest
@@ -170,6 +171,9 @@ def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
     cols = []
     for f in (a, b):
         rows = list(_csv.reader(open(f)))
+        # every column with its unit (docs/output.md), the references' too (x_21_ref was bare)
+        assert [h for h in rows[0] if not re.fullmatch(r"\S+ \[[^\]]+\]", h)] == []
+        assert {"x_21_ref [m]", "theta_13_ref [rad]", "controller [-]"} <= set(rows[0])
         head = [h.split(" [")[0] for h in rows[0]]
         cols.append({h: np.array([float(r[k]) for r in rows[1:]]) for k, h in enumerate(head[:-1])})
     assert cols[0].keys() == cols[1].keys()

@@ -68,6 +68,30 @@ def test_switch_labels_do_not_overlap_and_stay_inside_the_axes(switches):
         assert frame.x0 <= bb.x0 and bb.x1 <= frame.x1 and frame.y0 <= bb.y0 and bb.y1 <= frame.y1
 
 
+def test_legends_hide_no_data_and_stay_inside_the_figure():
+    """The attitudes of the 2-3 runs (80 -> 57 deg, 130 deg, 10 deg; the legend of the top
+    panel covered the 130 deg line, docs/fe-plant.md): rendered, no legend box contains a
+    point of any plotted line of the figure, and every legend lies inside the figure."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    a, b = _run(20.0, switch=17.33), _run(20.0, dq=1e-3, dw=1e-4, switch=17.46)
+    fig = comparison_figure(a, b, plant_deviation(a, b), labels=("sbc", "com"), title="x\ny")
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    legends = [x.get_legend() for x in fig.axes if x.get_legend() is not None]
+    assert len(legends) == 4                       # attitudes, errors, w, rest lengths
+    points = np.vstack([line.get_transform().transform(line.get_xydata())
+                        for x in fig.axes for line in x.get_lines() if len(line.get_xydata())])
+    assert len(points) > 10 * a.t.size
+    frame = fig.bbox
+    for leg in legends:
+        bb = leg.get_window_extent(r)
+        inside = ((points[:, 0] >= bb.x0) & (points[:, 0] <= bb.x1)
+                  & (points[:, 1] >= bb.y0) & (points[:, 1] <= bb.y1))
+        assert not inside.any(), (leg.get_texts()[0].get_text(), points[inside][:3])
+        assert frame.x0 <= bb.x0 and bb.x1 <= frame.x1 and frame.y0 <= bb.y0 and bb.y1 <= frame.y1
+
+
 def test_switch_label_places_stack_close_switches_only():
     # same side and within 20 % of the span: one above the other; far apart: the same height
     assert switch_label_places([17.33, 17.46], 20.0) == [(0.02, "right"), (0.11, "right")]
