@@ -31,9 +31,11 @@ def switch_label_places(times, t_span: float, *, close: float = 0.2) -> list:
     return places
 
 
-def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "") -> Path:
+def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "",
+                          reference: str = "eq. 5.68") -> Path:
     """:func:`comparison_figure` written to ``png``."""
-    return save_figure(comparison_figure(a, b, dev, labels=labels, title=title), Path(png))
+    return save_figure(comparison_figure(a, b, dev, labels=labels, title=title, reference=reference),
+                       Path(png))
 
 
 def _legend_outside(ax, entries, labels) -> None:
@@ -48,14 +50,15 @@ def _legend_outside(ax, entries, labels) -> None:
               borderaxespad=0.0)
 
 
-def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
-    """Five panels over time: the bar attitudes of both runs against the reference, their
-    tracking errors q - q_ref, the membrane deflections w_k, the commanded rest lengths (one
-    tendon of each family) and the deviation between the plants (bars [mrad], left axis; w
-    [mm], right axis; both logarithmic). Colour: the signal; run A solid, run B dashed; the
-    legends right of the panels (they hide no data); a run that stopped early is marked."""
-    fig = new_figure(figsize=(10.5, 14))
-    ax = fig.subplots(5, 1, sharex=True)
+def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", reference: str = "eq. 5.68"):
+    """Six panels over time: the bar attitudes of both runs against the reference
+    (``reference``: its equation), their tracking errors q - q_ref, the membrane deflections
+    w_k, the commanded rest lengths (one tendon of each family), the deviation between the
+    plants of the bar angles [mrad] and of the base positions [mm] and that of w [mm] (both
+    logarithmic). Colour: the signal; run A solid, run B dashed; the legends right of the
+    panels (they hide no data); a run that stopped early is marked."""
+    fig = new_figure(figsize=(10.5, 16))
+    ax = fig.subplots(6, 1, sharex=True, height_ratios=[1, 1, 1, 1, 0.7, 0.7])
     names = a.names["q"]
     colours = [f"C{i}" for i in range(10)]
     bars = []
@@ -66,7 +69,7 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
             ax[0].plot(r.t, np.degrees(r.z[:, k]), ls, color=c)
             ax[1].plot(r.t, 1e3 * (r.z[:, k] - r.q_d[:, k]), ls, color=c)
         ax[0].plot(a.t, np.degrees(a.q_d[:, k]), ":", color="k", lw=0.9)
-    _legend_outside(ax[0], bars + [("references (eq. 5.68)", "k", ":")], labels)
+    _legend_outside(ax[0], bars + [(f"references ({reference})", "k", ":")], labels)
     _legend_outside(ax[1], bars, labels)
     ax[0].set_ylabel("bar attitude [deg]")
     ax[1].set_ylabel("tracking error q - q_ref [mrad]")
@@ -84,19 +87,24 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
     _legend_outside(ax[3], [(f"rest length {a.names['tendons'][j]}", colours[i % 10], "-")
                             for i, j in enumerate(seen.values())], labels)
     ax[3].set_ylabel("rest length [m]")
-    # the axis labels name the two curves (in their colours): no legend over the data
-    ax[4].plot(dev["t"], 1e3 * dev["q"], "-", color="C0")
-    ax[4].set_ylabel(f"bars: max |q ({labels[1]}) - q ({labels[0]})| [mrad]", color="C0")
-    ax[4].set_yscale("log")
-    tw = ax[4].twinx()
-    tw.plot(dev["t"], 1e3 * dev["w"], "-", color="C3")
-    tw.set_ylabel(f"membrane: max |w ({labels[1]}) - w ({labels[0]})| [mm]", color="C3")
-    tw.set_yscale("log")
-    for x, d in ((ax[4], 1e3 * dev["q"]), (tw, 1e3 * dev["w"])):
+    vs = f"|{labels[1]} - {labels[0]}|"
+    devs = [(ax[4], 1e3 * dev["q"], "C0", f"bar angles: max {vs} [mrad]")]
+    if np.isfinite(dev["bases"]).all():
+        devs.append((ax[4], 1e3 * dev["bases"], "C1", f"stage bases: max {vs} [mm]"))
+    devs.append((ax[5], 1e3 * dev["w"], "C3", f"w_k: max {vs} [mm]"))
+    for x in ax[4:]:
+        x.set_yscale("log")
+    for x, d, c, lab in devs:
+        x.plot(dev["t"], d, "-", color=c, label=lab)
+    for x in ax[4:]:
+        d = np.concatenate([line.get_ydata() for line in x.get_lines()])
         top = float(np.max(d)) if d.size else 0.0
         if top > 0:           # three decades below the largest deviation: the start is exact
             x.set_ylim(1e-3 * top, 2.0 * top)
-    ax[4].set_xlabel("time [s]")
+        x.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    ax[4].set_ylabel("bar deviation\n[mrad, mm]")
+    ax[5].set_ylabel("membrane deviation\n[mm]")
+    ax[5].set_xlabel("time [s]")
     t_span = max(a.t[-1], b.t[-1])
     switches = [(r.switch_time, lab, ls) for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--"))
                 if r.switch_time is not None]
