@@ -55,8 +55,9 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", referenc
     (``reference``: its equation), their tracking errors q - q_ref, the membrane deflections
     w_k, the commanded rest lengths (one tendon of each family), the deviation between the
     plants of the bar angles [mrad] and of the base positions [mm] and that of w [mm] (both
-    logarithmic). Colour: the signal; run A solid, run B dashed; the legends right of the
-    panels (they hide no data); a run that stopped early is marked."""
+    logarithmic). Colour: the signal; run A solid, run B dashed and drawn above every run-A
+    line (a signal of A does not hide another's B); the legends right of the panels (they
+    hide no data); a run that stopped early is marked."""
     fig = new_figure(figsize=(10.5, 16))
     ax = fig.subplots(6, 1, sharex=True, height_ratios=[1, 1, 1, 1, 0.7, 0.7])
     names = a.names["q"]
@@ -65,25 +66,25 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", referenc
     for i, k in enumerate(_bar_signals(names)):
         c = colours[i % 10]
         bars.append((names[k], c, "-"))
-        for r, ls in ((a, "-"), (b, "--")):
-            ax[0].plot(r.t, np.degrees(r.z[:, k]), ls, color=c)
-            ax[1].plot(r.t, 1e3 * (r.z[:, k] - r.q_d[:, k]), ls, color=c)
+        for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
+            ax[0].plot(r.t, np.degrees(r.z[:, k]), ls, color=c, zorder=z)
+            ax[1].plot(r.t, 1e3 * (r.z[:, k] - r.q_d[:, k]), ls, color=c, zorder=z)
         ax[0].plot(a.t, np.degrees(a.q_d[:, k]), ":", color="k", lw=0.9)
     _legend_outside(ax[0], bars + [(f"references ({reference})", "k", ":")], labels)
     _legend_outside(ax[1], bars, labels)
     ax[0].set_ylabel("bar attitude [deg]")
     ax[1].set_ylabel("tracking error q - q_ref [mrad]")
     for i, n in enumerate(a.names["w"]):
-        for r, ls in ((a, "-"), (b, "--")):
-            ax[2].plot(r.t, 1e3 * r.w[:, i], ls, color=colours[i % 10])
+        for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
+            ax[2].plot(r.t, 1e3 * r.w[:, i], ls, color=colours[i % 10], zorder=z)
     _legend_outside(ax[2], [(n, colours[i % 10], "-") for i, n in enumerate(a.names["w"])], labels)
     ax[2].set_ylabel("membrane deflection w [mm]")
     seen = {}
     for j, n in enumerate(a.names["tendons"]):
         seen.setdefault(n.rsplit("_", 1)[0], j)
     for i, j in enumerate(seen.values()):
-        for r, ls in ((a, "-"), (b, "--")):
-            ax[3].plot(r.t, r.u[:, j], ls, color=colours[i % 10])
+        for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
+            ax[3].plot(r.t, r.u[:, j], ls, color=colours[i % 10], zorder=z)
     _legend_outside(ax[3], [(f"rest length {a.names['tendons'][j]}", colours[i % 10], "-")
                             for i, j in enumerate(seen.values())], labels)
     ax[3].set_ylabel("rest length [m]")
