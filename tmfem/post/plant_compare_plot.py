@@ -99,9 +99,10 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", referenc
         x.plot(dev["t"], d, "-", color=c, label=lab)
     for x in ax[4:]:
         d = np.concatenate([line.get_ydata() for line in x.get_lines()])
-        top = float(np.max(d)) if d.size else 0.0
-        if top > 0:           # three decades below the largest deviation: the start is exact
-            x.set_ylim(1e-3 * top, 2.0 * top)
+        d = d[np.isfinite(d) & (d > 0)]
+        if d.size:            # down to the smallest deviation, at most four decades below the
+            top = float(d.max())                       # largest (the start is exact: zero)
+            x.set_ylim(max(1e-4 * top, 0.5 * float(d.min())), 2.0 * top)
         x.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ax[4].set_ylabel("bar deviation\n[mrad, mm]")
     ax[5].set_ylabel("membrane deviation\n[mm]")
