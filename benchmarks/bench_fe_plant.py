@@ -12,10 +12,15 @@ constraint products T^T K dexp T).
 
 ``--deploy cable|fixed-rate``: instead, the 2-3 deployment itself (the adaptive PFL of 7.4 at
 the reference with the plant's tendon law, docs/fe-plant.md) on the MTC plant with that
-tendon law, from its packaged equilibrium, through :func:`run_deployment`.
+tendon law, from its packaged equilibrium, through :func:`run_deployment`; with
+``--lpv-controller FILE`` the LPV deployment of 8.4 (preset 2-3-lpv) with that saved design
+(``tmfem control lpv ... --save FILE``, rebuilt and checked on its grid as ``tmfem deploy``
+does) instead of the adaptive PFL. The controller's calls (its measurement included) are
+timed apart from the plant's.
 
     .venv/bin/python benchmarks/bench_fe_plant.py [--plant mtc|sbc] [--preset 2-3-deploy|1-4D]
-        [--mesh 10] [--t-end 2] [--jacobian step] [--deploy cable|fixed-rate]
+        [--mesh 10] [--t-end 2] [--jacobian step] [--deploy cable|fixed-rate
+        [--lpv-controller FILE]]
 """
 from __future__ import annotations
 
@@ -36,18 +41,19 @@ from timing import print_breakdown
 
 
 class Timed:
-    """Proxy that times the plant calls the driver and the integrator make."""
+    """Proxy that times the calls ``keys`` (default: those of a plant the driver and the
+    integrator make) of ``plant`` (a plant or a controller)."""
 
     KEYS = ("residual", "newton_matrix", "jacobians", "factorize", "outputs")
 
-    def __init__(self, plant):
-        self.plant = plant
-        self.t = dict.fromkeys(self.KEYS, 0.0)
-        self.n = dict.fromkeys(self.KEYS, 0)
+    def __init__(self, plant, keys=KEYS):
+        self.plant, self.keys = plant, tuple(keys)
+        self.t = dict.fromkeys(self.keys, 0.0)
+        self.n = dict.fromkeys(self.keys, 0)
 
     def __getattr__(self, name):
         fn = getattr(self.plant, name)
-        if name not in self.KEYS:
+        if name not in self.keys:
             return fn
 
         def timed(*a, **kw):
@@ -83,7 +89,10 @@ def main():
     ap.add_argument("--t-end", type=float, default=2.0)
     ap.add_argument("--jacobian", default="step", choices=["iteration", "step", "reuse"])
     ap.add_argument("--deploy", choices=["cable", "fixed-rate"])
+    ap.add_argument("--lpv-controller", metavar="FILE")
     a = ap.parse_args()
+    if a.lpv_controller and not a.deploy:
+        ap.error("--lpv-controller: the LPV deployment on the MTC plant, expected --deploy cable|fixed-rate")
     if a.plant == "mtc" and a.preset == "1-4D":
         ap.error("--plant mtc: 1-4D has H_1j nodes along the bars (the SBC model only)")
     if a.deploy:
@@ -132,18 +141,29 @@ def main():
 
 
 def deployment(a):
-    """The 2-3 deployment on the MTC plant (``--deploy``), timed as :func:`main`."""
+    """The 2-3 deployment on the MTC plant (``--deploy``; ``--lpv-controller``: the LPV one of
+    8.4), timed as :func:`main`, the controller's calls apart."""
     from tmfem.control.deploy import run_deployment
-    from tmfem.control.state_estimate import mtc_deployment_plant
+    from tmfem.control.state_estimate import deployment_plant
     from tmfem.reference.deployments import setup
     t0 = time.perf_counter()
-    s = setup("2-3-deploy", controller="adaptive", evaluation="reference", tendon_law=a.deploy)
-    plant = Timed(mtc_deployment_plant(s.model, load_preset("2-3-deploy-initial"),
-                                       mesh_n=a.mesh, tendon_law=a.deploy))
-    print(f"2-3 deployment on MTC 3x{a.mesh}x{a.mesh} ({a.deploy} tendons): {plant.x0.size} free "
-          f"DOFs; set-up (COM, PFL, FE start equilibrium) {time.perf_counter() - t0:.2f} s")
+    if a.lpv_controller:
+        from types import SimpleNamespace
+        from tmfem.cli.deploy_lpv import BUILDERS, design
+        from tmfem.reference.deployments import lpv_setup
+        plant, d, _ = design(SimpleNamespace(lpv_controller=a.lpv_controller, dt=0.01), "2-3-lpv")
+        dep = lpv_setup("2-3-lpv", plant)
+        s, initial = dep.setup(BUILDERS["lpv"](dep, d)), dep.packaged()
+        what = f"LPV deployment (8.4, gamma = {d.gamma:.4g})"
+    else:
+        s = setup("2-3-deploy", controller="adaptive", evaluation="reference", tendon_law=a.deploy)
+        initial, what = load_preset("2-3-deploy-initial"), "deployment (adaptive PFL of 7.4)"
+    plant = Timed(deployment_plant("mtc", s.model, initial, mesh_n=a.mesh, tendon_law=a.deploy))
+    ctrl = Timed(s.controller, keys=("reset", "output", "update"))
+    print(f"2-3 {what} on MTC 3x{a.mesh}x{a.mesh} ({a.deploy} tendons): {plant.x0.size} free "
+          f"DOFs; set-up (COM, controller, FE start equilibrium) {time.perf_counter() - t0:.2f} s")
     c0, w0 = time.process_time(), time.perf_counter()
-    r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
+    r = run_deployment(model=s.model, reference=s.reference, controller=ctrl, z0=s.z0,
                        t_end=a.t_end, dt=0.01, plant=plant, jacobian=a.jacobian)
     cpu, wall = time.process_time() - c0, time.perf_counter() - w0
     steps = r.t.size - 1
@@ -151,7 +171,9 @@ def deployment(a):
           f"{cpu:.2f} s, {cpu / steps * 1e3:.1f} ms CPU per step (target < 300 ms: "
           f"{'met' if cpu / steps < 0.3 else 'NOT met'}); load average {os.getloadavg()[0]:.1f} "
           f"on {os.cpu_count()} cores")
-    print_breakdown(plant.t, plant.n, wall, "PFL, Park loop, solves, recovery")
+    print_breakdown({**plant.t, **{f"controller {k}": v for k, v in ctrl.t.items()}},
+                    {**plant.n, **{f"controller {k}": v for k, v in ctrl.n.items()}}, wall,
+                    "limits, Park loop, solves, recovery")
 
 
 if __name__ == "__main__":

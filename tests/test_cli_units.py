@@ -77,3 +77,25 @@ def test_csv_headers_carry_units(tmp_path, capsys):
     # every column of the COM history has a unit, the membrane coordinates included
     assert all(h.endswith("]") for h in head) and "eta_1 [kg^0.5 m]" in head
     capsys.readouterr()
+
+
+_UNIT = r"\S+ \[[^\]]+\]"
+
+
+@pytest.mark.parametrize("argv", [
+    ["--preset", "2-3-deploy", "--controller", "adaptive", "--t-end", "0.03"],
+    ["--preset", "1-4D", "--controller", "adaptive-lqr", "--t-end", "0.03"],
+])
+def test_every_column_of_the_7_4_deployment_csv_has_a_unit(argv, tmp_path, capsys):
+    # docs/fe-plant.md, docs/output.md: "units in the header"; the references q_d (eq. 5.68)
+    # carry their signals' units (x_21_ref was bare), the controller label "-"
+    import csv
+    import re
+    c = tmp_path / "d.csv"
+    assert main(["deploy", *argv, "--csv", str(c)]) == 0
+    capsys.readouterr()
+    head = next(csv.reader(open(c)))
+    assert [h for h in head if not re.fullmatch(_UNIT, h)] == []
+    assert head[-1] == "controller [-]" and "theta_11_ref [rad]" in head
+    if argv[1] == "2-3-deploy":
+        assert {"x_21_ref [m]", "z_23_ref [m]", "x_21 [m]", "r_P_21 [m]", "L_S_11 [m]"} <= set(head)

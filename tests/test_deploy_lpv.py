@@ -4,6 +4,7 @@ psi = 8.36 deg; the full 6 x 3 runs are in docs/lpv.md). Sources: eq. 5.100 (ref
 (rest lengths never above the tendon lengths), 8.4 (Euler load 1332.3 N)."""
 import json
 import os
+import re
 
 import numpy as np
 import pytest
@@ -150,7 +151,8 @@ def _check_follows_the_com_run(runs, plant, bound):
 def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
     """`tmfem deploy --preset 2-3-lpv --plant mtc --compare-plant com --compare-plot`: the same
     design (a fresh controller) on the 3 x 2 x 2 MTC and the COM plant over 0.3 s; the JSON's
-    bar deviation is the largest |q_mtc - q_com| of the two CSVs (computed here from the files),
+    bar-angle and base deviations are the largest |q_mtc - q_com| of the two CSVs over the
+    angles and over the base positions (computed here from the files),
     both runs name the same controller (design, gamma) and their own plant's tendon law."""
     import csv as _csv
     pl, d, path = design21
@@ -170,13 +172,18 @@ def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
     cols = []
     for f in (a, b):
         rows = list(_csv.reader(open(f)))
+        # every column with its unit (docs/output.md), the references' too (x_21_ref was bare)
+        assert [h for h in rows[0] if not re.fullmatch(r"\S+ \[[^\]]+\]", h)] == []
+        assert {"x_21_ref [m]", "theta_13_ref [rad]", "controller [-]"} <= set(rows[0])
         head = [h.split(" [")[0] for h in rows[0]]
         cols.append({h: np.array([float(r[k]) for r in rows[1:]]) for k, h in enumerate(head[:-1])})
     assert cols[0].keys() == cols[1].keys()
     q = [n for n in cols[0] if n + "_ref" in cols[0]]
-    dq = max(np.max(np.abs(cols[0][n] - cols[1][n])) for n in q)
-    assert dq > 0
-    assert np.radians(c["deviation"]["max_bar_deviation_deg"]) == pytest.approx(dq, rel=1e-6)
+    dev = {kind: max(np.max(np.abs(cols[0][n] - cols[1][n])) for n in q if n.startswith(pre))
+           for kind, pre in (("angles", ("theta", "psi")), ("bases", ("x_", "y_", "z_")))}
+    assert dev["angles"] > 0 and dev["bases"] > 0
+    assert np.radians(c["deviation"]["max_bar_deviation_deg"]) == pytest.approx(dev["angles"], rel=1e-6)
+    assert c["deviation"]["max_base_deviation_m"] == pytest.approx(dev["bases"], rel=1e-6)
     assert c["deviation"]["common_record_s"] == pytest.approx(0.3)
 
 

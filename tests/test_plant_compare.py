@@ -42,10 +42,26 @@ def test_plant_deviation_is_the_largest_difference_over_the_common_record():
     assert "2" not in s["bar_deviation_at_times_deg"]
     assert s["max_membrane_deflection_deviation_m"] == pytest.approx(5e-4)
     assert s["max_rest_length_deviation_m"] == pytest.approx(3e-3)
+    assert np.isnan(dev["bases"]).all() and "max_base_deviation_m" not in s
     c = _run(1.0)
     c.names = {**c.names, "q": Q[::-1]}
     with pytest.raises(InputError, match="expected two runs of one deployment"):
         plant_deviation(a, c)
+
+
+def test_bar_angles_and_base_positions_deviate_apart():
+    # a base position 5 mm off and the angles 1 mrad: the angle deviation is 1 mrad, the base
+    # one 5 mm -- not max(1e-3 rad, 5e-3 m) (radians against metres) as one maximum over q
+    a, b = _run(1.0), _run(1.0, dq=1e-3)
+    for r in (a, b):
+        r.names = {**r.names, "q": ["theta_11", "psi_11", "x_21", "theta_21"]}
+    b.z[:, 2] = a.z[:, 2] + 5e-3
+    dev = plant_deviation(a, b)
+    assert np.allclose(dev["q"], 1e-3) and np.allclose(dev["bases"], 5e-3)
+    s = deviation_summary(dev)
+    assert s["max_bar_deviation_deg"] == pytest.approx(np.degrees(1e-3))
+    assert s["max_base_deviation_m"] == pytest.approx(5e-3)
+    assert s["base_deviation_at_times_m"]["0.3"] == pytest.approx(5e-3)
 
 
 @pytest.mark.parametrize("switches", [(17.33, 17.46), (17.46, 17.33), (2.0, 2.1), (5.0, 15.0)])
@@ -65,6 +81,30 @@ def test_switch_labels_do_not_overlap_and_stay_inside_the_axes(switches):
     assert not boxes[0].overlaps(boxes[1])
     frame = ax.get_window_extent(r)
     for bb in boxes:
+        assert frame.x0 <= bb.x0 and bb.x1 <= frame.x1 and frame.y0 <= bb.y0 and bb.y1 <= frame.y1
+
+
+def test_legends_hide_no_data_and_stay_inside_the_figure():
+    """The attitudes of the 2-3 runs (80 -> 57 deg, 130 deg, 10 deg; the legend of the top
+    panel covered the 130 deg line, docs/fe-plant.md): rendered, no legend box contains a
+    point of any plotted line of the figure, and every legend lies inside the figure."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    a, b = _run(20.0, switch=17.33), _run(20.0, dq=1e-3, dw=1e-4, switch=17.46)
+    fig = comparison_figure(a, b, plant_deviation(a, b), labels=("sbc", "com"), title="x\ny")
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    r = canvas.get_renderer()
+    legends = [x.get_legend() for x in fig.axes if x.get_legend() is not None]
+    assert len(legends) == 6          # attitudes, errors, w, rest lengths, the two deviations
+    points = np.vstack([line.get_transform().transform(line.get_xydata())
+                        for x in fig.axes for line in x.get_lines() if len(line.get_xydata())])
+    assert len(points) > 10 * a.t.size
+    frame = fig.bbox
+    for leg in legends:
+        bb = leg.get_window_extent(r)
+        inside = ((points[:, 0] >= bb.x0) & (points[:, 0] <= bb.x1)
+                  & (points[:, 1] >= bb.y0) & (points[:, 1] <= bb.y1))
+        assert not inside.any(), (leg.get_texts()[0].get_text(), points[inside][:3])
         assert frame.x0 <= bb.x0 and bb.x1 <= frame.x1 and frame.y0 <= bb.y0 and bb.y1 <= frame.y1
 
 

@@ -97,7 +97,7 @@ def test_2_3_adaptive_deployment_on_the_sbc_plant_is_the_mtc_one(bars, capsys):
     # on the SBC plant with q measured as the bars' rigid fit (the default) and as their
     # chords: its gains are low enough that the bars' bending modes stay out of the loop; over
     # the first 2 s on 3 x 4 x 4 its bars stay within 0.5 mrad of the same deployment on the
-    # MTC plant (measured 0.047 mrad with the chords, 0.057 mrad with the rigid fit; 3 x 10 x 10
+    # MTC plant (measured 0.041 mrad with either, the bases within 0.047 / 0.057 mm; 3 x 10 x 10
     # over 20 s with the switch: 0.20 mrad, docs/fe-plant.md), no rest length above its
     # tendon, and the FE tendons slack only where the allocation holds the P_2j at zero tension
     import json

@@ -189,7 +189,8 @@ def test_three_model_vibration(tmp_path, capsys):
     assert r["peak_to_peak"]["SBC"]["B_12_z"] == pytest.approx(r["peak_to_peak"]["MTC"]["B_12_z"],
                                                               rel=0.02)
     head = next(csv.reader(open(tmp_path / "v.csv")))
-    assert {"SBC_theta_12", "MTC_w_1", "COM_B_14_z", "SBC_tendon_deflection"} <= set(head)
+    assert {"SBC_theta_12 [rad]", "MTC_w_1 [m]", "COM_B_14_z [m]", "SBC_tendon_deflection [m]"} <= set(head)
+    assert head[0] == "t [s]" and all(h.endswith("]") for h in head)        # every column's unit
     assert (tmp_path / "v.png").stat().st_size > 10_000
 
 

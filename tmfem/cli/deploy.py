@@ -218,12 +218,14 @@ def _run_on(args, s, plant_kind: str, mesh_n):
                               partial=plant is not None)
 
 
-def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str) -> dict:
+def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str,
+                   reference: str = "eq. 5.68") -> dict:
     """The same deployment on ``--compare-plant`` and its deviation from run ``r`` (both
     deployment kinds): ``rerun(plant)`` runs it there with a fresh controller of the same
     options (the adaptive PFL, the switch and the LPV observer carry state) and returns the
     result and its extra JSON entries; ``controller``: those options (JSON of both runs),
-    ``about``: their summary for the plot's title. The CSV and the plot if asked for."""
+    ``about``: their summary for the plot's title, ``reference``: the equation of the
+    reference q_d (the plot's legend). The CSV and the plot if asked for."""
     from tmfem.control.plant_compare import deviation_summary, plant_deviation
     from tmfem.reference.deployments import write_csv
     r2, extra = rerun(args.compare_plant)
@@ -241,7 +243,8 @@ def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str) -> d
                      f"{k[6:]} {v}" for k, v in o.items() if k != "plant_damping_s" or v))
                      for (p, o), ls in zip(runs, ("solid", "dashed"))))
         out["plot"] = str(plot_plant_comparison(
-            args.compare_plot, r, r2, dev, labels=(args.plant, args.compare_plant), title=title))
+            args.compare_plot, r, r2, dev, labels=(args.plant, args.compare_plant), title=title,
+            reference=reference))
     return out
 
 

@@ -197,7 +197,8 @@ def run(args) -> dict:
         src = args.lpv_controller or "synthesised here"
         out["compare"] = compare_plants(
             args, r, rerun, mesh_n=mesh_n, controller=ctrl,
-            about=f"gamma = {d.gamma:.4g}, {src}" + (f", noise {args.noise:g}" if args.noise else ""))
+            about=f"gamma = {d.gamma:.4g}, {src}" + (f", noise {args.noise:g}" if args.noise else ""),
+            reference="eq. 5.100")
     out["total_wall_time_s"] = time.perf_counter() - t0
     out["failed_checks"] = diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out

@@ -68,8 +68,10 @@ def theta_reference(t, *, theta_0: float, theta_e: float, omega_r: float, xi_r: 
 N_PATH = 400
 
 
-def _angle_mask(q_names) -> np.ndarray:
-    return np.array([n.startswith(("theta", "psi")) for n in q_names])
+def angle_mask(q_names) -> np.ndarray:
+    """True where a bar coordinate of ``q_names`` is an angle (theta, psi of eqs. 3.1-3.2,
+    [rad]), False where it is a position (the bases x, y, z of the upper stages, [m])."""
+    return np.array([n.startswith(("theta", "psi")) for n in q_names], dtype=bool)
 
 
 @dataclass
@@ -108,7 +110,7 @@ class DeploymentReference:
         if abs(th0 - the) < 1e-9:
             raise InputError("deployment reference: expected different initial and final "
                              f"declination angles, found theta_0 = theta_e = {np.degrees(th0):.6g} deg")
-        self._angles = _angle_mask(self.q_names)
+        self._angles = angle_mask(self.q_names)
         if self.r_mb is not None:
             if self.bases is not None or self.initial.M != 1:
                 raise InputError("deployment path: expected the Delta rule (r_mb) for a "

@@ -17,7 +17,7 @@ from tmfem.io.series import SeriesWriter
 #: Units of the named signals of a run. ``eta_k``: the COM's membrane modal coordinates; the
 #: modes are mass-normalised (phi^T M phi = 1, M in kg, docs/com.md), so eta = w / phi
 #: carries kg^0.5 m. ``ur_k``/``vr_k``/``wr_k``: membrane point coordinates (eq. 5.17).
-_UNITS = [(r"t", "s"), (r"(theta|psi|sigma)_\d+(_ref)?", "rad"), (r"w_\d+", "m"),
+_UNITS = [(r"t", "s"), (r"(theta|psi|sigma)_\d+", "rad"), (r"w_\d+", "m"),
           (r"[xyz]_\d+", "m"), (r"[A-Z]+_[\d,]+_[xyz]", "m"), (r"tendon_deflection", "m"),
           (r"(kinetic|strain|eta)_energy", "J"), (r"eta_\d+", "kg^0.5 m"), (r"[uvw]r_\d+", "m"),
           (r"u_.+|r_.+|L_.+", "m"), (r"T_.+|force_.+", "N")]
@@ -26,8 +26,10 @@ _UNITS = [(r"t", "s"), (r"(theta|psi|sigma)_\d+(_ref)?", "rad"), (r"w_\d+", "m")
 def column_header(name: str) -> str:
     """``name [unit]`` for the CSV header of a run history (``theta_11`` -> ``theta_11 [rad]``,
     ``theta_11_dot`` -> ``theta_11_dot [rad/s]``, ``B_12_z`` -> ``B_12_z [m]``, ``eta_1`` ->
-    ``eta_1 [kg^0.5 m]``, see :data:`_UNITS`); a name without a known unit stays bare."""
+    ``eta_1 [kg^0.5 m]``, see :data:`_UNITS`); the reference of a signal (``x_21_ref``: q_d of
+    eq. 5.68) has the signal's unit; a name without a known unit stays bare."""
     base, rate = (name[:-4], True) if name.endswith("_dot") else (name, False)
+    base = base[:-4] if base.endswith("_ref") else base
     for pattern, unit in _UNITS:
         if re.fullmatch(pattern, base):
             return f"{name} [{unit}/s]" if rate else f"{name} [{unit}]"

@@ -31,61 +31,82 @@ def switch_label_places(times, t_span: float, *, close: float = 0.2) -> list:
     return places
 
 
-def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "") -> Path:
+def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "",
+                          reference: str = "eq. 5.68") -> Path:
     """:func:`comparison_figure` written to ``png``."""
-    return save_figure(comparison_figure(a, b, dev, labels=labels, title=title), Path(png))
+    return save_figure(comparison_figure(a, b, dev, labels=labels, title=title, reference=reference),
+                       Path(png))
 
 
-def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
-    """Five panels over time: the bar attitudes of both runs against the reference, their
-    tracking errors q - q_ref, the membrane deflections w_k, the commanded rest lengths (one tendon of each family) and the
-    deviation between the plants (bars [mrad], left axis; w [mm], right axis; both
-    logarithmic). Run A solid,
-    run B dashed; a run that stopped early is marked."""
-    fig = new_figure(figsize=(8.5, 14))
-    ax = fig.subplots(5, 1, sharex=True)
+def _legend_outside(ax, entries, labels) -> None:
+    """The legend of panel ``ax`` to the right of the axes, where it hides no data: one entry
+    per signal in its colour (``entries``: (label, colour, line style)), then the line style of
+    each plant (``labels``: run A solid, run B dashed)."""
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], color=c, ls=ls, label=n) for n, c, ls in entries]
+    handles += [Line2D([], [], color="k", ls=ls, label=f"{lab} plant")
+                for lab, ls in zip(labels, ("-", "--"))]
+    ax.legend(handles=handles, fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0),
+              borderaxespad=0.0)
+
+
+def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", reference: str = "eq. 5.68"):
+    """Six panels over time: the bar attitudes of both runs against the reference
+    (``reference``: its equation), their tracking errors q - q_ref, the membrane deflections
+    w_k, the commanded rest lengths (one tendon of each family), the deviation between the
+    plants of the bar angles [mrad] and of the base positions [mm] and that of w [mm] (both
+    logarithmic). Colour: the signal; run A solid, run B dashed and drawn above every run-A
+    line (a signal of A does not hide another's B); the legends right of the panels (they
+    hide no data); a run that stopped early is marked."""
+    fig = new_figure(figsize=(10.5, 16))
+    ax = fig.subplots(6, 1, sharex=True, height_ratios=[1, 1, 1, 1, 0.7, 0.7])
     names = a.names["q"]
     colours = [f"C{i}" for i in range(10)]
+    bars = []
     for i, k in enumerate(_bar_signals(names)):
         c = colours[i % 10]
-        ax[0].plot(a.t, np.degrees(a.z[:, k]), "-", color=c, label=f"{names[k]} ({labels[0]})")
-        ax[0].plot(b.t, np.degrees(b.z[:, k]), "--", color=c, label=f"{names[k]} ({labels[1]})")
-        ax[0].plot(a.t, np.degrees(a.q_d[:, k]), ":", color="k", lw=0.9,
-                   label="references (eq. 5.68)" if i == 0 else None)
-        ax[1].plot(a.t, 1e3 * (a.z[:, k] - a.q_d[:, k]), "-", color=c, label=f"{names[k]} ({labels[0]})")
-        ax[1].plot(b.t, 1e3 * (b.z[:, k] - b.q_d[:, k]), "--", color=c, label=f"{names[k]} ({labels[1]})")
+        bars.append((names[k], c, "-"))
+        for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
+            ax[0].plot(r.t, np.degrees(r.z[:, k]), ls, color=c, zorder=z)
+            ax[1].plot(r.t, 1e3 * (r.z[:, k] - r.q_d[:, k]), ls, color=c, zorder=z)
+        ax[0].plot(a.t, np.degrees(a.q_d[:, k]), ":", color="k", lw=0.9)
+    _legend_outside(ax[0], bars + [(f"references ({reference})", "k", ":")], labels)
+    _legend_outside(ax[1], bars, labels)
     ax[0].set_ylabel("bar attitude [deg]")
     ax[1].set_ylabel("tracking error q - q_ref [mrad]")
     for i, n in enumerate(a.names["w"]):
-        ax[2].plot(a.t, 1e3 * a.w[:, i], "-", color=colours[i], label=f"{n} ({labels[0]})")
-        ax[2].plot(b.t, 1e3 * b.w[:, i], "--", color=colours[i], label=f"{n} ({labels[1]})")
+        for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
+            ax[2].plot(r.t, 1e3 * r.w[:, i], ls, color=colours[i % 10], zorder=z)
+    _legend_outside(ax[2], [(n, colours[i % 10], "-") for i, n in enumerate(a.names["w"])], labels)
     ax[2].set_ylabel("membrane deflection w [mm]")
     seen = {}
     for j, n in enumerate(a.names["tendons"]):
-        fam = n.rsplit("_", 1)[0]
-        if fam not in seen:
-            seen[fam] = j
-    for i, (fam, j) in enumerate(seen.items()):
-        c = colours[i % 10]
-        n = a.names["tendons"][j]
-        ax[3].plot(a.t, a.u[:, j], "-", color=c, label=f"rest length {n} ({labels[0]})")
-        ax[3].plot(b.t, b.u[:, j], "--", color=c, label=f"rest length {n} ({labels[1]})")
+        seen.setdefault(n.rsplit("_", 1)[0], j)
+    for i, j in enumerate(seen.values()):
+        for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
+            ax[3].plot(r.t, r.u[:, j], ls, color=colours[i % 10], zorder=z)
+    _legend_outside(ax[3], [(f"rest length {a.names['tendons'][j]}", colours[i % 10], "-")
+                            for i, j in enumerate(seen.values())], labels)
     ax[3].set_ylabel("rest length [m]")
-    l1, = ax[4].plot(dev["t"], 1e3 * dev["q"], "-", color="C0",
-                     label=f"bars: max |q ({labels[1]}) - q ({labels[0]})| [mrad]")
-    ax[4].set_ylabel("bar deviation [mrad]", color="C0")
-    ax[4].set_yscale("log")
-    tw = ax[4].twinx()
-    l2, = tw.plot(dev["t"], 1e3 * dev["w"], "-", color="C3",
-                  label=f"membrane: max |w ({labels[1]}) - w ({labels[0]})| [mm]")
-    tw.set_ylabel("membrane deflection deviation [mm]", color="C3")
-    tw.set_yscale("log")
-    for x, d in ((ax[4], 1e3 * dev["q"]), (tw, 1e3 * dev["w"])):
-        top = float(np.max(d)) if d.size else 0.0
-        if top > 0:           # three decades below the largest deviation: the start is exact
-            x.set_ylim(1e-3 * top, 2.0 * top)
-    tw.legend(handles=[l1, l2], fontsize=7, loc="lower right")   # drawn above both axes
-    ax[4].set_xlabel("time [s]")
+    vs = f"|{labels[1]} - {labels[0]}|"
+    devs = [(ax[4], 1e3 * dev["q"], "C0", f"bar angles: max {vs} [mrad]")]
+    if np.isfinite(dev["bases"]).all():
+        devs.append((ax[4], 1e3 * dev["bases"], "C1", f"stage bases: max {vs} [mm]"))
+    devs.append((ax[5], 1e3 * dev["w"], "C3", f"w_k: max {vs} [mm]"))
+    for x in ax[4:]:
+        x.set_yscale("log")
+    for x, d, c, lab in devs:
+        x.plot(dev["t"], d, "-", color=c, label=lab)
+    for x in ax[4:]:
+        d = np.concatenate([line.get_ydata() for line in x.get_lines()])
+        d = d[np.isfinite(d) & (d > 0)]
+        if d.size:            # down to the smallest deviation, at most four decades below the
+            top = float(d.max())                       # largest (the start is exact: zero)
+            x.set_ylim(max(1e-4 * top, 0.5 * float(d.min())), 2.0 * top)
+        x.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
+    ax[4].set_ylabel("bar deviation\n[mrad, mm]")
+    ax[5].set_ylabel("membrane deviation\n[mm]")
+    ax[5].set_xlabel("time [s]")
     t_span = max(a.t[-1], b.t[-1])
     switches = [(r.switch_time, lab, ls) for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--"))
                 if r.switch_time is not None]
@@ -105,11 +126,9 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
                            xycoords=("data", "axes fraction"), fontsize=7, color="r",
                            ha="left" if early else "right",
                            bbox={"fc": "white", "ec": "none", "alpha": 0.8}, zorder=10)
-    for x in ax[:4]:
-        x.legend(fontsize=6, ncol=3)
     for x in ax:
         x.grid(alpha=0.3)
     if title:                 # wrapped to the figure's width: a long title is not cropped
-        ax[0].set_title("\n".join(textwrap.fill(line, 105) for line in title.split("\n")),
-                        fontsize=9)
+        fig.suptitle("\n".join(textwrap.fill(line, 130) for line in title.split("\n")),
+                     fontsize=9)
     return fig

@@ -92,12 +92,13 @@ def check_choices(preset: str, *, controller: str = "adaptive-hinf", uncertainty
 def csv_columns(r) -> list[str]:
     """Header of the deployment CSV: one column per named signal, with its unit
     (:func:`tmfem.io.run.column_header`): time, q, the references q_d, w, rest lengths u,
-    tendon lengths L, the zero-dynamics energy and the active controller (a label)."""
+    tendon lengths L, the zero-dynamics energy and the active controller (a label, unit
+    ``[-]`` as the dimensionless JSON entries of :mod:`tmfem.io.units`)."""
     from tmfem.io.run import column_header
     n = r.names
     names = (["t"] + n["q"] + [f"{q}_ref" for q in n["q"]] + n["w"] + n["u"]
              + [f"L_{t}" for t in n["tendons"]] + ["eta_energy"])
-    return [column_header(c) for c in names] + ["controller"]
+    return [column_header(c) for c in names] + ["controller [-]"]
 
 
 def write_csv(path, r) -> str:

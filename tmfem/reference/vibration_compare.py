@@ -189,11 +189,13 @@ def format_vibration_compare(c: dict, system) -> str:
 
 
 def write_vibration_csv(path, t, signals) -> Path:
-    """One row per time: t and every model's signals (``SBC_theta_12``, ``MTC_w_1``, ...)."""
+    """One row per time: t and every model's signals with their units
+    (:func:`tmfem.io.run.column_header`: ``t [s]``, ``SBC_theta_12 [rad]``, ``MTC_w_1 [m]``, ...)."""
+    from tmfem.io.run import column_header
     cols = [(m, s) for m in MODELS for s in signals[m]]
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["t"] + [f"{m}_{s}" for m, s in cols])
+        w.writerow([column_header("t")] + [f"{m}_{column_header(s)}" for m, s in cols])
         data = np.column_stack([t] + [signals[m][s] for m, s in cols])
         w.writerows(data.tolist())
     return Path(path)
