@@ -2,6 +2,7 @@
 the experiments of docs/fe-plant.md, "What was tried". Prints one line per experiment.
 
     .venv/bin/python demos/sbc_1_4d_diagnosis.py [--mesh 4] [--t-end 3] [--only response,open-loop,closed]
+        [--actuation rest-length|force]
 
 ``response``: psi_11 after a 1 mm step of the four SL rest lengths, COM and the SBC measured
 at the chords and by the rigid fit of the bars. ``open-loop``: the rest lengths of the COM's
@@ -9,7 +10,12 @@ own closed-loop run (uncertainty ``exact``) applied to the SBC plant, undamped a
 Rayleigh damping. ``closed``: the closed loop for combinations of the uncertainty model, the
 bar measurement, the PFL's feedback damping mu and the plant damping beta: where it stopped,
 its largest bar error, its deviation from the COM run of the same controller, the smallest
-rest-length margin and the tendon forces of SL_1, SU_1 at the end of the record.
+rest-length margin and the tendon forces of SL_1, SU_1 at the end of the record (the COM law
+k (|d| - u) at the measured q and the FE tendons' own). ``--actuation force``: the SBC tendons
+tension-servoed (:mod:`tmfem.control.tension_actuation`) in ``closed`` and ``weak``. ``weak``:
+the bar response to a step of the tendon forces along the weakest and the strongest singular
+direction of the COM's B_q at the packaged state (force actuation: the SBC's tendons get the
+COM's force step exactly), COM against SBC.
 """
 from __future__ import annotations
 
@@ -59,14 +65,14 @@ def open_loop(mesh, t_end):
               f"{r.plant_report['min_tendon_force_N']:.2f} N, failure: {r.failure}", flush=True)
 
 
-def closed(mesh, t_end):
+def closed(mesh, t_end, actuation="rest-length"):
     for unc, bars, mu, beta in CLOSED:
         runs = []
         for plant in ("sbc", "com"):
             s = setup("1-4D", controller="adaptive", uncertainty=unc, evaluation="reference")
             s.adaptive.feedback_damping = mu
-            p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, bars=bars, beta=beta) \
-                if plant == "sbc" else None
+            p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, bars=bars, beta=beta,
+                                     actuation=actuation) if plant == "sbc" else None
             runs.append(run_deployment(model=s.model, reference=s.reference, controller=s.controller,
                                        z0=s.z0, t_end=t_end, plant=p, partial=True,
                                        jacobian="step" if p else "reuse"))
@@ -80,8 +86,49 @@ def closed(mesh, t_end):
               f"bar error max {1e3 * err:.2f} mrad (COM {1e3 * np.max(np.abs(rc.z[:n, :nq] - rc.q_d[:n])):.2f}), "
               f"deviation from COM max {1e3 * dev.max():.2f} mrad at {r.t[np.argmax(dev)]:.2f} s, "
               f"margin {1e3 * r.min_margin:.2f} mm, model tendon forces SL_1, SU_1 at the end "
-              f"{T[0]:.2f}, {T[4]:.2f} N (COM run {(k * (rc.lengths[n - 1] - rc.u[n - 1]))[[0, 4]].round(2)})",
-              flush=True)
+              f"{T[0]:.2f}, {T[4]:.2f} N (COM run {(k * (rc.lengths[n - 1] - rc.u[n - 1]))[[0, 4]].round(2)}), "
+              f"FE {r.tendon_force[-1, 0]:.2f}, {r.tendon_force[-1, 4]:.2f} N; deviation at 0.1, 0.3, "
+              f"0.5 s: {np.round(1e3 * dev[[i for i in (10, 30, 50) if i < n]], 2)} mrad", flush=True)
+
+
+def weak(mesh, actuation):
+    """The symmetric deployment's input-response map, COM against SBC: theta_11, psi_11 [mrad]
+    after a 1 N step of the tension of every SL_j (every SU_j), from rest in each plant's
+    packaged equilibrium, minus the unperturbed response, at 10, 20, 50, 100 ms: the 2 x 2
+    matrices G(t) of each plant, and G_COM^-1 G_SBC, the loop the PFL closes on the SBC with
+    the COM's inversion (identity where the SBC answers as the COM). Its eigenvalues far from
+    1 are the directions the inversion gets wrong; the singular values of B_q [1_SL, 1_SU]
+    (the COM at the packaged state) say which is weak."""
+    from tmfem.control.pfl import partition
+    s = setup("1-4D", controller="adaptive")
+    com, nq = s.model, s.model.nq
+    terms = partition(*com.matrices(s.z0, np.zeros(com.nz)), nq=nq)
+    n = len(com.u0) // 2
+    S = np.kron(np.eye(2), np.ones((n, 1)))                 # (8, 2): all SL, all SU
+    _, sv, Vt = np.linalg.svd(terms.B_q @ S)
+    r0 = start_rest_lengths(INITIAL, "cable", com.u0)
+    sbc = sbc_deployment_plant(com, INITIAL, mesh_n=mesh, actuation=actuation)
+    idx = [com.state_names.index("theta_11"), com.state_names.index("psi_11")]
+    print(f"weak: B_q [1_SL, 1_SU] at the packaged state: singular values {np.round(sv, 3)} "
+          f"(rad/s^2 per m), ratio {sv[0] / sv[-1]:.0f}; weakest input (SL, SU) "
+          f"{np.round(Vt[-1] / np.max(np.abs(Vt[-1])), 3)}")
+    G = {}
+    for pname, p in (("COM", StatePlant(com, z0=s.z0)), (f"SBC {actuation}", sbc)):
+        base = simulate(p, t_end=0.1, dt=0.01, controller=r0, jacobian="step").y[:, idx]
+        cols = []
+        for j in range(2):
+            du = -S[:, j] / com.k                           # a 1 N tension step of a family
+            cols.append(1e3 * (simulate(p, t_end=0.1, dt=0.01, controller=r0 + du,
+                                        jacobian="step").y[:, idx] - base))
+        G[pname] = np.stack(cols, axis=2)                   # (n_t, 2 outputs, 2 inputs)
+        for k in (1, 2, 5, 10):
+            print(f"weak {pname:18s} {10 * k:3d} ms: [theta_11, psi_11] per N of SL / SU "
+                  f"{np.round(G[pname][k].T, 4).tolist()} mrad", flush=True)
+    gc, gs = G.values()
+    for k in (1, 2, 5, 10):
+        L = np.linalg.solve(gc[k], gs[k])
+        print(f"weak G_COM^-1 G_SBC at {10 * k:3d} ms: {np.round(L, 3).tolist()}, eigenvalues "
+              f"{np.round(np.linalg.eigvals(L), 3)}", flush=True)
 
 
 def main():
@@ -89,6 +136,7 @@ def main():
     ap.add_argument("--mesh", type=int, default=4)
     ap.add_argument("--t-end", type=float, default=3.0)
     ap.add_argument("--only", default="response,open-loop,closed")
+    ap.add_argument("--actuation", default="rest-length", choices=["rest-length", "force"])
     a = ap.parse_args()
     only = a.only.split(",")
     if "response" in only:
@@ -96,7 +144,9 @@ def main():
     if "open-loop" in only:
         open_loop(a.mesh, a.t_end)
     if "closed" in only:
-        closed(a.mesh, a.t_end)
+        closed(a.mesh, a.t_end, a.actuation)
+    if "weak" in only:
+        weak(a.mesh, a.actuation)
 
 
 if __name__ == "__main__":
