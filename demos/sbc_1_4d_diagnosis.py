@@ -129,6 +129,30 @@ def weak(mesh, actuation):
         L = np.linalg.solve(gc[k], gs[k])
         print(f"weak G_COM^-1 G_SBC at {10 * k:3d} ms: {np.round(L, 3).tolist()}, eigenvalues "
               f"{np.round(np.linalg.eigvals(L), 3)}", flush=True)
+    # the same map at the frequency of the swing: tensions sin(2 pi f t) [N] of every SL_j
+    # (every SU_j), the responses' complex amplitudes fitted over the last three periods
+    t_end = 0.5
+    for f in (2.0, 6.0, 12.5):
+        H = {}
+        for pname, p in (("COM", StatePlant(com, z0=s.z0)), (f"SBC {actuation}", sbc)):
+            base = simulate(p, t_end=t_end, dt=0.01, controller=r0, jacobian="step")
+            cols = []
+            for j in range(2):
+                def u(t, j=j):
+                    return r0 - S[:, j] / com.k * np.sin(2 * np.pi * f * t)
+                r = simulate(p, t_end=t_end, dt=0.01, controller=OpenLoop(u), jacobian="step")
+                m = r.t >= t_end - 3.0 / f - 1e-9
+                X = np.column_stack([np.sin(2 * np.pi * f * r.t[m]), np.cos(2 * np.pi * f * r.t[m]),
+                                     np.ones(m.sum()), r.t[m]])
+                c = np.linalg.lstsq(X, 1e3 * (r.y[m][:, idx] - base.y[m][:, idx]), rcond=None)[0]
+                cols.append(c[0] + 1j * c[1])               # in phase - i quadrature [mrad/N]
+            H[pname] = np.stack(cols, axis=1)
+        lam, vec = np.linalg.eig(np.linalg.solve(*H.values()))
+        vec = vec / vec[np.argmax(np.abs(vec), axis=0), np.arange(2)]
+        print(f"weak {f:4.1f} Hz: COM [theta_11, psi_11] per N of SL / SU "
+              f"{np.round(H['COM'].T, 4).tolist()}; G_COM^-1 G_SBC eigenvalues {np.round(lam, 3)} "
+              f"(|.| {np.round(np.abs(lam), 3)}, phase {np.round(np.degrees(np.angle(lam)), 1)} deg), "
+              f"eigenvectors (SL, SU tension) {np.round(vec.T, 3).tolist()}", flush=True)
 
 
 def main():

@@ -37,13 +37,14 @@ def plot_plant_comparison(png, a, b, dev, *, labels=("A", "B"), title: str = "")
 
 
 def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
-    """Five panels over time: the bar attitudes of both runs against the reference, their
-    tracking errors q - q_ref, the membrane deflections w_k, the commanded rest lengths (one tendon of each family) and the
-    deviation between the plants (bars [mrad], left axis; w [mm], right axis; both
-    logarithmic). Run A solid,
-    run B dashed; a run that stopped early is marked."""
-    fig = new_figure(figsize=(8.5, 14))
-    ax = fig.subplots(5, 1, sharex=True)
+    """Six panels over time: the bar attitudes of both runs against the reference, their
+    tracking errors q - q_ref, the membrane deflections w_k, the commanded rest lengths and
+    each plant's own tendon forces (one tendon of each family; ``tendon_force``: the COM's
+    k (|d| - u), an FE plant's elements) and the deviation between the plants (bars [mrad],
+    left axis; w [mm], right axis; both logarithmic). Run A solid, run B dashed; a run that
+    stopped early is marked."""
+    fig = new_figure(figsize=(8.5, 16.5))
+    ax = fig.subplots(6, 1, sharex=True)
     names = a.names["q"]
     colours = [f"C{i}" for i in range(10)]
     for i, k in enumerate(_bar_signals(names)):
@@ -70,22 +71,27 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
         n = a.names["tendons"][j]
         ax[3].plot(a.t, a.u[:, j], "-", color=c, label=f"rest length {n} ({labels[0]})")
         ax[3].plot(b.t, b.u[:, j], "--", color=c, label=f"rest length {n} ({labels[1]})")
-    ax[3].set_ylabel("rest length [m]")
-    l1, = ax[4].plot(dev["t"], 1e3 * dev["q"], "-", color="C0",
+        for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--")):
+            tf = getattr(r, "tendon_force", None)            # a record without it: no curve
+            if tf is not None and tf.size:
+                ax[4].plot(r.t, tf[:, j], ls, color=c, label=f"{n} ({lab})")
+    ax[3].set_ylabel("commanded rest length [m]")
+    ax[4].set_ylabel("tendon force [N]")
+    l1, = ax[5].plot(dev["t"], 1e3 * dev["q"], "-", color="C0",
                      label=f"bars: max |q ({labels[1]}) - q ({labels[0]})| [mrad]")
-    ax[4].set_ylabel("bar deviation [mrad]", color="C0")
-    ax[4].set_yscale("log")
-    tw = ax[4].twinx()
+    ax[5].set_ylabel("bar deviation [mrad]", color="C0")
+    ax[5].set_yscale("log")
+    tw = ax[5].twinx()
     l2, = tw.plot(dev["t"], 1e3 * dev["w"], "-", color="C3",
                   label=f"membrane: max |w ({labels[1]}) - w ({labels[0]})| [mm]")
     tw.set_ylabel("membrane deflection deviation [mm]", color="C3")
     tw.set_yscale("log")
-    for x, d in ((ax[4], 1e3 * dev["q"]), (tw, 1e3 * dev["w"])):
+    for x, d in ((ax[5], 1e3 * dev["q"]), (tw, 1e3 * dev["w"])):
         top = float(np.max(d)) if d.size else 0.0
         if top > 0:           # three decades below the largest deviation: the start is exact
             x.set_ylim(1e-3 * top, 2.0 * top)
     tw.legend(handles=[l1, l2], fontsize=7, loc="lower right")   # drawn above both axes
-    ax[4].set_xlabel("time [s]")
+    ax[5].set_xlabel("time [s]")
     t_span = max(a.t[-1], b.t[-1])
     switches = [(r.switch_time, lab, ls) for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--"))
                 if r.switch_time is not None]
@@ -105,7 +111,7 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
                            xycoords=("data", "axes fraction"), fontsize=7, color="r",
                            ha="left" if early else "right",
                            bbox={"fc": "white", "ec": "none", "alpha": 0.8}, zorder=10)
-    for x in ax[:4]:
+    for x in ax[:5]:
         x.legend(fontsize=6, ncol=3)
     for x in ax:
         x.grid(alpha=0.3)
