@@ -1,25 +1,27 @@
 """The 1-4(D) deployment (7.4, adaptive PFL without the switch, dt = 0.01 s) on the SBC plant:
 the experiments of docs/fe-plant.md, "What was tried". Prints one line per experiment.
 
-    .venv/bin/python demos/sbc_1_4d_diagnosis.py [--mesh 4] [--t-end 3] [--only response,open-loop,closed]
-        [--actuation rest-length|force]
+    .venv/bin/python demos/sbc_1_4d_diagnosis.py [--mesh 4] [--t-end 3]
+        [--only response,open-loop,closed,weak] [--actuation rest-length|force]
 
 ``response``: psi_11 after a 1 mm step of the four SL rest lengths, COM and the SBC measured
 at the chords and by the rigid fit of the bars. ``open-loop``: the rest lengths of the COM's
 own closed-loop run (uncertainty ``exact``) applied to the SBC plant, undamped and with
 Rayleigh damping. ``closed``: the closed loop for combinations of the uncertainty model, the
-bar measurement, the PFL's feedback damping mu and the plant damping beta: where it stopped,
-its largest bar error, its deviation from the COM run of the same controller, the smallest
-rest-length margin and the tendon forces of SL_1, SU_1 at the end of the record (the COM law
-k (|d| - u) at the measured q and the FE tendons' own). ``--actuation force``: the SBC tendons
-tension-servoed (:mod:`tmfem.control.tension_actuation`) in ``closed`` and ``weak``. ``weak``:
-the bar response to a step of the tendon forces along the weakest and the strongest singular
-direction of the COM's B_q at the packaged state (force actuation: the SBC's tendons get the
-COM's force step exactly), COM against SBC.
+bar measurement, the PFL's feedback damping mu, the plant damping beta and the gain growth
+omega_e of eq. 5.69: where it stopped, its largest bar error, its deviation from the COM run
+of the same controller, the smallest rest-length margin and the tendon forces of SL_1, SU_1
+at the end of the record (the COM law k (|d| - u) at the measured q and the FE tendons' own).
+``weak`` (not in the default list): the symmetric deployment's input-response map
+[theta_11, psi_11] per N of every SL_j / every SU_j, COM against SBC, after a tension step
+and at 2, 6 and 12.5 Hz, and G_COM^-1 G_SBC (identity where the SBC answers as the COM).
+``--actuation force``: the SBC tendons tension-servoed (:mod:`tmfem.control.tension_actuation`)
+in ``closed`` and ``weak``.
 """
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
 
 import numpy as np
 
@@ -31,11 +33,14 @@ from tmfem.simulation.driver import simulate
 from tmfem.system import load_preset
 
 INITIAL = load_preset("1-4D-initial")
-#: (uncertainty, bars, feedback damping mu, plant damping beta [s]); the PFL at the reference
-CLOSED = [("initial", "chord", 0.0, 0.0), ("initial", "rigid", 0.0, 0.0),
-          ("initial", "rigid", 0.0, 1e-3), ("initial", "rigid", 1 / 30, 0.0),
-          ("exact", "rigid", 0.0, 0.0), ("exact", "rigid", 1 / 30, 0.0),
-          ("exact", "rigid", 1 / 30, 1e-3)]
+#: (uncertainty, bars, feedback damping mu, plant damping beta [s], omega_e [rad/s] of eq. 5.69
+#: or None for Table 7.1's 150); the PFL at the reference
+CLOSED = [("initial", "chord", 0.0, 0.0, None), ("initial", "rigid", 0.0, 0.0, None),
+          ("initial", "rigid", 0.0, 1e-3, None), ("initial", "rigid", 1 / 30, 0.0, None),
+          ("exact", "rigid", 0.0, 0.0, None), ("exact", "rigid", 1 / 30, 0.0, None),
+          ("exact", "rigid", 1 / 30, 1e-3, None), ("initial", "rigid", 0.0, 1e-3, 24.0),
+          ("initial", "rigid", 0.0, 0.0, 24.0), ("initial", "rigid", 0.0, 1e-3, 0.0),
+          ("exact", "rigid", 0.0, 1e-3, 24.0)]
 
 
 def response(mesh):
@@ -66,11 +71,13 @@ def open_loop(mesh, t_end):
 
 
 def closed(mesh, t_end, actuation="rest-length"):
-    for unc, bars, mu, beta in CLOSED:
+    for unc, bars, mu, beta, omega_e in CLOSED:
         runs = []
         for plant in ("sbc", "com"):
             s = setup("1-4D", controller="adaptive", uncertainty=unc, evaluation="reference")
             s.adaptive.feedback_damping = mu
+            if omega_e is not None:
+                s.adaptive.gains = replace(s.adaptive.gains, omega_e=omega_e)
             p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, bars=bars, beta=beta,
                                      actuation=actuation) if plant == "sbc" else None
             runs.append(run_deployment(model=s.model, reference=s.reference, controller=s.controller,
@@ -82,13 +89,17 @@ def closed(mesh, t_end, actuation="rest-length"):
         dev = np.max(np.abs(r.z[:, :nq] - rc.z[:n, :nq]), axis=1)
         k = s.model.k
         T = k * (r.lengths[-1] - r.u[-1])
-        print(f"closed {unc:7s} bars={bars:5s} mu={mu:.3g} beta={beta:g}: reached {r.t[-1]:.2f} s, "
+        late = r.t >= 0.3 - 1e-9
+        print(f"closed {unc:7s} bars={bars:5s} mu={mu:.3g} beta={beta:g} omega_e="
+              f"{150.0 if omega_e is None else omega_e:g}: reached {r.t[-1]:.2f} s, "
               f"bar error max {1e3 * err:.2f} mrad (COM {1e3 * np.max(np.abs(rc.z[:n, :nq] - rc.q_d[:n])):.2f}), "
               f"deviation from COM max {1e3 * dev.max():.2f} mrad at {r.t[np.argmax(dev)]:.2f} s, "
               f"margin {1e3 * r.min_margin:.2f} mm, model tendon forces SL_1, SU_1 at the end "
               f"{T[0]:.2f}, {T[4]:.2f} N (COM run {(k * (rc.lengths[n - 1] - rc.u[n - 1]))[[0, 4]].round(2)}), "
               f"FE {r.tendon_force[-1, 0]:.2f}, {r.tendon_force[-1, 4]:.2f} N; deviation at 0.1, 0.3, "
-              f"0.5 s: {np.round(1e3 * dev[[i for i in (10, 30, 50) if i < n]], 2)} mrad", flush=True)
+              f"0.5 s: {np.round(1e3 * dev[[i for i in (10, 30, 50) if i < n]], 2)} mrad, after 0.3 s "
+              f"at most {1e3 * np.max(dev[late], initial=0.0):.2f} mrad; smallest FE SU_1 force after "
+              f"0.3 s {np.min(r.tendon_force[late, 4], initial=np.inf):.2f} N", flush=True)
 
 
 def weak(mesh, actuation):
