@@ -120,6 +120,15 @@ def weak(mesh, actuation):
     r0 = start_rest_lengths(INITIAL, "cable", com.u0)
     sbc = sbc_deployment_plant(com, INITIAL, mesh_n=mesh, actuation=actuation)
     idx = [com.state_names.index("theta_11"), com.state_names.index("psi_11")]
+    # statics: the SBC's own tendon forces at its packaged equilibrium (rigid-fit q_s) against
+    # the forces that hold the COM at q_s (eq. 5.46 at rest: B_q u = -F_q)
+    zs = sbc.outputs(sbc.x0, sbc.v0)[:com.nz]
+    sbc.dyn.model.set_tendon_lengths(r0)
+    T_sbc = sbc.dyn.member_forces(sbc.x0)["tendon_force"]
+    ts = partition(*com.matrices(zs, np.zeros(com.nz)), nq=nq)
+    T_com = com.tendon_forces(zs, np.linalg.solve(ts.B_q, -ts.F_q))
+    print(f"weak: statics at the SBC's packaged rigid-fit q_s: SBC tendon forces SL_1, SU_1 "
+          f"{T_sbc[[0, n]].round(2)} N, the COM held at q_s by {T_com[[0, n]].round(2)} N")
     print(f"weak: B_q [1_SL, 1_SU] at the packaged state: singular values {np.round(sv, 3)} "
           f"(rad/s^2 per m), ratio {sv[0] / sv[-1]:.0f}; weakest input (SL, SU) "
           f"{np.round(Vt[-1] / np.max(np.abs(Vt[-1])), 3)}")
