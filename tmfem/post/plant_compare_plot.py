@@ -112,7 +112,8 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = ""):
                            ha="left" if early else "right",
                            bbox={"fc": "white", "ec": "none", "alpha": 0.8}, zorder=10)
     for x in ax[:5]:
-        x.legend(fontsize=6, ncol=3)
+        if x.get_legend_handles_labels()[0]:          # the force panel of a record without forces
+            x.legend(fontsize=6, ncol=3)
     for x in ax:
         x.grid(alpha=0.3)
     if title:                 # wrapped to the figure's width: a long title is not cropped
