@@ -32,7 +32,10 @@ model's :class:`~tmfem.models.mtc.dynamics.MTCDynamics` or the SBC model's
 :class:`~tmfem.models.sbc.dynamics.SBCDynamics`, the tendon rest lengths as inputs,
 M a + C v + f_int(x; u) = 0) whose outputs are that estimate
 y = [z, z'], so every controller built for the COM plant (the adaptive PFL, the switch, the
-linear controllers) runs on it unchanged. :func:`fe_state_of` places the FE model in the
+linear controllers) runs on it unchanged; its tendons either take the commanded rest lengths
+or, with ``actuation="force"``, the COM's tension at the measured q through tension-servoed
+winches (:meth:`FEStatePlant.actuate`, :mod:`tmfem.control.tension_actuation`).
+:func:`fe_state_of` places the FE model in the
 configuration of a COM state (bars at q, membrane on the COM's field, tendons straight);
 :func:`mtc_deployment_plant` and :func:`sbc_deployment_plant` (:func:`deployment_plant` by
 name) build the plant of a deployment, started at rest in its own equilibrium of the
