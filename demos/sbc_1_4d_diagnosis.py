@@ -16,11 +16,13 @@ at the end of the record (the COM law k (|d| - u) at the measured q and the FE t
 [theta_11, psi_11] per N of every SL_j / every SU_j, COM against SBC, after a tension step
 and at 2, 6 and 12.5 Hz, and G_COM^-1 G_SBC (identity where the SBC answers as the COM).
 ``--actuation force``: the SBC tendons tension-servoed (:mod:`tmfem.control.tension_actuation`)
-in ``closed`` and ``weak``.
+in ``closed`` and ``weak``; ``--bar-E-factor F``: the SBC plant of ``closed`` and ``weak`` built
+with the bars' Young's modulus times F (the COM, of rigid bars, unchanged).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 from dataclasses import replace
 
 import numpy as np
@@ -41,6 +43,18 @@ CLOSED = [("initial", "chord", 0.0, 0.0, None), ("initial", "rigid", 0.0, 0.0, N
           ("exact", "rigid", 1 / 30, 1e-3, None), ("initial", "rigid", 0.0, 1e-3, 24.0),
           ("initial", "rigid", 0.0, 0.0, 24.0), ("initial", "rigid", 0.0, 1e-3, 0.0),
           ("exact", "rigid", 0.0, 1e-3, 24.0)]
+
+
+@contextlib.contextmanager
+def bar_modulus(system, factor):
+    """The system's bars with E scaled by ``factor`` inside the block (the SBC plant is built
+    there; the COM's bars are rigid)."""
+    bar = system.bar
+    object.__setattr__(system, "bar", replace(bar, E=bar.E * factor))
+    try:
+        yield
+    finally:
+        object.__setattr__(system, "bar", bar)
 
 
 def response(mesh):
@@ -70,7 +84,7 @@ def open_loop(mesh, t_end):
               f"{r.plant_report['min_tendon_force_N']:.2f} N, failure: {r.failure}", flush=True)
 
 
-def closed(mesh, t_end, actuation="rest-length"):
+def closed(mesh, t_end, actuation="rest-length", bar_factor=1.0):
     for unc, bars, mu, beta, omega_e in CLOSED:
         runs = []
         for plant in ("sbc", "com"):
@@ -78,8 +92,11 @@ def closed(mesh, t_end, actuation="rest-length"):
             s.adaptive.feedback_damping = mu
             if omega_e is not None:
                 s.adaptive.gains = replace(s.adaptive.gains, omega_e=omega_e)
-            p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, bars=bars, beta=beta,
-                                     actuation=actuation) if plant == "sbc" else None
+            p = None
+            if plant == "sbc":
+                with bar_modulus(s.model.system, bar_factor):
+                    p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, bars=bars, beta=beta,
+                                             actuation=actuation)
             runs.append(run_deployment(model=s.model, reference=s.reference, controller=s.controller,
                                        z0=s.z0, t_end=t_end, plant=p, partial=True,
                                        jacobian="step" if p else "reuse"))
@@ -102,7 +119,7 @@ def closed(mesh, t_end, actuation="rest-length"):
               f"0.3 s {np.min(r.tendon_force[late, 4], initial=np.inf):.2f} N", flush=True)
 
 
-def weak(mesh, actuation):
+def weak(mesh, actuation, bar_factor=1.0):
     """The symmetric deployment's input-response map, COM against SBC: theta_11, psi_11 [mrad]
     after a 1 N step of the tension of every SL_j (every SU_j), from rest in each plant's
     packaged equilibrium, minus the unperturbed response, at 10, 20, 50, 100 ms: the 2 x 2
@@ -118,7 +135,8 @@ def weak(mesh, actuation):
     S = np.kron(np.eye(2), np.ones((n, 1)))                 # (8, 2): all SL, all SU
     _, sv, Vt = np.linalg.svd(terms.B_q @ S)
     r0 = start_rest_lengths(INITIAL, "cable", com.u0)
-    sbc = sbc_deployment_plant(com, INITIAL, mesh_n=mesh, actuation=actuation)
+    with bar_modulus(com.system, bar_factor):
+        sbc = sbc_deployment_plant(com, INITIAL, mesh_n=mesh, actuation=actuation)
     idx = [com.state_names.index("theta_11"), com.state_names.index("psi_11")]
     # statics: the SBC's own tendon forces at its packaged equilibrium (rigid-fit q_s) against
     # the forces that hold the COM at q_s (eq. 5.46 at rest: B_q u = -F_q)
@@ -181,6 +199,7 @@ def main():
     ap.add_argument("--t-end", type=float, default=3.0)
     ap.add_argument("--only", default="response,open-loop,closed")
     ap.add_argument("--actuation", default="rest-length", choices=["rest-length", "force"])
+    ap.add_argument("--bar-E-factor", type=float, default=1.0)
     a = ap.parse_args()
     only = a.only.split(",")
     if "response" in only:
@@ -188,9 +207,9 @@ def main():
     if "open-loop" in only:
         open_loop(a.mesh, a.t_end)
     if "closed" in only:
-        closed(a.mesh, a.t_end, a.actuation)
+        closed(a.mesh, a.t_end, a.actuation, a.bar_E_factor)
     if "weak" in only:
-        weak(a.mesh, a.actuation)
+        weak(a.mesh, a.actuation, a.bar_E_factor)
 
 
 if __name__ == "__main__":
