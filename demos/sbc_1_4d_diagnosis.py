@@ -2,7 +2,7 @@
 the experiments of docs/fe-plant.md, "What was tried". Prints one line per experiment.
 
     .venv/bin/python demos/sbc_1_4d_diagnosis.py [--mesh 4] [--t-end 3]
-        [--only response,open-loop,closed,weak] [--actuation rest-length|force]
+        [--only response,open-loop,closed,weak] [--actuation rest-length|force] [--bar-E-factor F]
 
 ``response``: psi_11 after a 1 mm step of the four SL rest lengths, COM and the SBC measured
 at the chords and by the rigid fit of the bars. ``open-loop``: the rest lengths of the COM's
