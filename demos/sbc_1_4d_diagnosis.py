@@ -2,7 +2,8 @@
 the experiments of docs/fe-plant.md, "What was tried". Prints one line per experiment.
 
     .venv/bin/python demos/sbc_1_4d_diagnosis.py [--mesh 4] [--t-end 3]
-        [--only response,open-loop,closed,weak] [--actuation rest-length|force] [--bar-E-factor F]
+        [--only response,open-loop,closed,weak,deploy] [--actuation rest-length|force]
+        [--bar-E-factor F] [--beta BETA] [--plot cmp.png]
 
 ``response``: psi_11 after a 1 mm step of the four SL rest lengths, COM and the SBC measured
 at the chords and by the rigid fit of the bars. ``open-loop``: the rest lengths of the COM's
@@ -15,6 +16,10 @@ at the end of the record (the COM law k (|d| - u) at the measured q and the FE t
 ``weak`` (not in the default list): the symmetric deployment's input-response map
 [theta_11, psi_11] per N of every SL_j / every SU_j, COM against SBC, after a tension step
 and at 2, 6 and 12.5 Hz, and G_COM^-1 G_SBC (identity where the SBC answers as the COM).
+``deploy`` (not in the default list): the 7.4 deployment with its switch (``adaptive-hinf``,
+uncertainty ``initial``, the PFL at the reference) over ``--t-end`` on the SBC plant (plant
+damping ``--beta``, default 0) and on the COM: record, switch, final error, the FE report and
+the deviation; ``--plot`` writes the comparison figure.
 ``--actuation force``: the SBC tendons tension-servoed (:mod:`tmfem.control.tension_actuation`)
 in ``closed`` and ``weak``; ``--bar-E-factor F``: the SBC plant of ``closed`` and ``weak`` built
 with the bars' Young's modulus times F (the COM, of rigid bars, unchanged).
@@ -193,6 +198,35 @@ def weak(mesh, actuation, bar_factor=1.0):
               f"eigenvectors (SL, SU tension) {np.round(vec.T, 3).tolist()}", flush=True)
 
 
+def deploy(mesh, t_end, actuation, bar_factor, beta, plot):
+    from tmfem.control.plant_compare import deviation_summary, plant_deviation
+    runs = {}
+    for plant in ("sbc", "com"):
+        s = setup("1-4D", controller="adaptive-hinf", evaluation="reference")
+        p = None
+        if plant == "sbc":
+            with bar_modulus(s.model.system, bar_factor):
+                p = sbc_deployment_plant(s.model, INITIAL, mesh_n=mesh, beta=beta,
+                                         actuation=actuation)
+        r = runs[plant] = run_deployment(model=s.model, reference=s.reference,
+                                         controller=s.controller, z0=s.z0, t_end=t_end, plant=p,
+                                         partial=True, jacobian="step" if p else "reuse")
+        rep = {k: v for k, v in (r.plant_report or {}).items() if not isinstance(v, np.ndarray)}
+        print(f"deploy {plant}: reached {r.t[-1]:.2f} s, switch {r.switch_time}, final error "
+              f"{r.relative_error[-1]:.4g}, margin {1e3 * r.min_margin:.2f} mm, failure "
+              f"{r.failure}; {rep}", flush=True)
+    dev = plant_deviation(runs["sbc"], runs["com"])
+    print(f"deploy deviation: {deviation_summary(dev)}", flush=True)
+    if plot:
+        from tmfem.post.plant_compare_plot import plot_plant_comparison
+        plot_plant_comparison(plot, runs["sbc"], runs["com"], dev, labels=("sbc", "com"),
+                              title=f"1-4D deployment, adaptive-hinf (PFL at the reference, "
+                                    f"fixed-rate tendon model, uncertainty initial) on both "
+                                    f"plants\nsbc plant (solid): mesh {mesh}, bars E x "
+                                    f"{bar_factor:g}, actuation {actuation}, damping {beta:g} s; "
+                                    f"com plant (dashed)")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--mesh", type=int, default=4)
@@ -200,6 +234,8 @@ def main():
     ap.add_argument("--only", default="response,open-loop,closed")
     ap.add_argument("--actuation", default="rest-length", choices=["rest-length", "force"])
     ap.add_argument("--bar-E-factor", type=float, default=1.0)
+    ap.add_argument("--beta", type=float, default=0.0)
+    ap.add_argument("--plot")
     a = ap.parse_args()
     only = a.only.split(",")
     if "response" in only:
@@ -210,6 +246,8 @@ def main():
         closed(a.mesh, a.t_end, a.actuation, a.bar_E_factor)
     if "weak" in only:
         weak(a.mesh, a.actuation, a.bar_E_factor)
+    if "deploy" in only:
+        deploy(a.mesh, a.t_end, a.actuation, a.bar_E_factor, a.beta, a.plot)
 
 
 if __name__ == "__main__":
