@@ -15,13 +15,15 @@ Q = ["theta_11", "psi_11", "theta_21", "psi_21"]
 
 def _run(t_end, dq=0.0, dw=0.0, du=0.0, switch=None, dt=0.01):
     """A record of 2-3-like signals on [0, t_end]: q(t), q_d = q at dq = 0, three membrane
-    points, two tendons; offsets dq(t), dw, du added to every signal."""
+    points, two tendons and their forces; offsets dq(t), dw, du added to every signal."""
     t = np.arange(round(t_end / dt) + 1) * dt
     base = np.column_stack([1.4 - 0.4 * (1 - np.exp(-t / 5)), 2.27 + 0 * t, 1.4 + 0 * t, 0.17 + 0 * t])
     w = 1e-3 * np.column_stack([np.sin(2 * np.pi * k * t) for k in (1, 2, 3)])
     u = np.column_stack([0.62 + 0.02 * t, 0.5 + 0.034 * t])
     off = dq(t) if callable(dq) else np.full(t.size, dq)
+    force = np.column_stack([20.0 + 2.0 * np.sin(3 * t), 8.0 + 0 * t])
     return SimpleNamespace(t=t, z=base + off[:, None], q_d=base, w=w + dw, u=u + du,
+                           tendon_force=force,
                            names={"q": Q, "w": ["w_1", "w_2", "w_3"], "tendons": ["S_11", "P_21"]},
                            switch_time=switch, failure=None)
 
@@ -95,7 +97,7 @@ def test_legends_hide_no_data_and_stay_inside_the_figure():
     canvas.draw()
     r = canvas.get_renderer()
     legends = [x.get_legend() for x in fig.axes if x.get_legend() is not None]
-    assert len(legends) == 6          # attitudes, errors, w, rest lengths, the two deviations
+    assert len(legends) == 7    # attitudes, errors, w, rest lengths, forces, the two deviations
     points = np.vstack([line.get_transform().transform(line.get_xydata())
                         for x in fig.axes for line in x.get_lines() if len(line.get_xydata())])
     assert len(points) > 10 * a.t.size

@@ -63,6 +63,14 @@ def configure(parser) -> None:
                         help="stiffness-proportional Rayleigh damping C = BETA K_0 [s] of the FE "
                              "plant (--plant or --compare-plant mtc|sbc; default none: the "
                              "undamped plant)")
+    parser.add_argument("--plant-actuation", choices=["rest-length", "force"],
+                        help="the FE plant's tendon actuators (--plant or --compare-plant "
+                             "mtc|sbc): rest-length (the commanded rest lengths are set on the FE "
+                             "tendons, the dissertation's actuators; default) or force "
+                             "(tension-servoed winches: the command becomes the COM's tendon force "
+                             "k (|d(q)| - u) at the measured q, realised on the FE tendon at its "
+                             "measured length and held over the sample; the PFL's tendon model is "
+                             "then the COM's fixed rates, docs/fe-plant.md)")
     parser.add_argument("--compare-plant", choices=["com", "mtc", "sbc"],
                         help="run the same deployment on this plant too and compare (JSON "
                              "'compare': its figures and the deviation between the plants)")
@@ -117,7 +125,7 @@ def run(args) -> dict:
     fe = args.plant != "com" or args.compare_plant not in (None, "com")
     pfl_at = args.pfl_at or ("reference" if fe else "state")
     frozen = (args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"]) == "initial"
-    tendons = (args.plant_tendons or "cable") if fe and not frozen else "fixed-rate"
+    tendons = fe_tendon_model(args) if fe and not frozen else "fixed-rate"
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path, evaluation=pfl_at,
               tendon_law=tendons)
@@ -163,6 +171,27 @@ def plant_tendons(args, plant: str) -> str:
     return {"com": "fixed-rate", "sbc": "cable"}.get(plant) or args.plant_tendons or "cable"
 
 
+def plant_actuation(args) -> str:
+    """The FE plants' tendon actuators: ``--plant-actuation``, default rest-length."""
+    return getattr(args, "plant_actuation", None) or "rest-length"
+
+
+def controlled_tendon_law(args, plant: str) -> str:
+    """The tendon law the controller drives on ``plant``: a force-actuated FE plant's
+    tendons follow the COM's law at the measured q (the fixed rates of eq. 5.19,
+    :mod:`tmfem.control.tension_actuation`), otherwise :func:`plant_tendons`."""
+    if plant != "com" and plant_actuation(args) == "force":
+        return "fixed-rate"
+    return plant_tendons(args, plant)
+
+
+def fe_tendon_model(args) -> str:
+    """The adaptive PFL's tendon model with an FE plant in the run (outside eq. 5.72): the
+    tendon law the controller drives on the FE plant (:func:`controlled_tendon_law`)."""
+    fe = args.plant if args.plant != "com" else args.compare_plant
+    return controlled_tendon_law(args, fe)
+
+
 def tendon_model_warnings(args, tendons: str) -> list:
     """Where the adaptive PFL's tendon model ``tendons`` is not the tendon law of a plant it
     drives (the same controller on both plants of a comparison, docs/fe-plant.md): one line
@@ -170,7 +199,7 @@ def tendon_model_warnings(args, tendons: str) -> list:
     import sys
     out = []
     for p in [args.plant] + ([args.compare_plant] if args.compare_plant else []):
-        law = plant_tendons(args, p)
+        law = controlled_tendon_law(args, p)
         if law != tendons:
             out.append(f"the PFL's tendon model ({tendons}) is not the {p} plant's tendon law "
                        f"({law}): the run on the {p} plant has this model error too")
@@ -186,7 +215,8 @@ def plant_options(args, plant: str, mesh_n) -> dict:
         return {"plant_tendons": plant_tendons(args, plant)}
     return {"plant_mesh": mesh_n, "plant_tendons": plant_tendons(args, plant),
             **({"plant_bars": sbc_bars(args)} if plant == "sbc" else {}),
-            "plant_damping_s": getattr(args, "plant_damping", None) or 0.0}
+            "plant_damping_s": getattr(args, "plant_damping", None) or 0.0,
+            "plant_actuation": plant_actuation(args)}
 
 
 def sbc_bars(args) -> str:
@@ -200,7 +230,8 @@ def plant_arguments(args, plant: str) -> dict:
     :func:`tmfem.control.state_estimate.deployment_plant` (both deployment kinds)."""
     return {"tendon_law": args.plant_tendons if plant == "mtc" else None,
             "bars": sbc_bars(args) if plant == "sbc" else None,
-            "beta": (args.plant_damping or 0.0) if plant != "com" else 0.0}
+            "beta": (args.plant_damping or 0.0) if plant != "com" else 0.0,
+            "actuation": plant_actuation(args) if plant != "com" else "rest-length"}
 
 
 def _run_on(args, s, plant_kind: str, mesh_n):
@@ -249,9 +280,10 @@ def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str,
 
 
 def check_plant(args) -> int | None:
-    """The FE plants' options, checked before any work: ``--plant-mesh`` and
-    ``--plant-damping`` belong to an FE plant, ``--plant-tendons`` to an MTC plant (the SBC
-    model has the cable law only), ``--plant-bars`` to an SBC plant; the
+    """The FE plants' options, checked before any work: ``--plant-mesh``,
+    ``--plant-damping`` and ``--plant-actuation`` belong to an FE plant (force actuation on
+    the COM plant is refused: the COM is the design model), ``--plant-tendons`` to an MTC
+    plant (the SBC model has the cable law only), ``--plant-bars`` to an SBC plant; the
     MTC model has no nodes along the bars, so no 1-N(D) system; ``--compare-plant`` differs
     from ``--plant`` and ``--compare-plot``/``--compare-csv`` need it; the mesh within the
     machine's budget. Returns the plant mesh (None without an FE plant)."""
@@ -272,13 +304,19 @@ def check_plant(args) -> int | None:
                          f"--compare-plant sbc, found --plant-bars {args.plant_bars} with "
                          f"{' and '.join(plants)}")
     if not fe:
+        if plant_actuation(args) == "force":
+            raise InputError("--plant-actuation force belongs to an FE plant (--plant or "
+                             "--compare-plant mtc|sbc): the COM is the design model, whose tendon "
+                             "forces k (|d(q)| - u) are what the force actuator reproduces on an FE "
+                             "plant; found --plant-actuation force with --plant com")
         for opt, val, fe_kinds in (("--plant-mesh", args.plant_mesh, "mtc|sbc"),
                                    ("--plant-tendons", args.plant_tendons, "mtc"),
-                                   ("--plant-damping", args.plant_damping, "mtc|sbc")):
+                                   ("--plant-damping", args.plant_damping, "mtc|sbc"),
+                                   ("--plant-actuation", args.plant_actuation, "mtc|sbc")):
             if val is not None:
                 raise InputError(f"{opt} belongs to --plant {fe_kinds} or --compare-plant "
-                                 f"{fe_kinds} (the COM plant has no membrane mesh, FE tendons or FE "
-                                 f"damping), found {opt} {val} with --plant com")
+                                 f"{fe_kinds} (the COM plant has no membrane mesh, FE tendons, FE "
+                                 f"damping or FE actuators), found {opt} {val} with --plant com")
         return None
     if args.plant_tendons is not None and "mtc" not in fe:
         raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "

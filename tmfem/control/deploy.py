@@ -161,6 +161,8 @@ class DeploymentResult:
     plant_report: dict | None = None
     names: dict = field(default_factory=dict)
     failure: str | None = None
+    tendon_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    actuator: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
         """The JSON figures of issue 13."""
@@ -200,7 +202,10 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     outputs are the COM state y = [z, z'] serves (a finite-element plant through its state
     estimate, :class:`tmfem.control.state_estimate.FEStatePlant`): the run records that y as
     z, z', and a plant with a ``recover(states)`` method adds what only it knows (the FE
-    tendon forces and slack, the membrane deflections its sensors measure) as ``plant_report``.
+    tendon forces and slack, the membrane deflections its sensors measure) as ``plant_report``;
+    the plant's own tendon forces over time are ``tendon_force`` (the COM's k (|d| - u), or
+    the FE tendons' from ``recover``) and a force-actuated FE plant's tension demand and FE rest
+    lengths ``actuator`` (:class:`tmfem.control.state_estimate.FEStatePlant`).
 
     ``partial``: a run whose integration fails (:class:`ConvergenceError`, a diverging closed
     loop) returns what it recorded up to the failure, with the message in ``failure``,
@@ -245,8 +250,12 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     w = np.array([o[0] for o in out])
     L = np.array([o[2] for o in out])
     report = recover(np.array(S), u) if recover is not None else None
+    tendon_force = model.k * (L - u)               # the COM's tendons (eq. 3.8, fixed k)
+    actuator = {}
     if report is not None:
         w = report.pop("w")
+        tendon_force = report.pop("tendon_force")
+        actuator = {k: report.pop(k) for k in ("tension_demand", "fe_rest_lengths") if k in report}
         slack = report.pop("slack", None)
         if slack is not None:
             report["first_slack_s"] = float(t_rec[np.argmax(slack > 0)]) if np.any(slack) else None
@@ -276,6 +285,7 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
                 "bar_t": t_rec[idx], "bar": bar, "von_mises": vm, "tendon": sigma_t},
         condition_numbers=np.asarray(cond, dtype=float), wall_time=wall,
         allocation_active=np.asarray(alloc, dtype=float), plant_report=report, failure=failure,
+        tendon_force=tendon_force, actuator=actuator,
         names={"q": list(model.system.q_names), "u": model.input_names,
                "tendons": [t.name for t in model.system.tendons],
                "w": [f"w_{i + 1}" for i in range(len(model.output_points))]})

@@ -32,7 +32,10 @@ model's :class:`~tmfem.models.mtc.dynamics.MTCDynamics` or the SBC model's
 :class:`~tmfem.models.sbc.dynamics.SBCDynamics`, the tendon rest lengths as inputs,
 M a + C v + f_int(x; u) = 0) whose outputs are that estimate
 y = [z, z'], so every controller built for the COM plant (the adaptive PFL, the switch, the
-linear controllers) runs on it unchanged. :func:`fe_state_of` places the FE model in the
+linear controllers) runs on it unchanged; its tendons either take the commanded rest lengths
+or, with ``actuation="force"``, the COM's tension at the measured q through tension-servoed
+winches (:meth:`FEStatePlant.actuate`, :mod:`tmfem.control.tension_actuation`).
+:func:`fe_state_of` places the FE model in the
 configuration of a COM state (bars at q, membrane on the COM's field, tendons straight);
 :func:`mtc_deployment_plant` and :func:`sbc_deployment_plant` (:func:`deployment_plant` by
 name) build the plant of a deployment, started at rest in its own equilibrium of the
@@ -42,6 +45,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from tmfem.control.tension_actuation import (ACTUATIONS, fe_element_lengths, fe_tendon_lengths,
+                                             rest_length_for_tension, tension_demand)
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
 from tmfem.models.mtc.post import member_state, q_from_positions
@@ -160,13 +165,18 @@ class COMStateEstimator:
         _, _, psi = q_index(com.system.M, com.system.N)
         self._psi = psi.ravel()
 
+    def bar_coordinates(self, x, xf=None) -> np.ndarray:
+        """q of the free-DOF FE state x (the rigid fit or the chords, ``bars``); ``xf``: its
+        node positions when already computed (``dyn.positions(x)``)."""
+        if self.bars == "rigid":
+            return rigid_bar_fit(self.com.system, *self.dyn.bar_chain_positions(x))
+        xf = self.dyn.positions(x) if xf is None else xf
+        return q_from_positions(self.com.system, xf[:, self._system_node])
+
     def modal(self, x) -> np.ndarray:
         """[q, eta] (modal coordinates) of the free-DOF FE positions x."""
         xf = self.dyn.positions(x)
-        if self.bars == "rigid":
-            q = rigid_bar_fit(self.com.system, *self.dyn.bar_chain_positions(x))
-        else:
-            q = q_from_positions(self.com.system, xf[:, self._system_node])
+        q = self.bar_coordinates(x, xf)
         xm = xf[:, :self._n_mesh]
         r = to_floating((self._I @ xm.T).T, xm[:, self._corners])
         delta = self.com.zeta(q)[:self._nd]
@@ -201,9 +211,18 @@ class FEStatePlant:
     bars : {"chord", "rigid"}, optional
         How the estimate measures q (:class:`COMStateEstimator`; default
         :func:`default_bar_measure`: rigid on the SBC plant, chord on the MTC plant).
+    actuation : {"rest-length", "force"}, optional
+        What the commanded rest lengths u_c do (:meth:`actuate`): set the FE tendons' rest
+        lengths (default, the dissertation's actuators) or be turned into the COM's tendon
+        tension at the measured q, which tension-servoed winches realise on the FE tendons
+        (:mod:`tmfem.control.tension_actuation`).
     """
 
-    def __init__(self, dyn, com, *, x0=None, v0=None, bars: str | None = None):
+    def __init__(self, dyn, com, *, x0=None, v0=None, bars: str | None = None,
+                 actuation: str = "rest-length"):
+        if actuation not in ACTUATIONS:
+            raise InputError(f"plant actuation: expected one of {ACTUATIONS}, found {actuation!r}")
+        self.actuation, self.com = actuation, com
         self.dyn, self.estimator = dyn, COMStateEstimator(com, dyn, bars=bars)
         self.input_names = list(dyn.input_names)
         if self.input_names != list(com.input_names):
@@ -217,6 +236,22 @@ class FEStatePlant:
         if self.x0.shape != dyn.x0.shape or self.v0.shape != dyn.v0.shape:
             raise InputError(f"FE plant start state: expected {dyn.x0.shape} free DOFs, found "
                              f"{self.x0.shape} and {self.v0.shape}")
+
+    def actuate(self, x, u) -> np.ndarray:
+        """The FE tendons' rest lengths for the commanded rest lengths u at the sampled state x
+        (:func:`tmfem.simulation.driver.simulate` holds them over the step): u itself
+        (``actuation="rest-length"``), or (``"force"``) those whose FE tendon forces at their
+        measured lengths are the COM's tension T_d = max(0, k (|d(q)| - u)) at the measured q
+        (:mod:`tmfem.control.tension_actuation`)."""
+        if self.actuation == "rest-length":
+            return np.asarray(u, dtype=float)
+        return rest_length_for_tension(self.dyn.mtc, fe_element_lengths(self.dyn, x),
+                                       self.tension_demand(x, u))
+
+    def tension_demand(self, x, u) -> np.ndarray:
+        """T_d [N] of the force actuator: the COM's tendon forces at the q measured from the
+        FE state x under the commanded rest lengths u (:func:`tension_demand`)."""
+        return tension_demand(self.com, self.estimator.bar_coordinates(x), u)
 
     def residual(self, x, v, a, t, u=None):
         return self.dyn.residual(x, v, a, t, u)
@@ -237,19 +272,29 @@ class FEStatePlant:
 
     def recover(self, states, inputs, *, stress_every: int = 10) -> dict:
         """What the FE model alone knows over a run, from its recorded states (n, n_free) and
-        inputs (n, n_t): the membrane deflections w_k its sensors measure at the plant's
-        output points (eqs. 5.36-5.38, :meth:`FEPlant.outputs`), the forces of its
-        tension-only tendon elements, how often one went slack and which (the COM's tendons
+        commanded inputs (n, n_t): the membrane deflections w_k its sensors measure at the
+        plant's output points (eqs. 5.36-5.38, :meth:`FEPlant.outputs`), the forces of its
+        tension-only tendon elements (``tendon_force``, (n, n_t): the mean of each tendon's
+        elements), how often one went slack and which (the COM's tendons
         cannot), its bar compression (the SBC model: the larger of the two segments of a bar
         carrying H_1j) and, every ``stress_every`` samples, its membrane's peak stresses
         (``dyn.membrane_stress``: the MTC membrane's Gauss points, the SBC shell's three
-        surfaces). ``slack``: the number of slack tendon elements per sample.
+        surfaces). ``slack``: the number of slack tendon elements per sample. The FE rest
+        lengths are those :meth:`actuate` set at each sample; with force actuation also the
+        tension demand T_d and those rest lengths (``tension_demand``, ``fe_rest_lengths``,
+        (n, n_t)), the largest |T - T_d| of the tendons at the samples and the smallest FE
+        margin L - r (L the FE tendon length).
         """
         dyn = self.dyn
         nq = len(dyn.model.system.q_names)
-        w, T, Te, bar, vm, p1, slack_t = [], [], [], [], [], [], []
-        for k, (x, u) in enumerate(zip(states, inputs)):
+        w, T, Te, bar, vm, p1, slack_t, Td, R, L = [], [], [], [], [], [], [], [], [], []
+        force = self.actuation == "force"
+        for k, (x, uc) in enumerate(zip(states, inputs)):
             w.append(dyn.outputs(x)[nq:])
+            u = self.actuate(x, uc)
+            if force:
+                Td.append(self.tension_demand(x, uc)); R.append(u)
+                L.append(fe_tendon_lengths(dyn, x))
             dyn.model.set_tendon_lengths(u)
             m = dyn.member_forces(x)
             T.append(m["tendon_force"]); Te.append(m["element_force"]); bar.append(m["bar_force"])
@@ -260,7 +305,14 @@ class FEStatePlant:
         dyn.model.set_tendon_lengths(dyn.u0)
         T, Te, bar = np.array(T), np.array(Te), np.array(bar)
         slack = np.sum(Te <= 0.0, axis=1)
-        return {"w": np.array(w), "model": dyn.name, "free_dofs": int(dyn.x0.size),
+        extra = {}
+        if force:
+            Td, R = np.array(Td), np.array(R)
+            extra = {"tension_demand": Td, "fe_rest_lengths": R,
+                     "max_tension_error_N": float(np.max(np.abs(T - Td))),
+                     "min_fe_rest_length_margin_m": float(np.min(np.array(L) - R))}
+        return {"w": np.array(w), "tendon_force": T, "actuation": self.actuation, **extra,
+                "model": dyn.name, "free_dofs": int(dyn.x0.size),
                 "max_tendon_stress_Pa": float(np.max(T / dyn.mtc.tendon_area)),
                 "min_tendon_force_N": float(np.min(T)),
                 "tendon_slack_samples": int(np.sum(slack > 0)),
@@ -333,7 +385,8 @@ def start_rest_lengths(initial, tendon_law: str, nominal) -> np.ndarray:
 
 
 def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
-                         tendon_law: str = "cable", beta: float = 0.0) -> FEStatePlant:
+                         tendon_law: str = "cable", beta: float = 0.0,
+                         actuation: str = "rest-length") -> FEStatePlant:
     """The MTC model of the COM's system (its rest lengths, N x mesh_n x mesh_n membrane,
     ``tendon_elements`` trusses per tendon, the tendon law of :class:`MTCModel`) as the plant
     of a deployment, its sensors at the COM's output points.
@@ -343,7 +396,8 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     = 0) the FE statics are solved under :func:`start_rest_lengths` -- the bars take their
     axial strain, the membrane and tendons their FE shapes -- so that the run starts without
     the transient of an FE state out of equilibrium. ``beta``: stiffness-proportional
-    Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe_plant.FEPlant`)."""
+    Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe_plant.FEPlant`);
+    ``actuation``: rest-length or tension-servoed tendons (:class:`FEStatePlant`)."""
     from tmfem.models.mtc.dynamics import MTCDynamics
     from tmfem.models.mtc.model import MTCModel
     fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
@@ -352,12 +406,12 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
     st = fe.solve_static(x0=com_positions(com, fe, packaged_state(com, initial)))
     fe.set_tendon_lengths(com.u0)
-    return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free])
+    return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free], actuation=actuation)
 
 
 def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
                          bar_elements: int = 1, bars: str = "rigid",
-                         beta: float = 0.0) -> FEStatePlant:
+                         beta: float = 0.0, actuation: str = "rest-length") -> FEStatePlant:
     """The SBC model of the COM's system (MITC4 shell membrane, four-node beam bars -- with
     H_1j a node of the bar for a 1-N(D) system --, tension-only tendons of the cable law
     k = EA / r, its sensors at the COM's output points) as the plant of a deployment.
@@ -375,7 +429,8 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     :class:`COMStateEstimator`); ``beta``: stiffness-proportional
     Rayleigh damping C = beta K_0 (K_0 at that equilibrium; docs/fe-plant.md: without it the
     undamped SBC plant's Park integration diverges during the 1-4(D) deployment even under
-    the COM run's smooth rest lengths)."""
+    the COM run's smooth rest lengths); ``actuation``: rest-length or tension-servoed tendons
+    (:class:`FEStatePlant`)."""
     from tmfem.models.sbc.dynamics import SBCDynamics
     from tmfem.models.sbc.model import SBCModel
     sbc = SBCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
@@ -386,7 +441,7 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     st = sbc.solve_static(start=sbc.state_from_mtc(pre.x))
     sbc.set_tendon_lengths(com.u0)
     dyn = SBCDynamics(sbc, st.state, output_points=com.output_points, beta=beta)
-    return FEStatePlant(dyn, com, bars=bars)
+    return FEStatePlant(dyn, com, bars=bars, actuation=actuation)
 
 
 #: the plants a deployment can run on: the COM it is designed on and the two FE models
@@ -394,13 +449,16 @@ PLANTS = ("com", "mtc", "sbc")
 
 
 def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
-                     tendon_law: str | None = None, bars: str | None = None, beta: float = 0.0):
+                     tendon_law: str | None = None, bars: str | None = None, beta: float = 0.0,
+                     actuation: str = "rest-length"):
     """The plant ``kind`` of a deployment of the COM's system from the packaged design
     ``initial``: None for ``"com"`` (:func:`tmfem.control.deploy.run_deployment` builds the
     COM plant), :func:`mtc_deployment_plant` (``tendon_law`` default ``"cable"``) or
     :func:`sbc_deployment_plant` (the SBC model has the cable law only: ``"fixed-rate"`` is
     refused; ``bars``: its bar measurement, default ``"rigid"``, refused on the other plants);
-    ``beta``: the FE plant's Rayleigh damping C = beta K_0 (refused for the COM)."""
+    ``beta``: the FE plant's Rayleigh damping C = beta K_0 (refused for the COM);
+    ``actuation``: the FE plant's tendon actuators (:class:`FEStatePlant`; ``"force"`` refused
+    for the COM, the design model whose tendons the force actuator imitates)."""
     if kind not in PLANTS:
         raise InputError(f"plant: expected one of {list(PLANTS)}, found {kind!r}")
     if bars is not None and kind != "sbc":
@@ -409,12 +467,19 @@ def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
     if beta and kind == "com":
         raise InputError(f"plant damping beta = {beta}: expected an FE plant (mtc, sbc), found "
                          "the COM plant (its damping is the design model's)")
+    if actuation not in ACTUATIONS:
+        raise InputError(f"plant actuation: expected one of {ACTUATIONS}, found {actuation!r}")
+    if actuation != "rest-length" and kind == "com":
+        raise InputError(f"plant actuation {actuation!r}: expected an FE plant (mtc, sbc), found "
+                         "the COM plant (the design model: its tendon forces are the ones the "
+                         "force actuator reproduces on an FE plant)")
     if kind == "com":
         return None
     if kind == "sbc":
         if tendon_law not in (None, "cable"):
             raise InputError(f"SBC plant tendons: the SBC model has the cable law only (EA fixed, "
                              f"k = EA / r); expected 'cable', found {tendon_law!r}")
-        return sbc_deployment_plant(com, initial, mesh_n=mesh_n, bars=bars or "rigid", beta=beta)
+        return sbc_deployment_plant(com, initial, mesh_n=mesh_n, bars=bars or "rigid", beta=beta,
+                                    actuation=actuation)
     return mtc_deployment_plant(com, initial, mesh_n=mesh_n, tendon_law=tendon_law or "cable",
-                                beta=beta)
+                                beta=beta, actuation=actuation)

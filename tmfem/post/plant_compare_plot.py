@@ -51,15 +51,16 @@ def _legend_outside(ax, entries, labels) -> None:
 
 
 def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", reference: str = "eq. 5.68"):
-    """Six panels over time: the bar attitudes of both runs against the reference
+    """Seven panels over time: the bar attitudes of both runs against the reference
     (``reference``: its equation), their tracking errors q - q_ref, the membrane deflections
-    w_k, the commanded rest lengths (one tendon of each family), the deviation between the
-    plants of the bar angles [mrad] and of the base positions [mm] and that of w [mm] (both
-    logarithmic). Colour: the signal; run A solid, run B dashed and drawn above every run-A
+    w_k, the commanded rest lengths and each plant's own tendon forces (one tendon of each
+    family; ``tendon_force``: the COM's k (|d| - u), an FE plant's elements), the deviation
+    between the plants of the bar angles [mrad] and of the base positions [mm] and that of w
+    [mm] (both logarithmic). Colour: the signal; run A solid, run B dashed and drawn above every run-A
     line (a signal of A does not hide another's B); the legends right of the panels (they
     hide no data); a run that stopped early is marked."""
-    fig = new_figure(figsize=(10.5, 16))
-    ax = fig.subplots(6, 1, sharex=True, height_ratios=[1, 1, 1, 1, 0.7, 0.7])
+    fig = new_figure(figsize=(10.5, 18))
+    ax = fig.subplots(7, 1, sharex=True, height_ratios=[1, 1, 1, 1, 1, 0.7, 0.7])
     names = a.names["q"]
     colours = [f"C{i}" for i in range(10)]
     bars = []
@@ -85,28 +86,34 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", referenc
     for i, j in enumerate(seen.values()):
         for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
             ax[3].plot(r.t, r.u[:, j], ls, color=colours[i % 10], zorder=z)
-    _legend_outside(ax[3], [(f"rest length {a.names['tendons'][j]}", colours[i % 10], "-")
-                            for i, j in enumerate(seen.values())], labels)
-    ax[3].set_ylabel("rest length [m]")
+            tf = getattr(r, "tendon_force", None)       # a record without forces: no curve
+            if tf is not None and tf.size:
+                ax[4].plot(r.t, tf[:, j], ls, color=colours[i % 10], zorder=z)
+    for x, what in ((ax[3], "rest length"), (ax[4], "tendon force")):
+        if x.get_lines():                               # the force panel of a record without forces
+            _legend_outside(x, [(f"{what} {a.names['tendons'][j]}", colours[i % 10], "-")
+                                for i, j in enumerate(seen.values())], labels)
+    ax[3].set_ylabel("commanded rest length [m]")
+    ax[4].set_ylabel("tendon force [N]")
     vs = f"|{labels[1]} - {labels[0]}|"
-    devs = [(ax[4], 1e3 * dev["q"], "C0", f"bar angles: max {vs} [mrad]")]
+    devs = [(ax[5], 1e3 * dev["q"], "C0", f"bar angles: max {vs} [mrad]")]
     if np.isfinite(dev["bases"]).all():
-        devs.append((ax[4], 1e3 * dev["bases"], "C1", f"stage bases: max {vs} [mm]"))
-    devs.append((ax[5], 1e3 * dev["w"], "C3", f"w_k: max {vs} [mm]"))
-    for x in ax[4:]:
+        devs.append((ax[5], 1e3 * dev["bases"], "C1", f"stage bases: max {vs} [mm]"))
+    devs.append((ax[6], 1e3 * dev["w"], "C3", f"w_k: max {vs} [mm]"))
+    for x in ax[5:]:
         x.set_yscale("log")
     for x, d, c, lab in devs:
         x.plot(dev["t"], d, "-", color=c, label=lab)
-    for x in ax[4:]:
+    for x in ax[5:]:
         d = np.concatenate([line.get_ydata() for line in x.get_lines()])
         d = d[np.isfinite(d) & (d > 0)]
         if d.size:            # down to the smallest deviation, at most four decades below the
             top = float(d.max())                       # largest (the start is exact: zero)
             x.set_ylim(max(1e-4 * top, 0.5 * float(d.min())), 2.0 * top)
         x.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
-    ax[4].set_ylabel("bar deviation\n[mrad, mm]")
-    ax[5].set_ylabel("membrane deviation\n[mm]")
-    ax[5].set_xlabel("time [s]")
+    ax[5].set_ylabel("bar deviation\n[mrad, mm]")
+    ax[6].set_ylabel("membrane deviation\n[mm]")
+    ax[6].set_xlabel("time [s]")
     t_span = max(a.t[-1], b.t[-1])
     switches = [(r.switch_time, lab, ls) for r, lab, ls in ((a, labels[0], "-"), (b, labels[1], "--"))
                 if r.switch_time is not None]

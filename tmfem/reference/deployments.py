@@ -92,13 +92,25 @@ def check_choices(preset: str, *, controller: str = "adaptive-hinf", uncertainty
 def csv_columns(r) -> list[str]:
     """Header of the deployment CSV: one column per named signal, with its unit
     (:func:`tmfem.io.run.column_header`): time, q, the references q_d, w, rest lengths u,
-    tendon lengths L, the zero-dynamics energy and the active controller (a label, unit
-    ``[-]`` as the dimensionless JSON entries of :mod:`tmfem.io.units`)."""
+    tendon lengths L, the zero-dynamics energy, the plant's own tendon forces T (the FE
+    plant's elements, the COM's k (L - u)), with force actuation the tension demand T_d and the
+    FE rest lengths r_fe, and the active controller (a label, unit ``[-]`` as the
+    dimensionless JSON entries of :mod:`tmfem.io.units`)."""
     from tmfem.io.run import column_header
     n = r.names
     names = (["t"] + n["q"] + [f"{q}_ref" for q in n["q"]] + n["w"] + n["u"]
-             + [f"L_{t}" for t in n["tendons"]] + ["eta_energy"])
+             + [f"L_{t}" for t in n["tendons"]] + ["eta_energy"]
+             + [f"{p}_{t}" for p, _ in _tendon_signals(r) for t in n["tendons"]])
     return [column_header(c) for c in names] + ["controller [-]"]
+
+
+def _tendon_signals(r) -> list:
+    """(column prefix, array (n, n_t)) of the run's tendon signals after the COM columns: the
+    plant's own tendon forces ``T`` and, with force actuation, the tension demand ``T_d`` and
+    the FE rest lengths set ``r_fe`` (:class:`tmfem.control.deploy.DeploymentResult`)."""
+    out = [("T", r.tendon_force)] if r.tendon_force.size else []
+    return out + [(p, r.actuator[k]) for p, k in (("T_d", "tension_demand"),
+                                                  ("r_fe", "fe_rest_lengths")) if k in r.actuator]
 
 
 def write_csv(path, r) -> str:
@@ -111,7 +123,9 @@ def write_csv(path, r) -> str:
             wr.writerow([f"{r.t[k]:.6g}"] + [f"{v:.10g}" for v in r.z[k, :nq]]
                         + [f"{v:.10g}" for v in r.q_d[k]] + [f"{v:.10g}" for v in r.w[k]]
                         + [f"{v:.10g}" for v in r.u[k]] + [f"{v:.10g}" for v in r.lengths[k]]
-                        + [f"{r.eta_energy[k]:.6g}", r.controller[min(k, len(r.controller) - 1)]])
+                        + [f"{r.eta_energy[k]:.6g}"]
+                        + [f"{v:.10g}" for _, a in _tendon_signals(r) for v in a[k]]
+                        + [r.controller[min(k, len(r.controller) - 1)]])
     return str(path)
 
 

@@ -7,7 +7,10 @@ the inputs u from a controller sampled every step (zero-order hold, see
 
     y_n = outputs(x_n, v_n, u_{n-1}),   u_n = k(t_n, y_n, x_c,n),   x_c,n+1 = update(t_n, y_n, x_c,n),
 
-and the plant stepped from t_n to t_n+1 with u_n held. Any model's plant serves: the
+and the plant stepped from t_n to t_n+1 with u_n held -- or, for a plant with actuators
+(``plant.actuate(x, u)``), with the input its model receives for the command u_n at the
+sampled state x_n held (a tension-servoed tendon, :mod:`tmfem.control.tension_actuation`;
+the record keeps the commanded u_n). Any model's plant serves: the
 control-oriented model (eq. 5.27) and the finite-element models (M a + C v + f_int(x; u) with
 the tendon rest lengths u as inputs).
 """
@@ -81,7 +84,9 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
     ----------
     plant : tmfem.models.base.Plant
         ``residual``, ``jacobians`` (and optionally ``newton_matrix``, ``factorize``),
-        ``outputs``, ``x0``, ``v0``, ``u0``, ``input_names``, ``output_names``.
+        ``outputs``, ``x0``, ``v0``, ``u0``, ``input_names``, ``output_names``; optionally
+        ``actuate(x, u)``, the model input realising the command u at the sampled state x
+        (module docstring).
     t_end, dt : float
         Duration and step (7.4: dt = 0.01 s).
     controller : Controller, array, callable or None
@@ -116,6 +121,7 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
     x0 = np.asarray(plant.x0 if x0 is None else x0, dtype=float)
     v0 = np.asarray(plant.v0 if v0 is None else v0, dtype=float)
     nu = len(plant.input_names)
+    actuate = getattr(plant, "actuate", None)
     measure = outputs or getattr(ctrl, "reads_outputs", True)
     y0 = np.asarray(plant.outputs(x0, v0, loop.u), dtype=float) if measure else None
     xc = ctrl.reset(0.0, y0, dt)
@@ -129,7 +135,7 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
             raise InputError(f"controller {ctrl.name}: expected {nu} finite inputs at t = {t:.6g} s, "
                              f"found {u}")
         state["xc"] = ctrl.update(t, y, state["xc"])
-        loop.u = u
+        loop.u = u if actuate is None else np.asarray(actuate(x, u), dtype=float)
         T.append(t); U.append(u); C.append(ctrl.name)
         if outputs:
             Y.append(y)
