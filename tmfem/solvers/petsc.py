@@ -51,6 +51,10 @@ PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/backends
 #: right-hand sides per MUMPS solve of the block eigensolver (8: 6.5 ms per column against
 #: 28 ms for single solves at 78k DOF; larger blocks need more columns in all)
 EIG_BLOCK = 8
+#: right-hand sides per block of the redundant eigensolver, split by columns over the ranks
+#: (8: 4 per rank on 2 ranks, 2.6-3.1 s of CPU at 78k DOF against 3.2-3.7 s with 8 per
+#: rank and 3.7-4.7 s with SLEPc; docs/backends.md, petsc6)
+EIG_BLOCK_REDUNDANT = 8
 #: smallest problem for the block eigensolver (smaller ones: SLEPc)
 EIG_BLOCK_MIN_N = 400
 
@@ -154,7 +158,7 @@ class PetscBackend:
         parallel factors under ``mpiexec -n P > 1``); ``"redundant"``: the same block
         method under ``mpiexec -n P > 1`` on every rank's own sequential factors of the
         whole K - sigma M (:mod:`tmfem.solvers.petsc_redundant`), each block of
-        P x EIG_BLOCK right-hand sides split by columns between the ranks (on one rank it
+        :data:`EIG_BLOCK_REDUNDANT` right-hand sides split by columns between the ranks (on one rank it
         is ``"block"``); refused (:class:`~tmfem.errors.ResourceLimit`) when MUMPS
         estimates more than ``eig_memory_mb`` per rank; ``"slepc"``: SLEPc's Krylov-Schur
         (one parallel solve per vector), which reads the ``eps_`` options (refused with
@@ -649,8 +653,8 @@ class PetscBackend:
         SLEPc's), vectors distributed by rows. The factors: the parallel ones (in the
         static solve's analysed Mat with ``reuse``, else in a KSP of its own) with
         EIG_BLOCK right-hand sides per solve, or with ``redundant`` every rank's own
-        sequential ones (:mod:`tmfem.solvers.petsc_redundant`) with EIG_BLOCK right-hand
-        sides per rank and solve, split by columns; :class:`RedundantDoesNotFit` when they
+        sequential ones (:mod:`tmfem.solvers.petsc_redundant`) with EIG_BLOCK_REDUNDANT
+        right-hand sides per solve, split by columns over the ranks; :class:`RedundantDoesNotFit` when they
         exceed the memory budget (nothing left allocated)."""
         from tmfem.solvers.block_krylov import block_krylov_schur, start_block
         from tmfem.solvers.petsc_redundant import default_budget_mb, redundant_shift_invert
@@ -658,7 +662,7 @@ class PetscBackend:
         n = Kp.getSize()[0]
         comm = self.comm.tompi4py()
         lo, hi = Kp.getOwnershipRange()
-        b = EIG_BLOCK * (comm.size if redundant else 1)
+        b = EIG_BLOCK_REDUNDANT if redundant else EIG_BLOCK
         dense, own = {}, []
 
         def mat(key, m):
