@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import logging
 import os
+import time
 
 import numpy as np
 
@@ -162,6 +163,7 @@ def redundant_shift_invert(PETSc, A, budget_mb: int, make_ksp) -> RedundantShift
     """
     comm = A.getComm().tompi4py()
     n = A.getSize()[0]
+    cpu = time.process_time()
     everything = PETSc.IS().createStride(n, 0, 1, comm=PETSc.COMM_SELF)
     try:
         (S,) = A.createSubMatrices(everything)
@@ -191,6 +193,7 @@ def redundant_shift_invert(PETSc, A, budget_mb: int, make_ksp) -> RedundantShift
         if failed is not None:
             raise failed
         raise PETSc.Error(76)          # PETSC_ERR_LIB: MUMPS' factorisation failed on some rank
-    log.debug("redundant factorisation: n = %d, MUMPS estimate %d MB per rank (budget %d MB)",
-              n, estimate, budget_mb)
+    log.debug("redundant factorisation: n = %d, MUMPS estimate %d MB per rank (budget %d MB), "
+              "gathered and factorised in %.2f s of CPU", n, estimate, budget_mb,
+              time.process_time() - cpu)
     return RedundantShiftInvert(PETSc, comm, S, ksp, A.getOwnershipRange())
