@@ -12,7 +12,9 @@ Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py
     The generalised Hermitian problem K v = w M v (eq. 5.32) by shift-and-invert about
     ``sigma`` (the factorisation of K - sigma M by the same MUMPS Cholesky): on one rank
     the block Krylov-Schur of :mod:`tmfem.solvers.block_krylov` (MUMPS solves of 8
-    right-hand sides at once), under ``mpiexec -n P > 1`` SLEPc EPS Krylov-Schur
+    right-hand sides at once), under ``mpiexec -n P > 1`` the same on every rank's own
+    sequential factors with each block's columns split over the ranks
+    (:mod:`tmfem.solvers.petsc_redundant`), or SLEPc EPS Krylov-Schur when those do not fit
     (``eig_solver``); the k eigenvalues nearest to sigma, vectors M-orthonormal (the
     B-inner product, then a Rayleigh-Ritz step in their span, so that repeated eigenvalues
     come out as full M-orthonormal pairs).
@@ -120,7 +122,6 @@ def _shift_invert_failure(sigma: float, exc):
                           f"found the shift-invert factorisation failing (PETSc error {exc.ierr})")
 
 
-
 @dataclass(eq=False)
 class _Factorisation:
     """A cache entry of :class:`PetscBackend`: the Mat of one sparsity pattern and its KSP
@@ -129,7 +130,7 @@ class _Factorisation:
     ksp: object                      #: PETSc KSP factorising it
     generation: int                  #: bumped at each refactorisation; -1 once destroyed
     symmetric: bool                  #: Cholesky (True) or LU
-    serial: int                      #: creation count, the same on every rank (:meth:`PetscBackend._reap`)
+    serial: int                      #: creation count, the same on every rank (``_reap``)
     #: mass pattern -> whether it lies within this pattern (:meth:`PetscBackend._analysed`)
     mass_within: weakref.WeakKeyDictionary = field(default_factory=weakref.WeakKeyDictionary)
 
@@ -158,8 +159,8 @@ class PetscBackend:
         parallel factors under ``mpiexec -n P > 1``); ``"redundant"``: the same block
         method under ``mpiexec -n P > 1`` on every rank's own sequential factors of the
         whole K - sigma M (:mod:`tmfem.solvers.petsc_redundant`), each block of
-        :data:`EIG_BLOCK_REDUNDANT` right-hand sides split by columns between the ranks (on one rank it
-        is ``"block"``); refused (:class:`~tmfem.errors.ResourceLimit`) when MUMPS
+        :data:`EIG_BLOCK_REDUNDANT` right-hand sides split by columns between the ranks
+        (on one rank it is ``"block"``); refused (:class:`~tmfem.errors.ResourceLimit`) when MUMPS
         estimates more than ``eig_memory_mb`` per rank; ``"slepc"``: SLEPc's Krylov-Schur
         (one parallel solve per vector), which reads the ``eps_`` options (refused with
         the block solvers); ``"auto"`` (default): ``"block"`` on one rank, ``"redundant"``

@@ -78,8 +78,7 @@ class RedundantShiftInvert:
         self._S, self._ksp = S, ksp
         self.F = ksp.getPC().getFactorMatrix()
         self.n = S.getSize()[0]
-        self.lo, self.hi = rows
-        bounds = comm.allgather(rows)
+        bounds = comm.allgather(rows)          # every rank's rows [lo, hi) of the blocks
         self._row_counts = np.array([hi - lo for lo, hi in bounds])
         self._dense = {}
 
@@ -88,6 +87,7 @@ class RedundantShiftInvert:
         return np.array_split(np.arange(m), self.comm.size)
 
     def _seq_dense(self, key, m: int):
+        """A sequential dense Mat (n, m), one per key and m (reused across the blocks)."""
         PETSc = self.PETSc
         if (key, m) not in self._dense:
             D = PETSc.Mat().createDense((self.n, m), comm=PETSc.COMM_SELF)
@@ -128,6 +128,7 @@ class RedundantShiftInvert:
         return out
 
     def destroy(self) -> None:
+        """Free this rank's dense work Mats, KSP (the factors) and gathered matrix."""
         for D in self._dense.values():
             D.destroy()
         self._dense.clear()
@@ -136,6 +137,7 @@ class RedundantShiftInvert:
 
 
 def _displs(counts: np.ndarray) -> np.ndarray:
+    """Displacements of consecutive MPI buffer segments of the given counts."""
     return np.concatenate(([0], np.cumsum(counts)[:-1]))
 
 
