@@ -12,7 +12,9 @@ Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py
     The generalised Hermitian problem K v = w M v (eq. 5.32) by shift-and-invert about
     ``sigma`` (the factorisation of K - sigma M by the same MUMPS Cholesky): on one rank
     the block Krylov-Schur of :mod:`tmfem.solvers.block_krylov` (MUMPS solves of 8
-    right-hand sides at once), under ``mpiexec -n P > 1`` SLEPc EPS Krylov-Schur
+    right-hand sides at once), under ``mpiexec -n P > 1`` the same on every rank's own
+    sequential factors with each block's columns split over the ranks
+    (:mod:`tmfem.solvers.petsc_redundant`), or SLEPc EPS Krylov-Schur when those do not fit
     (``eig_solver``); the k eigenvalues nearest to sigma, vectors M-orthonormal (the
     B-inner product, then a Rayleigh-Ritz step in their span, so that repeated eigenvalues
     come out as full M-orthonormal pairs).
@@ -34,12 +36,15 @@ from __future__ import annotations
 import hashlib
 import logging
 import shlex
+import weakref
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
-from tmfem.errors import BackendUnavailable, ConvergenceError, InputError
+from tmfem.errors import BackendUnavailable, ConvergenceError, InputError, ResourceLimit
+from tmfem.solvers.petsc_redundant import RedundantDoesNotFit
 
 log = logging.getLogger(__name__)
 
@@ -48,6 +53,10 @@ PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/backends
 #: right-hand sides per MUMPS solve of the block eigensolver (8: 6.5 ms per column against
 #: 28 ms for single solves at 78k DOF; larger blocks need more columns in all)
 EIG_BLOCK = 8
+#: right-hand sides per block of the redundant eigensolver, split by columns over the ranks
+#: (8: 4 per rank on 2 ranks, 2.6-3.1 s of CPU at 78k DOF against 3.2-3.7 s with 8 per
+#: rank and 3.7-4.7 s with SLEPc; docs/backends.md, petsc6)
+EIG_BLOCK_REDUNDANT = 8
 #: smallest problem for the block eigensolver (smaller ones: SLEPc)
 EIG_BLOCK_MIN_N = 400
 
@@ -113,6 +122,19 @@ def _shift_invert_failure(sigma: float, exc):
                           f"found the shift-invert factorisation failing (PETSc error {exc.ierr})")
 
 
+@dataclass(eq=False)
+class _Factorisation:
+    """A cache entry of :class:`PetscBackend`: the Mat of one sparsity pattern and its KSP
+    (MUMPS' analysis and factors), with the bookkeeping of its solves."""
+    mat: object                      #: PETSc Mat holding the latest matrix of the pattern
+    ksp: object                      #: PETSc KSP factorising it
+    generation: int                  #: bumped at each refactorisation; -1 once destroyed
+    symmetric: bool                  #: Cholesky (True) or LU
+    serial: int                      #: creation count, the same on every rank (``_reap``)
+    #: mass pattern -> whether it lies within this pattern (:meth:`PetscBackend._analysed`)
+    mass_within: weakref.WeakKeyDictionary = field(default_factory=weakref.WeakKeyDictionary)
+
+
 class PetscBackend:
     """PETSc/SLEPc backend (module docstring).
 
@@ -131,16 +153,28 @@ class PetscBackend:
     eig_tol : float
         Relative residual tolerance of the eigenpairs (||Op x - theta x|| <= eig_tol |theta|
         of the shift-invert operator, both eigen solvers).
-    eig_solver : {"auto", "block", "slepc"}
+    eig_solver : {"auto", "redundant", "block", "slepc"}
         ``"block"``: :func:`tmfem.solvers.block_krylov.block_krylov_schur`, a block
-        Krylov-Schur on MUMPS solves of :data:`EIG_BLOCK` right-hand sides at once;
-        ``"slepc"``: SLEPc's Krylov-Schur (one solve per vector), which reads the ``eps_``
-        options (refused with ``"block"``); ``"auto"`` (default): the block solver on one
-        rank, SLEPc under ``mpiexec -n P > 1`` (PETSc 3.18's MUMPS solve of several
-        right-hand sides on 2 ranks costs as much per column as single solves: 36 ms per
-        column in blocks of 8 against 67 ms per single solve at 78k DOF, where the block
-        method needs ~2.3x the columns) or when ``eps_`` options are given. Problems of
-        fewer than :data:`EIG_BLOCK_MIN_N` unknowns always go to SLEPc.
+        Krylov-Schur on MUMPS solves of :data:`EIG_BLOCK` right-hand sides at once (on the
+        parallel factors under ``mpiexec -n P > 1``); ``"redundant"``: the same block
+        method under ``mpiexec -n P > 1`` on every rank's own sequential factors of the
+        whole K - sigma M (:mod:`tmfem.solvers.petsc_redundant`), each block of
+        :data:`EIG_BLOCK_REDUNDANT` right-hand sides split by columns between the ranks
+        (on one rank it is ``"block"``); refused (:class:`~tmfem.errors.ResourceLimit`) when MUMPS
+        estimates more than ``eig_memory_mb`` per rank; ``"slepc"``: SLEPc's Krylov-Schur
+        (one parallel solve per vector), which reads the ``eps_`` options (refused with
+        the block solvers); ``"auto"`` (default): ``"block"`` on one rank, ``"redundant"``
+        under ``mpiexec -n P > 1`` and SLEPc when the redundant factors do not fit (PETSc
+        3.18's parallel MUMPS solve of several right-hand sides costs as much per column
+        as single solves: 36 ms per column in blocks of 8 against 67 ms per single solve
+        at 78k DOF, where the block method needs ~2.3x the columns), SLEPc when ``eps_``
+        options are given. Problems of fewer than :data:`EIG_BLOCK_MIN_N` unknowns always
+        go to SLEPc.
+    eig_memory_mb : int, optional
+        Memory per rank for the redundant factorisation (MUMPS ICNTL(23), checked by MUMPS
+        against its estimate before it allocates the factors); default
+        :data:`tmfem.solvers.petsc_redundant.MEMORY_SHARE` of the node's available memory
+        shared by its ranks. Only with ``eig_solver`` "auto" or "redundant".
     """
 
     name = "petsc"
@@ -150,7 +184,7 @@ class PetscBackend:
     distributed_assembly = True
 
     def __init__(self, *, solver: str = "direct", rtol: float | None = None, options=None,
-                 eig_tol: float = 1e-12, eig_solver: str = "auto"):
+                 eig_tol: float = 1e-12, eig_solver: str = "auto", eig_memory_mb: int | None = None):
         self.PETSc, self.SLEPc = petsc_modules()
         if solver not in ("direct", "iterative"):
             raise InputError(f"backend 'petsc': expected solver 'direct' or 'iterative', found {solver!r}")
@@ -163,18 +197,32 @@ class PetscBackend:
             raise InputError(f"backend 'petsc': expected 0 < rtol < 1, found {self.rtol}")
         self.options = parse_options(options)
         self.eig_tol = float(eig_tol)
-        if eig_solver not in ("auto", "block", "slepc"):
-            raise InputError(f"backend 'petsc': expected eig_solver 'auto', 'block' or 'slepc', "
-                             f"found {eig_solver!r}")
+        if eig_solver not in ("auto", "redundant", "block", "slepc"):
+            raise InputError(f"backend 'petsc': expected eig_solver 'auto', 'redundant', 'block' or "
+                             f"'slepc', found {eig_solver!r}")
         eps = sorted(k for k in self.options if k.startswith("eps_"))
-        if eps and eig_solver == "block":
+        if eps and eig_solver in ("block", "redundant"):
             raise InputError(f"backend 'petsc': the options {', '.join('-' + k for k in eps)} are "
-                             "SLEPc's: expected eig_solver='slepc' with them, found 'block'")
+                             f"SLEPc's: expected eig_solver='slepc' with them, found {eig_solver!r}")
+        if eig_memory_mb is not None:
+            if eig_solver not in ("auto", "redundant"):
+                raise InputError(f"backend 'petsc': eig_memory_mb applies to the redundant eigen "
+                                 f"solve (eig_solver 'auto' or 'redundant'), found {eig_solver!r}")
+            if int(eig_memory_mb) < 1:
+                raise InputError(f"backend 'petsc': expected eig_memory_mb >= 1, found {eig_memory_mb}")
+        self.eig_memory_mb = None if eig_memory_mb is None else int(eig_memory_mb)
+        #: SLEPc when the redundant factors do not fit ("auto"), else the refusal
+        self._eig_fallback = eig_solver == "auto"
+        parallel = self.PETSc.COMM_WORLD.size > 1
         if eig_solver == "auto":
-            eig_solver = "block" if self.PETSc.COMM_WORLD.size == 1 and not eps else "slepc"
+            eig_solver = "slepc" if eps else ("redundant" if parallel else "block")
+        elif eig_solver == "redundant" and not parallel:
+            eig_solver = "block"
         self.eig_solver = eig_solver
+        #: the eigen solver of the latest ``eigsh`` ("block", "redundant" or "slepc")
+        self.last_eig_solver = None
         self.comm = self.PETSc.COMM_WORLD
-        self._cache = {}          # sparsity pattern -> [Mat, KSP, generation, symmetric, serial]
+        self._cache = {}          # sparsity pattern -> _Factorisation
         self._dead = []           # retired cache entries, destroyed by _reap
         self._serial = 0          # creation count of cache entries (the same on every rank)
 
@@ -216,9 +264,9 @@ class PetscBackend:
             M = self.PETSc.Mat().createAIJ(size=((hi - lo, n), (hi - lo, n)), csr=(ip, ix, Al.data),
                                            comm=self.comm)
         else:
-            M = entry[0]
+            M = entry.mat
             M.setValuesCSR(ip, ix, Al.data)
-            entry[2] += 1              # earlier solves of this Mat are stale now
+            entry.generation += 1      # earlier solves of this Mat are stale now
         M.assemble()
         return M, key
 
@@ -235,15 +283,14 @@ class PetscBackend:
         key = ("dist", id(A.pattern))
         entry = self._cache.get(key)
         if entry is None:
-            import weakref
             # the factorisation lives as long as the pattern (the model's assembler): the id
             # of a dead pattern may come back, its Mat must not
             weakref.finalize(A.pattern, self._drop, key).atexit = False
             M = base.mat.duplicate(copy=True)
         else:
-            M = entry[0]
+            M = entry.mat
             base.mat.copy(M, structure=self.PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-            entry[2] += 1              # earlier solves of this Mat are stale now
+            entry.generation += 1      # earlier solves of this Mat are stale now
         if base is not A:
             d, _ = M.createVecs()
             lo, hi = M.getOwnershipRange()
@@ -266,23 +313,23 @@ class PetscBackend:
         """Destroy the retired entries that every rank has retired, in the order they were
         created (collective: called where every rank enters, at each factorisation and
         eigen solve)."""
-        serials = sorted(e[4] for e in self._dead)
+        serials = sorted(e.serial for e in self._dead)
         if self.comm.size > 1:
             common = set(serials)
             for other in self.comm.tompi4py().allgather(serials):
                 common &= set(other)
             serials = sorted(common)
         for serial in serials:
-            entry = next(e for e in self._dead if e[4] == serial)
+            entry = next(e for e in self._dead if e.serial == serial)
             self._dead.remove(entry)
             self._destroy(entry)
 
     @staticmethod
     def _destroy(entry) -> None:
         """Free the Mat and KSP of a cache entry (collective); its solves are stale."""
-        entry[2] = -1
-        entry[1].destroy()
-        entry[0].destroy()
+        entry.generation = -1
+        entry.ksp.destroy()
+        entry.mat.destroy()
 
     def _symmetric(self, A, M) -> bool:
         """Whether A (scipy, the same on every rank) or its PETSc Mat M equals its transpose
@@ -360,25 +407,25 @@ class PetscBackend:
         n = M.getSize()[0]
         sym = self._symmetric(A, M)
         entry = self._cache.get(key)
-        if entry is None or entry[3] != sym:
+        if entry is None or entry.symmetric != sym:
             ksp = PETSc.KSP().create(comm=self.comm)
             M.setOption(PETSc.Mat.Option.SYMMETRIC, sym)
             ksp.setOperators(M)
             self._configure(ksp, sym)
             if entry is not None:          # the same pattern (and Mat M), the other symmetry
                 old = self._cache.pop(key)
-                old[2] = -1                # its solves are stale
-                old[1].destroy()
+                old.generation = -1        # its solves are stale
+                old.ksp.destroy()
             self._serial += 1
-            entry = [M, ksp, 0, sym, self._serial]
+            entry = _Factorisation(M, ksp, 0, sym, self._serial)
             if len(self._cache) >= 4:
                 self._destroy(self._cache.pop(next(iter(self._cache))))
             self._cache[key] = entry
         else:
-            ksp = entry[1]
+            ksp = entry.ksp
             ksp.setOperators(M)
-        entry[2] += 1
-        generation = entry[2]
+        entry.generation += 1
+        generation = entry.generation
         try:
             ksp.setUp()
         except PETSc.Error as exc:
@@ -396,7 +443,7 @@ class PetscBackend:
         x_vec, b_vec = M.createVecs()
 
         def solve(b, *, rtol: float | None = None):
-            if entry[2] != generation:
+            if entry.generation != generation:
                 raise InputError("petsc: this solve belongs to an earlier factorisation of a matrix "
                                  "of the same pattern, which has since been refactorised")
             b = np.asarray(b, dtype=float)
@@ -501,9 +548,22 @@ class PetscBackend:
             raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
         sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
         reuse = self._analysed(K, M) if sym else None
-        if self.eig_solver == "block" and sym and n >= EIG_BLOCK_MIN_N:
-            w, V = self._block_eigsh(Kp, Mp, k, float(sigma), reuse)
-        else:
+        w = None
+        self.last_eig_solver = "slepc"
+        if self.eig_solver in ("block", "redundant") and sym and n >= EIG_BLOCK_MIN_N:
+            try:
+                w, V = self._block_eigsh(Kp, Mp, k, float(sigma), reuse,
+                                         redundant=self.eig_solver == "redundant")
+                self.last_eig_solver = self.eig_solver
+            except RedundantDoesNotFit as exc:
+                if not self._eig_fallback:
+                    raise ResourceLimit(f"eigen (petsc, eig_solver='redundant'): expected every "
+                                        f"rank's factors of K - sigma M within {exc.budget_mb} MB "
+                                        f"(eig_memory_mb), found MUMPS' estimate {exc.estimate_mb} "
+                                        "MB per rank; use a larger eig_memory_mb, or eig_solver "
+                                        "'slepc' or 'block' (the distributed factors)") from None
+                log.info("eigen (petsc): %s; SLEPc on the distributed factors instead", exc)
+        if w is None:
             w, V = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym, reuse)
         order = np.argsort(np.abs(w - sigma), kind="stable")[:k]
         w, V = w[order], V[:, order]
@@ -535,15 +595,12 @@ class PetscBackend:
                 and type(M) is DistributedMatrix):
             return None
         entry = self._cache.get(("dist", id(K.pattern)))
-        if entry is None or not entry[3] or any(key.startswith("st_") for key in self.options) \
+        if entry is None or not entry.symmetric or any(key.startswith("st_") for key in self.options) \
                 or any(key.startswith("st_") for key in self.PETSc.Options().getAll()):
             return None
-        if len(entry) < 6:
-            import weakref
-            entry.append(weakref.WeakKeyDictionary())    # M's pattern -> within K's?
-        subset = entry[5].get(M.pattern)
+        subset = entry.mass_within.get(M.pattern)
         if subset is None:
-            subset = entry[5][M.pattern] = self._subset(M.mat, K.mat)
+            subset = entry.mass_within[M.pattern] = self._subset(M.mat, K.mat)
         return entry if subset else None
 
     def _subset(self, B, A) -> bool:
@@ -566,8 +623,8 @@ class PetscBackend:
         numerically factorised by the entry's KSP (the analysis reused); the KSP. Earlier
         solves of the entry are stale from here on."""
         PETSc = self.PETSc
-        A, ksp = entry[0], entry[1]
-        entry[2] += 1
+        A, ksp = entry.mat, entry.ksp
+        entry.generation += 1
         Kp.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         ksp.setOperators(A)
@@ -577,32 +634,37 @@ class PetscBackend:
             raise _shift_invert_failure(sigma, exc) from None
         return ksp
 
-    def _block_eigsh(self, Kp, Mp, k: int, sigma: float, reuse=None):
+    def _st_ksp(self, A, comm) -> object:
+        """The eigen solve's own KSP (prefix ``st_``, as SLEPc's) of the symmetric A: MUMPS
+        Cholesky, then the ``st_`` options."""
+        ksp = self.PETSc.KSP().create(comm=comm)
+        ksp.setOptionsPrefix("st_")
+        ksp.setOperators(A)
+        ksp.setType("preonly")
+        ksp.getPC().setType("cholesky")
+        ksp.getPC().setFactorSolverType("mumps")
+        with self._database({key: v for key, v in self.options.items() if key.startswith("st_")}):
+            ksp.setFromOptions()
+        return ksp
+
+    def _block_eigsh(self, Kp, Mp, k: int, sigma: float, reuse=None, redundant: bool = False):
         """(w, V) of K v = w M v, the k eigenvalues nearest to sigma and their M-orthonormal
         vectors (full arrays on every rank), by :func:`block_krylov_schur` on the MUMPS
         Cholesky factors of K - sigma M (the ``st_`` options apply to its KSP, as to
-        SLEPc's), EIG_BLOCK right-hand sides per solve, vectors distributed by rows."""
+        SLEPc's), vectors distributed by rows. The factors: the parallel ones (in the
+        static solve's analysed Mat with ``reuse``, else in a KSP of its own) with
+        EIG_BLOCK right-hand sides per solve, or with ``redundant`` every rank's own
+        sequential ones (:mod:`tmfem.solvers.petsc_redundant`) with EIG_BLOCK_REDUNDANT
+        right-hand sides per solve, split by columns over the ranks; :class:`RedundantDoesNotFit` when they
+        exceed the memory budget (nothing left allocated)."""
         from tmfem.solvers.block_krylov import block_krylov_schur, start_block
+        from tmfem.solvers.petsc_redundant import default_budget_mb, redundant_shift_invert
         PETSc = self.PETSc
         n = Kp.getSize()[0]
-        if reuse is None:
-            A = Kp.duplicate(copy=True)
-            A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-            A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-            ksp = PETSc.KSP().create(comm=self.comm)
-            ksp.setOptionsPrefix("st_")
-            ksp.setOperators(A)
-            ksp.setType("preonly")
-            ksp.getPC().setType("cholesky")
-            ksp.getPC().setFactorSolverType("mumps")
-            with self._database({key: v for key, v in self.options.items() if key.startswith("st_")}):
-                ksp.setFromOptions()
-        else:
-            A = reuse[0]
-        b = EIG_BLOCK
-        lo, hi = A.getOwnershipRange()
         comm = self.comm.tompi4py()
-        dense = {}
+        lo, hi = Kp.getOwnershipRange()
+        b = EIG_BLOCK_REDUNDANT if redundant else EIG_BLOCK
+        dense, own = {}, []
 
         def mat(key, m):
             """A dense PETSc Mat (n, m) of rows distributed as A's, one per key and m."""
@@ -619,19 +681,35 @@ class PetscBackend:
             return Bm
 
         try:
-            if reuse is None:
+            if reuse is not None and not redundant:
+                F = self._shifted_in(reuse, Kp, Mp, sigma).getPC().getFactorMatrix()
+            else:
+                A = Kp.duplicate(copy=True)
+                own.append(A)
+                A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+                A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
                 try:
-                    ksp.setUp()
+                    if redundant:
+                        budget = self.eig_memory_mb or default_budget_mb(comm)
+                        op = redundant_shift_invert(PETSc, A, budget,
+                                                    lambda S: self._st_ksp(S, PETSc.COMM_SELF))
+                        own.append(op)
+                        own.remove(A)
+                        A.destroy()             # only the sequential copies are needed
+                    else:
+                        own.append(self._st_ksp(A, self.comm))
+                        own[-1].setUp()
+                        F = own[-1].getPC().getFactorMatrix()
                 except PETSc.Error as exc:
                     raise _shift_invert_failure(sigma, exc) from None
-            else:
-                ksp = self._shifted_in(reuse, Kp, Mp, sigma)
-            F = ksp.getPC().getFactorMatrix()
 
-            def solve(X):
-                out = mat("x", X.shape[1])
-                F.matSolve(block(X, "b"), out)
-                return np.array(out.getDenseArray())
+            if redundant:
+                solve = op.solve
+            else:
+                def solve(X):
+                    out = mat("x", X.shape[1])
+                    F.matSolve(block(X, "b"), out)
+                    return np.array(out.getDenseArray())
 
             def mass(X):
                 key = ("m", X.shape[1])
@@ -648,10 +726,10 @@ class PetscBackend:
         finally:
             for Bm in dense.values():
                 Bm.destroy()
-            if reuse is None:
-                ksp.destroy()
-                A.destroy()
-        log.debug("eigen (petsc, block): %d modes, %d restarts", k, restarts)
+            for obj in reversed(own):
+                obj.destroy()
+        log.debug("eigen (petsc, %s): %d modes, %d restarts", "redundant" if redundant else "block",
+                  k, restarts)
         V = X if comm.size == 1 else np.concatenate(comm.allgather(X), axis=0)
         return sigma + 1.0 / theta, V
 
@@ -665,9 +743,9 @@ class PetscBackend:
         n = Kp.getSize()[0]
         E = SLEPc.EPS().create(comm=self.comm)
         if reuse is not None:
-            reuse[2] += 1                      # its Mat becomes K - sigma M: solves are stale
-            Kp.copy(reuse[0], structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-            Kp = reuse[0]
+            reuse.generation += 1              # its Mat becomes K - sigma M: solves are stale
+            Kp.copy(reuse.mat, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+            Kp = reuse.mat
         try:
             E.setOperators(Kp, Mp)
             E.setProblemType(SLEPc.EPS.ProblemType.GHEP if sym else SLEPc.EPS.ProblemType.GNHEP)
@@ -694,7 +772,7 @@ class PetscBackend:
             if reuse is not None:
                 st.setMatMode(SLEPc.ST.MatMode.INPLACE)
                 st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-                st.setKSP(reuse[1])
+                st.setKSP(reuse.ksp)
             try:
                 E.solve()
             except PETSc.Error as exc:
