@@ -168,3 +168,32 @@ def test_damping_tangent_refusals(sbc):
         check_plant(parser.parse_args(base + ["--plant", "sbc", "--plant-mesh", "2"]))
     with pytest.raises(InputError, match="--plant com"):
         check_plant(parser.parse_args(base + ["--plant-damping", "1e-3"]))
+
+
+def test_deployment_plant_damping_tangent_default():
+    """A damped deployment plant takes the current tangent unless told otherwise (the
+    default chosen from the runs of docs/fe-plant.md "Plant damping along the path"), an
+    undamped one has no damping to take it for; the CLI reports the tangent in force with
+    --plant-damping and passes --plant-damping-tangent through."""
+    from tmfem.cli.deploy import plant_arguments, plant_options
+    from tmfem.reference.deployments import setup
+    s = setup("2-3-deploy", controller="adaptive", evaluation="reference")
+    init = load_preset("2-3-deploy-initial")
+    tangent = {}
+    for name, kw in (("default", {"beta": BETA}), ("initial", {"beta": BETA,
+                                                              "damping_tangent": "initial"}),
+                     ("undamped", {})):
+        tangent[name] = deployment_plant("mtc", s.model, init, mesh_n=2, **kw).dyn
+    assert tangent["default"].damping_tangent == "current"
+    assert tangent["initial"].damping_tangent == "initial"
+    assert tangent["undamped"].damping_tangent == "initial" and tangent["undamped"].C is None
+    parser = build_parser()
+    base = ["deploy", "--preset", "2-3-deploy", "--plant", "mtc", "--plant-damping", "1e-3"]
+    args = parser.parse_args(base)
+    assert plant_arguments(args, "mtc")["damping_tangent"] is None
+    assert plant_options(args, "mtc", 2)["plant_damping_tangent"] == "current"
+    args = parser.parse_args(base + ["--plant-damping-tangent", "initial"])
+    assert plant_arguments(args, "mtc")["damping_tangent"] == "initial"
+    assert plant_options(args, "mtc", 2)["plant_damping_tangent"] == "initial"
+    assert "plant_damping_tangent" not in plant_options(
+        parser.parse_args(["deploy", "--preset", "2-3-deploy", "--plant", "mtc"]), "mtc", 2)
