@@ -63,6 +63,12 @@ def configure(parser) -> None:
                         help="stiffness-proportional Rayleigh damping C = BETA K_0 [s] of the FE "
                              "plant (--plant or --compare-plant mtc|sbc; default none: the "
                              "undamped plant)")
+    parser.add_argument("--plant-damping-tangent", choices=["current", "initial"],
+                        help="the tangent of the FE plant's damping (--plant-damping): current "
+                             "(C_n = BETA K_T(x_n), the tangent at every sampled state, held over "
+                             "the step: a bar's rigid rotation meets no axial damping; default) or "
+                             "initial (C = BETA K_0, the tangent at the packaged equilibrium, which "
+                             "drags the deploying bars, docs/fe-plant.md)")
     parser.add_argument("--plant-actuation", choices=["rest-length", "force"],
                         help="the FE plant's tendon actuators (--plant or --compare-plant "
                              "mtc|sbc): rest-length (the commanded rest lengths are set on the FE "
@@ -216,7 +222,16 @@ def plant_options(args, plant: str, mesh_n) -> dict:
     return {"plant_mesh": mesh_n, "plant_tendons": plant_tendons(args, plant),
             **({"plant_bars": sbc_bars(args)} if plant == "sbc" else {}),
             "plant_damping_s": getattr(args, "plant_damping", None) or 0.0,
+            **({"plant_damping_tangent": damping_tangent(args)}
+               if getattr(args, "plant_damping", None) else {}),
             "plant_actuation": plant_actuation(args)}
+
+
+def damping_tangent(args) -> str:
+    """The FE plant's damping tangent: ``--plant-damping-tangent``, default
+    :data:`tmfem.control.state_estimate.DEPLOYMENT_DAMPING_TANGENT`."""
+    from tmfem.control.state_estimate import DEPLOYMENT_DAMPING_TANGENT
+    return getattr(args, "plant_damping_tangent", None) or DEPLOYMENT_DAMPING_TANGENT
 
 
 def sbc_bars(args) -> str:
@@ -231,7 +246,8 @@ def plant_arguments(args, plant: str) -> dict:
     return {"tendon_law": args.plant_tendons if plant == "mtc" else None,
             "bars": sbc_bars(args) if plant == "sbc" else None,
             "beta": (args.plant_damping or 0.0) if plant != "com" else 0.0,
-            "actuation": plant_actuation(args) if plant != "com" else "rest-length"}
+            "actuation": plant_actuation(args) if plant != "com" else "rest-length",
+            "damping_tangent": args.plant_damping_tangent if plant != "com" else None}
 
 
 def _run_on(args, s, plant_kind: str, mesh_n):
@@ -281,7 +297,8 @@ def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str,
 
 def check_plant(args) -> int | None:
     """The FE plants' options, checked before any work: ``--plant-mesh``,
-    ``--plant-damping`` and ``--plant-actuation`` belong to an FE plant (force actuation on
+    ``--plant-damping`` (and ``--plant-damping-tangent``, which needs it) and
+    ``--plant-actuation`` belong to an FE plant (force actuation on
     the COM plant is refused: the COM is the design model), ``--plant-tendons`` to an MTC
     plant (the SBC model has the cable law only), ``--plant-bars`` to an SBC plant; the
     MTC model has no nodes along the bars, so no 1-N(D) system; ``--compare-plant`` differs
@@ -312,12 +329,18 @@ def check_plant(args) -> int | None:
         for opt, val, fe_kinds in (("--plant-mesh", args.plant_mesh, "mtc|sbc"),
                                    ("--plant-tendons", args.plant_tendons, "mtc"),
                                    ("--plant-damping", args.plant_damping, "mtc|sbc"),
+                                   ("--plant-damping-tangent", args.plant_damping_tangent,
+                                    "mtc|sbc"),
                                    ("--plant-actuation", args.plant_actuation, "mtc|sbc")):
             if val is not None:
                 raise InputError(f"{opt} belongs to --plant {fe_kinds} or --compare-plant "
                                  f"{fe_kinds} (the COM plant has no membrane mesh, FE tendons, FE "
                                  f"damping or FE actuators), found {opt} {val} with --plant com")
         return None
+    if args.plant_damping_tangent is not None and not args.plant_damping:
+        raise InputError(f"--plant-damping-tangent belongs to --plant-damping (the tangent of "
+                         f"the FE plant's damping C = BETA K), found --plant-damping-tangent "
+                         f"{args.plant_damping_tangent} without --plant-damping")
     if args.plant_tendons is not None and "mtc" not in fe:
         raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "
                          f"law only (EA fixed, k = EA / r); expected no --plant-tendons with "

@@ -253,6 +253,11 @@ class FEStatePlant:
         FE state x under the commanded rest lengths u (:func:`tension_demand`)."""
         return tension_demand(self.com, self.estimator.bar_coordinates(x), u)
 
+    def sample(self, x, u) -> None:
+        """The FE plant's per-sample hook (:meth:`tmfem.models.fe_plant.FEPlant.sample`) at
+        the sampled state x under the model input u (:meth:`actuate`'s)."""
+        self.dyn.sample(x, u)
+
     def residual(self, x, v, a, t, u=None):
         return self.dyn.residual(x, v, a, t, u)
 
@@ -384,9 +389,24 @@ def start_rest_lengths(initial, tendon_law: str, nominal) -> np.ndarray:
     return L - T * np.asarray(nominal, dtype=float) / EA
 
 
+#: the damping tangent of a damped deployment plant when none is given (docs/fe-plant.md,
+#: "Plant damping along the path")
+DEPLOYMENT_DAMPING_TANGENT = "current"
+
+
+def deployment_damping_tangent(damping_tangent, beta: float):
+    """The damping tangent of a deployment plant: the given one, else
+    :data:`DEPLOYMENT_DAMPING_TANGENT` where there is stiffness-proportional damping (beta >
+    0; none without it, :func:`tmfem.models.fe_plant.check_damping_tangent`)."""
+    if damping_tangent is None and beta:
+        return DEPLOYMENT_DAMPING_TANGENT
+    return damping_tangent
+
+
 def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
                          tendon_law: str = "cable", beta: float = 0.0,
-                         actuation: str = "rest-length") -> FEStatePlant:
+                         actuation: str = "rest-length",
+                         damping_tangent: str | None = None) -> FEStatePlant:
     """The MTC model of the COM's system (its rest lengths, N x mesh_n x mesh_n membrane,
     ``tendon_elements`` trusses per tendon, the tendon law of :class:`MTCModel`) as the plant
     of a deployment, its sensors at the COM's output points.
@@ -397,12 +417,15 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     axial strain, the membrane and tendons their FE shapes -- so that the run starts without
     the transient of an FE state out of equilibrium. ``beta``: stiffness-proportional
     Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe_plant.FEPlant`);
+    ``damping_tangent``: K_0 (``"initial"``) or the tangent at every sample (``"current"``,
+    C_n = beta K_T(x_n)), default :data:`DEPLOYMENT_DAMPING_TANGENT`, only with beta > 0;
     ``actuation``: rest-length or tension-servoed tendons (:class:`FEStatePlant`)."""
     from tmfem.models.mtc.dynamics import MTCDynamics
     from tmfem.models.mtc.model import MTCModel
     fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                   rest_lengths=com.u0, tendon_law=tendon_law)
-    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points, beta=beta)
+    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points, beta=beta,
+                      damping_tangent=deployment_damping_tangent(damping_tangent, beta))
     fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
     st = fe.solve_static(x0=com_positions(com, fe, packaged_state(com, initial)))
     fe.set_tendon_lengths(com.u0)
@@ -411,7 +434,8 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
 
 def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
                          bar_elements: int = 1, bars: str = "rigid",
-                         beta: float = 0.0, actuation: str = "rest-length") -> FEStatePlant:
+                         beta: float = 0.0, actuation: str = "rest-length",
+                         damping_tangent: str | None = None) -> FEStatePlant:
     """The SBC model of the COM's system (MITC4 shell membrane, four-node beam bars -- with
     H_1j a node of the bar for a 1-N(D) system --, tension-only tendons of the cable law
     k = EA / r, its sensors at the COM's output points) as the plant of a deployment.
@@ -429,8 +453,10 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     :class:`COMStateEstimator`); ``beta``: stiffness-proportional
     Rayleigh damping C = beta K_0 (K_0 at that equilibrium; docs/fe-plant.md: without it the
     undamped SBC plant's Park integration diverges during the 1-4(D) deployment even under
-    the COM run's smooth rest lengths); ``actuation``: rest-length or tension-servoed tendons
-    (:class:`FEStatePlant`)."""
+    the COM run's smooth rest lengths); ``damping_tangent``: K_0 (``"initial"``) or the
+    tangent at every sample (``"current"``, C_n = beta K_T(x_n), which does not damp the bars'
+    rigid rotation), default :data:`DEPLOYMENT_DAMPING_TANGENT`, only with beta > 0;
+    ``actuation``: rest-length or tension-servoed tendons (:class:`FEStatePlant`)."""
     from tmfem.models.sbc.dynamics import SBCDynamics
     from tmfem.models.sbc.model import SBCModel
     sbc = SBCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
@@ -440,7 +466,8 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     pre = mtc.solve_static(x0=com_positions(com, mtc, packaged_state(com, initial)))
     st = sbc.solve_static(start=sbc.state_from_mtc(pre.x))
     sbc.set_tendon_lengths(com.u0)
-    dyn = SBCDynamics(sbc, st.state, output_points=com.output_points, beta=beta)
+    dyn = SBCDynamics(sbc, st.state, output_points=com.output_points, beta=beta,
+                      damping_tangent=deployment_damping_tangent(damping_tangent, beta))
     return FEStatePlant(dyn, com, bars=bars, actuation=actuation)
 
 
@@ -450,13 +477,15 @@ PLANTS = ("com", "mtc", "sbc")
 
 def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
                      tendon_law: str | None = None, bars: str | None = None, beta: float = 0.0,
-                     actuation: str = "rest-length"):
+                     actuation: str = "rest-length", damping_tangent: str | None = None):
     """The plant ``kind`` of a deployment of the COM's system from the packaged design
     ``initial``: None for ``"com"`` (:func:`tmfem.control.deploy.run_deployment` builds the
     COM plant), :func:`mtc_deployment_plant` (``tendon_law`` default ``"cable"``) or
     :func:`sbc_deployment_plant` (the SBC model has the cable law only: ``"fixed-rate"`` is
     refused; ``bars``: its bar measurement, default ``"rigid"``, refused on the other plants);
-    ``beta``: the FE plant's Rayleigh damping C = beta K_0 (refused for the COM);
+    ``beta``: the FE plant's Rayleigh damping C = beta K_0 (refused for the COM) and
+    ``damping_tangent`` its tangent (:func:`sbc_deployment_plant`; refused for the COM and
+    without beta);
     ``actuation``: the FE plant's tendon actuators (:class:`FEStatePlant`; ``"force"`` refused
     for the COM, the design model whose tendons the force actuator imitates)."""
     if kind not in PLANTS:
@@ -467,6 +496,9 @@ def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
     if beta and kind == "com":
         raise InputError(f"plant damping beta = {beta}: expected an FE plant (mtc, sbc), found "
                          "the COM plant (its damping is the design model's)")
+    if damping_tangent is not None and kind == "com":
+        raise InputError(f"plant damping tangent {damping_tangent!r}: expected an FE plant (mtc, "
+                         "sbc), found the COM plant (it has no FE damping)")
     if actuation not in ACTUATIONS:
         raise InputError(f"plant actuation: expected one of {ACTUATIONS}, found {actuation!r}")
     if actuation != "rest-length" and kind == "com":
@@ -480,6 +512,6 @@ def deployment_plant(kind: str, com, initial, *, mesh_n: int = 10,
             raise InputError(f"SBC plant tendons: the SBC model has the cable law only (EA fixed, "
                              f"k = EA / r); expected 'cable', found {tendon_law!r}")
         return sbc_deployment_plant(com, initial, mesh_n=mesh_n, bars=bars or "rigid", beta=beta,
-                                    actuation=actuation)
+                                    actuation=actuation, damping_tangent=damping_tangent)
     return mtc_deployment_plant(com, initial, mesh_n=mesh_n, tendon_law=tendon_law or "cable",
-                                beta=beta, actuation=actuation)
+                                beta=beta, actuation=actuation, damping_tangent=damping_tangent)

@@ -6,7 +6,12 @@ integrated in time with Park's method (eqs. 5.34-5.35) as the plant
     r(u, v, a; rest) = M a + C v + f_int(u; rest) = 0,      C = alpha M + beta K_0,
 
 on their free reduced dofs u, with the tendon rest lengths as inputs (eq. 5.19), the constant
-mass at the equilibrium, K_0 the tangent there and f_int the model's internal force. What a
+mass at the equilibrium, K_0 the tangent there and f_int the model's internal force. With
+``damping_tangent="current"`` the stiffness-proportional part takes the tangent of the
+sampled state instead, C_n = alpha M + beta K_T(x_n), held over the step from t_n
+(:meth:`FEPlant.sample`; tangent-stiffness-proportional Rayleigh damping): K_0's axial bar
+stiffness along the equilibrium's bar axes damps a bar's rigid rotation away from them, K_T's
+does not (docs/fe-plant.md, "Plant damping along the path"). What a
 state u *is* differs -- the MTC model's independent node positions, the SBC model's
 translations and rotation vectors counted from the equilibrium -- and each model's plant says
 so through three hooks (:meth:`FEPlant.configuration`, :meth:`FEPlant.positions`,
@@ -37,6 +42,26 @@ from tmfem.models.mtc.post import q_from_positions
 from tmfem.models.mtc.topology import to_floating
 
 
+#: where the stiffness-proportional damping beta K takes its tangent (module docstring)
+DAMPING_TANGENTS = ("initial", "current")
+
+
+def check_damping_tangent(damping_tangent, beta: float) -> str:
+    """The damping tangent of an FE plant of stiffness-proportional damping ``beta``: the
+    given one of :data:`DAMPING_TANGENTS` (refused without that damping, beta = 0, where the
+    tangent does not enter C), default ``"initial"`` (C = alpha M + beta K_0)."""
+    if damping_tangent is None:
+        return "initial"
+    if damping_tangent not in DAMPING_TANGENTS:
+        raise InputError(f"damping tangent: expected one of {DAMPING_TANGENTS}, found "
+                         f"{damping_tangent!r}")
+    if not beta:
+        raise InputError(f"damping tangent {damping_tangent!r}: expected stiffness-proportional "
+                         f"damping beta > 0 (the tangent enters C through beta K only), found "
+                         f"beta = {beta}")
+    return damping_tangent
+
+
 class FEPlant(ABC):
     """Shared part of the finite-element plants (module docstring); a
     :class:`tmfem.models.base.Plant`.
@@ -57,15 +82,18 @@ class FEPlant(ABC):
     constraints = None
     free = None
 
-    def _setup(self, M, *, alpha: float, beta: float, perturb, output_points) -> None:
-        """Mass ``M`` (reduced), K_0, damping, monitored points, names and the start state."""
+    def _setup(self, M, *, alpha: float, beta: float, perturb, output_points,
+               damping_tangent: str | None = None) -> None:
+        """Mass ``M`` (reduced), K_0, damping (``damping_tangent``:
+        :func:`check_damping_tangent`), monitored points, names and the start state."""
         if not (np.isfinite(alpha) and np.isfinite(beta) and alpha >= 0 and beta >= 0):
             raise InputError(f"Rayleigh damping: expected alpha, beta >= 0, found {alpha}, {beta}")
+        self.damping_tangent = check_damping_tangent(damping_tangent, beta)
         f = self.free
         self.M = M[f][:, f].tocsc()
         self.K0 = self._tangent(self.state0())
         self.alpha, self.beta = float(alpha), float(beta)
-        self.C = (self.alpha * self.M + self.beta * self.K0).tocsc() if (alpha or beta) else None
+        self.C = self.damping_matrix(self.K0) if (alpha or beta) else None
         system = self.model.system
         pts = system.monitor_points.T if output_points is None else np.reshape(output_points, (-1, 2))
         self.output_points = [tuple(map(float, p)) for p in pts]
@@ -131,6 +159,19 @@ class FEPlant(ABC):
         """Tangent K_T (eqs. 4.4-4.6) on the free dofs at the free-dof state x."""
         _, K = self.model.residual(self.configuration(x))
         return K[self.free][:, self.free].tocsc()
+
+    def damping_matrix(self, K):
+        """Rayleigh damping C = alpha M + beta K of the tangent K (K_0, or K_T(x_n))."""
+        return (self.alpha * self.M + self.beta * K).tocsc()
+
+    def sample(self, x, u=None) -> None:
+        """The driver's hook at every sample (:func:`tmfem.simulation.driver.simulate`): with
+        ``damping_tangent="current"`` C_n = alpha M + beta K_T(x_n; u) at the sampled state
+        x_n under the input u held over the step, kept until the next sample (dr/dv = C_n
+        stays exact in Park's Newton); with ``"initial"`` nothing (C = alpha M + beta K_0)."""
+        if self.damping_tangent == "current":
+            self._inputs(u)
+            self.C = self.damping_matrix(self._tangent(x))
 
     def jacobians(self, x, v, a, t, u=None):
         """(dr/dx, dr/dv, dr/da) = (K_T, C, M)."""

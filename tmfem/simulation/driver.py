@@ -10,7 +10,9 @@ the inputs u from a controller sampled every step (zero-order hold, see
 and the plant stepped from t_n to t_n+1 with u_n held -- or, for a plant with actuators
 (``plant.actuate(x, u)``), with the input its model receives for the command u_n at the
 sampled state x_n held (a tension-servoed tendon, :mod:`tmfem.control.tension_actuation`;
-the record keeps the commanded u_n). Any model's plant serves: the
+the record keeps the commanded u_n); a plant with a per-sample hook (``plant.sample(x, u)``)
+is told the sampled state x_n and that held input before the step (an FE plant's damping on
+the current tangent, :meth:`tmfem.models.fe_plant.FEPlant.sample`). Any model's plant serves: the
 control-oriented model (eq. 5.27) and the finite-element models (M a + C v + f_int(x; u) with
 the tendon rest lengths u as inputs).
 """
@@ -85,7 +87,8 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
     plant : tmfem.models.base.Plant
         ``residual``, ``jacobians`` (and optionally ``newton_matrix``, ``factorize``),
         ``outputs``, ``x0``, ``v0``, ``u0``, ``input_names``, ``output_names``; optionally
-        ``actuate(x, u)``, the model input realising the command u at the sampled state x
+        ``actuate(x, u)``, the model input realising the command u at the sampled state x,
+        and ``sample(x, u)``, called with the sampled state and the input held over the step
         (module docstring).
     t_end, dt : float
         Duration and step (7.4: dt = 0.01 s).
@@ -122,6 +125,7 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
     v0 = np.asarray(plant.v0 if v0 is None else v0, dtype=float)
     nu = len(plant.input_names)
     actuate = getattr(plant, "actuate", None)
+    sample = getattr(plant, "sample", None)
     measure = outputs or getattr(ctrl, "reads_outputs", True)
     y0 = np.asarray(plant.outputs(x0, v0, loop.u), dtype=float) if measure else None
     xc = ctrl.reset(0.0, y0, dt)
@@ -136,6 +140,8 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
                              f"found {u}")
         state["xc"] = ctrl.update(t, y, state["xc"])
         loop.u = u if actuate is None else np.asarray(actuate(x, u), dtype=float)
+        if sample is not None:
+            sample(x, loop.u)
         T.append(t); U.append(u); C.append(ctrl.name)
         if outputs:
             Y.append(y)

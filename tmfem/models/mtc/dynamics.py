@@ -61,6 +61,9 @@ class MTCDynamics(FEPlant):
         The static equilibrium (``model.solve_static().x``); the fixed DOFs stay there.
     alpha, beta : float
         Rayleigh damping C = alpha M + beta K_0 [1/s, s] (default: undamped).
+    damping_tangent : {"initial", "current"}, optional
+        The tangent of beta K: K_0 at x_eq (default) or K_T at every sampled state
+        (:meth:`tmfem.models.fe_plant.FEPlant.sample`); only with beta > 0.
     perturb : dict, optional
         Initial perturbation by coordinate name (``theta_12_dot=0.01``).
     output_points : array (2, n) or list of (x_f, y_f), optional
@@ -70,13 +73,14 @@ class MTCDynamics(FEPlant):
     name = "mtc"
 
     def __init__(self, model, x_eq, *, alpha: float = 0.0, beta: float = 0.0,
-                 perturb: dict | None = None, output_points=None):
+                 perturb: dict | None = None, output_points=None,
+                 damping_tangent: str | None = None):
         self.model = self.mtc = model
         self.dofmap, self.constraints = model.topology.dofmap, model.topology.constraints
         self.free = model.free
         self.xr_eq = model.reduce(np.asarray(x_eq, dtype=float))
         self._setup(model.mass(), alpha=alpha, beta=beta, perturb=perturb,
-                    output_points=output_points)
+                    output_points=output_points, damping_tangent=damping_tangent)
 
     def state0(self) -> np.ndarray:
         """The equilibrium as a free-DOF state."""

@@ -57,8 +57,8 @@ class SBCDynamics(FEPlant):
     model : SBCModel
     state_eq : State
         The static equilibrium (``model.solve_static().state``).
-    alpha, beta, perturb, output_points :
-        Rayleigh damping, initial perturbation and monitored points, as for
+    alpha, beta, perturb, output_points, damping_tangent :
+        Rayleigh damping (and its tangent), initial perturbation and monitored points, as for
         :class:`tmfem.models.mtc.dynamics.MTCDynamics`.
     """
 
@@ -68,7 +68,8 @@ class SBCDynamics(FEPlant):
     predictor = "velocity"
 
     def __init__(self, model, state_eq, *, alpha: float = 0.0, beta: float = 0.0,
-                 perturb: dict | None = None, output_points=None):
+                 perturb: dict | None = None, output_points=None,
+                 damping_tangent: str | None = None):
         self.model, self.mtc = model, model.mtc
         self.dofmap, self.constraints = model.dofmap, model.constraints
         self.free = model.free
@@ -76,7 +77,7 @@ class SBCDynamics(FEPlant):
         self._n_mtc = model.numbering.n_mtc_nodes
         self._tr = self.dofmap.translation_dofs(np.arange(self._n_mtc))       # (n, 3)
         self._setup(model.mass(state_eq), alpha=alpha, beta=beta, perturb=perturb,
-                    output_points=output_points)
+                    output_points=output_points, damping_tangent=damping_tangent)
 
     def state0(self) -> np.ndarray:
         """The equilibrium: zero increments."""
