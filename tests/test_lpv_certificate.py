@@ -164,6 +164,8 @@ def test_refinement_makes_a_design_grid_certificate_hold_on_the_finer_grid(nonli
     ref = r.refinement
     assert ref["passed"] and ref["stopped"] == "passed" and ref["points_added"] == 1
     assert ref["rounds"][0]["added_at"] == [[1.0]] and ref["rounds"][0]["failing"] == 3
+    # the re-solve started where the cut fails (scaled eigenvalue > 0) and ended below -margin
+    assert ref["rounds"][0]["start_scaled_eig"] > 0 > -1e-8 > ref["rounds"][0]["largest_scaled_eig"]
     assert r.gamma == c.gamma and r.lower_bound == c.lower_bound
     after, minX = largest_brl(r.lyapunov, r.gamma, d, fine)
     assert after < 0 and minX > 0
