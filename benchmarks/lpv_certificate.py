@@ -3,7 +3,7 @@ docs/lpv.md, output feedback) for a saved state-feedback design.
 
 Run: .venv/bin/python benchmarks/lpv_certificate.py --design F.npz [--budget 900] [--rtol 0.05]
          [--upper G] [--fine] [--cache DIR] [--save-certificate X.npz | --certificate X.npz]
-         [--refine [--per-round 4] [--rounds 8] [--refine-budget 1200] [--refine-gamma G]
+         [--refine [--per-round 4] [--rounds 8] [--refine-budget 1200] [--refine-gamma G] [--refine-max-iter 150]
          [--save-refined Y.npz]]
 
 Builds the design plant on the design's grid (COM linearisations at the symmetric equilibria
@@ -15,7 +15,8 @@ verify_output_feedback. --cache keeps the plants as pickles. --save-certificate 
 certificate's X(rho) (LPVStateFeedback.save, no gain rows), --certificate reads one instead of
 solving. --refine (implies --fine): the cutting-plane refinement of refine_certificate on the 4x
 finer grid (the worst --per-round failing points per round, at most --rounds re-solves within
---refine-budget s, at the certificate's gamma or --refine-gamma), then the re-check; --save-refined
+--refine-budget s, at the certificate's gamma or --refine-gamma, --refine-max-iter L-BFGS iterations per smoothing
+stage), then the re-check; --save-refined
 writes the refined X(rho). Prints one JSON object (times wall and CPU).
 """
 import argparse
@@ -63,10 +64,12 @@ def main():
     ap.add_argument("--refine-budget", type=float, default=1200.0)
     ap.add_argument("--save-refined", default=None)
     ap.add_argument("--refine-gamma", type=float, default=None)
+    ap.add_argument("--refine-max-iter", type=int, default=150)
     a = ap.parse_args()
     if (a.per_round != 4 or a.rounds != 8 or a.refine_budget != 1200.0 or a.save_refined
-            or a.refine_gamma is not None) and not a.refine:
-        ap.error("--per-round, --rounds, --refine-budget, --refine-gamma and --save-refined apply with --refine only")
+            or a.refine_gamma is not None or a.refine_max_iter != 150) and not a.refine:
+        ap.error("--per-round, --rounds, --refine-budget, --refine-gamma, --refine-max-iter and --save-refined "
+                 "apply with --refine only")
     if a.certificate and (a.save_certificate or a.upper is not None):
         ap.error("--certificate reads a saved X(rho): --save-certificate and --upper do not apply")
     logging.basicConfig(level=logging.WARNING, format="%(asctime)s %(name)s: %(message)s")
@@ -98,7 +101,7 @@ def main():
         out["fine_plant_s"] = time.perf_counter() - t
         if a.refine:
             c = refine_certificate(c, of, fine, W_e=0.5, W_u=0.05, per_round=a.per_round, max_rounds=a.rounds,
-                                   time_budget=a.refine_budget, gamma=a.refine_gamma)
+                                   time_budget=a.refine_budget, gamma=a.refine_gamma, max_iter=a.refine_max_iter)
             if a.save_refined:
                 c.lyapunov.save(a.save_refined)
             out.update({k: val for k, val in c.to_dict().items() if k.startswith("rate_bounded_refinement")})
