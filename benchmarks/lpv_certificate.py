@@ -104,7 +104,8 @@ def main():
                                    time_budget=a.refine_budget, gamma=a.refine_gamma, max_iter=a.refine_max_iter)
             if a.save_refined:
                 c.lyapunov.save(a.save_refined)
-            out.update({k: val for k, val in c.to_dict().items() if k.startswith("rate_bounded_refinement")})
+            # the refined certificate's keys (its gamma, --refine-gamma) replace the design grid's
+            out.update(c.to_dict(), rate_bounded_design_grid_gamma=out["rate_bounded_gamma"])
         t = time.perf_counter()
         v = verify_output_feedback(of, fine, W_e=0.5, W_u=0.05, dt=0.01, certificate=c, allow_failure=True)
         out.update({k: val for k, val in v.to_dict().items() if k not in out}, fine_s=time.perf_counter() - t)
