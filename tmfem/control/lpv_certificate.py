@@ -262,16 +262,16 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
     largest |entry| in the original coordinates) is not a small violation: for the 2-3 loop,
     +1.4e-5 there is +1.1 in EIGOPT's scaled, balanced coordinates (docs/lpv.md), so the
     smoothing schedule ``t_schedule`` is the bisection's (1e-2, 1e-3, 1e-4), and each round
-    reports the start's largest scaled eigenvalue (``start_scaled_eig``). Ends when the fine grid passes
-    (``refinement["passed"]``), after ``max_rounds`` re-solves, when ``time_budget`` seconds are
-    spent, or when a re-solve finds no point (reported, not a proof: EIGOPT is local).
+    reports the start's largest scaled eigenvalue (``start_scaled_eig``). Ends when the fine grid
+    passes (``refinement["passed"]``), after ``max_rounds`` re-solves, when ``time_budget`` seconds
+    are spent, or when a re-solve finds no point (reported, not a proof: EIGOPT is local).
 
     ``fine`` must contain the design grid (e.g. ``plant.resampled(plant.refined(4))`` or the
     COM linearisations on ``plant.refined(4)``): the imposed points are points of ``fine``.
     ``gamma``: the level of the re-check and the re-solves (default the certificate's; a level
     above it relaxes the w and p blocks, not the Lyapunov block A X + X A^T - dX/dt, which any
-    level needs negative). Returns a new certificate (gamma that level): X(rho) the last one found (the input's when no round found one),
-    ``refinement`` the rounds (points added, largest fine-grid eigenvalue before each round,
+    level needs negative). Returns a new certificate (gamma that level): X(rho) the last one
+    found (the input's when no round found one), ``refinement`` the rounds (points added, largest fine-grid eigenvalue before each round,
     evaluations, times) and ``passed``.
 
     Raises
