@@ -164,6 +164,8 @@ def test_refinement_makes_a_design_grid_certificate_hold_on_the_finer_grid(nonli
     ref = r.refinement
     assert ref["passed"] and ref["stopped"] == "passed" and ref["points_added"] == 1
     assert ref["rounds"][0]["added_at"] == [[1.0]] and ref["rounds"][0]["failing"] == 3
+    # the re-solve started where the cut fails (scaled eigenvalue > 0) and ended below -margin
+    assert ref["rounds"][0]["start_scaled_eig"] > 0 > -1e-8 > ref["rounds"][0]["largest_scaled_eig"]
     assert r.gamma == c.gamma and r.lower_bound == c.lower_bound
     after, minX = largest_brl(r.lyapunov, r.gamma, d, fine)
     assert after < 0 and minX > 0
@@ -189,6 +191,12 @@ def test_refinement_budgets_and_refusals(nonlinear):
         refine_certificate(c, d, nonlinear_oscillator(np.linspace(0, 1.9, 5)), W_e=W_E, W_u=W_U)
     with pytest.raises(InputError, match="per_round"):
         refine_certificate(c, d, fine, W_e=W_E, W_u=W_U, per_round=0)
+    with pytest.raises(InputError, match="level gamma >="):
+        refine_certificate(c, d, fine, W_e=W_E, W_u=W_U, gamma=0.9 * c.gamma)
+    # at a higher level the result is certified there (the LMI assembled in the test, at that gamma)
+    r = refine_certificate(c, d, fine, W_e=W_E, W_u=W_U, per_round=1, gamma=1.2 * c.gamma)
+    assert r.refinement["passed"] and r.gamma == pytest.approx(1.2 * c.gamma) == r.lyapunov.gamma
+    assert largest_brl(r.lyapunov, r.gamma, d, fine)[0] < 0
     none = rate_bounded_certificate(d, pl, W_e=W_E, W_u=W_U, time_budget=1e-9)
     with pytest.raises(InputError, match="found none"):
         refine_certificate(none, d, fine, W_e=W_E, W_u=W_U)

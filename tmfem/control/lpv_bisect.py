@@ -222,9 +222,7 @@ def _lowest_free_level(e: EigOpt, z, lo: float, hi: float, *, margin: float, rto
     LMIs of eq. 5.95 decrease with gamma (-gamma I blocks), so the sign test is monotone. ``hi``
     when ``z`` fails there too."""
     def holds(g):
-        scale = tuple(None if X is None else np.maximum(np.abs(X).max(axis=(-2, -1)), 1e-300)
-                      for X in e.matrices(z, g))
-        return e.largest(z, g, scale) < -margin
+        return e.largest(z, g) < -margin
     if not holds(hi):
         return hi
     a, b = lo, hi

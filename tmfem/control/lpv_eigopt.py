@@ -202,9 +202,21 @@ class EigOpt:
         D[:, n:, :n] = Phi.transpose(0, 2, 1)
         return M, -Pr, D
 
-    def largest(self, z, gamma, scale) -> float:
+    def scales(self, z, gamma, matrices=None) -> tuple:
+        """Each matrix's scale at ``z`` (its largest |entry|; None for an absent block): the
+        divisors s_iv of the scaled eigenvalues (module docstring), fixed for a level.
+        ``matrices``: those of :meth:`matrices` at (z, gamma) when already computed."""
+        return tuple(None if X is None else np.maximum(np.abs(X).max(axis=(-2, -1)), 1e-300)
+                     for X in (self.matrices(z, gamma) if matrices is None else matrices))
+
+    def largest(self, z, gamma, scale=None) -> float:
+        """The largest scaled eigenvalue over every LMI at ``z`` (``scale``: default
+        :meth:`scales` at ``z`` itself)."""
+        Ms = self.matrices(z, gamma)
+        if scale is None:
+            scale = self.scales(z, gamma, Ms)
         return float(max(np.linalg.eigvalsh(X / s[..., None, None])[..., -1].max()
-                         for X, s in zip(self.matrices(z, gamma), scale) if X is not None))
+                         for X, s in zip(Ms, scale) if X is not None))
 
     def _fg(self, z, t, gamma, scale, margin, deadline, found):
         self.evaluations += 1
@@ -250,8 +262,7 @@ class EigOpt:
         "time" (``deadline``, a ``time.perf_counter`` value, passed) or "done" (the schedule
         ran out; the eigenvalue says whether the point is feasible)."""
         t0 = time.perf_counter()
-        scale = tuple(None if X is None else np.maximum(np.abs(X).max(axis=(-2, -1)), 1e-300)
-                      for X in self.matrices(z, gamma))
+        scale = self.scales(z, gamma)
         worst = self.largest(z, gamma, scale)
         log.info("LPV eigenvalue optimisation at gamma = %.5g: start, largest scaled eigenvalue %.3e",
                  gamma, worst)
