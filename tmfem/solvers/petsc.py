@@ -12,10 +12,10 @@ Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py
     The generalised Hermitian problem K v = w M v (eq. 5.32) by shift-and-invert about
     ``sigma`` (the factorisation of K - sigma M by the same MUMPS Cholesky): on one rank
     the block Krylov-Schur of :mod:`tmfem.solvers.block_krylov` (MUMPS solves of 8
-    right-hand sides at once), under ``mpiexec -n P > 1`` the same on every rank's own
-    sequential factors with each block's columns split over the ranks
-    (:mod:`tmfem.solvers.petsc_redundant`), or SLEPc EPS Krylov-Schur when those do not fit
-    (``eig_solver``); the k eigenvalues nearest to sigma, vectors M-orthonormal (the
+    right-hand sides at once), under ``mpiexec -n P > 1`` SLEPc EPS Krylov-Schur, or on
+    request the block method on every rank's own sequential factors with each block's
+    columns split over the ranks (:mod:`tmfem.solvers.petsc_redundant`; ``eig_solver``);
+    the k eigenvalues nearest to sigma, vectors M-orthonormal (the
     B-inner product, then a Rayleigh-Ritz step in their span, so that repeated eigenvalues
     come out as full M-orthonormal pairs).
 
@@ -163,18 +163,19 @@ class PetscBackend:
         (on one rank it is ``"block"``); refused (:class:`~tmfem.errors.ResourceLimit`) when MUMPS
         estimates more than ``eig_memory_mb`` per rank; ``"slepc"``: SLEPc's Krylov-Schur
         (one parallel solve per vector), which reads the ``eps_`` options (refused with
-        the block solvers); ``"auto"`` (default): ``"block"`` on one rank, ``"redundant"``
-        under ``mpiexec -n P > 1`` and SLEPc when the redundant factors do not fit (PETSc
-        3.18's parallel MUMPS solve of several right-hand sides costs as much per column
-        as single solves: 36 ms per column in blocks of 8 against 67 ms per single solve
-        at 78k DOF, where the block method needs ~2.3x the columns), SLEPc when ``eps_``
-        options are given. Problems of fewer than :data:`EIG_BLOCK_MIN_N` unknowns always
+        the block solvers); ``"auto"`` (default): ``"block"`` on one rank, SLEPc under
+        ``mpiexec -n P > 1`` or when ``eps_`` options are given (PETSc 3.18's parallel MUMPS
+        solve of several right-hand sides costs as much per column as single solves: 36 ms
+        per column in blocks of 8 against 67 ms per single solve at 78k DOF, where the block
+        method needs ~2.3x the columns; ``"redundant"`` is as fast as SLEPc at 78k DOF and
+        27 % slower at 309k DOF on 2 idle cores, faster only on oversubscribed ones:
+        docs/backends.md). Problems of fewer than :data:`EIG_BLOCK_MIN_N` unknowns always
         go to SLEPc.
     eig_memory_mb : int, optional
         Memory per rank for the redundant factorisation (MUMPS ICNTL(23), checked by MUMPS
         against its estimate before it allocates the factors); default
         :data:`tmfem.solvers.petsc_redundant.MEMORY_SHARE` of the node's available memory
-        shared by its ranks. Only with ``eig_solver`` "auto" or "redundant".
+        shared by its ranks. Only with ``eig_solver`` "redundant".
     """
 
     name = "petsc"
@@ -205,17 +206,15 @@ class PetscBackend:
             raise InputError(f"backend 'petsc': the options {', '.join('-' + k for k in eps)} are "
                              f"SLEPc's: expected eig_solver='slepc' with them, found {eig_solver!r}")
         if eig_memory_mb is not None:
-            if eig_solver not in ("auto", "redundant"):
+            if eig_solver != "redundant":
                 raise InputError(f"backend 'petsc': eig_memory_mb applies to the redundant eigen "
-                                 f"solve (eig_solver 'auto' or 'redundant'), found {eig_solver!r}")
+                                 f"solve (eig_solver 'redundant'), found {eig_solver!r}")
             if int(eig_memory_mb) < 1:
                 raise InputError(f"backend 'petsc': expected eig_memory_mb >= 1, found {eig_memory_mb}")
         self.eig_memory_mb = None if eig_memory_mb is None else int(eig_memory_mb)
-        #: SLEPc when the redundant factors do not fit ("auto"), else the refusal
-        self._eig_fallback = eig_solver == "auto"
         parallel = self.PETSc.COMM_WORLD.size > 1
         if eig_solver == "auto":
-            eig_solver = "slepc" if eps else ("redundant" if parallel else "block")
+            eig_solver = "slepc" if eps or parallel else "block"
         elif eig_solver == "redundant" and not parallel:
             eig_solver = "block"
         self.eig_solver = eig_solver
@@ -556,13 +555,11 @@ class PetscBackend:
                                          redundant=self.eig_solver == "redundant")
                 self.last_eig_solver = self.eig_solver
             except RedundantDoesNotFit as exc:
-                if not self._eig_fallback:
-                    raise ResourceLimit(f"eigen (petsc, eig_solver='redundant'): expected every "
-                                        f"rank's factors of K - sigma M within {exc.budget_mb} MB "
-                                        f"(eig_memory_mb), found MUMPS' estimate {exc.estimate_mb} "
-                                        "MB per rank; use a larger eig_memory_mb, or eig_solver "
-                                        "'slepc' or 'block' (the distributed factors)") from None
-                log.info("eigen (petsc): %s; SLEPc on the distributed factors instead", exc)
+                raise ResourceLimit(f"eigen (petsc, eig_solver='redundant'): expected every "
+                                    f"rank's factors of K - sigma M within {exc.budget_mb} MB "
+                                    f"(eig_memory_mb), found MUMPS' estimate {exc.estimate_mb} "
+                                    "MB per rank; use a larger eig_memory_mb, or eig_solver "
+                                    "'slepc' or 'block' (the distributed factors)") from None
         if w is None:
             w, V = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym, reuse)
         order = np.argsort(np.abs(w - sigma), kind="stable")[:k]
