@@ -604,3 +604,50 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
         assert sym.getPerfInfo()["count"] - s0 == analyses
         assert num.getPerfInfo()["count"] - n0 == 1
         assert np.allclose(modes.omega2, ref.omega2, rtol=2e-8, atol=0)
+
+
+def _modal_cli(*argv):
+    p = subprocess.run([sys.executable, "-m", "tmfem", "modal", *argv], capture_output=True,
+                       text=True, cwd=ROOT)
+    return p
+
+
+def test_cli_eig_solver_refused_without_the_petsc_backend():
+    # --eig-solver chooses the PETSc backend's eigen solver: with scipy (the default) and
+    # with the control-oriented model (no backend) it is refused before any work
+    for extra in ([], ["--backend", "scipy"], ["--model", "com"]):
+        p = _modal_cli("--preset", "2-3", "--mesh", "4", "--modes", "4", "--eig-solver", "slepc",
+                       *extra)
+        assert p.returncode == 2, p.stderr
+        assert "--eig-solver slepc: option does not apply" in p.stderr
+        assert "expected --backend petsc, found --backend scipy" in p.stderr
+
+
+@needs_petsc
+def test_cli_eig_solver_chooses_the_solver_and_agrees_with_scipy():
+    # source: the same command with scipy (ARPACK shift-invert on the scipy matrices):
+    # frequencies to 1e-8; the JSON names the solver that ran (4x12x12: 2 000 free dofs,
+    # above the block solver's minimum size)
+    argv = ["--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
+    ref = json.loads(_modal_cli(*argv).stdout)
+    assert "eig_solver" not in ref
+    for solver, ran in (("slepc", "slepc"), ("block", "block"), ("auto", "block")):
+        p = _modal_cli(*argv, "--backend", "petsc", "--eig-solver", solver)
+        assert p.returncode == 0, p.stderr
+        d = json.loads(p.stdout)
+        assert d["eig_solver"] == ran
+        assert np.allclose(d["freq_hz"], ref["freq_hz"], rtol=1e-8, atol=0)
+
+
+@needs_mpi
+def test_cli_eig_solver_redundant_under_two_ranks():
+    # source: the 1-process scipy command (frequencies to 1e-8); under 2 ranks "redundant" runs
+    # (every rank factorises the whole K - sigma M) where "auto" would take SLEPc
+    argv = ["modal", "--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
+    ref = json.loads(_modal_cli(*argv[1:]).stdout)
+    tmfem = [sys.executable, "-m", "tmfem"]
+    p = _mpirun(2, *argv, "--backend", "petsc", "--eig-solver", "redundant", program=tmfem)
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["eig_solver"] == "redundant"
+    assert np.allclose(d["freq_hz"], ref["freq_hz"], rtol=1e-8, atol=0)

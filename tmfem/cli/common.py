@@ -75,6 +75,11 @@ def model_options_from_args(args, command: str):
         raise InputError(f"{command} --model {args.model}: option does not apply: --backend "
                          f"(the {args.model} model solves small dense systems; --backend is for "
                          "the finite-element models)")
+    eig_solver = getattr(args, "eig_solver", None)
+    if eig_solver is not None and args.backend != "petsc":
+        raise InputError(f"{command} --eig-solver {eig_solver}: option does not apply: it chooses "
+                         "the PETSc backend's eigen solver: expected --backend petsc, found "
+                         f"--backend {args.backend or 'scipy'}")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
         check_model_budget(system, mesh=options["mesh"],
@@ -107,12 +112,22 @@ def check_outputs(args, command: str) -> None:
             output_file(path, option="--" + dest.replace("_", "-"), suffixes=suffixes)
 
 
+def backend_from_args(args):
+    """The backend of ``--backend`` (default scipy), with the PETSc eigen solver of
+    ``--eig-solver`` where the command has that option (refused without ``--backend petsc``)."""
+    from tmfem.solvers.backends import get_backend
+    eig_solver = getattr(args, "eig_solver", None)
+    if eig_solver is None:
+        return args.backend or "scipy"
+    return get_backend("petsc", eig_solver=eig_solver)
+
+
 def model_from_args(args, command: str):
     """(model, options): the model chosen by ``--model``, built from the system and its
     options (:func:`model_options_from_args`)."""
     from tmfem.models.base import get_spec
     system, options = model_options_from_args(args, command)
-    model = get_spec(args.model).build(system, options, args.backend or "scipy")
+    model = get_spec(args.model).build(system, options, backend_from_args(args))
     rest = getattr(model, "rest_lengths", None)
     if rest is not None and np.ndim(rest) == 1 and len(rest) == len(system.tendons):
         warn_long_rest_lengths(system, rest)     # all slack: an error before the solve

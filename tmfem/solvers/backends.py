@@ -186,11 +186,12 @@ def nested_dissection(A) -> np.ndarray:
     return np.concatenate([members[first[g]:first[g] + counts[g]] for g in np.asarray(order)])
 
 
-def _petsc_backend():
-    """The PETSc/SLEPc backend with its defaults (:class:`tmfem.solvers.petsc.PetscBackend`,
-    imported lazily; options through ``PETSC_OPTIONS``)."""
+def _petsc_backend(**options):
+    """The PETSc/SLEPc backend (:class:`tmfem.solvers.petsc.PetscBackend`, imported lazily;
+    ``options`` its keyword arguments, e.g. ``eig_solver``; PETSc's own options through
+    ``PETSC_OPTIONS``)."""
     from tmfem.solvers.petsc import PetscBackend
-    return PetscBackend()
+    return PetscBackend(**options)
 
 
 _BACKENDS = {"scipy": ScipyBackend, "petsc": _petsc_backend}
@@ -201,13 +202,20 @@ def backend_names() -> list[str]:
     return sorted(_BACKENDS)
 
 
-def get_backend(name: str | Backend | None = None) -> Backend:
-    """Return a backend by name ('scipy' default, 'petsc'), or pass an object through."""
+def get_backend(name: str | Backend | None = None, **options) -> Backend:
+    """Return a backend by name ('scipy' default, 'petsc') built with ``options`` (the PETSc
+    backend's keyword arguments; the scipy backend takes none), or pass an object through."""
     if name is None:
-        return ScipyBackend()
+        name = "scipy"
     if not isinstance(name, str):
+        if options:
+            raise InputError(f"backend: options {sorted(options)} apply to a backend built by "
+                             f"name, found a backend object {type(name).__name__}")
         return name
     cls = _BACKENDS.get(name)
     if cls is None:
         raise InputError(f"backend: expected one of {sorted(_BACKENDS)}, found {name!r}")
-    return cls()
+    if options and name == "scipy":
+        raise InputError(f"backend 'scipy': option does not apply: {', '.join(sorted(options))} "
+                         "(options of the PETSc backend: expected backend 'petsc')")
+    return cls(**options)
