@@ -150,6 +150,30 @@ def test_eigenvalue_optimisation_finds_a_feasible_point_above_the_optimum_only()
         synthesize_state_feedback(gp_of(pl), solver="EIGOPT")
 
 
+def test_threaded_eigendecompositions_give_the_serial_optimisation():
+    # source: the same optimisation without threads (workers=1), both at one BLAS thread: the
+    # threads decompose disjoint parts of the stack, so every evaluation is bit for bit the same
+    from threadpoolctl import threadpool_limits
+    from tmfem.control.lpv_eigopt import EigOpt
+    from tmfem.control.lpv_synthesis import Coordinates
+    pl = oscillator_plant()
+    gp = gp_of(pl.resampled(pl.refined(2)))              # 5 grid points x 2 rate vertices
+    co = Coordinates.of(gp)
+    g = 1.3 * synthesize_state_feedback(gp_of(pl)).gamma
+    runs = []
+    for workers in (1, 2, 3):
+        e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=g, workers=workers)
+        with threadpool_limits(limits=1, user_api="blas"):
+            z, top, reason = e.solve(g, e.riccati_start(g), t_schedule=(1e-3,), max_iter=20)
+        runs.append((z, top, reason, e.evaluations))
+        assert e._pool is None                            # the threads end with the solve
+    for z, top, reason, n in runs[1:]:
+        assert np.array_equal(z, runs[0][0]) and (top, reason, n) == runs[0][1:]
+    assert runs[0][3] > 1
+    with pytest.raises(InputError, match="workers a positive integer"):
+        EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=g, workers=0)
+
+
 def test_gamma_bisection_reaches_the_conic_optimum():
     # the oscillator of docs/lpv.md: Clarabel's optimum is the reference. The bisection between
     # the pointwise lower bound and 2 x it (continuation in gamma) stops when hi - lo <= 1e-3 hi:
