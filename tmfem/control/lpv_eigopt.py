@@ -13,11 +13,11 @@ the largest eigenvalue over all of them is negative. Its smooth upper bound
 V^T from the eigenvectors; d/dP of tr(Z11 (A P + P A^T)) = 2 A^T Z11, and so on), all grid
 points and vertices at once (batched ``eigh``, the stack split over ``workers`` threads: numpy's
 ``eigh`` releases the GIL, so LAPACK's ``syevd`` of different matrices runs on different cores
-with one BLAS thread each; about 80 % of an evaluation of the 2-3 LMIs). A level stops as soon as the largest scaled
-eigenvalue is below ``-margin``. Starting point: the pointwise state-feedback solutions
-(Riccati, :mod:`tmfem.control.hinf_are`) P_i = gamma X_i^-1, Q_i = K_i P_i, fitted affine in
-rho by least squares, or (continuation in gamma, :mod:`tmfem.control.lpv_bisect`) the point
-found at a higher level; coordinates: the diagonal balancing of the synthesis, then
+with one BLAS thread each; about 80 % of an evaluation of the 2-3 LMIs). A level stops as soon
+as the largest scaled eigenvalue is below ``-margin``. Starting point: the pointwise
+state-feedback solutions (Riccati, :mod:`tmfem.control.hinf_are`) P_i = gamma X_i^-1,
+Q_i = K_i P_i, fitted affine in rho by least squares, or (continuation in gamma,
+:mod:`tmfem.control.lpv_bisect`) the point found at a higher level; coordinates: the diagonal balancing of the synthesis, then
 x = L x_b with L L^T the centre point's P_i at the first level (so P_b ~ I).
 This is a feasibility method: failing at a level does not prove the level infeasible.
 """
@@ -116,8 +116,9 @@ class EigOpt:
 
     def __init__(self, gp, *, T, c_of, dvs, gamma: float, eps: float = 1e-4, sample_time: float | None = None,
                  radius: float = 1.0, balance_on=None, points=None, workers: int | None = None):
-        if workers is None:
-            workers = len(os.sched_getaffinity(0))
+        if workers is None:                          # the cores this process may run on
+            workers = (len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity")
+                       else os.cpu_count() or 1)
         if not (isinstance(workers, (int, np.integer)) and workers >= 1):
             raise InputError(f"EIGOPT: expected workers a positive integer, found {workers!r}")
         self.workers, self._pool = int(workers), None
