@@ -17,8 +17,9 @@ with one BLAS thread each; about 80 % of an evaluation of the 2-3 LMIs). A level
 as the largest scaled eigenvalue is below ``-margin``. Starting point: the pointwise
 state-feedback solutions (Riccati, :mod:`tmfem.control.hinf_are`) P_i = gamma X_i^-1,
 Q_i = K_i P_i, fitted affine in rho by least squares, or (continuation in gamma,
-:mod:`tmfem.control.lpv_bisect`) the point found at a higher level; coordinates: the diagonal balancing of the synthesis, then
-x = L x_b with L L^T the centre point's P_i at the first level (so P_b ~ I).
+:mod:`tmfem.control.lpv_bisect`) the point found at a higher level; coordinates: the diagonal
+balancing of the synthesis, then x = L x_b with L L^T the centre point's P_i at the first
+level (so P_b ~ I).
 This is a feasibility method: failing at a level does not prove the level infeasible.
 """
 from __future__ import annotations
