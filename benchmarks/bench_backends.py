@@ -142,7 +142,7 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int, eig_solve
     t2, c2 = time.perf_counter(), time.process_time()
     cpu_phases, wall_phases = dict(phases.cpu), dict(phases.wall)     # of the static solve
     f_static, c_static, s_static, cs_static = be.t_factor, be.c_factor, be.t_solve, be.c_solve
-    modes = m.modes(res.x, k=12)
+    modes = m.modes(res.x, k=12, tangent=res.tangent)
     t3, c3 = time.perf_counter(), time.process_time()
     its = (res.newton_iterations_tangent or [res.iterations])[-1]
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0

@@ -322,3 +322,18 @@ def test_mesh_interpolation_is_linear_and_matches_scipy_interpolate():
     ok = np.all(np.isfinite(ref), axis=0) & inner
     assert ok.sum() > 0.8 * nm
     assert np.allclose(xf[:, :nm][:, ok], ref[:, ok], rtol=0, atol=1e-12)
+
+
+def test_modes_reuse_the_static_tangent(paper_prestress_modes):
+    # source: the tangent assembled again at the equilibrium (the same kernels at the same
+    # positions: the same entries, bit for bit) and the modes of it (two ARPACK runs on one
+    # matrix differ by up to 2e-10 from their random start vectors); a tangent of the wrong
+    # kind or size is refused
+    m, res, ref = paper_prestress_modes
+    _, K = m.residual(m.reduce(res.x))
+    assert (res.tangent != K).nnz == 0
+    md = m.modes(res.x, k=12, tangent=res.tangent)
+    assert np.allclose(md.omega2, ref.omega2, rtol=1e-9, atol=0)
+    for bad in (res.tangent[:-1, :-1], res.tangent.toarray()):
+        with pytest.raises(InputError, match="expected the tangent of this model's static solve"):
+            m.modes(res.x, k=12, tangent=bad)

@@ -614,6 +614,45 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
         assert np.allclose(modes.omega2, ref.omega2, rtol=2e-8, atol=0)
 
 
+@needs_petsc
+def test_pattern_subset_check():
+    # source: the patterns themselves (a diagonal lies within a tridiagonal pattern, a
+    # corner entry does not), on the AIJ matrices the eigen solve's reuse check reads
+    from petsc4py import PETSc
+    from tmfem.solvers.petsc import PetscBackend
+    n = 6
+    tri = sp.diags([np.ones(n - 1), 2 * np.ones(n), np.ones(n - 1)], [-1, 0, 1], format="csr")
+    corner = sp.csr_matrix(sp.identity(n) + sp.csr_matrix(([1.0], ([0], [n - 1])), shape=(n, n)))
+
+    def aij(S):
+        return PETSc.Mat().createAIJ(size=S.shape, csr=(S.indptr.astype(PETSc.IntType),
+                                                        S.indices.astype(PETSc.IntType), S.data),
+                                     comm=PETSc.COMM_SELF)
+    be = PetscBackend()
+    assert be._subset(aij(sp.identity(n, format="csr")), aij(tri))
+    assert not be._subset(aij(corner), aij(tri))
+
+
+@needs_petsc
+def test_modes_reuse_the_static_distributed_tangent(models, equilibria):
+    # source: the scipy model's 12 modes at its equilibrium from the design; the modes of
+    # the distributed tangent the static solve assembled last agree with those of one
+    # assembled again at the equilibrium, and a scipy tangent is refused for it
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
+    st = m.solve_static(start="design")
+    again = m.modes(st.x, k=12)
+    reused = m.modes(st.x, k=12, tangent=st.tangent)
+    assert np.allclose(reused.omega2, again.omega2, rtol=1e-10, atol=0)
+    assert np.allclose(reused.omega2, ref.omega2, rtol=2e-8, atol=0)
+    with pytest.raises(InputError, match=r"expected the tangent of this model's static solve "
+                                         r"\(DistributedMatrix"):
+        m.modes(st.x, k=12, tangent=equilibria["1-4"].tangent)
+
+
 def _modal_cli(*argv):
     p = subprocess.run([sys.executable, "-m", "tmfem", "modal", *argv], capture_output=True,
                        text=True, cwd=ROOT)

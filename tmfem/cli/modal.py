@@ -34,7 +34,7 @@ def configure(parser) -> None:
 def mtc_modes(model, *, k: int, start: str = "undeformed", sequence: int | None = None):
     """Static equilibrium of ``model`` and its ``k`` lowest modes (eq. 5.32)."""
     res = model.solve_static(start=start, monitor=default_monitor(model.system), sequence=sequence)
-    modes = model.modes(res.x, k=k)
+    modes = model.modes(res.x, k=k, tangent=res.tangent)
     return res, modes
 
 

@@ -59,7 +59,7 @@ def _mtc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
                  patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
     res = m.solve_static(start="design")
     t1 = time.perf_counter()
-    md = m.modes(res.x, k=modes)
+    md = m.modes(res.x, k=modes, tangent=res.tangent)
     st = static_summary(m, res.x)
     return m, res.iterations, md.freq_hz, t1, {
         "Delta_mm": 1e3 * float(np.mean(st["Delta"])),

@@ -96,7 +96,7 @@ def model_frequencies(name: str, *, modes: int = 12, mesh_n: int = 10, tendon_el
         t0 = time.perf_counter()
         res = m.solve_static()
         eq = res.state if key == "SBC" else res.x
-        out[key] = m.modes(eq, k=modes).freq_hz
+        out[key] = m.modes(eq, k=modes, tangent=res.tangent).freq_hz
         times[key] = time.perf_counter() - t0
     if progress:
         progress("COM")

@@ -202,7 +202,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     # 3. modes -------------------------------------------------------------------------------
     freqs = {}
     for label, (model, res) in mtc.items():
-        md = model.modes(res.x, k=modes)
+        md = model.modes(res.x, k=modes, tangent=res.tangent)
         freqs[f"MTC {label}"] = md.freq_hz
         if label == "designed":
             shapes = model.topology.T @ md.shapes
@@ -220,7 +220,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         from tmfem.models.sbc.model import SBCModel
         for label, (rest, sys_k) in cases.items():
             sbc = SBCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
-            freqs[f"SBC {label}"] = sbc.modes(sbc.solve_static().state, k=modes).freq_hz
+            st = sbc.solve_static()
+            freqs[f"SBC {label}"] = sbc.modes(st.state, k=modes, tangent=st.tangent).freq_hz
     step(STEPS[4])
     K = default_membrane_modes(system)
     com_design = modal_summary(system, modes=modes, membrane_modes=K)

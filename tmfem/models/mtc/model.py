@@ -61,6 +61,11 @@ class StaticResult:
         The pseudo-time regularisation dt^2 of each step (inf once it is pure Newton).
     time : float
         Wall time [s].
+    newton_iterations_tangent : list of int
+        Iterations per level of a mesh-sequenced solve.
+    tangent : sparse matrix or DistributedMatrix, optional
+        The tangent at the equilibrium, as the last iteration assembled it (the reduced
+        T^T K T, or the distributed one on the free dofs): :meth:`MTCModel.modes` reuses it.
     """
 
     def __repr__(self) -> str:
@@ -75,6 +80,7 @@ class StaticResult:
     dt2_history: list
     time: float
     newton_iterations_tangent: list = field(default_factory=list)
+    tangent: object = None
 
 
 class MTCModel:
@@ -398,7 +404,8 @@ class MTCModel:
             rc = coarse.solve_static(start=start, tol=tol, max_iter=max_iter, monitor=monitor,
                                      progress=progress, sequence=sequence)
             x_fine = self.interpolate_from(coarse, rc.x)
-            del coarse                 # its element arrays and factorisations, before the fine level
+            rc.tangent = None          # with the coarse model: its element arrays and
+            del coarse                 # factorisations go before the fine level
             fine = self.solve_static(x0=x_fine, tol=tol, max_iter=max_iter, monitor=monitor,
                                      progress=progress)
             return StaticResult(
@@ -407,7 +414,7 @@ class MTCModel:
                 monitor={k: np.concatenate([rc.monitor[k], fine.monitor[k][1:]]) for k in fine.monitor},
                 dt2_history=rc.dt2_history + fine.dt2_history, time=time.perf_counter() - t0,
                 newton_iterations_tangent=(rc.newton_iterations_tangent or [rc.iterations])
-                + [fine.iterations])
+                + [fine.iterations], tangent=fine.tangent)
         x = self.initial_positions(start) if x0 is None else np.asarray(x0, dtype=float)
         free = self.free
         idx = {lab: self.topology.system_node[self.system.node_index(lab)] for lab in monitor}
@@ -453,7 +460,8 @@ class MTCModel:
         return StaticResult(x=self.full(positions(res.u)), iterations=res.iterations,
                             residual_history=res.residual_history,
                             monitor={k: np.array(v) for k, v in hist.items()},
-                            dt2_history=res.mu_history, time=time.perf_counter() - t0)
+                            dt2_history=res.mu_history, time=time.perf_counter() - t0,
+                            tangent=res.tangent)
 
     def _force_scale(self, x: np.ndarray) -> float:
         """1 N + the sum of |member forces| at positions x: the scale of the convergence test
@@ -473,21 +481,31 @@ class MTCModel:
                 f"{np.linalg.norm(c - c.mean(axis=1, keepdims=True), axis=0).mean():.4f} m")
 
     # ------------------------------------------------------------------ modes
-    def modes(self, x: np.ndarray, *, k: int = 12, sigma: float = -1.0):
+    def modes(self, x: np.ndarray, *, k: int = 12, sigma: float = -1.0, tangent=None):
         """Lowest ``k`` natural modes about the prestressed state x (eq. 5.32).
 
         ``sigma`` [rad^2/s^2] is the shift-invert shift; the default -1 sits just below the
         spectrum of deployable structures of metres and sub-hertz first modes (a shift far
         below, e.g. scaled by the stiff, light tendon nodes, makes ARPACK crawl).
+        ``tangent``: the tangent at x when already assembled (``StaticResult.tangent`` of
+        the static solve that gave x), instead of assembling it again.
         Returns a ``Modes`` of :func:`tmfem.solvers.lowest_modes` whose ``shapes`` are the
         reduced vectors; :meth:`full_shapes` maps them to all nodes.
         """
         dist = self.distributed
         if dist is None:
-            _, K = self.residual(self.reduce(x))
-            return lowest_modes(K, self.mass(), k=k, free=self.free, sigma=sigma, backend=self.backend)
-        _, K = dist.residual(State(x=self.full(self.reduce(x))))
-        return dist.modes(K, dist.mass(), k=k, sigma=sigma, backend=self.backend)
+            if tangent is None:
+                tangent = self.residual(self.reduce(x))[1]
+            else:
+                _check_tangent(tangent, sp.issparse(tangent), "sparse", self.free.size)
+            return lowest_modes(tangent, self.mass(), k=k, free=self.free, sigma=sigma,
+                                backend=self.backend)
+        if tangent is None:
+            tangent = dist.residual(State(x=self.full(self.reduce(x))))[1]
+        else:
+            from tmfem.solvers.distributed import DistributedMatrix
+            _check_tangent(tangent, isinstance(tangent, DistributedMatrix), "DistributedMatrix", dist.N)
+        return dist.modes(tangent, dist.mass(), k=k, sigma=sigma, backend=self.backend)
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
         """Mode shapes (3, n_nodes, k) from reduced vectors (3 n_red, k)."""
@@ -499,3 +517,12 @@ class MTCModel:
         """Rest lengths for which the design configuration is an equilibrium of this model
         (:func:`tmfem.models.mtc.design.consistent_rest_lengths`)."""
         return consistent_rest_lengths(self, tol=tol)
+
+
+def _check_tangent(K, of_kind: bool, kind: str, n: int) -> None:
+    """Refuse a ``tangent`` given to :meth:`MTCModel.modes` that is not the model's own
+    (``of_kind``: of the matrix kind its static solve assembles; n x n)."""
+    shape = tuple(getattr(K, "shape", ()))
+    if not of_kind or shape != (n, n):
+        raise InputError(f"modes: expected the tangent of this model's static solve ({kind} "
+                         f"{n}x{n}), found {type(K).__name__} of shape {shape}")
