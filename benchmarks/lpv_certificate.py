@@ -3,6 +3,7 @@ docs/lpv.md, output feedback) for a saved state-feedback design.
 
 Run: .venv/bin/python benchmarks/lpv_certificate.py --design F.npz [--budget 900] [--rtol 0.05]
          [--upper G] [--fine] [--cache DIR] [--save-certificate X.npz | --certificate X.npz]
+         [--estimator-refine R] [--fine-refine F]
          [--refine [--per-round 4] [--rounds 8] [--refine-budget 1200] [--refine-gamma G] [--refine-max-iter 150]
          [--save-refined Y.npz]]
 
@@ -10,14 +11,18 @@ Builds the design plant on the design's grid (COM linearisations at the symmetri
 of eq. 5.97), the gridded Kalman estimator (W_d = W_n = 0.001) on q and the membrane points,
 the 121-state loops and the EIGOPT bisection of the analysis LMI (X(rho) affine, +-10 deg/s)
 between the largest frozen norm and --upper (default 2 x it). With --fine, a found certificate
-is re-checked on the 4x finer grid (new linearisations) with the frozen checks of
+is re-checked on the --fine-refine (default 4) x finer grid (new linearisations) with the frozen checks of
 verify_output_feedback. --cache keeps the plants as pickles. --save-certificate writes the
 certificate's X(rho) (LPVStateFeedback.save, no gain rows), --certificate reads one instead of
-solving. --refine (implies --fine): the cutting-plane refinement of refine_certificate on the 4x
+solving. --refine (implies --fine): the cutting-plane refinement of refine_certificate on that
 finer grid (the worst --per-round failing points per round, at most --rounds re-solves within
 --refine-budget s, at the certificate's gamma or --refine-gamma, --refine-max-iter L-BFGS iterations per smoothing
 stage), then the re-check; --save-refined
-writes the refined X(rho). Prints one JSON object (times wall and CPU).
+writes the refined X(rho). --estimator-refine R: the Kalman estimator (its model and gains)
+on the design grid refined R times (new linearisations; K(rho) stays the design's), so that
+its interpolated model is nearer the true plant between design points; --fine-refine F: the
+re-check grid F times finer than the design grid (default 4; a multiple of R, and at least 2 R
+when R > 1, so that it checks between the estimator's points too). Prints one JSON object (times wall and CPU).
 """
 import argparse
 import json
@@ -65,7 +70,13 @@ def main():
     ap.add_argument("--save-refined", default=None)
     ap.add_argument("--refine-gamma", type=float, default=None)
     ap.add_argument("--refine-max-iter", type=int, default=150)
+    ap.add_argument("--estimator-refine", type=int, default=1)
+    ap.add_argument("--fine-refine", type=int, default=4)
     a = ap.parse_args()
+    R, F = a.estimator_refine, a.fine_refine
+    if R < 1 or F < 4 or F % R or (R > 1 and F < 2 * R):
+        ap.error(f"expected --estimator-refine R >= 1 and --fine-refine F >= 4, a multiple of R and >= 2 R "
+                 f"when R > 1 (points between the estimator's), found R = {R}, F = {F}")
     if (a.per_round != 4 or a.rounds != 8 or a.refine_budget != 1200.0 or a.save_refined
             or a.refine_gamma is not None or a.refine_max_iter != 150) and not a.refine:
         ap.error("--per-round, --rounds, --refine-budget, --refine-gamma, --refine-max-iter and --save-refined "
@@ -80,7 +91,12 @@ def main():
     shape = "x".join(str(ax.size) for ax in sf.axes)
     pl = plant_on(s, sf.axes[0], sf.axes[1], sf.rate_bounds, a.cache, f"plant_{shape}")
     t_plant = time.perf_counter() - t
-    of = design_output_feedback(sf, pl, tracked=s.q_names, measured=pl.state_names[:pl.nx // 2])
+    est = pl
+    if a.estimator_refine > 1:
+        ea = pl.refined(a.estimator_refine)
+        est = plant_on(s, ea[0], ea[1], pl.rate_bounds, a.cache, f"estimator{a.estimator_refine}_{shape}",
+                       membrane_points=pl.membrane_points)
+    of = design_output_feedback(sf, est, tracked=s.q_names, measured=pl.state_names[:pl.nx // 2])
     t, cpu = time.perf_counter(), time.process_time()
     if a.certificate:
         X = LPVStateFeedback.load(a.certificate)
@@ -92,12 +108,15 @@ def main():
         if a.save_certificate and c.found:
             c.lyapunov.save(a.save_certificate)
     out = {"design": a.design, "design_gamma": sf.gamma, "grid": list(pl.grid_shape), "plant_s": t_plant,
+           "estimator_grid": list(est.grid_shape),
            "loop_states": of.nx + len(of.tracked_rows) + of.nx, "certificate_cpu_s": time.process_time() - cpu,
            **c.to_dict()}
     if (a.fine or a.refine) and c.found:
         t = time.perf_counter()
-        fa = pl.refined(4)
-        fine = plant_on(s, fa[0], fa[1], pl.rate_bounds, a.cache, f"fine_{shape}", membrane_points=pl.membrane_points)
+        fa = pl.refined(a.fine_refine)
+        fine = plant_on(s, fa[0], fa[1], pl.rate_bounds, a.cache,
+                        f"fine_{shape}" if a.fine_refine == 4 else f"fine{a.fine_refine}_{shape}",
+                        membrane_points=pl.membrane_points)
         out["fine_plant_s"] = time.perf_counter() - t
         if a.refine:
             c = refine_certificate(c, of, fine, W_e=0.5, W_u=0.05, per_round=a.per_round, max_rounds=a.rounds,
