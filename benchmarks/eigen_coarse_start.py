@@ -32,17 +32,17 @@ def main(argv=None) -> int:
     nc, nf = int(argv[0]), int(argv[1])
     system = system_1_4(1.5025)
     mc = MTCModel(system, mesh_n=nc, tendon_elements=3)
-    xc = mc.solve_static(sequence=10).x
-    coarse = mc.modes(xc, k=12)
+    rc = mc.solve_static(sequence=10)
+    xc = rc.x
+    coarse = mc.modes(xc, k=12, tangent=rc.tangent)
     mf = MTCModel(system, mesh_n=nf, tendon_elements=3)
-    xf = mf.solve_static(x0=mf.interpolate_from(mc, xc)).x
+    rf = mf.solve_static(x0=mf.interpolate_from(mc, xc))
     S = mc.full_shapes(coarse.shapes)
     base = mf.reduce(mf.interpolate_from(mc, xc))
     idx = np.flatnonzero(mf.free)
     V0 = np.column_stack([mf.reduce(mf.interpolate_from(mc, xc + S[:, :, j])) - base
                           for j in range(12)])[idx]
-    _, K = mf.residual(mf.reduce(xf))
-    K, M = sp.csr_matrix(K)[idx][:, idx], sp.csr_matrix(mf.mass())[idx][:, idx]
+    K, M = sp.csr_matrix(rf.tangent)[idx][:, idx], sp.csr_matrix(mf.mass())[idx][:, idx]
     sigma, n = -1.0, idx.size
     lu = get_backend("scipy").factorize(sp.csc_matrix(K - sigma * M))
     columns = [0]
