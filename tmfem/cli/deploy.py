@@ -6,6 +6,7 @@ Every option and output path is checked before the controller design (docs/cli.m
 from __future__ import annotations
 
 import time
+from dataclasses import astuple
 
 from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_time_steps, output_dir, output_file, positive_float,
@@ -91,6 +92,13 @@ def configure(parser) -> None:
                              "plant's own stiffness stays in the loop; default with an FE "
                              "plant, where the law at the state diverges, docs/fe-plant.md); "
                              "a --compare-plant run uses the same controller")
+    parser.add_argument("--gains", type=pfl_gains, metavar="OMEGA_0,OMEGA_E,TAU,D_C",
+                        help="the adaptive PFL's gains of eq. 5.69, omega(t) = omega_0 + omega_e "
+                             "(1 - exp(-t / tau)), d_q = 2 d_c omega, k_q = omega^2, in rad/s, "
+                             "rad/s, s and - (default: the preset's Table 7.1 row; 1-4D "
+                             "15,150,20,1.5). A crossover below the FE plant's unmodelled "
+                             "dynamics, e.g. 10,0,20,1 with --uncertainty no-MG, deploys 1-4D on "
+                             "the SBC plant (docs/fe-plant.md)")
     parser.add_argument("--t-end", type=positive_float, default=20.0, help="duration [s]")
     parser.add_argument("--dt", type=positive_float, default=0.01, help="sample time [s]")
     parser.add_argument("--csv", help="write every named signal (one column each, units in the header)")
@@ -98,6 +106,26 @@ def configure(parser) -> None:
     parser.add_argument("--gif", help="animation of the deployment (GIF)")
     parser.add_argument("--vtk", metavar="DIR", help="ParaView series of the configuration")
     deploy_lpv.configure(parser)
+
+
+def pfl_gains(text: str) -> tuple:
+    """argparse ``type`` of ``--gains``: four comma-separated numbers omega_0, omega_e, tau,
+    d_c (checked by :class:`tmfem.control.adaptive.Gains`)."""
+    import argparse
+    from tmfem.control.adaptive import Gains
+    parts = text.split(",")
+    try:
+        values = tuple(float(v) for v in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 4:
+        raise argparse.ArgumentTypeError(f"expected four comma-separated numbers OMEGA_0,OMEGA_E,"
+                                         f"TAU,D_C, found {text!r}")
+    try:
+        Gains(*values)
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    return values
 
 
 def run(args) -> dict:
@@ -134,12 +162,13 @@ def run(args) -> dict:
     tendons = fe_tendon_model(args) if fe and not frozen else "fixed-rate"
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path, evaluation=pfl_at,
-              tendon_law=tendons)
+              tendon_law=tendons, gains=args.gains)
     warnings = tendon_model_warnings(args, tendons)
     r = _run_on(args, s, args.plant, mesh_n)
     # the controller's options, the same on both plants of a comparison (docs/fe-plant.md)
     ctrl = {"controller": args.controller, "uncertainty": s.adaptive.uncertainty,
-            "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons}
+            "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons,
+            "pfl_gains": list(astuple(s.adaptive.gains))}
     out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
            **ctrl, "path": args.path or DEPLOYMENTS[args.preset]["path"],
            **r.summary(), **s.info}
@@ -152,12 +181,13 @@ def run(args) -> dict:
         def rerun(kind):
             s2 = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
                        allocation=args.allocation, path=args.path, evaluation=pfl_at,
-                       tendon_law=tendons)
+                       tendon_law=tendons, gains=args.gains)
             return _run_on(args, s2, kind, mesh_n), {}
         out["compare"] = compare_plants(
             args, r, rerun, mesh_n=mesh_n, controller=ctrl,
             about=f"PFL at the {pfl_at}, its tendon model {tendons}, uncertainty "
-                  f"{s.adaptive.uncertainty}, allocation {s.adaptive.allocation}")
+                  f"{s.adaptive.uncertainty}, allocation {s.adaptive.allocation}, gains "
+                  f"{','.join(f'{g:g}' for g in astuple(s.adaptive.gains))}")
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
     # to the failure are written, the exit code is 1 (docs/cli.md, docs/fe-plant.md)

@@ -23,7 +23,7 @@ from tmfem.errors import InfeasibleController, InputError
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
 SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
 #: options of the 7.4 deployments that do not apply to the LPV one (None or False: not given)
-NOT_LPV = ("uncertainty", "allocation", "pfl_at")
+NOT_LPV = ("uncertainty", "allocation", "pfl_at", "gains")
 
 
 def configure(parser) -> None:

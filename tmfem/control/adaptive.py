@@ -83,6 +83,14 @@ class Gains:
     tau: float
     d_c: float
 
+    def __post_init__(self):
+        values = (self.omega_0, self.omega_e, self.tau, self.d_c)
+        if not (np.all(np.isfinite(values)) and self.omega_0 > 0 and self.omega_e >= 0
+                and self.tau > 0 and self.d_c > 0):
+            raise InputError(f"PFL gains (eq. 5.69): expected omega_0 > 0, omega_e >= 0 [rad/s], "
+                             f"tau > 0 [s] and d_c > 0, found omega_0 = {self.omega_0}, "
+                             f"omega_e = {self.omega_e}, tau = {self.tau}, d_c = {self.d_c}")
+
     def __call__(self, t: float) -> tuple[float, float]:
         """(d_q, k_q) at time t (eqs. 5.47, 5.69)."""
         w = self.omega_0 + self.omega_e * (1 - np.exp(-t / self.tau))

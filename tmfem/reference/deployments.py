@@ -47,8 +47,10 @@ def inside_points(system, points, *, inset: float = 1e-3):
 
 def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
           allocation: str = "bounded", path: str | None = None, evaluation: str = "state",
-          tendon_law: str = "fixed-rate"):
+          tendon_law: str = "fixed-rate", gains=None):
     """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`).
+    ``gains``: the PFL's (omega_0, omega_e, tau, d_c) of eq. 5.69 in rad/s, rad/s, s and -
+    (default: the preset's Table 7.1 row).
     ``path`` (default the preset's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
     membrane stretch Delta linear in s), ``"table-7-7-bases"`` (2-3: the stage-2 base on the
     reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
@@ -63,7 +65,7 @@ def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | 
     p = DEPLOYMENTS[preset]
     path = path or p["path"]
     final, initial = load_preset(preset), load_preset(preset + "-initial")
-    w0, we, tau, dc = p["table_7_1"]
+    w0, we, tau, dc = p["table_7_1"] if gains is None else gains
     return build_deployment(final=final, initial=initial, omega_r=p["omega_r"],
                             gains=Gains(omega_0=w0, omega_e=we, tau=tau, d_c=dc),
                             uncertainty=uncertainty or p["uncertainty"],
