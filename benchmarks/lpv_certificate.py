@@ -3,7 +3,7 @@ docs/lpv.md, output feedback) for a saved state-feedback design.
 
 Run: .venv/bin/python benchmarks/lpv_certificate.py --design F.npz [--budget 900] [--rtol 0.05]
          [--upper G] [--fine] [--cache DIR] [--save-certificate X.npz | --certificate X.npz]
-         [--estimator-refine R] [--fine-refine F]
+         [--estimator-refine R] [--fine-refine F] [--estimator-interpolation multilinear|spline]
          [--refine [--per-round 4] [--rounds 8] [--refine-budget 1200] [--refine-gamma G] [--refine-max-iter 150]
          [--save-refined Y.npz]]
 
@@ -22,7 +22,9 @@ writes the refined X(rho). --estimator-refine R: the Kalman estimator (its model
 on the design grid refined R times (new linearisations; K(rho) stays the design's), so that
 its interpolated model is nearer the true plant between design points; --fine-refine F: the
 re-check grid F times finer than the design grid (default 4; a multiple of R, and at least 2 R
-when R > 1, so that it checks between the estimator's points too). Prints one JSON object (times wall and CPU).
+when R > 1, so that it checks between the estimator's points too); --estimator-interpolation:
+how the estimator's model and gains are evaluated between its points (GriddedLPV.interpolate;
+default multilinear). Prints one JSON object (times wall and CPU).
 """
 import argparse
 import json
@@ -72,6 +74,7 @@ def main():
     ap.add_argument("--refine-max-iter", type=int, default=150)
     ap.add_argument("--estimator-refine", type=int, default=1)
     ap.add_argument("--fine-refine", type=int, default=4)
+    ap.add_argument("--estimator-interpolation", choices=["multilinear", "spline"], default="multilinear")
     a = ap.parse_args()
     R, F = a.estimator_refine, a.fine_refine
     if R < 1 or F < 4 or F % R or (R > 1 and F < 2 * R):
@@ -96,7 +99,8 @@ def main():
         ea = pl.refined(a.estimator_refine)
         est = plant_on(s, ea[0], ea[1], pl.rate_bounds, a.cache, f"estimator{a.estimator_refine}_{shape}",
                        membrane_points=pl.membrane_points)
-    of = design_output_feedback(sf, est, tracked=s.q_names, measured=pl.state_names[:pl.nx // 2])
+    of = design_output_feedback(sf, est, tracked=s.q_names, measured=pl.state_names[:pl.nx // 2],
+                                interpolation=a.estimator_interpolation)
     t, cpu = time.perf_counter(), time.process_time()
     if a.certificate:
         X = LPVStateFeedback.load(a.certificate)
@@ -108,7 +112,7 @@ def main():
         if a.save_certificate and c.found:
             c.lyapunov.save(a.save_certificate)
     out = {"design": a.design, "design_gamma": sf.gamma, "grid": list(pl.grid_shape), "plant_s": t_plant,
-           "estimator_grid": list(est.grid_shape),
+           "estimator_grid": list(est.grid_shape), "estimator_interpolation": a.estimator_interpolation,
            "loop_states": of.nx + len(of.tracked_rows) + of.nx, "certificate_cpu_s": time.process_time() - cpu,
            **c.to_dict()}
     if (a.fine or a.refine) and c.found:

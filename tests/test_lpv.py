@@ -122,6 +122,35 @@ def test_interpolation_is_exact_for_affine_plant_and_refuses_outside():
         pl.at([2.5])
 
 
+def _polynomial_plant(interpolation):
+    """A 1x1 plant on a 5 x 3 grid with a(r, s) = r^3 - 2 r s^2 + s + 1, cubic in r and
+    quadratic in s: what the tensor splines of degree min(3, n - 1) reproduce exactly."""
+    r, s = np.linspace(0.0, 2.0, 5), np.array([0.0, 0.5, 1.5])
+    a = lambda x, y: x**3 - 2 * x * y**2 + y + 1.0          # noqa: E731
+    A = np.array([[[[a(x, y)]] for y in s] for x in r])
+    one = np.ones((5, 3, 1, 1))
+    return a, GriddedLPV(axes=[r, s], parameter_names=["r", "s"], A=A, B=one, C=one, D=0 * one,
+                         rate_bounds=[[-1, 1], [-1, 1]], state_names=["x"], input_names=["u"],
+                         output_names=["y"], interpolation=interpolation)
+
+
+def test_spline_interpolation_is_exact_for_a_cubic_quadratic_field():
+    """GriddedLPV(interpolation="spline") reproduces a field cubic along the 5-point axis and
+    quadratic along the 3-point one between grid points (closed form), and both methods the
+    grid values; the multilinear interpolation misses the off-grid value; an unknown method
+    is refused."""
+    a, spline = _polynomial_plant("spline")
+    _, linear = _polynomial_plant("multilinear")
+    for rho in ([0.5, 0.5], [1.0, 1.5], [0.0, 0.0]):
+        assert spline.at(rho)[0][0, 0] == pytest.approx(a(*rho), abs=1e-12)
+        assert linear.at(rho)[0][0, 0] == pytest.approx(a(*rho), abs=1e-12)
+    for rho in ([0.3, 0.2], [1.7, 1.1], [1.25, 0.9]):
+        assert spline.at(rho)[0][0, 0] == pytest.approx(a(*rho), abs=1e-12)
+        assert abs(linear.at(rho)[0][0, 0] - a(*rho)) > 1e-3
+    with pytest.raises(InputError, match="interpolation expected one of"):
+        _polynomial_plant("cubic")
+
+
 def test_off_grid_verification_passes_and_refuses_a_wrong_plant():
     pl = oscillator_plant()
     ctrl = synthesize_state_feedback(gp_of(pl))

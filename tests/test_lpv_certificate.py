@@ -174,6 +174,28 @@ def test_refinement_makes_a_design_grid_certificate_hold_on_the_finer_grid(nonli
     assert v.to_dict()["rate_bounded_verification_max_eig"] < 0
 
 
+def test_spline_estimator_on_a_finer_grid_carries_the_certificate_off_the_design_grid(nonlinear):
+    """The stiffness 1 + rho^2 is a parabola: an estimator on the grid [0, 1, 2] with
+    ``interpolation="spline"`` has the true plant as its model between its points (the
+    multilinear one on the same points: stiffness 1.5 at rho = 0.5 against 1.25), and the
+    design-grid certificate of that loop (K(rho) of the 2-point design, X(rho) on [0, 2], the
+    estimator's gains taken at the design points) holds on the 5-point grid: the LMI
+    assembled here and verify_output_feedback. (The 2-point design's own estimator fails
+    there: the refinement test above.)"""
+    pl, d, c, fine = nonlinear
+    est = nonlinear_oscillator([0.0, 1.0, 2.0])
+    de = design_output_feedback(d.state_feedback, est, tracked=["y"], measured=["y"], W_d=0.3,
+                                W_n=0.01, interpolation="spline")
+    dl = design_output_feedback(d.state_feedback, est, tracked=["y"], measured=["y"], W_d=0.3, W_n=0.01)
+    np.testing.assert_allclose(de.estimator.at([0.5])[0], fine.A[1], atol=1e-12)
+    assert dl.estimator.at([0.5])[0][1, 0] == pytest.approx(-1.5)
+    ce = rate_bounded_certificate(de, pl, W_e=W_E, W_u=W_U, rtol=1e-2)
+    assert ce.found
+    lmi, minX = largest_brl(ce.lyapunov, ce.gamma, de, fine)
+    assert lmi < 0 and minX > 0
+    assert verify_output_feedback(de, fine, W_e=W_E, W_u=W_U, certificate=ce).passed
+
+
 def test_refinement_budgets_and_refusals(nonlinear):
     from tmfem.control.lpv_certificate import refine_certificate
     pl, d, c, fine = nonlinear

@@ -198,3 +198,24 @@ def test_estimator_is_driven_by_the_saturated_input(design):
     assert u[0] > 0.5
     Gu = d.step_matrices([rho], dt)[1]
     np.testing.assert_allclose(lim.update(0.0, y, xc)[:2] - free.update(0.0, y, xc)[:2], Gu @ (0.5 - u), atol=1e-14)
+
+
+def test_spline_estimator_interpolation(design, tmp_path):
+    """``interpolation="spline"``: the estimator's model through the grid points (here affine
+    in rho, so both methods give the true A between them), its gains L(rho) the parabola
+    through the three grid gains (the multilinear ones differ off the grid), the method
+    saved with the design; an unknown method is refused."""
+    pl, d = design
+    ds = design_output_feedback(d.state_feedback, pl, tracked=["y"], measured=["y"], W_d=0.3,
+                                W_n=0.01, interpolation="spline")
+    assert ds.estimator.interpolation == "spline" and d.estimator.interpolation == "multilinear"
+    rho = [0.7]
+    np.testing.assert_allclose(ds.estimator.at(rho)[0], [[0, 1], [-1.7, -0.1]], atol=1e-13)
+    L = ds.estimator.B[:, :, 1:]
+    parabola = np.polynomial.polynomial.polyval(0.7, np.polynomial.polynomial.polyfit([0, 1, 2], L[:, :, 0], 2))
+    np.testing.assert_allclose(ds.estimator.at(rho)[1][:, 1], parabola, rtol=1e-12)
+    assert np.abs(d.estimator.at(rho)[1][:, 1] - parabola).max() > 1e-6
+    ds.save(tmp_path / "of.npz")
+    assert str(np.load(tmp_path / "of.npz")["interpolation"]) == "spline"
+    with pytest.raises(InputError, match="interpolation expected one of"):
+        design_output_feedback(d.state_feedback, pl, tracked=["y"], measured=["y"], interpolation="cubic")

@@ -17,7 +17,7 @@ MAX_VERIFY_POINTS = 500
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
 LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma", "gamma_rtol",
             "time_budget", "fixed_gamma", "sample_time", "start", "output_feedback", "noise", "rate_certificate",
-            "certificate_rounds")
+            "certificate_rounds", "estimator_interpolation", "estimator_refine")
 
 #: EIGOPT defaults: relative bracket width of the gamma bisection, its time budget [s]
 GAMMA_RTOL, TIME_BUDGET = 0.05, 300.0
@@ -71,6 +71,17 @@ def configure(parser) -> None:
                              "certificate fails on the finer grid (each imposes the 4 worst failing points of "
                              "that grid and re-solves at the same gamma, within another --time-budget; default "
                              f"{CERTIFICATE_ROUNDS}, 0: none; docs/lpv.md)")
+    parser.add_argument("--estimator-interpolation", choices=("multilinear", "spline"), default=None,
+                        help="lpv --output-feedback: how the Kalman estimator's model and gains are "
+                             "evaluated between grid points: multilinear (default) or tensor-product "
+                             "splines of degree min(3, points - 1) per parameter, 13-16 x closer to the "
+                             "2-3 plant between the 6 x 3 points (docs/lpv.md)")
+    parser.add_argument("--estimator-refine", type=int, default=None, metavar="R",
+                        help="lpv --output-feedback: the Kalman estimator's model and gains on the design grid "
+                             "refined R times (new COM linearisations; K(rho) and the certificate stay on the "
+                             "design grid; default 1); with R > 1, --refine must be a multiple of R and >= 2 R. "
+                             "With --estimator-interpolation spline and R = 2 the rate-bounded certificate of the "
+                             "2-3 loop holds on the 21 x 9 grid (docs/lpv.md)")
     parser.add_argument("--noise", type=float, default=None,
                         help="lpv --output-feedback: measurement-noise weight W_n of the estimator design "
                              "and of the verified norm [rad, m] (default 0.001)")
@@ -195,16 +206,35 @@ def synthesise(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
 
 
 def fine_plant(cfg: dict, plant):
-    """The plant on the grid ``refine`` times finer (new COM linearisations, the design's
-    membrane points)."""
+    """The plant on the grid ``refine`` times finer (:func:`refined_plant`)."""
+    return refined_plant(cfg["system"], plant, cfg["refine"], what="verification plant")
+
+
+def refined_plant(s, plant, factor: int, *, what: str):
+    """The plant of system ``s`` on the grid ``factor`` times finer than ``plant``'s (new COM
+    linearisations, the design's membrane points)."""
     from tmfem.cli.common import progress_bar
     from tmfem.control.lpv_plant import com_lpv_plant
     from tmfem.reference.tables import deployment_bases
-    s = cfg["system"]
-    fine_axes = plant.refined(cfg["refine"])
-    with progress_bar(fine_axes[0].size * fine_axes[1].size, 1, "verification plant (grid points)") as bar:
-        return com_lpv_plant(s, theta=fine_axes[0], psi=fine_axes[1], bases=deployment_bases(s),
+    axes = plant.refined(factor)
+    with progress_bar(axes[0].size * axes[1].size, 1, f"{what} (grid points)") as bar:
+        return com_lpv_plant(s, theta=axes[0], psi=axes[1], bases=deployment_bases(s),
                              rate_bounds=plant.rate_bounds, membrane_points=plant.membrane_points, progress=bar)
+
+
+def check_estimator_refine(R, *, refine: int, output_feedback: bool) -> int:
+    """``--estimator-refine R`` (default 1): the estimator's grid R times finer than the
+    design's; with R > 1 the verification grid (``--refine``) must be a multiple of R and at
+    least 2 R times finer, so that it checks between the estimator's points too."""
+    if R is None:
+        return 1
+    if not output_feedback:
+        raise InputError("lpv: option --estimator-refine applies with --output-feedback only")
+    if R < 1 or (R > 1 and (refine % R or refine < 2 * R)):
+        raise InputError(f"--estimator-refine: expected an integer R >= 1 with the verification refinement "
+                         f"--refine {refine} a multiple of R and >= 2 R when R > 1 (points between the "
+                         f"estimator's), found {R}")
+    return R
 
 
 def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
@@ -216,7 +246,8 @@ def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
     return verify(ctrl, interconnection_8_1(fine, tracked=cfg["system"].q_names), sample_time=sample_time)
 
 
-def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None):
+def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None, interpolation="multilinear",
+                    estimator_plant=None):
     """The observer-based output feedback on q and the membrane point coordinates, verified
     frozen on the fine grid (sampled at ``dt`` when given). JSON: ``gamma`` becomes the
     largest frozen closed-loop norm from [q_d, n_d, n] to p over the fine grid
@@ -224,13 +255,17 @@ def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None):
     the LMI of K(rho) re-checked there. ``certificate``: (rtol, time budget, rounds) of the
     rate-bounded certificate of the loop (:mod:`tmfem.control.lpv_certificate`) on the design grid,
     refined by cutting planes on the fine grid (at most ``rounds`` re-solves within another time
-    budget) and re-checked there (keys ``rate_bounded_*``), or None."""
+    budget) and re-checked there (keys ``rate_bounded_*``), or None. ``estimator_plant``: the
+    Kalman estimator's plant on a grid finer than the design's (default ``plant``);
+    ``interpolation``: the estimator's between its grid points."""
     from tmfem.cli.common import progress_bar
     from tmfem.control.lpv_output import design_output_feedback, verify_output_feedback
     nz = plant.nx // 2
     measured = list(plant.state_names[:nz])          # q and the K point coordinates (eq. 5.17)
     t0 = time.perf_counter()
-    d = design_output_feedback(ctrl, plant, tracked=s.q_names, measured=measured, W_n=noise)
+    est = plant if estimator_plant is None else estimator_plant
+    d = design_output_feedback(ctrl, est, tracked=s.q_names, measured=measured, W_n=noise,
+                               interpolation=interpolation)
     cert = None
     if certificate is not None:
         from tmfem.control.lpv_certificate import rate_bounded_certificate, refine_certificate
@@ -248,6 +283,7 @@ def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None):
     with progress_bar(int(np.prod(fine.grid_shape)), 1, "output-feedback verification (points)") as bar:
         vo = verify_output_feedback(d, fine, W_e=0.5, W_u=0.05, dt=dt, certificate=cert, progress=bar)
     return d, {"output_feedback": True, "measured": measured, "noise_weight": noise, "W_d": d.W_d,
+               "estimator_interpolation": interpolation, "estimator_grid": list(est.grid_shape),
                "state_feedback_gamma": ctrl.gamma, "gamma": vo.max_hinf,
                "guarantee": ("rate-bounded (X(rho) of the loop on the design grid, re-checked on the fine grid)"
                              if cert is not None and cert.found else
@@ -266,6 +302,8 @@ def run(args) -> dict:
     output_file(args.save, option="--save", suffixes=(".npz",))
     if args.noise is not None and not args.output_feedback:
         raise InputError("lpv: option --noise applies with --output-feedback only")
+    if args.estimator_interpolation is not None and not args.output_feedback:
+        raise InputError("lpv: option --estimator-interpolation applies with --output-feedback only")
     if args.rate_certificate and not args.output_feedback:
         raise InputError("lpv: option --rate-certificate applies with --output-feedback only")
     if args.certificate_rounds is not None and not args.rate_certificate:
@@ -281,18 +319,22 @@ def run(args) -> dict:
     if args.spec is not None:
         raise InputError(f"lpv: expected --preset (a preset with a printed LPV grid), found the file {args.spec!r}")
     cfg = check_synthesis(args, solver=args.solver or "SCS", preset=args.preset or "2-3-lpv")
+    R = check_estimator_refine(args.estimator_refine, refine=cfg["refine"], output_feedback=bool(args.output_feedback))
     plant, gp, bound, out = design_plant(cfg, rate_deg=rate)
     out = {"action": "lpv", **out}
     if args.bound_only:
         return out
     ctrl, syn = synthesise(cfg, gp, bound, max_iter=args.max_iter, sample_time=args.sample_time)
     fine = fine_plant(cfg, plant)
+    est = None if R == 1 else refined_plant(cfg["system"], plant, R, what="estimator plant")
     v = verify_finer(cfg, plant, ctrl, sample_time=args.sample_time, fine=fine)
     out = {**out, **syn, **v.to_dict()}
     saved = ctrl
     if args.output_feedback:
         saved, extra = output_feedback(ctrl, plant, fine, cfg["system"], noise, args.sample_time,
-                                       certificate=(cfg["rtol"], cfg["budget"], rounds) if args.rate_certificate else None)
+                                       certificate=(cfg["rtol"], cfg["budget"], rounds) if args.rate_certificate else None,
+                                       interpolation=args.estimator_interpolation or "multilinear",
+                                       estimator_plant=est)
         out = {**out, **extra}
     if args.save:
         saved.save(args.save)

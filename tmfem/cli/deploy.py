@@ -145,7 +145,8 @@ def run(args) -> dict:
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
         return deploy_lpv.run(args)
-    lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise") + deploy_lpv.SYNTHESIS)
+    lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise", "estimator_interpolation",
+                                       "estimator_refine") + deploy_lpv.SYNTHESIS)
     if lpv_opts:
         raise InputError(f"options {lpv_opts} apply to --controller lpv only, found --controller {args.controller}")
     args.allocation = args.allocation or "bounded"

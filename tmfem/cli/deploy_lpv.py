@@ -33,6 +33,13 @@ def configure(parser) -> None:
     parser.add_argument("--solver", choices=("EIGOPT", "CLARABEL", "SCS"), default=None,
                         help="--controller lpv: synthesis solver (default EIGOPT, docs/lpv.md)")
     control_lpv.configure_synthesis(parser, prefix="--controller lpv: ")
+    parser.add_argument("--estimator-interpolation", choices=("multilinear", "spline"), default=None,
+                        help="--controller lpv-output: how the Kalman estimator's model and gains are "
+                             "evaluated between grid points (default multilinear; spline: tensor-product "
+                             "splines, docs/lpv.md)")
+    parser.add_argument("--estimator-refine", type=int, default=None, metavar="R",
+                        help="--controller lpv-output: the Kalman estimator on the design grid refined R "
+                             "times (new COM linearisations; default 1; docs/lpv.md)")
     parser.add_argument("--noise", type=float, default=None, metavar="SIGMA",
                         help="LPV deployment: measurement noise, seeded Gaussian samples of this standard "
                              "deviation [rad, m; rad/s, m/s] per step on every signal the controller reads "
@@ -56,6 +63,12 @@ def check(args) -> int | None:
     if bad:
         raise InputError(f"--controller {args.controller}: options {bad} do not apply to the LPV deployment "
                          f"of {args.preset} (reference of eq. 5.100 on the {own} path, no PFL)")
+    for opt in ("estimator_interpolation", "estimator_refine"):
+        if getattr(args, opt) is not None and args.controller != "lpv-output":
+            raise InputError(f"--{opt.replace('_', '-')} belongs to --controller lpv-output (the estimator "
+                             f"of the output feedback), found --controller {args.controller}")
+    if args.estimator_refine is not None and args.estimator_refine < 1:
+        raise InputError(f"--estimator-refine: expected an integer R >= 1, found {args.estimator_refine}")
     if args.lpv_controller is not None:
         syn = given(args, SYNTHESIS)
         if syn:
@@ -75,19 +88,23 @@ def lpv_state_feedback(dep, design):
     return state_feedback_controller(dep, design)
 
 
-def lpv_output_feedback(dep, design):
+def lpv_output_feedback(dep, design, *, interpolation: str = "multilinear", estimator_plant=None):
     """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv_output`
     with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
     reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
     the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
     enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/lpv.md); the control law about rho_r(t)
     as the state feedback's; the estimator is driven by the input saturated to the rest-length
-    limits [1 mm, |tendon|(q_m)] of the run at the measured q."""
+    limits [1 mm, |tendon|(q_m)] of the run at the measured q; ``interpolation``: the
+    estimator's between grid points (:class:`~tmfem.control.lpv_plant.GriddedLPV`);
+    ``estimator_plant``: its plant on a finer grid than the design's (default the design plant)."""
     from tmfem.control.limits import tendon_lengths
     from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
     pl, system = dep.plant, dep.model.system
     nz, n, nq = pl.nx // 2, pl.nx, dep.model.nq
-    of = design_output_feedback(design, pl, tracked=system.q_names, measured=pl.state_names[:nz])
+    of = design_output_feedback(design, pl if estimator_plant is None else estimator_plant,
+                                tracked=system.q_names, measured=pl.state_names[:nz],
+                                interpolation=interpolation)
     return LPVOutputController(of, measured_index=np.arange(nz), rho_index=[n, n + 1],
                                reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho,
                                schedule="estimate",
@@ -132,7 +149,7 @@ DESIGNS = {"lpv": design, "lpv-output": design}
 BUILDERS = {"lpv": lpv_state_feedback, "lpv-output": lpv_output_feedback}
 
 
-def _run_on(args, dep, d, kind: str, mesh_n):
+def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
     """(set-up, result) of the LPV deployment with a fresh controller of ``d`` (the
     ``--controller`` builder, with ``--noise`` its seeded measurement noise) on the plant
     ``kind``: an FE plant starts in its own equilibrium of the packaged configuration under
@@ -141,7 +158,7 @@ def _run_on(args, dep, d, kind: str, mesh_n):
     from tmfem.cli.deploy import plant_arguments
     from tmfem.control.deploy import run_deployment
     from tmfem.control.state_estimate import deployment_plant
-    c = BUILDERS[args.controller](dep, d)
+    c = BUILDERS[args.controller](dep, d, **estimator_options)
     if args.noise:
         from tmfem.simulation.controllers import MeasurementNoise
         c = MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
@@ -178,12 +195,21 @@ def run(args) -> dict:
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
     dep = lpv_setup(args.preset, plant)
-    s, r = _run_on(args, dep, d, args.plant, mesh_n)
+    est = {}          # the output feedback's estimator options (check: lpv-output only)
+    if args.estimator_interpolation:
+        est["interpolation"] = args.estimator_interpolation
+    if (args.estimator_refine or 1) > 1:
+        est["estimator_plant"] = control_lpv.refined_plant(dep.model.system, plant, args.estimator_refine,
+                                                           what="estimator plant")
+    s, r = _run_on(args, dep, d, args.plant, mesh_n, est)
     # the keys of the 7.4 deployments (tmfem.cli.deploy.run; no PFL: uncertainty, allocation and
     # pfl_at None), then the design's
     ctrl = {"controller": args.controller, "uncertainty": None, "allocation": None, "pfl_at": None,
             "gamma": d.gamma, "lpv_controller": args.lpv_controller,
-            "measurement_noise_sigma": args.noise or 0.0}
+            "measurement_noise_sigma": args.noise or 0.0,
+            "estimator_interpolation": (args.estimator_interpolation or "multilinear")
+            if args.controller == "lpv-output" else None,
+            "estimator_refine": (args.estimator_refine or 1) if args.controller == "lpv-output" else None}
     out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
            **ctrl, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(), **s.info,
            **_figures(r), **info}
@@ -192,7 +218,7 @@ def run(args) -> dict:
                                                  f"(gamma = {d.gamma:.4g}), eq. 5.100"))
     if args.compare_plant:
         def rerun(kind):
-            _, r2 = _run_on(args, dep, d, kind, mesh_n)
+            _, r2 = _run_on(args, dep, d, kind, mesh_n, est)
             return r2, _figures(r2)
         src = args.lpv_controller or "synthesised here"
         out["compare"] = compare_plants(

@@ -73,11 +73,13 @@ def closed_loop_lpv(design, plant: GriddedLPV, *, W_e: float, W_u: float) -> Gen
 def estimator_error_lpv(design, plant: GriddedLPV) -> GeneralisedLPV:
     """The estimation error of ``design`` on the grid of ``plant`` as a generalised plant
     without control input: eps' = (A - L C_m) eps + [W_d B, -W_n L] [n_d; n], p = eps
-    (module docstring)."""
+    (module docstring). The gains L are the estimator's at ``plant``'s points: its own grid
+    may be finer (it must contain them, as the separation start assumes its model exact
+    there)."""
     from tmfem.control.lpv_output import _measurement
     C, _ = _measurement(plant, design.measured)
     shp, n = plant.grid_shape, plant.nx
-    L = design.estimator.B[..., design.nu:]
+    L = np.array([design.model(rho)[3] for _, rho in plant.points()]).reshape(shp + (n, C.shape[-2]))
     B1 = np.concatenate([design.W_d * plant.B, -design.W_n * L], -1)
     gp = GeneralisedLPV.from_matrices(axes=plant.axes, parameter_names=plant.parameter_names,
                                       rate_bounds=plant.rate_bounds, A=plant.A - L @ C, B1=B1,

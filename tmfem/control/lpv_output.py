@@ -18,12 +18,14 @@ measurement noise W_n n (white, intensities W_d^2 I and W_n^2 I):
 
     A S + S A^T + W_d^2 B B^T - S C_m^T C_m S / W_n^2 = 0,     L = S C_m^T / W_n^2,
 
-and L(rho) is interpolated multilinearly between grid points, as are A, B, C_m, x_e, u_e,
-y_e of the estimator's model; K(rho) is the rational function of the state-feedback design.
+and L(rho) is interpolated between grid points (multilinearly, or by splines:
+:class:`~tmfem.control.lpv_plant.GriddedLPV`), as are A, B, C_m, x_e, u_e, y_e of the
+estimator's model, whose grid may be finer than the design's; K(rho) is the rational function
+of the state-feedback design.
 
 What is guaranteed. K(rho) carries the rate-bounded certificate of eqs. 5.95-5.96 on the
-design grid (for *state* feedback). The output-feedback loop has no rate-bounded certificate:
-at a design grid point the frozen closed loop has the eigenvalues of A + B2 K and of A - L C_m
+design grid (for *state* feedback). The output-feedback loop's own rate-bounded certificate is
+:mod:`tmfem.control.lpv_certificate`; without it, at a design grid point the frozen closed loop has the eigenvalues of A + B2 K and of A - L C_m
 (separation principle); between grid points and for the closed-loop H-infinity norm from
 w = [q_d, n_d, n] to p = [e_r, e_u], :func:`verify_output_feedback` checks frozen plants of a
 finer grid (frozen-parameter stability and norm only; nothing about varying rho), and the
@@ -151,10 +153,11 @@ class LPVOutputFeedback:
 
     def save(self, path) -> None:
         """The state-feedback coefficients (``LPVStateFeedback.save``) with the gridded gains
-        L_i (``L``), the measured names and the noise weights, in one ``.npz``."""
+        L_i (``L``), the measured names, the noise weights and the estimator's interpolation,
+        in one ``.npz``."""
         np.savez(path, **self.state_feedback.arrays(), L=self.estimator.B[..., self.nu:],
                  measured=np.array(self.measured), tracked_rows=self.tracked_rows, W_d=self.W_d,
-                 W_n=self.W_n)
+                 W_n=self.W_n, interpolation=self.estimator.interpolation)
 
 
 def _measurement(plant: GriddedLPV, names):
@@ -178,7 +181,7 @@ def _measurement(plant: GriddedLPV, names):
 
 def design_output_feedback(state_feedback: LPVStateFeedback, plant: GriddedLPV, *, tracked,
                            measured, W_d: float = 1e-3, W_n: float = 1e-3,
-                           eps: float = 0.0) -> LPVOutputFeedback:
+                           eps: float = 0.0, interpolation: str = "multilinear") -> LPVOutputFeedback:
     """The gridded Kalman estimator of ``plant`` for the signals ``measured`` and the
     output-feedback controller with ``state_feedback``.
 
@@ -192,6 +195,11 @@ def design_output_feedback(state_feedback: LPVStateFeedback, plant: GriddedLPV, 
     W_d, W_n : float
         Filter weights (module docstring; 8.3's W_d = 0.001 and 7.4's measurement-noise
         weight 0.001 by default).
+    interpolation : {"multilinear", "spline"}
+        How the estimator's model and gains are evaluated between grid points
+        (:class:`~tmfem.control.lpv_plant.GriddedLPV`). Splines bring the model 13-16 x closer
+        to the true 2-3 plant between the 6 x 3 design points (docs/lpv.md), where it
+        couples the estimation error to the state.
     """
     measured, tracked = list(measured), list(tracked)
     known = list(plant.output_names) + list(plant.state_names)
@@ -223,7 +231,8 @@ def design_output_feedback(state_feedback: LPVStateFeedback, plant: GriddedLPV, 
                      rate_bounds=plant.rate_bounds, state_names=plant.state_names,
                      input_names=list(plant.input_names) + [f"innovation_{m}" for m in measured],
                      output_names=measured, x_e=plant.x_e,
-                     u_e=np.concatenate([plant.u_e, np.zeros(shp + (ny,))], -1), y_e=y_e)
+                     u_e=np.concatenate([plant.u_e, np.zeros(shp + (ny,))], -1), y_e=y_e,
+                     interpolation=interpolation)
     return LPVOutputFeedback(state_feedback=state_feedback, estimator=est, measured=measured,
                              tracked_rows=np.array([measured.index(t) for t in tracked], dtype=int),
                              W_d=float(W_d), W_n=float(W_n))
