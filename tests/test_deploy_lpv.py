@@ -90,7 +90,7 @@ def test_cli_lpv_deployment_tracks_without_slack(design21, tmp_path, capsys):
     # PFL's own set-up (its RBF network, its tendon model and the warnings about that model)
     assert main(["deploy", "--preset", "1-4D", "--controller", "adaptive", "--t-end", "0.05", "--json"]) == 0
     keys74 = set(json.loads(capsys.readouterr().out)) - {"rbf_centres", "rbf_sigma", "w_bar",
-                                                             "pfl_tendon_model", "warnings"}
+                                                             "pfl_tendon_model", "pfl_gains", "warnings"}
     assert keys74 - {"csv"} <= set(out), keys74 - set(out)
     assert out["controller"] == "lpv" and out["gamma"] == 20.0 and out["design_grid_passed"]
     assert out["uncertainty"] is None and out["path"] == "table-7-7-bases"

@@ -477,8 +477,11 @@ def test_sbc_failure_on_one_rank_one_error_nonzero_exit():
 
 @needs_mpi
 def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
-    # source: the same command on 1 process with scipy (frequencies to 1e-8, static
-    # iterations equal); the VTK file written once, by rank 0
+    # source: the same command on 1 process with scipy (frequencies to their round-off floor,
+    # static iterations within one); the VTK file written once, by rank 0. The floor: entries
+    # of K known to eps relative move f_1 by up to 3.6e-8 here (the first-order estimate of the
+    # test above, on the same 1-4 SBC at mesh 6); a CI run measured 1.08e-8 in f_1, above the
+    # 1e-8 this test first asked
     argv = ["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "6", "--modes", "6",
             "--json"]
     p = _cli_in_rank_dirs(tmp_path, 2, *argv, "--backend", "petsc", "--vtk", "m.vtu")
@@ -489,7 +492,7 @@ def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
                         cwd=tmp_path)
     d1 = json.loads(p1.stdout)
     assert abs(d2["iterations"] - d1["iterations"]) <= 1          # round-off floor (above)
-    assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
+    assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=4e-8, atol=0)
 
 
 @needs_petsc
