@@ -194,6 +194,11 @@ def test_spline_estimator_on_a_finer_grid_carries_the_certificate_off_the_design
     lmi, minX = largest_brl(ce.lyapunov, ce.gamma, de, fine)
     assert lmi < 0 and minX > 0
     assert verify_output_feedback(de, fine, W_e=W_E, W_u=W_U, certificate=ce).passed
+    # an estimator grid without the design points is refused (the separation start needs them)
+    off = design_output_feedback(d.state_feedback, nonlinear_oscillator([-0.1, 1.0, 2.0]), tracked=["y"],
+                                 measured=["y"], W_d=0.3, W_n=0.01, interpolation="spline")
+    with pytest.raises(InputError, match="contain the design points"):
+        rate_bounded_certificate(off, pl, W_e=W_E, W_u=W_U, rtol=1e-2)
 
 
 def test_refinement_budgets_and_refusals(nonlinear):

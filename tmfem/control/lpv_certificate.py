@@ -77,6 +77,10 @@ def estimator_error_lpv(design, plant: GriddedLPV) -> GeneralisedLPV:
     may be finer (it must contain them, as the separation start assumes its model exact
     there)."""
     from tmfem.control.lpv_output import _measurement
+    for a, e, name in zip(plant.axes, design.estimator.axes, plant.parameter_names):
+        if not np.all(np.min(np.abs(a[:, None] - e[None, :]), axis=1) <= 1e-12 * max(1.0, np.abs(e).max())):
+            raise InputError(f"rate-bounded certificate: expected the estimator's grid to contain the design "
+                             f"points, found {name} values {a.tolist()} against the estimator's {e.tolist()}")
     C, _ = _measurement(plant, design.measured)
     shp, n = plant.grid_shape, plant.nx
     L = np.array([design.model(rho)[3] for _, rho in plant.points()]).reshape(shp + (n, C.shape[-2]))
