@@ -84,7 +84,8 @@ def rest_length_for_tension(mtc, element_lengths, T, *, tol: float = 1e-12,
     a = k * np.asarray(element_lengths, dtype=float)              # lambda_e = a_e / r
     L = np.bincount(e, weights=element_lengths, minlength=n_t)
     EA, cable = mtc.tendon_EA, mtc.tendon_law == "cable"
-    r = EA * L / (EA + T)                                          # the linear law, eq. 3.9
+    # the linear law, eq. 3.9; a zero demand is r = L exactly (EA L / EA can be an ulp off)
+    r = np.where(T == 0.0, L, EA * L / (EA + T))
     for _ in range(max_iter):
         lam = a / r[e]
         taut = lam > 1.0
