@@ -262,7 +262,7 @@ def test_gauss_arrays_equal_scikit_fem_basis(mem):
     from skfem import Basis, ElementQuad1
     sb = Basis(mem.skmesh, ElementQuad1(), intorder=3)
     for k in range(4):
-        np.testing.assert_allclose(mem._N[k], np.array(sb.basis[k][0].value), atol=1e-14)
+        np.testing.assert_allclose(mem._N[k], np.asarray(sb.basis[k][0]), atol=1e-14)
         np.testing.assert_allclose(mem._dN[k], np.array(sb.basis[k][0].grad), rtol=1e-12,
                                    atol=1e-12 * np.abs(mem._dN).max())
     np.testing.assert_allclose(mem._dx, np.array(sb.dx), rtol=1e-13)

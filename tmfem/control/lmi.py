@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -73,7 +74,11 @@ def solve(problem, *, solver: str, what: str, lmi_sizes: dict, tol: float = 1e-8
         opts = dict(eps=1e-9, max_iters=100000)
     t0 = time.perf_counter()
     try:
-        problem.solve(solver=solver, **opts)
+        with warnings.catch_warnings():
+            # cvxpy's warning of an inaccurate solution: its status is checked (and logged) below
+            warnings.filterwarnings("ignore", message="Solution may be inaccurate",
+                                    category=UserWarning)
+            problem.solve(solver=solver, **opts)
     except cp.error.SolverError as exc:
         raise InfeasibleController(f"{what}: expected the SDP solver {solver} to finish, it "
                                    f"failed: {exc}") from None

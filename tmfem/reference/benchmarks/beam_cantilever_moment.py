@@ -77,5 +77,4 @@ def plot(result: dict, png):
     bx.set_title(f"max error {100 * result['max_error_over_tip_displacement']:.2f} % of |tip displacement|")
     bx.legend(fontsize=8)
     bx.grid(True, alpha=0.3)
-    fig.tight_layout()
     return save_figure(fig, png)
