@@ -4,12 +4,13 @@
 
 Configurations (each run in a fresh process, so that peak memory is per run):
   scipy    the embedded backend (SuperLU symmetric mode with nested dissection, ARPACK)
-  petsc    PETSc/SLEPc on 1 rank (MUMPS Cholesky, SLEPc Krylov-Schur shift-invert); the
-           model assembles through tmfem.fem.distributed (one rank: all elements)
+  petsc    PETSc/SLEPc on 1 rank (MUMPS Cholesky; eigen: the block Krylov-Schur
+           shift-invert, PetscBackend eig_solver='auto'); the model assembles through
+           tmfem.fem.distributed (one rank: all elements)
   petsc2   the same under ``mpiexec -n 2``: each rank evaluates and assembles half of the
-           membrane elements into one parallel matrix; MUMPS on both ranks; eigen: each
-           rank's own sequential factors of K - sigma M and half of each block's columns
-           (PetscBackend eig_solver='auto': 'redundant'; --eig-solver slepc|block chooses)
+           membrane elements into one parallel matrix; MUMPS on both ranks; eigen: the
+           block Krylov-Schur on the parallel factors ('auto'; --eig-solver
+           slepc|redundant chooses the others)
 Columns: free DOFs, iterations of the static solve on the finest mesh, time per iteration
 (static time over all iterations, mesh sequencing from n = 10 included), static time, eigen
 time, time inside the backend's factorisations (incl. MUMPS/SuperLU analysis; their number)

@@ -512,10 +512,18 @@ def test_petsc_block_and_slepc_agree_on_the_mtc_modes():
 
 
 @needs_petsc
-def test_slepc_options_choose_slepc_and_are_refused_by_the_block_solver():
+def test_slepc_options_choose_slepc_and_are_refused_by_the_block_solver(monkeypatch):
     from tmfem.solvers.petsc import PetscBackend
-    assert PetscBackend().eig_solver == "block"                  # one rank
+    assert PetscBackend().eig_solver == "block"
     assert PetscBackend(options="-eps_ncv 40").eig_solver == "slepc"
+    # the same from the environment (PETSc reads PETSC_OPTIONS at its initialisation, this
+    # choice at every backend's construction)
+    monkeypatch.setenv("PETSC_OPTIONS", "-ksp_view -eps_tol 1e-10")
+    assert PetscBackend().eig_solver == "slepc"
+    with pytest.raises(InputError, match=r"-eps_tol \(options= or PETSC_OPTIONS\) are SLEPc's"):
+        PetscBackend(eig_solver="block")
+    monkeypatch.setenv("PETSC_OPTIONS", "-ksp_view")
+    assert PetscBackend().eig_solver == "block"
     with pytest.raises(InputError, match="expected eig_solver='slepc'"):
         PetscBackend(options="-eps_ncv 40", eig_solver="block")
     with pytest.raises(InputError, match="expected eig_solver 'auto', 'redundant', 'block' or 'slepc'"):
@@ -533,10 +541,9 @@ def test_slepc_options_choose_slepc_and_are_refused_by_the_block_solver():
 
 @needs_mpi
 def test_block_solver_under_two_ranks_agrees_with_scipy(models, equilibria):
-    # source: the scipy model's 12 modes at its own equilibrium from the design; under 2
-    # ranks the default is the redundant block solver; the block solver on the distributed
-    # factors is asked for (rows of the basis distributed, inner products summed over the
-    # ranks)
+    # source: the scipy model's 12 modes at its own equilibrium from the design; the block
+    # solver on the distributed factors (the default, here asked for: rows of the basis
+    # distributed, inner products summed over the ranks)
     from tmfem.solvers.petsc import EIG_BLOCK_MIN_N
     p = _mpirun(2, "1-4", "6", "--start", "design", "--eig-solver", "block")
     assert p.returncode == 0, p.stderr
@@ -553,10 +560,10 @@ def test_redundant_block_eigen_agrees_with_scipy(models, equilibria, ranks):
     # source: the scipy model's 12 modes at its own equilibrium from the design (ARPACK on
     # the scipy matrices) and the model's scipy mass for the M-orthonormality; every rank
     # factorises the whole K - sigma M sequentially and solves its share of the columns of
-    # each block (tmfem.solvers.petsc_redundant), on request; "auto" takes SLEPc under
-    # P > 1 ranks (as fast or faster on idle cores, docs/backends.md) and agrees as well
+    # each block (tmfem.solvers.petsc_redundant), on request; "auto" takes the block solver
+    # on the distributed factors under P > 1 ranks too, and "slepc" SLEPc: they agree as well
     ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
-    for solver, ran in (("redundant", "redundant"), ("auto", "slepc")):
+    for solver, ran in (("redundant", "redundant"), ("auto", "block"), ("slepc", "slepc")):
         p = _mpirun(ranks, "1-4", "6", "--start", "design", "--eig-solver", solver)
         assert p.returncode == 0, p.stderr
         run = json.loads(p.stdout.strip())
@@ -692,7 +699,8 @@ def test_cli_eig_solver_chooses_the_solver_and_agrees_with_scipy():
 @needs_mpi
 def test_cli_eig_solver_redundant_under_two_ranks():
     # source: the 1-process scipy command (frequencies to 1e-8); under 2 ranks "redundant" runs
-    # (every rank factorises the whole K - sigma M) where "auto" would take SLEPc
+    # (every rank factorises the whole K - sigma M) where "auto" would take the distributed
+    # factors
     argv = ["modal", "--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
     ref = json.loads(_modal_cli(*argv[1:]).stdout)
     tmfem = [sys.executable, "-m", "tmfem"]

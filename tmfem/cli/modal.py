@@ -22,7 +22,7 @@ def configure(parser) -> None:
     parser.add_argument("--modes", type=int, default=12, help="number of modes (default 12)")
     parser.add_argument("--eig-solver", choices=("auto", "block", "slepc", "redundant"), default=None,
                         help="the PETSc backend's eigen solver (--backend petsc only; default auto: "
-                             "block Krylov-Schur on 1 rank, SLEPc under mpiexec; redundant: every "
+                             "block Krylov-Schur, on the distributed factors under mpiexec; redundant: every "
                              "rank factorises the whole K - sigma M, for cores shared with other "
                              "jobs; docs/backends.md). The JSON's eig_solver says which one ran")
     parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu "

@@ -10,11 +10,12 @@ Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py
     the requested accuracy).
 ``eigsh(K, M, k, sigma) -> (w, V)``
     The generalised Hermitian problem K v = w M v (eq. 5.32) by shift-and-invert about
-    ``sigma`` (the factorisation of K - sigma M by the same MUMPS Cholesky): on one rank
-    the block Krylov-Schur of :mod:`tmfem.solvers.block_krylov` (MUMPS solves of 8
-    right-hand sides at once), under ``mpiexec -n P > 1`` SLEPc EPS Krylov-Schur, or on
-    request the block method on every rank's own sequential factors with each block's
-    columns split over the ranks (:mod:`tmfem.solvers.petsc_redundant`; ``eig_solver``);
+    ``sigma`` (the factorisation of K - sigma M by the same MUMPS Cholesky): the block
+    Krylov-Schur of :mod:`tmfem.solvers.block_krylov` (MUMPS solves of 4 right-hand sides
+    at once, on the parallel factors under ``mpiexec -n P > 1``), or on request SLEPc EPS
+    Krylov-Schur or the block method on every rank's own sequential factors with each
+    block's columns split over the ranks (:mod:`tmfem.solvers.petsc_redundant`;
+    ``eig_solver``);
     the k eigenvalues nearest to sigma, vectors M-orthonormal (the
     B-inner product, then a Rayleigh-Ritz step in their span, so that repeated eigenvalues
     come out as full M-orthonormal pairs).
@@ -35,6 +36,7 @@ from __future__ import annotations
 
 import hashlib
 import logging
+import os
 import shlex
 import weakref
 from contextlib import contextmanager
@@ -50,9 +52,12 @@ log = logging.getLogger(__name__)
 
 PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/backends.md)"
 
-#: right-hand sides per MUMPS solve of the block eigensolver (8: 6.5 ms per column against
-#: 28 ms for single solves at 78k DOF; larger blocks need more columns in all)
-EIG_BLOCK = 8
+#: right-hand sides per MUMPS solve of the block eigensolver, on 1 rank and on the parallel
+#: factors of P > 1 ranks (4: 80-84 columns for 12 modes against 120-136 with 8, 53 single
+#: solves in SLEPc; at 309k DOF on 1 rank 9.7-12.7 s against 12.8-14.8 s with 8, on 2 ranks
+#: 8.1-10.7 s against SLEPc's 9.5-12.7 s; equal within the drift at 20k-78k DOF;
+#: docs/backends.md, "The block eigen solver with 4 right-hand sides")
+EIG_BLOCK = 4
 #: right-hand sides per block of the redundant eigensolver, split by columns over the ranks
 #: (8: 4 per rank on 2 ranks, 2.6-3.1 s of CPU at 78k DOF against 3.2-3.7 s with 8 per
 #: rank and 3.7-4.7 s with SLEPc; docs/backends.md, petsc6)
@@ -104,6 +109,17 @@ def parse_options(options) -> dict:
             out[key] = tok
             key = None
     return out
+
+
+def environment_slepc_options() -> list[str]:
+    """Names (without '-') of the SLEPc eigen solver's options (``-eps_*``) in the
+    ``PETSC_OPTIONS`` environment variable."""
+    text = os.environ.get("PETSC_OPTIONS", "")
+    try:
+        tokens = shlex.split(text)
+    except ValueError:                 # unbalanced quotes: PETSc splits on blanks
+        tokens = text.split()
+    return [t.lstrip("-") for t in tokens if t.startswith("-eps_")]
 
 
 def _is_number(tok: str) -> bool:
@@ -163,14 +179,12 @@ class PetscBackend:
         (on one rank it is ``"block"``); refused (:class:`~tmfem.errors.ResourceLimit`) when MUMPS
         estimates more than ``eig_memory_mb`` per rank; ``"slepc"``: SLEPc's Krylov-Schur
         (one parallel solve per vector), which reads the ``eps_`` options (refused with
-        the block solvers); ``"auto"`` (default): ``"block"`` on one rank, SLEPc under
-        ``mpiexec -n P > 1`` or when ``eps_`` options are given (PETSc 3.18's parallel MUMPS
-        solve of several right-hand sides costs as much per column as single solves: 36 ms
-        per column in blocks of 8 against 67 ms per single solve at 78k DOF, where the block
-        method needs ~2.3x the columns; ``"redundant"`` is as fast as SLEPc at 78k DOF and
-        27 % slower at 309k DOF on 2 idle cores, faster only on oversubscribed ones:
-        docs/backends.md). Problems of fewer than :data:`EIG_BLOCK_MIN_N` unknowns always
-        go to SLEPc.
+        the block solvers); ``"auto"`` (default): ``"block"``, or SLEPc when ``eps_``
+        options are given (with 4 right-hand sides per block the block method needs 1.6x
+        SLEPc's columns and is as fast as SLEPc on 2 ranks at 20k-78k DOF, 14 % faster at
+        309k DOF; ``"redundant"`` is as fast as SLEPc at 78k DOF and 27 % slower at 309k
+        DOF on 2 idle cores, faster only on oversubscribed ones: docs/backends.md).
+        Problems of fewer than :data:`EIG_BLOCK_MIN_N` unknowns always go to SLEPc.
     eig_memory_mb : int, optional
         Memory per rank for the redundant factorisation (MUMPS ICNTL(23), checked by MUMPS
         against its estimate before it allocates the factors); default
@@ -201,10 +215,13 @@ class PetscBackend:
         if eig_solver not in ("auto", "redundant", "block", "slepc"):
             raise InputError(f"backend 'petsc': expected eig_solver 'auto', 'redundant', 'block' or "
                              f"'slepc', found {eig_solver!r}")
-        eps = sorted(k for k in self.options if k.startswith("eps_"))
+        # SLEPc's own options, from options= or from PETSC_OPTIONS, choose SLEPc under "auto"
+        eps = sorted(set(k for k in self.options if k.startswith("eps_"))
+                     | set(environment_slepc_options()))
         if eps and eig_solver in ("block", "redundant"):
-            raise InputError(f"backend 'petsc': the options {', '.join('-' + k for k in eps)} are "
-                             f"SLEPc's: expected eig_solver='slepc' with them, found {eig_solver!r}")
+            raise InputError(f"backend 'petsc': the options {', '.join('-' + k for k in eps)} "
+                             f"(options= or PETSC_OPTIONS) are SLEPc's: expected "
+                             f"eig_solver='slepc' with them, found {eig_solver!r}")
         if eig_memory_mb is not None:
             if eig_solver != "redundant":
                 raise InputError(f"backend 'petsc': eig_memory_mb applies to the redundant eigen "
@@ -214,7 +231,7 @@ class PetscBackend:
         self.eig_memory_mb = None if eig_memory_mb is None else int(eig_memory_mb)
         parallel = self.PETSc.COMM_WORLD.size > 1
         if eig_solver == "auto":
-            eig_solver = "slepc" if eps or parallel else "block"
+            eig_solver = "slepc" if eps else "block"
         elif eig_solver == "redundant" and not parallel:
             eig_solver = "block"
         self.eig_solver = eig_solver
@@ -535,8 +552,8 @@ class PetscBackend:
         """The k eigenpairs of K v = w M v nearest to ``sigma`` (eq. 5.32), ascending, by
         shift-and-invert (module docstring): the block Krylov-Schur of
         :mod:`tmfem.solvers.block_krylov` for symmetric K, M of at least
-        :data:`EIG_BLOCK_MIN_N` unknowns (``eig_solver`` "block", or "auto" on one rank),
-        else SLEPc's Krylov-Schur; V (n, k) M-orthonormal."""
+        :data:`EIG_BLOCK_MIN_N` unknowns (``eig_solver`` "block" or "auto"), else SLEPc's
+        Krylov-Schur; V (n, k) M-orthonormal."""
         import scipy.linalg as la
         self._reap()
         Kp, _ = self._mat(K, cache=False)
