@@ -203,8 +203,9 @@ def main(argv=None) -> int:
     if not args.json:
         print(f"# 1-4 MTC, static from the undeformed membrane + 12 modes; {os.cpu_count()} cpus, "
               f"load average {os.getloadavg()[0]:.2f} (wall times grow with it; CPU s is rank 0's)")
+        from tmfem.solvers.petsc import EIG_BLOCK
         print("# eigen (column 'eig'): scipy ARPACK shift-invert; petsc the block Krylov-Schur on "
-              "MUMPS solves of 8 right-hand sides ('block'), on every rank's own factors with the "
+              f"MUMPS solves of {EIG_BLOCK} right-hand sides ('block'), on every rank's own factors with the "
               "columns split ('redundant') or SLEPc Krylov-Schur ('slepc'); PetscBackend "
               f"eig_solver={args.eig_solver!r}; petsc2 MPI waiting: "
               + ("yield (--mca mpi_yield_when_idle 1)" if args.mpi_yield else "busy (Open MPI default)"))
