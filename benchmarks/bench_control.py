@@ -11,7 +11,7 @@ SB10FD (docs/control.md).
 import argparse
 import time
 
-from tmfem.control.design import deployed_hinf
+from tmfem.control.linear.deployed_design import deployed_hinf
 from tmfem.errors import InfeasibleController
 from tmfem.system import load_preset
 

@@ -18,8 +18,8 @@ def main() -> None:
     ap.add_argument("--mesh", type=int, default=4)
     ap.add_argument("--t-end", type=float, default=0.5)
     args = ap.parse_args()
-    from tmfem.control.deploy import run_deployment
-    from tmfem.control.state_estimate import sbc_deployment_plant
+    from tmfem.control.deployment.run import run_deployment
+    from tmfem.control.fe_plant.state_estimate import sbc_deployment_plant
     from tmfem.reference.deployments import setup
     from tmfem.system import load_preset
     init = load_preset("1-4D-initial")

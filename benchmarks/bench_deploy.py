@@ -15,7 +15,7 @@ import re
 import time
 
 from tmfem.cli.deploy import setup
-from tmfem.control.deploy import run_deployment
+from tmfem.control.deployment.run import run_deployment
 
 #: (label, regular expression on "file:line(function)") of the profile breakdown
 PARTS = [("controller: M_hat, F_hat, B_hat (casadi)", r"model\.py:\d+\(matrices\)"),

@@ -3,8 +3,8 @@
 The deployed 2-3 system (preset 2-3-deploy, Table 7.7) or 1-4(D) (``--preset 1-4D``, SBC
 only) on the MTC (``--plant mtc``, default) or SBC model (``--plant sbc``) with N x n x n
 membrane elements, in closed loop with the LQR state feedback of the COM linearisation
-(:func:`tmfem.control.deploy.lqr_state_feedback`) through the COM-state estimate
-(:class:`tmfem.control.state_estimate.FEStatePlant`), from theta_11' = 0.02 rad/s, dt = 0.01 s.
+(:func:`tmfem.control.deployment.run.lqr_state_feedback`) through the COM-state estimate
+(:class:`tmfem.control.fe_plant.state_estimate.FEStatePlant`), from theta_11' = 0.02 rad/s, dt = 0.01 s.
 Target (issue 15): a 20 s 2-3 deployment on the 3x10x10 MTC model in under 10 minutes, i.e.
 under 0.3 s per step. Prints the time per step and where it goes (for the SBC plant also
 inside its Newton matrix: element assembly, the exponential map's tangent operator, the
@@ -28,8 +28,8 @@ import argparse
 import os
 import time
 
-from tmfem.control.deploy import lqr_state_feedback
-from tmfem.control.state_estimate import FEStatePlant
+from tmfem.control.deployment.run import lqr_state_feedback
+from tmfem.control.fe_plant.state_estimate import FEStatePlant
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.models.mtc.dynamics import MTCDynamics
 from tmfem.models.mtc.model import MTCModel
@@ -143,8 +143,8 @@ def main():
 def deployment(a):
     """The 2-3 deployment on the MTC plant (``--deploy``; ``--lpv-controller``: the LPV one of
     8.4), timed as :func:`main`, the controller's calls apart."""
-    from tmfem.control.deploy import run_deployment
-    from tmfem.control.state_estimate import deployment_plant
+    from tmfem.control.deployment.run import run_deployment
+    from tmfem.control.fe_plant.state_estimate import deployment_plant
     from tmfem.reference.deployments import setup
     t0 = time.perf_counter()
     if a.lpv_controller:

@@ -13,9 +13,9 @@ import argparse
 import time
 
 from tmfem.cli.control_lpv import printed_grid
-from tmfem.control.lpv_bounds import pointwise_state_feedback_bound
-from tmfem.control.lpv_plant import com_lpv_plant
-from tmfem.control.lpv_synthesis import interconnection_8_1, synthesize_state_feedback
+from tmfem.control.lpv.bounds import pointwise_state_feedback_bound
+from tmfem.control.lpv.plant import com_lpv_plant
+from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
 from tmfem.errors import InfeasibleController
 from tmfem.reference.tables import PRINTED, deployment_bases
 from tmfem.system import load_preset
@@ -41,7 +41,7 @@ def main():
     t, c = time.perf_counter(), time.process_time()
     try:
         if a.solver == "EIGOPT":
-            from tmfem.control.lpv_bisect import bisect_gamma
+            from tmfem.control.lpv.bisect import bisect_gamma
             lb = pointwise_state_feedback_bound(gp).lower_bound
             print(f"pointwise bound {lb:.4f}: {time.perf_counter() - t:.1f} s wall, {time.process_time() - c:.1f} s CPU")
             gc = {"auto": None, "on": True, "off": False}[a.grid_continuation]

@@ -1,4 +1,4 @@
-"""Rate-bounded certificate of the 2-3 output-feedback LPV loop (tmfem.control.lpv_certificate;
+"""Rate-bounded certificate of the 2-3 output-feedback LPV loop (tmfem.control.lpv.certificate;
 docs/lpv.md, output feedback) for a saved state-feedback design.
 
 Run: .venv/bin/python benchmarks/lpv_certificate.py --design F.npz [--budget 900] [--rtol 0.05]
@@ -35,11 +35,11 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.control.lpv_certificate import (RateBoundedCertificate, _frozen_norms, closed_loop_lpv,
+from tmfem.control.lpv.certificate import (RateBoundedCertificate, _frozen_norms, closed_loop_lpv,
                                            rate_bounded_certificate, refine_certificate)
-from tmfem.control.lpv_output import design_output_feedback, verify_output_feedback
-from tmfem.control.lpv_plant import com_lpv_plant
-from tmfem.control.lpv_synthesis import LPVStateFeedback
+from tmfem.control.lpv.output_feedback import design_output_feedback, verify_output_feedback
+from tmfem.control.lpv.plant import com_lpv_plant
+from tmfem.control.lpv.synthesis import LPVStateFeedback
 from tmfem.reference.tables import deployment_bases
 from tmfem.system import load_preset
 

@@ -1,6 +1,6 @@
 """Why a design-grid certificate of the 2-3 output-feedback loop fails on the 4x finer grid
 (docs/lpv.md, "On the 2-3 loop"): for a saved X(rho) of the separation form X = M diag(P, beta Z) M^T
-(tmfem.control.lpv_certificate.separation_start; M: eps -> e = x_z - eps),
+(tmfem.control.lpv.certificate.separation_start; M: eps -> e = x_z - eps),
 
 1. the largest relative LMI eigenvalue on the fine grid with the error part re-weighted,
    beta x each of --betas (design points and the others counted apart);
@@ -22,11 +22,11 @@ import json
 import numpy as np
 from lpv_certificate import plant_on
 
-from tmfem.control.lpv_bisect import _coefficients
-from tmfem.control.lpv_certificate import closed_loop_lpv, pointwise_lmi_eigs
-from tmfem.control.lpv_eigopt import EigOpt
-from tmfem.control.lpv_output import design_output_feedback
-from tmfem.control.lpv_synthesis import Coordinates, LPVStateFeedback, lmi_matrix
+from tmfem.control.lpv.bisect import _coefficients
+from tmfem.control.lpv.certificate import closed_loop_lpv, pointwise_lmi_eigs
+from tmfem.control.lpv.eigopt import EigOpt
+from tmfem.control.lpv.output_feedback import design_output_feedback
+from tmfem.control.lpv.synthesis import Coordinates, LPVStateFeedback, lmi_matrix
 from tmfem.system import load_preset
 
 

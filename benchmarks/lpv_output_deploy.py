@@ -1,5 +1,5 @@
 """LPV state feedback against the observer-based output feedback in the 2-3 deployment of 8.4,
-through the library (tmfem.control.deploy.run_deployment; docs/lpv.md, output feedback).
+through the library (tmfem.control.deployment.run.run_deployment; docs/lpv.md, output feedback).
 
 Run: .venv/bin/python benchmarks/lpv_output_deploy.py [--gamma 20] [--t-end 20] [--dt 2e-4]
          [--sigma 0 1e-3] [--schedule measured|estimate] [--plot out.png]
@@ -18,12 +18,12 @@ import time
 
 import numpy as np
 
-from tmfem.control.deploy import run_deployment
-from tmfem.control.lpv_controller import LPVController
-from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
-from tmfem.control.lpv_plant import com_lpv_plant
-from tmfem.control.lpv_synthesis import interconnection_8_1, synthesize_state_feedback
-from tmfem.control.reference_trajectory import DeploymentReference
+from tmfem.control.deployment.run import run_deployment
+from tmfem.control.lpv.controller import LPVController
+from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
+from tmfem.control.lpv.plant import com_lpv_plant
+from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
+from tmfem.control.deployment.reference_trajectory import DeploymentReference
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.models.com.model import ControlOrientedModel
 from tmfem.reference.tables import deployment_bases

@@ -18,8 +18,8 @@ import dataclasses
 
 import numpy as np
 
-from tmfem.control.deploy import StatePlant, run_deployment
-from tmfem.control.state_estimate import mtc_deployment_plant
+from tmfem.control.deployment.run import StatePlant, run_deployment
+from tmfem.control.fe_plant.state_estimate import mtc_deployment_plant
 from tmfem.errors import ConvergenceError
 from tmfem.reference.deployments import setup
 from tmfem.simulation.driver import simulate

@@ -10,7 +10,7 @@ the FE plants started in their own packaged equilibrium as `tmfem deploy --plant
 * ``open-loop``: the rest lengths u(t) of the COM closed-loop run applied to each FE plant
   (zero-order hold): the largest bar deviation from the COM run;
 * ``loop``: the spectral radius of the linear sampled loop at the start
-  (:func:`tmfem.control.fe_sampled_loop.lpv_start_loop`) on the SBC plant (bars as designed,
+  (:func:`tmfem.control.fe_plant.sampled_loop.lpv_start_loop`) on the SBC plant (bars as designed,
   E x 10, E x 100, q from the bar chords), the MTC plant and the SBC plant with q from the
   bars' rigid fit (the default of the FE plants);
 * ``runs``: the closed loops over --t-end: record, failure, largest bar deviation from the COM
@@ -24,10 +24,10 @@ import dataclasses
 import numpy as np
 
 from tmfem.cli.deploy_lpv import design
-from tmfem.control.deploy import run_deployment
-from tmfem.control.fe_sampled_loop import dominant_eigenvalues, lpv_start_loop
-from tmfem.control.lpv_deploy import state_feedback_controller
-from tmfem.control.state_estimate import deployment_plant
+from tmfem.control.deployment.run import run_deployment
+from tmfem.control.fe_plant.sampled_loop import dominant_eigenvalues, lpv_start_loop
+from tmfem.control.lpv.deployment import state_feedback_controller
+from tmfem.control.fe_plant.state_estimate import deployment_plant
 from tmfem.errors import ConvergenceError
 from tmfem.reference.deployments import lpv_setup
 from tmfem.simulation.driver import simulate

@@ -20,7 +20,7 @@ and at 2, 6 and 12.5 Hz, and G_COM^-1 G_SBC (identity where the SBC answers as t
 uncertainty ``initial``, the PFL at the reference) over ``--t-end`` on the SBC plant (plant
 damping ``--beta``, default 0) and on the COM: record, switch, final error, the FE report and
 the deviation; ``--plot`` writes the comparison figure.
-``--actuation force``: the SBC tendons tension-servoed (:mod:`tmfem.control.tension_actuation`)
+``--actuation force``: the SBC tendons tension-servoed (:mod:`tmfem.control.fe_plant.tension_actuation`)
 in ``closed`` and ``weak``; ``--bar-E-factor F``: the SBC plant of ``closed`` and ``weak`` built
 with the bars' Young's modulus times F (the COM, of rigid bars, unchanged).
 """
@@ -32,8 +32,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from tmfem.control.deploy import StatePlant, run_deployment
-from tmfem.control.state_estimate import FEStatePlant, sbc_deployment_plant, start_rest_lengths
+from tmfem.control.deployment.run import StatePlant, run_deployment
+from tmfem.control.fe_plant.state_estimate import FEStatePlant, sbc_deployment_plant, start_rest_lengths
 from tmfem.reference.deployments import setup
 from tmfem.simulation.controllers import OpenLoop
 from tmfem.simulation.driver import simulate
@@ -132,7 +132,7 @@ def weak(mesh, actuation, bar_factor=1.0):
     the COM's inversion (identity where the SBC answers as the COM). Its eigenvalues far from
     1 are the directions the inversion gets wrong; the singular values of B_q [1_SL, 1_SU]
     (the COM at the packaged state) say which is weak."""
-    from tmfem.control.pfl import partition
+    from tmfem.control.deployment.pfl import partition
     s = setup("1-4D", controller="adaptive")
     com, nq = s.model, s.model.nq
     terms = partition(*com.matrices(s.z0, np.zeros(com.nz)), nq=nq)
@@ -199,7 +199,7 @@ def weak(mesh, actuation, bar_factor=1.0):
 
 
 def deploy(mesh, t_end, actuation, bar_factor, beta, plot):
-    from tmfem.control.plant_compare import deviation_summary, plant_deviation
+    from tmfem.control.fe_plant.compare import deviation_summary, plant_deviation
     runs = {}
     for plant in ("sbc", "com"):
         s = setup("1-4D", controller="adaptive-hinf", evaluation="reference")

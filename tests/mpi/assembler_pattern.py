@@ -1,4 +1,4 @@
-"""Run under mpiexec (or alone) by tests/test_petsc_backend.py: the DistributedAssembler's
+"""Run under mpiexec (or alone) by tests/solvers/test_petsc_backend.py: the DistributedAssembler's
 pattern and values against scipy's T^T K T on the unknowns, for element groups keyed per
 block pair (4-node elements of 3 consecutive dofs per node), a group of permuted local dofs
 (no blocks: keyed per entry) and an entry group, with a constraint map that ties dofs with

@@ -1,4 +1,4 @@
-"""Run under mpiexec by tests/test_petsc_backend.py: a finite-element model on the PETSc
+"""Run under mpiexec by tests/solvers/test_petsc_backend.py: a finite-element model on the PETSc
 backend, its tangent and mass assembled rank by rank (tmfem.fem.distributed: each rank
 evaluates its share of the membrane or shell elements), static equilibrium and 12 modes;
 rank 0 prints one JSON document.

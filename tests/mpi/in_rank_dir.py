@@ -1,4 +1,4 @@
-"""Run under mpiexec by tests/test_petsc_backend.py: ``tmfem ARGS...`` with the working
+"""Run under mpiexec by tests/solvers/test_petsc_backend.py: ``tmfem ARGS...`` with the working
 directory DIR/rank<r> of each rank r, so that relative output paths show which ranks wrote
 files (only rank 0 may).
 

@@ -1,4 +1,4 @@
-"""Run under mpiexec by tests/test_petsc_backend.py: two matrices whose rows on rank 0 have the
+"""Run under mpiexec by tests/solvers/test_petsc_backend.py: two matrices whose rows on rank 0 have the
 same pattern and whose rows on the last rank differ. The backend's pattern cache must take
 the same branch on every rank (else one rank creates a Mat while another updates one: a
 hang). Rank 0 prints the relative residuals of the two solves as JSON."""

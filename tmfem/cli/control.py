@@ -86,7 +86,7 @@ def run(args) -> dict:
         raise InputError(f"{args.action}: options {['--' + k.replace('_', '-') for k in lpv_given]} apply "
                          "to `tmfem control lpv` only")
     if args.action == "recheck":
-        from tmfem.control.design import recheck
+        from tmfem.control.linear.deployed_design import recheck
         if args.spec is None or args.preset is not None:
             raise InputError("recheck: expected one design file (.npz), found "
                              f"spec={args.spec!r}, --preset={args.preset!r}")
@@ -94,7 +94,7 @@ def run(args) -> dict:
         if given:
             raise InputError(f"recheck: options {given} do not apply")
         return {"action": "recheck", "file": args.spec, **recheck(args.spec)}
-    from tmfem.control.design import deployed_hinf, save_design
+    from tmfem.control.linear.deployed_design import deployed_hinf, save_design
     if args.action == "pbh":
         given = [k for k in _HINF_ONLY if getattr(args, k) is not None]
         if given:
@@ -115,14 +115,14 @@ def run(args) -> dict:
                         pbh_tol=args.pbh_tol, method=args.method or "lmi")
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
-        from tmfem.control.analysis import damping_table
+        from tmfem.control.linear.loop_plots import damping_table
         out["closed_loop_slowest"] = [list(r) for r in
                                       sorted(damping_table(res.design.closed_loop), key=lambda r: -r[2])[:3]]
         if args.save:
             save_design(res.design, args.save)
             out["saved"] = args.save
         if args.plot:
-            from tmfem.control.analysis import plot_design
+            from tmfem.control.linear.loop_plots import plot_design
             plot_design(res.design, open_loop=res.generalized, path=args.plot,
                         title=f"{system.name}: H-infinity design, gamma = {res.design.gamma:.4g}, "
                               f"alpha_1 = {res.design.alpha:g}")

@@ -126,7 +126,7 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
     start = None
     if eig["start"] is not None:
         from pathlib import Path
-        from tmfem.control.lpv_synthesis import LPVStateFeedback
+        from tmfem.control.lpv.synthesis import LPVStateFeedback
         if not Path(eig["start"]).is_file():
             raise InputError(f"--start: expected a design saved by `tmfem control lpv --save`, found no file "
                              f"{eig['start']!r}")
@@ -157,9 +157,9 @@ def design_plant(cfg: dict, *, rate_deg: float):
     """The gridded plant of ``cfg`` (:func:`check_synthesis`), its interconnection (Fig. 8.1)
     and the pointwise lower bound of gamma; returns (plant, gp, bound, JSON dict)."""
     from tmfem.cli.common import progress_bar
-    from tmfem.control.lpv_bounds import pointwise_state_feedback_bound
-    from tmfem.control.lpv_plant import com_lpv_plant
-    from tmfem.control.lpv_synthesis import interconnection_8_1
+    from tmfem.control.lpv.bounds import pointwise_state_feedback_bound
+    from tmfem.control.lpv.plant import com_lpv_plant
+    from tmfem.control.lpv.synthesis import interconnection_8_1
     from tmfem.reference.tables import deployment_bases
     s, th, ps = cfg["system"], cfg["theta"], cfg["psi"]
     rb = np.radians(rate_deg)
@@ -177,11 +177,11 @@ def design_plant(cfg: dict, *, rate_deg: float):
 def synthesise(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
     """The controller (EIGOPT: gamma bisection from --gamma or 2 x the bound, or the fixed
     level; CLARABEL/SCS: their gamma minimisation) and its JSON entries."""
-    from tmfem.control.lpv_synthesis import synthesize_state_feedback
+    from tmfem.control.lpv.synthesis import synthesize_state_feedback
     try:
         if cfg["solver"] == "EIGOPT" and not cfg["fixed"]:
             from tmfem.cli.common import progress_bar
-            from tmfem.control.lpv_bisect import bisect_gamma
+            from tmfem.control.lpv.bisect import bisect_gamma
             upper = cfg["gamma"] if cfg["gamma"] is not None else 2.0 * bound.lower_bound
             if upper <= bound.lower_bound:
                 raise InputError(f"--gamma {upper:g}: expected an upper level above the pointwise lower "
@@ -214,7 +214,7 @@ def refined_plant(s, plant, factor: int, *, what: str):
     """The plant of system ``s`` on the grid ``factor`` times finer than ``plant``'s (new COM
     linearisations, the design's membrane points)."""
     from tmfem.cli.common import progress_bar
-    from tmfem.control.lpv_plant import com_lpv_plant
+    from tmfem.control.lpv.plant import com_lpv_plant
     from tmfem.reference.tables import deployment_bases
     axes = plant.refined(factor)
     with progress_bar(axes[0].size * axes[1].size, 1, f"{what} (grid points)") as bar:
@@ -238,10 +238,10 @@ def check_estimator_refine(R, *, refine: int, output_feedback: bool) -> int:
 
 
 def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
-    """:func:`tmfem.control.lpv_verify.verify` on the grid ``refine`` times finer
+    """:func:`tmfem.control.lpv.verify.verify` on the grid ``refine`` times finer
     (:func:`fine_plant`, or ``fine`` when given); refuses a controller that fails there."""
-    from tmfem.control.lpv_synthesis import interconnection_8_1
-    from tmfem.control.lpv_verify import verify
+    from tmfem.control.lpv.synthesis import interconnection_8_1
+    from tmfem.control.lpv.verify import verify
     fine = fine_plant(cfg, plant) if fine is None else fine
     return verify(ctrl, interconnection_8_1(fine, tracked=cfg["system"].q_names), sample_time=sample_time)
 
@@ -253,13 +253,13 @@ def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None, interpola
     largest frozen closed-loop norm from [q_d, n_d, n] to p over the fine grid
     (``state_feedback_gamma`` the certified level of K(rho)); ``verification_max_eig`` stays
     the LMI of K(rho) re-checked there. ``certificate``: (rtol, time budget, rounds) of the
-    rate-bounded certificate of the loop (:mod:`tmfem.control.lpv_certificate`) on the design grid,
+    rate-bounded certificate of the loop (:mod:`tmfem.control.lpv.certificate`) on the design grid,
     refined by cutting planes on the fine grid (at most ``rounds`` re-solves within another time
     budget) and re-checked there (keys ``rate_bounded_*``), or None. ``estimator_plant``: the
     Kalman estimator's plant on a grid finer than the design's (default ``plant``);
     ``interpolation``: the estimator's between its grid points."""
     from tmfem.cli.common import progress_bar
-    from tmfem.control.lpv_output import design_output_feedback, verify_output_feedback
+    from tmfem.control.lpv.output_feedback import design_output_feedback, verify_output_feedback
     nz = plant.nx // 2
     measured = list(plant.state_names[:nz])          # q and the K point coordinates (eq. 5.17)
     t0 = time.perf_counter()
@@ -268,7 +268,7 @@ def output_feedback(ctrl, plant, fine, s, noise, dt, certificate=None, interpola
                                interpolation=interpolation)
     cert = None
     if certificate is not None:
-        from tmfem.control.lpv_certificate import rate_bounded_certificate, refine_certificate
+        from tmfem.control.lpv.certificate import rate_bounded_certificate, refine_certificate
         rtol, budget, rounds = certificate
         with progress_bar(budget, 1, "rate-bounded certificate (s of budget)") as bar:
             t1 = time.perf_counter()

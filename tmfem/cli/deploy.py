@@ -110,9 +110,9 @@ def configure(parser) -> None:
 
 def pfl_gains(text: str) -> tuple:
     """argparse ``type`` of ``--gains``: four comma-separated numbers omega_0, omega_e, tau,
-    d_c (checked by :class:`tmfem.control.adaptive.Gains`)."""
+    d_c (checked by :class:`tmfem.control.deployment.adaptive.Gains`)."""
     import argparse
-    from tmfem.control.adaptive import Gains
+    from tmfem.control.deployment.adaptive import Gains
     parts = text.split(",")
     try:
         values = tuple(float(v) for v in parts)
@@ -216,7 +216,7 @@ def plant_actuation(args) -> str:
 def controlled_tendon_law(args, plant: str) -> str:
     """The tendon law the controller drives on ``plant``: a force-actuated FE plant's
     tendons follow the COM's law at the measured q (the fixed rates of eq. 5.19,
-    :mod:`tmfem.control.tension_actuation`), otherwise :func:`plant_tendons`."""
+    :mod:`tmfem.control.fe_plant.tension_actuation`), otherwise :func:`plant_tendons`."""
     if plant != "com" and plant_actuation(args) == "force":
         return "fixed-rate"
     return plant_tendons(args, plant)
@@ -260,8 +260,8 @@ def plant_options(args, plant: str, mesh_n) -> dict:
 
 def damping_tangent(args) -> str:
     """The FE plant's damping tangent: ``--plant-damping-tangent``, default
-    :data:`tmfem.control.state_estimate.DEPLOYMENT_DAMPING_TANGENT`."""
-    from tmfem.control.state_estimate import DEPLOYMENT_DAMPING_TANGENT
+    :data:`tmfem.control.fe_plant.state_estimate.DEPLOYMENT_DAMPING_TANGENT`."""
+    from tmfem.control.fe_plant.state_estimate import DEPLOYMENT_DAMPING_TANGENT
     return getattr(args, "plant_damping_tangent", None) or DEPLOYMENT_DAMPING_TANGENT
 
 
@@ -273,7 +273,7 @@ def sbc_bars(args) -> str:
 
 def plant_arguments(args, plant: str) -> dict:
     """The FE plant's options of a run on ``plant`` as the keyword arguments of
-    :func:`tmfem.control.state_estimate.deployment_plant` (both deployment kinds)."""
+    :func:`tmfem.control.fe_plant.state_estimate.deployment_plant` (both deployment kinds)."""
     return {"tendon_law": args.plant_tendons if plant == "mtc" else None,
             "bars": sbc_bars(args) if plant == "sbc" else None,
             "beta": (args.plant_damping or 0.0) if plant != "com" else 0.0,
@@ -284,8 +284,8 @@ def plant_arguments(args, plant: str) -> dict:
 def _run_on(args, s, plant_kind: str, mesh_n):
     """The deployment of set-up ``s`` on ``plant_kind``; an FE-plant run that diverges returns
     its record up to the failure (``failure``)."""
-    from tmfem.control.deploy import run_deployment
-    from tmfem.control.state_estimate import deployment_plant
+    from tmfem.control.deployment.run import run_deployment
+    from tmfem.control.fe_plant.state_estimate import deployment_plant
     from tmfem.system.presets import load_preset
     plant = deployment_plant(plant_kind, s.model, load_preset(args.preset + "-initial"),
                              mesh_n=mesh_n or 10, **plant_arguments(args, plant_kind))
@@ -304,7 +304,7 @@ def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str,
     result and its extra JSON entries; ``controller``: those options (JSON of both runs),
     ``about``: their summary for the plot's title, ``reference``: the equation of the
     reference q_d (the plot's legend). The CSV and the plot if asked for."""
-    from tmfem.control.plant_compare import deviation_summary, plant_deviation
+    from tmfem.control.fe_plant.compare import deviation_summary, plant_deviation
     from tmfem.reference.deployments import write_csv
     r2, extra = rerun(args.compare_plant)
     dev = plant_deviation(r, r2)

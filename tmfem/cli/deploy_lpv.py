@@ -6,7 +6,7 @@ its design plant rebuilt on its grid) or synthesised on the fly with the options
 ``tmfem control lpv`` (EIGOPT by default, with the sampled-loop constraint at --dt), then
 verified on the finer grid. A controller built elsewhere (any object with the reset/output/
 update/name protocol of :mod:`tmfem.simulation.controllers` reading the measured LPV
-signals, :class:`tmfem.control.lpv_deploy.LPVDeployment`) deploys through :data:`DESIGNS`
+signals, :class:`tmfem.control.lpv.deployment.LPVDeployment`) deploys through :data:`DESIGNS`
 and :data:`BUILDERS` (a new ``--controller`` name adds an entry to each and to
 :data:`tmfem.reference.deployments.LPV_CONTROLLERS`).
 """
@@ -84,22 +84,22 @@ def check(args) -> int | None:
 
 def lpv_state_feedback(dep, design):
     """--controller lpv: the scheduled state feedback of 8.3 on the measured LPV signals."""
-    from tmfem.control.lpv_deploy import state_feedback_controller
+    from tmfem.control.lpv.deployment import state_feedback_controller
     return state_feedback_controller(dep, design)
 
 
 def lpv_output_feedback(dep, design, *, interpolation: str = "multilinear", estimator_plant=None):
-    """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv_output`
+    """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv.output_feedback`
     with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
     reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
     the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
     enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/lpv.md); the control law about rho_r(t)
     as the state feedback's; the estimator is driven by the input saturated to the rest-length
     limits [1 mm, |tendon|(q_m)] of the run at the measured q; ``interpolation``: the
-    estimator's between grid points (:class:`~tmfem.control.lpv_plant.GriddedLPV`);
+    estimator's between grid points (:class:`~tmfem.control.lpv.plant.GriddedLPV`);
     ``estimator_plant``: its plant on a finer grid than the design's (default the design plant)."""
-    from tmfem.control.limits import tendon_lengths
-    from tmfem.control.lpv_output import LPVOutputController, design_output_feedback
+    from tmfem.control.deployment.limits import tendon_lengths
+    from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
     pl, system = dep.plant, dep.model.system
     nz, n, nq = pl.nx // 2, pl.nx, dep.model.nq
     of = design_output_feedback(design, pl if estimator_plant is None else estimator_plant,
@@ -114,11 +114,11 @@ def lpv_output_feedback(dep, design, *, interpolation: str = "multilinear", esti
 def design(args, preset: str):
     """(design plant, state-feedback design, JSON entries): loaded and checked on its grid
     (sampled at --dt), or synthesised and verified on the finer grid."""
-    from tmfem.control.lpv_synthesis import LPVStateFeedback, interconnection_8_1
-    from tmfem.control.lpv_verify import verify
+    from tmfem.control.lpv.synthesis import LPVStateFeedback, interconnection_8_1
+    from tmfem.control.lpv.verify import verify
     if args.lpv_controller is not None:
         from tmfem.cli.common import progress_bar
-        from tmfem.control.lpv_plant import com_lpv_plant
+        from tmfem.control.lpv.plant import com_lpv_plant
         from tmfem.reference.tables import deployment_bases
         from tmfem.system import load_preset
         d = LPVStateFeedback.load(args.lpv_controller)
@@ -156,8 +156,8 @@ def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
     the rest lengths the controller starts with (docs/fe-plant.md)."""
     from tmfem.cli.common import progress_bar
     from tmfem.cli.deploy import plant_arguments
-    from tmfem.control.deploy import run_deployment
-    from tmfem.control.state_estimate import deployment_plant
+    from tmfem.control.deployment.run import run_deployment
+    from tmfem.control.fe_plant.state_estimate import deployment_plant
     c = BUILDERS[args.controller](dep, d, **estimator_options)
     if args.noise:
         from tmfem.simulation.controllers import MeasurementNoise

@@ -1,18 +1,17 @@
-"""Linear control of tensegrity-membrane systems (dissertation 7.3-7.4, eqs. 5.62-5.71).
+"""Control of tensegrity-membrane systems (dissertation ch. 5.5-5.6, 7 and 8).
 
-* :mod:`tmfem.control.plant`: linear plant at a deployed configuration in (q, v)
-  coordinates (eqs. 5.17-5.18, 5.62) and the generalised plant of Fig. 7.1;
-* :mod:`tmfem.control.pbh`: PBH eigenvector tests with margins (eq. 5.71);
-* :mod:`tmfem.control.hinf`: H-infinity output feedback by eliminated LMIs with
-  alpha-stability, controller recovery (eqs. 5.63-5.67), state feedback;
-* :mod:`tmfem.control.hinf_central`: the central (minimum-entropy) controller at
-  (1 + tol) gamma_opt, one well-defined member of a degenerate optimum's family;
-* :mod:`tmfem.control.design`: the end-to-end design, saving and re-checking;
-* :mod:`tmfem.control.analysis`: closed-loop plots;
-* deployment (7.2, 7.4, 7.6; docs/deployment.md): :mod:`tmfem.control.reference_trajectory`
-  (eq. 5.68), :mod:`tmfem.control.pfl` (eqs. 5.39-5.41), :mod:`tmfem.control.rbf`
-  (eqs. 5.44, 5.51-5.52), :mod:`tmfem.control.adaptive` (eq. 5.58), :mod:`tmfem.control.switching`
-  (eq. 5.70), :mod:`tmfem.control.deploy` (closed-loop runs; uses tmfem.simulation).
+Subpackages, one concept each:
+
+* :mod:`tmfem.control.linear`: linear plants at a deployed configuration and the generalised
+  plant of Fig. 7.1, PBH tests (eq. 5.71), H-infinity synthesis by LMIs and by Riccati
+  equations with alpha-stability (eqs. 5.63-5.67), the central controller, the end-to-end
+  design and its closed-loop plots;
+* :mod:`tmfem.control.deployment`: deployment by reference trajectories (eq. 5.68), partial
+  feedback linearisation (eqs. 5.39-5.41), RBF adaptation (eqs. 5.44, 5.51-5.58), rest-length
+  limits, the switch to a linear controller (eq. 5.70), closed-loop runs and stress recovery;
+* :mod:`tmfem.control.lpv`: gridded LPV synthesis, verification and deployment (ch. 8);
+* :mod:`tmfem.control.fe_plant`: the finite-element models as plants of a deployment
+  controller (state estimates, tension actuation, sampled loops, plant comparison).
 
 May import system, models, solvers, errors; imported only by cli, reference, simulation.
 See docs/control.md.

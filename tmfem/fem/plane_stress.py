@@ -22,7 +22,7 @@ point-load solution grows like log r), so the corner force for a given corner
 displacement decreases slowly (about like 1 / log n) and the peak stresses next to the
 corners grow without bound as the mesh is refined. The corner force F_Delta of eq. 3.21
 and the maximum stresses of Tables 6.3 and 6.5 are therefore properties of the mesh
-(4 x 10 x 10 in 6.2), not of the continuum; see tests/test_plane_stress.py.
+(4 x 10 x 10 in 6.2), not of the continuum; see tests/fem/test_plane_stress.py.
 
 ``law="tension-field"`` replaces eq. 5.8 by the tension-field (wrinkling) law of
 :mod:`tmfem.fem.tension_field` applied to the small strain eps: the problem is then

@@ -1,6 +1,6 @@
 """Plots and animation of a deployment run (dissertation Figures 7.2-7.5).
 
-``result`` is a :class:`tmfem.control.deploy.DeploymentResult` (read by attribute: t, z, q_d,
+``result`` is a :class:`tmfem.control.deployment.run.DeploymentResult` (read by attribute: t, z, q_d,
 w, u, lengths, switch_time, names).
 """
 from __future__ import annotations

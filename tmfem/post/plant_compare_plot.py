@@ -1,5 +1,5 @@
 """Plot of the same deployment on two plants (issue 15; deviations from
-:func:`tmfem.control.plant_compare.plant_deviation`)."""
+:func:`tmfem.control.fe_plant.compare.plant_deviation`)."""
 from __future__ import annotations
 
 import textwrap

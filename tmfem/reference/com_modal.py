@@ -41,7 +41,7 @@ def printed_bar_load_prestress_scale(model, *, mesh_n: int = 10) -> float | None
     the MTC comparison (:func:`tmfem.reference.designs.calibrate_on_bar_load`) applied to the
     COM's design. F_design is the largest stage-1 bar compression of
     :func:`tmfem.equilibrium.design.design_equilibrium`, whose tendon forces the COM's design
-    reproduces (tests/test_com_2_3.py); all design loads scale with the prestress (3.2)."""
+    reproduces (tests/models/com/test_com_2_3.py); all design loads scale with the prestress (3.2)."""
     pr = model.system.printed
     p = pr.get("bar_load_stage1", pr.get("bar_load"))
     if p is None or model.design is None:

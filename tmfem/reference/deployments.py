@@ -56,9 +56,9 @@ def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | 
     reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
     ``"linear"`` (every symmetric parameter linear in s). ``evaluation``: where the PFL
     evaluates its model terms (``"state"``, eq. 5.58, or ``"reference"``); ``tendon_law``: its
-    tendon model (``"fixed-rate"``, eq. 5.19, or ``"cable"``, :mod:`tmfem.control.adaptive`)."""
-    from tmfem.control.adaptive import Gains
-    from tmfem.control.deploy import build_deployment
+    tendon model (``"fixed-rate"``, eq. 5.19, or ``"cable"``, :mod:`tmfem.control.deployment.adaptive`)."""
+    from tmfem.control.deployment.adaptive import Gains
+    from tmfem.control.deployment.run import build_deployment
     from tmfem.reference.tables import deployment_bases
     from tmfem.system.presets import load_preset
     check_choices(preset, controller=controller, uncertainty=uncertainty, path=path)
@@ -109,7 +109,7 @@ def csv_columns(r) -> list[str]:
 def _tendon_signals(r) -> list:
     """(column prefix, array (n, n_t)) of the run's tendon signals after the COM columns: the
     plant's own tendon forces ``T`` and, with force actuation, the tension demand ``T_d`` and
-    the FE rest lengths set ``r_fe`` (:class:`tmfem.control.deploy.DeploymentResult`)."""
+    the FE rest lengths set ``r_fe`` (:class:`tmfem.control.deployment.run.DeploymentResult`)."""
     out = [("T", r.tendon_force)] if r.tendon_force.size else []
     return out + [(p, r.actuator[k]) for p, k in (("T_d", "tension_demand"),
                                                   ("r_fe", "fe_rest_lengths")) if k in r.actuator]
@@ -170,10 +170,10 @@ LPV_CONTROLLERS = ("lpv", "lpv-output")
 def lpv_setup(preset: str, plant, *, model_at: str = "final", system=None):
     """The deployment of 8.4 of ``preset`` for the design plant ``plant`` (its grid built with
     :func:`tmfem.reference.tables.deployment_bases`, as ``tmfem control lpv``):
-    :func:`tmfem.control.lpv_deploy.lpv_deployment` with the parameters of
+    :func:`tmfem.control.lpv.deployment.lpv_deployment` with the parameters of
     :data:`LPV_DEPLOYMENTS`; ``system``: the System deployed, default the preset's (another
     one, e.g. with stiffer bars, for a perturbation study of an FE plant)."""
-    from tmfem.control.lpv_deploy import lpv_deployment
+    from tmfem.control.lpv.deployment import lpv_deployment
     from tmfem.reference.tables import deployment_bases
     from tmfem.system.presets import load_preset
     if preset not in LPV_DEPLOYMENTS:

@@ -2,7 +2,7 @@
 
 Each function builds a small problem from the truss/membrane kernels and the solvers and
 returns plain arrays, so that ``demos/element_benchmarks.py`` prints and plots them and
-``tests/test_element_benchmarks.py`` compares them with their closed forms:
+``tests/fem/test_element_benchmarks.py`` compares them with their closed forms:
 
 * :func:`two_bar_arch` -- the two-bar (von Mises) arch of 4.5.3 by arc length, with the
   closed-form total-Lagrangian (Green strain) and engineering-strain load curves;

@@ -291,7 +291,7 @@ def _run_progress(factory, label):
 def _deployment(out: Path, spec: dict, *, dt: float, add, progress) -> dict:
     """Run the deployment ``spec`` (:data:`REPORT_DEPLOYMENT`) and write its CSV, plot, GIF and
     ParaView series into ``out`` (:func:`tmfem.reference.deployments.write_outputs`)."""
-    from tmfem.control.deploy import run_deployment
+    from tmfem.control.deployment.run import run_deployment
     from tmfem.reference.deployments import setup, write_outputs
 
     p = spec["preset"]

@@ -13,7 +13,7 @@ printed rest lengths:
   free parameters of a symmetric configuration.
 
 The reconstructions themselves (what was fitted, to which numbers, how well) are recorded in
-``docs/errata.md`` and asserted in ``tests/test_tables.py``; ``demos/equilibrium_*.py`` print
+``docs/errata.md`` and asserted in ``tests/reference/test_tables.py``; ``demos/equilibrium_*.py`` print
 them beside the printed tables.
 """
 from __future__ import annotations

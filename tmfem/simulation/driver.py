@@ -9,7 +9,7 @@ the inputs u from a controller sampled every step (zero-order hold, see
 
 and the plant stepped from t_n to t_n+1 with u_n held -- or, for a plant with actuators
 (``plant.actuate(x, u)``), with the input its model receives for the command u_n at the
-sampled state x_n held (a tension-servoed tendon, :mod:`tmfem.control.tension_actuation`;
+sampled state x_n held (a tension-servoed tendon, :mod:`tmfem.control.fe_plant.tension_actuation`;
 the record keeps the commanded u_n); a plant with a per-sample hook (``plant.sample(x, u)``)
 is told the sampled state x_n and that held input before the step (an FE plant's damping on
 the current tangent, :meth:`tmfem.models.fe_plant.FEPlant.sample`). Any model's plant serves: the

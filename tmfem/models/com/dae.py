@@ -1,7 +1,7 @@
 """The DAE of the control-oriented model (eq. 5.19) evaluated numerically, and the coordinate
 partitioning of eqs. 5.23-5.28 done numerically on it: an evaluation path independent of the
 symbolic elimination of :mod:`tmfem.models.com.graphs`, used to check it (tests, benchmark)
-and by controllers that need the DAE's own terms (:mod:`tmfem.control.adaptive`).
+and by controllers that need the DAE's own terms (:mod:`tmfem.control.deployment.adaptive`).
 
 zeta comes from Newton on Phi (:meth:`ControlOrientedModel.zeta`), the DAE matrices M, F, B
 and the constraint Jacobians from the model's ``graphs.dae`` and ``graphs.constraints``.

@@ -1,0 +1,711 @@
+"""PETSc/SLEPc backend (tmfem.solvers.petsc) against the scipy backend, and MPI runs.
+
+Source of every expected number: an independent formulation -- the scipy backend (SuperLU,
+ARPACK/LAPACK) on the same matrices, the residual of the linear system itself, and the
+serial run for the 2-rank run. The model-level statics use the solver layer's Newton on
+the MTC residual from the design (``MTCModel.solve_static`` has no ``backend=`` yet).
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from tmfem.errors import BackendUnavailable, ConvergenceError, InputError
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_missing_petsc4py_raises_backend_unavailable_naming_the_command(monkeypatch):
+    # source: the install contract of issue 11 (a missing backend names the command)
+    monkeypatch.setitem(sys.modules, "petsc4py", None)
+    from tmfem.solvers.backends import get_backend
+    with pytest.raises(BackendUnavailable, match="make install"):
+        get_backend("petsc")
+
+
+try:
+    import petsc4py  # noqa: F401
+    import slepc4py  # noqa: F401
+    HAVE_PETSC = True
+except ImportError:
+    HAVE_PETSC = False
+needs_petsc = pytest.mark.skipif(not HAVE_PETSC, reason="petsc4py/slepc4py not importable "
+                                 "(install: make install, i.e. scripts/install_petsc.sh)")
+
+
+@pytest.fixture(scope="module")
+def models():
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    return {p: MTCModel(load_preset(p), mesh_n=n) for p, n in (("1-4", 6), ("2-3", 4))}
+
+
+@pytest.fixture(scope="module")
+def equilibria(models):
+    # scipy reference: the model's own static solver from the design
+    return {p: m.solve_static(start="design") for p, m in models.items()}
+
+
+@needs_petsc
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_tangent_solves_agree(models, equilibria, preset):
+    from tmfem.solvers.backends import get_backend
+    m = models[preset]
+    _, K = m.residual(m.reduce(equilibria[preset].x))
+    Kf = K[m.free][:, m.free]
+    b = np.random.default_rng(1).standard_normal((Kf.shape[0], 2))
+    xs = get_backend("scipy").factorize(Kf)(b)
+    xp = get_backend("petsc").factorize(Kf)(b)
+    assert xp.shape == b.shape
+    assert np.linalg.norm(Kf @ xp - b) <= 1e-10 * np.linalg.norm(b) * 1e3
+    assert np.linalg.norm(xp - xs) <= 1e-9 * np.linalg.norm(xs)
+
+
+@needs_petsc
+def test_lu_for_unsymmetric_and_refactorisation_of_a_pattern():
+    from tmfem.solvers.backends import get_backend
+    be = get_backend("petsc")
+    n = 300
+    A = sp.diags([-np.ones(n - 1), 4 * np.ones(n), -2 * np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    b = np.linspace(0, 1, n)
+    solve = be.factorize(A)
+    x = solve(b)
+    assert np.linalg.norm(A @ x - b) <= 1e-12 * np.linalg.norm(b)
+    # same pattern, new values: the old solve refuses (no silent use of the new factors)
+    solve2 = be.factorize(2.0 * A)
+    assert np.allclose(solve2(b), x / 2, rtol=1e-12, atol=0)
+    with pytest.raises(InputError, match="earlier factorisation"):
+        solve(b)
+
+
+@needs_petsc
+def test_singular_matrix_is_the_scipy_error_type():
+    from tmfem.solvers.backends import SingularMatrix, get_backend
+    n = 40
+    A = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tolil()
+    A[7, :] = 0
+    A[:, 7] = 0
+    for name in ("scipy", "petsc"):
+        with pytest.raises(SingularMatrix, match="singular"):
+            get_backend(name).factorize(A.tocsr())(np.ones(n))
+
+
+@needs_petsc
+def test_iterative_cg_gamg_meets_the_unpreconditioned_tolerance(models, equilibria):
+    from tmfem.solvers.petsc import PetscBackend
+    m = models["1-4"]
+    _, K = m.residual(m.reduce(equilibria["1-4"].x))
+    Kf = sp.csr_matrix(K[m.free][:, m.free])
+    Mf = m.mass()[m.free][:, m.free]
+    A = Kf + 10.0 * Mf                       # SPD (K_T at a stable equilibrium, plus mass)
+    b = np.random.default_rng(2).standard_normal(A.shape[0])
+    for rtol in (1e-6, 1e-10):
+        x = PetscBackend(solver="iterative", rtol=rtol).factorize(A)(b)
+        assert np.linalg.norm(A @ x - b) <= rtol * np.linalg.norm(b) * 1.0001
+    with pytest.raises(InputError, match="'iterative' only"):
+        PetscBackend(rtol=1e-8)
+
+
+@needs_petsc
+def test_petsc_options_are_honoured():
+    # an unpreconditioned CG capped at 2 iterations cannot solve a 200-dof Laplacian: the
+    # options reach the KSP (from options=, and from PETSC_OPTIONS in a fresh process)
+    from tmfem.solvers.petsc import PetscBackend
+    n = 200
+    A = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    b = np.ones(n)
+    be = PetscBackend(solver="iterative", options="-pc_type none -ksp_max_it 2")
+    with pytest.raises(ConvergenceError, match="DIVERGED_ITS"):
+        be.factorize(A)(b)
+    # options do not leak into the next backend
+    x = PetscBackend(solver="iterative").factorize(A)(b)
+    assert np.linalg.norm(A @ x - b) <= 1e-10 * np.linalg.norm(b) * 1.0001
+    code = ("import numpy as np, scipy.sparse as sp; from tmfem.solvers.backends import get_backend\n"
+            f"n={n}; A=sp.diags([-np.ones(n-1),2*np.ones(n),-np.ones(n-1)],[-1,0,1]).tocsr()\n"
+            "get_backend('petsc').factorize(A)(np.ones(n))")
+    env = dict(os.environ, PETSC_OPTIONS="-ksp_type cg -pc_type none -ksp_max_it 2 "
+               "-ksp_error_if_not_converged 0")
+    p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert p.returncode != 0 and "DIVERGED_ITS" in p.stderr
+    with pytest.raises(InputError, match="'-name value' pairs"):
+        PetscBackend(options="ksp_type cg")
+
+
+@pytest.fixture(scope="module")
+def petsc_runs():
+    # the model on the PETSc backend: statics from the undeformed membrane (the trust-region
+    # continuation) and 12 modes, every factorisation and eigensolve through the backend
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    out = {}
+    for p, n in (("1-4", 6), ("2-3", 4)):
+        m = MTCModel(load_preset(p), mesh_n=n, backend="petsc")
+        st = m.solve_static()
+        out[p] = (m, st, m.modes(st.x, k=12))
+    return out
+
+
+@needs_petsc
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_static_equilibrium_and_frequencies_agree(models, petsc_runs, preset):
+    m = models[preset]
+    assert m.backend.name == "scipy"
+    ms, sts, mds = petsc_runs[preset]
+    assert ms.backend.name == "petsc"
+    st = m.solve_static()
+    x0 = m.initial_positions("undeformed")
+    u_scipy, u_petsc = st.x - x0, sts.x - x0
+    assert np.linalg.norm(u_petsc - u_scipy) <= 1e-9 * np.linalg.norm(u_scipy)
+    assert sts.iterations == st.iterations
+    md = m.modes(st.x, k=12)
+    assert np.allclose(mds.freq_hz, md.freq_hz, rtol=1e-8, atol=0)
+
+
+@needs_petsc
+@pytest.mark.parametrize("preset", ["1-4", "2-3"])
+def test_repeated_pairs_are_full_m_orthonormal_pairs(models, equilibria, preset):
+    from tmfem.solvers.petsc import PetscBackend
+    m = models[preset]
+    _, K = m.residual(m.reduce(equilibria[preset].x))
+    Kf, Mf = K[m.free][:, m.free], m.mass()[m.free][:, m.free]
+    # the backend's own eigenpairs (before lowest_modes' Rayleigh-Ritz) vs scipy's
+    w, V = PetscBackend().eigsh(Kf, Mf, 12, -1.0)
+    from tmfem.solvers.backends import ScipyBackend
+    # reference: ARPACK shift-invert (a start vector forces it below 600 dofs; the dense
+    # generalised eigh has an absolute error ~ eps lambda_max = 8e-9 rad^2/s^2 here,
+    # 1.5e-8 relative on the lowest eigenvalue 0.67, where shift-invert agrees to 2e-10)
+    ws, W = ScipyBackend().eigsh(Kf, Mf, 12, -1.0, v0=np.ones(Kf.shape[0]))
+    o = np.argsort(ws)
+    ws, W = ws[o], W[:, o]
+    W = W / np.sqrt(np.einsum("ij,ij->j", W, Mf @ W))
+    assert np.allclose(w, ws, rtol=1e-8, atol=0)
+    assert np.allclose(V.T @ (Mf @ V), np.eye(12), atol=1e-10)
+    assert np.linalg.norm(Kf @ V - Mf @ V * w) <= 1e-8 * np.linalg.norm(Kf @ V)
+    gaps = np.abs(np.diff(ws)) <= 1e-6 * np.abs(ws[1:])
+    assert gaps.any(), "expected at least one repeated pair (cyclic symmetry)"
+    # each cluster: the same M-orthogonal projector from both backends
+    start = 0
+    for j in range(1, 13):
+        if j == 12 or not gaps[j - 1]:
+            Pp = V[:, start:j] @ (V[:, start:j].T @ Mf)
+            Ps = W[:, start:j] @ (W[:, start:j].T @ Mf)
+            assert np.abs(Pp - Ps).max() <= 1e-6
+            start = j
+
+
+MPIEXEC = shutil.which("mpiexec")
+needs_mpi = pytest.mark.skipif(not (HAVE_PETSC and MPIEXEC), reason="petsc4py or mpiexec missing "
+                               "(install: make install)")
+
+
+def _mpirun(n, *args, timeout=120, program=None):
+    # this pytest process initialised MPI as a singleton, which puts Open MPI's own variables
+    # into os.environ: a child mpiexec that sees them thinks it is nested and exits
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
+    program = program or [sys.executable, str(ROOT / "tests" / "mpi" / "fe_distributed.py")]
+    cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", str(n), *program, *args]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT, env=env)
+
+
+@needs_mpi
+def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
+    # source: the same command on 1 process (rank-0 output must be the serial document)
+    tmfem = [sys.executable, "-m", "tmfem"]
+    argv = ["modal", "--model", "mtc", "--preset", "2-3", "--mesh", "4", "--modes", "4", "--json"]
+    p2 = _mpirun(2, *argv, "--backend", "petsc", program=tmfem)
+    assert p2.returncode == 0, p2.stderr
+    p1 = subprocess.run(tmfem + argv, capture_output=True, text=True, cwd=ROOT)
+    d2, d1 = json.loads(p2.stdout), json.loads(p1.stdout)     # exactly one document
+    assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
+    p = _mpirun(2, *argv, program=tmfem)
+    assert p.returncode == 2 and p.stderr.count("expected --backend petsc") == 1
+
+
+@needs_mpi
+def test_one_and_two_ranks_agree(models, equilibria):
+    # source: the scipy model's own static solve from the design and its 12 modes; the
+    # PETSc model assembles rank by rank (each rank its share of the membrane elements)
+    runs = {}
+    for n in (1, 2):
+        p = _mpirun(n, "1-4", "6", "--start", "design")
+        assert p.returncode == 0, p.stderr
+        lines = p.stdout.strip().splitlines()
+        assert len(lines) == 1          # one document, from rank 0 only
+        runs[n] = json.loads(lines[0])
+        assert runs[n]["ranks"] == n and runs[n]["distributed"]
+    m = models["1-4"]
+    x0 = m.reduce(m.initial_positions("design"))
+    xs = m.reduce(equilibria["1-4"].x)
+    for n in (1, 2):
+        x = np.array(runs[n]["x"])
+        assert np.linalg.norm(x - xs) <= 1e-9 * np.linalg.norm(xs - x0)
+        assert runs[n]["iterations"] == equilibria["1-4"].iterations
+    assert np.allclose(runs[2]["omega2"], runs[1]["omega2"], rtol=2e-8, atol=0)
+    ref = m.modes(equilibria["1-4"].x, k=12)
+    assert np.allclose(runs[2]["omega2"], ref.omega2, rtol=2e-8, atol=0)
+
+
+@needs_mpi
+def test_model_on_petsc_under_two_ranks_agrees(models):
+    # the static continuation from the undeformed membrane and the modes under 2 ranks
+    # (distributed assembly, MUMPS and SLEPc) agree with the scipy model
+    p = _mpirun(2, "1-4", "6")
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip())
+    m = models["1-4"]
+    st = m.solve_static()
+    x0 = m.reduce(m.initial_positions("undeformed"))
+    xs = m.reduce(st.x)
+    assert np.linalg.norm(np.array(run["x"]) - xs) <= 1e-9 * np.linalg.norm(xs - x0)
+    assert run["iterations"] == st.iterations
+    assert np.allclose(run["omega2"], m.modes(st.x, k=12).omega2, rtol=2e-8, atol=0)
+
+
+@needs_mpi
+def test_rank_local_pattern_changes_neither_hang_nor_mislead():
+    # source: the residual of the linear systems; rank 1's rows change pattern, rank 0's do
+    # not (the pattern cache and the symmetry test must agree over the ranks)
+    cmd = [MPIEXEC, "--allow-run-as-root", "--oversubscribe", "-n", "2", sys.executable,
+           str(ROOT / "tests" / "mpi" / "pattern_cache.py")]
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=60, env=env)
+    assert p.returncode == 0, p.stderr
+    assert max(json.loads(p.stdout)) <= 1e-12
+
+
+@needs_mpi
+def test_failure_on_one_rank_one_error_nonzero_exit():
+    # non-finite element matrices on rank 1: caught collectively, one message from rank 0
+    p = _mpirun(2, "1-4", "4", "--nan-rank", "1")
+    assert p.returncode != 0
+    assert p.stderr.count("error: ") == 1 and "non-finite entries" in p.stderr
+    assert p.stdout.strip() == ""
+    # an exception in rank 1 only while rank 0 waits in a collective call: aborted, no hang
+    p = _mpirun(2, "1-4", "4", "--fail-rank", "1", timeout=60)
+    assert p.returncode != 0
+    assert p.stderr.count("error: rank 1 of 2: FloatingPointError") == 1
+
+
+# ---------------------------------------------------------------- CLI under mpiexec: output
+def _cli_in_rank_dirs(tmp_path, n, *argv, timeout=120):
+    """``tmfem ARGV`` under ``mpiexec -n n``, each rank r in its own working directory
+    tmp_path/rank<r> (relative output paths then show which ranks wrote files)."""
+    return _mpirun(n, str(tmp_path), *argv, timeout=timeout,
+                   program=[sys.executable, str(ROOT / "tests" / "mpi" / "in_rank_dir.py")])
+
+
+def _written(tmp_path, rank):
+    d = tmp_path / f"rank{rank}"
+    return sorted(str(p.relative_to(d)) for p in d.rglob("*") if p.is_file())
+
+
+@needs_mpi
+def test_cli_static_writes_each_output_once_from_rank_0(tmp_path):
+    # source: the same command on 1 process (1 rank of the same distributed assembly): the
+    # document rank 0 prints must be its, displacements to 1e-9
+    argv = ["static", "--preset", "2-3", "--mesh", "4", "--backend", "petsc", "--json",
+            "--monitor", "B_11,A_21,B_21", "--vtk", "out/s.vtu"]
+    p = _cli_in_rank_dirs(tmp_path, 2, *argv)
+    assert p.returncode == 0, p.stderr
+    d2 = json.loads(p.stdout)                  # exactly one document on stdout
+    assert _written(tmp_path, 0) == ["out/s.vtu"] and _written(tmp_path, 1) == []
+    assert p.stderr.count("tmfem static: 2-3") == 1       # progress line from rank 0 only
+    p1 = subprocess.run([sys.executable, "-m", "tmfem", *argv[:-2]], capture_output=True,
+                        text=True, cwd=tmp_path)
+    d1 = json.loads(p1.stdout)
+    assert d2["iterations"] == d1["iterations"]
+    for lab, h1 in d1["monitor"].items():      # start -> equilibrium of the monitored nodes
+        u1 = np.subtract(h1[-1], h1[0])
+        u2 = np.subtract(d2["monitor"][lab][-1], d2["monitor"][lab][0])
+        assert np.linalg.norm(u2 - u1) <= 1e-9 * np.linalg.norm(u1)
+    assert np.allclose(list(d2["tendon_force"].values()), list(d1["tendon_force"].values()),
+                       rtol=1e-9, atol=0)
+
+
+@needs_mpi
+def test_cli_converge_writes_csv_and_plot_once_from_rank_0(tmp_path):
+    # source: the serial scipy run of the same study (frequencies to 1e-8)
+    conv = ["converge", "--preset", "2-3", "--mesh", "2,3", "--tendon-elements", "1",
+            "--modes", "3", "--json", "--csv", "c.csv", "--plot", "c.png"]
+    p = _cli_in_rank_dirs(tmp_path, 2, *conv, "--backend", "petsc")
+    assert p.returncode == 0, p.stderr
+    assert _written(tmp_path, 0) == ["c.csv", "c.png"] and _written(tmp_path, 1) == []
+    assert (tmp_path / "rank0" / "c.csv").read_text().count("\n") == 3   # header + 2 rows
+    rows2 = json.loads(p.stdout)["rows"]
+    p1 = subprocess.run([sys.executable, "-m", "tmfem", *conv[:-4]], capture_output=True,
+                        text=True, cwd=tmp_path)
+    rows1 = json.loads(p1.stdout)["rows"]
+    for r1, r2 in zip(rows1, rows2, strict=True):
+        f1, f2 = ([r[f"f{i}"] for i in (1, 2, 3)] for r in (r1, r2))
+        assert np.allclose(f2, f1, rtol=1e-8, atol=0)
+
+
+@needs_mpi
+def test_cli_output_refused_on_rank_0_only_is_one_error_exit_2(tmp_path):
+    # an output directory that rank 0 cannot create (a file is in the way in its working
+    # directory only): rank 0's check is collective, so every rank stops at once with the
+    # serial run's exit code 2 and one message, before any work (no abort after a grace)
+    (tmp_path / "rank0").mkdir(parents=True)
+    (tmp_path / "rank0" / "out").write_text("a file")
+    p = _cli_in_rank_dirs(tmp_path, 2, "modal", "--preset", "2-3", "--mesh", "4", "--backend",
+                          "petsc", "--vtk", "out/m.vtu", timeout=60)
+    assert p.returncode == 2, p.stderr
+    assert p.stderr.count("error:") == 1 and "--vtk" in p.stderr and "MPI_ABORT" not in p.stderr
+    assert p.stdout == ""
+
+
+@needs_petsc
+def test_distributed_tangent_held_by_a_caller_is_not_overwritten(models):
+    # source: the scipy tangent of the same states (a solver holds its iterate's tangent
+    # while it evaluates trial points: a refill in place would hand it another state's)
+    from tmfem.fem.element import State
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("2-3"), mesh_n=4, backend="petsc")
+    d, ms = m.distributed, models["2-3"]
+    x0 = m.initial_positions("design")
+    xs = [x0, 1.001 * x0, 1.002 * x0]
+    held = [d.residual(State(x=x))[1] for x in xs]          # all three alive at once
+    for x, K in zip(xs, held):
+        Ks = ms.residual(ms.reduce(x))[1][ms.free][:, ms.free]
+        assert np.allclose(K.diagonal(), Ks.diagonal(), rtol=1e-12, atol=0)
+    n_before = len(d._K)
+    del held
+    d.residual(State(x=x0))
+    assert len(d._K) == n_before                            # a dropped one is refilled
+
+
+# ---------------------------------------------------------------- SBC on distributed assembly
+@pytest.fixture(scope="module")
+def sbc_scipy():
+    # 1-4 SBC at 4 x 6 x 6: 937 free dofs, so that scipy's modes come from ARPACK
+    # shift-invert (its dense path below 600 dofs has an error ~ eps lambda_max, 1e-7 on the
+    # lowest SBC mode with the shells' stiff rotations: docs/backends.md)
+    from tmfem.models.sbc.model import SBCModel
+    from tmfem.system import load_preset
+    m = SBCModel(load_preset("1-4"), mesh_n=6)
+    st = m.solve_static()
+    return m, st, m.modes(st.state, k=12, tangent=st.tangent)
+
+
+@needs_petsc
+def test_sbc_distributed_tangent_and_its_symmetric_part_are_the_scipy_ones(sbc_scipy):
+    # source: the scipy assembly of the same state (T^T K T restricted to the free dofs)
+    from tmfem.models.sbc.model import SBCModel
+    m, st, _ = sbc_scipy
+    mp = SBCModel(m.system, mesh_n=6, backend="petsc")
+    d = mp.distributed
+    assert d is not None and d._shares[0] is not None          # the shells by elements
+    r, K = m.residual(st.state)
+    K = K.tocsr()[m.free][:, m.free]
+    rd, Kd = d.residual(st.state)
+    Kd = d.assembler.scipy(Kd)
+    assert np.abs(rd - r[m.free]).max() <= 1e-12 * np.abs(r).max() + 1e-9
+    assert abs(Kd - K).max() <= 1e-12 * abs(K).max()
+    Ks = d.assembler.scipy(d.residual(st.state, symmetric=True)[1])
+    assert abs(Ks - 0.5 * (K + K.T)).max() <= 1e-12 * abs(K).max()
+    assert abs(Ks - Ks.T).max() <= 1e-15 * abs(K).max()     # summation order only
+    Md = d.assembler.scipy(d.mass(mp._full_mass(st.state)))
+    Ms = m.mass(st.state).tocsr()[m.free][:, m.free]
+    assert abs(Md - Ms).max() <= 1e-14 * abs(Ms).max()
+    assert d.energy(st.state) == pytest.approx(m.energy(st.state), rel=1e-12)
+
+
+@needs_mpi
+def test_sbc_one_and_two_ranks_agree_with_scipy(sbc_scipy):
+    # source: the scipy SBC model's static solve from the undeformed membrane (MTC
+    # predictor, then the SBC trust region) and its 12 modes; the PETSc runs assemble the
+    # shells rank by rank (1 rank: in this process)
+    from tmfem.models.sbc.model import SBCModel
+    m, st, md = sbc_scipy
+    u = st.state.x - m.start_state().x
+    # frequencies to 1e-8, or to their round-off floor where that is coarser: entries of K
+    # known to eps relative move omega_i^2 by up to eps |phi_i|^T |K| |phi_i| (first-order
+    # perturbation, phi_i M-normalised), 7e-8 of omega_1^2 here (the shells' rotations,
+    # 1e14 against omega_1^2 = 0.67), i.e. 3.6e-8 in f_1; measured spread 1.4-4.4e-9
+    K = m.residual(st.state)[1].tocsr()[m.free][:, m.free]
+    phi = np.abs(md.shapes[m.free])
+    floor = np.finfo(float).eps * np.einsum("ij,ij->j", phi, abs(K) @ phi) / md.omega2
+    rtol = np.maximum(1e-8, floor / 2)
+    m1 = SBCModel(m.system, mesh_n=6, backend="petsc")
+    s1 = m1.solve_static()
+    runs = {1: {"ranks": 1, "distributed": m1.distributed is not None, "iterations": s1.iterations,
+                "predictor_iterations": s1.predictor_iterations, "x": s1.state.x, "R": s1.state.R,
+                "omega2": m1.modes(s1.state, k=12).omega2}}
+    p = _mpirun(2, "1-4", "6", "--model", "sbc")
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.strip().splitlines()
+    assert len(lines) == 1                             # one document, from rank 0 only
+    runs[2] = json.loads(lines[0])
+    for n, run in runs.items():
+        assert run["ranks"] == n and run["distributed"]
+        assert run["predictor_iterations"] == st.predictor_iterations
+        # the SBC stage starts on the round-off floor of its 1e-9 test (|r| ~ 1e-7 N against
+        # 9e-8 N: the thin shells' stiff rotations), so round-off decides between 1 and 2
+        # steps; the equilibrium is the same (below)
+        assert abs(run["iterations"] - st.iterations) <= 1
+        x = np.array(run["x"])
+        assert np.linalg.norm(x - st.state.x) <= 1e-9 * np.linalg.norm(u)
+        assert np.abs(np.array(run["R"]) - st.state.R).max() <= 1e-9
+        f = np.sqrt(np.array(run["omega2"])) / (2 * np.pi)
+        assert np.all(np.abs(f / md.freq_hz - 1) <= rtol)
+
+
+@needs_mpi
+def test_sbc_failure_on_one_rank_one_error_nonzero_exit():
+    # non-finite shell matrices on rank 1 only: caught collectively, one message from rank 0
+    p = _mpirun(2, "1-4", "4", "--model", "sbc", "--nan-rank", "1")
+    assert p.returncode != 0
+    assert p.stderr.count("error: ") == 1 and "non-finite entries" in p.stderr
+    assert p.stdout.strip() == ""
+    # the shell kernel of rank 1 raises while rank 0 waits in a collective call: one error,
+    # the job aborted (the MTC predictor's MUMPS factors, freed while rank 1 unwinds, are
+    # destroyed collectively later, not on the failing rank alone: no hang)
+    p = _mpirun(2, "1-4", "4", "--model", "sbc", "--fail-rank", "1", timeout=60)
+    assert p.returncode != 0
+    assert p.stderr.count("error: rank 1 of 2: FloatingPointError") == 1
+    assert p.stdout.strip() == ""
+
+
+@needs_mpi
+def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
+    # source: the same command on 1 process with scipy (frequencies to their round-off floor,
+    # static iterations within one); the VTK file written once, by rank 0. The floor: entries
+    # of K known to eps relative move f_1 by up to 3.6e-8 here (the first-order estimate of the
+    # test above, on the same 1-4 SBC at mesh 6); a CI run measured 1.08e-8 in f_1, above the
+    # 1e-8 this test first asked
+    argv = ["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "6", "--modes", "6",
+            "--json"]
+    p = _cli_in_rank_dirs(tmp_path, 2, *argv, "--backend", "petsc", "--vtk", "m.vtu")
+    assert p.returncode == 0, p.stderr
+    assert _written(tmp_path, 0) == ["m.vtu"] and _written(tmp_path, 1) == []
+    d2 = json.loads(p.stdout)                      # exactly one document on stdout
+    p1 = subprocess.run([sys.executable, "-m", "tmfem", *argv], capture_output=True, text=True,
+                        cwd=tmp_path)
+    d1 = json.loads(p1.stdout)
+    assert abs(d2["iterations"] - d1["iterations"]) <= 1          # round-off floor (above)
+    assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=4e-8, atol=0)
+
+
+@needs_petsc
+def test_petsc_block_and_slepc_agree_on_the_mtc_modes():
+    # source: SLEPc's Krylov-Schur on the same model; the 1-4 MTC model at its equilibrium
+    # (531 free dofs: the block solver's path; tmfem.solvers.block_krylov)
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import EIG_BLOCK_MIN_N, PetscBackend
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
+    assert m.distributed.N >= EIG_BLOCK_MIN_N
+    st = m.solve_static(start="design")
+    block = m.modes(st.x, k=12)
+    m.backend = PetscBackend(eig_solver="slepc")
+    slepc = m.modes(st.x, k=12)
+    assert np.allclose(block.freq_hz, slepc.freq_hz, rtol=1e-10, atol=0)
+
+
+@needs_petsc
+def test_slepc_options_choose_slepc_and_are_refused_by_the_block_solver(monkeypatch):
+    from tmfem.solvers.petsc import PetscBackend
+    assert PetscBackend().eig_solver == "block"
+    assert PetscBackend(options="-eps_ncv 40").eig_solver == "slepc"
+    # the same from the environment (PETSc reads PETSC_OPTIONS at its initialisation, this
+    # choice at every backend's construction)
+    monkeypatch.setenv("PETSC_OPTIONS", "-ksp_view -eps_tol 1e-10")
+    assert PetscBackend().eig_solver == "slepc"
+    with pytest.raises(InputError, match=r"-eps_tol \(options= or PETSC_OPTIONS\) are SLEPc's"):
+        PetscBackend(eig_solver="block")
+    monkeypatch.setenv("PETSC_OPTIONS", "-ksp_view")
+    assert PetscBackend().eig_solver == "block"
+    with pytest.raises(InputError, match="expected eig_solver='slepc'"):
+        PetscBackend(options="-eps_ncv 40", eig_solver="block")
+    with pytest.raises(InputError, match="expected eig_solver 'auto', 'redundant', 'block' or 'slepc'"):
+        PetscBackend(eig_solver="arpack")
+    with pytest.raises(InputError, match="expected eig_solver='slepc'"):
+        PetscBackend(options="-eps_ncv 40", eig_solver="redundant")
+    assert PetscBackend(eig_solver="redundant").eig_solver == "block"     # one rank: the same
+    with pytest.raises(InputError, match="eig_memory_mb applies to the redundant eigen solve"):
+        PetscBackend(eig_solver="slepc", eig_memory_mb=100)
+    with pytest.raises(InputError, match="eig_memory_mb applies to the redundant eigen solve"):
+        PetscBackend(eig_memory_mb=100)                   # "auto" never takes it
+    with pytest.raises(InputError, match="expected eig_memory_mb >= 1"):
+        PetscBackend(eig_solver="redundant", eig_memory_mb=0)
+
+
+@needs_mpi
+def test_block_solver_under_two_ranks_agrees_with_scipy(models, equilibria):
+    # source: the scipy model's 12 modes at its own equilibrium from the design; the block
+    # solver on the distributed factors (the default, here asked for: rows of the basis
+    # distributed, inner products summed over the ranks)
+    from tmfem.solvers.petsc import EIG_BLOCK_MIN_N
+    p = _mpirun(2, "1-4", "6", "--start", "design", "--eig-solver", "block")
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip())
+    m = models["1-4"]
+    assert m.free.sum() >= EIG_BLOCK_MIN_N                       # the block solver's size
+    ref = m.modes(equilibria["1-4"].x, k=12)
+    assert np.allclose(run["omega2"], ref.omega2, rtol=2e-8, atol=0)
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_redundant_block_eigen_agrees_with_scipy(models, equilibria, ranks):
+    # source: the scipy model's 12 modes at its own equilibrium from the design (ARPACK on
+    # the scipy matrices) and the model's scipy mass for the M-orthonormality; every rank
+    # factorises the whole K - sigma M sequentially and solves its share of the columns of
+    # each block (tmfem.solvers.petsc_redundant), on request; "auto" takes the block solver
+    # on the distributed factors under P > 1 ranks too, and "slepc" SLEPc: they agree as well
+    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    for solver, ran in (("redundant", "redundant"), ("auto", "block"), ("slepc", "slepc")):
+        p = _mpirun(ranks, "1-4", "6", "--start", "design", "--eig-solver", solver)
+        assert p.returncode == 0, p.stderr
+        run = json.loads(p.stdout.strip())
+        assert run["eig_solver"] == ran
+        freq = np.sqrt(run["omega2"]) / (2 * np.pi)
+        assert np.allclose(freq, ref.freq_hz, rtol=1e-8, atol=0)
+        assert run["m_orth"] <= 1e-10
+
+
+@needs_mpi
+def test_redundant_eigen_refused_when_over_its_memory(models):
+    # source: MUMPS' own estimate of the sequential factors (INFOG(16), 6 MB at 4x12x12
+    # against the budget of 1 MB: ICNTL(23)); one error from the two ranks, exit code 3
+    args = ("1-4", "12", "--start", "design", "--eig-memory-mb", "1")
+    p = _mpirun(2, *args, "--eig-solver", "redundant")
+    assert p.returncode == 3, p.stderr                       # ResourceLimit
+    assert p.stderr.count("expected every rank's factors of K - sigma M within 1 MB") == 1
+    assert "found MUMPS' estimate" in p.stderr
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [1, 2, 3])
+def test_block_pair_pattern_is_scipys_pattern_and_matrix(ranks):
+    # source: scipy's T^T K T of the same element matrices and entries (its structure from
+    # unit values and |T|, so no cancellation); the 4-node group is keyed per block pair
+    # (block size 3), the group of permuted local dofs and the entries per entry
+    p = _mpirun(ranks, program=[sys.executable, str(ROOT / "tests" / "mpi" / "assembler_pattern.py")])
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert out["block_sizes"] == [3, 1, 1]
+    assert out["pattern_equal"]
+    assert out["max_rel"] <= 1e-14
+
+
+@needs_petsc
+@pytest.mark.parametrize("eig_solver", ["block", "slepc"])
+def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria, eig_solver):
+    # source: the scipy model's 12 modes at its equilibrium from the design; PETSc's log of
+    # MUMPS' symbolic (MatCholFctrSym) and numeric factorisations: K - sigma M has the
+    # tangent's pattern (the mass lies within it), so the eigen solve factorises it
+    # numerically in the static solve's analysed pattern; an st_ option gives the eigen
+    # solve its own KSP, and with it its own analysis
+    from petsc4py import PETSc
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    PETSc.Log.begin()
+    sym, num = PETSc.Log.Event("MatCholFctrSym"), PETSc.Log.Event("MatCholFctrNum")
+    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    for options, analyses in ((None, 0), ("-st_mat_mumps_icntl_14 40", 1)):
+        m = MTCModel(load_preset("1-4"), mesh_n=6,
+                     backend=PetscBackend(eig_solver=eig_solver, options=options))
+        st = m.solve_static(start="design")
+        s0, n0 = sym.getPerfInfo()["count"], num.getPerfInfo()["count"]
+        modes = m.modes(st.x, k=12)
+        assert sym.getPerfInfo()["count"] - s0 == analyses
+        assert num.getPerfInfo()["count"] - n0 == 1
+        assert np.allclose(modes.omega2, ref.omega2, rtol=2e-8, atol=0)
+
+
+@needs_petsc
+def test_pattern_subset_check():
+    # source: the patterns themselves (a diagonal lies within a tridiagonal pattern, a
+    # corner entry does not), on the AIJ matrices the eigen solve's reuse check reads
+    from petsc4py import PETSc
+    from tmfem.solvers.petsc import PetscBackend
+    n = 6
+    tri = sp.diags([np.ones(n - 1), 2 * np.ones(n), np.ones(n - 1)], [-1, 0, 1], format="csr")
+    corner = sp.csr_matrix(sp.identity(n) + sp.csr_matrix(([1.0], ([0], [n - 1])), shape=(n, n)))
+
+    def aij(S):
+        return PETSc.Mat().createAIJ(size=S.shape, csr=(S.indptr.astype(PETSc.IntType),
+                                                        S.indices.astype(PETSc.IntType), S.data),
+                                     comm=PETSc.COMM_SELF)
+    be = PetscBackend()
+    assert be._subset(aij(sp.identity(n, format="csr")), aij(tri))
+    assert not be._subset(aij(corner), aij(tri))
+
+
+@needs_petsc
+def test_modes_reuse_the_static_distributed_tangent(models, equilibria):
+    # source: the scipy model's 12 modes at its equilibrium from the design; the modes of
+    # the distributed tangent the static solve assembled last agree with those of one
+    # assembled again at the equilibrium, and a scipy tangent is refused for it
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
+    st = m.solve_static(start="design")
+    again = m.modes(st.x, k=12)
+    reused = m.modes(st.x, k=12, tangent=st.tangent)
+    assert np.allclose(reused.omega2, again.omega2, rtol=1e-10, atol=0)
+    assert np.allclose(reused.omega2, ref.omega2, rtol=2e-8, atol=0)
+    with pytest.raises(InputError, match=r"expected the tangent of this model's static solve "
+                                         r"\(DistributedMatrix"):
+        m.modes(st.x, k=12, tangent=equilibria["1-4"].tangent)
+
+
+def _modal_cli(*argv):
+    p = subprocess.run([sys.executable, "-m", "tmfem", "modal", *argv], capture_output=True,
+                       text=True, cwd=ROOT)
+    return p
+
+
+def test_cli_eig_solver_refused_without_the_petsc_backend():
+    # --eig-solver chooses the PETSc backend's eigen solver: with scipy (the default) and
+    # with the control-oriented model (no backend) it is refused before any work
+    for extra in ([], ["--backend", "scipy"], ["--model", "com"]):
+        p = _modal_cli("--preset", "2-3", "--mesh", "4", "--modes", "4", "--eig-solver", "slepc",
+                       *extra)
+        assert p.returncode == 2, p.stderr
+        assert "--eig-solver slepc: option does not apply" in p.stderr
+        assert "expected --backend petsc, found --backend scipy" in p.stderr
+
+
+@needs_petsc
+def test_cli_eig_solver_chooses_the_solver_and_agrees_with_scipy():
+    # source: the same command with scipy (ARPACK shift-invert on the scipy matrices):
+    # frequencies to 1e-8; the JSON names the solver that ran (4x12x12: 2 000 free dofs,
+    # above the block solver's minimum size)
+    argv = ["--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
+    ref = json.loads(_modal_cli(*argv).stdout)
+    assert "eig_solver" not in ref
+    for solver, ran in (("slepc", "slepc"), ("block", "block"), ("auto", "block")):
+        p = _modal_cli(*argv, "--backend", "petsc", "--eig-solver", solver)
+        assert p.returncode == 0, p.stderr
+        d = json.loads(p.stdout)
+        assert d["eig_solver"] == ran
+        assert np.allclose(d["freq_hz"], ref["freq_hz"], rtol=1e-8, atol=0)
+
+
+@needs_mpi
+def test_cli_eig_solver_redundant_under_two_ranks():
+    # source: the 1-process scipy command (frequencies to 1e-8); under 2 ranks "redundant" runs
+    # (every rank factorises the whole K - sigma M) where "auto" would take the distributed
+    # factors
+    argv = ["modal", "--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
+    ref = json.loads(_modal_cli(*argv[1:]).stdout)
+    tmfem = [sys.executable, "-m", "tmfem"]
+    p = _mpirun(2, *argv, "--backend", "petsc", "--eig-solver", "redundant", program=tmfem)
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["eig_solver"] == "redundant"
+    assert np.allclose(d["freq_hz"], ref["freq_hz"], rtol=1e-8, atol=0)

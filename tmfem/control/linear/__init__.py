@@ -1,0 +1,3 @@
+"""Linear control at a deployed configuration (dissertation 7.3, eqs. 5.62-5.67, 5.71):
+generalised plants, PBH tests, H-infinity synthesis (LMI, Riccati, central controller),
+the end-to-end design and its closed-loop plots."""

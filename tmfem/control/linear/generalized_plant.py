@@ -1,0 +1,208 @@
+"""Linear plants for control at a deployed configuration (7.3, eqs. 5.17-5.18, 5.62, Fig. 7.1).
+
+* :func:`deployed_plant`: the control-oriented model in the coordinates of the controllers,
+  x_z = [q, v, q', v'] with v the relative transverse deflections of K membrane points
+  (eqs. 5.17-5.18), linearised about the deployed equilibrium (eq. 5.33 / 5.62): a
+  python-control ``StateSpace`` with every state as an output (the measured outputs of
+  Fig. 7.1 are q, v, q', v') and the tendon rest lengths as inputs.
+* :func:`generalized_plant`: the interconnection of Fig. 7.1 with the weights of 7.4 by
+  ``control.interconnect`` on named signals (our reading of the figure: docs/control.md).
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from tmfem.control.linear.hinf_lmi import GeneralizedPlant
+from tmfem.errors import InputError
+
+log = logging.getLogger(__name__)
+
+# Monitored membrane points of 7.4 (eqs. 5.73-5.75), (x_f, y_f) in m, and the design data of
+# 7.4 per system: K membrane modes, u_m of W_u, alpha_1 and the printed f_max.
+DEPLOYED = {
+    "1-4D": dict(points=[(1.0, 1.0), (2.0, 1.0), (1.0, 2.0)], K=3, u_m=0.01, alpha=0.5,
+                 f_max_hz=7.32, source="7.4.1, eq. 5.73"),
+    "1-6D": dict(points=[(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], K=5, u_m=0.02, alpha=0.4,
+                 f_max_hz=8.59, source="7.4.2, eq. 5.74"),
+    "2-3-deploy": dict(points=[(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], K=4, u_m=0.01,
+                       alpha=0.4, f_max_hz=9.83, source="7.4.3, eq. 5.75"),
+}
+W_E = 0.5        # W_e = 0.5 I (7.4, item 1)
+W_D = 0.001      # W_d1..4 = 0.001 I (7.4, item 2)
+
+
+def deployed_defaults(name: str) -> dict:
+    """The 7.4 design data (K, u_m, alpha_1, points, printed f_max) of a deployed preset."""
+    if name not in DEPLOYED:
+        raise InputError(f"deployed system: expected one of {sorted(DEPLOYED)}, found {name!r}")
+    return dict(DEPLOYED[name])
+
+
+def point_coordinates(basis, *, K: int, points) -> list:
+    """K membrane points for the coordinates v of eq. 5.18: the given monitored points
+    first, then mesh nodes chosen greedily (largest component of the node's row of mode
+    deflections orthogonal to the rows already chosen: column-pivoted Gram-Schmidt), so
+    that T_v_eta of eq. 5.17 is as well conditioned as the greedy choice allows."""
+    pts = [_on_membrane(basis, p) for p in points][:K]
+    mesh = basis.scalar_basis.mesh
+    nd = basis.n_delta
+    Phi_nodes = basis.shapes[1 + nd:, 2, :].T                   # (n_nodes, K): w of each mode
+    chosen = [basis.point_matrix(np.array([[x], [y]]), 2)[0, 1 + nd:] for x, y in pts]
+    corners = set(np.asarray(basis.mesh.corners).tolist())
+    cand = np.array([i for i in range(mesh.p.shape[1]) if i not in corners])
+    while len(pts) < K:
+        Q = np.linalg.qr(np.array(chosen).T)[0] if chosen else np.zeros((basis.K, 0))
+        rows = Phi_nodes[cand]
+        resid = rows - (rows @ Q) @ Q.T
+        j = int(np.argmax(np.linalg.norm(resid, axis=1)))
+        pts.append((float(mesh.p[0, cand[j]]), float(mesh.p[1, cand[j]])))
+        chosen.append(rows[j])
+    return pts
+
+
+def _on_membrane(basis, point, *, max_shift: float = 0.01):
+    """The point, or (if it lies just outside the discretised polygon, as the edge points
+    of eq. 5.73 do with r_mb = 1.414 m: side 1.9997 m) the nearest point on the segment to
+    the membrane centroid that lies inside, moved by at most ``max_shift`` x r_mb."""
+    x, y = map(float, point)
+    pm = basis.scalar_basis.mesh.p
+    c = pm.mean(axis=1)
+    r = float(np.max(np.linalg.norm(pm - c[:, None], axis=0)))
+    for s in np.linspace(0.0, max_shift, 101):
+        d = np.array([x, y]) - c
+        cand = c + d * (1 - s * r / max(np.linalg.norm(d), 1e-300))
+        try:
+            basis.point_matrix(cand[:, None], 2)
+        except InputError:
+            continue
+        if s > 0:
+            log.info("membrane point (%g, %g) lies outside the mesh: using (%.4f, %.4f)", x, y, *cand)
+        return (float(cand[0]), float(cand[1]))
+    raise InputError(f"membrane point ({x}, {y}) m: expected a point on the membrane (within "
+                     f"{max_shift * r:.3g} m of it), found it outside")
+
+
+@dataclass
+class DeployedPlant:
+    """Linearised COM at a deployed equilibrium in (q, v) coordinates (eqs. 5.18, 5.62).
+
+    ``ss`` has the states ``x_z = [q, v, q', v']`` (names ``theta_11 … wr_1 … *_dot``), the
+    inputs ``r_<tendon>`` (rest-length perturbations, m) and one output per state, named as
+    the state: the measured signals of Fig. 7.1 before noise.
+    """
+
+    ss: object
+    q_e: np.ndarray
+    u_e: np.ndarray
+    z_e: np.ndarray
+    points: list
+    frequencies_hz: np.ndarray
+    model: object
+    linearization: object
+
+    @property
+    def f_max_hz(self) -> float:
+        return float(self.frequencies_hz[-1])
+
+    @property
+    def n_q(self) -> int:
+        return len(self.q_e)
+
+    @property
+    def operating_point(self) -> dict:
+        return {"q_e": self.q_e, "u_e": self.u_e, "z_e": self.z_e,
+                "q_names": list(self.model.system.q_names), "u_names": list(self.ss.input_labels),
+                "membrane_points": [("w", x, y) for x, y in self.points]}
+
+
+def deployed_plant(system, *, membrane_modes: int | None = None, points=None, mesh_n: int = 10,
+                   rest_lengths="system", damping: float = 0.0) -> DeployedPlant:
+    """Linear plant at the deployed configuration (eqs. 5.17-5.18, 5.33, 5.62).
+
+    Parameters
+    ----------
+    system : System
+        The deployed (final) configuration, e.g. ``load_preset("1-4D")``.
+    membrane_modes : int, optional
+        K (7.4: 3 for 1-4(D), 5 for 1-6(D), 4 for 2-3); default from :data:`DEPLOYED`.
+    points : list of (x_f, y_f), optional
+        Membrane points of the coordinates v (eq. 5.18); default: the monitored points of
+        eqs. 5.73-5.75 completed to K by :func:`point_coordinates`.
+    rest_lengths : {"system", "design"} or array
+        u_e; "system": the printed rest lengths of the preset (Tables 7.3, 7.5, 7.7).
+    damping : float
+        Modal damping c_m of eq. 5.13 (7.4 states none: default 0).
+    """
+    from tmfem.models.com.linearize import linearize
+    from tmfem.models.com.model import ControlOrientedModel
+    import control
+    d = DEPLOYED.get(system.name, {})
+    K = membrane_modes if membrane_modes is not None else d.get("K")
+    if K is None:
+        raise InputError(f"membrane_modes: expected K for system {system.name!r} (no 7.4 default), found None")
+    modal = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, rest_lengths=rest_lengths,
+                                 damping=damping, output_points=[])
+    pts = points if points is not None else d.get("points", [])
+    pts = point_coordinates(modal.membrane, K=K, points=pts)
+    model = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, rest_lengths=modal.u0,
+                                 damping=damping, output_points=[],
+                                 membrane_points=[("w", x, y) for x, y in pts])
+    lin = linearize(model)
+    n = lin.A.shape[0]
+    sys = control.ss(lin.A, lin.B, np.eye(n), np.zeros((n, lin.B.shape[1])),
+                     states=list(lin.state_names), inputs=list(lin.input_names),
+                     outputs=list(lin.state_names), name="G")
+    return DeployedPlant(ss=sys, q_e=lin.z_e[: model.nq].copy(), u_e=lin.u_e.copy(),
+                         z_e=lin.z_e.copy(), points=pts, frequencies_hz=lin.frequencies_hz(),
+                         model=model, linearization=lin)
+
+
+def generalized_plant(plant: DeployedPlant, *, u_m: float, W_e: float = W_E, W_d: float = W_D):
+    """The generalised plant of Fig. 7.1 (weights of 7.4) by ``control.interconnect``.
+
+    Reading of Fig. 7.1 (docs/control.md): exogenous w = [q_d, v_d, n_q, n_v, n_q', n_v'],
+    measured y = [q_m - q_d, v_m - v_d, q'_m, v'_m] with x_m = x + W_d n (W_d1..4 on the
+    four noise blocks), regulated p = [e_d, e_u] with e_d = W_e ([q_d, v_d] - [q, v]) and
+    e_u = W_u u, W_u = I / u_m. The controller closes u = K(s) y.
+
+    Returns
+    -------
+    GeneralizedPlant
+        Partitioned eq. 5.62 (D22 = 0); signals w: ``ref_<q or v>``, ``n_<state>``; u: the
+        plant's ``r_<tendon>``; p: ``ed_<q or v>``, ``eu_r_<tendon>``; y: ``y_<state>``.
+    """
+    import control
+    if not (np.isfinite(u_m) and u_m > 0):
+        raise InputError(f"u_m: expected > 0 m, found {u_m!r}")
+    G = plant.ss
+    xs = list(G.state_labels)
+    nz = len(xs) // 2
+    z = xs[:nz]
+    us = list(G.input_labels)
+    nu = len(us)
+    ref = [f"ref_{s}" for s in z]
+    noise = [f"n_{s}" for s in xs]
+    We = control.ss([], [], [], W_e * np.eye(nz), inputs=[f"e_{s}" for s in z],
+                    outputs=[f"ed_{s}" for s in z], name="W_e")
+    Wu = control.ss([], [], [], np.eye(nu) / u_m, inputs=us, outputs=[f"eu_{s}" for s in us],
+                    name="W_u")
+    Wd = control.ss([], [], [], W_d * np.eye(2 * nz), inputs=noise,
+                    outputs=[f"dn_{s}" for s in xs], name="W_d")
+    # tracking error e = [q_d, v_d] - [q, v]
+    blocks = [G, We, Wu, Wd]
+    # e = ref - x_z[:nz]
+    E = control.ss([], [], [], np.hstack([np.eye(nz), -np.eye(nz)]),
+                   inputs=ref + z, outputs=[f"e_{s}" for s in z], name="sum_e")
+    # measured: y = x_m - [ref, 0] with x_m = x + W_d n
+    Ym = control.ss([], [], [], np.hstack([np.eye(2 * nz), np.eye(2 * nz),
+                                           -np.vstack([np.eye(nz), np.zeros((nz, nz))])]),
+                    inputs=xs + [f"dn_{s}" for s in xs] + ref,
+                    outputs=[f"y_{s}" for s in xs], name="sum_y")
+    blocks += [E, Ym]
+    inp = ref + noise + us
+    out = [f"ed_{s}" for s in z] + [f"eu_{s}" for s in us] + [f"y_{s}" for s in xs]
+    P = control.interconnect(blocks, inplist=inp, outlist=out, inputs=inp, outputs=out, name="P")
+    return GeneralizedPlant.from_ss(P, nw=len(ref) + len(noise), ny=len(xs))

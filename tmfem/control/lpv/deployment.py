@@ -1,0 +1,181 @@
+"""The LPV deployment of the 2-3 system (dissertation 8.4): reference of eq. 5.100, the
+COM plant, the measurement of the LPV states and scheduling parameters, and any controller
+on them.
+
+Reference (eq. 5.100): theta_r'' + 2 xi_r omega_r theta_r' + omega_r^2 theta_r =
+omega_r^2 theta_e with theta_r(0) = theta_0, theta_r'(0) = 0 and psi_r = psi_0 (xi_r = 1,
+omega_r = 0.3 rad/s, theta 77.32 -> 63 deg, psi_0 = 8.36 deg); q_d follows from eq. 5.97 with
+the stage bases of the design grid (:func:`tmfem.reference.tables.deployment_bases`), the
+closed form and path of :class:`tmfem.control.deployment.reference_trajectory.DeploymentReference`
+(eq. 5.100 is eq. 5.68 with a constant psi).
+
+Plant: the control-oriented model (eq. 5.27) built at the final configuration with its
+designed rest lengths, in modal membrane coordinates, started at rest in the initial
+configuration (as the 7.4 deployments, :func:`tmfem.control.deployment.run.run_deployment`: Park's
+method, rest-length limits), or an FE plant through its COM-state estimate started in its own
+equilibrium of :meth:`LPVDeployment.packaged` (docs/fe-plant.md).
+
+Measurement (:meth:`LPVDeployment.measure`): the plant's y = [z, z'] (modal) mapped onto the
+signals of the LPV design, y_lpv = [x_z, rho] with x_z = [q, v, q', v'] (v = T_v_eta eta, the
+membrane point coordinates of eq. 5.17 at the design plant's points) and rho = [theta_13,
+psi_13] read from q (8.4 schedules on the measured angles). Any controller with the
+reset/output/update/name protocol of :mod:`tmfem.simulation.controllers` on y_lpv deploys
+through :meth:`LPVDeployment.setup` (the state feedback: :func:`state_feedback_controller`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tmfem.errors import InputError
+from tmfem.system.geometry import wrap_angle
+
+class Measured:
+    """A controller on y_lpv = measure(y): the protocol of :mod:`tmfem.simulation.controllers`
+    with the plant outputs mapped first (the name is the inner controller's)."""
+
+    def __init__(self, inner, measure):
+        if not all(hasattr(inner, m) for m in ("reset", "output", "update", "name")):
+            raise InputError(f"LPV deployment: expected a controller with reset/output/update/name "
+                             f"(tmfem.simulation.controllers), found {type(inner).__name__}")
+        self.inner, self.measure = inner, measure
+
+    @property
+    def name(self) -> str:
+        return self.inner.name
+
+    def reset(self, t0, y0, dt):
+        return self.inner.reset(t0, self.measure(y0), dt)
+
+    def output(self, t, y, xc):
+        return self.inner.output(t, self.measure(y), xc)
+
+    def update(self, t, y, xc):
+        return self.inner.update(t, self.measure(y), xc)
+
+
+@dataclass
+class LPVDeployment:
+    """Model, reference and measurement of the 8.4 deployment (module docstring); ``plant``
+    is the design :class:`~tmfem.control.lpv.plant.GriddedLPV` (grid, equilibria, points)."""
+
+    model: object
+    reference: object
+    plant: object
+    T_veta: np.ndarray
+    z0: np.ndarray
+    z_e: np.ndarray
+    rho_q: list
+    info: dict
+    initial: object = None
+
+    def packaged(self):
+        """The initial (packaged) configuration as a designed System: its rest lengths those
+        the run starts with, u_e of the design grid at rho_r(0) (the controller's first
+        output at rest on the reference) -- the start of an FE plant
+        (:func:`tmfem.control.fe_plant.state_estimate.deployment_plant`)."""
+        return self.initial.replace(rest_lengths=self.plant.interpolate("u_e", self.reference_rho(0.0)))
+
+    @property
+    def signal_names(self) -> list:
+        """Names of y_lpv: the design plant's states, then its parameters."""
+        return list(self.plant.state_names) + list(self.plant.parameter_names)
+
+    def reference_rho(self, t) -> np.ndarray:
+        """rho_r(t) = [theta_13, psi_13] of the reference q_d(t) (eq. 5.100: theta_r, psi_0)."""
+        r = np.asarray(self.reference(t)[0], dtype=float)[self.rho_q].copy()
+        r[1] = wrap_angle(r[1])
+        return r
+
+    def measure(self, y) -> np.ndarray:
+        """y_lpv = [q, v, q', v', rho] from the plant outputs y = [z, z'] (modal)."""
+        y = np.asarray(y, dtype=float)
+        m = self.model
+        nq, nz = m.nq, m.nz
+        q, eta, qd, etad = y[:nq], y[nq:nz], y[nz:nz + nq], y[nz + nq:2 * nz]
+        rho = q[self.rho_q].copy()
+        rho[1] = wrap_angle(rho[1])
+        return np.concatenate([q, self.T_veta @ eta, qd, self.T_veta @ etad, rho])
+
+    def setup(self, controller):
+        """The :class:`tmfem.control.deployment.run.DeploymentSetup` of ``controller`` (any object with
+        the reset/output/update/name protocol on y_lpv) for :func:`~tmfem.control.deployment.run.
+        run_deployment` and :func:`tmfem.reference.deployments.write_outputs`."""
+        from tmfem.control.deployment.run import DeploymentSetup
+        return DeploymentSetup(model=self.model, reference=self.reference, adaptive=None,
+                               controller=Measured(controller, self.measure), linear=None, z0=self.z0,
+                               z_e=self.z_e, info=dict(self.info))
+
+
+def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: float, omega_r: float,
+                   bases, output_points, membrane_modes: int = 4, model_at: str = "final") -> LPVDeployment:
+    """The deployment of 8.4 of ``system`` from theta_0 to theta_e at psi_0 [rad] (eq. 5.100,
+    xi_r = 1, ``omega_r`` [rad/s]) for the design plant ``plant``
+    (:func:`~tmfem.control.lpv.plant.com_lpv_plant` of the same system with the same
+    ``bases`` rule; its membrane points define v); ``output_points``: the monitored membrane
+    points (eq. 5.101).
+
+    Raises
+    ------
+    InputError
+        The reference leaves the design grid, or the plant has no membrane points.
+    """
+    from tmfem.control.deployment.reference_trajectory import DeploymentReference
+    from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
+    from tmfem.models.com.coordinates import point_coordinates
+    from tmfem.models.com.model import ControlOrientedModel
+    for nm, v in (("theta_13", (theta_0, theta_e)), ("psi_13", (psi_0, psi_0))):
+        a = plant.axes[plant.parameter_names.index(nm)]
+        if min(v) < a[0] - 1e-9 or max(v) > a[-1] + 1e-9:
+            raise InputError(f"LPV deployment: expected the reference {nm} in "
+                             f"[{np.degrees(min(v)):.4g}, {np.degrees(max(v)):.4g}] deg inside the design "
+                             f"grid, found the grid [{np.degrees(a[0]):.4g}, {np.degrees(a[-1]):.4g}] deg")
+    if not plant.membrane_points:
+        raise InputError("LPV deployment: expected a design plant with membrane point coordinates "
+                         "(eq. 5.17, com_lpv_plant), found none")
+    final = with_configuration(system, configuration_5_97(system, theta_e, psi_0, **bases(theta_e, psi_0)))
+    initial = with_configuration(system, configuration_5_97(system, theta_0, psi_0, **bases(theta_0, psi_0)))
+    if model_at not in ("final", "initial"):
+        raise InputError(f"LPV deployment: model_at expected 'final' or 'initial', found {model_at!r}")
+    model = ControlOrientedModel(final if model_at == "final" else initial, membrane_modes=membrane_modes, output_points=output_points)
+    _, T_veta, _ = point_coordinates(model.membrane, plant.membrane_points)
+    ref = DeploymentReference(initial=initial.symmetric, final=final.symmetric, N=final.N,
+                              q_names=list(final.q_names), omega_r=omega_r, bases=bases)
+    z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
+    z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)]))
+    info = {"omega_r": omega_r, "xi_r": 1.0, "theta_0_deg": float(np.degrees(theta_0)),
+            "theta_e_deg": float(np.degrees(theta_e)), "psi_0_deg": float(np.degrees(psi_0)), "K": model.K,
+            "lpv_grid": list(plant.grid_shape)}
+    return LPVDeployment(model=model, reference=ref, plant=plant, T_veta=T_veta, z0=z0, z_e=z_e,
+                         rho_q=[list(final.q_names).index(n) for n in plant.parameter_names], info=info,
+                         initial=initial)
+
+
+def state_feedback_controller(dep: LPVDeployment, design):
+    """The scheduled state feedback of 8.3 (:class:`tmfem.control.lpv.controller.LPVController`)
+    of ``design`` on y_lpv, tracking q_d of eq. 5.100, gains at the measured rho, equilibria
+    x_e, u_e at the reference's rho_r(t).
+
+    Raises
+    ------
+    InputError
+        ``design`` is not over the states of the deployment's design plant.
+    """
+    from tmfem.control.lpv.controller import LPVController
+    pl = dep.plant
+    nq = dep.model.nq
+    want = list(pl.state_names) + [f"int_e_{n}" for n in dep.model.system.q_names]
+    if list(design.state_names) != want:
+        raise InputError(f"LPV controller: expected a design over the {len(want)} states of the "
+                         f"{pl.grid_shape} design plant ([x_z, integrals of e_q], eq. 5.98), found "
+                         f"{len(design.state_names)} states"
+                         + ("" if len(design.state_names) != len(want) else " with other names"))
+    for a, b in zip(design.axes, pl.axes):
+        if a.shape != b.shape or not np.allclose(a, b, rtol=0, atol=1e-9):
+            raise InputError(f"LPV controller: expected the design grid {[np.degrees(x).round(2).tolist() for x in pl.axes]} deg, "
+                             f"found {[np.degrees(x).round(2).tolist() for x in design.axes]} deg")
+    n = pl.nx
+    return LPVController(design, pl, state_index=np.arange(n), q_index=np.arange(nq),
+                         rho_index=[n, n + 1], reference=lambda t: dep.reference(t)[0],
+                         reference_rho=dep.reference_rho)
