@@ -1,14 +1,17 @@
 # Two commands do all the set-up on a fresh Debian machine with Python >= 3.11:
 #   make demo   -- install, then the complete analysis of the 1-4 system with its deployment
 #                  (tmfem report; out/1-4/index.md links every file)
-#   make test   -- install, then run the test suite
+#   make test   -- install, then run the fast test suite (every feature, a few minutes)
+# and beside them:
+#   make test-full     -- every test, the studies at full scale (about 40 min)
+#   make test-studies  -- only the studies, at the size given by TMFEM_SLOW_SCALE (CI: reduced)
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= out
 
-.PHONY: demo test install clean
+.PHONY: demo test test-full test-studies install clean
 
 install: $(STAMP)
 
@@ -28,8 +31,17 @@ $(STAMP): pyproject.toml $(VENV)/.syslibs
 demo: $(STAMP)
 	$(BIN)/tmfem report --preset 1-4 --out $(OUT)/1-4
 
+# two workers: the suite is CPU-bound and the machines have two cores
+PYTEST := $(BIN)/python -m pytest -q -n 2
+
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
+	$(PYTEST) -m "not slow"
+
+test-full: $(STAMP)
+	$(PYTEST)
+
+test-studies: $(STAMP)
+	$(PYTEST) -m slow
 
 clean:
 	rm -rf $(VENV) $(OUT)

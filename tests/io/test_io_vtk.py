@@ -1,5 +1,5 @@
 """VTK output (tmfem.io): files read back with meshio and with VTK itself (pyvista)."""
-import h5py  # noqa: F401  (XDMF); meshio, pyvista, h5py are declared dependencies (pyproject.toml):
+import h5py  # noqa: F401  (XDMF: the xdmf extra, installed with dev); meshio and pyvista are dependencies:
 import meshio            # a broken install must fail here, not skip
 import numpy as np
 import pytest
