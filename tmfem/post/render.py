@@ -41,11 +41,26 @@ def _part(pv, grid, kind: str):
     return grid.extract_cells(ids)
 
 
+def _trim(img: np.ndarray, *, pad: int = 12) -> np.ndarray:
+    """``img`` without the rows and columns of background around its content (``pad``
+    pixels of it kept), so that no picture has an empty band."""
+    ink = np.any(img[..., :3] != img[0, 0, :3], axis=-1)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    if rows.size == 0:
+        return img
+    r0, r1 = max(rows[0] - pad, 0), min(rows[-1] + pad + 1, img.shape[0])
+    c0, c1 = max(cols[0] - pad, 0), min(cols[-1] + pad + 1, img.shape[1])
+    return img[r0:r1, c0:c1]
+
+
 def _screenshot(plotter, png_path: Path) -> Path:
-    plotter.screenshot(str(png_path))
+    from PIL import Image
+
+    img = plotter.screenshot(return_img=True)
     plotter.close()
-    if not png_path.is_file() or png_path.stat().st_size == 0:
-        raise RuntimeError(f"pyvista wrote no image to {png_path}")
+    if img is None or img.size == 0:
+        raise RuntimeError(f"pyvista rendered no image for {png_path}")
+    Image.fromarray(_trim(np.asarray(img))).save(png_path)
     return png_path
 
 
@@ -120,6 +135,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
 
     p = pv.Plotter(off_screen=True, window_size=list(window_size))
     p.set_background(BACKGROUND)
+    legend = [["bar", "black"]]       # an entry for each part drawn in one colour
     p.add_mesh(_part(pv, grid, "bar").extract_surface(algorithm=None).tube(radius=r_bar, n_sides=16),
                color="black", smooth_shading=True)
 
@@ -127,6 +143,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
     if tendon_forces is None:
         p.add_mesh(tendons.extract_surface(algorithm=None).tube(radius=r_ten, n_sides=12), color="#2171b5",
                    smooth_shading=True)
+        legend.append(["tendon", "#2171b5"])
     else:
         f = np.asarray(tendons.cell_data["axial_force"], dtype=float)
         taut = f > 0
@@ -147,6 +164,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
         if np.any(~taut):
             slack = tendons.extract_cells(np.flatnonzero(~taut)).extract_surface(algorithm=None)
             p.add_mesh(slack.tube(radius=0.8 * r_ten, n_sides=8), color="#e41a1c", ambient=0.6)
+            legend.append(["tendon (slack)", "#e41a1c"])
 
     mem = _part(pv, grid, "membrane")
     if membrane is not None:
@@ -176,8 +194,10 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
         else:
             p.add_mesh(mem, color="#f4c27a", opacity=0.75, show_edges=True,
                        edge_color="#9a6a2a", line_width=0.5)
+            legend.append(["membrane", "#f4c27a"])
     else:
         p.add_mesh(mem, color="#f4c27a", opacity=0.6, show_edges=True, edge_color="#9a6a2a")
+        legend.append(["membrane", "#f4c27a"])
 
     p.add_mesh(pv.PolyData(np.ascontiguousarray(X.T)), color="black", point_size=8,
                render_points_as_spheres=True)
@@ -192,8 +212,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
                            show_points=False)
     if title:
         p.add_text(title, position="upper_edge", font_size=12, color="black")
-    p.add_legend([["bar", "black"], ["tendon (taut)", "#2171b5"], ["tendon (slack)", "#e41a1c"],
-                  ["membrane", "#f4c27a"]], bcolor="white", border=True, size=(0.2, 0.14),
+    p.add_legend(legend, bcolor="white", border=True, size=(0.2, 0.035 * len(legend)),
                  loc="upper right", face="rectangle")
     _set_view(p, X)
     p.camera.zoom(1.1)          # reset_camera frames the model; 1.3 cropped the 2-3's lowest node
@@ -224,6 +243,11 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
                  window_size=None) -> Path:
     """Render the first ``k`` mode shapes in a grid of views, off screen.
 
+    Each panel is a pyvista view of one mode (the prestressed state in grey, the displaced
+    shape coloured by |u| / max |u|); matplotlib lays the panels out with their titles (mode,
+    frequency and drawing scale), one shared colour bar and the caption, so that nothing
+    overlaps or is cropped.
+
     Parameters
     ----------
     points : ndarray (3, n)
@@ -237,8 +261,19 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
         Number of modes drawn.
     scale : float, optional
         Displacement scale; default makes each mode's largest displacement 15% of the
-        model size. Colour: displacement magnitude; grey: the undeformed state.
+        model size (the factor is printed in each panel's title).
+    title : str, optional
+        Caption above the panels.
+    window_size : (int, int), optional
+        Pixel size of the whole picture (default 500 x 420 per panel).
     """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import Normalize
+
     png_path = check_path(png_path, suffixes=(".png",))
     pv = _pv()
     # drawn from the same meshio.Mesh that write_modes writes (checks included)
@@ -251,34 +286,38 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
     rows = math.ceil(k / cols)
     if window_size is None:
         window_size = (500 * cols, 420 * rows)
+    panel = (int(window_size[0] // cols), int(window_size[1] // rows))
     base = pv.from_meshio(mesh)
-    p = pv.Plotter(off_screen=True, shape=(rows, cols), window_size=list(window_size),
-                   border=False)
-    for m in range(k):
-        p.subplot(m // cols, m % cols)
-        p.set_background(BACKGROUND)
+    dpi = 100
+    fig, axes = plt.subplots(rows, cols, figsize=(window_size[0] / dpi, window_size[1] / dpi + 0.9),
+                             dpi=dpi, squeeze=False, layout="constrained")
+    for m, ax in enumerate(axes.ravel()):
+        ax.set_axis_off()
+        if m >= k:
+            continue
         u = mesh.point_data[f"mode_{m + 1}"].T
         s = _mode_scale(X, u.T.ravel()) if scale is None else float(scale)
         g = base.copy()
         g.points = base.points + s * u.T
         mag = np.linalg.norm(u, axis=0)
-        name = f"|u| / max |u|, mode {m + 1}"          # one array name per panel: own bar
-        g.point_data[name] = mag / (mag.max() or 1.0)
+        g.point_data["|u| / max |u|"] = mag / (mag.max() or 1.0)
+        p = pv.Plotter(off_screen=True, window_size=list(panel), border=False)
+        p.set_background(BACKGROUND)
         p.add_mesh(base, color="#bbbbbb", style="wireframe", line_width=1)
-        p.add_mesh(g, scalars=name, cmap="plasma", clim=[0.0, 1.0], line_width=3,
-                   show_edges=False,
-                   # one bar (pyvista keeps one per title): every panel has the same scale
-                   scalar_bar_args={"title": "displacement / its maximum (every panel)",
-                                    "color": "black", "fmt": "%.1f", "vertical": False,
-                                    "position_x": 0.2, "position_y": 0.02, "width": 0.6,
-                                    "height": 0.07, "n_labels": 3, "title_font_size": 13,
-                                    "label_font_size": 11})
-        p.add_text(f"mode {m + 1}: {f[m]:.4g} Hz", position="upper_edge", font_size=10,
-                   color="black")
+        p.add_mesh(g, scalars="|u| / max |u|", cmap="plasma", clim=[0.0, 1.0], line_width=3,
+                   show_edges=False, show_scalar_bar=False)
         _set_view(p, X)
         p.camera.zoom(1.25)
-    if title:
-        p.subplot(rows - 1, 0)
-        p.add_text(title + " (grey: prestressed state; shapes scaled)", position="lower_left",
-                   font_size=12, color="black")
-    return _screenshot(p, png_path)
+        ax.imshow(_trim(np.asarray(p.screenshot(return_img=True))))
+        p.close()
+        ax.set_title(f"mode {m + 1}: {f[m]:.4g} Hz  (shape x {s:.3g})", fontsize=11)
+    fig.colorbar(ScalarMappable(Normalize(0.0, 1.0), "plasma"), ax=axes, location="bottom",
+                 shrink=0.4, aspect=40, label="|u| / max |u| of each mode (grey: the prestressed state)")
+    caption = "mode shapes drawn with their largest displacement at 15 % of the model size" \
+        if scale is None else f"mode shapes drawn at scale {float(scale):.3g}"
+    fig.suptitle(f"{title}\n{caption}" if title else caption, fontsize=12)
+    fig.savefig(png_path, dpi=dpi)
+    plt.close(fig)
+    if not png_path.is_file() or png_path.stat().st_size == 0:
+        raise RuntimeError(f"matplotlib wrote no image to {png_path}")
+    return png_path

@@ -179,10 +179,14 @@ def plot_configuration(png: Path, d, system) -> Path:
     ax.set_zlim(mid[2] - span, mid[2] + span)
     sm = ScalarMappable(cmap=cmap, norm=Normalize(0, tmax))
     fig.colorbar(sm, ax=ax, shrink=0.6, label="tendon force [N] (red: slack)")
-    ax.legend(handles=[Line2D([], [], color="k", lw=3, label="bar"),
-                       Line2D([], [], color=cmap(0.7), lw=1.2, label="tendon (colour: force)"),
-                       Line2D([], [], color="orange", alpha=0.5, lw=6, label="membrane")],
-              loc="upper left", fontsize=8)
+    # the legend shows the colours drawn: the tendons' median force, and red where one is slack
+    handles = [Line2D([], [], color="k", lw=3, label="bar"),
+               Line2D([], [], color=cmap(float(np.median(np.clip(T, 0, None))) / tmax), lw=1.2,
+                      label="tendon (colour: force)")]
+    if np.any(T <= 0):
+        handles.append(Line2D([], [], color="r", lw=1.2, label="tendon (slack)"))
+    handles.append(Line2D([], [], color="orange", alpha=0.5, lw=6, label="membrane"))
+    ax.legend(handles=handles, loc="upper left", fontsize=8)
     ax.set_title(f"{system.name}: design configuration")
     return save_figure(fig, png)
 
