@@ -12,31 +12,63 @@ import numpy as np
 from tmfem.post.plots import new_figure, save_figure
 
 
-def plot_deployment(png, result, *, title: str = "") -> Path:
-    """Three panels: bar attitudes theta_1j, psi_1j against their references (Fig. 7.2), the
-    membrane deflections w_1..w_3 (Fig. 7.3), rest lengths against their limits (the tendon
-    lengths, Fig. 7.4); the switching time as a dashed line."""
+def _family(name: str) -> str:
+    """The coordinate family of a bar coordinate: ``theta_12`` -> ``theta``, ``x_21`` -> ``x``."""
+    return name.rsplit("_", 1)[0]
+
+
+def _is_angle(family: str) -> bool:
+    return family in ("theta", "psi", "phi")
+
+
+def plot_deployment(png, result, *, title: str = "", coordinates=None) -> Path:
+    """The deployment run, one panel per coordinate family and one for the tracking error.
+
+    Panels: each family of the tracked bar coordinates (theta_ij, psi_ij in degrees; x, y, z
+    in metres) against its reference (Figures 7.2, 8.2; eqs. 5.68, 5.100); the tracking error
+    q - q_d of every tracked coordinate; the membrane deflections w_k (Figures 7.3, 8.3) with
+    their largest excursion marked; rest lengths against their limits, the tendon lengths
+    (Figures 7.4, 8.4). The switch to the linear controller is a dashed line in every panel.
+
+    Parameters
+    ----------
+    png : str or Path
+    result : DeploymentResult
+    title : str
+    coordinates : list of str, optional
+        The bar coordinates to draw (default every coordinate whose reference moves).
+    """
     r = result
-    fig = new_figure(figsize=(8, 10))
-    ax = fig.subplots(3, 1, sharex=True)
-    names = r.names["q"]
-    sel = [k for k, n in enumerate(names) if n.startswith(("theta_1", "psi_1"))][:4]
-    # bars 1 and 2 of a symmetric deployment move alike: bar 1 wide and pale under bar 2
-    for i, k in enumerate(sel):
-        first = i < 2
-        ln, = ax[0].plot(r.t, np.degrees(r.z[:, k]), lw=4.0 if first else 1.4,
-                         alpha=0.45 if first else 1.0, label=names[k])
-        ax[0].plot(r.t, np.degrees(r.q_d[:, k]), ":", color="k", lw=0.9,
-                   label="references (eq. 5.68)" if i == 0 else None)
-    ax[0].set_ylabel("bar attitude [deg]")
-    ax[0].legend(fontsize=7, ncol=3)
-    _deflections(ax[1], r)
-    _rest_lengths(ax[2], r)
+    names = list(r.names["q"])
+    if coordinates is None:
+        moving = np.ptp(r.q_d[:, :len(names)], axis=0) > 1e-9
+        coordinates = [n for n, m in zip(names, moving) if m] or names
+    idx = [names.index(n) for n in coordinates]
+    families = list(dict.fromkeys(_family(names[k]) for k in idx))
+    n_panels = len(families) + 3
+    fig = new_figure(figsize=(8, 2.4 * n_panels + 0.6))
+    ax = fig.subplots(n_panels, 1, sharex=True)
+    for a, fam in zip(ax, families):
+        conv, unit = (np.degrees, "deg") if _is_angle(fam) else ((lambda v: v), "m")
+        first = True
+        for k in idx:
+            if _family(names[k]) != fam:
+                continue
+            a.plot(r.t, conv(r.z[:, k]), lw=1.4, label=names[k])
+            a.plot(r.t, conv(r.q_d[:, k]), ":", color="k", lw=0.9,
+                   label="reference" if first else None)
+            first = False
+        a.set_ylabel(f"{fam} [{unit}]")
+        a.legend(fontsize=7, ncol=min(4, len(idx) + 1), loc="best")
+    _tracking_error(ax[len(families)], r, idx, names)
+    _deflections(ax[-2], r)
+    _rest_lengths(ax[-1], r)
     if r.switch_time is not None:
         for a in ax:
             a.axvline(r.switch_time, color="k", ls="--", lw=0.8)
-        ax[0].annotate(f"switch {r.switch_time:.2f} s", (r.switch_time, ax[0].get_ylim()[1]),
-                       fontsize=8, va="top")
+        ax[0].text(r.switch_time, 0.97, f" switch to the linear controller, {r.switch_time:.2f} s",
+                   transform=ax[0].get_xaxis_transform(), fontsize=8, va="top", ha="left",
+                   bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
     for a in ax:
         a.grid(alpha=0.3)
     if title:
@@ -44,12 +76,35 @@ def plot_deployment(png, result, *, title: str = "") -> Path:
     return save_figure(fig, Path(png))
 
 
+def _tracking_error(ax, r, idx, names) -> None:
+    """q - q_d of the tracked coordinates: degrees for angles, millimetres for positions."""
+    for k in idx:
+        fam = _family(names[k])
+        e = r.z[:, k] - r.q_d[:, k]
+        if _is_angle(fam):
+            ax.plot(r.t, np.degrees(e), lw=1.0, label=f"{names[k]} [deg]")
+        else:
+            ax.plot(r.t, 1e3 * e, lw=1.0, ls="--", label=f"{names[k]} [mm]")
+    ax.set_ylabel("tracking error q - q_d")
+    ax.legend(fontsize=7, ncol=4, loc="lower right")
+
+
 def _deflections(ax, r) -> None:
-    """w_1..w_3 [mm] against time (Figures 7.3, 8.3)."""
+    """w_k [mm] against time (Figures 7.3, 8.3), the largest excursion marked and, where it
+    follows the switch to the linear controller within 2 s, said to be its transient."""
     for k, n in enumerate(r.names["w"]):
         ax.plot(r.t, 1e3 * r.w[:, k], label=n)
     ax.set_ylabel("membrane deflection w [mm]")
-    ax.legend(fontsize=8)
+    if r.w.size:
+        i, k = np.unravel_index(np.argmax(np.abs(r.w)), r.w.shape)
+        t_peak, w_peak = float(r.t[i]), 1e3 * float(r.w[i, k])
+        text = f"largest |w|: {abs(w_peak):.3g} mm ({r.names['w'][k]}) at {t_peak:.2f} s"
+        if r.switch_time is not None and 0.0 <= t_peak - r.switch_time <= 2.0:
+            text += f",\n{t_peak - r.switch_time:.2f} s after the switch: its transient"
+        ax.annotate(text, (t_peak, w_peak), xytext=(0.02, 0.95), textcoords="axes fraction",
+                    fontsize=8, va="top", arrowprops=dict(arrowstyle="->", lw=0.7),
+                    bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1))
+        ax.legend(fontsize=8, loc="lower right")
 
 
 def _rest_lengths(ax, r) -> None:
@@ -68,29 +123,10 @@ def _rest_lengths(ax, r) -> None:
 
 
 def plot_lpv_deployment(png, result, *, title: str = "") -> Path:
-    """Figures 8.2-8.4: the attitudes (theta, psi) of bars b_11 and b_21 and the position
-    (x, y, z) of b_21's lower end A_21 against their references (eq. 5.100), the membrane
-    deflections w_1..w_3, rest lengths against their limits (the tendon lengths)."""
-    r = result
-    fig = new_figure(figsize=(8, 12))
-    ax = fig.subplots(4, 1, sharex=True)
-    names = r.names["q"]
-    for a, keys, scale, unit in ((ax[0], ("theta_11", "psi_11", "theta_21", "psi_21"), np.degrees, "deg"),
-                                 (ax[1], ("x_21", "y_21", "z_21"), lambda v: v, "m")):
-        for i, n in enumerate(keys):
-            k = names.index(n)
-            a.plot(r.t, scale(r.z[:, k]), label=n)
-            a.plot(r.t, scale(r.q_d[:, k]), ":", color="k", lw=0.9,
-                   label="references (eq. 5.100)" if i == 0 else None)
-        a.set_ylabel(f"bars b_11, b_21 [{unit}]")
-        a.legend(fontsize=7, ncol=3)
-    _deflections(ax[2], r)
-    _rest_lengths(ax[3], r)
-    for a in ax:
-        a.grid(alpha=0.3)
-    if title:
-        ax[0].set_title(title)
-    return save_figure(fig, Path(png))
+    """Figures 8.2-8.4: :func:`plot_deployment` on the attitudes of bars b_11, b_21 and the
+    position of b_21's lower end A_21, tracked against the references of eq. 5.100."""
+    return plot_deployment(png, result, title=title,
+                           coordinates=["theta_11", "psi_11", "theta_21", "psi_21", "x_21", "y_21", "z_21"])
 
 
 def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
