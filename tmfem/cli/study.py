@@ -115,8 +115,14 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
         emap = equilibrium_map(system, theta=th, psi=ps, progress=bar.callback("map rows"))
         (out / "equilibrium_map.json").write_text(json.dumps(with_units(emap.to_dict())))
         files["equilibrium_map.json"] = str(out / "equilibrium_map.json")
+        design = (c.theta[0], c.psi[0] - c.sigma[0])
+        # a finer map +-10 deg around the design resolves a thin feasible region
+        bar.step(f"equilibrium map {2 * k - 1}x{2 * k - 1} around the design")
+        detail = equilibrium_map(system, theta=design[0] + np.radians(np.linspace(-10, 10, 2 * k - 1)),
+                                 psi=design[1] + np.radians(np.linspace(-10, 10, 2 * k - 1)),
+                                 progress=bar.callback("map rows"))
         files["equilibrium_map.png"] = str(plot_equilibrium_map(
-            out / "equilibrium_map.png", emap, mark=(c.theta[0], c.psi[0] - c.sigma[0])))
+            out / "equilibrium_map.png", emap, mark=design, detail=detail))
         result["map_feasible_points"] = int(emap.feasible.sum())
     bar.step("done")
     return {"system": system.name, "ok": d.ok, "out": str(out), "files": files,
