@@ -11,7 +11,7 @@ inside its Newton matrix: element assembly, the exponential map's tangent operat
 constraint products T^T K dexp T).
 
 ``--deploy cable|fixed-rate``: instead, the 2-3 deployment itself (the adaptive PFL of 7.4 at
-the reference with the plant's tendon law, docs/fe-plant.md) on the MTC plant with that
+the reference with the plant's tendon law, docs/guides/fe-plant.md) on the MTC plant with that
 tendon law, from its packaged equilibrium, through :func:`run_deployment`; with
 ``--lpv-controller FILE`` the LPV deployment of 8.4 (preset 2-3-lpv) with that saved design
 (``tmfem control lpv ... --save FILE``, rebuilt and checked on its grid as ``tmfem deploy``
@@ -113,7 +113,7 @@ def main():
     else:
         fe = SBCModel(s, mesh_n=a.mesh, rest_lengths="system")
         dyn = sbc_dynamics.SBCDynamics(fe, fe.solve_static().state, perturb=perturb)
-    plant = Timed(FEStatePlant(dyn, com, bars="chord"))      # as measured in docs/fe-plant.md
+    plant = Timed(FEStatePlant(dyn, com, bars="chord"))      # as measured in docs/guides/fe-plant.md
     t_fe = time.perf_counter() - t0
     inner = []
     if a.plant == "sbc":

@@ -1,5 +1,5 @@
 """Why a design-grid certificate of the 2-3 output-feedback loop fails on the 4x finer grid
-(docs/lpv.md, "On the 2-3 loop"): for a saved X(rho) of the separation form X = M diag(P, beta Z) M^T
+(docs/guides/lpv.md, "On the 2-3 loop"): for a saved X(rho) of the separation form X = M diag(P, beta Z) M^T
 (tmfem.control.lpv.certificate.separation_start; M: eps -> e = x_z - eps),
 
 1. the largest relative LMI eigenvalue on the fine grid with the error part re-weighted,

@@ -1,5 +1,5 @@
 """The 2-3 deployment (7.4, Table 7.7) on a finite-element plant beside the same deployment on
-the control-oriented model (issue 15, docs/fe-plant.md): from two CSVs of ``tmfem deploy``
+the control-oriented model (issue 15, docs/guides/fe-plant.md): from two CSVs of ``tmfem deploy``
 (same controller, same dt), the deviation of the FE run from the COM run over time (largest
 bar-angle difference [mrad], largest stage-2 base-position difference [mm]), each run's
 tracking error |q - q_d| and the smallest rest-length margin |tendon| - r.

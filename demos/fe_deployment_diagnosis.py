@@ -1,5 +1,5 @@
 """Why the adaptive PFL of eq. 5.58 (terms at the measured state) diverges on the MTC plant,
-and what fixes it: the experiments of docs/fe-plant.md on the 2-3 deployment (7.4, Table
+and what fixes it: the experiments of docs/guides/fe-plant.md on the 2-3 deployment (7.4, Table
 7.7), adaptive PFL without the switch, dt = 0.01 s, 3 x 10 x 10 MTC plant with the COM's
 fixed-rate tendons unless stated. Prints one line per experiment: where the closed loop
 diverged (Park's Newton failed) or the largest bar error |q - q_d| (angles [mrad], bases [mm]).

@@ -1,5 +1,5 @@
 """Why the LPV deployment of 8.4 (2-3, scheduled state feedback of 8.3) diverges on the SBC
-plant measured through the bar chords: the experiments of docs/fe-plant.md ("The LPV deployment on the SBC plant"), dt = 0.01 s,
+plant measured through the bar chords: the experiments of docs/guides/fe-plant.md ("The LPV deployment on the SBC plant"), dt = 0.01 s,
 the FE plants started in their own packaged equilibrium as `tmfem deploy --plant` starts them.
 
     .venv/bin/python demos/lpv_sbc_diagnosis.py --lpv-controller c61.npz [--mesh 4] [--t-end 1]
@@ -34,7 +34,7 @@ from tmfem.simulation.driver import simulate
 from tmfem.system import load_preset
 
 #: the SBC plant measured through the bar chords, as diagnosed here (the plants' default is
-#: their rigid fit, which runs: docs/fe-plant.md)
+#: their rigid fit, which runs: docs/guides/fe-plant.md)
 CHORD = {"sbc": "chord"}
 
 

@@ -1,5 +1,5 @@
 """The 1-4(D) deployment (7.4, adaptive PFL without the switch, dt = 0.01 s) on the SBC plant:
-the experiments of docs/fe-plant.md, "What was tried". Prints one line per experiment.
+the experiments of docs/guides/fe-plant.md, "What was tried". Prints one line per experiment.
 
     .venv/bin/python demos/sbc_1_4d_diagnosis.py [--mesh 4] [--t-end 3]
         [--only response,open-loop,closed,weak,deploy] [--actuation rest-length|force]
