@@ -1,11 +1,11 @@
-"""Speed of a COM-designed controller on a finite-element plant (issue 15).
+"""Speed of a COM-designed controller on a finite-element plant.
 
 The deployed 2-3 system (preset 2-3-deploy, Table 7.7) or 1-4(D) (``--preset 1-4D``, SBC
 only) on the MTC (``--plant mtc``, default) or SBC model (``--plant sbc``) with N x n x n
 membrane elements, in closed loop with the LQR state feedback of the COM linearisation
 (:func:`tmfem.control.deployment.run.lqr_state_feedback`) through the COM-state estimate
 (:class:`tmfem.control.fe_plant.state_estimate.FEStatePlant`), from theta_11' = 0.02 rad/s, dt = 0.01 s.
-Target (issue 15): a 20 s 2-3 deployment on the 3x10x10 MTC model in under 10 minutes, i.e.
+Target: a 20 s 2-3 deployment on the 3x10x10 MTC model in under 10 minutes, i.e.
 under 0.3 s per step. Prints the time per step and where it goes (for the SBC plant also
 inside its Newton matrix: element assembly, the exponential map's tangent operator, the
 constraint products T^T K dexp T).

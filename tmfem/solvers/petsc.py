@@ -56,7 +56,7 @@ PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/guides/b
 #: factors of P > 1 ranks (4: 80-84 columns for 12 modes against 120-136 with 8, 53 single
 #: solves in SLEPc; at 309k DOF on 1 rank 9.7-12.7 s against 12.8-14.8 s with 8, on 2 ranks
 #: 8.1-10.7 s against SLEPc's 9.5-12.7 s; equal within the drift at 20k-78k DOF;
-#: docs/guides/backends.md, "The block eigen solver with 4 right-hand sides")
+#: docs/validation/benchmarks.md, "Eigen solvers")
 EIG_BLOCK = 4
 #: right-hand sides per block of the redundant eigensolver, split by columns over the ranks
 #: (8: 4 per rank on 2 ranks, 2.6-3.1 s of CPU at 78k DOF against 3.2-3.7 s with 8 per
