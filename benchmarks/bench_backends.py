@@ -24,7 +24,7 @@ OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
 per row).
 --mpi-yield: petsc2's waiting ranks yield the core (Open MPI ``--mca mpi_yield_when_idle 1``;
 helps on a loaded machine: busy-waiting takes the core from the working rank and other jobs).
-Targets (issue 11, 2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
+Targets (2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
 scipy time of 4x80x80; 1.2 M DOF < 5 min and < 16 GB.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Speed of the control-oriented model (issue 4): one evaluation of M_hat, F_hat, B_hat,
+"""Speed of the control-oriented model: one evaluation of M_hat, F_hat, B_hat,
 one linearisation, and a 20 s free vibration (dt = 0.01 s, Park) of the 2-3 and 1-4
 systems (presets; 2-3 is the design of Tables 6.5/6.7). Target: the 20 s run of the 2-3 system in < 2 s (ten times faster than real
 time). Prints wall and CPU times and where the time of the run goes.

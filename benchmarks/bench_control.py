@@ -4,9 +4,9 @@
 
 Prints, per system: plant size, LMI variables and block sizes, solver status and time,
 gamma, closed-loop max Re and ||T_pw||_inf. A failed synthesis is printed, not hidden.
-Target (issue 12): each synthesis < 60 s on the 2-core machine. ``central``: the central
-controller at 1.01 gamma_opt (issue 13), whose solve time is the Riccati bisection plus SLICOT
-SB10FD (docs/control.md).
+Target: each synthesis < 60 s on the 2-core machine. ``central``: the central
+controller at 1.01 gamma_opt, whose solve time is the Riccati bisection plus SLICOT
+SB10FD (docs/guides/control.md).
 """
 import argparse
 import time

@@ -1,4 +1,4 @@
-"""Speed of a 20 s deployment at dt = 0.01 s (issue 13 target: >= 10x faster than real time).
+"""Speed of a 20 s deployment at dt = 0.01 s (target: >= 10x faster than real time).
 
 Per system: the real-time factor t_end / time of the closed-loop run (Park's method with
 the controller in the loop), by wall time and by the process's CPU time (the machine is

@@ -1,17 +1,17 @@
-"""Speed of a COM-designed controller on a finite-element plant (issue 15).
+"""Speed of a COM-designed controller on a finite-element plant.
 
 The deployed 2-3 system (preset 2-3-deploy, Table 7.7) or 1-4(D) (``--preset 1-4D``, SBC
 only) on the MTC (``--plant mtc``, default) or SBC model (``--plant sbc``) with N x n x n
 membrane elements, in closed loop with the LQR state feedback of the COM linearisation
 (:func:`tmfem.control.deployment.run.lqr_state_feedback`) through the COM-state estimate
 (:class:`tmfem.control.fe_plant.state_estimate.FEStatePlant`), from theta_11' = 0.02 rad/s, dt = 0.01 s.
-Target (issue 15): a 20 s 2-3 deployment on the 3x10x10 MTC model in under 10 minutes, i.e.
+Target: a 20 s 2-3 deployment on the 3x10x10 MTC model in under 10 minutes, i.e.
 under 0.3 s per step. Prints the time per step and where it goes (for the SBC plant also
 inside its Newton matrix: element assembly, the exponential map's tangent operator, the
 constraint products T^T K dexp T).
 
 ``--deploy cable|fixed-rate``: instead, the 2-3 deployment itself (the adaptive PFL of 7.4 at
-the reference with the plant's tendon law, docs/fe-plant.md) on the MTC plant with that
+the reference with the plant's tendon law, docs/guides/fe-plant.md) on the MTC plant with that
 tendon law, from its packaged equilibrium, through :func:`run_deployment`; with
 ``--lpv-controller FILE`` the LPV deployment of 8.4 (preset 2-3-lpv) with that saved design
 (``tmfem control lpv ... --save FILE``, rebuilt and checked on its grid as ``tmfem deploy``
@@ -113,7 +113,7 @@ def main():
     else:
         fe = SBCModel(s, mesh_n=a.mesh, rest_lengths="system")
         dyn = sbc_dynamics.SBCDynamics(fe, fe.solve_static().state, perturb=perturb)
-    plant = Timed(FEStatePlant(dyn, com, bars="chord"))      # as measured in docs/fe-plant.md
+    plant = Timed(FEStatePlant(dyn, com, bars="chord"))      # as measured in docs/guides/fe-plant.md
     t_fe = time.perf_counter() - t0
     inner = []
     if a.plant == "sbc":

@@ -1,4 +1,4 @@
-"""Speed of the element kernels and of the linear solver (helper B's layer).
+"""Speed of the element kernels and of the linear solver.
 
     .venv/bin/python benchmarks/bench_kernels.py [--sizes 10,20,40,80]
 

@@ -5,7 +5,7 @@ Run: .venv/bin/python benchmarks/bench_lpv.py [--grid 2x2] [--solver SCS] [--max
          [--gamma-upper G] [--rtol 0.05] [--budget 300] [--grid-continuation auto|on|off]
 Prints the plant build time, the LMI sizes, the solve times (wall and CPU: the machine may be
 shared) and gamma for the 2-3 system of ch. 8 (preset 2-3-lpv) on a sub-grid of P_D (8.3);
-EIGOPT: the gamma bisection (docs/lpv.md) from --gamma-upper (default 2 x the pointwise bound),
+EIGOPT: the gamma bisection (docs/guides/lpv.md) from --gamma-upper (default 2 x the pointwise bound),
 with the continuation in the grid (6 x 1 first) as bisect_gamma decides (auto) or forced on/off;
 prints every level (also the sub-grid's), the bracket and the CPU time.
 """

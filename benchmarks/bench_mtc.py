@@ -9,7 +9,7 @@ iterations of all levels), static time (from the undeformed membrane, as `tmfem 
 tracemalloc), and, as a same-process baseline, one factorisation of the tangent with
 scipy's default spsolve (COLAMD, partial pivoting) against the backend's symmetric-mode
 SuperLU (minimum degree on A^T + A) that the model uses.
-Targets (issue 3): ~1.3k DOF static + 12 modes < 1 s; ~100k DOF < 60 s, on 2 cores.
+Targets: ~1.3k DOF static + 12 modes < 1 s; ~100k DOF < 60 s, on 2 cores.
 """
 from __future__ import annotations
 

@@ -7,8 +7,8 @@ predictor + SBC Newton, or the SBC trust-region iteration alone from the undefor
 membrane with ``--predictor none``), static time, modal time (12 modes, shift-invert) and
 their sum beside the MTC model's free DOFs, static and modal times (its default mesh
 sequencing) on the same mesh, and the ratio of the totals (build included in both);
-``--repeat N`` alternates N runs of both models and reports the best time of each. Issue 10
-targets: the paper's mesh (4 x 10 x 10) under 2 s beyond import; no worse than 3x the MTC model.
+``--repeat N`` alternates N runs of both models and reports the best time of each.
+Targets: the paper's mesh (4 x 10 x 10) under 2 s beyond import; no worse than 3x the MTC model.
 """
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """Rate-bounded certificate of the 2-3 output-feedback LPV loop (tmfem.control.lpv.certificate;
-docs/lpv.md, output feedback) for a saved state-feedback design.
+docs/guides/lpv.md, output feedback) for a saved state-feedback design.
 
 Run: .venv/bin/python benchmarks/lpv_certificate.py --design F.npz [--budget 900] [--rtol 0.05]
          [--upper G] [--fine] [--cache DIR] [--save-certificate X.npz | --certificate X.npz]

@@ -1,5 +1,5 @@
 """LPV state feedback against the observer-based output feedback in the 2-3 deployment of 8.4,
-through the library (tmfem.control.deployment.run.run_deployment; docs/lpv.md, output feedback).
+through the library (tmfem.control.deployment.run.run_deployment; docs/guides/lpv.md, output feedback).
 
 Run: .venv/bin/python benchmarks/lpv_output_deploy.py [--gamma 20] [--t-end 20] [--dt 2e-4]
          [--sigma 0 1e-3] [--schedule measured|estimate] [--plot out.png]

@@ -1,4 +1,4 @@
-"""Shared timing helpers of the benchmark scripts: best-of-n timing and where the time of a run
+"""Shared timing functions of the benchmark scripts: best-of-n timing and where the time of a run
 went, by timed call.
 
 Run as ``python benchmarks/<script>.py``; the scripts import this module from their own

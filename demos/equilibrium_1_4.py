@@ -1,7 +1,7 @@
 """1-4 symmetric system (6.2.1): our equilibrium design beside Tables 6.2 and 6.3.
 
 Run: .venv/bin/python demos/equilibrium_1_4.py
-The printed r_1^S = 1.529 m contradicts the printed tendon stress (see docs/errata.md).
+The printed r_1^S = 1.529 m contradicts the printed tendon stress (see docs/validation/errata.md).
 """
 import numpy as np
 

@@ -2,7 +2,7 @@
 
 Run: .venv/bin/python demos/equilibrium_1_4D.py   (also used by demos/equilibrium_1_6D.py)
 k_H is not printed (reconstructed: 0.25); the printed final psi = 30 deg is read as 24 deg
-(docs/errata.md). The "as printed" column block evaluates the printed final configuration.
+(docs/validation/errata.md). The "as printed" column block evaluates the printed final configuration.
 """
 import numpy as np
 

@@ -1,7 +1,7 @@
 """2-3 symmetric system (6.2.2): the printed design of Table 6.4 checked against ch. 3.
 
 Run: .venv/bin/python demos/equilibrium_2_3.py
-As printed the design is not an equilibrium (docs/errata.md); the table shows why.
+As printed the design is not an equilibrium (docs/validation/errata.md); the table shows why.
 """
 import numpy as np
 

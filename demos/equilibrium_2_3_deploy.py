@@ -2,7 +2,7 @@
 
 Run: .venv/bin/python demos/equilibrium_2_3_deploy.py
 r_2, z_2, sigma_2 are not printed; the presets carry the reconstructed rule
-(sigma_2 = psi_2 - psi_1, z_2 = 0.7 l cos theta, Delta = 1 mm; docs/errata.md).
+(sigma_2 = psi_2 - psi_1, z_2 = 0.7 l cos theta, Delta = 1 mm; docs/validation/errata.md).
 """
 import numpy as np
 

@@ -2,7 +2,7 @@
 
 Run: .venv/bin/python demos/equilibrium_2_3_lpv.py
 Table 8.1 does not print r_1, r_2, z_2, sigma_2, r_mb; we assume the 7.4.3 design and its
-rule (docs/errata.md) and check that every grid point is a symmetric equilibrium.
+rule (docs/validation/errata.md) and check that every grid point is a symmetric equilibrium.
 """
 import numpy as np
 

@@ -9,7 +9,7 @@ membrane and the first 12 frequencies for three prestress levels:
 * design: the rest lengths of tmfem.equilibrium's design (eq. 3.8 with F_Delta of the linear
   plane-stress membrane on the same mesh), i.e. the "consistent" preset;
 * implied: r_1^S = 1.5025 m, the value the dissertation's own Tables 6.3 and 6.6 imply
-  (docs/errata.md, "MTC: 1-4 prestress implied by Tables 6.3 and 6.6").
+  (docs/validation/errata.md, "MTC: 1-4 prestress implied by Tables 6.3 and 6.6").
 
 With --out, writes the history of B_14 (Fig. 6.1) as PNG and CSV, the VTK of the equilibrium
 and of the modes, and PNG renders.

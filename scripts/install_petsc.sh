@@ -29,7 +29,7 @@ done
 if [ ${#need[@]} -gt 0 ]; then
   if ! command -v apt-get >/dev/null 2>&1; then
     echo "tmfem: the PETSc backend needs ${need[*]} (Debian bookworm) and there is no apt-get;" \
-         "on other platforms see docs/backends.md (conda-forge petsc4py slepc4py)" >&2
+         "on other platforms see docs/guides/backends.md (conda-forge petsc4py slepc4py)" >&2
     exit 1
   fi
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"

@@ -2,7 +2,7 @@
 
 Every message states what was expected and what was found, with numbers, so that a
 user can act on it without reading a traceback. The CLI prints ``str(exc)`` on one
-line and exits with :attr:`TmfemError.exit_code` (the contract is in docs/cli.md):
+line and exits with :attr:`TmfemError.exit_code` (the contract is in docs/guides/cli.md):
 
 ====  ==========================================================================
 0     success (with ``--allow-infeasible``: also when checks failed; they are listed)

@@ -1,5 +1,5 @@
 """CLI misuse battery: every bad option or input gives one line on stderr and the exit code
-of the contract in docs/cli.md (tmfem.errors), before any expensive step. Sources of the
+of the contract in docs/guides/cli.md (tmfem.errors), before any expensive step. Sources of the
 numbers in the messages: the 1-4 preset (Table 6.2: |S_1| = 1.53111 m from eq. 3.29) and
 the memory estimate of tmfem.cli.common.check_mesh_budget."""
 import os
@@ -154,7 +154,7 @@ def test_failed_check_exits_1_unless_allowed(capsys):
     # above the 94.8 MPa yield of 7.4.1: a failed design check, which exited 0 before
     rc, out, err = run(["equilibrium", "--preset", "1-4D-initial", "--mesh", "4"], capsys)
     assert rc == REFUSED and "[FAIL] tendon yield" in out
-    assert last_line(err) == "tmfem equilibrium: failed checks: tendon yield (exit 1; see docs/cli.md)"
+    assert last_line(err) == "tmfem equilibrium: failed checks: tendon yield (exit 1; see docs/guides/cli.md)"
     rc, out, _ = run(["equilibrium", "--preset", "1-4D-initial", "--mesh", "4",
                       "--allow-infeasible"], capsys)
     assert rc == 0 and "[FAIL] tendon yield" in out

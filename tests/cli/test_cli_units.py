@@ -26,7 +26,7 @@ def test_unit_rules():
     assert unit_of("system") is None
     assert column_header("t") == "t [s]" and column_header("theta_11_dot") == "theta_11_dot [rad/s]"
     assert column_header("B_1,12_z") == "B_1,12_z [m]"
-    # mass-normalised membrane modes (phi^T M phi = 1, docs/com.md): eta = w / phi in kg^0.5 m
+    # mass-normalised membrane modes (phi^T M phi = 1, docs/guides/com.md): eta = w / phi in kg^0.5 m
     assert column_header("eta_1") == "eta_1 [kg^0.5 m]" and column_header("eta_2_dot") == "eta_2_dot [kg^0.5 m/s]"
 
 
@@ -87,7 +87,7 @@ _UNIT = r"\S+ \[[^\]]+\]"
     ["--preset", "1-4D", "--controller", "adaptive-lqr", "--t-end", "0.03"],
 ])
 def test_every_column_of_the_7_4_deployment_csv_has_a_unit(argv, tmp_path, capsys):
-    # docs/fe-plant.md, docs/output.md: "units in the header"; the references q_d (eq. 5.68)
+    # docs/guides/fe-plant.md, docs/guides/output.md: "units in the header"; the references q_d (eq. 5.68)
     # carry their signals' units (x_21_ref was bare), the controller label "-"
     import csv
     import re

@@ -63,7 +63,7 @@ def test_vibrate_cli_2_3_preset(capsys):
 
 def test_modal_com_prestress_scale_reproduces_table_6_6(capsys):
     # Table 6.6, COM column of 1-4 (tmfem.reference.tables.FREQUENCIES): reproduced at 1.2903 x the
-    # designed prestress, the printed tendon stress 37.98 MPa of Table 6.3 (docs/errata.md,
+    # designed prestress, the printed tendon stress 37.98 MPa of Table 6.3 (docs/validation/errata.md,
     # "1-4: the COM column of Table 6.6 corresponds to 1.290 x the designed prestress":
     # within 0.04 % after rounding to the printed 4 decimals; we allow 0.05 % unrounded)
     import numpy as np

@@ -125,7 +125,7 @@ def test_eq_3_40_proportional_to_reduced_general_matrix():
 def test_eq_3_41_bounds_on_r1_match_positive_null_vector():
     # positivity of the null vector of the general reduced matrix vs the bounds on r_1:
     # k_H r* < r_1 < r* (eq. 3.41) and r_1 < L sin(psi_1 + 2pi/N)/cos(pi/N), which eq. 3.41
-    # omits (derived in r1_bounds_1ND; docs/errata.md "ch. 3 / eq. 3.41")
+    # omits (derived in r1_bounds_1ND; docs/validation/errata.md "ch. 3 / eq. 3.41")
     n_in = n_341_wrong = 0
     for _ in range(80):
         N = int(rng.integers(3, 7))
@@ -158,7 +158,7 @@ def test_eq_3_41_misses_bound_example():
 
 def test_eq_3_41_membrane_condition_is_eq_3_36_not_eq_3_22():
     # eq. 3.41 states Delta > 0 with the 1-N expression of eq. 3.36 (r_1 of eq. 3.33); a
-    # 1-N(D) design has r_1 < r* and Delta of eq. 3.22 differs (docs/errata.md, "ch. 3").
+    # 1-N(D) design has r_1 < r* and Delta of eq. 3.22 differs (docs/validation/errata.md, "ch. 3").
     s = one_stage(50, 15, 0.5, l1=2.2, N=4, k_H=0.3)
     cf = check_1ND(s)
     st = corner_state(s)

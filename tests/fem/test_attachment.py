@@ -165,7 +165,7 @@ def test_cli_attachment(s14, capsys):
 def test_mtc_default_rest_lengths_come_from_the_design_on_its_own_mesh_and_attachment(s14):
     # the MTC model without given rest lengths takes those of the ch. 3 design (eqs. 3.8-3.9)
     # computed with the same membrane mesh and corner attachment, so both see the same corner
-    # stiffness; the point design on mesh 10 would give 1.50891 m instead (docs/errata.md)
+    # stiffness; the point design on mesh 10 would give 1.50891 m instead (docs/validation/errata.md)
     from tmfem.models.mtc.model import MTCModel
     m = MTCModel(s14, mesh_n=20, tendon_elements=1, attachment="distributed")
     d = design_equilibrium(s14, mesh_n=20, attachment="distributed")

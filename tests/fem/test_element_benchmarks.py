@@ -41,7 +41,7 @@ def test_arch_follows_green_curve_through_limit_point():
 
 def test_arch_as_printed_has_a_tiny_limit_load():
     # source: benchmarks.json von_mises_truss_numbers "dissertation 4.5.3 as printed": EA = 50 N
-    # (E = 5e7 Pa, A = 1 mm^2), P* = 1.539591e-07 N; see docs/errata.md (element benchmarks)
+    # (E = 5e7 Pa, A = 1 mm^2), P* = 1.539591e-07 N; see docs/validation/errata.md (element benchmarks)
     case = vm_case("dissertation 4.5.3 as printed")
     r = two_bar_arch(a=2.5, b=0.005, EA=5e7 * 1e-6)
     assert r.limits["P_green"] == pytest.approx(case["P_limit_green_N"], rel=1e-6)

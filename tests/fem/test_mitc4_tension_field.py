@@ -1,4 +1,4 @@
-"""MITC4 shell with the tension-field lamina law (docs/wrinkling.md, docs/shells.md).
+"""MITC4 shell with the tension-field lamina law (docs/guides/wrinkling.md, docs/guides/shells.md).
 
 Sources: finite differences of the residual (the consistent tangent) and of the strain
 energy, in taut, wrinkled and slack states; another model: the total-Lagrangian membrane

@@ -4,7 +4,7 @@ Sources: the von Karman curve and Levy's point (benchmarks.json
 levy_ss_square_plate_immovable_*), the elastica (elastica_end_moment_closed_form) and Sze et
 al.'s table (sze32_cantilever_end_moment), the Scordelis-Lo reference 0.3024
 (scordelis_lo_roof), the membrane element on the same mesh (4.5.4), and the discrete
-closed form of n linearly interpolated directors (docs/shells.md).
+closed form of n linearly interpolated directors (docs/guides/shells.md).
 """
 import json
 from pathlib import Path
@@ -57,7 +57,7 @@ def test_cantilever_roll_up_16x1_against_elastica_and_discrete_closed_form():
         # the FE solution is the uniform-curvature solution of the linearly interpolated directors
         assert abs(x["u_tip"] - x["u_discrete"]) <= 2e-3 * L and abs(x["w_tip"] - x["w_discrete"]) <= 2e-3 * L
     # and within 1 % of L of the elastica up to half the roll-up (the discrete form departs by
-    # (dtheta^2 / 6) of the rotation: 2.8 % of L at the closed circle; docs/errata.md)
+    # (dtheta^2 / 6) of the rotation: 2.8 % of L at the closed circle; docs/validation/errata.md)
     for x in rows:
         if x["lambda"] <= 0.5:
             assert abs(x["u_tip"] - x["u_elastica"]) <= 0.01 * L and abs(x["w_tip"] - x["w_elastica"]) <= 0.01 * L
@@ -71,7 +71,7 @@ def test_cantilever_roll_up_16x1_against_elastica_and_discrete_closed_form():
 def test_cantilever_roll_up_8x1_follows_the_chord_law_of_eq_4_12_not_the_elastica():
     """The 16 x 1 reference of benchmarks.json comes with "8x1 quite similar" (MBDyn's
     sze32_ref.dat): an element exact for constant curvature. The element of eq. 4.12 measures
-    an element's bending by the chord 2 sin(dtheta/2) (docs/errata.md, 4.5.2): on 8 x 1 it
+    an element's bending by the chord 2 sin(dtheta/2) (docs/validation/errata.md, 4.5.2): on 8 x 1 it
     follows that discrete closed form and misses the elastica by 12 % of L."""
     r = shell_cantilever_moment.roll_up(n=8, steps=10)
     L = 12.0

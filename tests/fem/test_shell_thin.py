@@ -1,4 +1,4 @@
-"""Thin shells: Jacobi-equilibrated Newton solves (docs/shells.md, "Thin shells").
+"""Thin shells: Jacobi-equilibrated Newton solves (docs/guides/shells.md, "Thin shells").
 
 Sources: closed forms of diagonal systems (the equilibrated solve is the same solution; a
 pivot-ratio singularity test of the unscaled matrix is a false alarm), the membrane of
@@ -42,7 +42,7 @@ def test_thin_prestressed_membrane_reaches_full_newton_convergence():
     A = Kp[free][:, free].toarray()
     d = jacobi_scaling(A)
     c, cs = np.linalg.cond(A), np.linalg.cond(A * np.outer(d, d))
-    assert c > 1e10                         # measured 1.7e10 (docs/shells.md)
+    assert c > 1e10                         # measured 1.7e10 (docs/guides/shells.md)
     assert cs < 1e-2 * c                    # measured 3.3e7
     # stage 2 (Fw = 0.1 N at B) in one step, Newton to 3e-10 of the load, Jacobi-scaled solves
     res = newton(lambda t: s.residual(t, 1.0), stage1.state, free=s.constraints.free, tol=3e-10,

@@ -1,7 +1,7 @@
 """The general structure API (tmfem.fem.structure).
 
 Sources: the pinched hemisphere of MacNeal & Harder (1985), radial displacement 0.0924 under
-the load (our check: mesh convergence towards it, docs/shells.md); Euler's load of a pinned
+the load (our check: mesh convergence towards it, docs/guides/shells.md); Euler's load of a pinned
 strut and a prestressed membrane's closed-form frequencies f = (1/2a) sqrt(N/(rho h)) sqrt(m^2+n^2)
 (benchmarks.json rectangular_membrane_uniform_tension); the truss closed form of a pinned bar;
 follower versus dead pressure on a small deflection (equal to first order).
@@ -19,7 +19,7 @@ from tmfem.fem.truss import TrussElement, TrussSet
 
 def pinched_hemisphere(n):
     """Quarter hemisphere with an 18 deg hole (R = 10, t = 0.04, E = 6.825e7, nu = 0.3),
-    forces +-1 at the equator on the x and y axes (the worked example of docs/shells.md)."""
+    forces +-1 at the equator on the x and y axes (the worked example of docs/guides/shells.md)."""
     R = 10.0
     m = MeshQuad.init_tensor(np.linspace(0, np.pi / 2, n + 1), np.linspace(np.deg2rad(18), np.pi / 2, n + 1))
     theta, psi = m.p

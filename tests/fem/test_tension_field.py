@@ -3,7 +3,7 @@
 Sources: the consistent tangent is checked against central finite differences of the stress
 (an independent formulation) in every state and next to the state boundaries; the energy
 against the stress (S = dW/dE by finite differences); the simple-shear strip against the
-closed form of a homogeneous tension field (docs/wrinkling.md: S = E e1 n1 n1^T,
+closed form of a homogeneous tension field (docs/guides/wrinkling.md: S = E e1 n1 n1^T,
 n1 at 45 degrees, effective shear modulus E/4 in the small-strain limit, Wagner's tension
 field, e.g. Mansfield 1989 "The bending and stretching of plates", 2nd ed., ch. 9).
 """
@@ -163,7 +163,7 @@ def _shear_strip(law, gamma=1e-3, H=0.1, L=1.0):
 def test_simple_shear_strip_tension_field_closed_form():
     gamma = 1e-3
     sol, st, mid = _shear_strip("tension-field", gamma)
-    # closed form (docs/wrinkling.md): S12 = E e1 cos(t) sin(t) -> E gamma / 4, t -> 45 deg
+    # closed form (docs/guides/wrinkling.md): S12 = E e1 cos(t) sin(t) -> E gamma / 4, t -> 45 deg
     assert st.S[2][mid].mean() == pytest.approx(MAT.E * gamma / 4, rel=2e-3)
     w = sol.wrinkling()
     qp = sol.membrane.law.state(sol.membrane.strain(sol.x)[1])

@@ -1,7 +1,7 @@
 """Tension-field membrane in boundary-value problems and in the models.
 
 Sources: the twisted prestressed annulus against the tension-field solution derived in
-tmfem.reference.wrinkling (docs/wrinkling.md; the problem of Mansfield 1970 and Miller &
+tmfem.reference.wrinkling (docs/guides/wrinkling.md; the problem of Mansfield 1970 and Miller &
 Hedgepeth 1982) and, below the onset torque, the closed-form taut (Lame + shear) solution;
 plane-stress design: positive homogeneity of the small-strain tension-field law (corner
 forces linear in Delta) and the energy bound W_TF <= W_SVK (Pipkin 1986: the relaxed energy is

@@ -26,7 +26,7 @@ def test_com_frequencies_close_to_mtc_1_4():
 
 
 def test_printed_rest_length_1_529_gives_a_soft_system_in_both_models():
-    # Table 6.2's r_1^S = 1.529 m (docs/errata.md): the COM and the MTC model both find a
+    # Table 6.2's r_1^S = 1.529 m (docs/validation/errata.md): the COM and the MTC model both find a
     # nearly unstressed system whose first frequency is ~0.04 Hz instead of 0.1367 Hz
     from tmfem.models.mtc.model import MTCModel
     from tmfem.reference.com_modal import modal_summary

@@ -1,4 +1,4 @@
-"""Stiffness-proportional plant damping on the current tangent (issue 15, docs/fe-plant.md
+"""Stiffness-proportional plant damping on the current tangent (issue 15, docs/guides/fe-plant.md
 "Plant damping along the path"): C_n = alpha M + beta K_T(x_n) at every sample
 (``damping_tangent="current"``) against C = alpha M + beta K_0 (``"initial"``)."""
 import numpy as np
@@ -172,7 +172,7 @@ def test_damping_tangent_refusals(sbc):
 
 def test_deployment_plant_damping_tangent_default():
     """A damped deployment plant takes the current tangent unless told otherwise (the
-    default chosen from the runs of docs/fe-plant.md "Plant damping along the path"), an
+    default chosen from the runs of docs/guides/fe-plant.md "Plant damping along the path"), an
     undamped one has no damping to take it for; the CLI reports the tangent in force with
     --plant-damping and passes --plant-damping-tangent through."""
     from tmfem.cli.deploy import plant_arguments, plant_options

@@ -1,4 +1,4 @@
-"""The rest-length rules have one meaning in every command (docs/mtc.md, "Rest-length rules"):
+"""The rest-length rules have one meaning in every command (docs/guides/mtc.md, "Rest-length rules"):
 ``design`` is the ch. 3 design on the analysis mesh, ``design@n`` the design on the n x n mesh
 held fixed. The same rule at the same mesh gives the same frequencies in ``tmfem modal`` and
 ``tmfem converge``; the two rules differ at a mesh other than n (source of the design: eqs.
@@ -37,7 +37,7 @@ def test_defaults_are_named_and_differ_off_the_design_mesh(capsys):
     src_c, f_conv = _freqs(["converge"] + base, capsys)
     assert (src_m, src_c) == ("design", "design@10")
     # on the 4 x 4 x 4 mesh the point-corner design is stiffer than on 10 x 10 (F_Delta falls
-    # like 1/log n, docs/equilibrium.md): shorter rest lengths, higher frequencies
+    # like 1/log n, docs/guides/equilibrium.md): shorter rest lengths, higher frequencies
     assert f_modal[0] > 1.02 * f_conv[0]
 
 

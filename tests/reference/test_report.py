@@ -36,7 +36,7 @@ def test_index_links_every_file(report):
     for f in ("deploy-1-4D.csv", "deploy-1-4D.png", "deploy-1-4D.gif", "deploy-1-4D/1-4D.pvd",
               "vibration_com/com_1-4.pvd", "modes.vtu", "statics.csv", "frequencies.csv"):
         assert f in links, f
-    assert "## Why ours and the printed values differ" in index and "docs/errata.md" in index
+    assert "## Why ours and the printed values differ" in index and "docs/validation/errata.md" in index
 
 
 def test_tables_carry_units_and_both_prestress_levels(report):
@@ -45,7 +45,7 @@ def test_tables_carry_units_and_both_prestress_levels(report):
                            "SBC implied [Hz]"]
     assert len(rows) == 1 + 6
     st = {r["quantity"]: r for r in csv.DictReader(open(report / "statics.csv"))}
-    # implied prestress: r_1^S = 1.5025 m (docs/errata.md), shorter than the design's, so the
+    # implied prestress: r_1^S = 1.5025 m (docs/validation/errata.md), shorter than the design's, so the
     # tendons carry more force than at the designed rest length (eq. 3.8)
     assert float(st["rest length S_11"]["MTC implied"]) == 1.5025
     assert float(st["rest length S_11"]["MTC designed"]) > 1.5025

@@ -3,7 +3,7 @@
 Every expected number has its source in a comment: a printed table value, or what follows
 from the dissertation's equations (eq. 3.8-3.9, 3.22, 3.29, 3.33, 3.40, 5.31) evaluated by us.
 The reconstructions (k_H of Tables 7.3/7.5, the 1-4(D) final psi, the stage-2 bases of
-Table 7.7, the ch. 8 design) are documented in docs/errata.md.
+Table 7.7, the ch. 8 design) are documented in docs/validation/errata.md.
 """
 import numpy as np
 import pytest
@@ -152,7 +152,7 @@ def test_table_7_7_free_fit_of_final_bases():
     assert x[0] == pytest.approx(-34.86, abs=0.01)
     assert x[1] == pytest.approx(0.7 * 1.8 * np.cos(rad(55)), abs=2e-4)
     assert x[2] == pytest.approx(c.r[1], abs=2e-4)          # the preset's r_2 (Delta = 1 mm)
-    assert c.r[1] == pytest.approx(0.52086, abs=1e-5)       # docs/errata.md (Table 7.7)
+    assert c.r[1] == pytest.approx(0.52086, abs=1e-5)       # docs/validation/errata.md (Table 7.7)
     assert np.abs(misfit).max() < 1e-4
 
 

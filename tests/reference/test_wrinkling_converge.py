@@ -1,4 +1,4 @@
-"""The MTC convergence study with the tension-field membrane (docs/mtc.md, "Wrinkling").
+"""The MTC convergence study with the tension-field membrane (docs/guides/mtc.md, "Wrinkling").
 
 Sources: the issue's convergence target (0.3 % between the two finest meshes) for the global
 modes 1-4, the rates of np.polyfit on log h, and the law itself (tension only: the minor

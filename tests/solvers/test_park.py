@@ -138,7 +138,7 @@ class _QuasiStaticArctan:
     """m x'' + arctan(x - A sin t) = 0 with m -> 0: a quasi-static dof, x = A sin t - tan(m a)
     (closed form), whose Newton matrix (K = 1 / (1 + (x - A sin t)^2), the mass term ~1e-8)
     makes plain Newton overshoot and diverge once the predictor misses by |z| > 1.39 (Newton
-    on arctan), as the SBC shell's soft rotations do (docs/sbc.md, "Free vibration on the
+    on arctan), as the SBC shell's soft rotations do (docs/guides/sbc.md, "Free vibration on the
     fine mesh")."""
 
     m, A = 1e-9, 100.0

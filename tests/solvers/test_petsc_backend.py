@@ -388,7 +388,7 @@ def test_distributed_tangent_held_by_a_caller_is_not_overwritten(models):
 def sbc_scipy():
     # 1-4 SBC at 4 x 6 x 6: 937 free dofs, so that scipy's modes come from ARPACK
     # shift-invert (its dense path below 600 dofs has an error ~ eps lambda_max, 1e-7 on the
-    # lowest SBC mode with the shells' stiff rotations: docs/backends.md)
+    # lowest SBC mode with the shells' stiff rotations: docs/guides/backends.md)
     from tmfem.models.sbc.model import SBCModel
     from tmfem.system import load_preset
     m = SBCModel(load_preset("1-4"), mesh_n=6)

@@ -5,7 +5,7 @@ Every module of this package that defines ``NAME``, ``HELP``, ``configure(parser
 ``--json`` it is printed as one JSON document on stdout, otherwise the module's
 ``format_text(result) -> str`` (or a default rendering) is printed.
 
-Exit codes (docs/cli.md): a :class:`tmfem.errors.TmfemError` becomes one line on stderr
+Exit codes (docs/guides/cli.md): a :class:`tmfem.errors.TmfemError` becomes one line on stderr
 and its ``exit_code`` (1 the analysis says no, 2 bad input, 3 too large for this machine,
 4 missing backend); a result whose ``ok`` is false or whose ``checks`` failed is printed
 and exits 1 unless the command was given ``--allow-infeasible``; an output path that
@@ -126,7 +126,7 @@ def _install_interrupt_handler(command: str):
 
 
 def main(argv=None) -> int:
-    """Entry point of the ``tmfem`` console script; returns the exit code (docs/cli.md)."""
+    """Entry point of the ``tmfem`` console script; returns the exit code (docs/guides/cli.md)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     mod = args._module
@@ -180,7 +180,7 @@ def _checks_exit(args, result, *, printing: bool = True) -> int:
     if failed and not getattr(args, "allow_infeasible", False):
         if printing:
             print(f"tmfem {args.command}: failed checks: {', '.join(map(str, failed))} "
-                  "(exit 1; see docs/cli.md)", file=sys.stderr)
+                  "(exit 1; see docs/guides/cli.md)", file=sys.stderr)
         return 1
     return 0
 
@@ -192,7 +192,7 @@ def _mpi_size() -> int:
 
 def _main_mpi(args, mod) -> int:
     """Under ``mpiexec -n P`` (P > 1): the PETSc backend only; the command runs on every rank,
-    rank 0 alone prints and writes the output files (docs/backends.md#mpi), an error is
+    rank 0 alone prints and writes the output files (docs/guides/backends.md#mpi), an error is
     printed once with a non-zero exit, never a hang."""
     import contextlib
     import io

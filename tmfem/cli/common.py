@@ -1,5 +1,5 @@
 """Options shared by subcommands (which system to use) and the checks every command runs on
-its options before any expensive step (docs/cli.md)."""
+its options before any expensive step (docs/guides/cli.md)."""
 from __future__ import annotations
 
 import argparse
@@ -49,7 +49,7 @@ def add_model_args(parser, command: str, *, default: str) -> None:
                         + f" (default {default})")
     parser.add_argument("--backend", choices=backend_names(), default=None,
                         help="linear-algebra backend of the finite-element models (default scipy; "
-                             "petsc: docs/backends.md)")
+                             "petsc: docs/guides/backends.md)")
     options, owners = {}, {}
     for name in specs:
         for o in model_options(name, command):
@@ -156,7 +156,7 @@ def add_membrane_law_arg(parser) -> None:
     from tmfem.fem.tension_field import MEMBRANE_LAWS
     parser.add_argument("--membrane-law", choices=MEMBRANE_LAWS, default="svk",
                         help="membrane law: St.Venant-Kirchhoff (svk, default, eq. 4.9/5.8) or "
-                             "tension-field (wrinkling; docs/wrinkling.md)")
+                             "tension-field (wrinkling; docs/guides/wrinkling.md)")
 
 
 def parse_perturbation(items, names) -> dict:
@@ -197,7 +197,7 @@ def progress_bar(t_end: float, dt: float, label: str):
     finally:
         bar.close()
 # ---------------------------------------------------------------------------- validation
-# Checked before any expensive step, so that a bad option costs nothing (docs/cli.md).
+# Checked before any expensive step, so that a bad option costs nothing (docs/guides/cli.md).
 
 def finite_float(text: str) -> float:
     """argparse ``type``: a finite float (``inf``, ``nan`` and ``1e999`` are refused)."""

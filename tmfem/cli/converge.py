@@ -39,7 +39,7 @@ def configure(parser) -> None:
                         help="finite-element model (mtc: membrane-truss-cable, 4.4; sbc: "
                              "shell-beam-cable, 4.3, the model of 6.3)")
     parser.add_argument("--backend", choices=backend_names(), default="scipy",
-                        help="linear-algebra backend (default scipy; docs/backends.md)")
+                        help="linear-algebra backend (default scipy; docs/guides/backends.md)")
     parser.add_argument("--mesh", default="10",
                         help="comma-separated membrane subdivisions n (N quads of n x n each)")
     parser.add_argument("--tendon-elements", default="3",
@@ -54,7 +54,7 @@ def configure(parser) -> None:
                              "design@10, the design of 6.2, for a system without rest lengths) "
                              "or GROUP=VALUE pairs such as S1=1.5025; or recomputed on each mesh: "
                              "'design' (the ch. 3 design on that mesh, the default of `tmfem "
-                             "modal`/`static`) or 'mtc' (docs/mtc.md)")
+                             "modal`/`static`) or 'mtc' (docs/guides/mtc.md)")
     parser.add_argument("--csv", help="write one row per run, as it finishes")
     parser.add_argument("--plot", help="PNG: frequencies and peak stresses against h")
 

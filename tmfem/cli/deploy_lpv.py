@@ -31,15 +31,15 @@ def configure(parser) -> None:
                         help="--controller lpv: a design saved by `tmfem control lpv --save` (else one "
                              "is synthesised with the options below)")
     parser.add_argument("--solver", choices=("EIGOPT", "CLARABEL", "SCS"), default=None,
-                        help="--controller lpv: synthesis solver (default EIGOPT, docs/lpv.md)")
+                        help="--controller lpv: synthesis solver (default EIGOPT, docs/guides/lpv.md)")
     control_lpv.configure_synthesis(parser, prefix="--controller lpv: ")
     parser.add_argument("--estimator-interpolation", choices=("multilinear", "spline"), default=None,
                         help="--controller lpv-output: how the Kalman estimator's model and gains are "
                              "evaluated between grid points (default multilinear; spline: tensor-product "
-                             "splines, docs/lpv.md)")
+                             "splines, docs/guides/lpv.md)")
     parser.add_argument("--estimator-refine", type=int, default=None, metavar="R",
                         help="--controller lpv-output: the Kalman estimator on the design grid refined R "
-                             "times (new COM linearisations; default 1; docs/lpv.md)")
+                             "times (new COM linearisations; default 1; docs/guides/lpv.md)")
     parser.add_argument("--noise", type=float, default=None, metavar="SIGMA",
                         help="LPV deployment: measurement noise, seeded Gaussian samples of this standard "
                              "deviation [rad, m; rad/s, m/s] per step on every signal the controller reads "
@@ -93,7 +93,7 @@ def lpv_output_feedback(dep, design, *, interpolation: str = "multilinear", esti
     with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
     reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
     the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
-    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/lpv.md); the control law about rho_r(t)
+    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/guides/lpv.md); the control law about rho_r(t)
     as the state feedback's; the estimator is driven by the input saturated to the rest-length
     limits [1 mm, |tendon|(q_m)] of the run at the measured q; ``interpolation``: the
     estimator's between grid points (:class:`~tmfem.control.lpv.plant.GriddedLPV`);
@@ -153,7 +153,7 @@ def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
     """(set-up, result) of the LPV deployment with a fresh controller of ``d`` (the
     ``--controller`` builder, with ``--noise`` its seeded measurement noise) on the plant
     ``kind``: an FE plant starts in its own equilibrium of the packaged configuration under
-    the rest lengths the controller starts with (docs/fe-plant.md)."""
+    the rest lengths the controller starts with (docs/guides/fe-plant.md)."""
     from tmfem.cli.common import progress_bar
     from tmfem.cli.deploy import plant_arguments
     from tmfem.control.deployment.run import run_deployment

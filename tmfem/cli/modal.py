@@ -24,7 +24,7 @@ def configure(parser) -> None:
                         help="the PETSc backend's eigen solver (--backend petsc only; default auto: "
                              "block Krylov-Schur, on the distributed factors under mpiexec; redundant: every "
                              "rank factorises the whole K - sigma M, for cores shared with other "
-                             "jobs; docs/backends.md). The JSON's eig_solver says which one ran")
+                             "jobs; docs/guides/backends.md). The JSON's eig_solver says which one ran")
     parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu "
                                       "[finite-element models]")
     parser.add_argument("--png", help="render the first six mode shapes to this PNG "

@@ -97,7 +97,7 @@ def format_text(r: dict) -> str:
                          f"{d['final_tracking_error']:.2g}")
         lines.insert(-1, "")
     if r.get("notes"):
-        lines += ["", "why ours and the printed values differ (docs/errata.md):"]
+        lines += ["", "why ours and the printed values differ (docs/validation/errata.md):"]
         lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
                   for n in r["notes"]]
     return "\n".join(lines)

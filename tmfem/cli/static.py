@@ -25,7 +25,7 @@ def configure(parser) -> None:
     parser.add_argument("--stress-plot", help="PNG maps of the membrane stresses in the floating "
                                               "frame (Figs. 6.3-6.4)")
     parser.add_argument("--wrinkle-plot", help="PNG map of the membrane states (taut / wrinkled / "
-                                               "slack) and tension directions (docs/wrinkling.md)")
+                                               "slack) and tension directions (docs/guides/wrinkling.md)")
     parser.add_argument("--progress", action="store_true", help="iteration progress on stderr")
 
 

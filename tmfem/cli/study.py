@@ -133,7 +133,7 @@ def format_text(r: dict) -> str:
     lines = [text_table(r["table"]), ""]
     notes = explanations(r["system"], "design")
     if notes:
-        lines += ["why ours and the printed values differ (docs/errata.md):"]
+        lines += ["why ours and the printed values differ (docs/validation/errata.md):"]
         lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
                   for n in notes] + [""]
     lines.append("checks: " + ("all passed" if r["ok"] else "FAILED: " + ", ".join(r["failed_checks"])))

@@ -14,5 +14,5 @@ Subpackages, one concept each:
   controller (state estimates, tension actuation, sampled loops, plant comparison).
 
 May import system, models, solvers, errors; imported only by cli, reference, simulation.
-See docs/control.md.
+See docs/guides/control.md.
 """

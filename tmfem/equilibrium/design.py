@@ -357,7 +357,7 @@ def design_equilibrium(system, *, q=None, mesh_n: int = 10, strict: bool = True,
         Linear-algebra backend of the plane-stress solves (:func:`tmfem.solvers.get_backend`).
     membrane_law : {"svk", "tension-field"}
         Plane-stress law of the membrane (eq. 5.8 or the tension-field law of
-        :mod:`tmfem.fem.tension_field`; docs/wrinkling.md).
+        :mod:`tmfem.fem.tension_field`; docs/guides/wrinkling.md).
     """
     q = system.q if q is None else np.asarray(q, dtype=float)
     E, model, sol = membrane_state(system, q, mesh_n=mesh_n, attachment=attachment, patch=patch,

@@ -186,7 +186,7 @@ def r1_bounds_1ND(*, l1, theta1, psi1, k_H, N):
     so it is positive if and only if ``lower < r_1 < min(upper, upper_SL)`` with
     lower = k_H L sin(psi_1)/cos a, upper = L sin(psi_1)/cos a (the two bounds of eq. 3.41)
     and upper_SL = L sin(psi_1 + 2a)/cos a, which eq. 3.41 omits; it binds when
-    psi_1 > pi/2 - pi/N (docs/errata.md).
+    psi_1 > pi/2 - pi/N (docs/validation/errata.md).
 
     Returns
     -------
@@ -221,7 +221,7 @@ def check_1ND(system) -> dict:
 
     The null vector of eq. 3.40 is tested directly; the bounds on r_1 of eq. 3.41 are
     reported alongside. Delta is that of eq. 3.22 with the actual r_1 (eq. 3.41 uses the
-    1-N expression of eq. 3.36, which assumes r_1 of eq. 3.33; see docs/errata.md).
+    1-N expression of eq. 3.36, which assumes r_1 of eq. 3.33; see docs/validation/errata.md).
 
     Raises
     ------

@@ -6,7 +6,7 @@ equilibrium design (:class:`tmfem.fem.plane_stress.PlaneStressMembrane`: the cor
 displacement is imposed on the patch). A point attachment (the corner *is* a membrane
 node) is singular in a 2-D sheet: the corner force for a given corner displacement falls
 like 1 / log(1/h) under refinement. A distributed one spreads the corner over a small patch
-and converges (docs/mtc.md, docs/errata.md).
+and converges (docs/guides/mtc.md, docs/validation/errata.md).
 """
 from __future__ import annotations
 

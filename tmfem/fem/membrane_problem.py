@@ -5,7 +5,7 @@ The total-Lagrangian membrane of :mod:`tmfem.fem.membrane` with a membrane law
 equilibrium f_int(x) = lam f_ext on the free dofs with the prescribed displacements scaled by
 the same load factor lam, reached by adaptive load stepping (:func:`tmfem.solvers.newton.load_stepping`,
 Newton at each step, eqs. 4.5-4.6). It is the public entry point for membrane benchmarks
-(docs/wrinkling.md): a strip in simple shear and a twisted annulus are in the test suite.
+(docs/guides/wrinkling.md): a strip in simple shear and a twisted annulus are in the test suite.
 """
 from __future__ import annotations
 

@@ -28,7 +28,7 @@ G_2 x e_3) and the plane-stress law with transverse shear modulus k G (k = 5/6) 
 S = C~ c with C~ = Q^T D Q (eq. 4.10). C~ is a property of the reference configuration and
 is computed once.
 
-Tension-field lamina (``law="tension-field"``, beyond the dissertation; docs/wrinkling.md).
+Tension-field lamina (``law="tension-field"``, beyond the dissertation; docs/guides/wrinkling.md).
 The in-plane part of the lamina law is replaced by the relaxed membrane law of
 :mod:`tmfem.fem.tension_field` evaluated on the local in-plane Green-Lagrange strain
 E_loc = [[e_11, e_12], [e_12, e_22]] (eps_loc = Q c) at every lamina integration point:

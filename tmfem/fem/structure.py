@@ -18,7 +18,7 @@ Rotations at 5-dof (shell) nodes are the two director rotations about the node's
 (eq. 4.16); the solvers update them by the exponential map (finite rotations). Shell nodes
 on a symmetry plane get a reference triad whose V_1 is the plane normal, so that the
 symmetry condition is "translation along the normal fixed, rotation about V_2 fixed".
-See docs/shells.md for a worked example.
+See docs/guides/shells.md for a worked example.
 """
 from __future__ import annotations
 
@@ -430,7 +430,7 @@ class Structure:
         residual norm is a poor merit function for bending-dominated shells (a linear
         predictor stretches the mid-surface), and the full Newton step converges.
         ``equilibrate``: each Newton system is solved with symmetric Jacobi scaling
-        (:func:`tmfem.solvers.newton.factorize`; thin shells, docs/shells.md).
+        (:func:`tmfem.solvers.newton.factorize`; thin shells, docs/guides/shells.md).
         Returns the converged states, the start included.
         """
         if not (isinstance(steps, (int, np.integer)) and steps >= 1):

@@ -15,7 +15,7 @@ from tmfem.io.series import SeriesWriter
 
 
 #: Units of the named signals of a run. ``eta_k``: the COM's membrane modal coordinates; the
-#: modes are mass-normalised (phi^T M phi = 1, M in kg, docs/com.md), so eta = w / phi
+#: modes are mass-normalised (phi^T M phi = 1, M in kg, docs/guides/com.md), so eta = w / phi
 #: carries kg^0.5 m. ``ur_k``/``vr_k``/``wr_k``: membrane point coordinates (eq. 5.17).
 _UNITS = [(r"t", "s"), (r"(theta|psi|sigma)_\d+", "rad"), (r"w_\d+", "m"),
           (r"[xyz]_\d+", "m"), (r"[A-Z]+_[\d,]+_[xyz]", "m"), (r"tendon_deflection", "m"),

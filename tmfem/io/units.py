@@ -35,7 +35,7 @@ _EXACT = {
     "checks": "value and limit in the SI unit of the checked quantity (Pa, N, m)",
     "closed_form": "S1, delta, delta_3_36, r1_equilibrium, r_mb in m; A, det, ratio -",
     "final": "per state: rad, rad/s (theta, psi), kg^0.5 m, kg^0.5 m/s (eta_k), m (positions)",
-    # LPV synthesis and deployment (docs/lpv.md)
+    # LPV synthesis and deployment (docs/guides/lpv.md)
     "gamma": "-", "gamma_feasible": "-", "gamma_not_found": "-", "gamma_lower_bound_proven": "-",
     "gamma_rtol": "-", "lpv_gamma_lower_bound": "-", "pointwise_gamma": "-", "printed_gamma_bound": "-",
     "verification_max_eig": "- (relative)", "verification_max_eig_at": "rad",

@@ -112,7 +112,7 @@ SHARED_OPTIONS = {
         "patch radius [m] of --attachment distributed (default 10%% of r_mb)"))),
     "membrane_law": Option("--membrane-law", "svk", None, dict(choices=MEMBRANE_LAWS, help=(
         "membrane law (of the shell's lamina in the SBC model): St.Venant-Kirchhoff (svk, "
-        "eq. 4.9) or tension-field (wrinkling, docs/wrinkling.md)"))),
+        "eq. 4.9) or tension-field (wrinkling, docs/guides/wrinkling.md)"))),
     "rayleigh": Option("--rayleigh", None, ("vibrate",), dict(
         type=float, nargs=2, metavar=("ALPHA", "BETA"),
         help="Rayleigh damping C = ALPHA M + BETA K_0 (default none)")),

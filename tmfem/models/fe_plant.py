@@ -11,7 +11,7 @@ mass at the equilibrium, K_0 the tangent there and f_int the model's internal fo
 sampled state instead, C_n = alpha M + beta K_T(x_n), held over the step from t_n
 (:meth:`FEPlant.sample`; tangent-stiffness-proportional Rayleigh damping): K_0's axial bar
 stiffness along the equilibrium's bar axes damps a bar's rigid rotation away from them, K_T's
-does not (docs/fe-plant.md, "Plant damping along the path"). What a
+does not (docs/guides/fe-plant.md, "Plant damping"). What a
 state u *is* differs -- the MTC model's independent node positions, the SBC model's
 translations and rotation vectors counted from the equilibrium -- and each model's plant says
 so through three hooks (:meth:`FEPlant.configuration`, :meth:`FEPlant.positions`,

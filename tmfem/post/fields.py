@@ -53,7 +53,7 @@ def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "poi
     ``von_mises`` and ``sigma_p1`` (element maxima over the quadrature points, as the maxima
     of Tables 6.3 / 6.5 are taken), ``sigma_p2`` (element minimum), ``von_mises_mean``,
     ``membrane_state`` (0 taut, 1 wrinkled, 2 slack) and ``wrinkle_direction`` (inertial
-    frame) of the membrane law's criterion (docs/wrinkling.md).
+    frame) of the membrane law's criterion (docs/guides/wrinkling.md).
     """
     from tmfem.fem.plane_stress import PlaneStressMembrane
 

@@ -7,7 +7,7 @@ node). Bars are drawn as their beam elements' segments (3 per four-node element)
 axial force N and the bending moment |M| = (M_1^2 + M_2^2)^(1/2) of the element (mean over
 its Gauss points), tendons as lines with their axial forces, the membrane as the shell quads
 with the stresses at the element centres on the bottom, middle and top surfaces and the
-lamina law's state there (taut / wrinkled / slack, docs/wrinkling.md).
+lamina law's state there (taut / wrinkled / slack, docs/guides/wrinkling.md).
 """
 from __future__ import annotations
 
@@ -46,7 +46,7 @@ def rotation_vectors(model, state, d=None) -> np.ndarray:
 
 
 def shell_wrinkling(model, state) -> dict:
-    """Cell data of the shell lamina law's states (docs/wrinkling.md): ``membrane_state``
+    """Cell data of the shell lamina law's states (docs/guides/wrinkling.md): ``membrane_state``
     (ne,) int32, 0 taut, 1 wrinkled, 2 slack, of the element centre's two thickness Gauss
     points, and ``wrinkle_direction`` (3, ne), the tension (wrinkle-crest) direction in the
     global axes of the reference surface, zero where the element is not wrinkled

@@ -77,7 +77,7 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
     prestress_scale : float
         Factor on the designed membrane prestress (1 = designed, see ControlOrientedModel).
     membrane_law : {"svk", "tension-field"}
-        Membrane basis about the linear or the tension-field prestress (docs/wrinkling.md).
+        Membrane basis about the linear or the tension-field prestress (docs/guides/wrinkling.md).
     """
     K = default_membrane_modes(system) if membrane_modes is None else int(membrane_modes)
     if not (isinstance(modes, int) and modes >= 1):
@@ -127,7 +127,7 @@ def format_summary(r: dict) -> str:
                      + (" ..." if len(forces) > 6 else ""))
     if "printed_stress_prestress_scale" in r:
         lines.append(f"prestress implied by the printed tendon stress: x{r['printed_stress_prestress_scale']:.4f}"
-                     " (--prestress-scale in the Python API, docs/com.md)")
+                     " (--prestress-scale in the Python API, docs/guides/com.md)")
     if "printed_bar_load_prestress_scale" in r:
         lines.append(f"prestress implied by the printed stage-1 bar load: x{r['printed_bar_load_prestress_scale']:.4f}")
     ref = r.get("dissertation", {}).get("COM", [])

@@ -4,7 +4,7 @@ The dissertation's parameters per deployment (7.4): omega_r of eq. 5.68, the gai
 Table 7.1 (eq. 5.69), the uncertainty model of the controller (eq. 5.72 for 1-4(D), M G
 ignored for 1-6(D) and 2-3) and the monitored membrane points of eqs. 5.73-5.75. The
 printed points lie on the membrane edges (mid-edge points of the polygon); they are moved
-1 mm toward the centroid so that they fall inside the mesh (docs/errata.md).
+1 mm toward the centroid so that they fall inside the mesh (docs/validation/errata.md).
 ``tmfem deploy`` and ``tmfem report`` run them (:func:`setup`, :func:`write_outputs`).
 """
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Evidence for the 2-3 design behind Tables 6.5 and 6.7 (identified with the MTC model;
-docs/errata.md) and the prestress calibration used to compare with them.
+docs/validation/errata.md) and the prestress calibration used to compare with them.
 
 The 2-3 design printed in Table 6.4 is not an equilibrium (Delta < 0, slack tendons), and
 its printed rest lengths fit no symmetric equilibrium of its dimensions. Tables 6.5 and 6.7

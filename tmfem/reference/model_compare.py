@@ -4,7 +4,7 @@ system beside the three printed columns, and the model-to-model differences 6.4 
 relative errors with respect to the SBC model: "less than 3 %" for 1-4, 6.4.1; "less than 1 %"
 for 2-3, 6.4.2).
 
-Each model is taken at the prestress the printed tables belong to (docs/errata.md):
+Each model is taken at the prestress the printed tables belong to (docs/validation/errata.md):
 
 * 1-4: the FE models at r_1^S = 1.5025 m (Tables 6.3 and 6.6 imply it; the printed 1.529 m
   of Table 6.2 leaves the system nearly unstressed), the COM at the prestress of the printed

@@ -5,7 +5,7 @@
 1. the equilibrium design of ch. 3 beside the printed Tables 6.2-6.3 (:mod:`tmfem.reference.study`);
 2. the static equilibrium of the membrane-truss-cable (MTC) FE model (4.4, 6.2) for the
    designed rest lengths *and* for the prestress the dissertation's own results imply
-   (:data:`IMPLIED_PRESTRESS`, docs/errata.md);
+   (:data:`IMPLIED_PRESTRESS`, docs/validation/errata.md);
 3. the 12 lowest modes of the MTC model, the shell-beam-cable (SBC) model and the
    control-oriented model (COM, ch. 5) at both prestress levels, beside Table 6.6 (eq. 5.32);
 4. free vibration of both models after the perturbation of 6.5 (Park's method, eq. 5.34-5.35);
@@ -29,15 +29,15 @@ from tabulate import tabulate
 log = logging.getLogger(__name__)
 
 #: Rest lengths [m] that the dissertation's printed results imply where its printed rest
-#: length contradicts them (docs/errata.md, "1-4 prestress"): Table 6.3's tendon stress and
+#: length contradicts them (docs/validation/errata.md, "1-4 prestress"): Table 6.3's tendon stress and
 #: bar load and the 12 frequencies of Table 6.6 all give r_1^S = 1.5025 m, not 1.529 m.
 IMPLIED_PRESTRESS = {"1-4": {"rest_lengths": {"S1": 1.5025},
-                             "source": "docs/errata.md, 1-4 prestress (Tables 6.3, 6.6)"}}
+                             "source": "docs/validation/errata.md, 1-4 prestress (Tables 6.3, 6.6)"}}
 
 #: Perturbation of the free-vibration runs of 6.5 (initial rate [rad/s] of one coordinate).
 VIBRATION_PERTURBATION = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}
 
-#: What the study and the report say beside their tables (reasons in docs/errata.md):
+#: What the study and the report say beside their tables (reasons in docs/validation/errata.md):
 #: ``design`` beside the equilibrium table, ``models`` beside the MTC/COM results.
 EXPLANATIONS = {
     "1-4": {"design": [
@@ -46,14 +46,14 @@ EXPLANATIONS = {
         "less prestress than the dissertation's results imply. The printed r_1^S = 1.529 m "
         "contradicts the dissertation's other tables: Table 6.3's tendon stress (37.98 MPa) "
         "and bar load (14.53 N) and all 12 frequencies of Table 6.6 agree on r_1^S = "
-        "1.5025 m (docs/errata.md, '1-4 prestress'); `tmfem report` runs the models at it.",
+        "1.5025 m (docs/validation/errata.md, '1-4 prestress'); `tmfem report` runs the models at it.",
         "Membrane peak stresses sit in the elements at the point-attached corners: they "
         "grow like 1/h under mesh refinement and are a property of the mesh, not of the "
-        "membrane (docs/errata.md, 'F_Delta and the membrane peak stresses are properties "
+        "membrane (docs/validation/errata.md, 'F_Delta and the membrane peak stresses are properties "
         "of the mesh'); the renders show element values.",
     ], "models": [
         "At the implied prestress the MTC frequencies match Table 6.6 to < 0.1 %; the COM "
-        "matches the printed COM column at 1.29 x the designed prestress (docs/errata.md, "
+        "matches the printed COM column at 1.29 x the designed prestress (docs/validation/errata.md, "
         "'COM frequencies').",
         "The MTC tendon stress at the implied prestress is ~2.6 % above the printed 37.98 "
         "MPa: the total-Lagrangian truss uses Green strain, eq. 3.8 the linear strain.",
@@ -68,7 +68,7 @@ def explanations(name: str, part: str) -> list[str]:
 #: The deployment (7.4) that the report of a system runs: the deployable variant, the
 #: controller's model error and the duration. 1-4(D) with the exact model switches to the
 #: H-infinity controller within 10 s; with the 7.4 choice (eq. 5.72) it does not switch within
-#: 20 s (docs/deployment.md, "Results"), so the report shows the switch with the exact model.
+#: 20 s (docs/guides/deployment.md, "Results"), so the report shows the switch with the exact model.
 REPORT_DEPLOYMENT = {"1-4": {"preset": "1-4D", "uncertainty": "exact", "t_end": 16.0,
                              "controller": "adaptive-hinf"}}
 
@@ -459,7 +459,7 @@ def _deployment_section(d, link, img) -> list[str]:
             "the H-infinity controller of 7.3: the central one at 1.01 gamma_opt), "
             f"{d['t_end']:g} s at dt = {d['dt_s']:g} s. The controller's model has no error "
             f"(`--uncertainty {d['uncertainty']}`): with the 7.4 model error (eq. 5.72) it does "
-            "not switch within 20 s (docs/deployment.md, 'Results'). Same run: `tmfem deploy "
+            "not switch within 20 s (docs/guides/deployment.md, 'Results'). Same run: `tmfem deploy "
             f"--preset {p} --uncertainty {d['uncertainty']} --t-end {d['t_end']:g}`.", "",
             f"Files: {link(f'deploy-{p}.csv')} (every signal, units in the header), "
             f"{link(f'deploy-{p}.png')}, {link(f'deploy-{p}.gif')} (animation), "
@@ -468,7 +468,7 @@ def _deployment_section(d, link, img) -> list[str]:
                      tablefmt="github", disable_numparse=True), "",
             *([("The largest tendon stress exceeds the yield stress: a start-up transient of "
                 "the rest-length commands (the printed 83 MPa is not reproduced; "
-                "docs/reproduction.md, 'Deployment (7.4)')."), ""]
+                "docs/validation/reproduction.md, 'Deployment (7.4)')."), ""]
               if d.get("tendon_yield_MPa") and 1e-6 * d["max_tendon_stress_Pa"] > d["tendon_yield_MPa"]
               else []),
             img(f"deploy-{p}.png", "deployment"), "", img(f"deploy-{p}.gif", "deployment animation"),
@@ -537,7 +537,7 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
           f"Printed: {printed['source'] if printed else 'none'}. MTC: membrane-truss-cable "
           "(4.4), SBC: shell-beam-cable (4.3, MITC4 shell and beam bars), both on the mesh "
           "above; COM: control-oriented model (ch. 5) with K membrane modes; 'x1.29' scales "
-          "the designed membrane prestress (docs/errata.md, 'COM frequencies').", "",
+          "the designed membrane prestress (docs/validation/errata.md, 'COM frequencies').", "",
           _largest_differences(freqs, printed), "",
           img("frequencies.png", "frequencies"), "", img("modes.png", "mode shapes"), ""]
     v = summary["vibration"]

@@ -13,7 +13,7 @@ printed rest lengths:
   free parameters of a symmetric configuration.
 
 The reconstructions themselves (what was fitted, to which numbers, how well) are recorded in
-``docs/errata.md`` and asserted in ``tests/reference/test_tables.py``; ``demos/equilibrium_*.py`` print
+``docs/validation/errata.md`` and asserted in ``tests/reference/test_tables.py``; ``demos/equilibrium_*.py`` print
 them beside the printed tables.
 """
 from __future__ import annotations
@@ -243,7 +243,7 @@ def top_radius_for_delta(*, l_M: float, theta_M: float, psi_rel: float, r_mb: fl
 
 
 def deployment_bases(system, *, z_ratio: float = 0.7, Delta: float = 1e-3, sigma2=None):
-    """Stage-2 base rule reconstructed from Table 7.7 for 2-stage systems (see docs/errata.md).
+    """Stage-2 base rule reconstructed from Table 7.7 for 2-stage systems (see docs/validation/errata.md).
 
     sigma_2 fixed (default: that of ``system``), z_2 = z_ratio l_1 cos(theta), r_2 from
     eq. 3.22 such that the membrane corner displacement is ``Delta``. Returns a callable

@@ -1,4 +1,4 @@
-"""Reference solutions of tension-field (wrinkling) membrane theory (docs/wrinkling.md).
+"""Reference solutions of tension-field (wrinkling) membrane theory (docs/guides/wrinkling.md).
 
 :func:`twisted_annulus`: an annular membrane a <= r <= b, prestressed by a radial
 displacement delta of its outer edge (held there, u_theta(b) = 0) and twisted by a rigid hub

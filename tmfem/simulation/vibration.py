@@ -113,7 +113,7 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
     Xa = np.array(XS)
     stats = out.stats(sim)
     if stats["min_tendon_force"] <= 0:
-        # the COM's tendons are bilateral springs (docs/com.md): a compressed tendon means the
+        # the COM's tendons are bilateral springs (docs/guides/com.md): a compressed tendon means the
         # motion left the model's range of validity
         log.warning("tendon %s goes slack (force %.4g N at t = %.4g s); the COM treats tendons "
                     "as two-sided springs", stats["min_tendon_force_tendon"],
@@ -202,7 +202,7 @@ def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_pat
         Backtracking on the Newton corrections (:func:`tmfem.solvers.park.park_integrate`;
         default on: a correction that reduces the residual is taken whole, so it changes
         nothing where plain Newton converges; the SBC shell's soft rotations on fine meshes
-        need it, docs/sbc.md "Free vibration on the fine mesh").
+        need it, docs/guides/sbc.md "Free vibration on the fine mesh").
 
     Outputs per step: q, w_k (eqs. 5.36, 5.38), the monitored bar ends, the largest tendon
     transverse deflection (eq. 5.37, relative to the equilibrium), kinetic and strain energy.

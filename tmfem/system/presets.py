@@ -1,7 +1,7 @@
 """Built-in systems of the dissertation, shipped as system files in ``presets/``.
 
 Each preset carries the consistent values by default (corrected or reconstructed where the
-dissertation's printed values contradict its own formulas, see ``docs/errata.md``) and a
+dissertation's printed values contradict its own formulas, see ``docs/validation/errata.md``) and a
 table ``[as_printed]`` with the values exactly as printed, merged in by
 ``load_preset(name, as_printed=True)``.
 """

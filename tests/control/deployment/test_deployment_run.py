@@ -1,6 +1,6 @@
 """Closed-loop deployments (dissertation 7.4): tracking, switching, no slack, bounded membrane
 vibration, stresses against the printed conclusions. Sources: 7.4.1-7.4.3 (switch times, Euler
-loads, yield stresses); reproduction figures in docs/reproduction.md."""
+loads, yield stresses); reproduction figures in docs/validation/reproduction.md."""
 import os
 
 import numpy as np
@@ -166,7 +166,7 @@ def test_2_3_clipped_inversion_leaves_the_reference(run23):
 @pytest.mark.slow
 def test_2_3_deployment_switches_to_hinf():
     # 7.4.3: switch at 17.86 s (eq. 5.70, R_c = 0.01), then the H-infinity controller of
-    # 7.3 (eliminated LMIs, docs/control.md) holds the deployed configuration; reduced: the
+    # 7.3 (eliminated LMIs, docs/guides/control.md) holds the deployed configuration; reduced: the
     # LQR stand-in after the switch
     s = setup("2-3-deploy", controller="adaptive-lqr" if REDUCED else "adaptive-hinf")
     r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
@@ -179,5 +179,5 @@ def test_2_3_deployment_switches_to_hinf():
     assert np.max(np.abs(r.w)) < 6e-3
     assert r.relative_error[-1] < 0.01
     # tendons below the yield stress of nylon (94.8 MPa, 7.4) after the switch as well
-    # (the earlier eliminated-LMI controller took the S_1j to 96.9 MPa, docs/deployment.md)
+    # (the earlier eliminated-LMI controller took the S_1j to 96.9 MPa, docs/guides/deployment.md)
     assert r.stress["max_tendon_stress_Pa"] < 94.8e6

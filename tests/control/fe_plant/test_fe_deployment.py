@@ -1,5 +1,5 @@
 """The 2-3 deployment of 7.4 (adaptive PFL, Table 7.7) on the MTC finite-element plant (issue
-15, docs/fe-plant.md): where the PFL evaluates its model, its tendon model, and the closed
+15, docs/guides/fe-plant.md): where the PFL evaluates its model, its tendon model, and the closed
 loop on the FE plant against the same controller on the control-oriented model."""
 import os
 
@@ -64,7 +64,7 @@ def test_pfl_options_refused(deploy23, kw, needle):
 
 
 def test_pfl_at_the_state_diverges_at_the_reference_tracks():
-    """The diagnosis of docs/fe-plant.md, on the 3 x 10 x 10 MTC plant with the COM's
+    """The diagnosis of docs/guides/fe-plant.md, on the 3 x 10 x 10 MTC plant with the COM's
     fixed-rate tendons over the first 1.5 s: the law of eq. 5.58 with its terms at the
     measured state cancels the structure's stiffness (up to omega^2 = 3.2e3 s^-2) against
     k_q <= 60 s^-2 and the closed loop diverges (Park's Newton fails at 1.4 s); with the
@@ -96,7 +96,7 @@ def test_2_3_deployment_on_the_mtc_plant():
     phase), never commands a rest length above its tendon's length, has a slack FE tendon
     only while a limit holds a rest length at its tendon's length (zero tension), stays within
     5 mrad (bar angles) and 5 mm (stage-2 bases) of the COM run over the whole run (measured:
-    2.9 mrad, 1.7 mm; docs/fe-plant.md) and switches (eq. 5.70) within 0.5 s of it, to a final
+    2.9 mrad, 1.7 mm; docs/guides/fe-plant.md) and switches (eq. 5.70) within 0.5 s of it, to a final
     error below R_c. Reduced: the first 2 s on the 3 x 5 x 5 mesh, adaptive PFL only."""
     controller, t_end, mesh = ("adaptive", 2.0, 5) if REDUCED else ("adaptive-hinf", 20.0, 10)
     runs = {}
@@ -130,7 +130,7 @@ def test_2_3_deployment_on_the_mtc_plant():
 def test_cli_defaults_of_the_fe_plant(capsys):
     """`tmfem deploy --plant mtc` runs the PFL at the reference with the plant's tendon law
     (cable by default), and names the FE tendons that went slack; `--pfl-at state` is
-    accepted on either plant (docs/cli.md: exit 0)."""
+    accepted on either plant (docs/guides/cli.md: exit 0)."""
     import json
     from tmfem.cli import main
     rc = main(["deploy", "--preset", "2-3-deploy", "--controller", "adaptive", "--plant", "mtc",

@@ -1,4 +1,4 @@
-"""One deployment on two plants (issue 15, docs/fe-plant.md): the deviation between the runs
+"""One deployment on two plants (issue 15, docs/guides/fe-plant.md): the deviation between the runs
 (tmfem.control.fe_plant.compare) against its definition on synthetic records, and the layout of
 the comparison plot (tmfem.post.plant_compare_plot)."""
 from types import SimpleNamespace
@@ -69,7 +69,7 @@ def test_bar_angles_and_base_positions_deviate_apart():
 @pytest.mark.parametrize("switches", [(17.33, 17.46), (17.46, 17.33), (2.0, 2.1), (5.0, 15.0)])
 def test_switch_labels_do_not_overlap_and_stay_inside_the_axes(switches):
     """Two switches 0.13 s apart over 20 s (the SBC and COM runs of the 2-3 deployment,
-    docs/fe-plant.md), either order, near the start, or far apart: the rendered labels are
+    docs/guides/fe-plant.md), either order, near the start, or far apart: the rendered labels are
     disjoint and inside the top panel."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     a, b = _run(20.0, switch=switches[0]), _run(20.0, dq=1e-3, dw=1e-4, switch=switches[1])
@@ -88,7 +88,7 @@ def test_switch_labels_do_not_overlap_and_stay_inside_the_axes(switches):
 
 def test_legends_hide_no_data_and_stay_inside_the_figure():
     """The attitudes of the 2-3 runs (80 -> 57 deg, 130 deg, 10 deg; the legend of the top
-    panel covered the 130 deg line, docs/fe-plant.md): rendered, no legend box contains a
+    panel covered the 130 deg line, docs/guides/fe-plant.md): rendered, no legend box contains a
     point of any plotted line of the figure, and every legend lies inside the figure."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     a, b = _run(20.0, switch=17.33), _run(20.0, dq=1e-3, dw=1e-4, switch=17.46)

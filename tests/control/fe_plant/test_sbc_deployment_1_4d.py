@@ -1,4 +1,4 @@
-"""The whole 1-4(D) deployment on the shell-beam-cable plant (issue 15, docs/fe-plant.md "The
+"""The whole 1-4(D) deployment on the shell-beam-cable plant (issue 15, docs/guides/fe-plant.md "The
 whole 1-4(D) deployment on the SBC plant: a crossover below the bars' bending").
 
 The 7.4 controller (adaptive PFL, switch to the H-infinity controller of 7.3) drives the
@@ -72,7 +72,7 @@ def test_1_4d_deploys_on_the_sbc_plant_with_the_crossover_below_the_bending():
 def test_table_7_1_gains_stop_the_same_sbc_plant():
     """The counterpart: the same plant and actuator under the 7.4 controller as printed
     (Table 7.1's omega(t) from 15 to 110 rad/s, d_c = 1.5, eq. 5.72) stops at 2.32 s on 4 x 4 x
-    4 (Park's Newton fails in a growing 12.4 Hz swing of the tendon forces; docs/fe-plant.md).
+    4 (Park's Newton fails in a growing 12.4 Hz swing of the tendon forces; docs/guides/fe-plant.md).
     Within 3 s the loop must fail, or the crossover would not be the cause."""
     r = _run("sbc", gains=None, uncertainty="initial", t_end=3.0)
     assert r.failure is not None and r.t[-1] < 3.0

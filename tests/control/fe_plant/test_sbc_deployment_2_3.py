@@ -1,4 +1,4 @@
-"""The 2-3 deployments on the SBC plant (issue 15, docs/fe-plant.md "The 2-3 deployments on
+"""The 2-3 deployments on the SBC plant (issue 15, docs/guides/fe-plant.md "The 2-3 deployments on
 the SBC plant"). Why the LPV deployment of 8.4 diverges there: the linear sampled loop of an
 FE plant under Park's method (:mod:`tmfem.control.fe_plant.sampled_loop`), checked against Park's
 characteristic equation, at the start of the LPV deployment on the SBC, the MTC and a
@@ -98,7 +98,7 @@ def test_2_3_adaptive_deployment_on_the_sbc_plant_is_the_mtc_one(bars, capsys):
     # chords: its gains are low enough that the bars' bending modes stay out of the loop; over
     # the first 2 s on 3 x 4 x 4 its bars stay within 0.5 mrad of the same deployment on the
     # MTC plant (measured 0.041 mrad with either, the bases within 0.047 / 0.057 mm; 3 x 10 x 10
-    # over 20 s with the switch: 0.20 mrad, docs/fe-plant.md), no rest length above its
+    # over 20 s with the switch: 0.20 mrad, docs/guides/fe-plant.md), no rest length above its
     # tendon, and the FE tendons slack only where the allocation holds the P_2j at zero tension
     import json
     from tmfem.cli import main

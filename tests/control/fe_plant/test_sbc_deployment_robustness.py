@@ -1,4 +1,4 @@
-"""The 1-4(D) deployment on the SBC plant (issue 15, docs/fe-plant.md "What was tried"): the
+"""The 1-4(D) deployment on the SBC plant (issue 15, docs/guides/fe-plant.md "What was tried"): the
 rigid-body measurement of the beam bars, the damped feedback inversion of the PFL and the
 Rayleigh damping of the FE plant, each against a closed form or the COM run."""
 import os
@@ -63,7 +63,7 @@ def test_rigid_fit_of_two_node_bars_is_their_chord(preset):
 
 def test_sbc_plant_measures_the_rigid_fit_by_default(dep):
     """The SBC plant's bar measurement defaults to the rigid fit (the chords see the beams'
-    bending modes, docs/fe-plant.md), on the library's plant as on the CLI's."""
+    bending modes, docs/guides/fe-plant.md), on the library's plant as on the CLI's."""
     from tmfem.cli.deploy import plant_arguments
     from tmfem.cli import build_parser
     s, init, plant, _ = dep
@@ -179,7 +179,7 @@ def test_damped_inversion_closed_form():
 
 @pytest.mark.slow
 def test_undamped_sbc_plant_fails_under_the_com_rest_lengths(dep):
-    """Whether the integrator or the controller fails (docs/fe-plant.md): the rest lengths of
+    """Whether the integrator or the controller fails (docs/guides/fe-plant.md): the rest lengths of
     the COM's own closed-loop 1-4(D) run (uncertainty 'exact', eq. 5.58), applied open loop
     to the 4 x 4 x 4 SBC plant, stop Park's Newton method before 2.5 s (measured 2.35 s, with
     every tendon taut: 6.8 N at least), and with stiffness-proportional Rayleigh damping

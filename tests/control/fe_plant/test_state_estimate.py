@@ -113,7 +113,7 @@ def test_start_rest_lengths_hold_the_packaged_design():
 ])
 def test_deploy_plant_options_refused_before_work(argv, code, needle, capsys):
     """Options of the FE plant that do not apply or cannot fit are refused with one line
-    before the controller design (exit 2 bad input, 3 resource limit; docs/cli.md)."""
+    before the controller design (exit 2 bad input, 3 resource limit; docs/guides/cli.md)."""
     from tmfem.cli import main
     rc = main(argv)
     err = capsys.readouterr().err.strip().splitlines()
@@ -125,7 +125,7 @@ def test_deployment_start_on_the_mtc_plant():
     COM's fixed-rate tendons, through run_deployment's plant hook: the plant starts at rest in
     its own equilibrium of the packaged design (within 2.5 mrad of the COM's z0), the run
     records the estimated state and the FE report, and the bars follow the reference within
-    5 mrad (the COM plant: within 1.7 mrad; docs/fe-plant.md)."""
+    5 mrad (the COM plant: within 1.7 mrad; docs/guides/fe-plant.md)."""
     from tmfem.cli.deploy import setup
     from tmfem.control.deployment.run import run_deployment
     from tmfem.control.fe_plant.state_estimate import mtc_deployment_plant

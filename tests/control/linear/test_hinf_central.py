@@ -5,7 +5,7 @@ Sources: the central controller formulas of Doyle, Glover, Khargonekar & Francis
 on the normalised problem, with the Riccati equations solved by scipy (not SLICOT); its
 minimum-entropy property (Mustafa & Glover 1990, ch. 5) with the entropy integrated from the
 frequency response; python-control's norms for the closed-loop checks; gamma_opt = ||D11|| =
-W_e = 0.5 for the plants of Fig. 7.1 with the 7.4 weights (docs/control.md).
+W_e = 0.5 for the plants of Fig. 7.1 with the 7.4 weights (docs/guides/control.md).
 """
 import control
 import numpy as np
@@ -131,7 +131,7 @@ def _noise_to_ed_h2(P, K):
 
 def test_1_4D_central_h2_not_above_the_lmi_route(plant14):
     # the central controller at 1.01 gamma_opt against the eliminated-LMI controller at the
-    # same gamma (Riccati point, docs/control.md): less noise in the tracking error
+    # same gamma (Riccati point, docs/guides/control.md): less noise in the tracking error
     from tmfem.control.linear.hinf_lmi import hinf_lmi
     d, alpha = plant14
     P = d.generalized
@@ -144,7 +144,7 @@ def test_1_4D_central_h2_not_above_the_lmi_route(plant14):
 @pytest.mark.slow
 def test_1_4D_central_h2_not_above_clarabels(plant14):
     # the same comparison against Clarabel's solution of the eliminated LMIs (the member of
-    # the degenerate optimum's family that damped the 1-4(D) membrane most, docs/control.md);
+    # the degenerate optimum's family that damped the 1-4(D) membrane most, docs/guides/control.md);
     # Clarabel's gamma is its own optimum x 1.01 (0.50509 against our 0.50500)
     from tmfem.control.linear.hinf_lmi import hinf_lmi
     d, alpha = plant14

@@ -3,7 +3,7 @@
 Sources of the reference values:
 * PBH vs the rank of the Kalman controllability matrix (python-control ``ctrb``);
 * LMI gamma vs python-control ``hinfsyn`` (Riccati, SLICOT SB10AD) on the same plants, and
-  on the alpha-shifted plant for alpha > 0 (the same problem, docs/control.md);
+  on the alpha-shifted plant for alpha > 0 (the same problem, docs/guides/control.md);
 * published benchmarks: P. Benner, R. Byers, V. Mehrmann, H. Xu, "A robust numerical
   method for the gamma-iteration in H-infinity control", Linear Algebra Appl. 425 (2007)
   548-570, Example 6.1 (a = 1: gamma_opt = 7.853923684022) and Example 6.4 (gamma_opt =
@@ -148,7 +148,7 @@ def test_published_benchmark_benner_2007_example_6_4():
 def test_published_benchmark_benner_2007_example_6_1_gamma():
     # gamma_opt = 7.853923684022 (Benner et al. 2007, Ex. 6.1, a = 1); hinfsyn reproduces it,
     # Clarabel's SDP ends 'optimal_inaccurate' 0.2 % above, the Riccati test of the same
-    # LMIs (solver ARE) to its bisection tolerance (docs/control.md)
+    # LMIs (solver ARE) to its bisection tolerance (docs/guides/control.md)
     P = _benner_6_1()
     g_pub = 7.853923684022
     assert control.hinfsyn(P.to_ss(), 1, 1)[2] == pytest.approx(g_pub, rel=1e-8)
@@ -341,7 +341,7 @@ def design_2_3():
 def test_2_3_open_loop_facts(design_2_3):
     d = design_2_3
     assert d.pbh.controllable and d.pbh.observable                   # 7.4.3
-    # printed 9.83 Hz; ours 10.065 Hz (docs/errata.md, "f_max of the 2-3 system")
+    # printed 9.83 Hz; ours 10.065 Hz (docs/validation/errata.md, "f_max of the 2-3 system")
     assert d.plant.f_max_hz == pytest.approx(10.065, abs=0.002)
 
 

@@ -1,5 +1,5 @@
 """Rate-bounded certificate of the output-feedback LPV loop (tmfem.control.lpv.certificate) on
-the oscillator of docs/lpv.md (not a tensegrity): against the bounded real lemma solved by
+the oscillator of docs/guides/lpv.md (not a tensegrity): against the bounded real lemma solved by
 cvxpy/Clarabel and assembled here from the frozen loops."""
 import itertools
 

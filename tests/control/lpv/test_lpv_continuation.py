@@ -1,6 +1,6 @@
 """Continuation in the grid of the gamma bisection (tmfem.control.lpv.bisect): with the
 sampled-loop LMI the bisection first runs on the grid with the last parameter collapsed to its
-middle value and starts the full grid from that design (docs/lpv.md)."""
+middle value and starts the full grid from that design (docs/guides/lpv.md)."""
 import numpy as np
 import pytest
 

@@ -1,6 +1,6 @@
 """The LPV deployment of 8.4 (`tmfem deploy --preset 2-3-lpv --controller lpv`): refusals, the
 measured LPV signals, and a reduced deployment (a 2 x 1 design grid theta in {63, 77.32} deg,
-psi = 8.36 deg; the full 6 x 3 runs are in docs/lpv.md). Sources: eq. 5.100 (reference), 7.4
+psi = 8.36 deg; the full 6 x 3 runs are in docs/guides/lpv.md). Sources: eq. 5.100 (reference), 7.4
 (rest lengths never above the tendon lengths), 8.4 (Euler load 1332.3 N)."""
 import json
 import os
@@ -172,7 +172,7 @@ def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
     cols = []
     for f in (a, b):
         rows = list(_csv.reader(open(f)))
-        # every column with its unit (docs/output.md), the references' too (x_21_ref was bare)
+        # every column with its unit (docs/guides/output.md), the references' too (x_21_ref was bare)
         assert [h for h in rows[0] if not re.fullmatch(r"\S+ \[[^\]]+\]", h)] == []
         assert {"x_21_ref [m]", "theta_13_ref [rad]", "controller [-]"} <= set(rows[0])
         head = [h.split(" [")[0] for h in rows[0]]
@@ -197,10 +197,10 @@ def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
 @pytest.mark.slow
 def test_lpv_deployment_on_the_mtc_plant_follows_the_com_run(design21, tmp_path, capsys):
     """The same scheduled state feedback on the MTC plant (issue 15; 3 x 5 x 5 here, the
-    3 x 10 x 10 run in docs/fe-plant.md): started in the FE's own equilibrium of the
+    3 x 10 x 10 run in docs/guides/fe-plant.md): started in the FE's own equilibrium of the
     packaged configuration, it tracks eq. 5.100, never commands a rest length above a tendon
     length, and its bar coordinates stay within 5 mrad / 5 mm of the COM run (measured on
-    3 x 10 x 10 over 20 s: see docs/fe-plant.md)."""
+    3 x 10 x 10 over 20 s: see docs/guides/fe-plant.md)."""
     pl, d, path = design21
     runs = _fe_and_com_runs(path, tmp_path, capsys, "mtc", ["--plant-mesh", "5"], "2" if REDUCED else "8")
     _check_follows_the_com_run(runs, "mtc", 5e-3)
@@ -213,7 +213,7 @@ def test_lpv_deployment_on_the_sbc_plant_with_rigid_fit_bars_follows_the_com_run
     beam nodes (--plant-bars rigid) the same deployment on 3 x 4 x 4 tracks, never commands a
     rest length above a tendon length and stays within 5 mrad / 5 mm of the COM run (measured
     over 4 s: 1.08 mrad / 1.48 mm, the largest at 0.14 s; the 6 x 1 design on 3 x 10 x 10 over
-    20 s: 0.35 mrad / 0.79 mm, docs/fe-plant.md), its FE tendons slack only at S_2j, P_2j."""
+    20 s: 0.35 mrad / 0.79 mm, docs/guides/fe-plant.md), its FE tendons slack only at S_2j, P_2j."""
     pl, d, path = design21
     runs = _fe_and_com_runs(path, tmp_path, capsys, "sbc", ["--plant-mesh", "4", "--plant-bars", "rigid"],
                             "1" if REDUCED else "4")

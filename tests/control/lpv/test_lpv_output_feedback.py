@@ -1,5 +1,5 @@
 """Observer-based LPV output feedback (tmfem.control.lpv.output_feedback) on the oscillator of
-docs/lpv.md (not a tensegrity), against python-control and closed forms."""
+docs/guides/lpv.md (not a tensegrity), against python-control and closed forms."""
 import control
 import numpy as np
 import pytest

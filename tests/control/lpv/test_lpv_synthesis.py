@@ -204,7 +204,7 @@ def test_threaded_eigendecompositions_give_the_serial_optimisation():
 
 
 def test_gamma_bisection_reaches_the_conic_optimum():
-    # the oscillator of docs/lpv.md: Clarabel's optimum is the reference. The bisection between
+    # the oscillator of docs/guides/lpv.md: Clarabel's optimum is the reference. The bisection between
     # the pointwise lower bound and 2 x it (continuation in gamma) stops when hi - lo <= 1e-3 hi:
     # its gamma is feasible (>= the optimum) and within 1e-3 (+ the 5e-4 by which the proven bound
     # lies below the optimum) of it, and passes the 4x finer check

@@ -194,7 +194,7 @@ def test_design_is_equilibrium_and_rest_lengths(m14, sys14):
 def test_frequencies_1_4_against_table_6_6(sys14):
     """Table 6.6, COM column, K = 5. The printed numbers are reproduced when the prestress
     is the one implied by the printed tendon stress of Table 6.3 (37.98 MPa, i.e. x1.290 our
-    designed prestress, see docs/errata.md); with the designed prestress the prestress-
+    designed prestress, see docs/validation/errata.md); with the designed prestress the prestress-
     dominated modes are lower by up to 12 %."""
     from tmfem.reference.com_modal import modal_summary
     r1 = modal_summary(sys14, modes=12, membrane_modes=5)

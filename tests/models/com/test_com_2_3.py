@@ -2,7 +2,7 @@
 translational kinetic energy (eqs. 5.10-5.11), the N = 3 layout of zeta, partitioning,
 design tendon forces, energy conservation and the COM column of Table 6.7. Uses the preset
 2-3: the final 2-3 configuration of Table 7.7 with the materials of Table 6.1, the design of
-Tables 6.5/6.7 (the printed Table 6.4 geometry has Delta < 0, docs/errata.md)."""
+Tables 6.5/6.7 (the printed Table 6.4 geometry has Delta < 0, docs/validation/errata.md)."""
 import casadi as ca
 import numpy as np
 import pytest

@@ -141,7 +141,7 @@ def test_design_prestress_agrees_with_linear_design():
 @pytest.fixture(scope="module")
 def paper_prestress_modes():
     # 4 x 10 x 10 membrane, 3 elements per tendon (6.4.1); rest length 1.5025 m, the value
-    # the dissertation's own Tables 6.3 and 6.6 imply (docs/errata.md, "MTC 1-4 prestress")
+    # the dissertation's own Tables 6.3 and 6.6 imply (docs/validation/errata.md, "MTC 1-4 prestress")
     s = load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
     m = MTCModel(s, mesh_n=10, tendon_elements=3)
     res = m.solve_static(start="undeformed")
@@ -169,7 +169,7 @@ def test_static_vs_table_6_3(paper_prestress_modes):
     # Table 6.3: bar load 14.53 N, max tendon stress 37.98 MPa, max sigma_p1 2.12 MPa,
     # max von Mises 1.91 MPa. Bar load within 1 %; tendon stress within 5 % (Green strain
     # of the TL truss vs the linear spring of eq. 3.8 at 1.9 % strain: 1.5 eps = 2.9 %);
-    # membrane peaks sit at the point-loaded corners and are mesh dependent (docs/mtc.md),
+    # membrane peaks sit at the point-loaded corners and are mesh dependent (docs/guides/mtc.md),
     # so only their order of magnitude is compared.
     m, res, _ = paper_prestress_modes
     st = static_summary(m, res.x)
@@ -204,7 +204,7 @@ def test_tendon_subdivision_does_not_change_frequencies():
 
 def test_distributed_attachment_close_to_point():
     # a small patch (radius 10 % of r_mb, 0.14 m) changes the four global modes little (they
-    # converge under refinement, docs/mtc.md); the membrane modes from mode 5 on are the
+    # converge under refinement, docs/guides/mtc.md); the membrane modes from mode 5 on are the
     # corner-sensitive ones. At mesh 20 the patch holds 8-9 nodes per corner, so the two
     # models really differ
     s = load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
@@ -284,7 +284,7 @@ def test_two_stage_system_lands_on_its_design():
     # (node balance of all 27 free-node equations, 6 bars + 21 tendons) the equilibrium
     # reached from the undeformed membrane is the design; and tmfem.equilibrium's linear
     # design (independent formulation, eq. 3.16) lands within 0.1 mm of it.
-    s = load_preset("2-3")      # the final 2-3 configuration of Table 7.7 (docs/errata.md)
+    s = load_preset("2-3")      # the final 2-3 configuration of Table 7.7 (docs/validation/errata.md)
     m = MTCModel(s, mesh_n=4, tendon_elements=1, rest_lengths="mtc")
     res = m.solve_static(start="undeformed")
     st = static_summary(m, res.x)

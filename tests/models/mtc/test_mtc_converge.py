@@ -20,7 +20,7 @@ MESHES = (4, 8, 12, 16) if REDUCED else (5, 10, 15, 20, 30)
 
 @pytest.fixture(scope="module")
 def system():
-    # the rest length implied by Tables 6.3/6.6 (docs/errata.md, "MTC 1-4 prestress")
+    # the rest length implied by Tables 6.3/6.6 (docs/validation/errata.md, "MTC 1-4 prestress")
     return load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
 
 
@@ -50,7 +50,7 @@ def test_distributed_attachment_peak_stress_converges(system):
 
 def test_study_rest_lengths_are_the_6_2_design_once():
     # a system without rest lengths: the study holds the ch. 3 design of 6.2 (point corners,
-    # mesh n = 10; r_1^S = 1.5089 m in docs/errata.md) on every mesh, not a design on some
+    # mesh n = 10; r_1^S = 1.5089 m in docs/validation/errata.md) on every mesh, not a design on some
     # other mesh (a 2 x 2 one gave 1.4953 m)
     from tmfem.equilibrium.design import design_equilibrium
     from tmfem.reference.convergence import resolve_rest_lengths

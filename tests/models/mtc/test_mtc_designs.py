@@ -1,5 +1,5 @@
 """The 2-3 design behind Tables 6.5 and 6.7: the preset ``2-3`` (tmfem.reference.designs;
-docs/errata.md)."""
+docs/validation/errata.md)."""
 from __future__ import annotations
 
 import numpy as np
@@ -55,7 +55,7 @@ def table_6_7_state():
 
 def test_frequencies_vs_table_6_7(table_6_7_state):
     # Table 6.7, MTC column: all 12 within 0.1 % (we find <= 0.03 %); the calibration factor is
-    # a few per cent (the mesh-dependent point-corner F_Delta, docs/mtc.md)
+    # a few per cent (the mesh-dependent point-corner F_Delta, docs/guides/mtc.md)
     m, res, st, modes, k = table_6_7_state
     assert 1.0 < k < 1.1
     assert st["bar_load_by_stage"][0] == pytest.approx(14.48, rel=1e-3)

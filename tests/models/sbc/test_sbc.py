@@ -15,7 +15,7 @@ from tmfem.system import load_preset
 
 
 def paper_1_4():
-    # the 1-4 system at the prestress Tables 6.3/6.6 imply (r_1^S = 1.5025 m; docs/errata.md,
+    # the 1-4 system at the prestress Tables 6.3/6.6 imply (r_1^S = 1.5025 m; docs/validation/errata.md,
     # as tests/models/mtc/test_mtc.py)
     return load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
 
@@ -77,7 +77,7 @@ def test_against_mtc_same_mesh(sbc_1_4):
 
 def test_frequencies_vs_table_6_7_sbc():
     # Table 6.7, SBC column: the 2-3 preset (the final configuration of Table 7.7, see
-    # docs/mtc.md "2-3"), 4 x 10 x 10 shells, 3 elements per tendon
+    # docs/guides/mtc.md "2-3"), 4 x 10 x 10 shells, 3 elements per tendon
     m = SBCModel(load_preset("2-3"), mesh_n=10, tendon_elements=3)
     res = m.solve_static()
     f = m.modes(res.state, k=12).freq_hz
@@ -128,7 +128,7 @@ def test_cli_modal_json(capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["model"] == "sbc" and out["rest_lengths"]["S_13"] == 1.5025
     assert out["dissertation"]["SBC"] == FREQUENCIES["1-4"]["SBC"][:4]
-    # the global modes 1-4 hardly depend on the mesh (docs/mtc.md): 4 x 4 x 4 within 2 %
+    # the global modes 1-4 hardly depend on the mesh (docs/guides/mtc.md): 4 x 4 x 4 within 2 %
     assert out["freq_hz"] == pytest.approx(FREQUENCIES["1-4"]["SBC"][:4], rel=2e-2)
 
 

@@ -1,8 +1,8 @@
-"""The SBC free vibration on the fine 4 x 20 x 20 mesh (docs/sbc.md, "Free vibration on the
+"""The SBC free vibration on the fine 4 x 20 x 20 mesh (docs/guides/sbc.md, "Free vibration on the
 fine mesh"): the run that stopped at t = 4.94 s, and how a failing model is named.
 
 Sources: the other FE model (the MTC model on the same mesh, an independent formulation of
-the same structure) within the bounds of the 4 x 10 x 10 comparison in docs/sbc.md ("The
+the same structure) within the bounds of the 4 x 10 x 10 comparison in docs/guides/sbc.md ("The
 three models side by side"), and energy conservation of the undamped system.
 """
 from __future__ import annotations
@@ -25,7 +25,7 @@ def test_compare_names_the_model_whose_integration_fails(monkeypatch, capsys):
                         functools.partial(driver.park_integrate, max_iter=1))
     rc = main(["compare", "--preset", "1-4", "--vibrate", "--mesh", "2", "--t-end", "0.05"])
     err = capsys.readouterr().err
-    assert rc == 1                                     # ConvergenceError (docs/cli.md)
+    assert rc == 1                                     # ConvergenceError (docs/guides/cli.md)
     line = [ln for ln in err.splitlines() if "error" in ln][-1]
     assert line.startswith("tmfem compare: error: SBC model of 1-4 (FE mesh 2): Park step 1 "
                            "(t = 0.01 s, dt = 0.01 s): Newton did not converge in 1 iterations")
@@ -51,7 +51,7 @@ def test_fine_mesh_1_4_vibration_runs_past_the_old_failure():
     for m in ("SBC", "MTC"):
         assert c["energy_drift_over_initial_kinetic"][m] < 0.08, m
     # the two FE models against each other, within the bounds of the 4 x 10 x 10 run
-    # (docs/sbc.md: first 2 s rms differences 1.0 % theta_12, 1.0 % B_12 z, 7.4 % w_1;
+    # (docs/guides/sbc.md: first 2 s rms differences 1.0 % theta_12, 1.0 % B_12 z, 7.4 % w_1;
     # amplitudes of the perturbed bar within 0.4 %); measured here 0.78 %, 0.78 %, 6.3 %,
     # 0.2 % (10 s) and 0.4 % (5 s), frequencies 0.3078 / 0.3079 Hz
     early = c["rms_difference_vs_SBC_early"]["MTC"]

@@ -48,8 +48,8 @@ def test_sbc_estimate_inverts_the_com_placement(dep):
 
 def test_sbc_plant_starts_in_its_packaged_equilibrium(dep):
     """The plant's reference state (u = 0) is the SBC equilibrium under the packaged design's
-    rest lengths: the residual there is at the SBC round-off floor (~1e-7 N, docs/sbc.md),
-    the bars bend at H_1j by a few mm (docs/sbc.md: 3.0 mm for 1-4D-initial on 4 x 10 x 10)
+    rest lengths: the residual there is at the SBC round-off floor (~1e-7 N, docs/guides/sbc.md),
+    the bars bend at H_1j by a few mm (docs/guides/sbc.md: 3.0 mm for 1-4D-initial on 4 x 10 x 10)
     and their chords sit within 6 mrad of the COM's rigid-bar start q_0 (measured 0.75 mrad
     in theta, 5.1 mrad in psi)."""
     s, init, plant, r0 = dep
@@ -98,7 +98,7 @@ def test_velocity_predictor_for_dofs_without_inertia(dep):
 
 
 def test_sbc_input_response_against_the_com(dep):
-    """What breaks the 1-4(D) loop on the SBC plant (docs/fe-plant.md): the response of the
+    """What breaks the 1-4(D) loop on the SBC plant (docs/guides/fe-plant.md): the response of the
     bar azimuth psi_11 to a 1 mm step of the four SL rest lengths, from rest at the
     packaged state, each plant against its own response to the packaged rest lengths. After
     0.1 s the two plants agree in sign and within 35 % (measured COM +1.37, SBC +1.04 mrad);
@@ -128,7 +128,7 @@ def test_sbc_input_response_against_the_com(dep):
 ])
 def test_deploy_sbc_options_refused_before_work(argv, needle, capsys):
     """FE-plant options that do not apply are refused with one line and exit 2 before the
-    controller design (docs/cli.md)."""
+    controller design (docs/guides/cli.md)."""
     from tmfem.cli import main
     rc = main(["deploy", "--preset", "1-4D", "--t-end", "0.05", *argv])
     err = capsys.readouterr().err.strip().splitlines()
@@ -205,7 +205,7 @@ def test_compare_warns_where_the_pfl_tendon_model_is_not_the_plants(capsys):
 @pytest.mark.slow
 def test_1_4d_sbc_deployment_fails_and_keeps_its_record(tmp_path, capsys):
     """The 1-4(D) deployment (7.4, adaptive + H-infinity) on the SBC plant measured through
-    the bar chords diverges within 0.2 s (docs/fe-plant.md: 0.11 s on 4 x 4 x 4 and 4 x 10 x
+    the bar chords diverges within 0.2 s (docs/guides/fe-plant.md: 0.11 s on 4 x 4 x 4 and 4 x 10 x
     10; 0.41 s with the default rigid fit): the CLI exits 1 naming
     the failed check, with the record up to the failure in the CSV and the comparison with
     the COM run (4 x 10 x 10; reduced: 4 x 4 x 4)."""
@@ -229,7 +229,7 @@ def test_lqr_designed_on_the_com_damps_the_sbc_plant():
     state feedback of the COM linearisation at the deployed 1-4(D) (eq. 5.33, R = I / u_m^2),
     closed around the deployed 4 x 4 x 4 SBC plant through the estimate from
     theta_11' = 0.02 rad/s, damps the bar: over the last of 3 s its amplitude is below half
-    the first second's peak (measured 0.29; open loop over 5 s: 0.84, docs/fe-plant.md)."""
+    the first second's peak (measured 0.29; open loop over 5 s: 0.84, docs/guides/fe-plant.md)."""
     from tmfem.control.deployment.run import lqr_state_feedback
     from tmfem.control.fe_plant.state_estimate import FEStatePlant
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes

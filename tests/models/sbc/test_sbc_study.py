@@ -27,7 +27,7 @@ REDUCED = os.environ.get("TMFEM_SLOW_SCALE", "") == "reduced"
 
 
 def paper_1_4():
-    # the prestress Tables 6.3/6.6 imply (docs/errata.md; as tests/models/sbc/test_sbc.py)
+    # the prestress Tables 6.3/6.6 imply (docs/validation/errata.md; as tests/models/sbc/test_sbc.py)
     return load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
 
 
@@ -113,7 +113,7 @@ def test_compare_2_3_beside_table_6_7():
         assert np.array(r["ours"][m]) == pytest.approx(ref[m], rel=5e-3)
     assert r["max_abs_vs_SBC"]["ours"]["MTC"] < 0.01
     # 6.4.2 states "less than 1 %"; Table 6.7 itself has COM/SBC - 1 = -1.09 % at modes 5-6
-    # (docs/errata.md), and ours reproduces the table's differences
+    # (docs/validation/errata.md), and ours reproduces the table's differences
     assert r["max_abs_vs_SBC"]["printed"]["COM"] == pytest.approx(0.0109, abs=2e-4)
     assert r["max_abs_vs_SBC"]["ours"]["COM"] == pytest.approx(r["max_abs_vs_SBC"]["printed"]["COM"],
                                                                abs=1.5e-3)

@@ -2,7 +2,7 @@
 
 Sources: Table 6.6 (the printed SBC/MTC differences of the 1-4 system, the dissertation's own
 measure of what the shell's bending stiffness changes) and another model (the MTC model with
-the tension-field membrane on the same mesh and rest lengths; docs/wrinkling.md, "SBC against
+the tension-field membrane on the same mesh and rest lengths; docs/guides/wrinkling.md, "SBC against
 MTC").
 """
 import numpy as np
@@ -15,7 +15,7 @@ from tmfem.system import load_preset
 
 
 def test_sbc_and_mtc_with_the_tension_field_law_1_4():
-    # 1-4 at the prestress Tables 6.3/6.6 imply (r_1^S = 1.5025 m, docs/errata.md), paper mesh
+    # 1-4 at the prestress Tables 6.3/6.6 imply (r_1^S = 1.5025 m, docs/validation/errata.md), paper mesh
     system = load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
     sbc = SBCModel(system, mesh_n=10, tendon_elements=3, membrane_law="tension-field")
     assert sbc.shell.law.name == "tension-field" and sbc.mtc.membrane_law == "tension-field"

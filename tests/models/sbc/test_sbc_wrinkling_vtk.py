@@ -1,4 +1,4 @@
-"""The shell lamina's wrinkling states in the SBC model's ParaView files (docs/wrinkling.md,
+"""The shell lamina's wrinkling states in the SBC model's ParaView files (docs/guides/wrinkling.md,
 "The SBC shell's states in ParaView").
 
 Sources: the element states computed by the tension-field law

@@ -12,7 +12,7 @@ FE state as sensors would give it:
   them) do not move; or from the bar end nodes (``bars="chord"``, eqs. 3.1-3.2,
   :func:`tmfem.models.mtc.post.q_from_positions`: the MTC plant's truss bars, whose chord is
   their rigid fit; on the SBC plant the chords A_ij-B_ij of the beams, which see their
-  bending, docs/fe-plant.md);
+  bending, docs/guides/fe-plant.md);
 * eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
   nodes (the SBC shell's mid-surface nodes) are taken into the floating frame of the current
   corners (eq. 3.3), interpolated at the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
@@ -64,7 +64,7 @@ def default_bar_measure(dyn) -> str:
     """The bar measurement of an FE plant when none is asked for: the rigid fit
     (:func:`rigid_bar_fit`) of a plant with nodes along its bars (``bar_chain_positions``: the
     SBC model's beams, whose chords see their bending modes -- the LPV loop measured through
-    them is unstable, docs/fe-plant.md), the chord of one with straight truss bars (the MTC
+    them is unstable, docs/guides/fe-plant.md), the chord of one with straight truss bars (the MTC
     model: there the chord is the rigid fit, the two end nodes being the whole bar)."""
     return "rigid" if hasattr(dyn, "bar_chain_positions") else "chord"
 
@@ -86,7 +86,7 @@ def rigid_bar_fit(system, X: np.ndarray, s: np.ndarray) -> np.ndarray:
     and theta = arccos(b_z), psi = atan2(b_y, b_x) (3.2). These are the coordinates of the
     bar's rigid-body modes: the bending modes are mass-orthogonal to them, so a force at an
     interior node (H_1j) moves them at once as it turns a rigid bar, where the chord A-B
-    moves only as the bending reaches the ends (docs/fe-plant.md). Straight bars give the
+    moves only as the bending reaches the ends (docs/guides/fe-plant.md). Straight bars give the
     chord."""
     s = np.asarray(s, dtype=float)
     m = np.zeros_like(s)
@@ -389,7 +389,7 @@ def start_rest_lengths(initial, tendon_law: str, nominal) -> np.ndarray:
     return L - T * np.asarray(nominal, dtype=float) / EA
 
 
-#: the damping tangent of a damped deployment plant when none is given (docs/fe-plant.md,
+#: the damping tangent of a damped deployment plant when none is given (docs/guides/fe-plant.md,
 #: "Plant damping along the path")
 DEPLOYMENT_DAMPING_TANGENT = "current"
 
@@ -451,7 +451,7 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     then bend under the tendons at H_1j. ``bars``: how the estimate measures q (the rigid fit
     of the beam nodes, default, or the bar chords, which see the bending modes,
     :class:`COMStateEstimator`); ``beta``: stiffness-proportional
-    Rayleigh damping C = beta K_0 (K_0 at that equilibrium; docs/fe-plant.md: without it the
+    Rayleigh damping C = beta K_0 (K_0 at that equilibrium; docs/guides/fe-plant.md: without it the
     undamped SBC plant's Park integration diverges during the 1-4(D) deployment even under
     the COM run's smooth rest lengths); ``damping_tangent``: K_0 (``"initial"``) or the
     tangent at every sample (``"current"``, C_n = beta K_T(x_n), which does not damp the bars'

@@ -68,7 +68,7 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         How the eliminated LMIs are solved (:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi`); default
         their Riccati characterisation (the plants of Fig. 7.1 are regular: D12 = [0; W_u],
         D21 = [-[I; 0], W_d I]), 0.3-3 s for the three systems against 3 s, 30 s and a
-        failure with Clarabel (docs/control.md).
+        failure with Clarabel (docs/guides/control.md).
     synthesize : bool
         False: plant and PBH only (``tmfem control pbh``).
     method : {"lmi", "riccati", "central"}
@@ -76,7 +76,7 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         alpha-shifted plant (:func:`~tmfem.control.linear.hinf_lmi.hinf_riccati`) or the central
         (minimum-entropy) controller at 1.01 gamma_opt
         (:func:`~tmfem.control.linear.hinf_central.hinf_central`: solver-independent; the default
-        of the deployments, docs/control.md).
+        of the deployments, docs/guides/control.md).
     """
     if method not in METHODS:
         raise InputError(f"method: expected one of {METHODS}, found {method!r}")
@@ -104,7 +104,7 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
 
 def save_design(design: HinfDesign, path) -> None:
     """Write plant (A, B1, B2, C1, C2, D11, D12, D21, D22), controller (Ak, Bk, Ck, Dk),
-    gamma, alpha, signal names and the operating point to an ``.npz`` (docs/control.md)."""
+    gamma, alpha, signal names and the operating point to an ``.npz`` (docs/guides/control.md)."""
     P, K = design.plant, design.controller
     op = design.operating_point
     np.savez(path, A=P.A, B1=P.B1, B2=P.B2, C1=P.C1, C2=P.C2, D11=P.D11, D12=P.D12, D21=P.D21,

@@ -6,7 +6,7 @@
   python-control ``StateSpace`` with every state as an output (the measured outputs of
   Fig. 7.1 are q, v, q', v') and the tendon rest lengths as inputs.
 * :func:`generalized_plant`: the interconnection of Fig. 7.1 with the weights of 7.4 by
-  ``control.interconnect`` on named signals (our reading of the figure: docs/control.md).
+  ``control.interconnect`` on named signals (our reading of the figure: docs/guides/control.md).
 """
 from __future__ import annotations
 
@@ -163,7 +163,7 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
 def generalized_plant(plant: DeployedPlant, *, u_m: float, W_e: float = W_E, W_d: float = W_D):
     """The generalised plant of Fig. 7.1 (weights of 7.4) by ``control.interconnect``.
 
-    Reading of Fig. 7.1 (docs/control.md): exogenous w = [q_d, v_d, n_q, n_v, n_q', n_v'],
+    Reading of Fig. 7.1 (docs/guides/control.md): exogenous w = [q_d, v_d, n_q, n_v, n_q', n_v'],
     measured y = [q_m - q_d, v_m - v_d, q'_m, v'_m] with x_m = x + W_d n (W_d1..4 on the
     four noise blocks), regulated p = [e_d, e_u] with e_d = W_e ([q_d, v_d] - [q, v]) and
     e_u = W_u u, W_u = I / u_m. The controller closes u = K(s) y.

@@ -1,7 +1,7 @@
 """The central (minimum-entropy) H-infinity controller at gamma = (1 + tol) gamma_opt.
 
 With the constant weights of 7.4 the optimum of eqs. 5.63-5.67 is the degenerate gamma_opt =
-||D11|| = W_e (docs/control.md): a whole family of controllers attains it and an LMI solver
+||D11|| = W_e (docs/guides/control.md): a whole family of controllers attains it and an LMI solver
 returns one of them, solver-dependent. This module picks one member by a stated secondary
 objective, independent of any solver:
 

@@ -4,7 +4,7 @@ Plant (eq. 5.62, D22 = 0)::
 
     x' = A x + B1 w + B2 u,   p = C1 x + D11 w + D12 u,   y = C2 x + D21 w
 
-Formulation (see docs/control.md):
+Formulation (see docs/guides/control.md):
 
 * **alpha-stability by a shift.** The LMIs are written for A_a = A + alpha_1 I. A
   controller (A_k', B_k, C_k, D_k) with a closed loop that meets the bounded real lemma
@@ -477,7 +477,7 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
     alpha : float
         alpha_1 >= 0: closed-loop poles with Re < -alpha_1 (7.3).
     solver : {"CLARABEL", "SCS", "ARE"}
-        SDP solver (SCS: first order, less accurate; see docs/control.md), or "ARE": the
+        SDP solver (SCS: first order, less accurate; see docs/guides/control.md), or "ARE": the
         same LMIs solved through their Riccati characterisation (regular plants only,
         :mod:`tmfem.control.linear.hinf_riccati`; the LMIs are re-evaluated at its point).
     eps : float
@@ -664,7 +664,7 @@ def hinf_riccati(plant: GeneralizedPlant, *, alpha: float = 0.0, verify_rtol: fl
     alpha-shifted plant A + alpha_1 I, shifted back (A_k - alpha_1 I) as in :func:`hinf_lmi`.
 
     For regular problems (D12 full column rank, D21 full row rank) only; used where the
-    LMI solver fails numerically (the 50-state 2-3 plant, docs/control.md). hinfsyn's own
+    LMI solver fails numerically (the 50-state 2-3 plant, docs/guides/control.md). hinfsyn's own
     gamma is not trusted: the returned ``gamma`` is the verified closed-loop norm.
     """
     import control

@@ -97,7 +97,7 @@ def pbh(A, B, C, *, tol: float = DEFAULT_TOL, cluster_rtol: float = 1e-8,
         A mode with margin <= tol is uncontrollable (unobservable). Default 1e-8: about
         1e8 times the double-precision unit roundoff, well above the rounding noise of the
         eigenvectors of a matrix with well-separated eigenvalues, far below the margins of
-        the deployed systems (>= 1e-4, docs/control.md).
+        the deployed systems (>= 1e-4, docs/guides/control.md).
     """
     A = np.asarray(A, dtype=float)
     B = np.atleast_2d(np.asarray(B, dtype=float))

@@ -13,7 +13,7 @@ Plant: the control-oriented model (eq. 5.27) built at the final configuration wi
 designed rest lengths, in modal membrane coordinates, started at rest in the initial
 configuration (as the 7.4 deployments, :func:`tmfem.control.deployment.run.run_deployment`: Park's
 method, rest-length limits), or an FE plant through its COM-state estimate started in its own
-equilibrium of :meth:`LPVDeployment.packaged` (docs/fe-plant.md).
+equilibrium of :meth:`LPVDeployment.packaged` (docs/guides/fe-plant.md).
 
 Measurement (:meth:`LPVDeployment.measure`): the plant's y = [z, z'] (modal) mapped onto the
 signals of the LPV design, y_lpv = [x_z, rho] with x_z = [q, v, q', v'] (v = T_v_eta eta, the

@@ -5,5 +5,5 @@ a few prestressed relative-deflection modes in the floating frame O_f; the corne
 constraints Phi(q, zeta) = 0 (eq. 3.5) are eliminated by coordinate partitioning
 (eqs. 5.20-5.28), giving the ODE  M_hat(z) z'' + F_hat(z, z') + B_hat(z) u = 0  whose input
 u is the vector of tendon rest lengths. Entry point: :class:`tmfem.models.com.model.ControlOrientedModel`
-(imported lazily to keep ``import tmfem`` light). See docs/com.md.
+(imported lazily to keep ``import tmfem`` light). See docs/guides/com.md.
 """

@@ -59,7 +59,7 @@ def membrane_potential_sx(membrane, layout, zeta, eta, *, prestress_scale: float
     """Membrane strain energy U_m = 1/2 Delta^T S Delta + 1/2 sum omega_i^2 eta_i^2 (eqs.
     5.4-5.6 for static shapes and fixed-corner modes, which are K-orthogonal), plus
     (s - 1) (S Delta_0)^T Delta when the designed prestress is scaled by s (the corner forces
-    at the design Delta_0 become s S Delta_0, the stiffness S is unchanged; docs/com.md)."""
+    at the design Delta_0 become s S Delta_0, the stiffness S is unchanged; docs/guides/com.md)."""
     d = zeta[: layout.n_delta]
     U = 0.5 * ca.dot(d, ca.mtimes(ca.DM(membrane.S), d))
     if prestress_scale != 1.0:

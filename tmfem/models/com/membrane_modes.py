@@ -10,7 +10,7 @@ expanded in modes phi_i computed with **all corners held** (a Craig-Bampton spli
 this choice the corner displacement of the membrane field is exactly Delta (phi_i = 0 at
 the corners) and nothing is counted twice; the static shapes and the modes are
 stiffness-orthogonal, so the strain energy separates exactly into
-U = 1/2 Delta^T S Delta + 1/2 sum_i omega_i^2 eta_i^2 (eqs. 5.4-5.6), see docs/com.md.
+U = 1/2 Delta^T S Delta + 1/2 sum_i omega_i^2 eta_i^2 (eqs. 5.4-5.6), see docs/guides/com.md.
 
 * In-plane: linear plane stress (eq. 5.8) of :class:`tmfem.fem.plane_stress.PlaneStressMembrane`
   (corner point attachments); Psi_k = response to a unit corner displacement.
@@ -159,7 +159,7 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
         dissertation's printed numbers imply; 1 = designed prestress).
     membrane_law : {"svk", "tension-field"}
         ``"svk"``: linear plane stress (eq. 5.8), the dissertation's basis. ``"tension-field"``
-        (docs/wrinkling.md): tau^s is the tension-only prestress of the tension-field law at
+        (docs/guides/wrinkling.md): tau^s is the tension-only prestress of the tension-field law at
         Delta_0, and the in-plane stiffness (static shapes, S, in-plane modes) is the law's
         consistent tangent about that state (a linearisation; S Delta_0 still equals the
         corner forces at Delta_0 since the law is positively homogeneous).

@@ -22,7 +22,7 @@ the graphs) in :mod:`~tmfem.models.com.dae`.
 
 Tendon forces follow eq. 3.8, T = k (|d| - r), with the spring constant of eq. 3.9 taken
 at the design rest length, k = EA / r_design, and held fixed: the input u = r then enters
-affinely (B(x) u, eq. 5.19) -- see docs/com.md.
+affinely (B(x) u, eq. 5.19) -- see docs/guides/com.md.
 """
 from __future__ import annotations
 
@@ -81,7 +81,7 @@ class ControlOrientedModel:
         ``system.monitor_points`` (eqs. 5.36/5.38 for the presets ``1-4`` and ``2-3``).
     membrane_law : {"svk", "tension-field"}
         Membrane basis about the linear (eq. 5.8) or the tension-field prestress
-        (:func:`tmfem.models.com.membrane_modes.build_membrane_basis`, docs/wrinkling.md).
+        (:func:`tmfem.models.com.membrane_modes.build_membrane_basis`, docs/guides/wrinkling.md).
     """
 
     def __init__(self, system, *, membrane_modes: int = 4, mesh_n: int = 10,

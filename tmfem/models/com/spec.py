@@ -25,9 +25,9 @@ SPEC = register(ModelSpec(
             "presets: 5 for 1-4, 4 for 2-3)"))),
         Option("--prestress-scale", 1.0, None, dict(type=float, help=(
             "factor on the designed membrane prestress (1 = designed; 1.2903 gives the printed "
-            "1-4 tendon stress and Table 6.6, docs/errata.md)"))),
+            "1-4 tendon stress and Table 6.6, docs/validation/errata.md)"))),
         Option("--membrane-law", "svk", None, dict(choices=MEMBRANE_LAWS, help=(
             "membrane basis about the linear (svk) or the tension-field prestress "
-            "(docs/wrinkling.md)"))),
+            "(docs/guides/wrinkling.md)"))),
         Option("--damping", 0.0, ("vibrate",), dict(type=float, help="modal damping c_m [1/s] (eq. 5.13)")),
     )))

@@ -4,7 +4,7 @@ Built from the same :class:`~tmfem.system.System` and the same gmsh membrane mes
 model (:mod:`tmfem.models.mtc`), whose numbering, rest lengths and start placement it reuses:
 
 * **membrane**: MITC4 shells (:class:`tmfem.fem.mitc4.MITC4Shell`, 4.3.1) of thickness
-  ``system.membrane.h`` (51 um for the presets; docs/shells.md, "the thin limit");
+  ``system.membrane.h`` (51 um for the presets; docs/guides/shells.md, "the thin limit");
 * **bars**: four-node beams (:class:`tmfem.fem.beam.BeamElement`, 4.3.2), ``bar_elements``
   per bar (6.2: one), solid circular section of diameter ``system.bar.d``; Poisson's ratio
   :data:`BAR_NU` (the system carries none);

@@ -78,7 +78,7 @@ def roll_up(*, n: int = 16, steps: int = 10, L: float = 12.0) -> dict:
     return {"rows": rows, "load_steps": steps, "mesh": f"{n}x1",
             "max_error_over_L_vs_elastica": err,
             "source": "elastica (benchmarks.json elastica_end_moment_closed_form); discrete closed form "
-                      "of the linearly interpolated directors (docs/shells.md)"}
+                      "of the linearly interpolated directors (docs/guides/shells.md)"}
 
 
 def plot(result: dict, png):

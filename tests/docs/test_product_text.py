@@ -1,0 +1,33 @@
+"""The documentation, examples, demos and benchmarks speak of the product: what it does, how
+to use it, why it is built so, its limits. They name no issue numbers, work sessions,
+branches, commit hashes, dates of measurements or people working on it (history is in git)."""
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+FILES = sorted([*ROOT.glob("docs/**/*.md"), ROOT / "README.md", *ROOT.glob("examples/*.py"),
+                *ROOT.glob("demos/*.py"), *ROOT.glob("benchmarks/*.py"), *ROOT.glob("docs/hooks/*.py")])
+PROCESS = re.compile(r"\bissues? \d+|\bissue's\b|\bsessions?\b|\bbranch(es)?\b|\bhelpers?\b|"
+                     r"\bthe lead\b|\(lead\b|\bstop \d+\b|\b20\d\d-\d\d-\d\d\b|\bthis machine state\b",
+                     re.IGNORECASE)
+HASH = re.compile(r"(?<![\w.+-])[0-9a-f]{7,40}(?![\w.])")
+
+
+def process_words(text: str) -> list[str]:
+    found = [m.group(0) for m in PROCESS.finditer(text)]
+    found += [h for h in HASH.findall(text)
+              if re.search(r"[a-f]", h) and re.search(r"\d", h) and not re.fullmatch(r"\d+e\d*", h)]
+    return found
+
+
+def test_the_scan_finds_process_words():
+    assert process_words("fixed in issue 13 on branch sbc14d, commit 862f9a6 (2026-12-03)") == \
+        ["issue 13", "branch", "2026-12-03", "862f9a6"]
+    assert process_words("E = 1.539595e-3, 165000000 Pa, mode 12") == []
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_process_words(path):
+    assert process_words(path.read_text()) == []
