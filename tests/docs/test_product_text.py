@@ -31,3 +31,25 @@ def test_the_scan_finds_process_words():
 @pytest.mark.parametrize("path", FILES, ids=lambda p: str(p.relative_to(ROOT)))
 def test_no_process_words(path):
     assert process_words(path.read_text()) == []
+
+
+# The package, its preset files and the tests speak of the product too. Their words are
+# scanned with the same patterns less the plain words that code uses in their ordinary
+# sense ("branch" of a root, "helper" function): there only their process uses are caught.
+CODE_FILES = sorted([*ROOT.glob("tmfem/**/*.py"), *ROOT.glob("tmfem/**/*.toml"), *ROOT.glob("tests/**/*.py")])
+CODE_PROCESS = re.compile(r"\bissues? \d+|\(issue\b|\bissue's\b|\b(this|that|earlier|later|last|next) sessions?\b|"
+                          r"\bhelpers? [A-Z]\d?\b|\bthe lead\b|\(lead\b|\bstop \d+\b|\bbranch (main|[a-z]+\d+)\b|"
+                          r"\bcommit [0-9a-f]{7,40}\b|\bmain [0-9a-f]{7,40}\b", re.IGNORECASE)
+SELF = Path(__file__).resolve()
+
+
+def test_the_code_scan_finds_process_words():
+    found = [m.group(0) for m in CODE_PROCESS.finditer(
+        "as measured (issue 15) by helper B2 in this session on main b5c1033; the branch of asin")]
+    assert found == ["(issue", "helper B2", "this session", "main b5c1033"]
+
+
+@pytest.mark.parametrize("path", [f for f in CODE_FILES if f.resolve() != SELF],
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_no_process_words_in_code(path):
+    assert [m.group(0) for m in CODE_PROCESS.finditer(path.read_text())] == []
