@@ -22,11 +22,12 @@ import json
 import numpy as np
 from lpv_certificate import plant_on
 
-from tmfem.control.lpv.bisect import _coefficients
 from tmfem.control.lpv.certificate import closed_loop_lpv, pointwise_lmi_eigs
 from tmfem.control.lpv.eigopt import EigOpt
 from tmfem.control.lpv.output_feedback import design_output_feedback
-from tmfem.control.lpv.synthesis import Coordinates, LPVStateFeedback, lmi_matrix
+from tmfem.control.lpv.coordinates import Coordinates
+from tmfem.control.lpv.generalized_plant import lmi_matrix
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.system import load_preset
 
 
@@ -94,8 +95,8 @@ def main():
                     "model_error_rel": float(np.abs(fine.A[worst] - A_model).max() / np.abs(fine.A[worst]).max())}
     co = Coordinates.of(gp)
     pts = [tuple(int(i) for i in k) for k in np.argwhere(on_design)] + order[:a.points]
-    e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=X.gamma, points=pts, balance_on=_coefficients(X, co, gp))
-    z = e.start_from(*_coefficients(X, co, gp))
+    e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=X.gamma, points=pts, balance_on=co.coefficients_of(X, gp))
+    z = e.start_from(*co.coefficients_of(X, gp))
     Ms = e.matrices(z, X.gamma)
     sc = e.scales(z, X.gamma, Ms)
     top = np.linalg.eigvalsh(Ms[0] / sc[0][..., None, None])[..., -1].max(axis=1)

@@ -23,6 +23,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError
+from tmfem.solvers.singular import SingularMatrix
 
 
 
@@ -34,10 +35,6 @@ class Backend(Protocol):
     def factorize(self, A) -> Callable[[np.ndarray], np.ndarray]: ...
 
     def eigsh(self, K, M, k: int, sigma: float, v0=None) -> tuple[np.ndarray, np.ndarray]: ...
-
-
-class SingularMatrix(ConvergenceError):
-    """A tangent matrix that cannot be factorised (a mechanism, a slack structure)."""
 
 
 class ScipyBackend:

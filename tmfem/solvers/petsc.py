@@ -45,12 +45,13 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from tmfem.errors import BackendUnavailable, ConvergenceError, InputError, ResourceLimit
+from tmfem.errors import ConvergenceError, InputError, ResourceLimit
+from tmfem.solvers.petsc_loader import petsc_modules
 from tmfem.solvers.petsc_redundant import RedundantDoesNotFit
+from tmfem.solvers.singular import SingularMatrix
 
 log = logging.getLogger(__name__)
 
-PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/backends.md)"
 
 #: right-hand sides per MUMPS solve of the block eigensolver, on 1 rank and on the parallel
 #: factors of P > 1 ranks (4: 80-84 columns for 12 modes against 120-136 with 8, 53 single
@@ -70,22 +71,6 @@ _KSP_REASONS = {-2: "DIVERGED_NULL", -3: "DIVERGED_ITS", -4: "DIVERGED_DTOL",
                 -5: "DIVERGED_BREAKDOWN", -6: "DIVERGED_BREAKDOWN_BICG",
                 -7: "DIVERGED_NONSYMMETRIC", -8: "DIVERGED_INDEFINITE_PC", -9: "DIVERGED_NANORINF",
                 -10: "DIVERGED_INDEFINITE_MAT", -11: "DIVERGED_PC_FAILED"}
-
-
-def petsc_modules():
-    """``(PETSc, SLEPc)`` imported (and initialised) lazily; :class:`BackendUnavailable`
-    naming the install command when petsc4py/slepc4py are missing or do not load."""
-    try:
-        import petsc4py
-        import slepc4py
-        petsc4py.init()
-        slepc4py.init()
-        from petsc4py import PETSc
-        from slepc4py import SLEPc
-    except ImportError as exc:
-        raise BackendUnavailable(f"backend 'petsc': expected petsc4py and slepc4py importable, found "
-                                 f"{exc}; install with: {PETSC_INSTALL}") from None
-    return PETSc, SLEPc
 
 
 def parse_options(options) -> dict:
@@ -133,7 +118,6 @@ def _is_number(tok: str) -> bool:
 def _shift_invert_failure(sigma: float, exc):
     """The :class:`SingularMatrix` of a failing factorisation of K - sigma M (PETSc error
     ``exc``) in an eigen solve."""
-    from tmfem.solvers.backends import SingularMatrix
     return SingularMatrix(f"eigen (petsc): expected K - sigma M non-singular for sigma={sigma:g}, "
                           f"found the shift-invert factorisation failing (PETSc error {exc.ierr})")
 
@@ -416,7 +400,6 @@ class PetscBackend:
         the same sparsity pattern reuses the PETSc objects (and MUMPS' analysis): an older
         ``solve`` of that pattern then raises instead of silently using the new factors.
         """
-        from tmfem.solvers.backends import SingularMatrix
         PETSc = self.PETSc
         self._reap()
         M, key = self._mat(A)

@@ -2,7 +2,7 @@
 import numpy as np
 
 from tmfem.control.lpv.plant import com_lpv_plant
-from tmfem.control.lpv.synthesis import interconnection_8_1
+from tmfem.control.lpv.generalized_plant import interconnection_8_1
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.model import ControlOrientedModel

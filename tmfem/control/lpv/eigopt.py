@@ -84,7 +84,7 @@ class EigOpt:
 
     Parameters
     ----------
-    gp : GeneralisedLPV
+    gp : GeneralizedLPV
     T : (n,) array
         Diagonal state scaling of the synthesis (x = T x_s).
     c_of : callable
