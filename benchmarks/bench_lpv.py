@@ -12,7 +12,7 @@ prints every level (also the sub-grid's), the bracket and the CPU time.
 import argparse
 import time
 
-from tmfem.cli.control_lpv import printed_grid
+from tmfem.cli.lpv_options import printed_grid
 from tmfem.control.lpv.bounds import pointwise_state_feedback_bound
 from tmfem.control.lpv.plant import com_lpv_plant
 from tmfem.control.lpv.generalized_plant import interconnection_8_1

@@ -23,10 +23,12 @@ import dataclasses
 
 import numpy as np
 
-from tmfem.cli.deploy_lpv import design
 from tmfem.control.deployment.run import run_deployment
 from tmfem.control.fe_plant.sampled_loop import dominant_eigenvalues, lpv_start_loop
 from tmfem.control.lpv.deployment import state_feedback_controller
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
+from tmfem.control.lpv.workflow import saved_design_plant
+from tmfem.reference.tables import deployment_bases
 from tmfem.control.fe_plant.state_estimate import deployment_plant
 from tmfem.errors import ConvergenceError
 from tmfem.reference.deployments import lpv_setup
@@ -61,7 +63,8 @@ def main():
     ap.add_argument("--only", default="start,open-loop,loop,runs")
     a = ap.parse_args()
     todo = a.only.split(",")
-    pl, d, _ = design(argparse.Namespace(lpv_controller=a.lpv_controller, dt=0.01), "2-3-lpv")
+    d, system = LPVStateFeedback.load(a.lpv_controller), load_preset("2-3-lpv")
+    pl = saved_design_plant(d, system, bases=deployment_bases(system))
     dep, s = deployment(pl, d)
     nq, nz = s.model.nq, s.model.nz
     com = run(s, None, a.t_end)

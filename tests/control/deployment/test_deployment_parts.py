@@ -248,7 +248,7 @@ def test_2_3_path_on_the_table_7_7_rule():
     # the 2-3 reference with the stage-2 base rule of Table 7.7 (deployment_bases): it ends
     # on the presets, keeps Delta = 1 mm (eq. 3.22, the rule's definition) along the path and
     # every point is a symmetric equilibrium (positive null vector of 3.3.2)
-    from tmfem.cli.deploy import setup
+    from tmfem.reference.deployments import setup
     from tmfem.control.deployment.run import _equilibrium_checker
     from tmfem.equilibrium.symmetric import membrane_delta_system
     from tmfem.equilibrium.symmetric_map import with_configuration
@@ -321,7 +321,7 @@ def test_partition_with_several_force_columns(model14):
 
 
 def test_setup_refuses_a_path_of_the_other_system_kind():
-    from tmfem.cli.deploy import setup
+    from tmfem.reference.deployments import setup
     with pytest.raises(InputError, match="expected 'linear' or 'delta'"):
         setup("1-4D", path="table-7-7-bases")
     with pytest.raises(InputError, match="allocation"):
