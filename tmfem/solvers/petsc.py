@@ -546,7 +546,7 @@ class PetscBackend:
         if not 1 <= k < n:
             raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
         sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
-        reuse = self._analysed(K, M) if sym else None
+        reuse = self._analyzed(K, M) if sym else None
         w = None
         self.last_eig_solver = "slepc"
         if self.eig_solver in ("block", "redundant") and sym and n >= EIG_BLOCK_MIN_N:
@@ -575,7 +575,7 @@ class PetscBackend:
         o = np.argsort(w)
         return w[o], V[:, o]
 
-    def _analysed(self, K, M):
+    def _analyzed(self, K, M):
         """The cache entry (Mat, KSP: MUMPS' analysis done) of the tangent K's pattern when
         the eigen solve can factorise K - sigma M in it, else None.
 

@@ -85,7 +85,7 @@ def test_input_matrix_check_refuses_singular_and_nonsquare():
 
 
 def test_rbf_values():
-    r = GaussianRBF(centres=[[0.0, 0.0], [1.0, 0.0]], sigma=0.5)
+    r = GaussianRBF(centers=[[0.0, 0.0], [1.0, 0.0]], sigma=0.5)
     phi = r(np.array([0.0, 0.5]))
     # eq. 5.44: |v - c|^2 = 0.25 and 1.25
     assert np.allclose(phi, np.exp(-np.array([0.25, 1.25]) / (2 * 0.25)))

@@ -110,7 +110,7 @@ def test_a_full_grid_design_restricted_to_the_line_is_a_sub_grid_design():
     ctrl, _ = bisect_gamma(gp, lower=lb, upper=2 * lb, rtol=0.05)
     assert ctrl.varying == [0, 1]
     sub = collapsed(gp, 1)
-    line = LPVStateFeedback(gamma=ctrl.gamma, P=ctrl.P[:2], Q=ctrl.Q[:2], centre=ctrl.centre,
+    line = LPVStateFeedback(gamma=ctrl.gamma, P=ctrl.P[:2], Q=ctrl.Q[:2], center=ctrl.center,
                             half_width=ctrl.half_width, varying=[0], axes=sub.axes, parameter_names=["a", "b"],
                             rate_bounds=ctrl.rate_bounds, state_names=ctrl.state_names, solver="restricted",
                             status="", solve_time=0.0, build_time=0.0, sizes={}, max_lmi_eig=np.nan, min_P_eig=np.nan)

@@ -165,7 +165,7 @@ def test_off_grid_verification_passes_and_refuses_a_wrong_plant():
     assert not verify(ctrl, bad, allow_failure=True).passed
 
 
-def test_eigenvalue_optimisation_finds_a_feasible_point_above_the_optimum_only():
+def test_eigenvalue_optimization_finds_a_feasible_point_above_the_optimum_only():
     # the conic optimum (Clarabel) of the oscillator; EIGOPT at a fixed level above it returns a
     # controller whose re-computed LMIs are negative and that passes the off-grid check, below
     # it none (a feasibility method cannot beat the optimum)
@@ -180,7 +180,7 @@ def test_eigenvalue_optimisation_finds_a_feasible_point_above_the_optimum_only()
         synthesize_state_feedback(gp_of(pl), solver="EIGOPT")
 
 
-def test_threaded_eigendecompositions_give_the_serial_optimisation():
+def test_threaded_eigendecompositions_give_the_serial_optimization():
     # source: the same optimisation without threads (workers=1), both at one BLAS thread: the
     # threads decompose disjoint parts of the stack, so every evaluation is bit for bit the same
     from threadpoolctl import threadpool_limits

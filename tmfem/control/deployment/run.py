@@ -307,7 +307,7 @@ class DeploymentSetup:
 
 def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      output_points=None, linear: str = "lqr", R_c: float = 0.01,
-                     n_centres: int = 10, w_bar: float = 100.0, gamma: float = 0.01,
+                     n_centers: int = 10, w_bar: float = 100.0, gamma: float = 0.01,
                      u_m: float = 0.01, membrane_modes: int | None = None,
                      check_path: bool = True, bases=None, allocation: str = "bounded",
                      hinf_method: str = "central", r_min: float = 1e-3,
@@ -325,7 +325,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     Riccati on [q, w]). ``evaluation``: where the PFL evaluates its model terms, at the
     measured state (eq. 5.58) or at the reference; ``tendon_law``: the PFL's tendon model,
     the rates of eq. 5.19 or k = EA / u (:mod:`tmfem.control.deployment.adaptive`)."""
-    from tmfem.control.deployment.adaptive import AdaptivePFL, reference_centres
+    from tmfem.control.deployment.adaptive import AdaptivePFL, reference_centers
     from tmfem.control.deployment.reference_trajectory import DeploymentReference
     from tmfem.control.deployment.rbf import GaussianRBF
     from tmfem.control.deployment.switching import SwitchingController
@@ -345,13 +345,13 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     if check_path:
         ref.check_equilibria(checker=_equilibrium_checker(final))
     t_settle = 8.0 / omega_r
-    C, sig = reference_centres(ref, t_end=t_settle, m=n_centres)
-    ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centres=C, sigma=sig),
+    C, sig = reference_centers(ref, t_end=t_settle, m=n_centers)
+    ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centers=C, sigma=sig),
                      w_bar=w_bar, gamma=gamma, uncertainty=uncertainty, allocation=allocation,
                      r_min=r_min, evaluation=evaluation, tendon_law=tendon_law)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
     z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)]))
-    info = {"rbf_centres": n_centres, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
+    info = {"rbf_centres": n_centers, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
     lin_ctrl = None
     ctrl = ad
     start = "bumpless"

@@ -134,13 +134,13 @@ def separation_start(design, plant: GriddedLPV, gp: GeneralizedLPV, gamma: float
     M[:n + nq, :n + nq] = np.eye(n + nq)
     M[n + nq:, :n] = np.eye(n)
     M[n + nq:, n + nq:] = -np.eye(n)
-    c0 = np.asarray(sf.centre, dtype=float)
+    c0 = np.asarray(sf.center, dtype=float)
     steps = [c0 + np.eye(c0.size)[k] * sf.half_width[k] for k in sf.varying]
     Zs = [Z.P_of(c0)] + [Z.P_of(r) - Z.P_of(c0) for r in steps]       # Z(rho) in the basis of P(rho)
     best = None
     for beta in betas:
         Xk = [M @ sla.block_diag(Pk, beta * Zk) @ M.T for Pk, Zk in zip(sf.P, Zs)]
-        X = LPVStateFeedback(gamma=gamma, P=Xk, Q=[np.zeros((0, 2 * n + nq))] * len(Xk), centre=sf.centre,
+        X = LPVStateFeedback(gamma=gamma, P=Xk, Q=[np.zeros((0, 2 * n + nq))] * len(Xk), center=sf.center,
                              half_width=sf.half_width, varying=sf.varying, axes=sf.axes,
                              parameter_names=sf.parameter_names, rate_bounds=sf.rate_bounds,
                              state_names=list(gp.state_names), solver="separation", status=f"beta = {beta:.1e}",
@@ -356,7 +356,7 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
             break
         Ps, _ = e.coefficients(z)
         X = LPVStateFeedback(gamma=gamma, P=[Tm_back(P, co.T) for P in Ps], Q=[np.zeros((0, gp.A.shape[-1]))] * len(Ps),
-                             centre=co.centre, half_width=co.half, varying=co.varying,
+                             center=co.center, half_width=co.half, varying=co.varying,
                              axes=[a.copy() for a in X.axes], parameter_names=list(X.parameter_names),
                              rate_bounds=X.rate_bounds.copy(), state_names=list(X.state_names), solver="EIGOPT",
                              status=f"refined: {len(imposed)} points imposed", solve_time=0.0, build_time=0.0,

@@ -25,12 +25,12 @@ log = logging.getLogger(__name__)
 @dataclass
 class Coordinates:
     """The synthesis coordinates of a generalised plant (module docstring): parameters
-    normalised to [-1, 1] over the grid (``centre``, ``half``; ``varying``: the parameters
+    normalised to [-1, 1] over the grid (``center``, ``half``; ``varying``: the parameters
     with more than one grid value), states x = T x_s, the rate vertices and the LMI sizes."""
 
     grid_shape: tuple
     T: np.ndarray
-    centre: np.ndarray
+    center: np.ndarray
     half: np.ndarray
     varying: list
     verts: np.ndarray
@@ -48,12 +48,12 @@ class Coordinates:
                  "lmis": int(np.prod(shp)) * len(verts), "lmi_size": n + nw + npp, "n_x": n, "n_w": nw,
                  "n_u": nu, "n_p": npp, "decision_variables": nvar}
         return cls(grid_shape=shp, T=state_scaling(gp.A[tuple(s // 2 for s in shp)]) if scale else np.ones(n),
-                   centre=(lo + hi) / 2, half=np.where(hi > lo, (hi - lo) / 2, 1.0), varying=varying,
+                   center=(lo + hi) / 2, half=np.where(hi > lo, (hi - lo) / 2, 1.0), varying=varying,
                    verts=verts, sizes=sizes)
 
     def c_of(self, rho) -> np.ndarray:
         """The coefficients [1, rho_n...] of P_k in P(rho) (eq. 5.99, normalised rho)."""
-        return np.concatenate([[1.0], ((np.asarray(rho) - self.centre) / self.half)[self.varying]])
+        return np.concatenate([[1.0], ((np.asarray(rho) - self.center) / self.half)[self.varying]])
 
     @property
     def dvs(self) -> list:
@@ -71,12 +71,12 @@ class Coordinates:
 
         def at(rho):
             return design.P_of(rho) / T[:, None] / T[None, :], design.Q_of(rho) / T[None, :]
-        P0, Q0 = at(self.centre)
+        P0, Q0 = at(self.center)
         Ps, Qs = [P0], [Q0]
         for k in self.varying:
-            d = np.zeros_like(self.centre)
+            d = np.zeros_like(self.center)
             d[k] = self.half[k]
-            P1, Q1 = at(self.centre + d)
+            P1, Q1 = at(self.center + d)
             Ps.append(P1 - P0)
             Qs.append(Q1 - Q0)
         return Ps, Qs
@@ -88,7 +88,7 @@ class Coordinates:
         (:func:`tmfem.control.lpv.verify.verify`)."""
         T = self.T
         ctrl = accepted_design(gp, [Tm_back(P, T) for P in Ps], [Q * T[None, :] for Q in Qs], gamma, T, self.verts,
-                         self.centre, self.half, self.varying, solver=solver, status=status, solve=solve,
+                         self.center, self.half, self.varying, solver=solver, status=status, solve=solve,
                          build=build, sizes=self.sizes, tol=-1e-300)
         if sample_time is not None:
             r = verify(ctrl, gp, sample_time=sample_time, allow_failure=True).max_sampled_radius
@@ -98,12 +98,12 @@ class Coordinates:
         return ctrl
 
 
-def accepted_design(gp, Pv, Qv, g, T, verts, centre, half, varying, *, solver, status, solve, build,
+def accepted_design(gp, Pv, Qv, g, T, verts, center, half, varying, *, solver, status, solve, build,
                     sizes, tol) -> LPVStateFeedback:
     """The design of coefficients P_k = ``Pv``, Q_k = ``Qv`` (original coordinates) at level
     ``g``, after re-computing every LMI (eq. 5.95) and P(rho_i) from them in floating point
     (largest eigenvalue in the scaled coordinates <= ``tol``, P > 0) at every grid point of
-    ``gp`` and rate vertex ``verts`` (``T``, ``centre``, ``half``, ``varying``: the
+    ``gp`` and rate vertex ``verts`` (``T``, ``center``, ``half``, ``varying``: the
     coordinates of :class:`Coordinates`); ``solver``, ``status``, ``solve``, ``build``,
     ``sizes``: the solve's record kept in the result.
 
@@ -117,7 +117,7 @@ def accepted_design(gp, Pv, Qv, g, T, verts, centre, half, varying, *, solver, s
     worst, minP = -np.inf, np.inf
     for idx in np.ndindex(*gp.grid_shape):
         rho = np.array([a[i] for a, i in zip(gp.axes, idx)])
-        c = np.concatenate([[1.0], ((rho - centre) / half)[varying]])
+        c = np.concatenate([[1.0], ((rho - center) / half)[varying]])
         P = sum(ck * Pk for ck, Pk in zip(c, Pv)); Q = sum(ck * Qk for ck, Qk in zip(c, Qv))
         minP = min(minP, np.linalg.eigvalsh((P * Ti[:, None] * Ti[None, :])).min())
         for v in verts:
@@ -131,7 +131,7 @@ def accepted_design(gp, Pv, Qv, g, T, verts, centre, half, varying, *, solver, s
                                    f"{worst:.3e} (expected <= {tol:.3e}) and min eig P {minP:.3e} "
                                    "(expected > 0)")
     log.info("LPV synthesis: gamma = %.6g (%s, %s, %.1f s)", g, solver, status, solve)
-    return LPVStateFeedback(gamma=g, P=Pv, Q=Qv, centre=centre, half_width=half, varying=varying,
+    return LPVStateFeedback(gamma=g, P=Pv, Q=Qv, center=center, half_width=half, varying=varying,
                             axes=[a.copy() for a in gp.axes], parameter_names=list(gp.parameter_names),
                             rate_bounds=gp.rate_bounds.copy(), state_names=list(gp.state_names),
                             solver=solver, status=status, solve_time=solve, build_time=build,

@@ -15,14 +15,14 @@ class LPVStateFeedback:
     """Result of :func:`synthesize_state_feedback`: K(rho) = Q(rho) P(rho)^-1 (eq. 5.99).
 
     ``P[k]``, ``Q[k]`` (k = 0..n_p) are the coefficients in the normalised parameters
-    rho_n = (rho - centre) / half_width (k = 0 the constant term); :meth:`P_of`, :meth:`Q_of`
+    rho_n = (rho - center) / half_width (k = 0 the constant term); :meth:`P_of`, :meth:`Q_of`
     and :meth:`gain` evaluate them at a parameter value in the original units.
     """
 
     gamma: float
     P: list
     Q: list
-    centre: np.ndarray
+    center: np.ndarray
     half_width: np.ndarray
     varying: list
     axes: list
@@ -39,9 +39,9 @@ class LPVStateFeedback:
 
     def _basis(self, rho) -> np.ndarray:
         rho = np.asarray(rho, dtype=float).reshape(-1)
-        if rho.size != len(self.centre):
-            raise InputError(f"LPV controller: expected {len(self.centre)} parameter values, found {rho.size}")
-        return np.concatenate([[1.0], ((rho - self.centre) / self.half_width)[self.varying]])
+        if rho.size != len(self.center):
+            raise InputError(f"LPV controller: expected {len(self.center)} parameter values, found {rho.size}")
+        return np.concatenate([[1.0], ((rho - self.center) / self.half_width)[self.varying]])
 
     def P_of(self, rho) -> np.ndarray:
         """P(rho) (eq. 5.99)."""
@@ -62,8 +62,8 @@ class LPVStateFeedback:
 
     def arrays(self) -> dict:
         """The coefficients, gamma and grid as arrays (the contents of :meth:`save`)."""
-        return dict(gamma=self.gamma, P=np.array(self.P), Q=np.array(self.Q), centre=self.centre,
-                    half_width=self.half_width, varying=np.isin(np.arange(len(self.centre)), self.varying),
+        return dict(gamma=self.gamma, P=np.array(self.P), Q=np.array(self.Q), centre=self.center,
+                    half_width=self.half_width, varying=np.isin(np.arange(len(self.center)), self.varying),
                     rate_bounds=self.rate_bounds, parameter_names=np.array(self.parameter_names),
                     state_names=np.array(self.state_names),
                     **{f"axis_{k}": a for k, a in enumerate(self.axes)})
@@ -96,7 +96,7 @@ class LPVStateFeedback:
         if len(P) != 1 + len(varying) or len(Q) != len(P):
             raise InputError(f"LPV controller file {str(path)!r}: expected {1 + len(varying)} coefficients "
                              f"P_k, Q_k (eq. 5.99 on its grid), found {len(P)} and {len(Q)}")
-        return cls(gamma=float(f["gamma"]), P=P, Q=Q, centre=f["centre"], half_width=f["half_width"],
+        return cls(gamma=float(f["gamma"]), P=P, Q=Q, center=f["centre"], half_width=f["half_width"],
                    varying=varying, axes=axes,
                    parameter_names=[str(v) for v in f["parameter_names"]], rate_bounds=f["rate_bounds"],
                    state_names=[str(v) for v in f["state_names"]], solver="loaded", status=f"from {path}",

@@ -114,7 +114,7 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
                          f"with solver {solver}")
     t0 = time.perf_counter()
     co = Coordinates.of(gp, scale=scale)
-    shp, T, centre, half, varying, verts, sizes = (co.grid_shape, co.T, co.centre, co.half, co.varying,
+    shp, T, center, half, varying, verts, sizes = (co.grid_shape, co.T, co.center, co.half, co.varying,
                                                     co.verts, co.sizes)
     n, nw, nu, npp = (gp.sizes[k] for k in ("n_x", "n_w", "n_u", "n_p"))
     N = n + nw + npp
@@ -143,7 +143,7 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
     psd_parts = []
     for idx in np.ndindex(*shp):
         rho = np.array([a[i] for a, i in zip(gp.axes, idx)])
-        c = np.concatenate([[1.0], ((rho - centre) / half)[varying]])
+        c = np.concatenate([[1.0], ((rho - center) / half)[varying]])
         A = Ti[:, None] * gp.A[idx] * T[None, :]
         B1 = Ti[:, None] * gp.B1[idx]
         B2 = Ti[:, None] * gp.B2[idx]
@@ -207,7 +207,7 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
         Pv = [Tm_back(_unsym(x[pcol(k):pcol(k) + ms], n), T) for k in range(nb)]
         Qv = [x[pcol(k) + ms:pcol(k) + ms + mq].reshape(nu, n, order="F") * T[None, :] for k in range(nb)]
         try:
-            return accepted_design(gp, Pv, Qv, g, T, verts, centre, half, varying, solver=s, status=status,
+            return accepted_design(gp, Pv, Qv, g, T, verts, center, half, varying, solver=s, status=status,
                                    solve=solve, build=build, sizes=sizes, tol=accuracy * scale_data)
         except InfeasibleController as exc:
             last = f"{s}: status {status} but {exc}"
