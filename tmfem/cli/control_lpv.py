@@ -6,8 +6,8 @@ import numpy as np
 
 from tmfem.cli import lpv_options
 from tmfem.cli.common import output_file
-from tmfem.control.lpv import workflow
-from tmfem.control.lpv.workflow import CERTIFICATE_ROUNDS
+from tmfem.control import lpv
+from tmfem.control.lpv.defaults import CERTIFICATE_ROUNDS
 from tmfem.errors import InputError
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
@@ -111,7 +111,7 @@ def run(args) -> dict:
     out = {**out, **syn, **v.to_dict()}
     saved = ctrl
     if args.output_feedback:
-        saved, extra = workflow.output_feedback_design(
+        saved, extra = lpv.output_feedback_design(
             ctrl, plant, fine, tracked=cfg["system"].q_names, noise=noise, sample_time=args.sample_time,
             certificate=(cfg["rtol"], cfg["budget"], rounds) if args.rate_certificate else None,
             interpolation=args.estimator_interpolation or "multilinear", estimator_plant=est, progress=lpv_options.progress)

@@ -9,14 +9,13 @@ import sys
 import time
 from dataclasses import astuple
 
+from tmfem import reference
 from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_mesh_budget, check_time_steps, output_dir, output_file,
                               positive_float, progress_bar)
 from tmfem.errors import InputError
 from tmfem.reference.deployments import (CONTROLLERS, DEPLOYMENTS, LPV_CONTROLLERS, LPV_DEPLOYMENTS,
                                          UNCERTAINTIES, check_choices, setup, write_outputs)
-from tmfem.reference.deployment_plants import (FEPlantOptions, compare_plants, diverged, packaged_system,
-                                               run_on_plant)
 from tmfem.system.presets import load_preset
 
 NAME = "deploy"
@@ -159,14 +158,9 @@ def run(args) -> dict:
                   path=args.path)
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
-    # one controller for both plants of a comparison: with an FE plant among them, the PFL
-    # at the reference and its tendon model the FE plant's tendon law (docs/fe-plant.md),
-    # except under eq. 5.72, whose F_q is frozen with the fixed rates of eq. 5.19
-    fe = args.plant != "com" or args.compare_plant not in (None, "com")
-    pfl_at = args.pfl_at or ("reference" if fe else "state")
-    frozen = (args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"]) == "initial"
-    plants = FEPlantOptions.of(args)
-    tendons = plants.fe_tendon_model() if fe and not frozen else "fixed-rate"
+    plants = reference.FEPlantOptions.of(args)
+    pfl_at = plants.pfl_evaluation(args.pfl_at)
+    tendons = plants.pfl_tendon_model(args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"])
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path, evaluation=pfl_at,
               tendon_law=tendons, gains=args.gains)
@@ -192,7 +186,7 @@ def run(args) -> dict:
                        allocation=args.allocation, path=args.path, evaluation=pfl_at,
                        tendon_law=tendons, gains=args.gains)
             return _run_on(args, s2, kind, mesh_n), {}
-        out["compare"] = compare_plants(
+        out["compare"] = reference.compare_plants(
             r, rerun, options=plants, preset=args.preset, csv=args.compare_csv, plot=args.compare_plot,
             mesh_n=mesh_n, controller=ctrl,
             about=f"PFL at the {pfl_at}, its tendon model {tendons}, uncertainty "
@@ -201,7 +195,7 @@ def run(args) -> dict:
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
     # to the failure are written, the exit code is 1 (docs/cli.md, docs/fe-plant.md)
-    out["failed_checks"] = diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+    out["failed_checks"] = reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out
 
 
@@ -209,9 +203,9 @@ def _run_on(args, s, plant_kind: str, mesh_n):
     """The deployment of set-up ``s`` on ``plant_kind``
     (:func:`tmfem.reference.deployment_plants.run_on_plant`)."""
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
-        return run_on_plant(s, kind=plant_kind, options=FEPlantOptions.of(args),
-                            initial=packaged_system(args.preset), mesh_n=mesh_n, t_end=args.t_end,
-                            dt=args.dt, progress=bar)
+        return reference.run_on_plant(s, kind=plant_kind, options=reference.FEPlantOptions.of(args),
+                                      initial=reference.packaged_system(args.preset), mesh_n=mesh_n,
+                                      t_end=args.t_end, dt=args.dt, progress=bar)
 
 
 def check_plant(args) -> int | None:
@@ -238,7 +232,7 @@ def check_plant(args) -> int | None:
                          f"--compare-plant sbc, found --plant-bars {args.plant_bars} with "
                          f"{' and '.join(plants)}")
     if not fe:
-        if FEPlantOptions.of(args).actuation() == "force":
+        if reference.FEPlantOptions.of(args).actuation() == "force":
             raise InputError("--plant-actuation force belongs to an FE plant (--plant or "
                              "--compare-plant mtc|sbc): the COM is the design model, whose tendon "
                              "forces k (|d(q)| - u) are what the force actuator reproduces on an FE "

@@ -18,17 +18,13 @@ from pathlib import Path
 
 import numpy as np
 
+from tmfem import reference, simulation
 from tmfem.cli import lpv_options
 from tmfem.cli.common import progress_bar
-from tmfem.control.lpv.deployment import output_feedback_controller, state_feedback_controller
-from tmfem.control.lpv.state_feedback import LPVStateFeedback
-from tmfem.control.lpv.workflow import saved_design_plant, verify_design
+from tmfem.control import lpv
 from tmfem.errors import InfeasibleController, InputError
-from tmfem.reference.deployment_plants import (FEPlantOptions, compare_plants, diverged,
-                                               run_on_plant)
-from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
+from tmfem.reference.deployments import LPV_DEPLOYMENTS
 from tmfem.reference.tables import deployment_bases
-from tmfem.simulation.controllers import MeasurementNoise
 from tmfem.system import load_preset
 
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
@@ -92,15 +88,15 @@ def design(args, preset: str):
     """(design plant, state-feedback design, JSON entries): loaded and checked on its grid
     (sampled at --dt), or synthesized and verified on the finer grid."""
     if args.lpv_controller is not None:
-        d = LPVStateFeedback.load(args.lpv_controller)
+        d = lpv.LPVStateFeedback.load(args.lpv_controller)
         s = load_preset(preset)
         n = int(np.prod([a.size for a in d.axes]))
         print(f"tmfem deploy: {preset}: rebuilding the design plant at its {n} grid points", file=sys.stderr)
         try:
-            plant = saved_design_plant(d, s, bases=deployment_bases(s), progress=lpv_options.progress)
+            plant = lpv.saved_design_plant(d, s, bases=deployment_bases(s), progress=lpv_options.progress)
         except InputError as exc:
             raise InputError(f"--lpv-controller {args.lpv_controller}: {exc}") from None
-        v = verify_design(d, plant, tracked=s.q_names, sample_time=args.dt)
+        v = lpv.verify_design(d, plant, tracked=s.q_names, sample_time=args.dt)
         return plant, d, {"lpv_controller": args.lpv_controller, "gamma": d.gamma,
                           **{f"design_grid_{k}": x for k, x in v.to_dict().items()}}
     cfg = lpv_options.check_synthesis(args, solver=args.solver or "EIGOPT", preset=preset)
@@ -115,7 +111,8 @@ def design(args, preset: str):
 #: --controller name -> design(args, preset) -> (design plant, design with ``gamma``, JSON entries)
 DESIGNS = {"lpv": design, "lpv-output": design}
 #: --controller name -> builder(deployment, design) of a controller on the LPV signals y_lpv
-BUILDERS = {"lpv": state_feedback_controller, "lpv-output": output_feedback_controller}
+#: (a function of :mod:`tmfem.control.lpv`)
+BUILDERS = {"lpv": "state_feedback_controller", "lpv-output": "output_feedback_controller"}
 
 
 def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
@@ -123,13 +120,14 @@ def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
     ``--controller`` builder, with ``--noise`` its seeded measurement noise) on the plant
     ``kind``: an FE plant starts in its own equilibrium of the packaged configuration under
     the rest lengths the controller starts with (docs/fe-plant.md)."""
-    c = BUILDERS[args.controller](dep, d, **estimator_options)
+    c = getattr(lpv, BUILDERS[args.controller])(dep, d, **estimator_options)
     if args.noise:
-        c = MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
+        c = simulation.MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
     s = dep.setup(c)
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller}) on {kind}") as bar:
-        r = run_on_plant(s, kind=kind, options=FEPlantOptions.of(args), initial=dep.packaged(),
-                         mesh_n=mesh_n, t_end=args.t_end, dt=args.dt, progress=bar)
+        r = reference.run_on_plant(s, kind=kind, options=reference.FEPlantOptions.of(args),
+                                   initial=dep.packaged(), mesh_n=mesh_n, t_end=args.t_end, dt=args.dt,
+                                   progress=bar)
     if not np.all(np.isfinite(r.z)):
         raise InfeasibleController(f"the LPV deployment of {args.preset} on the {kind} plant diverged "
                                    "(non-finite states)")
@@ -153,7 +151,7 @@ def run(args, *, mesh_n) -> dict:
         raise InputError(f"--noise: expected a standard deviation >= 0, found {args.noise}")
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
-    dep = lpv_setup(args.preset, plant)
+    dep = reference.lpv_setup(args.preset, plant)
     est = {}          # the output feedback's estimator options (check: lpv-output only)
     if args.estimator_interpolation:
         est["interpolation"] = args.estimator_interpolation
@@ -169,11 +167,11 @@ def run(args, *, mesh_n) -> dict:
             "estimator_interpolation": (args.estimator_interpolation or "multilinear")
             if args.controller == "lpv-output" else None,
             "estimator_refine": (args.estimator_refine or 1) if args.controller == "lpv-output" else None}
-    plants = FEPlantOptions.of(args)
+    plants = reference.FEPlantOptions.of(args)
     out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
            **ctrl, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(), **s.info,
            **_figures(r), **info}
-    out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
+    out.update(reference.write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
                              vtk=args.vtk, title=f"{args.preset} deployment on the {args.plant} plant: {args.controller} "
                                                  f"(gamma = {d.gamma:.4g}), eq. 5.100"))
     if args.compare_plant:
@@ -181,11 +179,11 @@ def run(args, *, mesh_n) -> dict:
             _, r2 = _run_on(args, dep, d, kind, mesh_n, est)
             return r2, _figures(r2)
         src = args.lpv_controller or "synthesised here"
-        out["compare"] = compare_plants(
+        out["compare"] = reference.compare_plants(
             r, rerun, options=plants, preset=args.preset, csv=args.compare_csv, plot=args.compare_plot,
             mesh_n=mesh_n, controller=ctrl,
             about=f"gamma = {d.gamma:.4g}, {src}" + (f", noise {args.noise:g}" if args.noise else ""),
             reference="eq. 5.100")
     out["total_wall_time_s"] = time.perf_counter() - t0
-    out["failed_checks"] = diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+    out["failed_checks"] = reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out

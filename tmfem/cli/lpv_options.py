@@ -1,6 +1,8 @@
 """The LPV options shared by ``tmfem control lpv`` and ``tmfem deploy --controller lpv``:
 the synthesis options, their checks, and the calls of the library's LPV workflow
-(:mod:`tmfem.control.lpv.workflow`) with the CLI's progress bars."""
+(:mod:`tmfem.control.lpv.workflow`) with the CLI's progress bars. The library is reached
+through the lazy attributes of its packages (``lpv.design_plant``), so that the command line
+starts without loading the models."""
 from __future__ import annotations
 
 import sys
@@ -9,9 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.cli.common import progress_bar
-from tmfem.control.lpv import workflow
-from tmfem.control.lpv.state_feedback import LPVStateFeedback
-from tmfem.control.lpv.workflow import GAMMA_RTOL, TIME_BUDGET
+from tmfem.control import lpv
+from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
 from tmfem.errors import InputError, ResourceLimit
 from tmfem.reference.tables import deployment_bases
 from tmfem.system import load_preset
@@ -82,7 +83,7 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
         if not Path(eig["start"]).is_file():
             raise InputError(f"--start: expected a design saved by `tmfem control lpv --save`, found no file "
                              f"{eig['start']!r}")
-        start = LPVStateFeedback.load(eig["start"])
+        start = lpv.LPVStateFeedback.load(eig["start"])
     rtol = GAMMA_RTOL if eig["gamma_rtol"] is None else eig["gamma_rtol"]
     budget = TIME_BUDGET if eig["time_budget"] is None else eig["time_budget"]
     if not (0 < rtol < 1):
@@ -116,7 +117,7 @@ def design_plant(cfg: dict, *, rate_deg: float):
     returns (plant, gp, bound, JSON dict)."""
     s, th, ps = cfg["system"], cfg["theta"], cfg["psi"]
     print(f"tmfem: {cfg['preset']}: linearising at {th.size * ps.size} grid points", file=sys.stderr)
-    p = workflow.design_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bound=np.radians(rate_deg),
+    p = lpv.design_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bound=np.radians(rate_deg),
                               progress=progress)
     out = {"preset": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,
            **p.bound.to_dict(), "printed_gamma_bound": 4.18}
@@ -126,7 +127,7 @@ def design_plant(cfg: dict, *, rate_deg: float):
 def synthesize(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
     """The controller of the settings ``cfg`` (:func:`tmfem.control.lpv.workflow.synthesize_design`)
     and its JSON entries."""
-    return workflow.synthesize_design(gp, bound=bound, solver=cfg["solver"], gamma=cfg["gamma"],
+    return lpv.synthesize_design(gp, bound=bound, solver=cfg["solver"], gamma=cfg["gamma"],
                                       fixed_gamma=cfg["fixed"], rtol=cfg["rtol"], time_budget=cfg["budget"],
                                       start=cfg["start"], max_iter=max_iter, sample_time=sample_time,
                                       progress=progress)
@@ -135,7 +136,7 @@ def synthesize(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
 def refined_plant(s, plant, factor: int, *, what: str):
     """The plant of system ``s`` on the grid ``factor`` times finer than ``plant``'s
     (:func:`tmfem.control.lpv.workflow.refined_plant`)."""
-    return workflow.refined_plant(s, plant, factor=factor, bases=deployment_bases(s), what=what,
+    return lpv.refined_plant(s, plant, factor=factor, bases=deployment_bases(s), what=what,
                                   progress=progress)
 
 
@@ -143,4 +144,4 @@ def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
     """:func:`tmfem.control.lpv.workflow.verify_design` on the grid ``refine`` times finer
     (or ``fine`` when given); refuses a controller that fails there."""
     fine = refined_plant(cfg["system"], plant, cfg["refine"], what="verification plant") if fine is None else fine
-    return workflow.verify_design(ctrl, fine, tracked=cfg["system"].q_names, sample_time=sample_time)
+    return lpv.verify_design(ctrl, fine, tracked=cfg["system"].q_names, sample_time=sample_time)

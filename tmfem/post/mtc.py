@@ -8,6 +8,7 @@ from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 from tmfem.io.paths import check_path
 from tmfem.models.mtc.topology import to_floating
 from tmfem.post.plots import new_figure, save_figure
+from tmfem.fem.tension_field import STATE_NAMES, WRINKLED
 
 
 def membrane_field(model, x: np.ndarray):
@@ -78,7 +79,6 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    from tmfem.fem.tension_field import STATE_NAMES, WRINKLED
     png = check_path(png, suffixes=(".png",))
     topo = model.topology
     xm = x[:, :topo.n_mesh]

@@ -77,6 +77,25 @@ class FEPlantOptions:
                            f"({law}): the run on the {p} plant has this model error too")
         return out
 
+    def fe_in_run(self) -> bool:
+        """An FE plant among the plants of the run and of its comparison run."""
+        return self.plant != "com" or self.compare_plant not in (None, "com")
+
+    def pfl_evaluation(self, given: str | None = None) -> str:
+        """Where the adaptive PFL evaluates its model terms: ``given``, else at the reference
+        q_d, q_d' with an FE plant in the run (the law at the state diverges there,
+        docs/fe-plant.md) and at the measured state (eq. 5.58) without."""
+        return given or ("reference" if self.fe_in_run() else "state")
+
+    def pfl_tendon_model(self, uncertainty: str) -> str:
+        """The adaptive PFL's tendon model under the controller's model error ``uncertainty``:
+        one controller drives both plants of a comparison, so with an FE plant among them the
+        FE plant's tendon law (:meth:`fe_tendon_model`), except under eq. 5.72
+        (``"initial"``), whose F_q is frozen with the fixed rates of eq. 5.19."""
+        if self.fe_in_run() and uncertainty != "initial":
+            return self.fe_tendon_model()
+        return "fixed-rate"
+
     def damping_tangent(self) -> str:
         """The FE plant's damping tangent: ``plant_damping_tangent``, default
         :data:`tmfem.control.fe_plant.state_estimate.DEPLOYMENT_DAMPING_TANGENT`."""

@@ -26,6 +26,7 @@ Vectors are replicated (O(n) per rank), matrices and factorisations distributed.
 from __future__ import annotations
 
 import logging
+import time
 
 import numpy as np
 import scipy.sparse as sp
@@ -110,7 +111,6 @@ def mpi_main(main, *, report, comm=None, grace: float = 5.0) -> int:
     code: a non-zero exit, never a hang. An unexpected exception (not a
     :class:`TmfemError`) is logged with its traceback.
     """
-    import time
     comm = comm_world() if comm is None else comm
     text, failure = None, None
     try:

@@ -43,11 +43,15 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg as la
 import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError, ResourceLimit
+from tmfem.solvers.block_krylov import block_krylov_schur, start_block
+from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather
 from tmfem.solvers.petsc_loader import petsc_modules
-from tmfem.solvers.petsc_redundant import RedundantDoesNotFit
+from tmfem.solvers.petsc_redundant import (RedundantDoesNotFit, default_budget_mb,
+                                           redundant_shift_invert)
 from tmfem.solvers.singular import SingularMatrix
 
 log = logging.getLogger(__name__)
@@ -238,7 +242,6 @@ class PetscBackend:
         """(PETSc Mat, key) of A: a DistributedMatrix's Mat, or this rank's rows of a
         replicated scipy matrix. With ``cache`` a new A of an earlier pattern only updates
         that Mat's values, so that MUMPS keeps its symbolic analysis."""
-        from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix
         if isinstance(A, (DistributedMatrix, ShiftedMatrix)):
             return self._dist_mat(A, cache=cache)
         if not sp.issparse(A):
@@ -276,7 +279,6 @@ class PetscBackend:
         and one MUMPS analysis per pattern, whichever assembled matrix of the pattern or
         shift of it comes; a later update of A leaves the factors of this one intact), the
         shift added to its diagonal."""
-        from tmfem.solvers.distributed import ShiftedMatrix
         base = A.base if isinstance(A, ShiftedMatrix) else A
         if not cache and base is A:
             return A.mat, None
@@ -527,7 +529,6 @@ class PetscBackend:
 
     def gather(self, vec) -> np.ndarray:
         """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
-        from tmfem.solvers.distributed import gather
         return gather(vec)
 
     # ------------------------------------------------------------------ eigenproblems
@@ -537,7 +538,6 @@ class PetscBackend:
         :mod:`tmfem.solvers.block_krylov` for symmetric K, M of at least
         :data:`EIG_BLOCK_MIN_N` unknowns (``eig_solver`` "block" or "auto"), else SLEPc's
         Krylov-Schur; V (n, k) M-orthonormal."""
-        import scipy.linalg as la
         self._reap()
         Kp, _ = self._mat(K, cache=False)
         Mp, _ = self._mat(M, cache=False)
@@ -587,7 +587,6 @@ class PetscBackend:
         PETSc's PCSetUp redoes the symbolic factorisation only when the nonzero pattern
         changes). Not with ``st_`` options (they configure the eigen solve's own KSP), an
         iterative solver or a matrix of another kind. Collective (the subset check)."""
-        from tmfem.solvers.distributed import DistributedMatrix
         if not (self.solver == "direct" and type(K) is DistributedMatrix
                 and type(M) is DistributedMatrix):
             return None
@@ -655,8 +654,6 @@ class PetscBackend:
         sequential ones (:mod:`tmfem.solvers.petsc_redundant`) with EIG_BLOCK_REDUNDANT
         right-hand sides per solve, split by columns over the ranks; :class:`RedundantDoesNotFit` when they
         exceed the memory budget (nothing left allocated)."""
-        from tmfem.solvers.block_krylov import block_krylov_schur, start_block
-        from tmfem.solvers.petsc_redundant import default_budget_mb, redundant_shift_invert
         PETSc = self.PETSc
         n = Kp.getSize()[0]
         comm = self.comm.tompi4py()

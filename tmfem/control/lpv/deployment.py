@@ -29,8 +29,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.control.deployment.limits import tendon_lengths
+from tmfem.control.deployment.reference_trajectory import DeploymentReference
+from tmfem.control.deployment.run import DeploymentSetup
+from tmfem.control.lpv.controller import LPVController
 from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
+from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.errors import InputError
+from tmfem.models.com.coordinates import point_coordinates
+from tmfem.models.com.model import ControlOrientedModel
 from tmfem.system.geometry import wrap_angle
 
 class Measured:
@@ -104,7 +110,6 @@ class LPVDeployment:
         """The :class:`tmfem.control.deployment.run.DeploymentSetup` of ``controller`` (any object with
         the reset/output/update/name protocol on y_lpv) for :func:`~tmfem.control.deployment.run.
         run_deployment` and :func:`tmfem.reference.deployments.write_outputs`."""
-        from tmfem.control.deployment.run import DeploymentSetup
         return DeploymentSetup(model=self.model, reference=self.reference, adaptive=None,
                                controller=Measured(controller, self.measure), linear=None, z0=self.z0,
                                z_e=self.z_e, info=dict(self.info))
@@ -123,10 +128,6 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
     InputError
         The reference leaves the design grid, or the plant has no membrane points.
     """
-    from tmfem.control.deployment.reference_trajectory import DeploymentReference
-    from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
-    from tmfem.models.com.coordinates import point_coordinates
-    from tmfem.models.com.model import ControlOrientedModel
     for nm, v in (("theta_13", (theta_0, theta_e)), ("psi_13", (psi_0, psi_0))):
         a = plant.axes[plant.parameter_names.index(nm)]
         if min(v) < a[0] - 1e-9 or max(v) > a[-1] + 1e-9:
@@ -164,7 +165,6 @@ def state_feedback_controller(dep: LPVDeployment, design):
     InputError
         ``design`` is not over the states of the deployment's design plant.
     """
-    from tmfem.control.lpv.controller import LPVController
     pl = dep.plant
     nq = dep.model.nq
     want = list(pl.state_names) + [f"int_e_{n}" for n in dep.model.system.q_names]

@@ -26,6 +26,7 @@ import numpy as np
 from tmfem.control.lpv.bisect import bisect_gamma
 from tmfem.control.lpv.bounds import PointwiseBound, pointwise_state_feedback_bound
 from tmfem.control.lpv.certificate import rate_bounded_certificate, refine_certificate
+from tmfem.control.lpv.defaults import CERTIFICATE_PER_ROUND, GAMMA_RTOL, TIME_BUDGET, W_E, W_U
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, interconnection_8_1
 from tmfem.control.lpv.output_feedback import (LPVOutputFeedback, design_output_feedback,
                                                verify_output_feedback)
@@ -34,13 +35,6 @@ from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.control.lpv.verify import Verification, verify
 from tmfem.errors import InfeasibleController, InputError
-
-#: EIGOPT defaults: relative bracket width of the gamma bisection, its time budget [s]
-GAMMA_RTOL, TIME_BUDGET = 0.05, 300.0
-#: cutting-plane rounds of the rate-bounded certificate on the finer grid, points added per round
-CERTIFICATE_ROUNDS, CERTIFICATE_PER_ROUND = 8, 4
-#: the weights of the interconnection of Figure 8.1 (8.3): W_e = 0.5 I, W_u = 0.05 I
-W_E, W_U = 0.5, 0.05
 
 
 @contextmanager
