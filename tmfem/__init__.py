@@ -30,6 +30,7 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "get_backend": "tmfem.solvers.backends",
     "PetscBackend": "tmfem.solvers.petsc",
     "hinf_lmi": "tmfem.control.linear.hinf_lmi",
+    "hinf_riccati": "tmfem.control.linear.hinf_lmi",
     "hinf_central": "tmfem.control.linear.hinf_central",
     "deployed_hinf": "tmfem.control.linear.deployed_design",
     "synthesize_state_feedback": "tmfem.control.lpv.synthesis",

@@ -7,10 +7,11 @@ imported from its module on first access and then cached in the package. So
 ``from tmfem.control.lpv import synthesize_state_feedback`` still work, and the import graph
 has no edges from a package to its modules (no cycles through ``__init__`` files).
 
-Heavy optional third-party dependencies (petsc4py and slepc4py through
-:func:`tmfem.solvers.petsc_loader.petsc_modules`, cvxpy, pyvista, matplotlib, gmsh, mpi4py)
-are imported inside the function that needs them; tmfem's own modules import each other
-at module level (docs/architecture.md, "Imports").
+Heavy third-party libraries (petsc4py and slepc4py through
+:func:`tmfem.solvers.petsc_loader.petsc_modules`, cvxpy, python-control, pyvista,
+matplotlib, gmsh, scikit-fem, meshio, mpi4py) are imported inside the function that needs
+them; tmfem's own modules import each other at module level (docs/architecture.md,
+"Imports").
 """
 from __future__ import annotations
 

@@ -54,11 +54,31 @@ class DesignPlant:
 
 
 def design_plant(system, *, theta, psi, bases, rate_bound: float, progress=no_progress) -> DesignPlant:
-    """The plant of ``system`` linearised at every point of the grid ``theta`` x ``psi`` [rad]
-    (stage bases ``bases(theta, psi)``, e.g. :func:`tmfem.reference.tables.deployment_bases`),
-    with rates |d rho/dt| <= ``rate_bound`` [rad/s], its interconnection of Figure 8.1 tracking
-    the system's q and the pointwise state-feedback lower bound of gamma
-    (:func:`~tmfem.control.lpv.bounds.pointwise_state_feedback_bound`)."""
+    """The gridded design plant of ``system`` and its interconnection of Figure 8.1.
+
+    The COM is linearised at the symmetric equilibria of eq. 5.97 at every grid point
+    (:func:`~tmfem.control.lpv.plant.com_lpv_plant`); the interconnection (eq. 5.98) tracks
+    the system's q; the pointwise state-feedback optimum of every frozen plant gives the lower
+    bound of gamma (:func:`~tmfem.control.lpv.bounds.pointwise_state_feedback_bound`).
+
+    Parameters
+    ----------
+    system : System
+        A symmetric 2-stage system (rho = theta_13, psi_13).
+    theta, psi : array_like
+        The grid axes [rad].
+    bases : callable
+        ``bases(theta, psi) -> {"r", "z", "sigma"}`` of the stage bases along the grid, e.g.
+        :func:`tmfem.reference.tables.deployment_bases`.
+    rate_bound : float
+        |d rho_k / dt| <= ``rate_bound`` [rad/s] for both parameters.
+    progress : callable, optional
+        The progress factory (module docstring).
+
+    Returns
+    -------
+    DesignPlant
+    """
     theta, psi = np.atleast_1d(theta), np.atleast_1d(psi)
     with progress(theta.size * psi.size, "LPV plant (grid points)") as bar:
         plant = com_lpv_plant(system, theta=theta, psi=psi, bases=bases,
@@ -70,9 +90,27 @@ def design_plant(system, *, theta, psi, bases, rate_bound: float, progress=no_pr
 
 def refined_plant(system, plant: GriddedLPV, *, factor: int, bases, what: str = "verification plant",
                   progress=no_progress) -> GriddedLPV:
-    """The plant of ``system`` on the grid ``factor`` times finer than ``plant``'s (new COM
-    linearisations, the design's membrane points and rate bounds); ``what`` names it in the
-    progress label."""
+    """The plant of ``system`` on the grid ``factor`` times finer than ``plant``'s.
+
+    New COM linearisations at the refined axes (:meth:`GriddedLPV.refined`) with the design's
+    membrane points and rate bounds: the true plant between the design points, where a design
+    is verified (8.3) or the estimator of the output feedback is built.
+
+    Parameters
+    ----------
+    system : System
+        The system of ``plant``.
+    plant : GriddedLPV
+        The design plant.
+    factor : int
+        Refinement of each axis (4: three new points between two design points).
+    bases : callable
+        The stage bases of ``plant`` (:func:`design_plant`).
+    what : str
+        The plant's name in the progress label.
+    progress : callable, optional
+        The progress factory (module docstring).
+    """
     axes = plant.refined(factor)
     with progress(axes[0].size * axes[1].size, f"{what} (grid points)") as bar:
         return com_lpv_plant(system, theta=axes[0], psi=axes[1], bases=bases,
@@ -87,12 +125,31 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
                       progress=no_progress) -> tuple[LPVStateFeedback, dict]:
     """The state feedback of eqs. 5.95-5.99 on ``generalized`` and its JSON entries.
 
-    ``solver`` "EIGOPT" without ``fixed_gamma``: the gamma bisection
-    (:func:`~tmfem.control.lpv.bisect.bisect_gamma`) between the pointwise lower bound and
-    ``gamma`` (default 2 x the bound) to relative width ``rtol`` within ``time_budget`` s,
-    from ``start`` when given; with ``fixed_gamma`` one feasible point at ``gamma``; "CLARABEL"
-    or "SCS": their minimisation of gamma (:func:`~tmfem.control.lpv.synthesis.synthesize_state_feedback`).
-    ``sample_time``: also the frozen loops sampled at this step stable (EIGOPT).
+    Parameters
+    ----------
+    generalized : GeneralizedLPV
+        The interconnection of Figure 8.1 (:func:`design_plant`).
+    bound : PointwiseBound
+        Its pointwise lower bound of gamma (:func:`design_plant`).
+    solver : {"EIGOPT", "CLARABEL", "SCS"}
+        "EIGOPT" without ``fixed_gamma``: the gamma bisection
+        (:func:`~tmfem.control.lpv.bisect.bisect_gamma`) between the bound and ``gamma``
+        (default 2 x the bound) to relative width ``rtol`` within ``time_budget`` s, from
+        ``start`` when given; with ``fixed_gamma`` one feasible point at ``gamma``.
+        "CLARABEL" or "SCS": their minimisation of gamma
+        (:func:`~tmfem.control.lpv.synthesis.synthesize_state_feedback`).
+    max_iter : int, optional
+        Iteration limit of each EIGOPT level or of the conic solver.
+    sample_time : float, optional
+        EIGOPT: also the frozen loops sampled at this zero-order-hold step stable.
+    progress : callable, optional
+        The progress factory (module docstring).
+
+    Returns
+    -------
+    (LPVStateFeedback, dict)
+        The design and its JSON entries (gamma, solver, status, sizes, times; the bisection's
+        levels and bracket).
 
     Raises
     ------
@@ -128,9 +185,18 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
 
 def verify_design(design: LPVStateFeedback, plant: GriddedLPV, *, tracked,
                   sample_time: float | None = None) -> Verification:
-    """:func:`tmfem.control.lpv.verify.verify` of ``design`` on the interconnection of
-    ``plant`` (e.g. a grid 4 x finer than the design's, :func:`refined_plant`) tracking
-    ``tracked``; refuses a controller that fails there."""
+    """The check of ``design`` between its grid points (8.3).
+
+    :func:`tmfem.control.lpv.verify.verify` on the interconnection of ``plant`` (e.g. a grid 4 x
+    finer than the design's, :func:`refined_plant`) tracking ``tracked``: the LMI of eq. 5.95 at
+    every point and rate vertex, the frozen closed loops, and with ``sample_time`` the loops
+    sampled with a zero-order hold at that step.
+
+    Raises
+    ------
+    InfeasibleController
+        Where the LMI does not hold or a frozen loop is unstable.
+    """
     return verify(design, interconnection_8_1(plant, tracked=tracked), sample_time=sample_time)
 
 
@@ -197,7 +263,8 @@ def output_feedback_design(design: LPVStateFeedback, plant: GriddedLPV, fine: Gr
 
 def saved_design_plant(design: LPVStateFeedback, system, *, bases, progress=no_progress) -> GriddedLPV:
     """The design plant of a saved ``design`` (:meth:`LPVStateFeedback.load`) rebuilt on its
-    grid (its rate bounds, the system's COM linearisations).
+    grid (its rate bounds, the COM linearisations of ``system`` with the stage bases
+    ``bases``), so that the design can be checked and deployed there.
 
     Raises
     ------
