@@ -114,7 +114,8 @@ def run(args) -> dict:
         saved, extra = lpv.output_feedback_design(
             ctrl, plant, fine, tracked=cfg["system"].q_names, noise=noise, sample_time=args.sample_time,
             certificate=(cfg["rtol"], cfg["budget"], rounds) if args.rate_certificate else None,
-            interpolation=args.estimator_interpolation or "multilinear", estimator_plant=est, progress=lpv_options.progress)
+            interpolation=args.estimator_interpolation or "multilinear", estimator_plant=est,
+            progress=lpv_options.progress)
         out = {**out, **extra}
     if args.save:
         saved.save(args.save)

@@ -19,6 +19,4 @@ See docs/control.md.
 """
 from tmfem._lazy import lazy_exports
 
-__getattr__, __dir__, __all__ = lazy_exports(__name__, {
-
-}, subpackages=('deployment', 'fe_plant', 'linear', 'lpv'))
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {}, subpackages=("deployment", "fe_plant", "linear", "lpv"))

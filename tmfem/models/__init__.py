@@ -15,4 +15,4 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "ControlOrientedModel": "tmfem.models.com.model",
     "Linearization": "tmfem.models.com.linearize",
     "linearize": "tmfem.models.com.linearize"
-}, subpackages=('com', 'mtc', 'sbc'))
+}, subpackages=("com", "mtc", "sbc"))

@@ -175,7 +175,8 @@ def test_force_actuation_sets_the_pfl_tendon_model_and_the_json():
     a = parse(["deploy", "--preset", "2-3-deploy", "--plant", "mtc", "--plant-actuation", "force",
                "--compare-plant", "com"])
     assert FEPlantOptions.of(a).fe_tendon_model() == "fixed-rate"
-    assert FEPlantOptions.of(a).controlled_tendon_law("mtc") == FEPlantOptions.of(a).controlled_tendon_law("com") == "fixed-rate"
+    o = FEPlantOptions.of(a)
+    assert o.controlled_tendon_law("mtc") == o.controlled_tendon_law("com") == "fixed-rate"
     assert FEPlantOptions.of(a).summary("mtc", 2)["plant_actuation"] == "force"
     b = parse(["deploy", "--preset", "2-3-deploy", "--plant", "mtc"])
     assert FEPlantOptions.of(b).fe_tendon_model() == "cable"
