@@ -37,13 +37,13 @@ def configure(parser) -> None:
                         help="hinf: how the eliminated LMIs are solved: ARE (default; their Riccati "
                              "characterisation, bisection on gamma, LMIs re-checked), or the SDP "
                              "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
-                             "docs/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (eigenvalue "
-                             "optimisation: bisection on gamma, or one level with --fixed-gamma; docs/lpv.md)")
+                             "docs/guides/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (eigenvalue "
+                             "optimisation: bisection on gamma, or one level with --fixed-gamma; docs/guides/lpv.md)")
     parser.add_argument("--method", choices=("lmi", "riccati", "central"), default=None,
                         help="lmi (default): eliminated LMIs of eq. 5.65; riccati: python-control "
                              "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant; central: the "
                              "central (minimum-entropy) controller at 1.01 gamma_opt, solver-"
-                             "independent, the one `tmfem deploy` uses (docs/control.md)")
+                             "independent, the one `tmfem deploy` uses (docs/guides/control.md)")
     parser.add_argument("--pbh-tol", type=float, default=None,
                         help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
     parser.add_argument("--save", help="write plant and controller to this .npz")
@@ -53,7 +53,7 @@ def configure(parser) -> None:
 
 #: Largest plant of `hinf`/`pbh`: 2 (n_q + K) states. 1-4(D) with K = 3 (22 states) takes
 #: seconds; the COM is built symbolically (K = 40: ~25 s) and the LMIs grow with the square
-#: of the states (the 50-state 2-3 LMI already fails in Clarabel, docs/control.md).
+#: of the states (the 50-state 2-3 LMI already fails in Clarabel, docs/guides/control.md).
 MAX_STATES = 60
 
 
@@ -70,7 +70,7 @@ def check_control_modes(system, K) -> None:
         raise ResourceLimit(f"--membrane-modes {K}: the plant of {system.name} has 2 (n_q + K) = "
                             f"{2 * (nq + K)} states; the limit is {MAX_STATES} (K <= "
                             f"{MAX_STATES // 2 - nq}): the symbolic model grows fast with K and "
-                            "the LMIs with the square of the states (docs/control.md)")
+                            "the LMIs with the square of the states (docs/guides/control.md)")
 
 
 def run(args) -> dict:

@@ -23,13 +23,13 @@ def configure(parser) -> None:
     parser.add_argument("--max-iter", type=int, default=None, help="lpv: SDP solver iteration limit")
     parser.add_argument("--sample-time", type=float, default=None,
                         help="lpv: EIGOPT: also require the frozen loops sampled at this zero-order-hold "
-                             "step [s] to be stable (8.4 runs at 0.01 s; docs/lpv.md)")
+                             "step [s] to be stable (8.4 runs at 0.01 s; docs/guides/lpv.md)")
     parser.add_argument("--bound-only", action="store_true", default=None,
                         help="lpv: only the pointwise state-feedback lower bound of gamma (no SDP)")
     parser.add_argument("--output-feedback", action="store_true", default=None,
                         help="lpv: observer-based output feedback on the measured q and membrane points "
                              "(K(rho) with a gridded Kalman estimator; frozen-parameter verification on the "
-                             "finer grid, sampled at --sample-time when given; docs/lpv.md)")
+                             "finer grid, sampled at --sample-time when given; docs/guides/lpv.md)")
     parser.add_argument("--rate-certificate", action="store_true", default=None,
                         help="lpv --output-feedback: also the rate-bounded certificate of the output-feedback "
                              "loop (analysis LMI with X(rho) affine, EIGOPT bisection on gamma with the "
@@ -39,18 +39,18 @@ def configure(parser) -> None:
                         help="lpv --rate-certificate: at most this many cutting-plane rounds when the design-grid "
                              "certificate fails on the finer grid (each imposes the 4 worst failing points of "
                              "that grid and re-solves at the same gamma, within another --time-budget; default "
-                             f"{CERTIFICATE_ROUNDS}, 0: none; docs/lpv.md)")
+                             f"{CERTIFICATE_ROUNDS}, 0: none; docs/guides/lpv.md)")
     parser.add_argument("--estimator-interpolation", choices=("multilinear", "spline"), default=None,
                         help="lpv --output-feedback: how the Kalman estimator's model and gains are "
                              "evaluated between grid points: multilinear (default) or tensor-product "
                              "splines of degree min(3, points - 1) per parameter, 13-16 x closer to the "
-                             "2-3 plant between the 6 x 3 points (docs/lpv.md)")
+                             "2-3 plant between the 6 x 3 points (docs/guides/lpv.md)")
     parser.add_argument("--estimator-refine", type=int, default=None, metavar="R",
                         help="lpv --output-feedback: the Kalman estimator's model and gains on the design grid "
                              "refined R times (new COM linearisations; K(rho) and the certificate stay on the "
                              "design grid; default 1); with R > 1, --refine must be a multiple of R and >= 2 R. "
                              "With --estimator-interpolation spline and R = 2 the rate-bounded certificate of the "
-                             "2-3 loop holds on the 21 x 9 grid (docs/lpv.md)")
+                             "2-3 loop holds on the 21 x 9 grid (docs/guides/lpv.md)")
     parser.add_argument("--noise", type=float, default=None,
                         help="lpv --output-feedback: measurement-noise weight W_n of the estimator design "
                              "and of the verified norm [rad, m] (default 0.001)")

@@ -1,7 +1,7 @@
 """``tmfem deploy``: closed-loop deployment of a 1-N(D) or 2-3 system (dissertation 7.4).
 
 The 7.4 parameters of each deployment are :data:`tmfem.reference.deployments.DEPLOYMENTS`.
-Every option and output path is checked before the controller design (docs/cli.md).
+Every option and output path is checked before the controller design (docs/guides/cli.md).
 """
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def configure(parser) -> None:
                              "adaptive-hinf-riccati (python-control hinfsyn), adaptive-lqr (LQR "
                              "state feedback) or adaptive (no switch); LPV presets (8.4): lpv (default; "
                              "the scheduled state feedback of 8.3) or lpv-output (its observer-based output feedback on the "
-                             "measured q and membrane points, docs/lpv.md)")
+                             "measured q and membrane points, docs/guides/lpv.md)")
     parser.add_argument("--uncertainty", choices=list(UNCERTAINTIES),
                         help="controller model error (default: the 7.4 choice of the preset)")
     parser.add_argument("--path", choices=["delta", "table-7-7-bases", "linear"],
@@ -62,7 +62,7 @@ def configure(parser) -> None:
                              "the beam nodes in the kinetic-energy norm: the bending modes do not "
                              "move them; default) or chord (the bar end nodes, which see the "
                              "beams' bending modes: the LPV loop diverges with them, "
-                             "docs/fe-plant.md)")
+                             "docs/guides/fe-plant.md)")
     parser.add_argument("--plant-damping", type=positive_float, metavar="BETA",
                         help="stiffness-proportional Rayleigh damping C = BETA K_0 [s] of the FE "
                              "plant (--plant or --compare-plant mtc|sbc; default none: the "
@@ -72,7 +72,7 @@ def configure(parser) -> None:
                              "(C_n = BETA K_T(x_n), the tangent at every sampled state, held over "
                              "the step: a bar's rigid rotation meets no axial damping; default) or "
                              "initial (C = BETA K_0, the tangent at the packaged equilibrium, which "
-                             "drags the deploying bars, docs/fe-plant.md)")
+                             "drags the deploying bars, docs/guides/fe-plant.md)")
     parser.add_argument("--plant-actuation", choices=["rest-length", "force"],
                         help="the FE plant's tendon actuators (--plant or --compare-plant "
                              "mtc|sbc): rest-length (the commanded rest lengths are set on the FE "
@@ -80,7 +80,7 @@ def configure(parser) -> None:
                              "(tension-servoed winches: the command becomes the COM's tendon force "
                              "k (|d(q)| - u) at the measured q, realised on the FE tendon at its "
                              "measured length and held over the sample; the PFL's tendon model is "
-                             "then the COM's fixed rates, docs/fe-plant.md)")
+                             "then the COM's fixed rates, docs/guides/fe-plant.md)")
     parser.add_argument("--compare-plant", choices=["com", "mtc", "sbc"],
                         help="run the same deployment on this plant too and compare (JSON "
                              "'compare': its figures and the deviation between the plants)")
@@ -93,7 +93,7 @@ def configure(parser) -> None:
                              "measured state, eq. 5.58; default without an FE plant) or reference (the "
                              "reference q_d, q_d' with the measured membrane coordinates: the "
                              "plant's own stiffness stays in the loop; default with an FE "
-                             "plant, where the law at the state diverges, docs/fe-plant.md); "
+                             "plant, where the law at the state diverges, docs/guides/fe-plant.md); "
                              "a --compare-plant run uses the same controller")
     parser.add_argument("--gains", type=pfl_gains, metavar="OMEGA_0,OMEGA_E,TAU,D_C",
                         help="the adaptive PFL's gains of eq. 5.69, omega(t) = omega_0 + omega_e "
@@ -101,7 +101,7 @@ def configure(parser) -> None:
                              "rad/s, s and - (default: the preset's Table 7.1 row; 1-4D "
                              "15,150,20,1.5). A crossover below the FE plant's unmodelled "
                              "dynamics, e.g. 10,0,20,1 with --uncertainty no-MG, deploys 1-4D on "
-                             "the SBC plant (docs/fe-plant.md)")
+                             "the SBC plant (docs/guides/fe-plant.md)")
     parser.add_argument("--t-end", type=positive_float, default=20.0, help="duration [s]")
     parser.add_argument("--dt", type=positive_float, default=0.01, help="sample time [s]")
     parser.add_argument("--csv", help="write every named signal (one column each, units in the header)")
@@ -168,7 +168,7 @@ def run(args) -> dict:
     for w in warnings:
         print(f"tmfem deploy: warning: {w}", file=sys.stderr)
     r = _run_on(args, s, args.plant, mesh_n)
-    # the controller's options, the same on both plants of a comparison (docs/fe-plant.md)
+    # the controller's options, the same on both plants of a comparison (docs/guides/fe-plant.md)
     ctrl = {"controller": args.controller, "uncertainty": s.adaptive.uncertainty,
             "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons,
             "pfl_gains": list(astuple(s.adaptive.gains))}
@@ -194,7 +194,7 @@ def run(args) -> dict:
                   f"{','.join(f'{g:g}' for g in astuple(s.adaptive.gains))}")
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
-    # to the failure are written, the exit code is 1 (docs/cli.md, docs/fe-plant.md)
+    # to the failure are written, the exit code is 1 (docs/guides/cli.md, docs/guides/fe-plant.md)
     out["failed_checks"] = reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out
 

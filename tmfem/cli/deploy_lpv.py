@@ -38,15 +38,15 @@ def configure(parser) -> None:
                         help="--controller lpv: a design saved by `tmfem control lpv --save` (else one "
                              "is synthesised with the options below)")
     parser.add_argument("--solver", choices=("EIGOPT", "CLARABEL", "SCS"), default=None,
-                        help="--controller lpv: synthesis solver (default EIGOPT, docs/lpv.md)")
+                        help="--controller lpv: synthesis solver (default EIGOPT, docs/guides/lpv.md)")
     lpv_options.configure_synthesis(parser, prefix="--controller lpv: ")
     parser.add_argument("--estimator-interpolation", choices=("multilinear", "spline"), default=None,
                         help="--controller lpv-output: how the Kalman estimator's model and gains are "
                              "evaluated between grid points (default multilinear; spline: tensor-product "
-                             "splines, docs/lpv.md)")
+                             "splines, docs/guides/lpv.md)")
     parser.add_argument("--estimator-refine", type=int, default=None, metavar="R",
                         help="--controller lpv-output: the Kalman estimator on the design grid refined R "
-                             "times (new COM linearisations; default 1; docs/lpv.md)")
+                             "times (new COM linearisations; default 1; docs/guides/lpv.md)")
     parser.add_argument("--noise", type=float, default=None, metavar="SIGMA",
                         help="LPV deployment: measurement noise, seeded Gaussian samples of this standard "
                              "deviation [rad, m; rad/s, m/s] per step on every signal the controller reads "
@@ -119,7 +119,7 @@ def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
     """(set-up, result) of the LPV deployment with a fresh controller of ``d`` (the
     ``--controller`` builder, with ``--noise`` its seeded measurement noise) on the plant
     ``kind``: an FE plant starts in its own equilibrium of the packaged configuration under
-    the rest lengths the controller starts with (docs/fe-plant.md)."""
+    the rest lengths the controller starts with (docs/guides/fe-plant.md)."""
     c = getattr(lpv, BUILDERS[args.controller])(dep, d, **estimator_options)
     if args.noise:
         c = simulation.MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)

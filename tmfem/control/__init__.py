@@ -15,7 +15,7 @@ Subpackages, one concept each:
   controller (state estimates, tension actuation, sampled loops, plant comparison).
 
 May import system, models, simulation, solvers, errors; imported only by cli and reference.
-See docs/control.md.
+See docs/guides/control.md.
 """
 from tmfem._lazy import lazy_exports
 

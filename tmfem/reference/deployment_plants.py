@@ -6,7 +6,7 @@ COM itself or an FE plant (the MTC or SBC model read through the COM-state estim
 holds the plants of a run and of its comparison run with the FE plant's options (tendon
 law, bar measurement, damping, actuators); :func:`run_on_plant` runs a deployment set-up on
 one plant and :func:`compare_plants` the same deployment on the second plant with its
-deviation (docs/fe-plant.md). ``tmfem deploy`` calls them with the options it parses.
+deviation (docs/guides/fe-plant.md). ``tmfem deploy`` calls them with the options it parses.
 """
 from __future__ import annotations
 
@@ -67,7 +67,7 @@ class FEPlantOptions:
 
     def tendon_model_warnings(self, tendons: str) -> list:
         """Where the adaptive PFL's tendon model ``tendons`` is not the tendon law of a plant it
-        drives (the same controller on both plants of a comparison, docs/fe-plant.md): one line
+        drives (the same controller on both plants of a comparison, docs/guides/fe-plant.md): one line
         each."""
         out = []
         for p in [self.plant] + ([self.compare_plant] if self.compare_plant else []):
@@ -84,7 +84,7 @@ class FEPlantOptions:
     def pfl_evaluation(self, given: str | None = None) -> str:
         """Where the adaptive PFL evaluates its model terms: ``given``, else at the reference
         q_d, q_d' with an FE plant in the run (the law at the state diverges there,
-        docs/fe-plant.md) and at the measured state (eq. 5.58) without."""
+        docs/guides/fe-plant.md) and at the measured state (eq. 5.58) without."""
         return given or ("reference" if self.fe_in_run() else "state")
 
     def pfl_tendon_model(self, uncertainty: str) -> str:
@@ -103,7 +103,7 @@ class FEPlantOptions:
 
     def bars(self) -> str:
         """The SBC plant's bar measurement: ``plant_bars``, default the rigid fit (the chords see
-        the beams' bending modes, docs/fe-plant.md)."""
+        the beams' bending modes, docs/guides/fe-plant.md)."""
         return self.plant_bars or "rigid"
 
     def summary(self, plant: str, mesh_n) -> dict:

@@ -65,7 +65,7 @@ def factorize(A, backend, *, equilibrate: bool = False):
     x = D (D A D)^-1 D b, the same solution with the backward error of the pivots measured on
     the scaled matrix. For tangents whose dofs differ in stiffness by orders of magnitude (the
     rotations of a thin shell carry ~h^2 times the stiffness of its translations,
-    docs/shells.md "Thin shells") this keeps the Newton increment accurate."""
+    docs/guides/shells.md "Thin shells") this keeps the Newton increment accurate."""
     if equilibrate:
         d = jacobi_scaling(A)
         if sp.issparse(A):

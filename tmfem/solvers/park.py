@@ -146,7 +146,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         decreases. The Newton direction is a descent direction of ||r||^2, so this only
         shortens corrections that overshoot: a system whose Newton matrix has
         near-singular, strongly nonlinear directions (the thin shell's rotations in the SBC
-        model, docs/sbc.md "Free vibration on the fine mesh"). Convergence is still judged on
+        model, docs/guides/sbc.md "Free vibration on the fine mesh"). Convergence is still judged on
         the full correction |dx|; a kept (modified-Newton) matrix whose direction does not
         decrease the residual is replaced by a fresh one.
     predictor : {"acceleration", "velocity"}
@@ -155,7 +155,7 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
         inertia (the SBC shell's nodal rotations, rotary inertia rho h^3 / 12): the
         acceleration re-solved after an input step is the residual moment divided by that
         inertia, and extrapolating it puts the predictor at rotations of radians, from where
-        Newton diverges (docs/fe-plant.md).
+        Newton diverges (docs/guides/fe-plant.md).
 
     Returns
     -------

@@ -61,11 +61,11 @@ log = logging.getLogger(__name__)
 #: factors of P > 1 ranks (4: 80-84 columns for 12 modes against 120-136 with 8, 53 single
 #: solves in SLEPc; at 309k DOF on 1 rank 9.7-12.7 s against 12.8-14.8 s with 8, on 2 ranks
 #: 8.1-10.7 s against SLEPc's 9.5-12.7 s; equal within the drift at 20k-78k DOF;
-#: docs/backends.md, "The block eigen solver with 4 right-hand sides")
+#: docs/validation/benchmarks.md, "Eigen solvers")
 EIG_BLOCK = 4
 #: right-hand sides per block of the redundant eigensolver, split by columns over the ranks
 #: (8: 4 per rank on 2 ranks, 2.6-3.1 s of CPU at 78k DOF against 3.2-3.7 s with 8 per
-#: rank and 3.7-4.7 s with SLEPc; docs/backends.md, petsc6)
+#: rank and 3.7-4.7 s with SLEPc; docs/guides/backends.md, petsc6)
 EIG_BLOCK_REDUNDANT = 8
 #: smallest problem for the block eigensolver (smaller ones: SLEPc)
 EIG_BLOCK_MIN_N = 400
@@ -171,7 +171,7 @@ class PetscBackend:
         options are given (with 4 right-hand sides per block the block method needs 1.6x
         SLEPc's columns and is as fast as SLEPc on 2 ranks at 20k-78k DOF, 14 % faster at
         309k DOF; ``"redundant"`` is as fast as SLEPc at 78k DOF and 27 % slower at 309k
-        DOF on 2 idle cores, faster only on oversubscribed ones: docs/backends.md).
+        DOF on 2 idle cores, faster only on oversubscribed ones: docs/guides/backends.md).
         Problems of fewer than :data:`EIG_BLOCK_MIN_N` unknowns always go to SLEPc.
     eig_memory_mb : int, optional
         Memory per rank for the redundant factorisation (MUMPS ICNTL(23), checked by MUMPS

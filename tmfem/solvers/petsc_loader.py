@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from tmfem.errors import BackendUnavailable
 
-PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/backends.md)"
+PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/guides/backends.md)"
 
 
 def petsc_modules():

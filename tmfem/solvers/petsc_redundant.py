@@ -10,7 +10,7 @@ triangular solves,
 and the columns are exchanged afterwards (rows stay distributed as in the rest of the
 block method: an ``Allgatherv`` of the right-hand sides' rows before the solve, an
 ``Alltoallv`` of the solutions' rows after it). PETSc 3.18's parallel MUMPS solve of
-several right-hand sides costs as much per column as single solves (docs/backends.md);
+several right-hand sides costs as much per column as single solves (docs/guides/backends.md);
 this one costs one sequential block solve of b / P columns per rank.
 
 The price is memory: P copies of the factors on a node instead of one distributed copy.

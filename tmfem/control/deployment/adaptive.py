@@ -31,7 +31,7 @@ M_hat, F_hat, B_hat (eq. 5.28) at the measured state (q, q', eta, eta'); the law
 the structure's own stiffness and puts k_q in its place, so a plant whose stiffness differs
 from the model's by more than k_q / omega_i^2 in a stiff direction i is unstable in closed
 loop (the 2-3 stage-2 bars moving in the membrane's plane: omega_i^2 up to 3.2e3 s^-2
-against k_q = 1-47 s^-2 over the first 1.4 s, a tolerance of 0.03-1.5 %; docs/fe-plant.md).
+against k_q = 1-47 s^-2 over the first 1.4 s, a tolerance of 0.03-1.5 %; docs/guides/fe-plant.md).
 ``"reference"`` takes them at the reference (q_d, q_d') with the measured membrane
 coordinates (eta, eta'): a feedforward along the reference plus the feedback
 D_q e' + K_q e (the "PD+" of robot control). The linearised closed loop then keeps the
@@ -54,7 +54,7 @@ factor mu s_1 in the metric of M_q, :func:`tmfem.control.deployment.pfl.bounded_
 on u + du). The COM's B_q of a 1-N(D) system is ill-conditioned (1-4(D): condition number
 ~220): in its weak directions -- combinations of SL and SU whose bar accelerations almost
 cancel on the rigid bars -- eq. 5.46 commands large tendon-force changes that an elastic
-structure answers differently (docs/fe-plant.md); the damping leaves the strong
+structure answers differently (docs/guides/fe-plant.md); the damping leaves the strong
 directions inverted and bounds the gain of the weak ones at 1 / (2 mu s_1).
 """
 from __future__ import annotations

@@ -12,7 +12,7 @@ progress s(t) = (theta_r - theta_0) / (theta_e - theta_0) in [0, 1]: by default 
 symmetric parameter p of eqs. 3.19-3.20 (theta_i, psi_i, z_i, r_i, sigma_i) moves as
 p(s) = p_0 + s (p_e - p_0). Two rules keep the membrane stretch Delta of eq. 3.22 -- and
 with it the prestress -- between its end values instead (a linear psi or linear bases
-stretch the membrane mid-path, see docs/deployment.md):
+stretch the membrane mid-path, see docs/guides/deployment.md):
 
 * 1-N(D) (``r_mb`` given): psi_r from eq. 3.22 solved for psi with
   Delta(s) = Delta_0 + s (Delta_e - Delta_0),
@@ -26,7 +26,7 @@ stretch the membrane mid-path, see docs/deployment.md):
 The path is checked against the equilibrium conditions (eq. 3.41 for 1-N(D): positive null
 vector of eq. 3.40 and Delta > 0; the positive null vector of the reduced symmetric
 equilibrium matrix of 3.3.2 otherwise). The dissertation does not print its psi_r(t) or its
-2-3 path; these rules are our choice (docs/deployment.md). q_d, q_d' and q_d'' follow from
+2-3 path; these rules are our choice (docs/guides/deployment.md). q_d, q_d' and q_d'' follow from
 eqs. 3.19-3.20 by the chain rule (q, dq/ds, d2q/ds2 from a cubic spline through the exact
 map s -> q at 401 points).
 """

@@ -217,7 +217,7 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
 
     ``partial``: a run whose integration fails (:class:`ConvergenceError`, a diverging closed
     loop) returns what it recorded up to the failure, with the message in ``failure``,
-    instead of raising (the record of a failing FE-plant run, docs/fe-plant.md).
+    instead of raising (the record of a failing FE-plant run, docs/guides/fe-plant.md).
 
     The loop runs with one BLAS thread: its dense algebra is small (the LPV gain's 71 x 71
     solve, the COM's Newton matrices), where OpenBLAS threads cost more than they give (a

@@ -6,7 +6,7 @@ The switch happens at the first sample where
     || (q - q_e) / q_e ||_2 <= R_c     (eq. 5.70, element-wise division; R_c = 0.01 in 7.4),
 
 and is permanent. q_d of eq. 5.70 is read as the final configuration q_e: with the
-time-varying reference the condition would hold at t = 0, where q = q_d(0) (docs/errata.md).
+time-varying reference the condition would hold at t = 0, where q = q_d(0) (docs/validation/errata.md).
 
 The linear controller is any :class:`tmfem.simulation.controllers.LinearController` from
 y_lin - y_e to u - u_e (an H-infinity controller of issue 12, an LQR state feedback, ...);

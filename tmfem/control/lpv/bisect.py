@@ -1,5 +1,5 @@
 """gamma minimisation of the gridded LPV state feedback (eqs. 5.95-5.96) by bisection over
-eigenvalue-optimisation levels, with continuation in gamma (docs/lpv.md).
+eigenvalue-optimisation levels, with continuation in gamma (docs/guides/lpv.md).
 
 The LMIs at a fixed gamma are solved for a feasible point by :class:`tmfem.control.lpv.eigopt.
 EigOpt`. :func:`bisect_gamma` brackets the optimum between a proven lower bound (the pointwise
@@ -16,7 +16,7 @@ feasible level, accepted only after the LMIs are re-computed in floating point.
 Continuation in the grid (automatic with the sampled-loop LMI and no given start, on a grid
 where more than one parameter varies): the pointwise Riccati start knows nothing of the
 sample time, and on the 2-3 plant at 6 x 3 with dt = 0.01 s the first level was not found
-from it (docs/lpv.md, run D). So the last varying parameter is first collapsed to its middle
+from it (docs/guides/lpv.md, run D). So the last varying parameter is first collapsed to its middle
 grid value (:func:`collapsed`; for 2-3 the 6 x 1 grid at psi_13 = 8.36 deg), the gamma
 bisection runs there (recursively: a further parameter is collapsed the same way) within half
 of the time budget, and its design, extended constant along the collapsed parameter
@@ -109,7 +109,7 @@ def bisect_gamma(gp: GeneralizedLPV, *, lower: float, upper: float, rtol: float 
         the full grid's lo (and ``not_found``): a full-grid design restricted to the sub-grid's
         line is a sub-grid design at the same gamma (the LMIs of the line are among the full
         grid's; the rate vertices +-v of the collapsed parameter average to its zero rate), so
-        that level is "not found" for the full grid in the same local sense (docs/lpv.md).
+        that level is "not found" for the full grid in the same local sense (docs/guides/lpv.md).
     first_free : bool
         From a given start (or the sub-grid design), the first level is the lowest gamma at
         which the start holds every LMI as it is (a bisection on the sign of the largest

@@ -1,5 +1,5 @@
 """Rate-bounded certificate of the output-feedback LPV loop (:mod:`tmfem.control.lpv.output_feedback`):
-an analysis LMI with a parameter-dependent Lyapunov matrix (docs/lpv.md).
+an analysis LMI with a parameter-dependent Lyapunov matrix (docs/guides/lpv.md).
 
 The loop of plant, integrators and gridded estimator (states x = [x_z, xi, e], w = [q_d, n_d, n],
 p = [W_e e_q, W_u u]; :meth:`~tmfem.control.lpv.output_feedback.LPVOutputFeedback.frozen_closed_loop`)
@@ -29,7 +29,7 @@ below the state feedback's margin; beta is the best of a logarithmic sweep on th
 Generic starts fail at the 2-3 size (121 states): the pointwise Riccati fit (largest scaled
 eigenvalue +0.98 after 587 evaluations) and a Z fitted to the pointwise Lyapunov solutions of
 A - L C_m (indefinite at 3 of the 18 points: the error dynamics' Lyapunov matrices rotate with
-theta as the plant's do); docs/lpv.md.
+theta as the plant's do); docs/guides/lpv.md.
 
 Not covered: the estimator's state is the absolute x^ and the law reads x^ - x_e(rho), so a
 moving rho adds dx_e/dt terms that this (as every linearised LPV analysis) leaves out; the
@@ -264,7 +264,7 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
     current X) re-solves the LMI at the certificate's gamma from the current X(rho); X(rho) stays
     affine in rho. A small relative eigenvalue of the fine-grid check (divided by the matrix's
     largest |entry| in the original coordinates) is not a small violation: for the 2-3 loop,
-    +1.4e-5 there is +1.1 in EIGOPT's scaled, balanced coordinates (docs/lpv.md), so the
+    +1.4e-5 there is +1.1 in EIGOPT's scaled, balanced coordinates (docs/guides/lpv.md), so the
     smoothing schedule ``t_schedule`` is the bisection's (1e-2, 1e-3, 1e-4), and each round
     reports the start's largest scaled eigenvalue (``start_scaled_eig``). Ends when the fine grid
     passes (``refinement["passed"]``), after ``max_rounds`` re-solves, when ``time_budget`` seconds

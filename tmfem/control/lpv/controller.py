@@ -9,7 +9,7 @@ the grid points (:class:`~tmfem.control.lpv.plant.GriddedLPV`) interpolated mult
 rho_e: the measured rho by default, or the parameters rho_r(t) of the reference
 (``reference_rho``). For a quasi-LPV plant, where rho is a state (theta_13), x_z - x_e(rho)
 has no component along rho: about the measured rho the feedback cannot see an error in
-theta_13 and only the integrators act (docs/lpv.md); about rho_r(t), x_z - x_e(rho_r) is
+theta_13 and only the integrators act (docs/guides/lpv.md); about rho_r(t), x_z - x_e(rho_r) is
 the deviation from the equilibrium the reference passes through, and u_e(rho_r) its
 feed-forward. Protocol of :mod:`tmfem.simulation.controllers`: the integrator advances by
 forward Euler over the sample time dt (zero-order hold of q_d - q).

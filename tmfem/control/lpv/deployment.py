@@ -13,7 +13,7 @@ Plant: the control-oriented model (eq. 5.27) built at the final configuration wi
 designed rest lengths, in modal membrane coordinates, started at rest in the initial
 configuration (as the 7.4 deployments, :func:`tmfem.control.deployment.run.run_deployment`: Park's
 method, rest-length limits), or an FE plant through its COM-state estimate started in its own
-equilibrium of :meth:`LPVDeployment.packaged` (docs/fe-plant.md).
+equilibrium of :meth:`LPVDeployment.packaged` (docs/guides/fe-plant.md).
 
 Measurement (:meth:`LPVDeployment.measure`): the plant's y = [z, z'] (modal) mapped onto the
 signals of the LPV design, y_lpv = [x_z, rho] with x_z = [q, v, q', v'] (v = T_v_eta eta, the
@@ -189,7 +189,7 @@ def output_feedback_controller(dep: LPVDeployment, design, *, interpolation: str
     ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
     reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
     the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
-    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/lpv.md); the control law about rho_r(t)
+    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/guides/lpv.md); the control law about rho_r(t)
     as the state feedback's; the estimator is driven by the input saturated to the rest-length
     limits [1 mm, |tendon|(q_m)] of the run at the measured q.
 

@@ -1,6 +1,6 @@
 """Feasible points of the gridded LPV LMIs (eqs. 5.95-5.96) by eigenvalue optimisation, for
 problems too large for the interior-point solvers (the 2-3 system: 72 LMIs of size 155, 12142
-variables; docs/lpv.md).
+variables; docs/guides/lpv.md).
 
 With P(rho) = P_0 + rho_1 P_1 + rho_2 P_2 and Q(rho) likewise (eq. 5.99, normalised
 parameters), the LMIs M_iv(P, Q) < 0 (grid point i, rate vertex v) and P(rho_i) > 0 hold iff

@@ -1,7 +1,7 @@
 """Output-feedback LPV control: the scheduled state feedback of eqs. 5.95-5.99 with a gridded
 Kalman estimator (the output feedback that 9.2 names as future work).
 
-Formulation (observer-based, frozen-parameter verified; docs/lpv.md). The plant of
+Formulation (observer-based, frozen-parameter verified; docs/guides/lpv.md). The plant of
 :func:`~tmfem.control.lpv.synthesis.interconnection_8_1` is measured through
 
     y_m = C_m(rho) x_z + W_n n,          (the bar coordinates q and the K membrane points of eq. 5.17)
@@ -182,7 +182,7 @@ def design_output_feedback(state_feedback: LPVStateFeedback, plant: GriddedLPV, 
     interpolation : {"multilinear", "spline"}
         How the estimator's model and gains are evaluated between grid points
         (:class:`~tmfem.control.lpv.plant.GriddedLPV`). Splines bring the model 13-16 x closer
-        to the true 2-3 plant between the 6 x 3 design points (docs/lpv.md), where it
+        to the true 2-3 plant between the 6 x 3 design points (docs/guides/lpv.md), where it
         couples the estimation error to the state.
     """
     measured, tracked = list(measured), list(tracked)

@@ -229,7 +229,7 @@ def choose_membrane_points(model, *, rings=(0.2, 0.4, 0.6), per_ring: int = 12) 
     """K point coordinates (eq. 5.17) for ``model`` chosen greedily among (u, v, w) at points
     on rings about the membrane centre (radii as fractions of r_mb): each step adds the
     candidate that maximises the smallest singular value of the rows of T_v_eta picked so
-    far. Ch. 8 does not print its points (docs/errata.md); this rule keeps T_v_eta well
+    far. Ch. 8 does not print its points (docs/validation/errata.md); this rule keeps T_v_eta well
     conditioned."""
     system = model.system
     c = membrane_corners_regular(system.N, system.r_mb).mean(axis=1)      # centre in O_f

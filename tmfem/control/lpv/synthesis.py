@@ -76,7 +76,7 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
     The LMIs are written directly as a sparse conic program (vec(M) = vec(M_0) + G x with
     Kronecker products: vec(A P) = (I kron A) vec(P)) and handed to Clarabel or SCS through
     their own interfaces: cvxpy's canonicalisation of the products A P ran out of memory on
-    the 2-3 plant (71 states, 2 x 2 grid; docs/lpv.md).
+    the 2-3 plant (71 states, 2 x 2 grid; docs/guides/lpv.md).
 
     Parameters
     ----------

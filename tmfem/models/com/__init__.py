@@ -6,7 +6,7 @@ constraints Phi(q, zeta) = 0 (eq. 3.5) are eliminated by coordinate partitioning
 (eqs. 5.20-5.28), giving the ODE  M_hat(z) z'' + F_hat(z, z') + B_hat(z) u = 0  whose input
 u is the vector of tendon rest lengths. Entry point: :class:`ControlOrientedModel`; its
 linearisation is :func:`tmfem.models.com.linearize.linearize` (also ``tmfem.linearize``).
-See docs/com.md.
+See docs/guides/com.md.
 """
 from tmfem._lazy import lazy_exports
 

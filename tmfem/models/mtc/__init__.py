@@ -1,5 +1,5 @@
 """Membrane-truss-cable (MTC) finite-element model (dissertation 4.4, 6.2-6.4): trusses for
-bars and tendons, a plane-stress membrane; statics, modes and dynamics. See docs/mtc.md.
+bars and tendons, a plane-stress membrane; statics, modes and dynamics. See docs/guides/mtc.md.
 """
 from tmfem._lazy import lazy_exports
 
