@@ -344,7 +344,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                               q_names=list(final.q_names), omega_r=omega_r, bases=bases,
                               r_mb=final.r_mb if delta_path else None)
     if check_path:
-        ref.check_equilibria(checker=_equilibrium_checker(final))
+        ref.check_equilibria(checker=equilibrium_checker(final))
     t_settle = 8.0 / omega_r
     C, sig = reference_centers(ref, t_end=t_settle, m=n_centers)
     ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centers=C, sigma=sig),
@@ -374,10 +374,11 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                            linear=lin_ctrl, z0=z0, z_e=z_e, info=info)
 
 
-def _equilibrium_checker(system):
-    """Equilibrium test of a symmetric configuration of ``system``: eqs. 3.40-3.41 for a
-    1-N(D) system (:func:`tmfem.equilibrium.symmetric.check_1ND`), the positive null vector
-    of the reduced symmetric matrix otherwise (3.3.2)."""
+def equilibrium_checker(system):
+    """The equilibrium test ``check(cfg)`` of a symmetric configuration of ``system`` (for
+    :meth:`~tmfem.control.deployment.reference_trajectory.DeploymentReference.check_equilibria`):
+    eqs. 3.40-3.41 for a 1-N(D) system (:func:`tmfem.equilibrium.symmetric.check_1ND`), the
+    positive null vector of the reduced symmetric matrix otherwise (3.3.2)."""
     if system.deployable:
         return lambda cfg: check_1ND(with_configuration(system, cfg))
 
