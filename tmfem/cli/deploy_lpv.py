@@ -171,9 +171,9 @@ def run(args, *, mesh_n) -> dict:
     out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
            **ctrl, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(), **s.info,
            **_figures(r), **info}
+    title = f"{args.preset} deployment on the {args.plant} plant: {args.controller} (gamma = {d.gamma:.4g}), eq. 5.100"
     out.update(reference.write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
-                             vtk=args.vtk, title=f"{args.preset} deployment on the {args.plant} plant: {args.controller} "
-                                                 f"(gamma = {d.gamma:.4g}), eq. 5.100"))
+                                       vtk=args.vtk, title=title))
     if args.compare_plant:
         def rerun(kind):
             _, r2 = _run_on(args, dep, d, kind, mesh_n, est)
