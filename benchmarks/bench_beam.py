@@ -25,7 +25,7 @@ def main(argv=None):
     from tmfem.fem.dofmap import DofMap
     from tmfem.fem.element import State
     from tmfem.fem.truss import TrussSet, truss_internal
-    from tmfem.solvers import newton
+    from tmfem.solvers.newton import newton
     from tmfem.solvers.backends import get_backend
 
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)

@@ -14,7 +14,7 @@ import pstats
 import re
 import time
 
-from tmfem.cli.deploy import setup
+from tmfem.reference.deployments import setup
 from tmfem.control.deployment.run import run_deployment
 
 #: (label, regular expression on "file:line(function)") of the profile breakdown

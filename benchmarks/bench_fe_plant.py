@@ -148,12 +148,15 @@ def deployment(a):
     from tmfem.reference.deployments import setup
     t0 = time.perf_counter()
     if a.lpv_controller:
-        from types import SimpleNamespace
-        from tmfem.cli.deploy_lpv import BUILDERS, design
+        from tmfem.control.lpv.deployment import state_feedback_controller
+        from tmfem.control.lpv.state_feedback import LPVStateFeedback
+        from tmfem.control.lpv.workflow import saved_design_plant
         from tmfem.reference.deployments import lpv_setup
-        plant, d, _ = design(SimpleNamespace(lpv_controller=a.lpv_controller, dt=0.01), "2-3-lpv")
+        from tmfem.reference.tables import deployment_bases
+        d, system = LPVStateFeedback.load(a.lpv_controller), load_preset("2-3-lpv")
+        plant = saved_design_plant(d, system, bases=deployment_bases(system))
         dep = lpv_setup("2-3-lpv", plant)
-        s, initial = dep.setup(BUILDERS["lpv"](dep, d)), dep.packaged()
+        s, initial = dep.setup(state_feedback_controller(dep, d)), dep.packaged()
         what = f"LPV deployment (8.4, gamma = {d.gamma:.4g})"
     else:
         s = setup("2-3-deploy", controller="adaptive", evaluation="reference", tendon_law=a.deploy)

@@ -12,10 +12,11 @@ prints every level (also the sub-grid's), the bracket and the CPU time.
 import argparse
 import time
 
-from tmfem.cli.control_lpv import printed_grid
+from tmfem.cli.lpv_options import printed_grid
 from tmfem.control.lpv.bounds import pointwise_state_feedback_bound
 from tmfem.control.lpv.plant import com_lpv_plant
-from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
+from tmfem.control.lpv.generalized_plant import interconnection_8_1
+from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.errors import InfeasibleController
 from tmfem.reference.tables import PRINTED, deployment_bases
 from tmfem.system import load_preset

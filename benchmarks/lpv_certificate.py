@@ -39,7 +39,7 @@ from tmfem.control.lpv.certificate import (RateBoundedCertificate, _frozen_norms
                                            rate_bounded_certificate, refine_certificate)
 from tmfem.control.lpv.output_feedback import design_output_feedback, verify_output_feedback
 from tmfem.control.lpv.plant import com_lpv_plant
-from tmfem.control.lpv.synthesis import LPVStateFeedback
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.reference.tables import deployment_bases
 from tmfem.system import load_preset
 

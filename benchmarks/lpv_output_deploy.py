@@ -22,7 +22,8 @@ from tmfem.control.deployment.run import run_deployment
 from tmfem.control.lpv.controller import LPVController
 from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
 from tmfem.control.lpv.plant import com_lpv_plant
-from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
+from tmfem.control.lpv.generalized_plant import interconnection_8_1
+from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.control.deployment.reference_trajectory import DeploymentReference
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.models.com.model import ControlOrientedModel

@@ -20,7 +20,8 @@ from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, line_mesh, rectang
 from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State
-from tmfem.solvers import lowest_modes, newton
+from tmfem.solvers import lowest_modes
+from tmfem.solvers.newton import newton
 
 SECTIONS = [BeamSection.rectangle(a=0.3, b=0.2), BeamSection.circle(d=0.2)]
 

@@ -19,7 +19,8 @@ from tmfem.fem.element import State, assemble
 from tmfem.fem.membrane import MembraneElement, MembraneTL
 from tmfem.fem.truss import TrussElement, TrussSet
 from tmfem.mesh.polygon import MembraneMesh
-from tmfem.solvers import lowest_modes, newton
+from tmfem.solvers import lowest_modes
+from tmfem.solvers.newton import newton
 from tmfem.system.materials import MembraneMaterial
 
 E, NU, RHO = 2e9, 0.3, 1500.0

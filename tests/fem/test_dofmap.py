@@ -16,7 +16,7 @@ from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State, assemble
 from tmfem.fem.truss import TrussElement, TrussSet
-from tmfem.solvers import newton
+from tmfem.solvers.newton import newton
 
 
 def test_numbering_of_mixed_nodes():

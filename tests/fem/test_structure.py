@@ -177,7 +177,7 @@ def test_shell_started_from_the_membrane_equilibrium_converges_at_once():
     of the load-stepped run."""
     from tmfem.reference.benchmarks.shell_square_membrane import shell_square_membrane
     from tmfem.reference.element_benchmarks import square_membrane
-    from tmfem.solvers import newton
+    from tmfem.solvers.newton import newton
     s, st, _, _, mesh = shell_square_membrane(n=5)
     mem = square_membrane(n=5)
     start = s.state_from_positions(s.X + mem.u)

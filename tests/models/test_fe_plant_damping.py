@@ -175,7 +175,7 @@ def test_deployment_plant_damping_tangent_default():
     default chosen from the runs of docs/guides/fe-plant.md "Plant damping along the path"), an
     undamped one has no damping to take it for; the CLI reports the tangent in force with
     --plant-damping and passes --plant-damping-tangent through."""
-    from tmfem.cli.deploy import plant_arguments, plant_options
+    from tmfem.reference.deployment_plants import FEPlantOptions
     from tmfem.reference.deployments import setup
     s = setup("2-3-deploy", controller="adaptive", evaluation="reference")
     init = load_preset("2-3-deploy-initial")
@@ -190,10 +190,10 @@ def test_deployment_plant_damping_tangent_default():
     parser = build_parser()
     base = ["deploy", "--preset", "2-3-deploy", "--plant", "mtc", "--plant-damping", "1e-3"]
     args = parser.parse_args(base)
-    assert plant_arguments(args, "mtc")["damping_tangent"] is None
-    assert plant_options(args, "mtc", 2)["plant_damping_tangent"] == "current"
+    assert FEPlantOptions.of(args).arguments("mtc")["damping_tangent"] is None
+    assert FEPlantOptions.of(args).summary("mtc", 2)["plant_damping_tangent"] == "current"
     args = parser.parse_args(base + ["--plant-damping-tangent", "initial"])
-    assert plant_arguments(args, "mtc")["damping_tangent"] == "initial"
-    assert plant_options(args, "mtc", 2)["plant_damping_tangent"] == "initial"
-    assert "plant_damping_tangent" not in plant_options(
-        parser.parse_args(["deploy", "--preset", "2-3-deploy", "--plant", "mtc"]), "mtc", 2)
+    assert FEPlantOptions.of(args).arguments("mtc")["damping_tangent"] == "initial"
+    assert FEPlantOptions.of(args).summary("mtc", 2)["plant_damping_tangent"] == "initial"
+    assert "plant_damping_tangent" not in FEPlantOptions.of(
+        parser.parse_args(["deploy", "--preset", "2-3-deploy", "--plant", "mtc"])).summary("mtc", 2)

@@ -5,7 +5,8 @@ import scipy.sparse as sp
 
 from tmfem.errors import BackendUnavailable, ConvergenceError, InputError
 from tmfem.fem.truss import TrussSet, truss_internal
-from tmfem.solvers import arc_length, get_backend, load_stepping, lowest_modes, newton
+from tmfem.solvers import arc_length, get_backend, load_stepping, lowest_modes
+from tmfem.solvers.newton import newton
 
 
 def bar_problem(P, EA=1e4, L=1.0):

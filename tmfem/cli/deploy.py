@@ -5,15 +5,18 @@ Every option and output path is checked before the controller design (docs/guide
 """
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import astuple
 
+from tmfem import reference
 from tmfem.cli import deploy_lpv
-from tmfem.cli.common import (check_time_steps, output_dir, output_file, positive_float,
-                              progress_bar)
+from tmfem.cli.common import (check_mesh_budget, check_time_steps, output_dir, output_file,
+                              positive_float, progress_bar)
 from tmfem.errors import InputError
 from tmfem.reference.deployments import (CONTROLLERS, DEPLOYMENTS, LPV_CONTROLLERS, LPV_DEPLOYMENTS,
                                          UNCERTAINTIES, check_choices, setup, write_outputs)
+from tmfem.system.presets import load_preset
 
 NAME = "deploy"
 HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
@@ -144,7 +147,8 @@ def run(args) -> dict:
                          f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
-        return deploy_lpv.run(args)
+        deploy_lpv.check(args)
+        return deploy_lpv.run(args, mesh_n=check_plant(args))
     lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise", "estimator_interpolation",
                                        "estimator_refine") + deploy_lpv.SYNTHESIS)
     if lpv_opts:
@@ -154,23 +158,21 @@ def run(args) -> dict:
                   path=args.path)
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
-    # one controller for both plants of a comparison: with an FE plant among them, the PFL
-    # at the reference and its tendon model the FE plant's tendon law (docs/guides/fe-plant.md),
-    # except under eq. 5.72, whose F_q is frozen with the fixed rates of eq. 5.19
-    fe = args.plant != "com" or args.compare_plant not in (None, "com")
-    pfl_at = args.pfl_at or ("reference" if fe else "state")
-    frozen = (args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"]) == "initial"
-    tendons = fe_tendon_model(args) if fe and not frozen else "fixed-rate"
+    plants = reference.FEPlantOptions.of(args)
+    pfl_at = plants.pfl_evaluation(args.pfl_at)
+    tendons = plants.pfl_tendon_model(args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"])
     s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path, evaluation=pfl_at,
               tendon_law=tendons, gains=args.gains)
-    warnings = tendon_model_warnings(args, tendons)
+    warnings = plants.tendon_model_warnings(tendons)
+    for w in warnings:
+        print(f"tmfem deploy: warning: {w}", file=sys.stderr)
     r = _run_on(args, s, args.plant, mesh_n)
     # the controller's options, the same on both plants of a comparison (docs/guides/fe-plant.md)
     ctrl = {"controller": args.controller, "uncertainty": s.adaptive.uncertainty,
             "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons,
             "pfl_gains": list(astuple(s.adaptive.gains))}
-    out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
+    out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
            **ctrl, "path": args.path or DEPLOYMENTS[args.preset]["path"],
            **r.summary(), **s.info}
     title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
@@ -184,146 +186,26 @@ def run(args) -> dict:
                        allocation=args.allocation, path=args.path, evaluation=pfl_at,
                        tendon_law=tendons, gains=args.gains)
             return _run_on(args, s2, kind, mesh_n), {}
-        out["compare"] = compare_plants(
-            args, r, rerun, mesh_n=mesh_n, controller=ctrl,
+        out["compare"] = reference.compare_plants(
+            r, rerun, options=plants, preset=args.preset, csv=args.compare_csv, plot=args.compare_plot,
+            mesh_n=mesh_n, controller=ctrl,
             about=f"PFL at the {pfl_at}, its tendon model {tendons}, uncertainty "
                   f"{s.adaptive.uncertainty}, allocation {s.adaptive.allocation}, gains "
                   f"{','.join(f'{g:g}' for g in astuple(s.adaptive.gains))}")
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
     # to the failure are written, the exit code is 1 (docs/guides/cli.md, docs/guides/fe-plant.md)
-    out["failed_checks"] = diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+    out["failed_checks"] = reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out
-
-
-def diverged(runs) -> list:
-    """The failed checks of (plant, result) pairs: a closed loop that diverged (``failure``)."""
-    return [f"closed loop on the {p} plant diverged at t = {v['t_end_s']:.4g} s" for p, v in runs
-            if v.get("failure")]
-
-
-def plant_tendons(args, plant: str) -> str:
-    """The tendon law of the plant ``plant`` of a run: the COM's fixed rates of eq. 5.19, the
-    SBC model's cable law k = EA / r, the MTC model's ``--plant-tendons`` (default cable)."""
-    return {"com": "fixed-rate", "sbc": "cable"}.get(plant) or args.plant_tendons or "cable"
-
-
-def plant_actuation(args) -> str:
-    """The FE plants' tendon actuators: ``--plant-actuation``, default rest-length."""
-    return getattr(args, "plant_actuation", None) or "rest-length"
-
-
-def controlled_tendon_law(args, plant: str) -> str:
-    """The tendon law the controller drives on ``plant``: a force-actuated FE plant's
-    tendons follow the COM's law at the measured q (the fixed rates of eq. 5.19,
-    :mod:`tmfem.control.fe_plant.tension_actuation`), otherwise :func:`plant_tendons`."""
-    if plant != "com" and plant_actuation(args) == "force":
-        return "fixed-rate"
-    return plant_tendons(args, plant)
-
-
-def fe_tendon_model(args) -> str:
-    """The adaptive PFL's tendon model with an FE plant in the run (outside eq. 5.72): the
-    tendon law the controller drives on the FE plant (:func:`controlled_tendon_law`)."""
-    fe = args.plant if args.plant != "com" else args.compare_plant
-    return controlled_tendon_law(args, fe)
-
-
-def tendon_model_warnings(args, tendons: str) -> list:
-    """Where the adaptive PFL's tendon model ``tendons`` is not the tendon law of a plant it
-    drives (the same controller on both plants of a comparison, docs/guides/fe-plant.md): one line
-    each, also on stderr."""
-    import sys
-    out = []
-    for p in [args.plant] + ([args.compare_plant] if args.compare_plant else []):
-        law = controlled_tendon_law(args, p)
-        if law != tendons:
-            out.append(f"the PFL's tendon model ({tendons}) is not the {p} plant's tendon law "
-                       f"({law}): the run on the {p} plant has this model error too")
-    for w in out:
-        print(f"tmfem deploy: warning: {w}", file=sys.stderr)
-    return out
-
-
-def plant_options(args, plant: str, mesh_n) -> dict:
-    """The plant's options of a run on ``plant`` for the JSON (the COM plant: its tendon law
-    only)."""
-    if plant == "com":
-        return {"plant_tendons": plant_tendons(args, plant)}
-    return {"plant_mesh": mesh_n, "plant_tendons": plant_tendons(args, plant),
-            **({"plant_bars": sbc_bars(args)} if plant == "sbc" else {}),
-            "plant_damping_s": getattr(args, "plant_damping", None) or 0.0,
-            **({"plant_damping_tangent": damping_tangent(args)}
-               if getattr(args, "plant_damping", None) else {}),
-            "plant_actuation": plant_actuation(args)}
-
-
-def damping_tangent(args) -> str:
-    """The FE plant's damping tangent: ``--plant-damping-tangent``, default
-    :data:`tmfem.control.fe_plant.state_estimate.DEPLOYMENT_DAMPING_TANGENT`."""
-    from tmfem.control.fe_plant.state_estimate import DEPLOYMENT_DAMPING_TANGENT
-    return getattr(args, "plant_damping_tangent", None) or DEPLOYMENT_DAMPING_TANGENT
-
-
-def sbc_bars(args) -> str:
-    """The SBC plant's bar measurement: ``--plant-bars``, default the rigid fit (the chords see
-    the beams' bending modes, docs/guides/fe-plant.md)."""
-    return getattr(args, "plant_bars", None) or "rigid"
-
-
-def plant_arguments(args, plant: str) -> dict:
-    """The FE plant's options of a run on ``plant`` as the keyword arguments of
-    :func:`tmfem.control.fe_plant.state_estimate.deployment_plant` (both deployment kinds)."""
-    return {"tendon_law": args.plant_tendons if plant == "mtc" else None,
-            "bars": sbc_bars(args) if plant == "sbc" else None,
-            "beta": (args.plant_damping or 0.0) if plant != "com" else 0.0,
-            "actuation": plant_actuation(args) if plant != "com" else "rest-length",
-            "damping_tangent": args.plant_damping_tangent if plant != "com" else None}
 
 
 def _run_on(args, s, plant_kind: str, mesh_n):
-    """The deployment of set-up ``s`` on ``plant_kind``; an FE-plant run that diverges returns
-    its record up to the failure (``failure``)."""
-    from tmfem.control.deployment.run import run_deployment
-    from tmfem.control.fe_plant.state_estimate import deployment_plant
-    from tmfem.system.presets import load_preset
-    plant = deployment_plant(plant_kind, s.model, load_preset(args.preset + "-initial"),
-                             mesh_n=mesh_n or 10, **plant_arguments(args, plant_kind))
+    """The deployment of set-up ``s`` on ``plant_kind``
+    (:func:`tmfem.reference.deployment_plants.run_on_plant`)."""
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
-        return run_deployment(model=s.model, reference=s.reference, controller=s.controller,
-                              z0=s.z0, t_end=args.t_end, dt=args.dt, progress=bar, plant=plant,
-                              jacobian="reuse" if plant is None else "step",
-                              partial=plant is not None)
-
-
-def compare_plants(args, r, rerun, *, mesh_n, controller: dict, about: str,
-                   reference: str = "eq. 5.68") -> dict:
-    """The same deployment on ``--compare-plant`` and its deviation from run ``r`` (both
-    deployment kinds): ``rerun(plant)`` runs it there with a fresh controller of the same
-    options (the adaptive PFL, the switch and the LPV observer carry state) and returns the
-    result and its extra JSON entries; ``controller``: those options (JSON of both runs),
-    ``about``: their summary for the plot's title, ``reference``: the equation of the
-    reference q_d (the plot's legend). The CSV and the plot if asked for."""
-    from tmfem.control.fe_plant.compare import deviation_summary, plant_deviation
-    from tmfem.reference.deployments import write_csv
-    r2, extra = rerun(args.compare_plant)
-    dev = plant_deviation(r, r2)
-    out = {"plant": args.compare_plant, **plant_options(args, args.compare_plant, mesh_n),
-           **controller, **r2.summary(), **extra, "deviation": deviation_summary(dev)}
-    if args.compare_csv:
-        out["csv"] = write_csv(args.compare_csv, r2)
-    if args.compare_plot:
-        from tmfem.post.plant_compare_plot import plot_plant_comparison
-        runs = [(p, plant_options(args, p, mesh_n)) for p in (args.plant, args.compare_plant)]
-        title = (f"{args.preset} deployment, the same controller on both plants: "
-                 f"{controller['controller']} ({about})\n" +
-                 "; ".join(f"{p} plant ({ls}): " + (", ".join(
-                     f"{k[6:]} {v}" for k, v in o.items() if k != "plant_damping_s" or v))
-                     for (p, o), ls in zip(runs, ("solid", "dashed"))))
-        out["plot"] = str(plot_plant_comparison(
-            args.compare_plot, r, r2, dev, labels=(args.plant, args.compare_plant), title=title,
-            reference=reference))
-    return out
+        return reference.run_on_plant(s, kind=plant_kind, options=reference.FEPlantOptions.of(args),
+                                      initial=reference.packaged_system(args.preset), mesh_n=mesh_n,
+                                      t_end=args.t_end, dt=args.dt, progress=bar)
 
 
 def check_plant(args) -> int | None:
@@ -335,8 +217,6 @@ def check_plant(args) -> int | None:
     MTC model has no nodes along the bars, so no 1-N(D) system; ``--compare-plant`` differs
     from ``--plant`` and ``--compare-plot``/``--compare-csv`` need it; the mesh within the
     machine's budget. Returns the plant mesh (None without an FE plant)."""
-    from tmfem.cli.common import check_mesh_budget
-    from tmfem.system.presets import load_preset
     plants = [args.plant] + ([args.compare_plant] if args.compare_plant else [])
     for opt in ("--compare-plot", "--compare-csv"):
         if getattr(args, opt[2:].replace("-", "_")) and not args.compare_plant:
@@ -352,7 +232,7 @@ def check_plant(args) -> int | None:
                          f"--compare-plant sbc, found --plant-bars {args.plant_bars} with "
                          f"{' and '.join(plants)}")
     if not fe:
-        if plant_actuation(args) == "force":
+        if reference.FEPlantOptions.of(args).actuation() == "force":
             raise InputError("--plant-actuation force belongs to an FE plant (--plant or "
                              "--compare-plant mtc|sbc): the COM is the design model, whose tendon "
                              "forces k (|d(q)| - u) are what the force actuator reproduces on an FE "

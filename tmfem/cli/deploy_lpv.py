@@ -14,11 +14,18 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
-from tmfem.cli import control_lpv
+from tmfem import reference, simulation
+from tmfem.cli import lpv_options
+from tmfem.cli.common import progress_bar
+from tmfem.control import lpv
 from tmfem.errors import InfeasibleController, InputError
+from tmfem.reference.deployments import LPV_DEPLOYMENTS
+from tmfem.reference.tables import deployment_bases
+from tmfem.system import load_preset
 
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
 SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
@@ -32,7 +39,7 @@ def configure(parser) -> None:
                              "is synthesised with the options below)")
     parser.add_argument("--solver", choices=("EIGOPT", "CLARABEL", "SCS"), default=None,
                         help="--controller lpv: synthesis solver (default EIGOPT, docs/guides/lpv.md)")
-    control_lpv.configure_synthesis(parser, prefix="--controller lpv: ")
+    lpv_options.configure_synthesis(parser, prefix="--controller lpv: ")
     parser.add_argument("--estimator-interpolation", choices=("multilinear", "spline"), default=None,
                         help="--controller lpv-output: how the Kalman estimator's model and gains are "
                              "evaluated between grid points (default multilinear; spline: tensor-product "
@@ -51,11 +58,9 @@ def given(args, names) -> list:
     return ["--" + k.replace("_", "-") for k in names if getattr(args, k, None) not in (None, False)]
 
 
-def check(args) -> int | None:
-    """Refusals before any work: options of the 7.4 deployments, the FE plant's options (those
-    of the 7.4 deployments, :func:`tmfem.cli.deploy.check_plant`), the paths. Returns the FE
-    plant's mesh (None on the COM plant)."""
-    from tmfem.reference.deployments import LPV_DEPLOYMENTS
+def check(args) -> None:
+    """Refusals before any work: options of the 7.4 deployments, the paths (the FE plant's
+    options are those of the 7.4 deployments, checked by :mod:`tmfem.cli.deploy`)."""
     bad = given(args, NOT_LPV)
     own = LPV_DEPLOYMENTS[args.preset]["path"]
     if args.path not in (None, own):
@@ -74,71 +79,31 @@ def check(args) -> int | None:
         if syn:
             raise InputError(f"--lpv-controller: options {syn} belong to a synthesis on the fly, found them "
                              "with a saved design")
-        from pathlib import Path
         if not (args.lpv_controller.endswith(".npz") and Path(args.lpv_controller).is_file()):
             raise InputError(f"--lpv-controller: expected an existing .npz file (tmfem control lpv --save), "
                              f"found {args.lpv_controller!r}")
-    from tmfem.cli.deploy import check_plant
-    return check_plant(args)
-
-
-def lpv_state_feedback(dep, design):
-    """--controller lpv: the scheduled state feedback of 8.3 on the measured LPV signals."""
-    from tmfem.control.lpv.deployment import state_feedback_controller
-    return state_feedback_controller(dep, design)
-
-
-def lpv_output_feedback(dep, design, *, interpolation: str = "multilinear", estimator_plant=None):
-    """--controller lpv-output: the observer-based output feedback of :mod:`tmfem.control.lpv.output_feedback`
-    with ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
-    reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
-    the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
-    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/guides/lpv.md); the control law about rho_r(t)
-    as the state feedback's; the estimator is driven by the input saturated to the rest-length
-    limits [1 mm, |tendon|(q_m)] of the run at the measured q; ``interpolation``: the
-    estimator's between grid points (:class:`~tmfem.control.lpv.plant.GriddedLPV`);
-    ``estimator_plant``: its plant on a finer grid than the design's (default the design plant)."""
-    from tmfem.control.deployment.limits import tendon_lengths
-    from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
-    pl, system = dep.plant, dep.model.system
-    nz, n, nq = pl.nx // 2, pl.nx, dep.model.nq
-    of = design_output_feedback(design, pl if estimator_plant is None else estimator_plant,
-                                tracked=system.q_names, measured=pl.state_names[:nz],
-                                interpolation=interpolation)
-    return LPVOutputController(of, measured_index=np.arange(nz), rho_index=[n, n + 1],
-                               reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho,
-                               schedule="estimate",
-                               input_limits=lambda u, ym: np.clip(u, 1e-3, tendon_lengths(system, ym[:nq])))
 
 
 def design(args, preset: str):
     """(design plant, state-feedback design, JSON entries): loaded and checked on its grid
-    (sampled at --dt), or synthesised and verified on the finer grid."""
-    from tmfem.control.lpv.synthesis import LPVStateFeedback, interconnection_8_1
-    from tmfem.control.lpv.verify import verify
+    (sampled at --dt), or synthesized and verified on the finer grid."""
     if args.lpv_controller is not None:
-        from tmfem.cli.common import progress_bar
-        from tmfem.control.lpv.plant import com_lpv_plant
-        from tmfem.reference.tables import deployment_bases
-        from tmfem.system import load_preset
-        d = LPVStateFeedback.load(args.lpv_controller)
+        d = lpv.LPVStateFeedback.load(args.lpv_controller)
         s = load_preset(preset)
-        if d.parameter_names != ["theta_13", "psi_13"] or len(d.axes) != 2:
-            raise InputError(f"--lpv-controller {args.lpv_controller}: expected a design scheduled on "
-                             f"['theta_13', 'psi_13'], found {d.parameter_names}")
-        n = d.axes[0].size * d.axes[1].size
+        n = int(np.prod([a.size for a in d.axes]))
         print(f"tmfem deploy: {preset}: rebuilding the design plant at its {n} grid points", file=sys.stderr)
-        with progress_bar(n, 1, "LPV plant (grid points)") as bar:
-            plant = com_lpv_plant(s, theta=d.axes[0], psi=d.axes[1], bases=deployment_bases(s),
-                                  rate_bounds=d.rate_bounds, progress=bar)
-        v = verify(d, interconnection_8_1(plant, tracked=s.q_names), sample_time=args.dt)
+        try:
+            plant = lpv.saved_design_plant(d, s, bases=deployment_bases(s), progress=lpv_options.progress)
+        except InputError as exc:
+            raise InputError(f"--lpv-controller {args.lpv_controller}: {exc}") from None
+        v = lpv.verify_design(d, plant, tracked=s.q_names, sample_time=args.dt)
         return plant, d, {"lpv_controller": args.lpv_controller, "gamma": d.gamma,
                           **{f"design_grid_{k}": x for k, x in v.to_dict().items()}}
-    cfg = control_lpv.check_synthesis(args, solver=args.solver or "EIGOPT", preset=preset)
-    plant, gp, bound, out = control_lpv.design_plant(cfg, rate_deg=10.0)
+    cfg = lpv_options.check_synthesis(args, solver=args.solver or "EIGOPT", preset=preset)
+    plant, gp, bound, out = lpv_options.design_plant(cfg, rate_deg=10.0)
     sample = args.dt if cfg["solver"] == "EIGOPT" else None
-    ctrl, syn = control_lpv.synthesise(cfg, gp, bound, sample_time=sample)
-    v = control_lpv.verify_finer(cfg, plant, ctrl, sample_time=args.dt)
+    ctrl, syn = lpv_options.synthesize(cfg, gp, bound, sample_time=sample)
+    v = lpv_options.verify_finer(cfg, plant, ctrl, sample_time=args.dt)
     out.pop("preset")
     return plant, ctrl, {**out, **syn, **v.to_dict()}
 
@@ -146,7 +111,8 @@ def design(args, preset: str):
 #: --controller name -> design(args, preset) -> (design plant, design with ``gamma``, JSON entries)
 DESIGNS = {"lpv": design, "lpv-output": design}
 #: --controller name -> builder(deployment, design) of a controller on the LPV signals y_lpv
-BUILDERS = {"lpv": lpv_state_feedback, "lpv-output": lpv_output_feedback}
+#: (a function of :mod:`tmfem.control.lpv`)
+BUILDERS = {"lpv": "state_feedback_controller", "lpv-output": "output_feedback_controller"}
 
 
 def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
@@ -154,21 +120,14 @@ def _run_on(args, dep, d, kind: str, mesh_n, estimator_options):
     ``--controller`` builder, with ``--noise`` its seeded measurement noise) on the plant
     ``kind``: an FE plant starts in its own equilibrium of the packaged configuration under
     the rest lengths the controller starts with (docs/guides/fe-plant.md)."""
-    from tmfem.cli.common import progress_bar
-    from tmfem.cli.deploy import plant_arguments
-    from tmfem.control.deployment.run import run_deployment
-    from tmfem.control.fe_plant.state_estimate import deployment_plant
-    c = BUILDERS[args.controller](dep, d, **estimator_options)
+    c = getattr(lpv, BUILDERS[args.controller])(dep, d, **estimator_options)
     if args.noise:
-        from tmfem.simulation.controllers import MeasurementNoise
-        c = MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
+        c = simulation.MeasurementNoise(c, sigma=args.noise, index=c.read_index, seed=0)
     s = dep.setup(c)
-    fe = deployment_plant(kind, s.model, dep.packaged(), mesh_n=mesh_n or 10,
-                          **plant_arguments(args, kind))
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} ({args.controller}) on {kind}") as bar:
-        r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
-                           t_end=args.t_end, dt=args.dt, progress=bar, plant=fe,
-                           jacobian="reuse" if fe is None else "step", partial=fe is not None)
+        r = reference.run_on_plant(s, kind=kind, options=reference.FEPlantOptions.of(args),
+                                   initial=dep.packaged(), mesh_n=mesh_n, t_end=args.t_end, dt=args.dt,
+                                   progress=bar)
     if not np.all(np.isfinite(r.z)):
         raise InfeasibleController(f"the LPV deployment of {args.preset} on the {kind} plant diverged "
                                    "(non-finite states)")
@@ -183,23 +142,21 @@ def _figures(r) -> dict:
             "rest_length_above_tendon_length_max_m": float(np.max(r.u - r.lengths))}
 
 
-def run(args) -> dict:
-    """The LPV deployment (module docstring); the JSON keys of the 7.4 deployments plus the
-    design's; with ``--compare-plant`` the same design (a fresh controller) on the second
-    plant (:func:`tmfem.cli.deploy.compare_plants`)."""
-    from tmfem.cli.deploy import compare_plants, diverged, plant_options
-    from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
-    mesh_n = check(args)
+def run(args, *, mesh_n) -> dict:
+    """The LPV deployment (module docstring) on the FE plant mesh ``mesh_n`` (None on the COM
+    plant); the JSON keys of the 7.4 deployments plus the design's; with ``--compare-plant``
+    the same design (a fresh controller) on the second plant
+    (:func:`tmfem.reference.deployment_plants.compare_plants`)."""
     if args.noise is not None and not (np.isfinite(args.noise) and args.noise >= 0):
         raise InputError(f"--noise: expected a standard deviation >= 0, found {args.noise}")
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
-    dep = lpv_setup(args.preset, plant)
+    dep = reference.lpv_setup(args.preset, plant)
     est = {}          # the output feedback's estimator options (check: lpv-output only)
     if args.estimator_interpolation:
         est["interpolation"] = args.estimator_interpolation
     if (args.estimator_refine or 1) > 1:
-        est["estimator_plant"] = control_lpv.refined_plant(dep.model.system, plant, args.estimator_refine,
+        est["estimator_plant"] = lpv_options.refined_plant(dep.model.system, plant, args.estimator_refine,
                                                            what="estimator plant")
     s, r = _run_on(args, dep, d, args.plant, mesh_n, est)
     # the keys of the 7.4 deployments (tmfem.cli.deploy.run; no PFL: uncertainty, allocation and
@@ -210,21 +167,23 @@ def run(args) -> dict:
             "estimator_interpolation": (args.estimator_interpolation or "multilinear")
             if args.controller == "lpv-output" else None,
             "estimator_refine": (args.estimator_refine or 1) if args.controller == "lpv-output" else None}
-    out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
+    plants = reference.FEPlantOptions.of(args)
+    out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
            **ctrl, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(), **s.info,
            **_figures(r), **info}
-    out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
-                             vtk=args.vtk, title=f"{args.preset} deployment on the {args.plant} plant: {args.controller} "
-                                                 f"(gamma = {d.gamma:.4g}), eq. 5.100"))
+    title = f"{args.preset} deployment on the {args.plant} plant: {args.controller} (gamma = {d.gamma:.4g}), eq. 5.100"
+    out.update(reference.write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
+                                       vtk=args.vtk, title=title))
     if args.compare_plant:
         def rerun(kind):
             _, r2 = _run_on(args, dep, d, kind, mesh_n, est)
             return r2, _figures(r2)
         src = args.lpv_controller or "synthesised here"
-        out["compare"] = compare_plants(
-            args, r, rerun, mesh_n=mesh_n, controller=ctrl,
+        out["compare"] = reference.compare_plants(
+            r, rerun, options=plants, preset=args.preset, csv=args.compare_csv, plot=args.compare_plot,
+            mesh_n=mesh_n, controller=ctrl,
             about=f"gamma = {d.gamma:.4g}, {src}" + (f", noise {args.noise:g}" if args.noise else ""),
             reference="eq. 5.100")
     out["total_wall_time_s"] = time.perf_counter() - t0
-    out["failed_checks"] = diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+    out["failed_checks"] = reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
     return out

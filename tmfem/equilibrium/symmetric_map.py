@@ -21,12 +21,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import minimize
 
 from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
 from tmfem.equilibrium.symmetric import membrane_delta_system
 from tmfem.errors import InputError
 from tmfem.system.geometry import SymmetricConfig, wrap_angle
-
 
 
 def configuration_5_97(system, theta: float, psi: float, *, r=None, z=None,
@@ -169,7 +169,6 @@ def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int =
     dict with ``r``, ``z``, ``sigma`` (length M), ``margin`` (> 0: a positive null vector
     exists), ``Delta`` and ``feasible``.
     """
-    from scipy.optimize import minimize
 
     c = system.symmetric
     if c is None or c.M < 2:

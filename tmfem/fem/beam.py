@@ -511,7 +511,7 @@ class BeamElement:
                 "Q1": kappa * b.G * sec.A * gam[..., 0], "Q2": kappa * b.G * sec.A * gam[..., 3],
                 "T": kt * b.G * (sec.I_t * gam[..., 4] - sec.I_s * gam[..., 2])}
 
-    def centreline(self, state, *, points_per_element: int = 16) -> np.ndarray:
+    def centerline(self, state, *, points_per_element: int = 16) -> np.ndarray:
         """Current axis positions (3, ne * points_per_element) along every element (eq. 4.19
         at r2 = r3 = 0), for plots."""
         r = np.linspace(-1.0, 1.0, points_per_element)

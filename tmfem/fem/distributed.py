@@ -34,7 +34,9 @@ from dataclasses import replace
 import numpy as np
 import scipy.sparse as sp
 
+from tmfem.errors import InputError
 from tmfem.solvers.distributed import DistributedAssembler, comm_world, element_share
+from tmfem.solvers.eigen import lowest_modes
 
 
 def for_backend(backend, elements, state0, T, free):
@@ -176,7 +178,6 @@ class DistributedElements:
         """The k lowest modes of (M omega^2 - K) phi = 0 (eq. 5.32) of a distributed tangent
         K and mass M on the free dofs (:func:`tmfem.solvers.eigen.lowest_modes`), the
         shapes on all reduced dofs (n_r, k), zero at the fixed ones."""
-        from tmfem.solvers.eigen import lowest_modes
         modes = lowest_modes(K, M, k=k, sigma=sigma, backend=backend)
         shapes = np.zeros((self.free.size, modes.shapes.shape[1]))
         shapes[self.free] = modes.shapes
@@ -201,7 +202,6 @@ def _on_pattern(K: sp.csr_matrix, indptr, indices) -> sp.csr_matrix:
     kk = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)) * n + K.indices
     pos = np.minimum(np.searchsorted(keys, kk), keys.size - 1)
     if keys.size == 0 or np.any(keys[pos] != kk):
-        from tmfem.errors import InputError
         raise InputError(f"distributed assembly: expected the tangent of an element set on its "
                          f"pattern of {indices.size} entries, found entries outside it")
     data = np.zeros(indices.size)

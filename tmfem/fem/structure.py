@@ -34,7 +34,8 @@ from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
-from tmfem.solvers import arc_length, lowest_modes, newton
+from tmfem.solvers import arc_length, lowest_modes
+from tmfem.solvers.newton import newton
 from tmfem.solvers.backends import get_backend
 from tmfem.solvers.newton import factorize
 

@@ -46,6 +46,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.fem.shell_section import ShellSection
 from tmfem.system.materials import MembraneMaterial
 
 MEMBRANE_LAWS = ("svk", "tension-field")
@@ -87,7 +88,6 @@ class MembraneLaw:
     name = ""
 
     def __init__(self, material):
-        from tmfem.fem.mitc4 import ShellSection     # mitc4 imports this module
         if not isinstance(material, (MembraneMaterial, ShellSection)):
             raise InputError(f"membrane law: expected a MembraneMaterial or ShellSection, found "
                              f"{type(material).__name__}")

@@ -1,14 +1,23 @@
 """Files for ParaView (meshio): one meshio.Mesh per result (:mod:`tmfem.io.meshes`), written
 by :mod:`tmfem.io.writer`; codes of members and nodes (:mod:`tmfem.io.codes`), the membrane
 as data (:mod:`tmfem.io.fields`), output paths (:mod:`tmfem.io.paths`), time series
-(:mod:`tmfem.io.series`), gmsh meshes (:mod:`tmfem.io.msh`)."""
-from tmfem.io.codes import FAMILY_CODES, KIND_CODES, configuration_cells
-from tmfem.io.fields import MembraneField
-from tmfem.io.meshes import configuration_mesh, modes_mesh
-from tmfem.io.paths import check_dir, check_path
-from tmfem.io.series import SeriesWriter, read_pvd, write_series
-from tmfem.io.writer import write_configuration, write_mesh, write_modes
+(:mod:`tmfem.io.series`), gmsh meshes (:mod:`tmfem.io.msh`).
+"""
+from tmfem._lazy import lazy_exports
 
-__all__ = ["FAMILY_CODES", "KIND_CODES", "MembraneField", "SeriesWriter", "check_dir",
-           "check_path", "configuration_cells", "configuration_mesh", "modes_mesh", "read_pvd",
-           "write_configuration", "write_mesh", "write_modes", "write_series"]
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "FAMILY_CODES": "tmfem.io.codes",
+    "KIND_CODES": "tmfem.io.codes",
+    "configuration_cells": "tmfem.io.codes",
+    "MembraneField": "tmfem.io.fields",
+    "configuration_mesh": "tmfem.io.meshes",
+    "modes_mesh": "tmfem.io.meshes",
+    "check_dir": "tmfem.io.paths",
+    "check_path": "tmfem.io.paths",
+    "SeriesWriter": "tmfem.io.series",
+    "read_pvd": "tmfem.io.series",
+    "write_series": "tmfem.io.series",
+    "write_configuration": "tmfem.io.writer",
+    "write_mesh": "tmfem.io.writer",
+    "write_modes": "tmfem.io.writer"
+})

@@ -123,7 +123,7 @@ def configuration_mesh(system, *, q=None, tendon_forces=None, rest_lengths=None,
 
 
 
-def normalise_cells(cells, n_points: int) -> list:
+def normalize_cells(cells, n_points: int) -> list:
     """Cells as (type, conn (nv, nc)) pairs from a dict or a list of pairs."""
     items = list(cells.items()) if isinstance(cells, dict) else list(cells)
     out = []
@@ -209,7 +209,7 @@ def modes_mesh(base_points, cells, shapes, freq_hz, *, point_data=None, cell_dat
     X, S, f = check_modes(base_points, shapes[:, None] if shapes.ndim == 1 else shapes, freq_hz,
                           points_name="base_points")
     n = X.shape[1]
-    blocks = normalise_cells(cells, n)
+    blocks = normalize_cells(cells, n)
     extra, cdata = block_data(point_data, cell_data, blocks, n)
     pdata = {f"mode_{k + 1}": S[:, k].reshape(n, 3) for k in range(S.shape[1])}
     pdata.update(extra)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.io.meshes import block_data, normalise_cells, to_meshio
+from tmfem.io.meshes import block_data, normalize_cells, to_meshio
 from tmfem.io.writer import write_configuration, write_mesh
 
 
@@ -61,7 +61,7 @@ class SeriesWriter:
         X = np.asarray(points, dtype=float)
         if X.ndim != 2 or X.shape[0] != 3:
             raise InputError(f"points: expected shape (3, n), found {X.shape}")
-        blocks = normalise_cells(cells, X.shape[1])
+        blocks = normalize_cells(cells, X.shape[1])
         pdata, cdata = block_data(point_data, cell_data, blocks, X.shape[1])
         path = write_mesh(self._next(), to_meshio(X, blocks, point_data=pdata, cell_data=cdata))
         return self._commit(time, path)

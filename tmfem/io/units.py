@@ -4,6 +4,7 @@ MPa; angles in rad unless the key ends in ``_deg``), so no number is without its
 from __future__ import annotations
 
 import re
+from tmfem.io.run import column_header
 
 # exact keys, then suffix rules; first match wins
 _EXACT = {
@@ -54,7 +55,6 @@ def unit_of(key: str) -> str | None:
     a key with a unit (e.g. ``rest_lengths``: {tendon: value}) carries that unit; the names of
     states and signals (``theta_11``, ``eta_2_dot``) have the units of the run histories
     (:func:`tmfem.io.run.column_header`)."""
-    from tmfem.io.run import column_header
     if key.startswith("design_grid_"):                 # an LPV design's check on its own grid
         key = key[len("design_grid_"):]
     if key in _EXACT:

@@ -1,4 +1,8 @@
-"""Meshes of the membrane polygon (gmsh) for the finite-element models."""
-from tmfem.mesh.polygon import MembraneMesh, polygon_quad_mesh
+"""Quadrilateral meshes of the membrane polygon (gmsh) for the finite-element models.
+"""
+from tmfem._lazy import lazy_exports
 
-__all__ = ["MembraneMesh", "polygon_quad_mesh"]
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "MembraneMesh": "tmfem.mesh.polygon",
+    "polygon_quad_mesh": "tmfem.mesh.polygon"
+})

@@ -10,7 +10,7 @@ import numpy as np
 from tmfem.post.plots import new_figure, save_figure
 
 #: colour per model (the SBC reference drawn first and thickest)
-MODEL_COLOURS = {"SBC": "black", "MTC": "tab:blue", "COM": "tab:orange"}
+MODEL_COLORS = {"SBC": "black", "MTC": "tab:blue", "COM": "tab:orange"}
 
 
 def plot_model_frequencies(png, r: dict) -> Path:
@@ -21,7 +21,7 @@ def plot_model_frequencies(png, r: dict) -> Path:
     ax, bx = fig.subplots(2, 1, sharex=True)
     n = len(r["printed"]["SBC"])
     k = np.arange(1, n + 1)
-    for m, c in MODEL_COLOURS.items():
+    for m, c in MODEL_COLORS.items():
         ax.plot(k, r["ours"][m][:n], "o-", color=c, ms=5, lw=1, label=f"{m} ours")
         ax.plot(k, r["printed"][m], "s", mfc="none", color=c, ms=8, label=f"{m} printed")
     ax.set_ylabel("natural frequency [Hz]")
@@ -29,7 +29,7 @@ def plot_model_frequencies(png, r: dict) -> Path:
     ax.legend(fontsize=7, ncol=3, loc="upper left")
     ax.grid(True, alpha=0.3)
     for m in ("MTC", "COM"):
-        c = MODEL_COLOURS[m]
+        c = MODEL_COLORS[m]
         bx.plot(k, 100 * np.asarray(r["vs_SBC"]["ours"][m]), "o-", color=c, ms=5, lw=1,
                 label=f"{m} / SBC - 1, ours")
         bx.plot(k, 100 * np.asarray(r["vs_SBC"]["printed"][m]), "s--", mfc="none", color=c, ms=7,
@@ -53,7 +53,7 @@ def plot_vibration_overlay(png, t, signals: dict, names: list, *, title: str = "
     axes = np.atleast_1d(fig.subplots(len(names), 1, sharex=True))
     for ax, s in zip(axes, names):
         angle = s.startswith(("theta", "psi"))
-        for m, c in MODEL_COLOURS.items():
+        for m, c in MODEL_COLORS.items():
             if s in signals.get(m, {}):
                 ax.plot(t, 1e3 * signals[m][s], color=c, lw=1.6 if m == "SBC" else 1.0,
                         ls="-" if m == "SBC" else "--", label=m)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.fem.plane_stress import PlaneStressMembrane, radial_directions
 from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 
 
@@ -24,7 +25,6 @@ def corner_radial_displacements(system, q=None) -> np.ndarray:
     the undeformed corner. For a symmetric system every entry equals Delta of eq. 3.22;
     a membrane is stretched only if all are positive (eq. 3.36).
     """
-    from tmfem.fem.plane_stress import radial_directions
 
     delta = system.corner_displacements(q)[0][:2]
     d = delta - delta.mean(axis=1, keepdims=True)
@@ -55,7 +55,6 @@ def membrane_design_field(system, *, q=None, n: int = 10, attachment: str = "poi
     ``membrane_state`` (0 taut, 1 wrinkled, 2 slack) and ``wrinkle_direction`` (inertial
     frame) of the membrane law's criterion (docs/guides/wrinkling.md).
     """
-    from tmfem.fem.plane_stress import PlaneStressMembrane
 
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise InputError(f"membrane mesh: expected n >= 1, found {n!r}")

@@ -8,6 +8,7 @@ from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 from tmfem.io.paths import check_path
 from tmfem.models.mtc.topology import to_floating
 from tmfem.post.plots import new_figure, save_figure
+from tmfem.fem.tension_field import STATE_NAMES, WRINKLED
 
 
 def membrane_field(model, x: np.ndarray):
@@ -78,7 +79,6 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
-    from tmfem.fem.tension_field import STATE_NAMES, WRINKLED
     png = check_path(png, suffixes=(".png",))
     topo = model.topology
     xm = x[:, :topo.n_mesh]
@@ -87,10 +87,10 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
     wr = model.membrane.wrinkling(xm)
     t = topo.mesh.t
     verts = np.stack([xf[0, t].T, xf[1, t].T], axis=-1)
-    colours = ["#d9d9d9", "#e6550d", "#3182bd"]
+    colors = ["#d9d9d9", "#e6550d", "#3182bd"]
     fig = new_figure(figsize=(7.0, 7.6))
     ax = fig.subplots()
-    pc = PolyCollection(verts, array=wr["state"].astype(float), cmap=ListedColormap(colours),
+    pc = PolyCollection(verts, array=wr["state"].astype(float), cmap=ListedColormap(colors),
                         edgecolors="none")
     pc.set_clim(-0.5, 2.5)
     ax.add_collection(pc)
@@ -107,7 +107,7 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
     ax.set_xlabel("x_f [m]")
     ax.set_ylabel("y_f [m]")
     fr = wr["fractions"]
-    ax.legend(handles=[Patch(color=colours[i], label=f"{n} ({100 * fr[n]:.1f} % of Gauss points)")
+    ax.legend(handles=[Patch(color=colors[i], label=f"{n} ({100 * fr[n]:.1f} % of Gauss points)")
                        for i, n in enumerate(STATE_NAMES)]
               + ([Line2D([], [], color="k", lw=0.8, label="tension (wrinkle) direction")]
                  if w.any() else []),

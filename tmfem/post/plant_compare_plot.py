@@ -62,10 +62,10 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", referenc
     fig = new_figure(figsize=(10.5, 18))
     ax = fig.subplots(7, 1, sharex=True, height_ratios=[1, 1, 1, 1, 1, 0.7, 0.7])
     names = a.names["q"]
-    colours = [f"C{i}" for i in range(10)]
+    colors = [f"C{i}" for i in range(10)]
     bars = []
     for i, k in enumerate(_bar_signals(names)):
-        c = colours[i % 10]
+        c = colors[i % 10]
         bars.append((names[k], c, "-"))
         for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
             ax[0].plot(r.t, np.degrees(r.z[:, k]), ls, color=c, zorder=z)
@@ -77,21 +77,21 @@ def comparison_figure(a, b, dev, *, labels=("A", "B"), title: str = "", referenc
     ax[1].set_ylabel("tracking error q - q_ref [mrad]")
     for i, n in enumerate(a.names["w"]):
         for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
-            ax[2].plot(r.t, 1e3 * r.w[:, i], ls, color=colours[i % 10], zorder=z)
-    _legend_outside(ax[2], [(n, colours[i % 10], "-") for i, n in enumerate(a.names["w"])], labels)
+            ax[2].plot(r.t, 1e3 * r.w[:, i], ls, color=colors[i % 10], zorder=z)
+    _legend_outside(ax[2], [(n, colors[i % 10], "-") for i, n in enumerate(a.names["w"])], labels)
     ax[2].set_ylabel("membrane deflection w [mm]")
     seen = {}
     for j, n in enumerate(a.names["tendons"]):
         seen.setdefault(n.rsplit("_", 1)[0], j)
     for i, j in enumerate(seen.values()):
         for r, ls, z in ((a, "-", 2.0), (b, "--", 2.1)):
-            ax[3].plot(r.t, r.u[:, j], ls, color=colours[i % 10], zorder=z)
+            ax[3].plot(r.t, r.u[:, j], ls, color=colors[i % 10], zorder=z)
             tf = getattr(r, "tendon_force", None)       # a record without forces: no curve
             if tf is not None and tf.size:
-                ax[4].plot(r.t, tf[:, j], ls, color=colours[i % 10], zorder=z)
+                ax[4].plot(r.t, tf[:, j], ls, color=colors[i % 10], zorder=z)
     for x, what in ((ax[3], "rest length"), (ax[4], "tendon force")):
         if x.get_lines():                               # the force panel of a record without forces
-            _legend_outside(x, [(f"{what} {a.names['tendons'][j]}", colours[i % 10], "-")
+            _legend_outside(x, [(f"{what} {a.names['tendons'][j]}", colors[i % 10], "-")
                                 for i, j in enumerate(seen.values())], labels)
     ax[3].set_ylabel("commanded rest length [m]")
     ax[4].set_ylabel("tendon force [N]")

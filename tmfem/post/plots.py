@@ -33,10 +33,10 @@ def mode_styles(k: int) -> list[dict]:
     get 12 different combinations (tab20 colours, four dash patterns, markers)."""
     from matplotlib import colormaps
 
-    colours = colormaps["tab20"].colors
+    colors = colormaps["tab20"].colors
     dashes = ["-", "--", "-.", ":"]
     markers = ["o", "s", "^", "D", "v", "P"]
-    return [{"color": colours[(2 * i) % 20 + (i // 10) % 2], "linestyle": dashes[i % 4],
+    return [{"color": colors[(2 * i) % 20 + (i // 10) % 2], "linestyle": dashes[i % 4],
              "marker": markers[i % 6]} for i in range(k)]
 
 

@@ -77,5 +77,5 @@ def cantilever_end_moment(*, n_elements: int = 5, n_steps: int = 20, E: float = 
     ue, we = elastica(path.lam, L)
     return CantileverRollUp(lam=path.lam, u_tip=u_tip, w_tip=w_tip, u_elastica=ue, w_elastica=we,
                             iterations=list(path.iterations), rejected=path.rejected,
-                            shapes=[beam.centreline(s) for s in path.u], L=L, EI=EI,
+                            shapes=[beam.centerline(s) for s in path.u], L=L, EI=EI,
                             n_elements=n_elements)

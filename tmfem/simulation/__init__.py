@@ -5,7 +5,13 @@
 * :mod:`tmfem.simulation.driver`: :func:`simulate`, Park's method or the trapezoidal rule
   (eqs. 5.34-5.35) on a :class:`tmfem.models.base.Plant` with the controller in the loop.
 """
-from tmfem.simulation.controllers import Controller, LinearController, OpenLoop
-from tmfem.simulation.driver import Simulation, simulate
+from tmfem._lazy import lazy_exports
 
-__all__ = ["Controller", "LinearController", "OpenLoop", "Simulation", "simulate"]
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "Controller": "tmfem.simulation.controllers",
+    "LinearController": "tmfem.simulation.controllers",
+    "OpenLoop": "tmfem.simulation.controllers",
+    "MeasurementNoise": "tmfem.simulation.controllers",
+    "Simulation": "tmfem.simulation.driver",
+    "simulate": "tmfem.simulation.driver"
+})

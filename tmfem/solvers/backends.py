@@ -16,14 +16,17 @@ MUMPS, SLEPc shift-invert, MPI); without petsc4py/slepc4py it raises
 """
 from __future__ import annotations
 
+import hashlib
 from typing import Callable, Protocol
 
 import numpy as np
+import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError
-
+from tmfem.solvers.petsc import PetscBackend
+from tmfem.solvers.singular import SingularMatrix
 
 
 class Backend(Protocol):
@@ -34,10 +37,6 @@ class Backend(Protocol):
     def factorize(self, A) -> Callable[[np.ndarray], np.ndarray]: ...
 
     def eigsh(self, K, M, k: int, sigma: float, v0=None) -> tuple[np.ndarray, np.ndarray]: ...
-
-
-class SingularMatrix(ConvergenceError):
-    """A tangent matrix that cannot be factorised (a mechanism, a slack structure)."""
 
 
 class ScipyBackend:
@@ -98,7 +97,6 @@ class ScipyBackend:
 
     def _permuted(self, A):
         """Nested-dissection permutation of A (cached by sparsity pattern) and P A P^T (csc)."""
-        import hashlib
         key = hashlib.sha1(A.indptr.tobytes() + A.indices.tobytes()).hexdigest() + str(A.shape)
         entry = self._orderings.get(key)
         if entry is None:
@@ -125,7 +123,6 @@ class ScipyBackend:
         1.9500 Hz in 2 of 6 runs; 0 of 8 with the larger space)."""
         n = K.shape[0]
         if k >= n - 1 or (n <= 600 and v0 is None):
-            import scipy.linalg as la
             Kd = K.toarray() if sp.issparse(K) else np.asarray(K)
             Md = M.toarray() if sp.issparse(M) else np.asarray(M)
             try:
@@ -186,15 +183,7 @@ def nested_dissection(A) -> np.ndarray:
     return np.concatenate([members[first[g]:first[g] + counts[g]] for g in np.asarray(order)])
 
 
-def _petsc_backend(**options):
-    """The PETSc/SLEPc backend (:class:`tmfem.solvers.petsc.PetscBackend`, imported lazily;
-    ``options`` its keyword arguments, e.g. ``eig_solver``; PETSc's own options through
-    ``PETSC_OPTIONS``)."""
-    from tmfem.solvers.petsc import PetscBackend
-    return PetscBackend(**options)
-
-
-_BACKENDS = {"scipy": ScipyBackend, "petsc": _petsc_backend}
+_BACKENDS = {"scipy": ScipyBackend, "petsc": PetscBackend}
 
 
 def backend_names() -> list[str]:

@@ -26,19 +26,20 @@ Vectors are replicated (O(n) per rank), matrices and factorisations distributed.
 from __future__ import annotations
 
 import logging
+import time
 
 import numpy as np
 import scipy.sparse as sp
 
 from tmfem import errors
 from tmfem.errors import InputError, TmfemError
+from tmfem.solvers.petsc_loader import petsc_modules
 
 log = logging.getLogger(__name__)
 
 
 def comm_world():
     """mpi4py's COMM_WORLD (through petsc4py, so that PETSc is initialised first)."""
-    from tmfem.solvers.petsc import petsc_modules
     PETSc, _ = petsc_modules()
     return PETSc.COMM_WORLD.tompi4py()
 
@@ -110,7 +111,6 @@ def mpi_main(main, *, report, comm=None, grace: float = 5.0) -> int:
     code: a non-zero exit, never a hang. An unexpected exception (not a
     :class:`TmfemError`) is logged with its traceback.
     """
-    import time
     comm = comm_world() if comm is None else comm
     text, failure = None, None
     try:
@@ -275,7 +275,6 @@ class DistributedAssembler:
     """
 
     def __init__(self, groups, n: int, *, T=None, keep=None, comm=None):
-        from tmfem.solvers.petsc import petsc_modules
         self.PETSc, _ = petsc_modules()
         self.comm = comm_world() if comm is None else comm
         if isinstance(groups, np.ndarray) or (isinstance(groups, list) and groups

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
@@ -63,7 +64,6 @@ def _solver(S, system=None):
     if sp.issparse(S):
         return get_backend(getattr(system, "backend", None)).factorize(S)
     S = np.asarray(S, dtype=float)
-    import scipy.linalg as sla
     lu = sla.lu_factor(S, check_finite=False)
     return lambda b: sla.lu_solve(lu, b, check_finite=False)
 

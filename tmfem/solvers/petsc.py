@@ -43,14 +43,19 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg as la
 import scipy.sparse as sp
 
-from tmfem.errors import BackendUnavailable, ConvergenceError, InputError, ResourceLimit
-from tmfem.solvers.petsc_redundant import RedundantDoesNotFit
+from tmfem.errors import ConvergenceError, InputError, ResourceLimit
+from tmfem.solvers.block_krylov import block_krylov_schur, start_block
+from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather
+from tmfem.solvers.petsc_loader import petsc_modules
+from tmfem.solvers.petsc_redundant import (RedundantDoesNotFit, default_budget_mb,
+                                           redundant_shift_invert)
+from tmfem.solvers.singular import SingularMatrix
 
 log = logging.getLogger(__name__)
 
-PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/guides/backends.md)"
 
 #: right-hand sides per MUMPS solve of the block eigensolver, on 1 rank and on the parallel
 #: factors of P > 1 ranks (4: 80-84 columns for 12 modes against 120-136 with 8, 53 single
@@ -70,22 +75,6 @@ _KSP_REASONS = {-2: "DIVERGED_NULL", -3: "DIVERGED_ITS", -4: "DIVERGED_DTOL",
                 -5: "DIVERGED_BREAKDOWN", -6: "DIVERGED_BREAKDOWN_BICG",
                 -7: "DIVERGED_NONSYMMETRIC", -8: "DIVERGED_INDEFINITE_PC", -9: "DIVERGED_NANORINF",
                 -10: "DIVERGED_INDEFINITE_MAT", -11: "DIVERGED_PC_FAILED"}
-
-
-def petsc_modules():
-    """``(PETSc, SLEPc)`` imported (and initialised) lazily; :class:`BackendUnavailable`
-    naming the install command when petsc4py/slepc4py are missing or do not load."""
-    try:
-        import petsc4py
-        import slepc4py
-        petsc4py.init()
-        slepc4py.init()
-        from petsc4py import PETSc
-        from slepc4py import SLEPc
-    except ImportError as exc:
-        raise BackendUnavailable(f"backend 'petsc': expected petsc4py and slepc4py importable, found "
-                                 f"{exc}; install with: {PETSC_INSTALL}") from None
-    return PETSc, SLEPc
 
 
 def parse_options(options) -> dict:
@@ -133,7 +122,6 @@ def _is_number(tok: str) -> bool:
 def _shift_invert_failure(sigma: float, exc):
     """The :class:`SingularMatrix` of a failing factorisation of K - sigma M (PETSc error
     ``exc``) in an eigen solve."""
-    from tmfem.solvers.backends import SingularMatrix
     return SingularMatrix(f"eigen (petsc): expected K - sigma M non-singular for sigma={sigma:g}, "
                           f"found the shift-invert factorisation failing (PETSc error {exc.ierr})")
 
@@ -254,7 +242,6 @@ class PetscBackend:
         """(PETSc Mat, key) of A: a DistributedMatrix's Mat, or this rank's rows of a
         replicated scipy matrix. With ``cache`` a new A of an earlier pattern only updates
         that Mat's values, so that MUMPS keeps its symbolic analysis."""
-        from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix
         if isinstance(A, (DistributedMatrix, ShiftedMatrix)):
             return self._dist_mat(A, cache=cache)
         if not sp.issparse(A):
@@ -292,7 +279,6 @@ class PetscBackend:
         and one MUMPS analysis per pattern, whichever assembled matrix of the pattern or
         shift of it comes; a later update of A leaves the factors of this one intact), the
         shift added to its diagonal."""
-        from tmfem.solvers.distributed import ShiftedMatrix
         base = A.base if isinstance(A, ShiftedMatrix) else A
         if not cache and base is A:
             return A.mat, None
@@ -416,7 +402,6 @@ class PetscBackend:
         the same sparsity pattern reuses the PETSc objects (and MUMPS' analysis): an older
         ``solve`` of that pattern then raises instead of silently using the new factors.
         """
-        from tmfem.solvers.backends import SingularMatrix
         PETSc = self.PETSc
         self._reap()
         M, key = self._mat(A)
@@ -544,7 +529,6 @@ class PetscBackend:
 
     def gather(self, vec) -> np.ndarray:
         """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
-        from tmfem.solvers.distributed import gather
         return gather(vec)
 
     # ------------------------------------------------------------------ eigenproblems
@@ -554,7 +538,6 @@ class PetscBackend:
         :mod:`tmfem.solvers.block_krylov` for symmetric K, M of at least
         :data:`EIG_BLOCK_MIN_N` unknowns (``eig_solver`` "block" or "auto"), else SLEPc's
         Krylov-Schur; V (n, k) M-orthonormal."""
-        import scipy.linalg as la
         self._reap()
         Kp, _ = self._mat(K, cache=False)
         Mp, _ = self._mat(M, cache=False)
@@ -563,7 +546,7 @@ class PetscBackend:
         if not 1 <= k < n:
             raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
         sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
-        reuse = self._analysed(K, M) if sym else None
+        reuse = self._analyzed(K, M) if sym else None
         w = None
         self.last_eig_solver = "slepc"
         if self.eig_solver in ("block", "redundant") and sym and n >= EIG_BLOCK_MIN_N:
@@ -592,7 +575,7 @@ class PetscBackend:
         o = np.argsort(w)
         return w[o], V[:, o]
 
-    def _analysed(self, K, M):
+    def _analyzed(self, K, M):
         """The cache entry (Mat, KSP: MUMPS' analysis done) of the tangent K's pattern when
         the eigen solve can factorise K - sigma M in it, else None.
 
@@ -604,7 +587,6 @@ class PetscBackend:
         PETSc's PCSetUp redoes the symbolic factorisation only when the nonzero pattern
         changes). Not with ``st_`` options (they configure the eigen solve's own KSP), an
         iterative solver or a matrix of another kind. Collective (the subset check)."""
-        from tmfem.solvers.distributed import DistributedMatrix
         if not (self.solver == "direct" and type(K) is DistributedMatrix
                 and type(M) is DistributedMatrix):
             return None
@@ -672,8 +654,6 @@ class PetscBackend:
         sequential ones (:mod:`tmfem.solvers.petsc_redundant`) with EIG_BLOCK_REDUNDANT
         right-hand sides per solve, split by columns over the ranks; :class:`RedundantDoesNotFit` when they
         exceed the memory budget (nothing left allocated)."""
-        from tmfem.solvers.block_krylov import block_krylov_schur, start_block
-        from tmfem.solvers.petsc_redundant import default_budget_mb, redundant_shift_invert
         PETSc = self.PETSc
         n = Kp.getSize()[0]
         comm = self.comm.tompi4py()

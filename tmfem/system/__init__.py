@@ -1,11 +1,24 @@
-"""System description (dissertation ch. 2): topology, geometry, materials, files, presets."""
-from tmfem.system.geometry import SymmetricConfig, bar_direction, beta, membrane_corners_regular
-from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
-from tmfem.system.presets import list_presets, load_preset
-from tmfem.system.spec import dump_system, load_system, system_from_dict, system_to_dict
-from tmfem.system.system import System
-from tmfem.system.topology import Tendon, tendon_topology
+"""System description (dissertation ch. 2): topology, geometry, materials, files and presets.
+Every model is built from one :class:`System` (:func:`load_system` reads a TOML file,
+:func:`load_preset` a packaged system of the dissertation).
+"""
+from tmfem._lazy import lazy_exports
 
-__all__ = ["System", "SymmetricConfig", "Tendon", "MembraneMaterial", "BarSection", "TendonSection",
-           "bar_direction", "beta", "membrane_corners_regular", "tendon_topology", "load_system",
-           "dump_system", "system_from_dict", "system_to_dict", "load_preset", "list_presets"]
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "SymmetricConfig": "tmfem.system.geometry",
+    "bar_direction": "tmfem.system.geometry",
+    "beta": "tmfem.system.geometry",
+    "membrane_corners_regular": "tmfem.system.geometry",
+    "BarSection": "tmfem.system.materials",
+    "MembraneMaterial": "tmfem.system.materials",
+    "TendonSection": "tmfem.system.materials",
+    "list_presets": "tmfem.system.presets",
+    "load_preset": "tmfem.system.presets",
+    "dump_system": "tmfem.system.spec",
+    "load_system": "tmfem.system.spec",
+    "system_from_dict": "tmfem.system.spec",
+    "system_to_dict": "tmfem.system.spec",
+    "System": "tmfem.system.system",
+    "Tendon": "tmfem.system.topology",
+    "tendon_topology": "tmfem.system.topology"
+})

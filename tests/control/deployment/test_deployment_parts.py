@@ -85,7 +85,7 @@ def test_input_matrix_check_refuses_singular_and_nonsquare():
 
 
 def test_rbf_values():
-    r = GaussianRBF(centres=[[0.0, 0.0], [1.0, 0.0]], sigma=0.5)
+    r = GaussianRBF(centers=[[0.0, 0.0], [1.0, 0.0]], sigma=0.5)
     phi = r(np.array([0.0, 0.5]))
     # eq. 5.44: |v - c|^2 = 0.25 and 1.25
     assert np.allclose(phi, np.exp(-np.array([0.25, 1.25]) / (2 * 0.25)))
@@ -248,8 +248,8 @@ def test_2_3_path_on_the_table_7_7_rule():
     # the 2-3 reference with the stage-2 base rule of Table 7.7 (deployment_bases): it ends
     # on the presets, keeps Delta = 1 mm (eq. 3.22, the rule's definition) along the path and
     # every point is a symmetric equilibrium (positive null vector of 3.3.2)
-    from tmfem.cli.deploy import setup
-    from tmfem.control.deployment.run import _equilibrium_checker
+    from tmfem.reference.deployments import setup
+    from tmfem.control.deployment.run import equilibrium_checker
     from tmfem.equilibrium.symmetric import membrane_delta_system
     from tmfem.equilibrium.symmetric_map import with_configuration
     from tmfem.reference.tables import deployment_bases
@@ -259,7 +259,7 @@ def test_2_3_path_on_the_table_7_7_rule():
     assert np.allclose(ref(0.0)[0], i.q, atol=1e-6)
     d = ref(80.0)[0] - f.q
     assert np.allclose(np.angle(np.exp(1j * d)), 0, atol=1e-6)
-    ss = ref.check_equilibria(checker=_equilibrium_checker(f), n=6)
+    ss = ref.check_equilibria(checker=equilibrium_checker(f), n=6)
     for s in ss:
         assert membrane_delta_system(with_configuration(f, ref.config(s))) == pytest.approx(1e-3, rel=1e-6)
     # a rule that misses an end is refused
@@ -293,7 +293,7 @@ def test_1ND_delta_path_keeps_the_stretch_linear():
     # 1-N(D): psi_r from eq. 3.22 with Delta linear in the progress s between its end values
     # (closed form of eq. 3.22 via SymmetricConfig.membrane_delta); ends on the presets,
     # equilibria along it (eq. 3.41), the stage-count and rule conflicts refused
-    from tmfem.control.deployment.run import _equilibrium_checker
+    from tmfem.control.deployment.run import equilibrium_checker
     f, i = load_preset("1-4D"), load_preset("1-4D-initial")
     ref = DeploymentReference(initial=i.symmetric, final=f.symmetric, N=4, q_names=list(f.q_names),
                               omega_r=0.7, r_mb=f.r_mb)
@@ -301,7 +301,7 @@ def test_1ND_delta_path_keeps_the_stretch_linear():
     for s in (0.0, 0.3, 0.7, 1.0):
         assert ref.config(s).membrane_delta(4, f.r_mb) == pytest.approx(D0 + s * (De - D0), abs=1e-12)
     assert np.allclose(ref(0.0)[0], i.q, atol=1e-9)
-    ref.check_equilibria(checker=_equilibrium_checker(f), n=6)
+    ref.check_equilibria(checker=equilibrium_checker(f), n=6)
     f23 = load_preset("2-3-deploy")
     with pytest.raises(InputError, match="one-stage"):
         DeploymentReference(initial=load_preset("2-3-deploy-initial").symmetric, final=f23.symmetric,
@@ -321,7 +321,7 @@ def test_partition_with_several_force_columns(model14):
 
 
 def test_setup_refuses_a_path_of_the_other_system_kind():
-    from tmfem.cli.deploy import setup
+    from tmfem.reference.deployments import setup
     with pytest.raises(InputError, match="expected 'linear' or 'delta'"):
         setup("1-4D", path="table-7-7-bases")
     with pytest.raises(InputError, match="allocation"):

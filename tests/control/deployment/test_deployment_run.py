@@ -6,7 +6,7 @@ import os
 import numpy as np
 import pytest
 
-from tmfem.cli.deploy import setup
+from tmfem.reference.deployments import setup
 from tmfem.control.deployment.run import run_deployment
 
 REDUCED = os.environ.get("TMFEM_SLOW_SCALE") == "reduced"

@@ -64,12 +64,12 @@ def test_rigid_fit_of_two_node_bars_is_their_chord(preset):
 def test_sbc_plant_measures_the_rigid_fit_by_default(dep):
     """The SBC plant's bar measurement defaults to the rigid fit (the chords see the beams'
     bending modes, docs/guides/fe-plant.md), on the library's plant as on the CLI's."""
-    from tmfem.cli.deploy import plant_arguments
+    from tmfem.reference.deployment_plants import FEPlantOptions
     from tmfem.cli import build_parser
     s, init, plant, _ = dep
     assert plant.estimator.bars == "rigid"
     args = build_parser().parse_args(["deploy", "--preset", "1-4D", "--plant", "sbc"])
-    assert plant_arguments(args, "sbc")["bars"] == "rigid"
+    assert FEPlantOptions.of(args).arguments("sbc")["bars"] == "rigid"
     assert FEStatePlant(plant.dyn, s.model, bars="chord").estimator.bars == "chord"
 
 

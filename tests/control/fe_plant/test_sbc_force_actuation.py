@@ -170,12 +170,13 @@ def test_force_actuation_sets_the_pfl_tendon_model_and_the_json():
     """With force actuation the FE plant's tendons follow the COM's law at the measured q, so
     the PFL's tendon model is the COM's fixed rates (no model-error warning for either plant
     of a comparison), and the JSON names the actuation."""
-    from tmfem.cli.deploy import controlled_tendon_law, fe_tendon_model, plant_options
+    from tmfem.reference.deployment_plants import FEPlantOptions
     parse = build_parser().parse_args
     a = parse(["deploy", "--preset", "2-3-deploy", "--plant", "mtc", "--plant-actuation", "force",
                "--compare-plant", "com"])
-    assert fe_tendon_model(a) == "fixed-rate"
-    assert controlled_tendon_law(a, "mtc") == controlled_tendon_law(a, "com") == "fixed-rate"
-    assert plant_options(a, "mtc", 2)["plant_actuation"] == "force"
+    assert FEPlantOptions.of(a).fe_tendon_model() == "fixed-rate"
+    o = FEPlantOptions.of(a)
+    assert o.controlled_tendon_law("mtc") == o.controlled_tendon_law("com") == "fixed-rate"
+    assert FEPlantOptions.of(a).summary("mtc", 2)["plant_actuation"] == "force"
     b = parse(["deploy", "--preset", "2-3-deploy", "--plant", "mtc"])
-    assert fe_tendon_model(b) == "cable"
+    assert FEPlantOptions.of(b).fe_tendon_model() == "cable"

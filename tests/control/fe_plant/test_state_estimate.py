@@ -126,7 +126,7 @@ def test_deployment_start_on_the_mtc_plant():
     its own equilibrium of the packaged design (within 2.5 mrad of the COM's z0), the run
     records the estimated state and the FE report, and the bars follow the reference within
     5 mrad (the COM plant: within 1.7 mrad; docs/guides/fe-plant.md)."""
-    from tmfem.cli.deploy import setup
+    from tmfem.reference.deployments import setup
     from tmfem.control.deployment.run import run_deployment
     from tmfem.control.fe_plant.state_estimate import mtc_deployment_plant
     s = setup("2-3-deploy", controller="adaptive")

@@ -10,7 +10,8 @@ import pytest
 from tests.control.lpv.test_lpv_output_feedback import W_E, W_U, oscillator
 from tmfem.control.lpv.certificate import rate_bounded_certificate
 from tmfem.control.lpv.output_feedback import design_output_feedback, verify_output_feedback
-from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
+from tmfem.control.lpv.generalized_plant import interconnection_8_1
+from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.errors import InfeasibleController, InputError
 
 

@@ -2,7 +2,7 @@
 import numpy as np
 
 from tmfem.control.lpv.plant import com_lpv_plant
-from tmfem.control.lpv.synthesis import interconnection_8_1
+from tmfem.control.lpv.generalized_plant import interconnection_8_1
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.model import ControlOrientedModel
@@ -10,7 +10,7 @@ from tmfem.reference.tables import deployment_bases
 from tmfem.system import load_preset
 
 
-def test_com_lpv_plant_point_coordinates_keep_the_frequencies_and_integrators_are_stabilisable():
+def test_com_lpv_plant_point_coordinates_keep_the_frequencies_and_integrators_are_stabilizable():
     s = load_preset("2-3-lpv")
     th, ps = np.radians([63.0, 77.32]), np.radians([8.36])
     pl = com_lpv_plant(s, theta=th, psi=ps, bases=deployment_bases(s))

@@ -4,9 +4,10 @@ middle value and starts the full grid from that design (docs/guides/lpv.md)."""
 import numpy as np
 import pytest
 
-from tmfem.control.lpv.bisect import _coefficients, bisect_gamma, collapsed
+from tmfem.control.lpv.bisect import bisect_gamma, collapsed
 from tmfem.control.lpv.bounds import pointwise_state_feedback_bound
-from tmfem.control.lpv.synthesis import Coordinates, GeneralisedLPV
+from tmfem.control.lpv.coordinates import Coordinates
+from tmfem.control.lpv.generalized_plant import GeneralizedLPV
 from tmfem.control.lpv.verify import verify
 from tmfem.errors import InputError
 
@@ -18,7 +19,7 @@ def two_parameter_oscillator(n_a=3, n_b=3):
     s = (n_a, n_b)
     A = np.array([[[[0, 1], [-(1 + ai), -0.1 - 0.2 * bj]] for bj in b] for ai in a])
     B = np.broadcast_to([[0.0], [1.0]], s + (2, 1))
-    gp = GeneralisedLPV.from_matrices(
+    gp = GeneralizedLPV.from_matrices(
         axes=[a, b], parameter_names=["a", "b"], rate_bounds=[[-0.5, 0.5], [-0.5, 0.5]], A=A, B1=B, B2=B,
         C1=np.broadcast_to([[1.0, 0], [0, 0]], s + (2, 2)), D11=np.zeros(s + (2, 1)),
         D12=np.broadcast_to([[0.0], [0.3]], s + (2, 1)))
@@ -78,7 +79,7 @@ def test_sampled_bisection_starts_from_the_collapsed_grid_design():
     sub = collapsed(gp, 1)
     sub_ctrl, _ = bisect_gamma(sub, lower=lb, upper=2 * lb, rtol=0.05, sample_time=dt)
     co = Coordinates.of(gp)
-    Ps, Qs = _coefficients(sub_ctrl, co, gp)
+    Ps, Qs = co.coefficients_of(sub_ctrl, gp)
     assert len(Ps) == 3 and not Ps[2].any() and not Qs[2].any()
     for a in gp.axes[0]:
         c = co.c_of([a, 0.5])
@@ -103,13 +104,13 @@ def test_a_full_grid_design_restricted_to_the_line_is_a_sub_grid_design():
     # why a level not found on the collapsed grid is carried into the full grid's bracket: the
     # full grid's P(rho), Q(rho) on the line b = 0.5 (normalised b = 0) hold the sub-grid's LMIs
     # at the same gamma (its points are full-grid points; the rate vertices +-v_b average out)
-    from tmfem.control.lpv.synthesis import LPVStateFeedback
+    from tmfem.control.lpv.state_feedback import LPVStateFeedback
     gp = two_parameter_oscillator()
     lb = pointwise_state_feedback_bound(gp).lower_bound
     ctrl, _ = bisect_gamma(gp, lower=lb, upper=2 * lb, rtol=0.05)
     assert ctrl.varying == [0, 1]
     sub = collapsed(gp, 1)
-    line = LPVStateFeedback(gamma=ctrl.gamma, P=ctrl.P[:2], Q=ctrl.Q[:2], centre=ctrl.centre,
+    line = LPVStateFeedback(gamma=ctrl.gamma, P=ctrl.P[:2], Q=ctrl.Q[:2], center=ctrl.center,
                             half_width=ctrl.half_width, varying=[0], axes=sub.axes, parameter_names=["a", "b"],
                             rate_bounds=ctrl.rate_bounds, state_names=ctrl.state_names, solver="restricted",
                             status="", solve_time=0.0, build_time=0.0, sizes={}, max_lmi_eig=np.nan, min_P_eig=np.nan)

@@ -9,7 +9,8 @@ from tmfem.control.linear.hinf_riccati import state_feedback_gamma
 from tmfem.control.lpv.bounds import pointwise_state_feedback_bound
 from tmfem.control.lpv.controller import LPVController
 from tmfem.control.lpv.plant import GriddedLPV
-from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
+from tmfem.control.lpv.generalized_plant import interconnection_8_1
+from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.errors import InputError
 
 X0 = 0.5        # equilibrium position of the oscillator at every grid point

@@ -50,7 +50,8 @@ def test_measured_wrapper_refuses_a_non_controller():
 def design21(tmp_path_factory):
     """A 2 x 1 grid design at gamma = 20 with the sampled-loop LMI at dt = 0.01 s, saved."""
     from tmfem.control.lpv.plant import com_lpv_plant
-    from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
+    from tmfem.control.lpv.generalized_plant import interconnection_8_1
+    from tmfem.control.lpv.synthesis import synthesize_state_feedback
     from tmfem.reference.tables import deployment_bases
     from tmfem.system import load_preset
     s = load_preset("2-3-lpv")
@@ -67,7 +68,7 @@ def test_measurement_starts_at_the_design_equilibrium(design21):
     # at the start (theta = 77.32, psi = 8.36 deg, at rest) the measured LPV state is the
     # equilibrium x_e of that grid point and the scheduling parameters are its angles
     from tmfem.reference.deployments import lpv_setup
-    from tmfem.control.lpv.synthesis import LPVStateFeedback
+    from tmfem.control.lpv.state_feedback import LPVStateFeedback
     pl, d, path = design21
     dep = lpv_setup("2-3-lpv", pl)
     y = dep.measure(np.concatenate([dep.z0, np.zeros_like(dep.z0)]))

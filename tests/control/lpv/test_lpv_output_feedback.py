@@ -8,7 +8,8 @@ import scipy.linalg as sla
 from tmfem.control.lpv.output_feedback import (LPVOutputController, design_output_feedback, kalman_gain,
                                       sampled_closed_loops, verify_output_feedback)
 from tmfem.control.lpv.plant import GriddedLPV
-from tmfem.control.lpv.synthesis import interconnection_8_1, synthesize_state_feedback
+from tmfem.control.lpv.generalized_plant import interconnection_8_1
+from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.errors import InfeasibleController, InputError
 from tmfem.simulation.controllers import LinearController, MeasurementNoise
 

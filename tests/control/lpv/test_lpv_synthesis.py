@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from tmfem.control.lpv.plant import GriddedLPV
-from tmfem.control.lpv.synthesis import GeneralisedLPV, synthesize_state_feedback
+from tmfem.control.lpv.generalized_plant import GeneralizedLPV
+from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.control.lpv.verify import verify
 from tmfem.errors import InfeasibleController, InputError
 
@@ -11,7 +12,7 @@ from tmfem.errors import InfeasibleController, InputError
 def scalar_gp(a, rate=0.0):
     """x' = a(rho) x + w + u, p = [x; u] on a grid rho = 0, 1, ..."""
     a = np.asarray(a, dtype=float); s = (a.size,)
-    return GeneralisedLPV.from_matrices(
+    return GeneralizedLPV.from_matrices(
         axes=[np.arange(a.size, dtype=float)], parameter_names=["r"], rate_bounds=[[-rate, rate]],
         A=a.reshape(s + (1, 1)), B1=np.ones(s + (1, 1)), B2=np.ones(s + (1, 1)),
         C1=np.broadcast_to([[1.0], [0.0]], s + (2, 1)), D11=np.zeros(s + (2, 1)),
@@ -82,7 +83,7 @@ def test_single_point_zero_rate_is_the_lti_state_feedback_problem():
     import control
     A, B1, B2, C1, D12 = lti_plant()
     nw = 2
-    gp = GeneralisedLPV.from_matrices(axes=[[0.0]], parameter_names=["r"], rate_bounds=[[0, 0]],
+    gp = GeneralizedLPV.from_matrices(axes=[[0.0]], parameter_names=["r"], rate_bounds=[[0, 0]],
                                       A=A[None], B1=B1[None], B2=B2[None], C1=C1[None],
                                       D11=np.zeros((1, 2, nw)), D12=D12[None])
     r = synthesize_state_feedback(gp, margin=1e-9)
@@ -107,7 +108,7 @@ def oscillator_plant(shift=0.0):
 
 def gp_of(plant):
     s = plant.grid_shape
-    return GeneralisedLPV.from_matrices(
+    return GeneralizedLPV.from_matrices(
         axes=plant.axes, parameter_names=plant.parameter_names, rate_bounds=plant.rate_bounds,
         A=plant.A, B1=plant.B, B2=plant.B, C1=np.concatenate([plant.C, np.zeros(s + (1, 2))], -2),
         D11=np.zeros(s + (2, 1)), D12=np.broadcast_to([[0.0], [0.3]], s + (2, 1)))
@@ -164,7 +165,7 @@ def test_off_grid_verification_passes_and_refuses_a_wrong_plant():
     assert not verify(ctrl, bad, allow_failure=True).passed
 
 
-def test_eigenvalue_optimisation_finds_a_feasible_point_above_the_optimum_only():
+def test_eigenvalue_optimization_finds_a_feasible_point_above_the_optimum_only():
     # the conic optimum (Clarabel) of the oscillator; EIGOPT at a fixed level above it returns a
     # controller whose re-computed LMIs are negative and that passes the off-grid check, below
     # it none (a feasibility method cannot beat the optimum)
@@ -179,12 +180,12 @@ def test_eigenvalue_optimisation_finds_a_feasible_point_above_the_optimum_only()
         synthesize_state_feedback(gp_of(pl), solver="EIGOPT")
 
 
-def test_threaded_eigendecompositions_give_the_serial_optimisation():
+def test_threaded_eigendecompositions_give_the_serial_optimization():
     # source: the same optimisation without threads (workers=1), both at one BLAS thread: the
     # threads decompose disjoint parts of the stack, so every evaluation is bit for bit the same
     from threadpoolctl import threadpool_limits
     from tmfem.control.lpv.eigopt import EigOpt
-    from tmfem.control.lpv.synthesis import Coordinates
+    from tmfem.control.lpv.coordinates import Coordinates
     pl = oscillator_plant()
     gp = gp_of(pl.resampled(pl.refined(2)))              # 5 grid points x 2 rate vertices
     co = Coordinates.of(gp)

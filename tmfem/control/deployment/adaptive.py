@@ -169,9 +169,9 @@ class AdaptivePFL:
         if model.membrane_points is not None:
             raise InputError("adaptive PFL: expected a model in modal coordinates "
                              "(membrane_points=None), found point coordinates")
-        if rbf.centres.shape[1] != 2 * model.nq:
+        if rbf.centers.shape[1] != 2 * model.nq:
             raise InputError(f"RBF centres: expected {2 * model.nq} columns (v_q = [q; q']), "
-                             f"found {rbf.centres.shape[1]}")
+                             f"found {rbf.centers.shape[1]}")
         if not (gamma > 0 and alpha > 0 and beta > 0):
             raise InputError(f"expected Gamma, alpha, beta > 0, found {gamma}, {alpha}, {beta}")
         self.model, self.reference, self.gains, self.rbf = model, reference, gains, rbf
@@ -290,7 +290,7 @@ class AdaptivePFL:
         return np.asarray(y)[: self.nq] - self.reference(t)[0]
 
 
-def reference_centres(reference, *, t_end: float, m: int) -> tuple[np.ndarray, float]:
+def reference_centers(reference, *, t_end: float, m: int) -> tuple[np.ndarray, float]:
     """RBF centres on the reference: v_c,i = [q_d(t_i); q_d'(t_i)] at m times evenly spaced
     over [0, t_end], and the width sigma_q = the largest distance between consecutive
     centres (neighbouring Gaussians overlap at exp(-1/2)). Our choice: 7.4 does not print

@@ -16,6 +16,8 @@ import weakref
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.models.com.graphs import BufferedFunction
+from tmfem.models.com.kinematics import tendon_lengths_sx
 
 #: compiled functions by id(system), with a weak reference that identifies the system
 _FUNCTIONS: dict = {}
@@ -27,9 +29,7 @@ def tendon_lengths(system, q) -> np.ndarray:
     entry = _FUNCTIONS.get(id(system))
     if entry is None or entry["system"]() is not system:
         import casadi as ca
-        from tmfem.models.com.kinematics import tendon_lengths_sx
         qs = ca.SX.sym("q", q.size)
-        from tmfem.models.com.graphs import BufferedFunction
         f = ca.Function("tendon_lengths", [qs], [ca.densify(tendon_lengths_sx(system, qs))])
         entry = {"f": BufferedFunction(f),
                  "system": weakref.ref(system, lambda _, k=id(system): _FUNCTIONS.pop(k, None)),

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import lsq_linear
 
 from tmfem.errors import InputError, SingularInputMatrix
 
@@ -120,7 +121,6 @@ def bounded_inversion(terms: PFLTerms, v, *, lower, upper,
         u = np.linalg.solve(terms.B_q, v)
     if np.all(u >= lower) and np.all(u <= upper):
         return u, False
-    from scipy.optimize import lsq_linear
     R = np.linalg.cholesky(0.5 * (terms.M_q + terms.M_q.T)).T if R is None else R
     A, b = R @ terms.B_q, R @ v
     if damping:

@@ -30,19 +30,19 @@ from tmfem.errors import InputError
 class GaussianRBF:
     """m Gaussian functions (eq. 5.44) with centres C (m, n_v) and one width sigma."""
 
-    def __init__(self, *, centres, sigma: float):
-        self.centres = np.atleast_2d(np.asarray(centres, dtype=float))
+    def __init__(self, *, centers, sigma: float):
+        self.centers = np.atleast_2d(np.asarray(centers, dtype=float))
         if not (np.isfinite(sigma) and sigma > 0):
             raise InputError(f"RBF width sigma_q: expected > 0, found {sigma!r}")
         self.sigma = float(sigma)
 
     @property
     def m(self) -> int:
-        return self.centres.shape[0]
+        return self.centers.shape[0]
 
     def __call__(self, v) -> np.ndarray:
         """Phi(v), shape (m,) (eq. 5.44)."""
-        d = self.centres - np.asarray(v, dtype=float)[None, :]
+        d = self.centers - np.asarray(v, dtype=float)[None, :]
         return np.exp(-np.einsum("ij,ij->i", d, d) / (2 * self.sigma**2))
 
 

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from tmfem.errors import InputError, InfeasibleDesign
 from tmfem.system.geometry import SymmetricConfig, wrap_angle
@@ -196,7 +197,6 @@ class DeploymentReference:
         (s = 0 and s = 1 among them). Returns its coefficients (4, N_PATH, n_q), highest
         power first, for q, dq/ds and d2q/ds2 of the chain rule of q_d' and q_d''."""
         if getattr(self, "_spline", None) is None:
-            from scipy.interpolate import CubicSpline
             ss = np.linspace(0.0, 1.0, N_PATH + 1)
             self._spline = CubicSpline(ss, np.array([self.q_of_s(s) for s in ss]), axis=0).c
         return self._spline

@@ -28,10 +28,19 @@ from dataclasses import dataclass, field
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from tmfem.control.deployment.adaptive import ALLOCATION, AdaptivePFL, reference_centers
 from tmfem.control.deployment.limits import RestLengthLimits
-from tmfem.control.deployment.switching import relative_error
-from tmfem.errors import ConvergenceError, InputError
+from tmfem.control.deployment.rbf import GaussianRBF
+from tmfem.control.deployment.recovery import StressRecovery
+from tmfem.control.deployment.reference_trajectory import DeploymentReference
+from tmfem.control.deployment.switching import SwitchingController, relative_error
+from tmfem.control.linear.deployed_design import deployed_hinf
+from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
+from tmfem.equilibrium.symmetric import check_1ND, membrane_delta_system
+from tmfem.equilibrium.symmetric_map import with_configuration
+from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
 from tmfem.models.com.linearize import linearize
+from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.models.com.plant import COMPlant
 from tmfem.simulation.controllers import LinearController
 from tmfem.simulation.driver import simulate
@@ -120,7 +129,6 @@ def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central")
     -------
     controller, measure, gamma
     """
-    from tmfem.control.linear.deployed_design import deployed_hinf
     if method not in HINF_NAMES:
         raise InputError(f"H-infinity method: expected one of {sorted(HINF_NAMES)}, found {method!r}")
     d = deployed_hinf(system, membrane_modes=membrane_modes, method=method)
@@ -215,7 +223,6 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     solve, the COM's Newton matrices), where OpenBLAS threads cost more than they give (a
     71 x 71 solve: 0.16 ms on one thread, 1.2-9 ms on two threads of a loaded 2-core
     machine)."""
-    from tmfem.control.deployment.recovery import StressRecovery
     if stress_every < 1:
         raise InputError(f"stress_every: expected >= 1, found {stress_every}")
     plant = StatePlant(model, z0=z0) if plant is None else plant
@@ -307,7 +314,7 @@ class DeploymentSetup:
 
 def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      output_points=None, linear: str = "lqr", R_c: float = 0.01,
-                     n_centres: int = 10, w_bar: float = 100.0, gamma: float = 0.01,
+                     n_centers: int = 10, w_bar: float = 100.0, gamma: float = 0.01,
                      u_m: float = 0.01, membrane_modes: int | None = None,
                      check_path: bool = True, bases=None, allocation: str = "bounded",
                      hinf_method: str = "central", r_min: float = 1e-3,
@@ -325,12 +332,6 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     Riccati on [q, w]). ``evaluation``: where the PFL evaluates its model terms, at the
     measured state (eq. 5.58) or at the reference; ``tendon_law``: the PFL's tendon model,
     the rates of eq. 5.19 or k = EA / u (:mod:`tmfem.control.deployment.adaptive`)."""
-    from tmfem.control.deployment.adaptive import AdaptivePFL, reference_centres
-    from tmfem.control.deployment.reference_trajectory import DeploymentReference
-    from tmfem.control.deployment.rbf import GaussianRBF
-    from tmfem.control.deployment.switching import SwitchingController
-    from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
-    from tmfem.control.deployment.adaptive import ALLOCATION
     if allocation not in ALLOCATION:
         raise InputError(f"allocation: expected one of {ALLOCATION}, found {allocation!r}")
     if linear not in ("lmi", "lqr", "hinf", "none"):
@@ -343,15 +344,15 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                               q_names=list(final.q_names), omega_r=omega_r, bases=bases,
                               r_mb=final.r_mb if delta_path else None)
     if check_path:
-        ref.check_equilibria(checker=_equilibrium_checker(final))
+        ref.check_equilibria(checker=equilibrium_checker(final))
     t_settle = 8.0 / omega_r
-    C, sig = reference_centres(ref, t_end=t_settle, m=n_centres)
-    ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centres=C, sigma=sig),
+    C, sig = reference_centers(ref, t_end=t_settle, m=n_centers)
+    ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centers=C, sigma=sig),
                      w_bar=w_bar, gamma=gamma, uncertainty=uncertainty, allocation=allocation,
                      r_min=r_min, evaluation=evaluation, tendon_law=tendon_law)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
     z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)]))
-    info = {"rbf_centres": n_centres, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
+    info = {"rbf_centres": n_centers, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
     lin_ctrl = None
     ctrl = ad
     start = "bumpless"
@@ -373,23 +374,18 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                            linear=lin_ctrl, z0=z0, z_e=z_e, info=info)
 
 
-def _equilibrium_checker(system):
-    """Equilibrium test of a symmetric configuration of ``system``: eqs. 3.40-3.41 for a
-    1-N(D) system (:func:`tmfem.equilibrium.symmetric.check_1ND`), the positive null vector
-    of the reduced symmetric matrix otherwise (3.3.2)."""
-    from tmfem.equilibrium.symmetric_map import with_configuration
+def equilibrium_checker(system):
+    """The equilibrium test ``check(cfg)`` of a symmetric configuration of ``system`` (for
+    :meth:`~tmfem.control.deployment.reference_trajectory.DeploymentReference.check_equilibria`):
+    eqs. 3.40-3.41 for a 1-N(D) system (:func:`tmfem.equilibrium.symmetric.check_1ND`), the
+    positive null vector of the reduced symmetric matrix otherwise (3.3.2)."""
     if system.deployable:
-        from tmfem.equilibrium.symmetric import check_1ND
         return lambda cfg: check_1ND(with_configuration(system, cfg))
-    from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
-    from tmfem.equilibrium.symmetric import membrane_delta_system
-    from tmfem.errors import SlackMembrane
 
     def check(cfg):
         s = with_configuration(system, cfg)
         nv = positive_null_vector(symmetric_matrix(s).A)
         if not nv.margin > 0:
-            from tmfem.errors import SlackTendon
             raise SlackTendon("expected a positive null vector of the symmetric equilibrium "
                               f"matrix (3.3.2), found margin {nv.margin:.3g}")
         d = membrane_delta_system(s)

@@ -1,3 +1,45 @@
-"""Gridded linear parameter-varying control (dissertation ch. 8): the LPV plant on a grid,
-state- and output-feedback synthesis with rate bounds, bounds, bisection, certificates,
-off-grid verification, the gain-scheduled controller and the LPV deployment."""
+"""Gridded linear parameter-varying control (dissertation ch. 8).
+
+The LPV plant on a grid (:class:`GriddedLPV`, :func:`com_lpv_plant`), the generalized plant
+of Figure 8.1 (:func:`interconnection_8_1`), state-feedback synthesis with rate bounds
+(:func:`synthesize_state_feedback`, :func:`bisect_gamma`), its pointwise lower bound, off-grid
+verification (:mod:`tmfem.control.lpv.verify`), the observer-based output feedback and its
+rate-bounded certificate, the gain-scheduled controllers and the LPV deployment of 8.4. The
+design workflow of ``tmfem control lpv`` is :mod:`tmfem.control.lpv.workflow`
+(:func:`design_plant`, :func:`synthesize_design`, :func:`refined_plant`, :func:`verify_design`,
+:func:`output_feedback_design`).
+"""
+from tmfem._lazy import lazy_exports
+
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "GriddedLPV": "tmfem.control.lpv.plant",
+    "com_lpv_plant": "tmfem.control.lpv.plant",
+    "GeneralizedLPV": "tmfem.control.lpv.generalized_plant",
+    "interconnection_8_1": "tmfem.control.lpv.generalized_plant",
+    "LPVStateFeedback": "tmfem.control.lpv.state_feedback",
+    "synthesize_state_feedback": "tmfem.control.lpv.synthesis",
+    "GammaBracket": "tmfem.control.lpv.bisect",
+    "bisect_gamma": "tmfem.control.lpv.bisect",
+    "PointwiseBound": "tmfem.control.lpv.bounds",
+    "pointwise_state_feedback_bound": "tmfem.control.lpv.bounds",
+    "Verification": "tmfem.control.lpv.verify",
+    "LPVOutputController": "tmfem.control.lpv.output_feedback",
+    "LPVOutputFeedback": "tmfem.control.lpv.output_feedback",
+    "design_output_feedback": "tmfem.control.lpv.output_feedback",
+    "verify_output_feedback": "tmfem.control.lpv.output_feedback",
+    "RateBoundedCertificate": "tmfem.control.lpv.certificate",
+    "rate_bounded_certificate": "tmfem.control.lpv.certificate",
+    "refine_certificate": "tmfem.control.lpv.certificate",
+    "LPVController": "tmfem.control.lpv.controller",
+    "LPVDeployment": "tmfem.control.lpv.deployment",
+    "lpv_deployment": "tmfem.control.lpv.deployment",
+    "output_feedback_controller": "tmfem.control.lpv.deployment",
+    "state_feedback_controller": "tmfem.control.lpv.deployment",
+    "DesignPlant": "tmfem.control.lpv.workflow",
+    "design_plant": "tmfem.control.lpv.workflow",
+    "output_feedback_design": "tmfem.control.lpv.workflow",
+    "refined_plant": "tmfem.control.lpv.workflow",
+    "saved_design_plant": "tmfem.control.lpv.workflow",
+    "synthesize_design": "tmfem.control.lpv.workflow",
+    "verify_design": "tmfem.control.lpv.workflow"
+})

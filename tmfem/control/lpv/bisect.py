@@ -31,7 +31,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tmfem.control.lpv.eigopt import EigOpt
-from tmfem.control.lpv.synthesis import Coordinates, GeneralisedLPV, LPVStateFeedback
+from tmfem.control.lpv.coordinates import Coordinates
+from tmfem.control.lpv.generalized_plant import GeneralizedLPV
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
@@ -67,7 +69,7 @@ class GammaBracket:
                               "optimum lies in [gamma_lower_bound_proven, gamma_feasible]"}
 
 
-def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float = 0.02,
+def bisect_gamma(gp: GeneralizedLPV, *, lower: float, upper: float, rtol: float = 0.02,
                  time_budget: float = 300.0, max_iter: int = 150, margin: float = 1e-8,
                  t_schedule=(1e-2, 1e-3, 1e-4), sample_time: float | None = None,
                  start: LPVStateFeedback | None = None, grid_continuation: bool | None = None,
@@ -150,7 +152,7 @@ def bisect_gamma(gp: GeneralisedLPV, *, lower: float, upper: float, rtol: float 
                                      sample_time=sample_time)
         first = f"sub-grid design {'x'.join(map(str, sub.grid_shape))} (gamma {start.gamma:.5g})"
     analysis = gp.sizes["n_u"] == 0
-    given = None if start is None else _coefficients(start, co, gp)
+    given = None if start is None else co.coefficients_of(start, gp)
     e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=upper, sample_time=sample_time,
                balance_on=given if analysis else None)
     levels, best, not_found = [], None, None
@@ -233,37 +235,15 @@ def _lowest_free_level(e: EigOpt, z, lo: float, hi: float, *, margin: float, rto
     return b
 
 
-def collapsed(gp: GeneralisedLPV, k: int) -> GeneralisedLPV:
+def collapsed(gp: GeneralizedLPV, k: int) -> GeneralizedLPV:
     """``gp`` on the sub-grid where parameter ``k`` takes only its middle grid value (index
     size // 2; for the 2-3 grid of P_D, psi_13 = 8.36 deg), the other axes and every rate bound
     unchanged."""
     mid = gp.grid_shape[k] // 2
     cut = lambda X: np.take(X, [mid], axis=k)               # noqa: E731
-    sub = GeneralisedLPV.from_matrices(
+    sub = GeneralizedLPV.from_matrices(
         axes=[a if j != k else a[[mid]] for j, a in enumerate(gp.axes)], parameter_names=gp.parameter_names,
         rate_bounds=gp.rate_bounds, A=cut(gp.A), B1=cut(gp.B1), B2=cut(gp.B2), C1=cut(gp.C1),
         D11=cut(gp.D11), D12=cut(gp.D12))
     sub.state_names = list(gp.state_names)
     return sub
-
-
-def _coefficients(design: LPVStateFeedback, co: Coordinates, gp):
-    """P_k, Q_k of ``design`` in the scaled coordinates (P = T P_s T, Q = Q_s T) and the
-    normalised parameters of ``co``: P(rho) is affine, so they are P at the centre and its
-    change over each half-width (zero along a parameter the design does not vary)."""
-    T = co.T
-    if list(design.state_names) != list(gp.state_names):
-        raise InputError("gamma bisection start: expected a design over the same states, found "
-                         f"{len(design.state_names)} states against {len(gp.state_names)}")
-
-    def at(rho):
-        return design.P_of(rho) / T[:, None] / T[None, :], design.Q_of(rho) / T[None, :]
-    P0, Q0 = at(co.centre)
-    Ps, Qs = [P0], [Q0]
-    for k in co.varying:
-        d = np.zeros_like(co.centre)
-        d[k] = co.half[k]
-        P1, Q1 = at(co.centre + d)
-        Ps.append(P1 - P0)
-        Qs.append(Q1 - Q0)
-    return Ps, Qs

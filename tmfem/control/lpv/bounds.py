@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.control.linear.hinf_riccati import state_feedback_gain, state_feedback_gamma
-from tmfem.control.lpv.synthesis import GeneralisedLPV, _state_scaling
+from tmfem.control.lpv.generalized_plant import GeneralizedLPV, state_scaling
 
 log = logging.getLogger(__name__)
 
@@ -38,14 +38,14 @@ class PointwiseBound:
                 "lpv_gamma_lower_bound_achieved_norm": self.achieved_norm}
 
 
-def pointwise_state_feedback_bound(gp: GeneralisedLPV, *, eps: float = 1e-8,
+def pointwise_state_feedback_bound(gp: GeneralizedLPV, *, eps: float = 1e-8,
                                    rtol: float = 1e-5) -> PointwiseBound:
     """gamma_SF at every grid point of ``gp`` (states scaled as in the synthesis, diagonal
     balancing of A at the grid centre; ``eps`` is the Riccati perturbation of
     :func:`~tmfem.control.linear.hinf_riccati.state_feedback_gamma` in those coordinates)."""
     import control
     shp = gp.grid_shape
-    T = _state_scaling(gp.A[tuple(s // 2 for s in shp)])
+    T = state_scaling(gp.A[tuple(s // 2 for s in shp)])
     Ti = 1.0 / T
 
     def scaled(idx):

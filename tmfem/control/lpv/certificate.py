@@ -43,26 +43,31 @@ import time
 from dataclasses import dataclass, field, replace
 
 import numpy as np
+import scipy.linalg as sla
 
+from tmfem.control.lpv.bisect import bisect_gamma
+from tmfem.control.lpv.coordinates import Coordinates, Tm_back
+from tmfem.control.lpv.eigopt import EigOpt
+from tmfem.control.lpv.generalized_plant import GeneralizedLPV, lmi_matrix
 from tmfem.control.lpv.plant import GriddedLPV
-from tmfem.control.lpv.synthesis import GeneralisedLPV, LPVStateFeedback
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
+from tmfem.control.lpv.verify import verify
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
 
 
-def closed_loop_lpv(design, plant: GriddedLPV, *, W_e: float, W_u: float) -> GeneralisedLPV:
+def closed_loop_lpv(design, plant: GriddedLPV, *, W_e: float, W_u: float) -> GeneralizedLPV:
     """The frozen closed loops of ``design`` with the plants of ``plant``'s grid (its A, B and
     measured C_m; the controller interpolated there) as a generalised plant without control
     input: its eq. 5.95 is the analysis LMI of the module docstring."""
-    from tmfem.control.lpv.output_feedback import _measurement
-    C, _ = _measurement(plant, design.measured)
+    C, _ = plant.measurement(design.measured)
     loops = [design.frozen_closed_loop(plant.A[idx], plant.B[idx], C[idx], rho, W_e=W_e, W_u=W_u)
              for idx, rho in plant.points()]
     shp = plant.grid_shape
     A, B1, C1, D11 = (np.array([lp[k] for lp in loops]).reshape(shp + loops[0][k].shape) for k in range(4))
     n = A.shape[-1]
-    gp = GeneralisedLPV.from_matrices(axes=plant.axes, parameter_names=plant.parameter_names,
+    gp = GeneralizedLPV.from_matrices(axes=plant.axes, parameter_names=plant.parameter_names,
                                       rate_bounds=plant.rate_bounds, A=A, B1=B1, B2=np.zeros(shp + (n, 0)), C1=C1,
                                       D11=D11, D12=np.zeros(shp + (C1.shape[-2], 0)))
     gp.state_names = (list(plant.state_names) + [f"int_e_{design.measured[i]}" for i in design.tracked_rows]
@@ -70,22 +75,21 @@ def closed_loop_lpv(design, plant: GriddedLPV, *, W_e: float, W_u: float) -> Gen
     return gp
 
 
-def estimator_error_lpv(design, plant: GriddedLPV) -> GeneralisedLPV:
+def estimator_error_lpv(design, plant: GriddedLPV) -> GeneralizedLPV:
     """The estimation error of ``design`` on the grid of ``plant`` as a generalised plant
     without control input: eps' = (A - L C_m) eps + [W_d B, -W_n L] [n_d; n], p = eps
     (module docstring). The gains L are the estimator's at ``plant``'s points: its own grid
     may be finer (it must contain them, as the separation start assumes its model exact
     there)."""
-    from tmfem.control.lpv.output_feedback import _measurement
     for a, e, name in zip(plant.axes, design.estimator.axes, plant.parameter_names):
         if not np.all(np.min(np.abs(a[:, None] - e[None, :]), axis=1) <= 1e-12 * max(1.0, np.abs(e).max())):
             raise InputError(f"rate-bounded certificate: expected the estimator's grid to contain the design "
                              f"points, found {name} values {a.tolist()} against the estimator's {e.tolist()}")
-    C, _ = _measurement(plant, design.measured)
+    C, _ = plant.measurement(design.measured)
     shp, n = plant.grid_shape, plant.nx
     L = np.array([design.model(rho)[3] for _, rho in plant.points()]).reshape(shp + (n, C.shape[-2]))
     B1 = np.concatenate([design.W_d * plant.B, -design.W_n * L], -1)
-    gp = GeneralisedLPV.from_matrices(axes=plant.axes, parameter_names=plant.parameter_names,
+    gp = GeneralizedLPV.from_matrices(axes=plant.axes, parameter_names=plant.parameter_names,
                                       rate_bounds=plant.rate_bounds, A=plant.A - L @ C, B1=B1,
                                       B2=np.zeros(shp + (n, 0)), C1=np.broadcast_to(np.eye(n), shp + (n, n)),
                                       D11=np.zeros(shp + (n, B1.shape[-1])), D12=np.zeros(shp + (n, 0)))
@@ -93,7 +97,7 @@ def estimator_error_lpv(design, plant: GriddedLPV) -> GeneralisedLPV:
     return gp
 
 
-def _frozen_norms(gp: GeneralisedLPV):
+def _frozen_norms(gp: GeneralizedLPV):
     """The largest frozen H-infinity norm over the grid of a generalised plant without input
     (python-control ``norm``) and where; refuses an unstable frozen system."""
     import control
@@ -109,7 +113,7 @@ def _frozen_norms(gp: GeneralisedLPV):
     return lo, lo_at
 
 
-def separation_start(design, plant: GriddedLPV, gp: GeneralisedLPV, gamma: float, *, time_budget: float,
+def separation_start(design, plant: GriddedLPV, gp: GeneralizedLPV, gamma: float, *, time_budget: float,
                      betas=np.logspace(-4, 6, 11)):
     """X(rho) = M diag(P(rho), beta Z(rho)) M^T of the module docstring (an LPVStateFeedback
     with no gain, coefficients in the state feedback's normalised parameters), beta the one of
@@ -121,10 +125,6 @@ def separation_start(design, plant: GriddedLPV, gp: GeneralisedLPV, gamma: float
     InfeasibleController
         No rate-bounded Z of the error system within ``time_budget``.
     """
-    import scipy.linalg as sla
-
-    from tmfem.control.lpv.bisect import bisect_gamma
-    from tmfem.control.lpv.verify import verify
     sf = design.state_feedback
     n, nq = design.nx, design.tracked_rows.size
     err = estimator_error_lpv(design, plant)
@@ -134,13 +134,13 @@ def separation_start(design, plant: GriddedLPV, gp: GeneralisedLPV, gamma: float
     M[:n + nq, :n + nq] = np.eye(n + nq)
     M[n + nq:, :n] = np.eye(n)
     M[n + nq:, n + nq:] = -np.eye(n)
-    c0 = np.asarray(sf.centre, dtype=float)
+    c0 = np.asarray(sf.center, dtype=float)
     steps = [c0 + np.eye(c0.size)[k] * sf.half_width[k] for k in sf.varying]
     Zs = [Z.P_of(c0)] + [Z.P_of(r) - Z.P_of(c0) for r in steps]       # Z(rho) in the basis of P(rho)
     best = None
     for beta in betas:
         Xk = [M @ sla.block_diag(Pk, beta * Zk) @ M.T for Pk, Zk in zip(sf.P, Zs)]
-        X = LPVStateFeedback(gamma=gamma, P=Xk, Q=[np.zeros((0, 2 * n + nq))] * len(Xk), centre=sf.centre,
+        X = LPVStateFeedback(gamma=gamma, P=Xk, Q=[np.zeros((0, 2 * n + nq))] * len(Xk), center=sf.center,
                              half_width=sf.half_width, varying=sf.varying, axes=sf.axes,
                              parameter_names=sf.parameter_names, rate_bounds=sf.rate_bounds,
                              state_names=list(gp.state_names), solver="separation", status=f"beta = {beta:.1e}",
@@ -205,7 +205,6 @@ def rate_bounded_certificate(design, plant: GriddedLPV, *, W_e: float, W_u: floa
     InfeasibleController
         When a frozen loop of the design grid is unstable (no certificate can exist).
     """
-    from tmfem.control.lpv.bisect import bisect_gamma
     if upper is not None and not (np.isfinite(upper) and upper > 0):
         raise InputError(f"rate-bounded certificate: expected an upper level > 0, found {upper!r}")
     t0 = time.perf_counter()
@@ -230,12 +229,11 @@ def rate_bounded_certificate(design, plant: GriddedLPV, *, W_e: float, W_u: floa
                                   time_s=time.perf_counter() - t0, message=X.status, start=info)
 
 
-def pointwise_lmi_eigs(lyapunov: LPVStateFeedback, gp: GeneralisedLPV, gamma: float | None = None):
+def pointwise_lmi_eigs(lyapunov: LPVStateFeedback, gp: GeneralizedLPV, gamma: float | None = None):
     """The largest relative eigenvalue of the analysis LMI (module docstring; over the rate
     vertices, divided by the matrix's largest |entry| as in :func:`tmfem.control.lpv.verify.verify`)
     and the smallest eigenvalue of X(rho), at every point of ``gp``'s grid (arrays of the grid's
     shape), with X(rho) = ``lyapunov.P_of`` and ``gamma`` (default the Lyapunov matrix's)."""
-    from tmfem.control.lpv.synthesis import lmi_matrix
     g = lyapunov.gamma if gamma is None else gamma
     dXs = [sum((v[k] / lyapunov.half_width[k]) * lyapunov.P[1 + j] for j, k in enumerate(lyapunov.varying))
            if lyapunov.varying else 0.0 * lyapunov.P[0] for v in gp.rate_vertices()]
@@ -285,9 +283,6 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
     InputError
         No found certificate, bad options, or a ``fine`` grid that misses a design point.
     """
-    from tmfem.control.lpv.bisect import _coefficients
-    from tmfem.control.lpv.eigopt import EigOpt
-    from tmfem.control.lpv.synthesis import Coordinates, Tm_back
     if not certificate.found:
         raise InputError("certificate refinement: expected a found rate-bounded certificate, found none "
                          f"({certificate.message})")
@@ -342,8 +337,8 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
             break
         imposed += new
         e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=gamma, points=imposed,
-                   balance_on=_coefficients(X, co, gp))
-        z0 = e.start_from(*_coefficients(X, co, gp))
+                   balance_on=co.coefficients_of(X, gp))
+        z0 = e.start_from(*co.coefficients_of(X, gp))
         row["start_scaled_eig"] = e.largest(z0, gamma)
         z, top, reason = e.solve(gamma, z0, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
                                  deadline=deadline)
@@ -361,7 +356,7 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
             break
         Ps, _ = e.coefficients(z)
         X = LPVStateFeedback(gamma=gamma, P=[Tm_back(P, co.T) for P in Ps], Q=[np.zeros((0, gp.A.shape[-1]))] * len(Ps),
-                             centre=co.centre, half_width=co.half, varying=co.varying,
+                             center=co.center, half_width=co.half, varying=co.varying,
                              axes=[a.copy() for a in X.axes], parameter_names=list(X.parameter_names),
                              rate_bounds=X.rate_bounds.copy(), state_names=list(X.state_names), solver="EIGOPT",
                              status=f"refined: {len(imposed)} points imposed", solve_time=0.0, build_time=0.0,

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.control.lpv.plant import GriddedLPV
-from tmfem.control.lpv.synthesis import LPVStateFeedback
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.errors import InputError
 
 

@@ -28,7 +28,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tmfem.control.deployment.limits import tendon_lengths
+from tmfem.control.deployment.reference_trajectory import DeploymentReference
+from tmfem.control.deployment.run import DeploymentSetup
+from tmfem.control.lpv.controller import LPVController
+from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
+from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.errors import InputError
+from tmfem.models.com.coordinates import point_coordinates
+from tmfem.models.com.model import ControlOrientedModel
 from tmfem.system.geometry import wrap_angle
 
 class Measured:
@@ -102,7 +110,6 @@ class LPVDeployment:
         """The :class:`tmfem.control.deployment.run.DeploymentSetup` of ``controller`` (any object with
         the reset/output/update/name protocol on y_lpv) for :func:`~tmfem.control.deployment.run.
         run_deployment` and :func:`tmfem.reference.deployments.write_outputs`."""
-        from tmfem.control.deployment.run import DeploymentSetup
         return DeploymentSetup(model=self.model, reference=self.reference, adaptive=None,
                                controller=Measured(controller, self.measure), linear=None, z0=self.z0,
                                z_e=self.z_e, info=dict(self.info))
@@ -121,10 +128,6 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
     InputError
         The reference leaves the design grid, or the plant has no membrane points.
     """
-    from tmfem.control.deployment.reference_trajectory import DeploymentReference
-    from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
-    from tmfem.models.com.coordinates import point_coordinates
-    from tmfem.models.com.model import ControlOrientedModel
     for nm, v in (("theta_13", (theta_0, theta_e)), ("psi_13", (psi_0, psi_0))):
         a = plant.axes[plant.parameter_names.index(nm)]
         if min(v) < a[0] - 1e-9 or max(v) > a[-1] + 1e-9:
@@ -162,7 +165,6 @@ def state_feedback_controller(dep: LPVDeployment, design):
     InputError
         ``design`` is not over the states of the deployment's design plant.
     """
-    from tmfem.control.lpv.controller import LPVController
     pl = dep.plant
     nq = dep.model.nq
     want = list(pl.state_names) + [f"int_e_{n}" for n in dep.model.system.q_names]
@@ -179,3 +181,31 @@ def state_feedback_controller(dep: LPVDeployment, design):
     return LPVController(design, pl, state_index=np.arange(n), q_index=np.arange(nq),
                          rho_index=[n, n + 1], reference=lambda t: dep.reference(t)[0],
                          reference_rho=dep.reference_rho)
+
+
+def output_feedback_controller(dep: LPVDeployment, design, *, interpolation: str = "multilinear",
+                               estimator_plant=None):
+    """The observer-based output feedback of :mod:`tmfem.control.lpv.output_feedback` with
+    ``design``'s K(rho) and a gridded Kalman estimator (W_d = W_n = 0.001) on the design plant,
+    reading the positions of y_lpv (q and the membrane point coordinates of eq. 5.17), scheduled on
+    the estimated theta_13, psi_13 (the measured ones at the start: noise in the measured rho
+    enters x_e(rho), u_e(rho) and K(rho) unfiltered, docs/guides/lpv.md); the control law about rho_r(t)
+    as the state feedback's; the estimator is driven by the input saturated to the rest-length
+    limits [1 mm, |tendon|(q_m)] of the run at the measured q.
+
+    Parameters
+    ----------
+    interpolation : {"multilinear", "spline"}
+        The estimator's between grid points (:class:`~tmfem.control.lpv.plant.GriddedLPV`).
+    estimator_plant : GriddedLPV, optional
+        The estimator's plant on a finer grid than the design's (default the design plant).
+    """
+    pl, system = dep.plant, dep.model.system
+    nz, n, nq = pl.nx // 2, pl.nx, dep.model.nq
+    of = design_output_feedback(design, pl if estimator_plant is None else estimator_plant,
+                                tracked=system.q_names, measured=pl.state_names[:nz],
+                                interpolation=interpolation)
+    return LPVOutputController(of, measured_index=np.arange(nz), rho_index=[n, n + 1],
+                               reference=lambda t: dep.reference(t)[0], reference_rho=dep.reference_rho,
+                               schedule="estimate",
+                               input_limits=lambda u, ym: np.clip(u, 1e-3, tendon_lengths(system, ym[:nq])))

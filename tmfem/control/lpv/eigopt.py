@@ -31,6 +31,7 @@ from concurrent.futures import ThreadPoolExecutor
 from contextlib import ExitStack
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.optimize as so
 from threadpoolctl import threadpool_limits
 
@@ -72,7 +73,6 @@ def _eigh(X, pool, parts: int):
 def zoh(A, B, dt):
     """Zero-order-hold discretisation A_d = e^(A dt), B_d = int_0^dt e^(A s) ds B of stacked
     (A, B) (the exponential of [[A, B], [0, 0]] dt)."""
-    import scipy.linalg as sla
     n, m = A.shape[-1], B.shape[-1]
     E = np.array([sla.expm(np.block([[a, b], [np.zeros((m, n + m))]]) * dt) for a, b in zip(A, B)])
     return E[:, :n, :n], E[:, :n, n:]
@@ -84,7 +84,7 @@ class EigOpt:
 
     Parameters
     ----------
-    gp : GeneralisedLPV
+    gp : GeneralizedLPV
     T : (n,) array
         Diagonal state scaling of the synthesis (x = T x_s).
     c_of : callable

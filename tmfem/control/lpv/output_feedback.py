@@ -41,7 +41,10 @@ import scipy.linalg as sla
 
 from tmfem.control.lpv.controller import Scheduled
 from tmfem.control.lpv.plant import GriddedLPV
-from tmfem.control.lpv.synthesis import LPVStateFeedback, _state_scaling
+from tmfem.control.lpv.certificate import closed_loop_lpv
+from tmfem.control.lpv.generalized_plant import state_scaling
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
+from tmfem.control.lpv.verify import verify
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
@@ -57,7 +60,7 @@ def kalman_gain(A, B, C, *, W_d: float, W_n: float, eps: float = 0.0) -> np.ndar
     InfeasibleController
         When the filter Riccati equation has no stabilising solution ((A, C) not detectable).
     """
-    T = _state_scaling(A)
+    T = state_scaling(A)
     Ti = 1.0 / T
     As, Bs, Cs = Ti[:, None] * A * T[None, :], Ti[:, None] * B, C * T[None, :]
     Qn = W_d ** 2 * Bs @ Bs.T + eps * np.eye(A.shape[0])
@@ -160,25 +163,6 @@ class LPVOutputFeedback:
                  W_n=self.W_n, interpolation=self.estimator.interpolation)
 
 
-def _measurement(plant: GriddedLPV, names):
-    """C_m and y_e of the measured signals: plant outputs (their rows of C, which must not
-    depend on u) or states (rows of the identity, y_e = x_e)."""
-    shp = plant.grid_shape
-    C = np.zeros(shp + (len(names), plant.nx))
-    y_e = np.zeros(shp + (len(names),))
-    for k, nm in enumerate(names):
-        if nm in plant.output_names:
-            i = plant.output_names.index(nm)
-            if np.any(plant.D[..., i, :] != 0):
-                raise InputError(f"output feedback: measured output {nm!r} must not depend on u directly "
-                                 "(its row of D is nonzero)")
-            C[..., k, :], y_e[..., k] = plant.C[..., i, :], plant.y_e[..., i]
-        else:
-            i = plant.state_names.index(nm)
-            C[..., k, i], y_e[..., k] = 1.0, plant.x_e[..., i]
-    return C, y_e
-
-
 def design_output_feedback(state_feedback: LPVStateFeedback, plant: GriddedLPV, *, tracked,
                            measured, W_d: float = 1e-3, W_n: float = 1e-3,
                            eps: float = 0.0, interpolation: str = "multilinear") -> LPVOutputFeedback:
@@ -218,7 +202,7 @@ def design_output_feedback(state_feedback: LPVStateFeedback, plant: GriddedLPV, 
     if state_feedback.P[0].shape[0] != n + nq:
         raise InputError(f"output feedback: expected a state feedback over {n} + {nq} states, found "
                          f"{state_feedback.P[0].shape[0]}")
-    C, y_e = _measurement(plant, measured)
+    C, y_e = plant.measurement(measured)
     ny = len(measured)
     L = np.zeros(plant.grid_shape + (n, ny))
     for idx, rho in plant.points():
@@ -320,7 +304,7 @@ def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e:
         When a check fails, unless ``allow_failure`` (then ``passed`` is False).
     """
     import control
-    C, _ = _measurement(plant, design.measured)
+    C, _ = plant.measurement(design.measured)
     cl, cl_at, hn, hn_at = -np.inf, None, -np.inf, None
     sr, sr_at, sf = (-np.inf, None, -np.inf) if dt else (None, None, None)
     for k, (idx, rho) in enumerate(plant.points()):
@@ -342,8 +326,6 @@ def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e:
             progress(k + 1, int(np.prod(plant.grid_shape)))
     chk = None
     if certificate is not None and certificate.found:
-        from tmfem.control.lpv.certificate import closed_loop_lpv
-        from tmfem.control.lpv.verify import verify
         chk = verify(certificate.lyapunov, closed_loop_lpv(design, plant, W_e=W_e, W_u=W_u), allow_failure=True)
     ok = cl < 0 and (not dt or sr < 1) and (chk is None or chk.max_lmi_eig < 0)
     res = OutputFeedbackVerification(grid=plant.grid_shape, max_cl_real=cl, max_cl_real_at=cl_at, max_hinf=hn,

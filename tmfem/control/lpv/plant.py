@@ -198,6 +198,25 @@ class GriddedLPV:
                           rate_bounds=self.rate_bounds.copy(), state_names=self.state_names,
                           input_names=self.input_names, output_names=self.output_names, **out)
 
+    def measurement(self, names):
+        """C_m and y_e of the measured signals ``names``: plant outputs (their rows of C, which
+        must not depend on u) or states (rows of the identity, y_e = x_e), on the grid
+        (shapes ``grid_shape + (len(names), nx)`` and ``grid_shape + (len(names),)``)."""
+        shp = self.grid_shape
+        C = np.zeros(shp + (len(names), self.nx))
+        y_e = np.zeros(shp + (len(names),))
+        for k, nm in enumerate(names):
+            if nm in self.output_names:
+                i = self.output_names.index(nm)
+                if np.any(self.D[..., i, :] != 0):
+                    raise InputError(f"output feedback: measured output {nm!r} must not depend on u directly "
+                                     "(its row of D is nonzero)")
+                C[..., k, :], y_e[..., k] = self.C[..., i, :], self.y_e[..., i]
+            else:
+                i = self.state_names.index(nm)
+                C[..., k, i], y_e[..., k] = 1.0, self.x_e[..., i]
+        return C, y_e
+
     def to_ss(self, index):
         """python-control ``StateSpace`` with named signals at grid point ``index``."""
         import control

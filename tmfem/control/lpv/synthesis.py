@@ -1,6 +1,7 @@
 """Gridded LPV state-feedback H-infinity synthesis with rate bounds (eqs. 5.90-5.99, 8.3).
 
-The generalised plant of Figure 8.1 (built by :func:`interconnection_8_1`)
+The generalized plant of Figure 8.1 (built by
+:func:`~tmfem.control.lpv.generalized_plant.interconnection_8_1`)
 
     x' = A x + B1 w + B2 u,   p = C1 x + D11 w + D12 u          (eq. 5.90)
 
@@ -25,226 +26,17 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
-from tmfem.control.lpv.plant import GriddedLPV
+from tmfem.control.lpv.coordinates import Coordinates, Tm_back, accepted_design
+from tmfem.control.lpv.eigopt import feasible_point
+from tmfem.control.lpv.generalized_plant import GeneralizedLPV
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
-
-
-@dataclass
-class GeneralisedLPV:
-    """Generalised LPV plant (eq. 5.90) on a grid: x' = A x + B1 w + B2 u, p = C1 x + D11 w + D12 u.
-
-    Arrays have shape ``grid_shape + (rows, cols)``; ``axes``, ``parameter_names`` and
-    ``rate_bounds`` as in :class:`~tmfem.control.lpv.plant.GriddedLPV`.
-    """
-
-    axes: list
-    parameter_names: list
-    rate_bounds: np.ndarray
-    A: np.ndarray
-    B1: np.ndarray
-    B2: np.ndarray
-    C1: np.ndarray
-    D11: np.ndarray
-    D12: np.ndarray
-    state_names: list = field(default_factory=list)
-
-    @property
-    def grid_shape(self) -> tuple:
-        return tuple(np.size(a) for a in self.axes)
-
-    @property
-    def sizes(self) -> dict:
-        return {"n_x": self.A.shape[-1], "n_w": self.B1.shape[-1], "n_u": self.B2.shape[-1],
-                "n_p": self.C1.shape[-2]}
-
-    def points(self):
-        plant = self._as_lpv()
-        return plant.points()
-
-    def _as_lpv(self) -> GriddedLPV:
-        n = self.A.shape[-1]
-        return GriddedLPV(axes=self.axes, parameter_names=self.parameter_names,
-                          A=self.A, B=self.B2, C=self.C1, D=self.D12, rate_bounds=self.rate_bounds,
-                          state_names=[f"x{i}" for i in range(n)],
-                          input_names=[f"u{i}" for i in range(self.B2.shape[-1])],
-                          output_names=[f"p{i}" for i in range(self.C1.shape[-2])])
-
-    def rate_vertices(self) -> np.ndarray:
-        return self._as_lpv().rate_vertices()
-
-    @classmethod
-    def from_matrices(cls, *, axes, parameter_names, rate_bounds, A, B1, B2, C1, D11, D12):
-        """From arrays (validated: finite, consistent sizes)."""
-        arrs = {k: np.asarray(v, dtype=float) for k, v in
-                dict(A=A, B1=B1, B2=B2, C1=C1, D11=D11, D12=D12).items()}
-        shape = tuple(np.size(a) for a in axes)
-        n, nw, nu, npp = (arrs["A"].shape[-1], arrs["B1"].shape[-1], arrs["B2"].shape[-1],
-                          arrs["C1"].shape[-2])
-        want = dict(A=(n, n), B1=(n, nw), B2=(n, nu), C1=(npp, n), D11=(npp, nw), D12=(npp, nu))
-        for k, v in arrs.items():
-            if v.shape != shape + want[k] or not np.all(np.isfinite(v)):
-                raise InputError(f"generalised LPV plant: {k} expected shape {shape + want[k]} with "
-                                 f"finite entries, found {v.shape}")
-        rb = np.asarray(rate_bounds, dtype=float).reshape(len(shape), 2)
-        return cls(axes=[np.atleast_1d(np.asarray(a, dtype=float)) for a in axes],
-                   parameter_names=list(parameter_names), rate_bounds=rb, **arrs)
-
-
-def interconnection_8_1(plant: GriddedLPV, *, tracked, W_e: float = 0.5, W_u: float = 0.05,
-                        W_d: float = 0.001) -> GeneralisedLPV:
-    """The interconnection of Figure 8.1 with the integral of the tracking error (eq. 5.98).
-
-    Plant x_z' = A x_z + B (u + W_d n_d), q = T_qx x_z (``tracked``: the output names of q;
-    their rows of C, eq. 5.18). States x = [x_z; e~_q], e~_q' = e_q = q_d - q (eq. 5.98);
-    exogenous w = [q_d; n_d]; regulated p = [e_r; e_u] = [W_e e_q; W_u u]. Weights are
-    scalar multiples of I (8.3: W_e = 0.5 I, W_u = 0.05 I, W_d = 0.001 I).
-    """
-    tracked = list(tracked)
-    missing = [t for t in tracked if t not in plant.output_names]
-    if missing or not tracked:
-        raise InputError(f"interconnection: tracked outputs must be plant outputs, found unknown "
-                         f"{missing or 'none given'}")
-    for nm, v in (("W_e", W_e), ("W_u", W_u), ("W_d", W_d)):
-        if not (np.isfinite(v) and v > 0):
-            raise InputError(f"interconnection: {nm} expected > 0, found {v!r}")
-    rows = [plant.output_names.index(t) for t in tracked]
-    if np.any(plant.D[..., rows, :] != 0):
-        raise InputError("interconnection: tracked outputs must not depend on u directly (D rows nonzero)")
-    T = plant.C[..., rows, :]
-    shp = plant.grid_shape
-    n, m, nq = plant.nx, plant.nu, len(rows)
-    Z = lambda r, c: np.zeros(shp + (r, c))            # noqa: E731
-    I = lambda k: np.broadcast_to(np.eye(k), shp + (k, k))   # noqa: E731
-    A = np.concatenate([np.concatenate([plant.A, Z(n, nq)], -1),
-                        np.concatenate([-T, Z(nq, nq)], -1)], -2)
-    B1 = np.concatenate([np.concatenate([Z(n, nq), W_d * plant.B], -1),
-                         np.concatenate([I(nq), Z(nq, m)], -1)], -2)
-    B2 = np.concatenate([plant.B, Z(nq, m)], -2)
-    C1 = np.concatenate([np.concatenate([-W_e * T, Z(nq, nq)], -1), Z(m, n + nq)], -2)
-    D11 = np.concatenate([np.concatenate([W_e * I(nq), Z(nq, m)], -1), Z(m, nq + m)], -2)
-    D12 = np.concatenate([Z(nq, m), W_u * I(m)], -2)
-    g = GeneralisedLPV.from_matrices(axes=plant.axes, parameter_names=plant.parameter_names,
-                                     rate_bounds=plant.rate_bounds, A=A, B1=B1, B2=B2, C1=C1,
-                                     D11=D11, D12=D12)
-    g.state_names = list(plant.state_names) + [f"int_e_{t}" for t in tracked]
-    return g
-
-
-@dataclass
-class LPVStateFeedback:
-    """Result of :func:`synthesize_state_feedback`: K(rho) = Q(rho) P(rho)^-1 (eq. 5.99).
-
-    ``P[k]``, ``Q[k]`` (k = 0..n_p) are the coefficients in the normalised parameters
-    rho_n = (rho - centre) / half_width (k = 0 the constant term); :meth:`P_of`, :meth:`Q_of`
-    and :meth:`gain` evaluate them at a parameter value in the original units.
-    """
-
-    gamma: float
-    P: list
-    Q: list
-    centre: np.ndarray
-    half_width: np.ndarray
-    varying: list
-    axes: list
-    parameter_names: list
-    rate_bounds: np.ndarray
-    state_names: list
-    solver: str
-    status: str
-    solve_time: float
-    build_time: float
-    sizes: dict
-    max_lmi_eig: float
-    min_P_eig: float
-
-    def _basis(self, rho) -> np.ndarray:
-        rho = np.asarray(rho, dtype=float).reshape(-1)
-        if rho.size != len(self.centre):
-            raise InputError(f"LPV controller: expected {len(self.centre)} parameter values, found {rho.size}")
-        return np.concatenate([[1.0], ((rho - self.centre) / self.half_width)[self.varying]])
-
-    def P_of(self, rho) -> np.ndarray:
-        """P(rho) (eq. 5.99)."""
-        return sum(c * Pk for c, Pk in zip(self._basis(rho), self.P))
-
-    def Q_of(self, rho) -> np.ndarray:
-        """Q(rho) (eq. 5.99)."""
-        return sum(c * Qk for c, Qk in zip(self._basis(rho), self.Q))
-
-    def gain(self, rho) -> np.ndarray:
-        """K(rho) = Q(rho) P(rho)^-1 (8.3)."""
-        return sla.solve(self.P_of(rho), self.Q_of(rho).T, assume_a="pos").T
-
-    def summary(self) -> dict:
-        return {"gamma": self.gamma, "solver": self.solver, "status": self.status,
-                "solve_time_s": self.solve_time, "build_time_s": self.build_time,
-                "sizes": self.sizes, "max_lmi_eig": self.max_lmi_eig, "min_P_eig": self.min_P_eig}
-
-    def arrays(self) -> dict:
-        """The coefficients, gamma and grid as arrays (the contents of :meth:`save`)."""
-        return dict(gamma=self.gamma, P=np.array(self.P), Q=np.array(self.Q), centre=self.centre,
-                    half_width=self.half_width, varying=np.isin(np.arange(len(self.centre)), self.varying),
-                    rate_bounds=self.rate_bounds, parameter_names=np.array(self.parameter_names),
-                    state_names=np.array(self.state_names),
-                    **{f"axis_{k}": a for k, a in enumerate(self.axes)})
-
-    def save(self, path) -> None:
-        """Write the coefficients, gamma and grid to an ``.npz`` file."""
-        np.savez(path, **self.arrays())
-
-    @classmethod
-    def load(cls, path) -> "LPVStateFeedback":
-        """The coefficients, gamma and grid written by :meth:`save` (sizes and residuals are
-        re-computed by whoever uses it: :func:`tmfem.control.lpv.verify.verify`).
-
-        Raises
-        ------
-        InputError
-            Not a file written by :meth:`save`.
-        """
-        try:
-            d = np.load(path, allow_pickle=False)
-            keys = ("gamma", "P", "Q", "centre", "half_width", "varying", "rate_bounds",
-                    "parameter_names", "state_names")
-            f = {k: d[k] for k in keys}
-        except (OSError, KeyError, ValueError) as exc:
-            raise InputError(f"LPV controller file {str(path)!r}: expected an .npz written by "
-                             f"`tmfem control lpv --save` (keys gamma, P, Q, ...), found {exc}") from None
-        axes = [d[f"axis_{k}"] for k in range(len(f["parameter_names"]))]
-        P, Q = list(f["P"]), list(f["Q"])
-        varying = [k for k, a in enumerate(axes) if a.size > 1]      # as in the synthesis
-        if len(P) != 1 + len(varying) or len(Q) != len(P):
-            raise InputError(f"LPV controller file {str(path)!r}: expected {1 + len(varying)} coefficients "
-                             f"P_k, Q_k (eq. 5.99 on its grid), found {len(P)} and {len(Q)}")
-        return cls(gamma=float(f["gamma"]), P=P, Q=Q, centre=f["centre"], half_width=f["half_width"],
-                   varying=varying, axes=axes,
-                   parameter_names=[str(v) for v in f["parameter_names"]], rate_bounds=f["rate_bounds"],
-                   state_names=[str(v) for v in f["state_names"]], solver="loaded", status=f"from {path}",
-                   solve_time=0.0, build_time=0.0, sizes={"n_x": P[0].shape[0], "coefficients": len(P)},
-                   max_lmi_eig=float("nan"), min_P_eig=float("nan"))
-
-
-def lmi_matrix(*, A, B1, B2, C1, D11, D12, P, Q, dP, gamma) -> np.ndarray:
-    """The (symmetric) matrix of eq. 5.95 with H1, F of eq. 5.96 for numeric P, Q, dP, gamma."""
-    nw, npp = B1.shape[1], C1.shape[0]
-    APBQ = A @ P + B2 @ Q
-    H1 = APBQ + APBQ.T - dP
-    F = C1 @ P + D12 @ Q
-    return np.block([[H1, B1, F.T], [B1.T, -gamma * np.eye(nw), D11.T], [F, D11, -gamma * np.eye(npp)]])
-
-
-def _state_scaling(A: np.ndarray) -> np.ndarray:
-    """Diagonal T (x = T x_s) balancing A (LAPACK gebal, scaling only)."""
-    _, (sca, _) = sla.matrix_balance(A, permute=False, separate=True)
-    return sca
 
 
 def _triangle(N: int, solver: str):
@@ -275,7 +67,7 @@ def _sym_basis(n: int) -> sp.csr_matrix:
     return sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n * n, a.size))
 
 
-def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", margin: float = 1e-6,
+def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", margin: float = 1e-6,
                               scale: bool = True, accuracy: float = 1e-5,
                               max_iter: int | None = None, gamma: float | None = None,
                               sample_time: float | None = None) -> LPVStateFeedback:
@@ -322,7 +114,7 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
                          f"with solver {solver}")
     t0 = time.perf_counter()
     co = Coordinates.of(gp, scale=scale)
-    shp, T, centre, half, varying, verts, sizes = (co.grid_shape, co.T, co.centre, co.half, co.varying,
+    shp, T, center, half, varying, verts, sizes = (co.grid_shape, co.T, co.center, co.half, co.varying,
                                                     co.verts, co.sizes)
     n, nw, nu, npp = (gp.sizes[k] for k in ("n_x", "n_w", "n_u", "n_p"))
     N = n + nw + npp
@@ -334,7 +126,6 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
     In = sp.identity(n, format="csr")
     log.info("LPV synthesis: %s", sizes)
     if solver == "EIGOPT":
-        from tmfem.control.lpv.eigopt import feasible_point
         t1 = time.perf_counter()
         Ps, Qs, _, nev = feasible_point(gp, gamma, T=T, c_of=co.c_of, dvs=co.dvs, max_iter=max_iter or 150,
                                         sample_time=sample_time)
@@ -352,7 +143,7 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
     psd_parts = []
     for idx in np.ndindex(*shp):
         rho = np.array([a[i] for a, i in zip(gp.axes, idx)])
-        c = np.concatenate([[1.0], ((rho - centre) / half)[varying]])
+        c = np.concatenate([[1.0], ((rho - center) / half)[varying]])
         A = Ti[:, None] * gp.A[idx] * T[None, :]
         B1 = Ti[:, None] * gp.B1[idx]
         B2 = Ti[:, None] * gp.B2[idx]
@@ -416,106 +207,14 @@ def synthesize_state_feedback(gp: GeneralisedLPV, *, solver: str = "CLARABEL", m
         Pv = [Tm_back(_unsym(x[pcol(k):pcol(k) + ms], n), T) for k in range(nb)]
         Qv = [x[pcol(k) + ms:pcol(k) + ms + mq].reshape(nu, n, order="F") * T[None, :] for k in range(nb)]
         try:
-            return _accepted(gp, Pv, Qv, g, T, verts, centre, half, varying, solver=s, status=status,
-                             solve=solve, build=build, sizes=sizes, tol=accuracy * scale_data)
+            return accepted_design(gp, Pv, Qv, g, T, verts, center, half, varying, solver=s, status=status,
+                                   solve=solve, build=build, sizes=sizes, tol=accuracy * scale_data)
         except InfeasibleController as exc:
             last = f"{s}: status {status} but {exc}"
             log.warning("LPV synthesis: %s", last)
     raise InfeasibleController(f"LPV state-feedback synthesis (eqs. 5.95-5.96) on a {shp} grid with "
                                f"{len(verts)} rate vertices failed: {last}; expected an optimal, "
                                "accurate solution")
-
-
-@dataclass
-class Coordinates:
-    """The synthesis coordinates of a generalised plant (module docstring): parameters
-    normalised to [-1, 1] over the grid (``centre``, ``half``; ``varying``: the parameters
-    with more than one grid value), states x = T x_s, the rate vertices and the LMI sizes."""
-
-    grid_shape: tuple
-    T: np.ndarray
-    centre: np.ndarray
-    half: np.ndarray
-    varying: list
-    verts: np.ndarray
-    sizes: dict
-
-    @classmethod
-    def of(cls, gp: GeneralisedLPV, *, scale: bool = True) -> "Coordinates":
-        shp = gp.grid_shape
-        n, nw, nu, npp = (gp.sizes[k] for k in ("n_x", "n_w", "n_u", "n_p"))
-        lo = np.array([a[0] for a in gp.axes]); hi = np.array([a[-1] for a in gp.axes])
-        varying = [k for k in range(len(shp)) if shp[k] > 1]
-        verts = gp.rate_vertices()
-        nvar = (1 + len(varying)) * (n * (n + 1) // 2 + nu * n) + 1
-        sizes = {"grid_points": int(np.prod(shp)), "rate_vertices": len(verts),
-                 "lmis": int(np.prod(shp)) * len(verts), "lmi_size": n + nw + npp, "n_x": n, "n_w": nw,
-                 "n_u": nu, "n_p": npp, "decision_variables": nvar}
-        return cls(grid_shape=shp, T=_state_scaling(gp.A[tuple(s // 2 for s in shp)]) if scale else np.ones(n),
-                   centre=(lo + hi) / 2, half=np.where(hi > lo, (hi - lo) / 2, 1.0), varying=varying,
-                   verts=verts, sizes=sizes)
-
-    def c_of(self, rho) -> np.ndarray:
-        """The coefficients [1, rho_n...] of P_k in P(rho) (eq. 5.99, normalised rho)."""
-        return np.concatenate([[1.0], ((np.asarray(rho) - self.centre) / self.half)[self.varying]])
-
-    @property
-    def dvs(self) -> list:
-        """The coefficients of P_k in dP/dt at each rate vertex."""
-        return [np.concatenate([[0.0], (v / self.half)[self.varying]]) for v in self.verts]
-
-    def accepted(self, gp, Ps, Qs, gamma, *, solver, status, solve, build,
-                 sample_time: float | None = None) -> "LPVStateFeedback":
-        """:func:`_accepted` (strictly negative LMIs) of P_k, Q_k given in the scaled coordinates;
-        with ``sample_time`` also every frozen sampled loop of the grid stable
-        (:func:`tmfem.control.lpv.verify.verify`)."""
-        T = self.T
-        ctrl = _accepted(gp, [Tm_back(P, T) for P in Ps], [Q * T[None, :] for Q in Qs], gamma, T, self.verts,
-                         self.centre, self.half, self.varying, solver=solver, status=status, solve=solve,
-                         build=build, sizes=self.sizes, tol=-1e-300)
-        if sample_time is not None:
-            from tmfem.control.lpv.verify import verify
-            r = verify(ctrl, gp, sample_time=sample_time, allow_failure=True).max_sampled_radius
-            if not r < 1:
-                raise InfeasibleController(f"the frozen loops sampled at {sample_time} s have spectral radius "
-                                           f"{r:.6f} (expected < 1)")
-        return ctrl
-
-
-def _accepted(gp, Pv, Qv, g, T, verts, centre, half, varying, *, solver, status, solve, build, sizes,
-              tol) -> LPVStateFeedback:
-    """The result, after re-computing every LMI (eq. 5.95) and P(rho_i) from P_k, Q_k in
-    floating point (largest eigenvalue in the scaled coordinates <= ``tol``, P > 0).
-
-    Raises
-    ------
-    InfeasibleController
-        When an LMI or P fails.
-    """
-    Ti = 1.0 / T
-    n, nw, npp = gp.sizes["n_x"], gp.sizes["n_w"], gp.sizes["n_p"]
-    worst, minP = -np.inf, np.inf
-    for idx in np.ndindex(*gp.grid_shape):
-        rho = np.array([a[i] for a, i in zip(gp.axes, idx)])
-        c = np.concatenate([[1.0], ((rho - centre) / half)[varying]])
-        P = sum(ck * Pk for ck, Pk in zip(c, Pv)); Q = sum(ck * Qk for ck, Qk in zip(c, Qv))
-        minP = min(minP, np.linalg.eigvalsh((P * Ti[:, None] * Ti[None, :])).min())
-        for v in verts:
-            dP = sum((v[k] / half[k]) * Pv[1 + j] for j, k in enumerate(varying)) if varying \
-                else np.zeros((n, n))
-            M = lmi_matrix(A=gp.A[idx], B1=gp.B1[idx], B2=gp.B2[idx], C1=gp.C1[idx],
-                           D11=gp.D11[idx], D12=gp.D12[idx], P=P, Q=Q, dP=dP, gamma=g)
-            worst = max(worst, _max_eig_congruent(M, T, nw + npp))
-    if not (worst <= tol and minP > 0):
-        raise InfeasibleController(f"the LMI re-computed from the solution has largest eigenvalue "
-                                   f"{worst:.3e} (expected <= {tol:.3e}) and min eig P {minP:.3e} "
-                                   "(expected > 0)")
-    log.info("LPV synthesis: gamma = %.6g (%s, %s, %.1f s)", g, solver, status, solve)
-    return LPVStateFeedback(gamma=g, P=Pv, Q=Qv, centre=centre, half_width=half, varying=varying,
-                            axes=[a.copy() for a in gp.axes], parameter_names=list(gp.parameter_names),
-                            rate_bounds=gp.rate_bounds.copy(), state_names=list(gp.state_names),
-                            solver=solver, status=status, solve_time=solve, build_time=build,
-                            sizes=sizes, max_lmi_eig=float(worst), min_P_eig=float(minP))
 
 
 def _unsym(p: np.ndarray, n: int) -> np.ndarray:
@@ -550,14 +249,3 @@ def _solve_conic(solver, q, A, b, *, cones, max_iter):
                   max_iters=max_iter or 100000).solve()
     status = res["info"]["status"]
     return (res["x"] if status in ("solved", "solved (inaccurate - reached max_iters)") else None), status
-def Tm_back(Ps: np.ndarray, T: np.ndarray) -> np.ndarray:
-    """P in original coordinates from the scaled one: x = T x_s  ->  P = T P_s T."""
-    return T[:, None] * Ps * T[None, :]
-
-
-def _max_eig_congruent(M: np.ndarray, T: np.ndarray, n_extra: int) -> float:
-    """Largest eigenvalue of diag(T^-1, I) M diag(T^-1, I) (the LMI in the scaled
-    coordinates, where the margin is imposed; the sign is that of M)."""
-    d = np.concatenate([1.0 / T, np.ones(n_extra)])
-    S = d[:, None] * M * d[None, :]
-    return float(np.linalg.eigvalsh((S + S.T) / 2).max())

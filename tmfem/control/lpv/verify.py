@@ -12,7 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.lpv.synthesis import GeneralisedLPV, LPVStateFeedback, lmi_matrix
+from tmfem.control.lpv.eigopt import zoh
+from tmfem.control.lpv.generalized_plant import GeneralizedLPV, lmi_matrix
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.errors import InfeasibleController
 
 log = logging.getLogger(__name__)
@@ -41,7 +43,7 @@ class Verification:
                 "sampled_max_radius_at": self.max_sampled_radius_at, "passed": self.passed}
 
 
-def verify(controller: LPVStateFeedback, gp: GeneralisedLPV, *, allow_failure: bool = False,
+def verify(controller: LPVStateFeedback, gp: GeneralizedLPV, *, allow_failure: bool = False,
            sample_time: float | None = None) -> Verification:
     """Check ``controller`` on every point of ``gp`` (e.g. a grid 4x finer than the design's);
     with ``sample_time`` also the frozen loops sampled with a zero-order hold at that step
@@ -57,7 +59,6 @@ def verify(controller: LPVStateFeedback, gp: GeneralisedLPV, *, allow_failure: b
         not stable, unless ``allow_failure`` (then ``passed`` is False).
     """
     verts = gp.rate_vertices()
-    from tmfem.control.lpv.eigopt import zoh
     worst, worst_at, cl, cl_at, sr, sr_at = -np.inf, None, -np.inf, None, -np.inf, None
     for idx in np.ndindex(*gp.grid_shape):
         rho = np.array([a[i] for a, i in zip(gp.axes, idx)])

@@ -1,0 +1,147 @@
+"""The LPV options shared by ``tmfem control lpv`` and ``tmfem deploy --controller lpv``:
+the synthesis options, their checks, and the calls of the library's LPV workflow
+(:mod:`tmfem.control.lpv.workflow`) with the CLI's progress bars. The library is reached
+through the lazy attributes of its packages (``lpv.design_plant``), so that the command line
+starts without loading the models."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from tmfem.cli.common import progress_bar
+from tmfem.control import lpv
+from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
+from tmfem.errors import InputError, ResourceLimit
+from tmfem.reference.tables import deployment_bases
+from tmfem.system import load_preset
+
+#: Largest verification grid: every point is one COM linearisation (~2 s for 2-3 on this
+#: machine under load), so 500 points is about a quarter of an hour.
+MAX_VERIFY_POINTS = 500
+
+
+def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
+    """The synthesis options shared by `tmfem control lpv` and `tmfem deploy --controller lpv`."""
+    parser.add_argument("--grid", default=None, help=prefix + "theta x psi points of the printed grid (8.3; default 6x3)")
+    parser.add_argument("--refine", type=int, default=None,
+                        help=prefix + "verification grid refinement factor (>= 4, default 4)")
+    parser.add_argument("--gamma", type=float, default=None,
+                        help=prefix + "EIGOPT: the first (upper) level of the gamma bisection (default 2 x the "
+                             "pointwise lower bound), or the only level with --fixed-gamma")
+    parser.add_argument("--gamma-rtol", type=float, default=None,
+                        help=prefix + f"EIGOPT: stop the bisection when (hi - lo) <= rtol hi (default {GAMMA_RTOL})")
+    parser.add_argument("--time-budget", type=float, default=None,
+                        help=prefix + f"EIGOPT: seconds for the gamma bisection (default {TIME_BUDGET:g})")
+    parser.add_argument("--fixed-gamma", action="store_true", default=None,
+                        help=prefix + "EIGOPT: a feasible point at --gamma only (no bisection)")
+    parser.add_argument("--start", metavar="FILE.npz", default=None,
+                        help=prefix + "EIGOPT bisection: start the first level from this saved design (e.g. "
+                             "one on a sub-grid: continuation in the grid) instead of the Riccati fit (with "
+                             "--sample-time and no --start, the bisection first runs on the grid with psi "
+                             "at its middle value and starts from that design)")
+
+
+def printed_grid(spec: str, printed: dict):
+    """The --grid AxB points of the printed LPV grid (evenly spread, both ends; one point: the middle)."""
+    try:
+        nt, nps = (int(v) for v in spec.lower().split("x"))
+    except ValueError:
+        raise InputError(f"--grid: expected AxB (e.g. 6x3), found {spec!r}") from None
+    th, ps = np.radians(printed["theta_grid_deg"]), np.radians(printed["psi_grid_deg"])
+    if not (1 <= nt <= th.size and 1 <= nps <= ps.size):
+        raise InputError(f"--grid: expected at most {th.size}x{ps.size} points of the printed grid, found {spec}")
+    # k evenly spread points including both ends; one point: the middle one (psi_0 = 8.36 deg of
+    # eq. 5.100 on the printed psi axis, so a reduced grid still holds the 8.4 reference)
+    pick = lambda a, k: a[np.round(np.linspace(0, a.size - 1, k)).astype(int)] if k > 1 \
+        else a[[a.size // 2]]                                                    # noqa: E731
+    return pick(th, nt), pick(ps, nps)
+
+
+def check_synthesis(args, *, solver: str, preset: str) -> dict:
+    """The synthesis options, checked before any work; returns the resolved settings
+    (system, grid axes, refine, EIGOPT bisection or fixed level)."""
+    refine = 4 if args.refine is None else args.refine
+    if refine < 4:
+        raise InputError(f"--refine: expected >= 4 (the issue's verification standard), found {refine}")
+    if solver not in ("CLARABEL", "SCS", "EIGOPT"):
+        raise InputError(f"--solver {solver}: applies to `tmfem control hinf` only; lpv takes CLARABEL, SCS or EIGOPT")
+    eig = {k: getattr(args, k, None) for k in ("gamma_rtol", "time_budget", "fixed_gamma", "start")}
+    if solver != "EIGOPT":
+        given = [k for k, v in {**eig, "gamma": args.gamma, "sample_time": getattr(args, "sample_time", None)}.items()
+                 if v is not None]
+        if given:
+            raise InputError(f"options {['--' + k.replace('_', '-') for k in given]} apply to --solver EIGOPT "
+                             f"only, found --solver {solver}")
+    elif args.fixed_gamma:
+        if args.gamma is None or any(eig[k] is not None for k in ("gamma_rtol", "time_budget", "start")):
+            raise InputError("--fixed-gamma: expected --gamma G and none of --gamma-rtol, --time-budget, --start "
+                             "(one level, no bisection)")
+    start = None
+    if eig["start"] is not None:
+        if not Path(eig["start"]).is_file():
+            raise InputError(f"--start: expected a design saved by `tmfem control lpv --save`, found no file "
+                             f"{eig['start']!r}")
+        start = lpv.LPVStateFeedback.load(eig["start"])
+    rtol = GAMMA_RTOL if eig["gamma_rtol"] is None else eig["gamma_rtol"]
+    budget = TIME_BUDGET if eig["time_budget"] is None else eig["time_budget"]
+    if not (0 < rtol < 1):
+        raise InputError(f"--gamma-rtol: expected 0 < rtol < 1, found {rtol}")
+    if not (np.isfinite(budget) and budget > 0):
+        raise InputError(f"--time-budget: expected seconds > 0, found {budget}")
+    if args.gamma is not None and not (np.isfinite(args.gamma) and args.gamma > 0):
+        raise InputError(f"--gamma: expected > 0, found {args.gamma}")
+    s = load_preset(preset)
+    printed = dict(s.printed or {})
+    if "theta_grid_deg" not in printed or "psi_grid_deg" not in printed:
+        raise InputError(f"preset {preset!r}: expected a printed LPV grid (theta_grid_deg, psi_grid_deg), found none")
+    th, ps = printed_grid(args.grid or "6x3", printed)
+    fine_n = [(a.size - 1) * refine + 1 for a in (th, ps)]
+    if fine_n[0] * fine_n[1] > MAX_VERIFY_POINTS:
+        raise ResourceLimit(f"--grid {args.grid or '6x3'} --refine {refine}: the verification grid "
+                            f"has {fine_n[0]} x {fine_n[1]} = {fine_n[0] * fine_n[1]:,} points, one COM "
+                            f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
+    return {"system": s, "preset": preset, "theta": th, "psi": ps, "refine": refine, "solver": solver,
+            "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget, "start": start}
+
+
+def progress(total, label):
+    """The library's ``progress`` factory as a CLI progress bar."""
+    return progress_bar(total, 1, label)
+
+
+def design_plant(cfg: dict, *, rate_deg: float):
+    """The gridded plant of ``cfg`` (:func:`check_synthesis`), its interconnection (Fig. 8.1)
+    and the pointwise lower bound of gamma (:func:`tmfem.control.lpv.workflow.design_plant`);
+    returns (plant, gp, bound, JSON dict)."""
+    s, th, ps = cfg["system"], cfg["theta"], cfg["psi"]
+    print(f"tmfem: {cfg['preset']}: linearising at {th.size * ps.size} grid points", file=sys.stderr)
+    p = lpv.design_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bound=np.radians(rate_deg),
+                              progress=progress)
+    out = {"preset": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,
+           **p.bound.to_dict(), "printed_gamma_bound": 4.18}
+    return p.plant, p.generalized, p.bound, out
+
+
+def synthesize(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
+    """The controller of the settings ``cfg`` (:func:`tmfem.control.lpv.workflow.synthesize_design`)
+    and its JSON entries."""
+    return lpv.synthesize_design(gp, bound=bound, solver=cfg["solver"], gamma=cfg["gamma"],
+                                      fixed_gamma=cfg["fixed"], rtol=cfg["rtol"], time_budget=cfg["budget"],
+                                      start=cfg["start"], max_iter=max_iter, sample_time=sample_time,
+                                      progress=progress)
+
+
+def refined_plant(s, plant, factor: int, *, what: str):
+    """The plant of system ``s`` on the grid ``factor`` times finer than ``plant``'s
+    (:func:`tmfem.control.lpv.workflow.refined_plant`)."""
+    return lpv.refined_plant(s, plant, factor=factor, bases=deployment_bases(s), what=what,
+                                  progress=progress)
+
+
+def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
+    """:func:`tmfem.control.lpv.workflow.verify_design` on the grid ``refine`` times finer
+    (or ``fine`` when given); refuses a controller that fails there."""
+    fine = refined_plant(cfg["system"], plant, cfg["refine"], what="verification plant") if fine is None else fine
+    return lpv.verify_design(ctrl, fine, tracked=cfg["system"].q_names, sample_time=sample_time)
