@@ -124,7 +124,7 @@ def test_arc_length_and_follower_pressure_agree_with_load_control():
 def test_structure_refusals():
     xs = np.linspace(0, 1, 3)
     s = Structure.shell(MeshQuad.init_tensor(xs, xs), section=ShellSection(E=1, nu=0, thickness=0.1))
-    with pytest.raises(InputError, match="normal 'x', 'y' or 'z'"):
+    with pytest.raises(InputError, match="normal 'x', 'y', 'z' or a 3-vector"):
         s.symmetry([0], normal="w")
     with pytest.raises(InputError, match="parallel to the director"):
         s.symmetry([0], normal="z")

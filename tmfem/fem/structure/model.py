@@ -31,6 +31,8 @@ import scipy.sparse as sp
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
+from tmfem.fem.structure.reactions import Reactions, nodal_vectors
+from tmfem.fem.structure.supports import Supports
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
@@ -94,12 +96,16 @@ def gmsh_quad_mesh():
 
 @dataclass
 class StructureState:
-    """A solution: the nodal :class:`State`, its load factor and Newton iterations."""
+    """A solution: the nodal :class:`State`, its load factor and Newton iterations;
+    ``reaction`` (ndof,): the generalized support reactions of the solve
+    (:meth:`Structure.reactions`), ``linear``: a small-displacement solution."""
 
     state: State
     lam: float = 1.0
     iterations: int = 0
     residual_history: list = field(default_factory=list)
+    reaction: np.ndarray | None = None
+    linear: bool = False
 
     @property
     def x(self) -> np.ndarray:
@@ -131,14 +137,14 @@ class Structure:
         self.elements: list = []
         self.shells: list[MITC4Shell] = []
         self.frames = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
-        self._fixed = np.zeros(self.dofmap.ndof, bool)
-        self._prescribed = np.zeros(self.dofmap.ndof)
+        self.axes = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
+        self.supports = Supports(self.dofmap)
+        self.node_sets: dict[str, np.ndarray] = {}
         self._force = np.zeros(self.dofmap.ndof)
         self._pressures: list[ShellPressure] = []
         self._base_force = np.zeros(self.dofmap.ndof)
         self._base_pressures: list[ShellPressure] = []
         self._moments: list = []
-        self._dependent: list = []
         self._cm = None
 
     # ------------------------------------------------------------------ building
@@ -178,7 +184,18 @@ class Structure:
                              f"({self.dofmap.ndof} dofs), found {getattr(element, 'dofmap', None)}")
         self.elements.append(element)
 
+    def node_set(self, name: str, nodes) -> np.ndarray:
+        """Name a node set (indices, mask or another set's name); the name then stands for the
+        nodes in every call that takes nodes (supports, loads, reaction resultants)."""
+        nodes = self._nodes(nodes)
+        self.node_sets[str(name)] = nodes
+        return nodes
+
     def _nodes(self, nodes) -> np.ndarray:
+        if isinstance(nodes, str):
+            if nodes not in self.node_sets:
+                raise InputError(f"structure: expected a node set from {sorted(self.node_sets)}, found {nodes!r}")
+            return self.node_sets[nodes]
         nodes = np.asarray(nodes)
         if nodes.dtype == bool:
             if nodes.shape != (self.n_nodes,):
@@ -194,71 +211,130 @@ class Structure:
             raise InputError("structure: expected at least one node to satisfy the predicate, found none")
         return nodes
 
-    def _dof_index(self, nodes, dofs) -> np.ndarray:
-        nodes = self._nodes(nodes)
-        out = []
-        for n in nodes:
-            names = DOF_NAMES[int(self.dofmap.counts[n])]
-            want = names if dofs == "all" else ((dofs,) if isinstance(dofs, str) else tuple(dofs))
-            bad = [d for d in want if d not in names]
-            if bad:
-                raise InputError(f"structure: node {n} has dofs {names}, expected names from them, found {bad}")
-            out += [self.dofmap.offset[n] + names.index(d) for d in want]
-        return np.asarray(out, dtype=np.int64)
+    def _names(self, n: int, dofs) -> tuple:
+        names = DOF_NAMES[int(self.dofmap.counts[n])]
+        if isinstance(dofs, str) and dofs == "all":
+            return names
+        want = (dofs,) if isinstance(dofs, str) else tuple(dofs)
+        allowed = names + (("rx", "ry", "rz") if self.dofmap.counts[n] == 5 else ())
+        bad = [d for d in want if d not in allowed]
+        if bad:
+            raise InputError(f"structure: node {n} has dofs {names}, expected names from them, found {bad}")
+        return want
+
+    def _row(self, n: int, name: str) -> tuple[str, np.ndarray]:
+        """(field, coefficients) of the dof ``name`` of node n: ux uy uz and rx ry rz along the
+        node's local axes (:meth:`local_frame`, default x, y, z), r1 r2 about its reference
+        V_1, V_2; rx ry rz at a 5-dof node project on (V_1, V_2)."""
+        A = self.axes[n]
+        if name in ("ux", "uy", "uz"):
+            return "u", A[:, "xyz".index(name[1])]
+        if name in ("r1", "r2"):
+            return "r", np.eye(2)[int(name[1]) - 1]
+        d = A[:, "xyz".index(name[1])]
+        if self.dofmap.counts[n] == 5:
+            return "r", self.frames[n][:, :2].T @ d
+        return "r", d
 
     def fix(self, nodes, dofs="all") -> None:
-        """Fix dofs of ``nodes``: "all", a name (``ux uy uz`` translations, ``r1 r2`` shell
-        rotations about V_1, V_2, ``rx ry rz`` beam rotations) or a list of names."""
-        self._fixed[self._dof_index(nodes, dofs)] = True
+        """Fix dofs of ``nodes``: "all", a name (``ux uy uz`` translations and ``rx ry rz``
+        rotations along the node's local axes, :meth:`local_frame`; ``r1 r2`` shell rotations
+        about V_1, V_2) or a list of names. Adds to the node's supports (docs/shells.md)."""
+        label = f"fix({dofs!r})"
+        for n in self._nodes(nodes):
+            for name in self._names(int(n), dofs):
+                f, c = self._row(int(n), name)
+                self.supports.add(n, f, c, label=label)
         self._cm = None
 
-    def symmetry(self, nodes, *, normal: str) -> None:
-        """Symmetry plane with normal along a global axis ("x", "y" or "z") through ``nodes``:
-        the normal translation is fixed and the rotation may only be about the normal (shell
-        nodes get V_1 along the normal's projection on their tangent plane, r2 fixed; beam
-        nodes keep the rotation about the normal only)."""
-        if normal not in _AXES:
-            raise InputError(f"symmetry: expected normal 'x', 'y' or 'z', found {normal!r}")
-        ax = _AXES[normal]
-        nodes = self._nodes(nodes)
-        e = np.zeros(3)
-        e[ax] = 1.0
-        for n in nodes:
+    def symmetry(self, nodes, *, normal) -> None:
+        """Symmetry plane through ``nodes`` with ``normal`` ("x", "y", "z" or a 3-vector): the
+        translation along the normal is fixed and the rotation may only be about the normal
+        (a shell node: the rotation about the tangent direction normal to the plane's trace
+        is fixed; a 6-dof node: both rotations about axes in the plane). Adds to the node's
+        supports: a node on two planes gets the conditions of both."""
+        if isinstance(normal, str):
+            if normal not in _AXES:
+                raise InputError(f"symmetry: expected normal 'x', 'y', 'z' or a 3-vector, found {normal!r}")
+            e = np.eye(3)[_AXES[normal]]
+        else:
+            e = np.asarray(normal, dtype=float)
+            if e.shape != (3,) or np.linalg.norm(e) == 0:
+                raise InputError(f"symmetry: expected normal 'x', 'y', 'z' or a 3-vector, found {normal!r}")
+            e = e / np.linalg.norm(e)
+        label = f"symmetry(normal={normal!r})"
+        in_plane = np.linalg.svd(e[None, :])[2][1:]                  # (2, 3) orthonormal, _|_ e
+        for n in self._nodes(nodes):
             c = int(self.dofmap.counts[n])
-            self._fixed[self.dofmap.offset[n] + ax] = True
+            self.supports.add(n, "u", e, label=label)
             if c == 5:
-                Vn = self.frames[n][:, 2]
-                v1 = e - (e @ Vn) * Vn
-                if np.linalg.norm(v1) < 1e-8:
+                e2 = self.frames[n][:, :2].T @ e
+                if np.linalg.norm(e2) < 1e-8:
                     raise InputError(f"symmetry: node {n}: the plane normal {normal} is parallel to the "
                                      f"director; expected a plane that cuts the shell")
-                v1 /= np.linalg.norm(v1)
-                self._set_frame(n, np.column_stack([v1, np.cross(Vn, v1), Vn]))
-                self._fixed[self.dofmap.offset[n] + 4] = True
+                self.supports.add(n, "r", np.array([-e2[1], e2[0]]), label=label)
             elif c == 6:
-                for k in range(3):
-                    if k != ax:
-                        self._fixed[self.dofmap.offset[n] + 3 + k] = True
+                for d in in_plane:
+                    self.supports.add(n, "r", d, label=label)
         self._cm = None
 
-    def _set_frame(self, n: int, frame: np.ndarray) -> None:
-        self.frames[n] = frame
-        for sh in self.shells:
-            sh.frames[n] = frame
+    def local_frame(self, nodes, axes) -> None:
+        """Local (skew) axes of ``nodes``: ``axes`` (3, 3) with the axes as columns, (len(nodes),
+        3, 3), or a callable ``axes(x, y, z) -> (len(nodes), 3, 3)``. The dof names of later
+        :meth:`fix` and :meth:`prescribe` calls at these nodes (``ux uy uz``, ``rx ry rz``) and
+        the local reactions (:meth:`reactions`) refer to them; supports given before keep
+        their directions."""
+        nodes = self._nodes(nodes)
+        A = axes(*self.X[:, nodes]) if callable(axes) else axes
+        A = np.broadcast_to(np.asarray(A, dtype=float), (nodes.size, 3, 3))
+        err = np.abs(np.einsum("nki,nkj->nij", A, A) - np.eye(3)).max(axis=(1, 2))
+        if np.any(err > 1e-8) or np.any(np.linalg.det(A) < 0):
+            raise InputError(f"local frame: expected orthonormal right-handed axes (columns), found "
+                             f"an error of {err.max():.2e} or a reflection at node(s) "
+                             f"{nodes[(err > 1e-8) | (np.linalg.det(A) < 0)][:5].tolist()}")
+        self.axes[nodes] = A
 
-    def pin(self, node: int, *, to: int) -> None:
+    def pin(self, node: int, *, to) -> None:
         """Translation-only connection: the translations of ``node`` follow those of ``to``
-        (its rotations, if any, stay free: a pin)."""
-        self._dependent.append((int(node), np.array([int(to)]), np.array([1.0])))
+        (its rotations, if any, stay free: a pin). Refused for a node that is pinned or
+        supported already, or whose master is pinned."""
+        self.supports.pin(int(node), [int(to)], [1.0], label=f"pin({int(node)}, to={int(to)})")
         self._cm = None
 
-    def prescribe(self, nodes, dof: str, value: float) -> None:
-        """Prescribed displacement ``value`` [m] (or rotation [rad]) of dof ``dof`` at
-        ``nodes``, reached at load factor 1 (displacement control)."""
-        idx = self._dof_index(nodes, dof)
-        self._fixed[idx] = True
-        self._prescribed[idx] = float(value)
+    def prescribe(self, nodes, dof: str, value) -> None:
+        """Prescribed displacement [m] (or rotation [rad]) of dof ``dof`` (names as in
+        :meth:`fix`) at ``nodes``, reached at load factor 1 (displacement control). ``value``:
+        a number, one per node, or a callable ``value(x, y, z)`` of the reference positions.
+        A dof constrained already is refused (conflicting or redundant)."""
+        nodes = self._nodes(nodes)
+        v = value(*self.X[:, nodes]) if callable(value) else value
+        v = np.broadcast_to(np.asarray(v, dtype=float), nodes.shape) if np.ndim(v) <= 1 else None
+        if v is None or not np.all(np.isfinite(v)):
+            raise InputError(f"prescribe: expected a finite value per node ({nodes.size}), found {value!r}")
+        for n, vn in zip(nodes, v):
+            (name,) = self._names(int(n), dof)
+            f, c = self._row(int(n), name)
+            self.supports.add(n, f, c, value=float(vn), prescribed=True, label=f"prescribe({dof!r})")
         self._cm = None
+
+    def release(self, nodes, dofs="all") -> None:
+        """Remove the supports of ``nodes``: "all" (every support, prescription and the pin of
+        the node) or dof names (the supports along exactly those directions). A name with
+        nothing to release is refused."""
+        for n in self._nodes(nodes):
+            if isinstance(dofs, str) and dofs == "all":
+                self.supports.release(n)
+                continue
+            for name in self._names(int(n), dofs):
+                f, c = self._row(int(n), name)
+                if self.supports.release(n, f, c) == 0:
+                    raise InputError(f"release: node {n}: expected a support along {name}, found none")
+        self._cm = None
+
+    def copy(self) -> "Structure":
+        """An independent copy (supports, loads and element sets; the backend is shared)."""
+        import copy as _copy
+        return _copy.deepcopy(self, memo={id(self.backend): self.backend})
 
     def point_load(self, nodes, *, force=(0.0, 0.0, 0.0), moment=None) -> None:
         """Point force [N] (3,) on each of ``nodes`` and optional moment [N m] (3,): on a 5-dof
@@ -326,16 +402,23 @@ class Structure:
         self._moments = []
         self._base_pressures += self._pressures
         self._pressures = []
-        self._prescribed = np.zeros(self.dofmap.ndof)
+        self.supports.freeze()
+        self._cm = None
 
     # ------------------------------------------------------------------ equations
     @property
     def constraints(self) -> ConstraintMap:
-        """The constraint map (dependent nodes, fixed and prescribed dofs)."""
+        """The constraint map of the supports, prescriptions and pins
+        (:meth:`tmfem.fem.structure.supports.Supports.build`)."""
         if self._cm is None:
-            self._cm = ConstraintMap.build(self.dofmap, dependent=self._dependent,
-                                           fixed_dofs=np.flatnonzero(self._fixed))
-        return self._cm
+            self._cm = self.supports.build()
+        return self._cm[0]
+
+    @property
+    def _prescribed(self) -> np.ndarray:
+        """Full prescribed displacement at load factor 1 (ndof,)."""
+        self.constraints
+        return self._cm[1]
 
     def reference_state(self) -> State:
         """The undeformed state."""
@@ -416,7 +499,42 @@ class Structure:
         rhs = rhs - K @ up
         u = up.copy()
         u[idx] = factorize(K[idx][:, idx], self.backend, equilibrate=True)(rhs[idx])
-        return StructureState(state=s0.advanced(cm.full(u), self.dofmap), lam=1.0, iterations=1)
+        return StructureState(state=s0.advanced(cm.full(u), self.dofmap), lam=1.0, iterations=1,
+                              reaction=self._reaction(K @ u - cm.residual(f0)), linear=True)
+
+    def _reaction(self, r_red: np.ndarray) -> np.ndarray:
+        """Generalized reactions (ndof,) from a reduced residual T^T (f_int - f_ext)."""
+        cm = self.constraints
+        return cm.independent(np.where(cm.free, 0.0, r_red))
+
+    def reactions(self, st: StructureState, *, frame: str = "global") -> Reactions:
+        """Support reactions of the solution ``st`` (:mod:`tmfem.fem.structure.reactions`):
+        force [N] and moment [N m] per node, in global axes or (``frame="local"``) in each
+        node's local axes (:meth:`local_frame`). Computed by the solve; for a state made
+        otherwise, from the residual T^T (f_int - f_ext) at ``st``."""
+        if frame not in ("global", "local"):
+            raise InputError(f"reactions: expected frame 'global' or 'local', found {frame!r}")
+        g = st.reaction
+        if g is None:
+            g = self._reaction(self.residual(st.state, st.lam)[0])
+        at = self.reference_state() if st.linear else st.state
+        f, m = nodal_vectors(g, at, self.dofmap)
+        if frame == "local":
+            f, m = np.einsum("nki,kn->in", self.axes, f), np.einsum("nki,kn->in", self.axes, m)
+        return Reactions(force=f, moment=m, x=at.x, frame=frame)
+
+    def applied(self, st: StructureState) -> tuple[np.ndarray, np.ndarray]:
+        """Applied nodal forces [N] (3, n) and moments [N m] (3, n) at ``st`` (point loads,
+        pressures on the current surface, base loads), global axes: with :meth:`reactions`
+        the free-body check sum R + sum F = 0."""
+        at = self.reference_state() if st.linear else st.state
+        f, _ = self.external(at, 1.0 if st.linear else st.lam, tangent=False)
+        return nodal_vectors(f, at, self.dofmap)
+
+    def resultant(self, st: StructureState, nodes=None, *, about=(0.0, 0.0, 0.0)):
+        """Resultant force [N] (3,) and moment [N m] (3,) about ``about`` of the reactions at
+        ``nodes`` (indices, mask or a :meth:`node_set` name; default all)."""
+        return self.reactions(st).resultant(None if nodes is None else self._nodes(nodes), about=about)
 
     def solve(self, *, steps: int = 10, lam_end: float = 1.0, tol: float = 1e-8, max_iter: int = 30,
               line_search: bool = False, min_step: float = 1e-4, start: StructureState | None = None,
@@ -459,7 +577,7 @@ class Structure:
                 continue
             lam = target
             cur = StructureState(state=res.u, lam=lam, iterations=res.iterations,
-                                 residual_history=res.residual_history)
+                                 residual_history=res.residual_history, reaction=self._reaction(res.r))
             out.append(cur)
             if callback is not None:
                 callback(cur)
@@ -549,7 +667,9 @@ class Structure:
             cd["Q"].append(r["Qs"])
             for j, name in enumerate(("bottom", "mid", "top")):
                 cd[f"von_mises_{name}"].append(r["von_mises"][:, j])
-        point_data = {"displacement": u, "rotation": self.rotation_vectors(st).T}
+        reac = self.reactions(st)
+        point_data = {"displacement": u, "rotation": self.rotation_vectors(st).T,
+                      "reaction_force [N]": reac.force.T, "reaction_moment [N m]": reac.moment.T}
         if Vn is not None:
             point_data["director"] = Vn
         return meshio.Mesh(points=pts, cells=cells, point_data=point_data, cell_data=cd)
