@@ -31,14 +31,16 @@ import scipy.sparse as sp
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
+from tmfem.fem.structure.path import Path
 from tmfem.fem.structure.reactions import Reactions, nodal_vectors
 from tmfem.fem.structure.supports import Supports
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
-from tmfem.solvers import arc_length, lowest_modes, newton
+from tmfem.solvers import lowest_modes, newton
 from tmfem.solvers.backends import get_backend
-from tmfem.solvers.newton import factorize
+from tmfem.solvers.continuation import follow, negative_pivots
+from tmfem.solvers.newton import factorize, submatrix
 
 log = logging.getLogger(__name__)
 
@@ -98,7 +100,9 @@ def gmsh_quad_mesh():
 class StructureState:
     """A solution: the nodal :class:`State`, its load factor and Newton iterations;
     ``reaction`` (ndof,): the generalized support reactions of the solve
-    (:meth:`Structure.reactions`), ``linear``: a small-displacement solution."""
+    (:meth:`Structure.reactions`), ``linear``: a small-displacement solution;
+    ``negative_pivots`` of the tangent and the ``event`` ("limit point", "bifurcation") of
+    the step that reached it, when the path following computed them."""
 
     state: State
     lam: float = 1.0
@@ -106,6 +110,8 @@ class StructureState:
     residual_history: list = field(default_factory=list)
     reaction: np.ndarray | None = None
     linear: bool = False
+    negative_pivots: int | None = None
+    event: str | None = None
 
     @property
     def x(self) -> np.ndarray:
@@ -440,17 +446,25 @@ class Structure:
                                             nodal_normals(x, sh.conn)[:, sh.nodes])
         return StructureState(state=State(x=x.copy(), R=R, frames=self.frames), lam=lam)
 
-    def external(self, state: State, lam: float, *, tangent: bool = True):
-        """External force F_base + lam (F_point + F_pressure(state)) and its load stiffness
-        (base loads: :meth:`freeze_loads`)."""
-        f = self._base_force + lam * (self._force + self._moment_vector())
+    def _load_part(self, state: State, *, live: bool, tangent: bool = True):
+        """The live loads at load factor 1 (point, moment, line, body, pressure) or the base
+        loads (:meth:`freeze_loads`) at ``state``, and their load stiffness d f / d u."""
+        f = self._force + self._moment_vector() if live else self._base_force.copy()
         K = None
-        for pl, c in [(p, 1.0) for p in self._base_pressures] + [(p, lam) for p in self._pressures]:
+        for pl in (self._pressures if live else self._base_pressures):
             fp, Kp = pl.load(state, tangent=tangent)
-            f = f + c * fp
+            f = f + fp
             if Kp is not None:
-                K = c * Kp if K is None else K + c * Kp
+                K = Kp if K is None else K + Kp
         return f, K
+
+    def external(self, state: State, lam: float, *, tangent: bool = True):
+        """External force F_base + lam F_live(state) and its load stiffness (base loads:
+        :meth:`freeze_loads`)."""
+        fb, Kb = self._load_part(state, live=False, tangent=tangent)
+        fl, Kl = self._load_part(state, live=True, tangent=tangent)
+        K = Kb if Kl is None else (lam * Kl if Kb is None else Kb + lam * Kl)
+        return fb + lam * fl, K
 
     def residual(self, state: State, lam: float):
         """Reduced residual T^T (f_int - f_ext) and tangent T^T (K - K_load) T."""
@@ -536,28 +550,52 @@ class Structure:
         ``nodes`` (indices, mask or a :meth:`node_set` name; default all)."""
         return self.reactions(st).resultant(None if nodes is None else self._nodes(nodes), about=about)
 
-    def solve(self, *, steps: int = 10, lam_end: float = 1.0, tol: float = 1e-8, max_iter: int = 30,
-              line_search: bool = False, min_step: float = 1e-4, start: StructureState | None = None,
-              callback=None, equilibrate: bool = True) -> list[StructureState]:
-        """Nonlinear statics by load (and displacement) control from ``start`` (default the
-        reference state at lam = 0) to ``lam_end`` in ``steps`` equal increments; a step whose
-        Newton iteration fails is retried in halves down to ``min_step``.
+    def _system(self, state: State, lam: float):
+        """(r, K, q) of :func:`tmfem.solvers.continuation.follow`: the reduced residual
+        T^T (f_int - f_base - lam f_live), its tangent and q = T^T f_live(state)."""
+        cm = self.constraints
+        f, K = assemble(self.elements, state)
+        fb, Kb = self._load_part(state, live=False)
+        fl, Kl = self._load_part(state, live=True)
+        for Kp, c in ((Kb, 1.0), (Kl, lam)):
+            if Kp is not None:
+                K = K - c * Kp
+        return cm.residual(f - fb - lam * fl), cm.tangent(K), cm.residual(fl)
 
-        Newton (eq. 4.6) converges when ||r|| <= tol * scale, scale = ||F(lam = 1)|| (or the
-        reaction of the prescribed displacements). ``line_search`` is off by default: the
-        residual norm is a poor merit function for bending-dominated shells (a linear
-        predictor stretches the mid-surface), and the full Newton step converges.
-        ``equilibrate``: each Newton system is solved with symmetric Jacobi scaling
-        (:func:`tmfem.solvers.newton.factorize`; thin shells, docs/shells.md).
-        Returns the converged states, the start included.
+    def _stability(self, state: State, lam: float) -> int | None:
+        _, K = self.residual(state, lam)
+        return negative_pivots(submatrix(K, np.flatnonzero(self.constraints.free)))
+
+    def solve(self, *, steps: int = 10, lam_end: float = 1.0, tol: float = 1e-8, max_iter: int = 30,
+              line_search: bool = False, min_step: float = 1e-4, start=None, callback=None,
+              equilibrate: bool = True, stability: bool = False) -> Path:
+        """Load control: from ``start`` (a state or a :class:`Path`, default the reference
+        state at lam = 0) to ``lam_end`` in ``steps`` equal increments of the load factor,
+        which scales the live loads and the prescribed displacements together; Newton at
+        every step (eq. 4.6); a failed step is retried in halves down to ``min_step``.
+
+        Newton converges when ||r|| <= tol * scale, scale = ||F(lam = 1)|| (or the reaction
+        of the prescribed displacements). ``line_search`` is off by default: the residual norm
+        is a poor merit function for bending-dominated shells (a linear predictor stretches
+        the mid-surface), and the full Newton step converges. ``equilibrate``: Jacobi-scaled
+        solves (docs/shells.md, thin shells). ``stability``: count the negative pivots of the
+        tangent at every converged step (a bifurcation indicator; an extra factorization).
+
+        Returns a :class:`Path` of every converged state (the start included) that says why
+        it stopped: "completed", or, when a step fails below ``min_step``, "limit point" (the
+        tangent at the failed iterate has more negative pivots than at the last converged
+        state: continue with :meth:`solve_arc_length`) or "divergence".
         """
         if not (isinstance(steps, (int, np.integer)) and steps >= 1):
             raise InputError(f"solve: expected steps >= 1, found {steps!r}")
+        controls = dict(steps=steps, lam_end=lam_end, tol=tol, max_iter=max_iter, line_search=line_search,
+                        min_step=min_step, equilibrate=equilibrate, stability=stability)
         scale = self._scale()
-        cur = start or StructureState(state=self.reference_state(), lam=0.0)
+        cur = self._start(start)
         out = [cur]
         dlam = (lam_end - cur.lam) / steps
         lam = cur.lam
+        reason, message = "completed", f"load factor {lam_end:g} reached"
         while (lam_end - lam) * np.sign(dlam) > 1e-12 * abs(lam_end):
             d = dlam if abs(dlam) <= abs(lam_end - lam) else lam_end - lam
             target = lam + d
@@ -571,43 +609,140 @@ class Structure:
                 dlam = 0.5 * d
                 log.info("structure: step to lam = %g failed (%s); halving", target, exc)
                 if abs(dlam) < min_step:
-                    raise ConvergenceError(f"structure: expected to reach load factor {lam_end:g}, stuck at "
-                                           f"{lam:g} (increment {abs(d):.2e} failed, below min_step "
-                                           f"{min_step:g} after halving): {exc}") from None
+                    before = cur.negative_pivots if cur.negative_pivots is not None else \
+                        self._stability(cur.state, cur.lam)
+                    failed = getattr(exc, "u", None)
+                    after = self._stability(failed, target) if isinstance(failed, State) else None
+                    limit = before is not None and after is not None and after > before
+                    reason = "limit point" if limit else "divergence"
+                    message = (f"stuck at load factor {lam:g} on the way to {lam_end:g} (increment {abs(d):.2e} "
+                               f"failed, below min_step {min_step:g})"
+                               + (f"; negative pivots {before} -> {after}: continue with solve_arc_length"
+                                  if limit else "") + f": {exc}")
+                    log.warning("structure: load control stopped (%s): %s", reason, message)
+                    break
                 continue
             lam = target
+            piv = self._stability(res.u, lam) if stability else None
+            event = ("bifurcation" if piv is not None and cur.negative_pivots is not None
+                     and piv != cur.negative_pivots else None)
             cur = StructureState(state=res.u, lam=lam, iterations=res.iterations,
-                                 residual_history=res.residual_history, reaction=self._reaction(res.r))
+                                 residual_history=res.residual_history, reaction=self._reaction(res.r),
+                                 negative_pivots=piv, event=event)
             out.append(cur)
             if callback is not None:
                 callback(cur)
-        return out
+        return Path(out, method="load", controls=controls, reason=reason, message=message)
 
-    def solve_arc_length(self, *, dl: float, n_steps: int = 50, lam_max: float | None = None,
-                         tol: float = 1e-8, stop=None, start: StructureState | None = None
-                         ) -> list[StructureState]:
-        """Arc-length continuation (Crisfield, :func:`tmfem.solvers.arc_length`) for point
-        loads and dead pressure (a follower pressure or prescribed displacements are refused:
-        the solver takes a fixed reference load). Starts from ``start`` (an equilibrium under
-        the base loads of :meth:`freeze_loads`; default the reference state)."""
-        if any(p.follower for p in self._pressures) or np.any(self._prescribed):
-            raise InputError("arc length: expected dead loads only, found a follower pressure or "
-                             "prescribed displacements (use solve())")
+    def _start(self, start) -> StructureState:
+        if start is None:
+            return StructureState(state=self.reference_state(), lam=0.0)
+        return start[-1] if isinstance(start, Path) else start
+
+    def _follow(self, method: str, *, start, controls: dict, **kwargs) -> Path:
+        if np.any(self._prescribed):
+            raise InputError(f"{method}: expected no prescribed displacements to reach (they belong "
+                             f"to load control, solve()), found some; freeze_loads() makes them permanent")
+        cur = self._start(start)
+        cont = {}
+        if isinstance(start, Path) and start.method == method:
+            cont = dict(start_increment=start.increment, start_pivots=start[-1].negative_pivots)
+        scale = float(np.linalg.norm(self._system(cur.state, cur.lam)[2][self.constraints.free]))
+        if scale == 0.0:
+            raise InputError(f"{method}: expected live loads (point, pressure, line, body), found none")
+        res = follow(self._system, cur.state, lam0=cur.lam, free=self.constraints.free, method=method,
+                     update=self.advance, backend=self.backend, scale=scale, **cont, **kwargs)
+        states = [cur]
+        for s, info in zip(res.u[1:], res.steps[1:]):
+            states.append(StructureState(state=s, lam=info.lam, iterations=info.iterations,
+                                         residual_history=info.residuals, negative_pivots=info.negative_pivots,
+                                         event=info.event))
+        if cur.negative_pivots is None:
+            cur.negative_pivots = res.steps[0].negative_pivots
+        return Path(states, method=method, controls=controls, reason=res.reason, message=res.message,
+                    increment=res.increment, dl=res.dl)
+
+    def solve_arc_length(self, *, dl: float, max_steps: int = 50, lam_max: float | None = None,
+                         psi: float = 0.0, tol: float = 1e-8, max_iter: int = 25, target_iter: int = 5,
+                         dl_min: float | None = None, dl_max: float | None = None, growth: float = 2.0,
+                         cutback: float = 0.5, stability: bool = True, stop_at=(), stop=None,
+                         start=None, equilibrate: bool = True, n_steps: int | None = None) -> Path:
+        """Arc-length continuation (Crisfield; :mod:`tmfem.solvers.continuation`) of the live
+        loads (point, line, body loads and pressures, dead or follower) from ``start`` (an
+        equilibrium; default the reference state; a :class:`Path` of an arc-length run is
+        continued in its direction with its arc).
+
+        Controls: ``dl`` first arc (2-norm of the step's increment over the free dofs [m and
+        rad], plus psi^2 Dlam^2 |q|^2); ``psi`` load term (0: cylindrical); ``max_steps``
+        budget (``n_steps`` is its old name); ``lam_max`` target load factor; ``tol``
+        residual tolerance relative to |q|; ``max_iter`` Newton iterations per step;
+        ``target_iter``, ``growth``, ``cutback``, ``dl_min``, ``dl_max`` arc adaptation
+        (dl (target_iter/iterations)^(1/2), limited per step to [cutback, growth] times dl
+        and to [dl_min, dl_max], default [1e-4, 10] dl; a failed step is retried with
+        cutback dl); ``stability`` negative pivot count per step; ``stop_at`` events that
+        stop the run ("limit point", "bifurcation"); ``stop(state, lam)`` a user stop.
+        Returns a :class:`Path` with every converged state and the reason it stopped.
+        """
+        if n_steps is not None:
+            max_steps = n_steps
+        controls = dict(dl=dl, max_steps=max_steps, lam_max=lam_max, psi=psi, tol=tol, max_iter=max_iter,
+                        target_iter=target_iter, dl_min=dl_min, dl_max=dl_max, growth=growth, cutback=cutback,
+                        stability=stability, stop_at=stop_at, stop=stop, equilibrate=equilibrate)
+        if isinstance(start, Path) and start.method == "arc-length" and start.dl is not None:
+            dl = start.dl
+        kw = {k: v for k, v in controls.items() if k != "dl"}
+        return self._follow("arc-length", start=start, controls=controls, dl=dl, **kw)
+
+    def solve_displacement_control(self, *, node: int, dof: str, increment: float, target: float | None = None,
+                                   max_steps: int = 50, tol: float = 1e-8, max_iter: int = 25,
+                                   target_iter: int = 5, growth: float = 1.0, cutback: float = 0.5,
+                                   stability: bool = True, stop_at=(), stop=None, start=None,
+                                   equilibrate: bool = True) -> Path:
+        """Displacement control (Batoz & Dhatt): the dof ``dof`` (a name of :meth:`fix`) of
+        ``node`` advances by ``increment`` [m or rad] per step and the load factor of the live
+        loads follows, through load maxima, up to the displacement ``target`` from the start
+        (the last step lands on it) or ``max_steps`` steps. ``growth`` > 1 lets the increment
+        grow after easy steps (as the arc of :meth:`solve_arc_length`); ``cutback`` halves a
+        failed one. Other controls as :meth:`solve_arc_length`. Returns a :class:`Path`."""
+        if target is not None and target * increment <= 0:
+            raise InputError(f"displacement control: expected a target on the side of the increment "
+                             f"{increment:g}, found {target!r}")
+        (n,) = self._nodes([node])
+        (name,) = self._names(int(n), dof)
+        f, c = self._row(int(n), name)
+        k = int(np.argmax(np.abs(c)))
+        if abs(abs(c[k]) - 1) > 1e-12:
+            raise InputError(f"displacement control: expected a dof along a global axis (or r1, r2), found {name} "
+                             f"along {np.round(c, 3).tolist()} (the node's local frame)")
+        full = int(self.dofmap.offset[n] + (k if f == "u" else 3 + k))
         cm = self.constraints
-        f1, _ = self.external(self.reference_state(), 1.0, tangent=False)
-        f0, _ = self.external(self.reference_state(), 0.0, tangent=False)
-        q = cm.residual(f1 - f0)
+        red = int(cm.reduced_of[full])
+        if red < 0 or not cm.free[red] or (cm.L is not None and abs(abs(cm.L[red, red]) - 1) > 1e-12):
+            raise InputError(f"displacement control: expected a free dof, found {name} of node {n} constrained")
+        sign = float(np.sign(cm.L[red, red])) if cm.L is not None else 1.0
+        controls = dict(node=int(n), dof=dof, increment=increment, target=target, max_steps=max_steps, tol=tol,
+                        max_iter=max_iter, target_iter=target_iter, growth=growth, cutback=cutback,
+                        stability=stability, stop_at=stop_at, stop=stop, equilibrate=equilibrate)
+        done = 0.0
+        if isinstance(start, Path) and start.method == "displacement" and target is not None:
+            done = float(np.sign(c[k]) * (self.displacements(start[-1]) - self.displacements(start[0]))[k, n]) \
+                if f == "u" else 0.0
+        return self._follow("displacement", start=start, controls=controls, dl=sign * increment,
+                            control=red, u_target=None if target is None else sign * (target - done),
+                            max_steps=max_steps, tol=tol, max_iter=max_iter, target_iter=target_iter,
+                            dl_max=abs(increment) * max(growth, 1.0) ** 10, growth=growth, cutback=cutback,
+                            stability=stability, stop_at=stop_at, stop=stop, equilibrate=equilibrate)
 
-        def internal(s):
-            f, K = assemble(self.elements, s)
-            fb, Kb = self.external(s, 0.0)
-            return cm.residual(f - fb), cm.tangent(K if Kb is None else K - Kb)
-        s0 = self.reference_state() if start is None else start.state
-        path = arc_length(internal, q, s0, free=cm.free, dl=dl, n_steps=n_steps,
-                          lam_max=lam_max, tol=tol, update=self.advance, backend=self.backend,
-                          stop=None if stop is None else (lambda s, lam: stop(StructureState(s, lam))))
-        its = [0] + list(path.iterations)
-        return [StructureState(state=s, lam=float(lam), iterations=i) for s, lam, i in zip(path.u, path.lam, its)]
+    def resume(self, path: Path, **changes) -> Path:
+        """Continue a stopped run where it stopped, with its method and controls (``changes``
+        override some, e.g. ``max_steps=`` or ``lam_max=``); returns the whole path, the
+        states of ``path`` first."""
+        method = {"load": self.solve, "arc-length": self.solve_arc_length,
+                  "displacement": self.solve_displacement_control}[path.method]
+        kw = {**path.controls, **changes}
+        more = method(start=path, **kw)
+        return Path(list(path) + list(more[1:]), method=more.method, controls=kw, reason=more.reason,
+                    message=more.message, increment=more.increment, dl=more.dl)
 
     def mass(self, state: State | None = None) -> sp.csr_matrix:
         """Mass matrix (ndof, ndof): sum of the element sets' masses (shell and beam rotary
