@@ -31,6 +31,7 @@ import scipy.sparse as sp
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
+from tmfem.fem.structure.loads import LineLoad, LoadCases
 from tmfem.fem.structure.path import Path
 from tmfem.fem.structure.reactions import Reactions, nodal_vectors
 from tmfem.fem.structure.supports import Supports
@@ -146,11 +147,7 @@ class Structure:
         self.axes = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
         self.supports = Supports(self.dofmap)
         self.node_sets: dict[str, np.ndarray] = {}
-        self._force = np.zeros(self.dofmap.ndof)
-        self._pressures: list[ShellPressure] = []
-        self._base_force = np.zeros(self.dofmap.ndof)
-        self._base_pressures: list[ShellPressure] = []
-        self._moments: list = []
+        self.loads = LoadCases(self.dofmap.ndof)
         self._cm = None
 
     # ------------------------------------------------------------------ building
@@ -342,31 +339,32 @@ class Structure:
         import copy as _copy
         return _copy.deepcopy(self, memo={id(self.backend): self.backend})
 
-    def point_load(self, nodes, *, force=(0.0, 0.0, 0.0), moment=None) -> None:
+    def point_load(self, nodes, *, force=(0.0, 0.0, 0.0), moment=None, case: str = "default") -> None:
         """Point force [N] (3,) on each of ``nodes`` and optional moment [N m] (3,): on a 5-dof
         node its components along the node's reference V_1, V_2 (the moment follows the node's
-        triad), on a 6-dof node about x, y, z."""
+        triad; a shell node takes no moment about its director), on a 6-dof node about x, y, z.
+        ``case``: the load case (:meth:`combine`)."""
         nodes = self._nodes(nodes)
         force = np.asarray(force, dtype=float)
-        if force.shape != (3,):
-            raise InputError(f"point load: expected a force of 3 components, found {force.shape}")
-        self._force[self.dofmap.translation_dofs(nodes)] += force
+        if force.shape != (3,) or not np.all(np.isfinite(force)):
+            raise InputError(f"point load: expected a finite force of 3 components, found {force!r}")
+        c = self.loads.case(case)
+        np.add.at(c.force, self.dofmap.translation_dofs(nodes).ravel(), np.tile(force, nodes.size))
         if moment is not None:
             m = np.asarray(moment, dtype=float)
-            if m.shape != (3,):
-                raise InputError(f"point load: expected a moment of 3 components, found {m.shape}")
+            if m.shape != (3,) or not np.all(np.isfinite(m)):
+                raise InputError(f"point load: expected a finite moment of 3 components, found {moment!r}")
             bad = nodes[self.dofmap.counts[nodes] == 3]
             if bad.size:
                 raise InputError(f"point load: nodes {bad[:5].tolist()} have no rotations; a moment needs "
                                  f"5 or 6 dofs")
-            self._moments += [(int(n), m) for n in nodes]
-        self._cm = None
+            c.moments += [(int(n), m) for n in nodes]
 
-    def _moment_vector(self) -> np.ndarray:
-        """Generalised forces of the point moments: m . V_1, m . V_2 of the reference triads
-        at 5-dof nodes (read when solving, so later symmetry() triads count), m at 6-dof nodes."""
+    def _moment_vector(self, moments) -> np.ndarray:
+        """Generalized forces of point moments [(node, m)]: m . V_1, m . V_2 of the reference
+        triads at 5-dof nodes (read when solving, after every add_shell), m at 6-dof nodes."""
         f = np.zeros(self.dofmap.ndof)
-        for n, m in self._moments:
+        for n, m in moments:
             o = self.dofmap.offset[n] + 3
             if self.dofmap.counts[n] == 5:
                 f[o:o + 2] += self.frames[n][:, :2].T @ m
@@ -374,9 +372,65 @@ class Structure:
                 f[o:o + 3] += m
         return f
 
-    def surface_load(self, q, *, elements=None, shell: int = 0) -> None:
-        """Dead distributed load q [N/m^2] (3,) per unit reference mid-surface area (e.g. self
-        weight), as consistent nodal forces f_k = int h_k q dA."""
+    def _lines(self, where) -> np.ndarray:
+        """Line elements (k, ne) of a line load: a (2, ne) or (4, ne) array, a beam element set
+        (its elements), or nodes (indices, mask, set name) whose shell element edges (both ends
+        in the set) carry it."""
+        if isinstance(where, BeamElement):
+            return where.beams.conn
+        if not isinstance(where, str):
+            arr = np.asarray(where)
+            if arr.ndim == 2 and arr.dtype != bool:
+                if arr.shape[0] not in (2, 4):
+                    raise InputError(f"line load: expected lines of shape (2 or 4, ne), found {arr.shape}")
+                self.dofmap.check_element_nodes(arr, int(self.dofmap.counts[arr.ravel()[0]]), element="line load",
+                                                dofs="the same number of dofs")
+                return arr.astype(np.int64)
+        nodes = self._nodes(where)
+        inside = np.zeros(self.n_nodes, bool)
+        inside[nodes] = True
+        edges = np.hstack([np.vstack([sh.conn[k], sh.conn[(k + 1) % 4]]) for sh in self.shells for k in range(4)]) \
+            if self.shells else np.zeros((2, 0), np.int64)
+        edges = edges[:, inside[edges].all(axis=0)]
+        edges = np.unique(np.sort(edges, axis=0), axis=1)
+        if edges.shape[1] == 0:
+            raise InputError(f"line load: expected shell element edges with both nodes among the {nodes.size} "
+                             f"given nodes, found none (give the lines as a (2, ne) array)")
+        return edges
+
+    def line_load(self, where, q, *, follower: bool = False, case: str = "default") -> None:
+        """Line load along ``where`` (shell edges between the given nodes or a set name, a (2,
+        ne) array of edges, a (4, ne) beam connectivity or a beam element set), as consistent
+        nodal forces (:mod:`tmfem.fem.structure.loads`): dead, q [N/m] (3,) or q(x, y, z) ->
+        (3, m) per unit reference length; or ``follower``, q [N/m] per unit current length
+        along the current shell director."""
+        ld = LineLoad(X=self.X, lines=self._lines(where), dofmap=self.dofmap, q=q, follower=follower,
+                      frames=self.frames)
+        c = self.loads.case(case)
+        if follower:
+            c.loads.append(ld)
+        else:
+            c.force += ld.load(None)[0]
+
+    def gravity(self, g=(0.0, 0.0, -9.81), *, case: str = "default") -> None:
+        """Body load of every element set's mass in the acceleration field g [m/s^2] (3,):
+        f = M a_g with a_g = g on every translation (consistent: f_k = int rho h_k g dV; the
+        rotary inertia takes no part). Add the elements first."""
+        g = np.asarray(g, dtype=float)
+        if g.shape != (3,) or not np.all(np.isfinite(g)):
+            raise InputError(f"gravity: expected a finite acceleration of 3 components, found {g!r}")
+        if not self.elements:
+            raise InputError("gravity: expected element sets (add them first), found none")
+        a = np.zeros(self.dofmap.ndof)
+        a[self.dofmap.translation_dofs(np.arange(self.n_nodes))] = g
+        f = self.mass() @ a
+        if not np.any(f):
+            raise InputError("gravity: expected element sets with mass (rho > 0), found a massless model")
+        self.loads.case(case).force += f
+
+    def surface_load(self, q, *, elements=None, shell: int = 0, case: str = "default") -> None:
+        """Dead distributed load q [N/m^2] (3,) per unit reference mid-surface area, as
+        consistent nodal forces f_k = int h_k q dA."""
         if not self.shells:
             raise InputError("surface load: expected a shell element set, found none")
         q = np.asarray(q, dtype=float)
@@ -385,10 +439,11 @@ class Structure:
         sh = self.shells[shell]
         conn = sh.conn if elements is None else sh.conn[:, np.asarray(elements)]
         dA = ShellPressure(X=self.X, conn=conn, dofmap=self.dofmap, p=1.0, follower=False).nodal_areas()
-        np.add.at(self._force, self.dofmap.translation_dofs(conn.ravel()), dA.ravel()[:, None] * q[None, :])
-        self._cm = None
+        np.add.at(self.loads.case(case).force, self.dofmap.translation_dofs(conn.ravel()),
+                  dA.ravel()[:, None] * q[None, :])
 
-    def pressure(self, p, *, elements=None, shell: int = 0, follower: bool = True) -> ShellPressure:
+    def pressure(self, p, *, elements=None, shell: int = 0, follower: bool = True,
+                 case: str = "default") -> ShellPressure:
         """Pressure p [Pa] on the elements of a shell set (all by default), along the element
         normal (the directors' side); ``follower`` acts on the current surface."""
         if not self.shells:
@@ -396,18 +451,19 @@ class Structure:
         sh = self.shells[shell]
         conn = sh.conn if elements is None else sh.conn[:, np.asarray(elements)]
         pl = ShellPressure(X=self.X, conn=conn, dofmap=self.dofmap, p=p, follower=follower)
-        self._pressures.append(pl)
+        self.loads.case(case).loads.append(pl)
         return pl
 
+    def combine(self, **factors) -> None:
+        """Load combination: the live load is sum_c factors[c] F_c over the named load cases
+        (others 0), e.g. ``combine(dead=1.35, live=1.5)``; ``combine()``: every case with 1."""
+        self.loads.combine(factors)
+
     def freeze_loads(self) -> None:
-        """Make the loads defined so far a constant base load (no longer scaled by the load
-        factor) and the prescribed displacements reached so far permanent: the loads defined
-        next are the live load of the following :meth:`solve` (prestress, then load)."""
-        self._base_force = self._base_force + self._force + self._moment_vector()
-        self._force = np.zeros(self.dofmap.ndof)
-        self._moments = []
-        self._base_pressures += self._pressures
-        self._pressures = []
+        """Make the (combined) loads defined so far a constant base load (no longer scaled by
+        the load factor) and the prescribed displacements reached so far permanent: the loads
+        defined next are the live load of the following :meth:`solve` (prestress, then load)."""
+        self.loads.freeze(self._moment_vector)
         self.supports.freeze()
         self._cm = None
 
@@ -449,14 +505,9 @@ class Structure:
     def _load_part(self, state: State, *, live: bool, tangent: bool = True):
         """The live loads at load factor 1 (point, moment, line, body, pressure) or the base
         loads (:meth:`freeze_loads`) at ``state``, and their load stiffness d f / d u."""
-        f = self._force + self._moment_vector() if live else self._base_force.copy()
-        K = None
-        for pl in (self._pressures if live else self._base_pressures):
-            fp, Kp = pl.load(state, tangent=tangent)
-            f = f + fp
-            if Kp is not None:
-                K = Kp if K is None else K + Kp
-        return f, K
+        if live:
+            return self.loads.live(state, self._moment_vector, tangent=tangent)
+        return self.loads.base(state, tangent=tangent)
 
     def external(self, state: State, lam: float, *, tangent: bool = True):
         """External force F_base + lam F_live(state) and its load stiffness (base loads:
