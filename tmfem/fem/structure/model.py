@@ -33,6 +33,7 @@ from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.structure.loads import LineLoad, LoadCases
 from tmfem.fem.structure.path import Path
+from tmfem.fem.structure.results import beam_nodal_section_forces, shell_nodal_results
 from tmfem.fem.structure.reactions import Reactions, nodal_vectors
 from tmfem.fem.structure.supports import Supports
 from tmfem.fem.dofmap import DofMap
@@ -97,11 +98,33 @@ def gmsh_quad_mesh():
     return read_quad_mesh((np.asarray(coords).reshape(-1, 3).T, index[nodes]))
 
 
+def oriented_quads(X: np.ndarray, quads: np.ndarray, orient) -> np.ndarray:
+    """Quads (4, ne) with the node order of every element whose normal g_1 x g_2 at its
+    centre points against ``orient`` (a vector (3,) or ``orient(x, y, z) -> (3, ne)`` at the
+    centres) reversed to (0, 3, 2, 1) (:meth:`Structure.add_shell`)."""
+    if quads.ndim != 2 or quads.shape[0] != 4:
+        raise InputError(f"shell: expected quadrilaterals of shape (4, ne), found {quads.shape}")
+    xe = X[:, quads]                                                     # (3, 4, ne)
+    n = np.cross((xe[:, 2] - xe[:, 0]).T, (xe[:, 3] - xe[:, 1]).T).T     # diagonals: 2 x g_1 x g_2
+    want = np.asarray(orient(*xe.mean(axis=1)) if callable(orient) else orient, dtype=float)
+    want = np.broadcast_to(want.reshape(3, -1), n.shape)
+    dot = np.einsum("ie,ie->e", n, want)
+    if np.any(np.abs(dot) <= 1e-12 * np.linalg.norm(n, axis=0) * np.linalg.norm(want, axis=0)):
+        bad = np.flatnonzero(np.abs(dot) <= 1e-12 * np.linalg.norm(n, axis=0) * np.linalg.norm(want, axis=0))
+        raise InputError(f"shell: expected an orient direction off the element planes, found it in the plane "
+                         f"(or zero) at elements {bad[:5].tolist()}")
+    out = quads.copy()
+    flip = dot < 0
+    out[:, flip] = quads[[0, 3, 2, 1]][:, flip]
+    return out
+
+
 @dataclass
 class StructureState:
     """A solution: the nodal :class:`State`, its load factor and Newton iterations;
     ``reaction`` (ndof,): the generalized support reactions of the solve
-    (:meth:`Structure.reactions`), ``linear``: a small-displacement solution;
+    (:meth:`Structure.reactions`), ``linear``: a small-displacement solution
+    (``increment``: its dofs (ndof,));
     ``negative_pivots`` of the tangent and the ``event`` ("limit point", "bifurcation") of
     the step that reached it, when the path following computed them."""
 
@@ -113,6 +136,7 @@ class StructureState:
     linear: bool = False
     negative_pivots: int | None = None
     event: str | None = None
+    increment: np.ndarray | None = None
 
     @property
     def x(self) -> np.ndarray:
@@ -152,26 +176,39 @@ class Structure:
 
     # ------------------------------------------------------------------ building
     @classmethod
-    def shell(cls, mesh, *, section: ShellSection, normals=None, shear: str = "mitc",
+    def shell(cls, mesh, *, section: ShellSection, normals=None, orient=None, shear: str = "mitc",
               law="svk", backend="scipy") -> "Structure":
         """A shell structure from a quad mesh (scikit-fem ``MeshQuad``, ``meshio.Mesh``,
         meshio-readable path or ``(points, quads)``; flat or curved in 3-D): every node a 5-dof
-        shell node, one MITC4 element set. ``normals`` (3, n): reference directors; ``shear``
-        and ``law`` (in-plane lamina law, "svk" or "tension-field"): see :class:`MITC4Shell`;
-        ``backend``: see :class:`Structure`."""
+        shell node, one MITC4 element set. ``normals`` (3, n): reference directors; ``orient``:
+        the side the directors point to (:meth:`add_shell`); ``shear`` and ``law`` (in-plane
+        lamina law, "svk" or "tension-field"): see :class:`MITC4Shell`; ``backend``: see
+        :class:`Structure`."""
         p, t = read_quad_mesh(mesh)
         s = cls(points=p, dofs=5, backend=backend)
-        s.add_shell(t, section=section, normals=normals, shear=shear, law=law)
+        s.add_shell(t, section=section, normals=normals, orient=orient, shear=shear, law=law)
         return s
 
     @property
     def n_nodes(self) -> int:
         return self.X.shape[1]
 
-    def add_shell(self, quads, *, section: ShellSection, normals=None, shear: str = "mitc",
+    def add_shell(self, quads, *, section: ShellSection, normals=None, orient=None, shear: str = "mitc",
                   law="svk") -> MITC4Shell:
         """Add MITC4 elements on the 5-dof nodes ``quads`` (4, ne); ``law``: the in-plane
-        lamina law ("svk" or "tension-field", :class:`MITC4Shell`)."""
+        lamina law ("svk" or "tension-field", :class:`MITC4Shell`).
+
+        Director convention: the directors (and the normal of pressures, the top surface
+        r_3 = 1 and the results frame) point to the side of the element normal g_1 x g_2,
+        i.e. by the right-hand rule around the element's node order; given ``normals`` are
+        turned to that side. ``orient`` chooses the side instead: a vector (3,) or a callable
+        ``orient(x, y, z) -> (3, ne)`` at the element centres; every element whose normal
+        points against it gets its node order reversed (0, 3, 2, 1), so that its normal and
+        the directors point along ``orient`` (e.g. ``(0, 0, 1)`` for a plate, the outward
+        radius for a cylinder)."""
+        quads = np.asarray(quads, dtype=np.int64)
+        if orient is not None:
+            quads = oriented_quads(self.X, quads, orient)
         sh = MITC4Shell(X=self.X, conn=quads, section=section, dofmap=self.dofmap, normals=normals,
                         shear=shear, law=law)
         self.frames[sh.nodes] = sh.frames[sh.nodes]
@@ -565,7 +602,20 @@ class Structure:
         u = up.copy()
         u[idx] = factorize(K[idx][:, idx], self.backend, equilibrate=True)(rhs[idx])
         return StructureState(state=s0.advanced(cm.full(u), self.dofmap), lam=1.0, iterations=1,
-                              reaction=self._reaction(K @ u - cm.residual(f0)), linear=True)
+                              reaction=self._reaction(K @ u - cm.residual(f0)), linear=True,
+                              increment=cm.full(u))
+
+    #: scale of the displacement at which the stresses of a linear solution are evaluated
+    _LINEAR_PROBE = 1e-6
+
+    def _stress_state(self, st: StructureState) -> tuple[State, float]:
+        """The state the stresses of ``st`` are evaluated at and the factor to multiply them
+        by: a linear solution's stresses are the linear part of the strain, taken at the
+        displacement scaled by 1e-6 (the Green-Lagrange terms quadratic in it vanish to
+        1e-6 relative) and scaled back; a nonlinear state as it is."""
+        if st.linear and st.increment is not None:
+            return self.reference_state().advanced(self._LINEAR_PROBE * st.increment, self.dofmap), 1 / self._LINEAR_PROBE
+        return st.state, 1.0
 
     def _reaction(self, r_red: np.ndarray) -> np.ndarray:
         """Generalized reactions (ndof,) from a reduced residual T^T (f_int - f_ext)."""
@@ -829,34 +879,71 @@ class Structure:
             return np.zeros((3, self.n_nodes))
         return Rotation.from_matrix(st.state.R).as_rotvec().T
 
+    def stresses(self, st: StructureState) -> dict:
+        """Nodal results of ``st`` (:mod:`tmfem.fem.structure.results`): for the shells the
+        Gauss-point stresses extrapolated to the nodes and averaged, ``sigma_<s>`` (n, 5)
+        [s11, s22, s12, s13, s23] [Pa], ``principal_<s>`` (n, 2) and ``von_mises_<s>`` (n,)
+        [Pa] at s = bottom, mid, top, ``N`` [N/m], ``M`` [N m/m], ``Q`` [N/m]; for the beams
+        ``beam_N``, ``beam_Q1``, ``beam_Q2`` [N], ``beam_M1``, ``beam_M2``, ``beam_T`` [N m].
+        NaN at nodes outside the element sets; where two sets share a node, the last wins."""
+        out = {}
+        at, c = self._stress_state(st)
+        for e in self.elements:
+            if isinstance(e, MITC4Shell):
+                part = shell_nodal_results(e, at, self.n_nodes)
+            elif isinstance(e, BeamElement):
+                part = {f"beam_{k}": v for k, v in beam_nodal_section_forces(e, at, self.n_nodes).items()}
+            else:
+                continue
+            for k, v in part.items():
+                v = c * v
+                out[k] = v if k not in out else np.where(np.isnan(v), out[k], v)
+        return out
+
     def to_meshio(self, st: StructureState, *, deformed: bool = False):
-        """A ``meshio.Mesh`` of the shells' quads (reference or deformed points) with point data
-        ``displacement`` (from the reference configuration, inertial frame: a generic structure
-        has no floating frame, so this is not the tensegrity membrane's ``displacement_Of`` of
-        :data:`tmfem.io.fields.DISPLACEMENT_FIELD`), ``rotation`` and ``director`` and cell
-        data per element ``N`` (membrane
-        forces N11 N22 N12 [N/m]), ``M`` (bending moments M11 M22 M12 [N m/m]), ``Q`` (shear
-        forces [N/m]) and ``von_mises_bottom/mid/top`` [Pa] (local 2nd Piola-Kirchhoff
-        stresses at the element centre, frame of eq. 4.11)."""
+        """A ``meshio.Mesh`` of the shells' quads and the beams' axis segments (reference or
+        deformed points). Point data: ``displacement`` [m] (from the reference configuration,
+        inertial frame: a generic structure has no floating frame, so this is not the
+        tensegrity membrane's ``displacement_Of`` of :data:`tmfem.io.fields.DISPLACEMENT_FIELD`),
+        ``rotation`` [rad] and ``director``, ``reaction_force [N]``, ``reaction_moment [N m]``
+        and the nodal results of :meth:`stresses` with their units in the name (``N [N/m]``,
+        ``sigma_top [Pa]``, ``beam_M1 [N m]``, ...). Cell data of the shells (element centre):
+        ``N`` (membrane forces N11 N22 N12 [N/m]), ``M`` (bending moments M11 M22 M12 [N m/m]),
+        ``Q`` (shear forces [N/m]) and ``von_mises_bottom/mid/top`` [Pa] (local 2nd
+        Piola-Kirchhoff stresses, frame of eq. 4.16); the beams' cells hold NaN there."""
         import meshio
-        if not self.shells:
-            raise InputError("to_meshio: expected a shell element set, found none")
+        beams = [e for e in self.elements if isinstance(e, BeamElement)]
+        if not self.shells and not beams:
+            raise InputError("to_meshio: expected a shell or beam element set, found none")
         pts = (st.state.x if deformed else self.X).T
         u = self.displacements(st).T
         Vn = np.einsum("nij,nj->ni", st.state.R, self.frames[:, :, 2]) if st.state.R is not None else None
-        cells, cd = [], {k: [] for k in ("N", "M", "Q", "von_mises_bottom", "von_mises_mid", "von_mises_top")}
+        keys = {"N": 3, "M": 3, "Q": 2, "von_mises_bottom": 0, "von_mises_mid": 0, "von_mises_top": 0}
+        cells, cd = [], {k: [] for k in keys}
+        at, c = self._stress_state(st)
         for sh in self.shells:
             cells.append(("quad", sh.conn.T))
-            r = sh.stresses(st.state)
-            cd["N"].append(r["N"])
-            cd["M"].append(r["M"])
-            cd["Q"].append(r["Qs"])
+            r = sh.stresses(at)
+            cd["N"].append(c * r["N"])
+            cd["M"].append(c * r["M"])
+            cd["Q"].append(c * r["Qs"])
             for j, name in enumerate(("bottom", "mid", "top")):
-                cd[f"von_mises_{name}"].append(r["von_mises"][:, j])
+                cd[f"von_mises_{name}"].append(c * r["von_mises"][:, j])
+        for b in beams:
+            seg = np.vstack([b.beams.conn[:-1].T.ravel(), b.beams.conn[1:].T.ravel()]).T
+            cells.append(("line", seg))
+            for k, width in keys.items():
+                cd[k].append(np.full((seg.shape[0], width) if width else seg.shape[0], np.nan))
         reac = self.reactions(st)
         point_data = {"displacement": u, "rotation": self.rotation_vectors(st).T,
                       "reaction_force [N]": reac.force.T, "reaction_moment [N m]": reac.moment.T}
         if Vn is not None:
             point_data["director"] = Vn
+        for k, v in self.stresses(st).items():
+            point_data[f"{k} [{_UNITS[k.split('_')[0] if k.startswith(('sigma', 'principal', 'von')) else k]}]"] = v
         return meshio.Mesh(points=pts, cells=cells, point_data=point_data, cell_data=cd)
 
+
+#: units of the nodal result fields of :meth:`Structure.stresses`
+_UNITS = {"sigma": "Pa", "principal": "Pa", "von": "Pa", "N": "N/m", "M": "N m/m", "Q": "N/m",
+          "beam_N": "N", "beam_Q1": "N", "beam_Q2": "N", "beam_M1": "N m", "beam_M2": "N m", "beam_T": "N m"}
