@@ -31,6 +31,7 @@ import scipy.sparse as sp
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
+from tmfem.fem.structure.from_mesh import structure_from_mesh
 from tmfem.fem.structure.loads import LineLoad, LoadCases
 from tmfem.fem.structure.path import Path
 from tmfem.fem.structure.results import beam_nodal_section_forces, shell_nodal_results
@@ -171,6 +172,7 @@ class Structure:
         self.axes = np.broadcast_to(np.eye(3), (self.n_nodes, 3, 3)).copy()
         self.supports = Supports(self.dofmap)
         self.node_sets: dict[str, np.ndarray] = {}
+        self.element_sets: dict = {}
         self.loads = LoadCases(self.dofmap.ndof)
         self._cm = None
 
@@ -188,6 +190,16 @@ class Structure:
         s = cls(points=p, dofs=5, backend=backend)
         s.add_shell(t, section=section, normals=normals, orient=orient, shear=shear, law=law)
         return s
+
+    @classmethod
+    def from_mesh(cls, mesh, *, shells=None, beams=None, trusses=None, orient=None,
+                  backend="scipy") -> "Structure":
+        """A structure from a mesh with physical groups (gmsh ``.msh``, ``meshio.Mesh``):
+        ``shells`` {group: ShellSection}, ``beams`` {group: dict(section=, E=, nu=, rho=,
+        v1=)}, ``trusses`` {group: dict(EA=, rhoA=, tension_only=)}; every physical group
+        becomes a node set (:mod:`tmfem.fem.structure.from_mesh`)."""
+        return structure_from_mesh(cls, mesh, shells=shells, beams=beams, trusses=trusses, orient=orient,
+                                   backend=backend)
 
     @property
     def n_nodes(self) -> int:
