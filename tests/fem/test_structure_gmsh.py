@@ -100,3 +100,23 @@ def test_shell_with_an_edge_beam_from_one_gmsh_model(tmp_path):
     assert w == pytest.approx(P * L**3 / (3 * EI) + w_shear, rel=0.005)
     F, _ = s.resultant(st)
     np.testing.assert_allclose(F, [0, 0, -P], atol=1e-8 * abs(P))
+
+
+def test_bars_and_tendons_of_a_system_meshed_by_gmsh():
+    """Every bar and tendon of a preset system becomes a line with its ends at the system's
+    nodes, in one physical group per family."""
+    from tmfem.mesh.frame import system_frame_mesh
+    from tmfem.system.presets import load_preset
+    system = load_preset("1-4")
+    m = system_frame_mesh(system)
+    sets = {k: v["line"] for k, v in m.cell_sets_dict.items() if not k.startswith("gmsh:")}
+    families = sorted({f"tendons_{t.family}" for t in system.tendons})
+    assert sorted(sets) == sorted(["bars"] + families)
+    assert sets["bars"].size == system.bar_connectivity.shape[1]
+    assert sum(sets[f].size for f in families) == len(system.tendons)
+    X = system.nodes()
+    lines = np.concatenate([c.data for c in m.cells if c.type == "line"])
+    ends = m.points[lines]                                            # (m, 2, 3)
+    want = np.hstack([system.bar_connectivity, system.tendon_connectivity])
+    np.testing.assert_allclose(ends[:, 0], X[:, want[0]].T, atol=1e-12)
+    np.testing.assert_allclose(ends[:, 1], X[:, want[1]].T, atol=1e-12)
