@@ -26,9 +26,12 @@ Every run returns every converged point with a :class:`StepInfo` (load factor, N
 iterations, residual norms, arc, number of negative pivots of the tangent, event) and why
 it stopped: "completed" (``lam_max`` or the displacement target reached), "budget"
 (``max_steps``), "divergence", "stopped" (``stop`` callback), or an event named in
-``stop_at``: "limit point" (the load increment changed sign) or "bifurcation" (the number
-of negative pivots of the tangent changed while the load increment kept its sign: a
-bifurcation indicator, Sylvester's law of inertia on the LDL^T pivots). The result holds
+``stop_at``: "limit point" or "bifurcation". Both are seen in the number of negative pivots
+of the tangent (Sylvester's law of inertia on its LDL^T pivots): when it changes in a step,
+an eigenvalue crossed zero; if the current stiffness q.K^-1 q changed sign with it, q has a
+component on that mode and the load passed a maximum or minimum (limit point), else the
+path crossed a bifurcation point. Without the pivot count (``stability=False``) a change of
+sign of the load increment marks a limit point. The result holds
 the last increment and arc, so a run can be continued where it stopped (``start_increment``,
 ``dl``).
 """
@@ -193,6 +196,7 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
                 solve = solve_tangent(K)
                 qf = np.asarray(q)[idx]
                 dut = solve(qf)
+                stiff = float(qf @ dut)                   # current stiffness q.K^-1 q at the point
                 if method == "arc-length":
                     w2 = psi**2 * float(qf @ qf)
                     norm_t = np.sqrt(float(dut @ dut) + w2)
@@ -257,11 +261,19 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
         if reason == "divergence":
             break
         event = None
-        if prev is not None and np.sign(Dlam) != np.sign(prev[1]) and prev[1] != 0 and Dlam != 0:
-            event = "limit point"
         new_piv = negative_pivots(submatrix(Kt, idx)) if stability else None
-        if event is None and new_piv is not None and pivots is not None and new_piv != pivots:
-            event = "bifurcation"
+        if new_piv is not None and pivots is not None and new_piv != pivots:
+            # an eigenvalue of K crossed zero: at a limit point q has a component on its mode
+            # and the current stiffness q.K^-1 q changes sign with it; at a bifurcation not
+            try:
+                qn_new = np.asarray(q)[idx]
+                turned = np.sign(qn_new @ solve_tangent(Kt)(qn_new)) != np.sign(stiff)
+            except ConvergenceError:
+                turned = True
+            event = "limit point" if turned else "bifurcation"
+        elif new_piv is None and prev is not None and prev[1] != 0 and Dlam != 0 and \
+                np.sign(Dlam) != np.sign(prev[1]):
+            event = "limit point"
         u, lam, K, pivots = ut, lam + Dlam, Kt, new_piv if stability else pivots
         if method == "displacement":
             u_c += sgn_dl * step_abs
