@@ -196,3 +196,26 @@ def test_release_and_copy():
     w = clamped.displacements(clamped.solve_linear())[2, -1]
     EI = 1e6 * 0.25 * 0.05**3 / 12
     assert w == pytest.approx(-2.0 * 1.0 / (3 * EI), rel=0.01)
+
+
+def test_bad_input_to_the_new_calls_is_refused_in_one_line():
+    xs = np.linspace(0, 1, 3)
+    s = Structure.shell(MeshQuad.init_tensor(xs, xs), section=ShellSection(E=1, nu=0, thickness=0.1))
+    with pytest.raises(InputError, match=r"one per node|finite value per node"):
+        s.prescribe([0, 1], "ux", [1.0, 2.0, 3.0])
+    with pytest.raises(InputError, match=r"axes of shape \(3, 3\)"):
+        s.local_frame([0], np.eye(2))
+    with pytest.raises(InputError, match="orthonormal"):
+        s.local_frame([0], 2 * np.eye(3))
+    s.point_load([4], force=(0, 0, 1.0), case="live")
+    with pytest.raises(InputError, match="finite factors"):
+        s.combine(live="x")
+    with pytest.raises(InputError, match="node set"):
+        s.fix("nowhere")
+    with pytest.raises(InputError, match="first step dl"):
+        s.solve_arc_length(dl=-1.0)
+    with pytest.raises(InputError, match="expected a free dof"):
+        s.fix([8], "uz")
+        s.solve_displacement_control(node=8, dof="uz", increment=0.1)
+    with pytest.raises(InputError, match="shell element edges"):
+        s.line_load([0, 8], (0, 0, 1.0))

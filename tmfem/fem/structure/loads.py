@@ -63,7 +63,7 @@ class LoadCases:
         unknown = sorted(set(factors) - set(self.cases))
         if unknown:
             raise InputError(f"combine: expected load cases from {sorted(self.cases)}, found {unknown}")
-        bad = {k: v for k, v in factors.items() if not np.isfinite(float(v))}
+        bad = {k: v for k, v in factors.items() if not (isinstance(v, (int, float, np.number)) and np.isfinite(v))}
         if bad:
             raise InputError(f"combine: expected finite factors, found {bad}")
         self.factors = {k: float(v) for k, v in factors.items()} or None

@@ -337,8 +337,10 @@ class Structure:
         the local reactions (:meth:`reactions`) refer to them; supports given before keep
         their directions."""
         nodes = self._nodes(nodes)
-        A = axes(*self.X[:, nodes]) if callable(axes) else axes
-        A = np.broadcast_to(np.asarray(A, dtype=float), (nodes.size, 3, 3))
+        A = np.asarray(axes(*self.X[:, nodes]) if callable(axes) else axes, dtype=float)
+        if A.shape not in ((3, 3), (nodes.size, 3, 3)):
+            raise InputError(f"local frame: expected axes of shape (3, 3) or ({nodes.size}, 3, 3), found {A.shape}")
+        A = np.broadcast_to(A, (nodes.size, 3, 3))
         err = np.abs(np.einsum("nki,nkj->nij", A, A) - np.eye(3)).max(axis=(1, 2))
         if np.any(err > 1e-8) or np.any(np.linalg.det(A) < 0):
             raise InputError(f"local frame: expected orthonormal right-handed axes (columns), found "
@@ -359,8 +361,8 @@ class Structure:
         a number, one per node, or a callable ``value(x, y, z)`` of the reference positions.
         A dof constrained already is refused (conflicting or redundant)."""
         nodes = self._nodes(nodes)
-        v = value(*self.X[:, nodes]) if callable(value) else value
-        v = np.broadcast_to(np.asarray(v, dtype=float), nodes.shape) if np.ndim(v) <= 1 else None
+        v = np.asarray(value(*self.X[:, nodes]) if callable(value) else value, dtype=float)
+        v = np.broadcast_to(v, nodes.shape) if v.shape in ((), (1,), nodes.shape) else None
         if v is None or not np.all(np.isfinite(v)):
             raise InputError(f"prescribe: expected a finite value per node ({nodes.size}), found {value!r}")
         for n, vn in zip(nodes, v):
