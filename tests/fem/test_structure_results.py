@@ -9,7 +9,6 @@ width b the moment per unit width P (L - x) / b with surface stresses -+ 6 M / h
 """
 import meshio
 import numpy as np
-import pytest
 from skfem import MeshQuad
 
 from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, line_mesh

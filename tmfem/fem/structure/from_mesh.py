@@ -60,6 +60,7 @@ def structure_from_mesh(cls, mesh, *, shells=None, beams=None, trusses=None, ori
     orient : the director side of the shells (:meth:`Structure.add_shell`).
     """
     import meshio
+
     from tmfem.fem.beam import BeamElement, BeamSet
     from tmfem.fem.truss import TrussElement, TrussSet
     if not isinstance(mesh, meshio.Mesh):

@@ -31,15 +31,15 @@ import scipy.sparse as sp
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
-from tmfem.fem.structure.from_mesh import structure_from_mesh
-from tmfem.fem.structure.loads import LineLoad, LoadCases
-from tmfem.fem.structure.path import Path
-from tmfem.fem.structure.results import beam_nodal_section_forces, shell_nodal_results
-from tmfem.fem.structure.reactions import Reactions, nodal_vectors
-from tmfem.fem.structure.supports import Supports
 from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
+from tmfem.fem.structure.from_mesh import structure_from_mesh
+from tmfem.fem.structure.loads import LineLoad, LoadCases
+from tmfem.fem.structure.path import Path
+from tmfem.fem.structure.reactions import Reactions, nodal_vectors
+from tmfem.fem.structure.results import beam_nodal_section_forces, shell_nodal_results
+from tmfem.fem.structure.supports import Supports
 from tmfem.solvers import lowest_modes, newton
 from tmfem.solvers.backends import get_backend
 from tmfem.solvers.continuation import follow, negative_pivots
@@ -530,7 +530,8 @@ class Structure:
     @property
     def _prescribed(self) -> np.ndarray:
         """Full prescribed displacement at load factor 1 (ndof,)."""
-        self.constraints
+        if self._cm is None:
+            self._cm = self.supports.build()
         return self._cm[1]
 
     def reference_state(self) -> State:

@@ -131,7 +131,7 @@ class Supports:
         if chained or any(node in p[0] for p in self.pins.values()):
             raise InputError(f"{label}: node {node}: expected no chain of pins, found "
                              + (f"master(s) {chained} pinned themselves" if chained
-                                else "node {node} is a master of a pinned node".format(node=node)))
+                                else f"node {node} is a master of a pinned node"))
         if self.rows.get((node, "u")):
             names = [describe("u", r.c, 3) for r in self.rows[(node, "u")]]
             raise InputError(f"{label}: node {node} has supports on {names} ({self.rows[(node, 'u')][0].label}); "
