@@ -16,34 +16,7 @@ from tmfem.errors import InputError
 from tmfem.fem.mitc4 import ShellSection
 from tmfem.fem.structure import Structure
 from tmfem.fem.truss import TrussElement, TrussSet
-
-R_CYL, L_CYL = 300.0, 600.0
-
-
-def pinched_cylinder_octant(n, *, how="symmetry", order=("x", "y")):
-    """Octant of the pinched cylinder (R = 300, L = 600, t = 3, E = 3e6, nu = 0.3, P = 1):
-    x along the axis, the load P/4 at (0, 0, R) on the planes x = 0 and y = 0, diaphragm
-    (uy = uz = 0) at x = L/2. ``how="by hand"`` fixes the load node's translations and
-    both rotations explicitly instead of giving it two symmetry planes."""
-    m = MeshQuad.init_tensor(np.linspace(0, L_CYL / 2, n + 1), np.linspace(0, np.pi / 2, n + 1))
-    x, th = m.p
-    p = np.vstack([x, R_CYL * np.sin(th), R_CYL * np.cos(th)])
-    s = Structure.shell((p, m.t), section=ShellSection(E=3e6, nu=0.3, thickness=3.0),
-                        normals=np.vstack([0 * x, np.sin(th), np.cos(th)]))
-    on = {"x": lambda x, y, z: np.isclose(x, 0), "y": lambda x, y, z: np.isclose(y, 0, atol=1e-9)}
-    A = s.nodes_where(lambda x, y, z: on["x"](x, y, z) & on["y"](x, y, z))
-    for plane in order:
-        nodes = s.nodes_where(on[plane])
-        if how == "by hand":
-            nodes = np.setdiff1d(nodes, A)
-        s.symmetry(nodes, normal=plane)
-    if how == "by hand":
-        s.fix(A, ["ux", "uy", "r1", "r2"])
-    s.symmetry(s.nodes_where(lambda x, y, z: np.isclose(z, 0, atol=1e-9)), normal="z")
-    s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, L_CYL / 2)), ["uy", "uz"])
-    s.point_load(A, force=(0, 0, -0.25))
-    return s, int(A[0])
-
+from tmfem.reference.benchmarks.shell_pinched_cylinder import model as pinched_cylinder
 
 def _w(s, A):
     return -s.displacements(s.solve_linear())[2, A]
@@ -52,7 +25,7 @@ def _w(s, A):
 def test_a_node_on_two_symmetry_planes_gets_both_conditions():
     w = {}
     for how, order in (("symmetry", ("x", "y")), ("symmetry", ("y", "x")), ("by hand", ("x", "y"))):
-        s, A = pinched_cylinder_octant(16, how=how, order=order)
+        s, A = pinched_cylinder(n=16, how=how, order=order)
         w[how, order] = _w(s, A)
     ref = w["by hand", ("x", "y")]
     assert w["symmetry", ("x", "y")] == pytest.approx(ref, rel=1e-10)
@@ -62,7 +35,7 @@ def test_a_node_on_two_symmetry_planes_gets_both_conditions():
 def test_pinched_cylinder_octant_converges_to_the_published_value():
     ratio = []
     for n in (8, 16, 32):
-        s, A = pinched_cylinder_octant(n)
+        s, A = pinched_cylinder(n=n)
         ratio.append(_w(s, A) / 1.8248e-5)
     # MITC4 converges from below: 0.75, 0.93, 0.989
     assert ratio[0] < ratio[1] < ratio[2] < 1.0
