@@ -235,6 +235,6 @@ def test_bad_input_is_refused_with_numbers():
                         section=ShellSection(E=1, nu=0, thickness=0.1))
     s = Structure.shell((X, conn), section=ShellSection(E=1, nu=0, thickness=0.1))
     with pytest.raises(InputError, match="expected names"):
-        s.fix([0], "rz")
+        s.fix([0], "r3")
     with pytest.raises(InputError, match="loads or prescribed"):
         s.solve()

@@ -117,6 +117,9 @@ def test_arc_length_and_follower_pressure_agree_with_load_control():
     w_dead = s.displacements(s.solve(steps=4)[-1])[2, c]
     s, c = _pressed_plate(True)
     w_follower = s.displacements(s.solve(steps=4)[-1])[2, c]
+    arc = s.solve_arc_length(dl=0.01, max_steps=200, lam_max=1.0)[-1]      # follower load stiffness
+    assert s.displacements(arc)[2, c] == pytest.approx(
+        s.displacements(s.solve(steps=4, lam_end=arc.lam)[-1])[2, c], rel=1e-6)
     # w/a = 1 %: the follower load differs from the dead one by the small rotations only
     assert w_follower == pytest.approx(w_dead, rel=0.02) and w_follower != w_dead
 
@@ -124,12 +127,13 @@ def test_arc_length_and_follower_pressure_agree_with_load_control():
 def test_structure_refusals():
     xs = np.linspace(0, 1, 3)
     s = Structure.shell(MeshQuad.init_tensor(xs, xs), section=ShellSection(E=1, nu=0, thickness=0.1))
-    with pytest.raises(InputError, match="normal 'x', 'y' or 'z'"):
+    with pytest.raises(InputError, match="normal 'x', 'y', 'z' or a 3-vector"):
         s.symmetry([0], normal="w")
     with pytest.raises(InputError, match="parallel to the director"):
         s.symmetry([0], normal="z")
     s.pressure(1.0, follower=True)
-    with pytest.raises(InputError, match="dead loads only"):
+    s.prescribe([0], "ux", 0.1)
+    with pytest.raises(InputError, match="no prescribed displacements"):
         s.solve_arc_length(dl=0.1)
     with pytest.raises(InputError, match="steps >= 1"):
         s.solve(steps=0)

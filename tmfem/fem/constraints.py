@@ -7,6 +7,10 @@ a pinned connection between a shell corner and a bar top: the bar top's translat
 follow the corner, its rotations stay its own). Forces map back by ``T^T f`` and tangents by
 ``T^T K T`` (the constraint adds no stiffness). Fixed dofs are removed by the ``free`` mask
 on the reduced dofs.
+
+A block of independent dofs may be expressed in a local (skew) basis: ``u_block = Q u~``
+with Q orthonormal, so that ``T = T_0 L`` with L block-diagonal, and a fixed dof of such a
+block fixes its local component (a support along a skew direction, a symmetry plane).
 """
 from __future__ import annotations
 
@@ -26,15 +30,18 @@ class ConstraintMap:
     ``reduced_of`` (int, ndof: the reduced dof of each independent dof, -1 at dependent ones).
     """
 
-    def __init__(self, T: sp.csr_matrix, free: np.ndarray, reduced_of: np.ndarray):
+    def __init__(self, T: sp.csr_matrix, free: np.ndarray, reduced_of: np.ndarray,
+                 L: sp.csr_matrix | None = None):
         self.T = T.tocsr()
         self.free = np.asarray(free, dtype=bool)
         self.reduced_of = reduced_of
+        self.L = L
 
     @classmethod
     def build(cls, dofmap: DofMap, *, dependent: Sequence[tuple[int, np.ndarray, np.ndarray]] = (),
               fixed_nodes=(), fixed_dofs=(),
-              dependent_dofs: Sequence[tuple[int, np.ndarray, np.ndarray]] = ()) -> "ConstraintMap":
+              dependent_dofs: Sequence[tuple[int, np.ndarray, np.ndarray]] = (),
+              bases: Sequence[tuple[np.ndarray, np.ndarray]] = ()) -> "ConstraintMap":
         """Constraint map of ``dofmap``.
 
         Parameters
@@ -50,6 +57,10 @@ class ConstraintMap:
             Single dofs (full numbering, any field) that are ``sum_i weights[i] u[master_dofs[i]]``
             of independent dofs: a linear multi-point constraint (e.g. the spin constraint
             of a pinned bar, :func:`tmfem.fem.beam.spin_constraint`).
+        bases : sequence of (dofs, Q)
+            Independent dofs (k,) (full numbering) expressed in a local orthonormal basis Q
+            (k, k): ``u[dofs] = Q u~``. A fixed dof ``dofs[j]`` then fixes the local component
+            ``u~_j``.
         """
         n = dofmap.ndof
         dep_nodes = np.array([d[0] for d in dependent], dtype=np.int64)
@@ -92,8 +103,13 @@ class ConstraintMap:
             rows.append(np.full(masters.size, int(dof)))
             cols.append(reduced_of[masters])
             vals.append(w)
+        nr = int(independent.sum())
         T = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(n, int(independent.sum())))
+                          shape=(n, nr))
+        L = None
+        if len(bases):
+            L = _local_bases(bases, reduced_of, nr)
+            T = (T @ L).tocsr()
         fixed = list(np.asarray(fixed_dofs, dtype=np.int64).ravel())
         fn = np.asarray(fixed_nodes, dtype=np.int64).ravel()
         if fn.size:
@@ -103,7 +119,7 @@ class ConstraintMap:
             raise InputError("constraints: a fixed dof belongs to a dependent node (fix its masters)")
         free = np.ones(T.shape[1], dtype=bool)
         free[reduced_of[fixed]] = False
-        return cls(T, free, reduced_of)
+        return cls(T, free, reduced_of, L)
 
     @property
     def n_reduced(self) -> int:
@@ -118,6 +134,16 @@ class ConstraintMap:
         keep = self.reduced_of >= 0
         out = np.empty(self.n_reduced)
         out[self.reduced_of[keep]] = np.asarray(u)[keep]
+        return out if self.L is None else self.L.T @ out
+
+    def independent(self, v_r: np.ndarray) -> np.ndarray:
+        """A full vector (ndof,) that holds the reduced vector ``v_r`` at the independent dofs
+        (rotated back from the local bases) and zero at the dependent ones: the reduced
+        residual at the fixed dofs becomes the nodal reactions of the supports."""
+        v = np.asarray(v_r, dtype=float) if self.L is None else self.L @ v_r
+        out = np.zeros(self.reduced_of.size)
+        keep = self.reduced_of >= 0
+        out[keep] = v[self.reduced_of[keep]]
         return out
 
     def residual(self, f: np.ndarray) -> np.ndarray:
@@ -127,3 +153,27 @@ class ConstraintMap:
     def tangent(self, K: sp.spmatrix) -> sp.csr_matrix:
         """Reduced tangent T^T K T."""
         return (self.T.T @ K @ self.T).tocsr()
+
+
+def _local_bases(bases, reduced_of: np.ndarray, nr: int) -> sp.csr_matrix:
+    """Block-diagonal L (nr, nr): identity, with the blocks Q of ``bases`` (module docstring)."""
+    rows, cols, vals = [], [], []
+    inside = np.zeros(nr, dtype=bool)
+    for dofs, Q in bases:
+        dofs = np.asarray(dofs, dtype=np.int64)
+        Q = np.asarray(Q, dtype=float)
+        r = reduced_of[dofs]
+        if Q.shape != (dofs.size, dofs.size) or np.any(r < 0) or inside[r].any():
+            raise InputError(f"constraints: expected a local basis ({dofs.size} x {dofs.size}) on "
+                             f"independent dofs given once, found shape {Q.shape} on dofs {dofs.tolist()}")
+        if not np.allclose(Q.T @ Q, np.eye(dofs.size), atol=1e-10):
+            raise InputError(f"constraints: expected an orthonormal local basis on dofs {dofs.tolist()}")
+        inside[r] = True
+        rows.append(np.repeat(r, r.size))
+        cols.append(np.tile(r, r.size))
+        vals.append(Q.ravel())
+    rest = np.flatnonzero(~inside)
+    rows.append(rest)
+    cols.append(rest)
+    vals.append(np.ones(rest.size))
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(nr, nr))

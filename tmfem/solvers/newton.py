@@ -343,86 +343,27 @@ def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: 
 
     The predictor follows the previous increment's direction (sign of Delta u_prev . du_t), so
     the path goes through limit points; of the two roots of the constraint in each corrector
-    iteration the one closer to the previous increment direction is taken.
+    iteration the one closer to the previous increment direction is taken. This is
+    :func:`tmfem.solvers.continuation.follow` for a fixed load f_ext (no pivot counts, plain
+    solves), raising when it stops short.
 
     Returns
     -------
     LoadPath with ``lam`` (m,) and ``u`` (m, n), the starting state included.
     """
-    be = get_backend(backend)
-    u = _copy(u0, update)
+    from tmfem.solvers.continuation import follow
     f_ext = np.asarray(f_ext, dtype=float)
-    n = f_ext.size
-    idx = free_index(free, n)
-    q = f_ext[idx]
-    qn = float(np.linalg.norm(q))
-    if qn == 0.0:
+    if float(np.linalg.norm(f_ext[free_index(free, f_ext.size)])) == 0.0:
         raise InputError("arc length: expected a non-zero reference load on the free dofs, found 0")
-    dl_min = dl * 1e-4 if dl_min is None else dl_min
-    dl_max = dl * 10 if dl_max is None else dl_max
-    lam = 0.0
-    lams, us, its = [lam], [_copy(u, update)], []
-    fint, K = internal(u)
-    prev = None            # previous converged increment (du, dlam)
-    rejected = 0
-    for step in range(1, n_steps + 1):
-        while True:
-            try:
-                solve = factorize(submatrix(K, idx), be)
-                dut = solve(q)
-                if prev is None:
-                    sign = 1.0
-                else:
-                    sign = 1.0 if dut @ prev[0] >= 0 else -1.0
-                Du = sign * dl * dut / np.linalg.norm(dut)
-                Dlam = sign * dl / np.linalg.norm(dut)
-                history = []
-                ok = False
-                for it in range(1, max_iter + 1):
-                    ut = _advance(u, idx, Du, n, update)
-                    fi, Kt = internal(ut)
-                    r = fi[idx] - (lam + Dlam) * q
-                    rn = float(np.linalg.norm(r))
-                    history.append(rn)
-                    if not np.isfinite(rn):
-                        break
-                    if rn <= tol * qn:
-                        ok = True
-                        break
-                    solve = factorize(submatrix(Kt, idx), be)
-                    dur = -solve(r)
-                    dut = solve(q)
-                    a = dut @ dut
-                    w = Du + dur
-                    b = 2.0 * dut @ w
-                    c = w @ w - dl**2
-                    disc = b * b - 4.0 * a * c
-                    if disc < 0:
-                        break
-                    roots = [(-b + np.sqrt(disc)) / (2 * a), (-b - np.sqrt(disc)) / (2 * a)]
-                    cands = [w + s * dut for s in roots]
-                    k = int(np.argmax([cand @ Du for cand in cands]))
-                    Du, Dlam = cands[k], Dlam + roots[k]
-            except ConvergenceError:
-                ok = False
-            if ok:
-                break
-            rejected += 1
-            dl *= 0.5
-            if dl < dl_min:
-                raise _fail(f"arc length: step {step}: expected convergence, found none down to arc "
-                            f"length {2 * dl:.3e} (< dl_min {dl_min:.3e}) at load factor {lam:g}; "
-                            f"residual history {[f'{h:.3e}' for h in history]}", step=step,
-                            history=history, load_factor=lam, u=u)
-        u = ut
-        lam += Dlam
-        K = Kt
-        prev = (Du, Dlam)
-        lams.append(lam)
-        us.append(_copy(u, update))
-        its.append(it)
-        dl = float(np.clip(dl * np.sqrt(target_iter / max(it, 1)), dl_min, dl_max))
-        if (lam_max is not None and lam >= lam_max) or (stop is not None and stop(u, lam)):
-            break
-    return LoadPath(lam=np.array(lams), u=np.array(us) if update is None else us, iterations=its,
-                    rejected=rejected)
+
+    def system(u, lam):
+        fint, K = internal(u)
+        return np.asarray(fint) - lam * f_ext, K, f_ext
+    res = follow(system, u0, free=free, dl=dl, max_steps=n_steps, lam_max=lam_max, tol=tol, max_iter=max_iter,
+                 target_iter=target_iter, dl_min=dl_min, dl_max=dl_max, growth=np.inf, stability=False,
+                 stop=stop, update=update, backend=backend, equilibrate=False)
+    if res.reason == "divergence":
+        raise _fail(f"arc length: {res.message}", step=len(res.steps), history=res.steps[-1].residuals,
+                    load_factor=res.steps[-1].lam, u=res.u[-1])
+    its = [st.iterations for st in res.steps[1:]]
+    return LoadPath(lam=res.lam, u=np.array(res.u) if update is None else res.u, iterations=its)

@@ -65,7 +65,7 @@ def roll_up(*, n: int = 16, steps: int = 10, L: float = 12.0) -> dict:
     """Load stepping in ``steps`` equal increments of the moment to the full circle on an
     n x 1 mesh; rows against the elastica and the discrete closed form."""
     s, tip = model(n=n, L=L)
-    path = s.solve(steps=steps)
+    path = s.solve(steps=steps).check()
     rows = []
     for st in path:
         u = s.displacements(st)[:, tip].mean(axis=1)

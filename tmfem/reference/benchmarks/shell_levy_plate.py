@@ -43,7 +43,7 @@ def run(*, reduced: bool = False, n: int = 10, steps: int = 16) -> dict:
     """Load stepping to P = 400 in ``steps`` equal increments (``reduced``: 8)."""
     P_max = 400.0
     s, c = model(n=n, P_max=P_max)
-    path = s.solve(steps=8 if reduced else steps)
+    path = s.solve(steps=8 if reduced else steps).check()
     levy, vk = LEVY_POINT, VON_KARMAN
     rows = []
     for st in path[1:]:

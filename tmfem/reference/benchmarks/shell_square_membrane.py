@@ -32,10 +32,10 @@ def shell_square_membrane(*, n: int = 10, a: float = 2.0, F: float = 2.749, Fw: 
     s.point_load([A], force=(c, 0, 0))
     s.point_load([B], force=(c, c, 0))
     s.point_load([C], force=(0, c, 0))
-    stage1 = s.solve(steps=1)[-1]
+    stage1 = s.solve(steps=1).check()[-1]
     s.freeze_loads()
     s.point_load([B], force=(0, 0, Fw))
-    path = s.solve(steps=steps, start=type(stage1)(state=stage1.state, lam=0.0))
+    path = s.solve(steps=steps, start=type(stage1)(state=stage1.state, lam=0.0)).check()
     return s, path[-1], stage1, path, mesh
 
 
