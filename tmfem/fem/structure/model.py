@@ -40,10 +40,10 @@ from tmfem.fem.structure.path import Path
 from tmfem.fem.structure.reactions import Reactions, nodal_vectors
 from tmfem.fem.structure.results import beam_nodal_section_forces, shell_nodal_results
 from tmfem.fem.structure.supports import Supports
-from tmfem.solvers import lowest_modes, newton
+from tmfem.solvers import lowest_modes
 from tmfem.solvers.backends import get_backend
 from tmfem.solvers.continuation import follow, negative_pivots
-from tmfem.solvers.newton import factorize, submatrix
+from tmfem.solvers.newton import factorize, newton, submatrix
 
 log = logging.getLogger(__name__)
 
