@@ -99,7 +99,7 @@ def director_frames(normals: np.ndarray) -> np.ndarray:
     return np.stack([V1.T, V2.T, Vn.T], axis=2)
 
 
-def _quad_shape(xi: np.ndarray):
+def quad_shape(xi: np.ndarray):
     """Bilinear shape functions h (4, m) and derivatives dh (4, 2, m) at reference points
     xi (2, m) of the unit square (scikit-fem ``ElementQuad1``, eq. 4.13)."""
     from skfem import ElementQuad1
@@ -117,7 +117,7 @@ def nodal_normals(X: np.ndarray, conn: np.ndarray) -> np.ndarray:
     X = np.asarray(X, dtype=float)
     conn = np.asarray(conn, dtype=np.int64)
     corners = np.array([[0.0, 1.0, 1.0, 0.0], [0.0, 0.0, 1.0, 1.0]])
-    _, dh = _quad_shape(corners)                          # (4 nodes, 2, 4 corners)
+    _, dh = quad_shape(corners)                          # (4 nodes, 2, 4 corners)
     xe = X[:, conn]                                       # (3, 4, ne)
     g = np.einsum("kac,ike->eaci", dh, xe)                # (ne, 2, corner, 3)
     n = np.cross(g[:, 0], g[:, 1])                        # (ne, corner, 3)
@@ -162,7 +162,7 @@ class _Points:
 
     def __init__(self, shell, xi, wq, r3, wz, *, output_frame: bool = False):
         self.xi, self.r3 = np.asarray(xi, float), np.asarray(r3, float)
-        self.h, self.dh = _quad_shape(self.xi)                       # (4, nq), (4, 2, nq)
+        self.h, self.dh = quad_shape(self.xi)                       # (4, nq), (4, 2, nq)
         self.wt13, self.wt23 = shell._tie_weights(self.xi)           # (nt, nq) each
         Xe, De = shell._Xe, shell._De                                # (ne, 4, 3)
         Ga = np.einsum("kaq,eki->eqai", self.dh, Xe)                 # (ne, nq, 2, 3)
@@ -295,7 +295,7 @@ class MITC4Shell:
         self._gxi = xq
         nt = self._tie_xi.shape[1] // 2
         self._nt = nt
-        self._tie_h, self._tie_dh = _quad_shape(self._tie_xi)
+        self._tie_h, self._tie_dh = quad_shape(self._tie_xi)
         Gt = np.einsum("kat,eki->etai", self._tie_dh, self._Xe)              # (ne, 2 nt, 2, 3)
         self._tie_G = np.stack([Gt[:, :nt, 0], Gt[:, nt:, 1]], axis=1)      # (ne, 2 comp, nt, 3)
         self._tie_G3 = np.einsum("kt,eki->eti", self._tie_h, self._De).reshape(self.ne, 2, nt, 3)
@@ -638,7 +638,7 @@ class ShellPressure:
         from skfem.quadrature import get_quadrature
         from skfem.refdom import RefQuad
         xq, self._wq = get_quadrature(RefQuad, 3)
-        self._h, self._dh = _quad_shape(xq)
+        self._h, self._dh = quad_shape(xq)
         self._asm = Assembler(dofmap.element_dofs(conn), dofmap.ndof)
 
     def load(self, state, *, tangent: bool = True):

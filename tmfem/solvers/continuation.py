@@ -47,7 +47,7 @@ import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.backends import get_backend
-from tmfem.solvers.newton import _advance, _copy, factorize, free_index, submatrix
+from tmfem.solvers.newton import advance, copy_iterate, factorize, free_index, submatrix
 
 log = logging.getLogger(__name__)
 
@@ -157,7 +157,7 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
     if unknown:
         raise InputError(f"path following: expected stop_at events from 'limit point', 'bifurcation', found {sorted(unknown)}")
     be = get_backend(backend)
-    u = _copy(u0, update)
+    u = copy_iterate(u0, update)
     lam = float(lam0)
     r, K, q = system(u, lam)
     n = np.asarray(r).size
@@ -178,7 +178,7 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
     dl_max = step_abs * 10 if dl_max is None else dl_max
     pivots = negative_pivots(submatrix(K, idx)) if (stability and start_pivots is None) else start_pivots
     steps = [StepInfo(lam=lam, negative_pivots=pivots)]
-    us = [_copy(u, update)]
+    us = [copy_iterate(u, update)]
     prev = None if start_increment is None else (np.asarray(start_increment[0], float), float(start_increment[1]))
     u_c = 0.0                                     # control dof's displacement from the start
     reason, message = "budget", f"{max_steps} steps done"
@@ -208,7 +208,7 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
                     Dlam = sgn_dl * step_abs / dut[c]
                 Du = Dlam * dut
                 ref = (Du, Dlam) if prev is None else prev
-                ut = _advance(u, idx, Du, n, update)
+                ut = advance(u, idx, Du, n, update)
                 for it in range(1, max_iter + 1):
                     r, Kt, q = system(ut, lam + Dlam)
                     rf = np.asarray(r)[idx]
@@ -240,7 +240,7 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
                         dlam = -dur[c] / dut[c]
                     d = dur + dlam * dut
                     Du, Dlam = Du + d, Dlam + dlam
-                    ut = _advance(ut, idx, d, n, update)
+                    ut = advance(ut, idx, d, n, update)
                 else:
                     why = f"no convergence in {max_iter} iterations"
                 if ok and method == "arc-length" and prev is not None and \
@@ -281,7 +281,7 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
         info = StepInfo(lam=lam, iterations=it, residuals=history, arc=step_abs,
                         negative_pivots=new_piv, event=event)
         steps.append(info)
-        us.append(_copy(u, update))
+        us.append(copy_iterate(u, update))
         if callback is not None:
             callback(u, info)
         step_abs = float(np.clip(step_abs * np.clip(np.sqrt(target_iter / max(it, 1)), cutback, growth),

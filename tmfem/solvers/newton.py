@@ -91,7 +91,7 @@ def factorize(A, backend, *, equilibrate: bool = False):
     return lambda b: sla.lu_solve((lu, piv), b, check_finite=False)
 
 
-def _advance(u, idx, du, n: int, update):
+def advance(u, idx, du, n: int, update):
     """The iterate after the increment ``du`` on the free dofs ``idx``: ``u + du`` (additive
     unknowns), or ``update(u, du_full)`` for unknowns that do not add (finite rotations)."""
     if update is None:
@@ -103,7 +103,9 @@ def _advance(u, idx, du, n: int, update):
     return update(u, full)
 
 
-def _copy(u, update):
+def copy_iterate(u, update):
+    """A copy of the iterate ``u`` that later updates leave alone (an iterate of unknowns that
+    do not add is a new object at each ``update`` already)."""
     return np.array(u, dtype=float, copy=True) if update is None else u
 
 
@@ -175,7 +177,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         when the residual is not finite, the tangent is singular or ``max_iter`` is exceeded.
     """
     be = get_backend(backend)
-    u = _copy(u0, update)
+    u = copy_iterate(u0, update)
     r, K = residual(u)
     r = np.asarray(r, dtype=float)
     n = r.size
@@ -204,7 +206,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         du = -solve(r[idx])
         alpha, best = 1.0, None
         while True:
-            ut = _advance(u, idx, alpha * du, n, update)
+            ut = advance(u, idx, alpha * du, n, update)
             rt, Kt = residual(ut)
             rt = np.asarray(rt, dtype=float)
             rnt = float(np.linalg.norm(rt[idx]))
@@ -273,9 +275,9 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
         When the increment falls below ``dlam_min``; carries the step, the residual history
         of the last failure and the load factor that could not be reached.
     """
-    u = _copy(u0, update)
+    u = copy_iterate(u0, update)
     lam, dlam = 0.0, min(float(dlam0), 1.0)
-    lams, us, its = [0.0], [_copy(u, update)] if store else [], []
+    lams, us, its = [0.0], [copy_iterate(u, update)] if store else [], []
     r1 = residual_lam(u, dlam)[0] if (scale is None or update is not None) else None
     idx = free_index(free, u.size if update is None else np.asarray(r1).size)
     if scale is None:
@@ -304,7 +306,7 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
         lams.append(lam)
         its.append(res.iterations)
         if store:
-            us.append(_copy(u, update))
+            us.append(copy_iterate(u, update))
         if callback is not None:
             callback(lam, u)
         if res.iterations < target_iter:

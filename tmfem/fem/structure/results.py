@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.fem.mitc4 import _quad_shape
+from tmfem.fem.mitc4 import quad_shape
 from tmfem.fem.plane_stress import von_mises
 
 SURFACES = ("bottom", "mid", "top")
@@ -58,7 +58,7 @@ def shell_nodal_results(shell, state, n_nodes: int) -> dict:
     (n_nodes, 5) [Pa], ``principal_<surface>`` (n_nodes, 2) [Pa], ``von_mises_<surface>``
     (n_nodes,) [Pa], ``N`` (n_nodes, 3) [N/m], ``M`` (n_nodes, 3) [N m/m], ``Q`` (n_nodes,
     2) [N/m]."""
-    H = _quad_shape(GAUSS_2X2)[0]                                       # (4 nodes, 4 points)
+    H = quad_shape(GAUSS_2X2)[0]                                       # (4 nodes, 4 points)
     E = np.linalg.inv(H.T)                                              # nodes from points
     at = [shell.stresses(state, xi=GAUSS_2X2[:, g]) for g in range(4)]
     fields = {"sigma": np.stack([r["sigma"] for r in at]), "N": np.stack([r["N"] for r in at]),
