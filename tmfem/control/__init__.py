@@ -16,3 +16,13 @@ Subpackages, one concept each:
 May import system, models, solvers, errors; imported only by cli, reference, simulation.
 See docs/control.md.
 """
+
+_LINEAR = ("GeneralizedPlant", "HinfResult", "hinfsyn", "hinfsyn_state")
+
+
+def __getattr__(name):
+    # python-control-style synthesis entry points, imported on first use
+    if name in _LINEAR:
+        from tmfem.control import linear
+        return getattr(linear, name)
+    raise AttributeError(f"module 'tmfem.control' has no attribute {name!r}")
