@@ -70,7 +70,8 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
     a.plot(pol.real, pol.imag, "x", color="0.5", label="open loop")
     pcl = T.poles()
     a.plot(pcl.real, pcl.imag, ".", color="C0", label="closed loop")
-    a.axvline(-design.alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-design.alpha:g}")
+    a.axvline(-design.alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-design.alpha:g}"
+              if design.alpha else "Re s = 0")
     a.set_xlabel("Re s [1/s]")
     a.set_ylabel("Im s [rad/s]")
     a.set_xscale("symlog", linthresh=1.0)
@@ -90,8 +91,8 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
         groups.setdefault(s.split("_")[0] if "_" in s else s, []).append(i)
     if 1 < len(groups) <= 6:
         for k, (g, idx) in enumerate(groups.items()):
-            a.loglog(f, _sigma_max(T[idx, :], w)[:, 0], color=f"C{k + 2}", lw=1,
-                     label=f"T_pw, outputs {g}_*")
+            a.loglog(f, _sigma_max(T[idx, :], w)[:, 0], color=f"C{k + 2}", lw=1, ls="--",
+                     label=f"T_pw, outputs {g}_*" if len(idx) > 1 else f"T_pw, output {outs[idx[0]]}")
     P11 = control.ss(P.A, P.B1, P.C1, P.D11)
     if np.any(P.B1) or np.any(P.D11):
         a.loglog(f, np.maximum(_sigma_max(P11, w)[:, 0], 1e-300), color="0.5", ls="--",
@@ -114,6 +115,10 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
     # step responses of the tracked coordinates
     a = ax[1, 0]
     _steps(a, T, design)
+    if sets:
+        a.text(0.02, 0.5, "gamma is the feedthrough bound: the H-infinity objective does not ask\n"
+               "this loop to track (its tracking is whatever the chosen controller does)",
+               transform=a.transAxes, fontsize=8, bbox=dict(fc="w", ec="k", alpha=0.85))
     # gamma of each route
     a = ax[1, 1]
     _routes(a, routes or {}, design, bound, sets)
