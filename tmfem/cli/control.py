@@ -105,8 +105,8 @@ def run(args) -> dict:
     if args.solver == "EIGOPT":
         raise InputError("--solver EIGOPT: applies to `tmfem control lpv` only")
     if args.method in ("riccati", "central") and args.solver is not None:
-        raise InputError(f"--solver {args.solver}: applies to --method lmi or auto only, found --method "
-                         f"{args.method}")
+        raise InputError(f"--solver {args.solver}: applies to --method lmi only (or to the LMI fallback "
+                         f"of --method auto), found --method {args.method}")
     output_file(args.save, option="--save", suffixes=(".npz",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
     system = system_from_args(args)
@@ -114,7 +114,8 @@ def run(args) -> dict:
     print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
                         solver=args.solver, synthesize=args.action == "hinf",
-                        pbh_tol=args.pbh_tol, method=args.method or DEFAULT_METHOD)
+                        pbh_tol=args.pbh_tol,
+                        method=args.method or ("lmi" if args.solver else DEFAULT_METHOD))
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
         from tmfem.control.linear.loop_plots import damping_table

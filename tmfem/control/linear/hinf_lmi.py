@@ -43,6 +43,7 @@ import numpy as np
 from tmfem.control.linear.closed_loop import (HinfDesign, check_loop, closed_loop, controller_ss,
                                               verify)
 from tmfem.control.linear.hinf_central import verified_gamma
+from tmfem.control.linear.hinf_riccati import strict_point
 from tmfem.control.linear.lmi import (SolverReport, max_eig, null_basis, projection_solution, solve,
                                       sym)
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
@@ -371,7 +372,6 @@ def _are_point(P, alpha, gamma, max_cond, eps_ladder=(1e-3, 1e-4, 1e-5, 1e-6, 1e
     gives a negative closed-loop bounded real lemma with cond(I - RS) <= ``max_cond``, else
     the first with a negative one. Returns (R, S, (A_k, B_k, C_k, D_k), cond, lam), R and S
     in the coordinates of ``P``."""
-    from tmfem.control.linear.hinf_riccati import strict_point
     found, why = [], []
     for e in eps_ladder:
         try:

@@ -19,6 +19,16 @@ Riccati characterisation (Gahinet & Apkarian, Int. J. Robust Nonlinear Control 4
   D11^T, D21^T), so S = gamma Y^-1 with Y the dual game solution;
 * [[R, I], [I, S]] > 0 is then rho(X Y) < gamma^2.
 
+The test at one gamma (:func:`riccati_test`) has three outcomes: "feasible", "infeasible"
+with a certificate (gamma at or below the feedthrough bound, a stabilising solution that is
+indefinite, rho(XY) >= gamma^2, a Hamiltonian eigenvalue on the imaginary axis) or
+"unknown" (no Riccati solver found a stabilising solution, and no certificate either: a
+numerical failure, never read as infeasibility). Each Riccati equation is solved by scipy
+and, if that fails, by SLICOT SG02AD, and a solution counts only if its closed-loop matrix is
+Hurwitz. The bisection (:func:`bisect_verified`) moves its upper end only where a
+controller built at that level has a verified closed loop, and its certified lower end
+only on a certificate.
+
 So the LMI optimum gamma is found by bisection on these tests (two Riccati equations of
 order n per step, against an SDP whose interior-point iterations cost O(n^6) for a dense
 Schur complement), and a strictly feasible LMI point for a gamma above the optimum comes from

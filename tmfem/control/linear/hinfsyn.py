@@ -48,6 +48,7 @@ from tmfem.control.linear.hinf_lmi import hinf_gamma, hinf_lmi, hinf_state_feedb
 from tmfem.control.linear.hinf_riccati import (bisect_verified, check_regular, gamma_lower_bound,
                                                state_feedback_gain, state_feedback_verdict)
 from tmfem.control.linear.hinf_slicot import hinf_slicot
+from tmfem.control.linear.lmi import SolverReport
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.control.linear.pbh import require_stabilizable_detectable
 from tmfem.errors import InfeasibleController, InputError
@@ -403,7 +404,6 @@ def hinfsyn_state(P, ncon: int, *, method: str = "auto", alpha: float = 0.0,
 def _state_feedback_riccati(G: GeneralizedPlant, *, alpha: float, gamma_tol: float) -> HinfDesign:
     """Verified Riccati bisection for u = K x (:func:`hinfsyn_state`)."""
     import control
-    from tmfem.control.linear.lmi import SolverReport
     n = G.A.shape[0]
     Aa = G.A + alpha * np.eye(n)
     args = (Aa, G.B1, G.B2, G.C1, G.D11, G.D12)

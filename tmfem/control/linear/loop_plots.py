@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from tmfem.control.linear.hinf_riccati import gamma_lower_bound
+from tmfem.control.linear.hinfsyn import hinfsyn
 from tmfem.errors import TmfemError
 
 
@@ -33,7 +35,6 @@ def damping_table(sys) -> list:
 def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot")) -> dict:
     """gamma and verified norm of each route of :func:`tmfem.control.linear.hinfsyn.hinfsyn`
     on ``plant`` (GeneralizedPlant): name -> (gamma, norm) or the refusal's message."""
-    from tmfem.control.linear.hinfsyn import hinfsyn
     out = {}
     for r in routes:
         try:
@@ -56,7 +57,6 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
     the result of :func:`route_levels` (computed here when None and ``open_loop`` is given).
     """
     import control
-    from tmfem.control.linear.hinf_riccati import gamma_lower_bound
     from tmfem.post.plots import new_figure, save_figure
     T = design.closed_loop
     P = open_loop if open_loop is not None else design.plant

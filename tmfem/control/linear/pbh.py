@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.errors import InfeasibleController, InputError
 
 DEFAULT_TOL = 1e-8
 
@@ -132,7 +132,6 @@ def require_stabilizable_detectable(A, B2, C2, *, alpha: float = 0.0, tol: float
         its margin.
     """
     import scipy.linalg as sla
-    from tmfem.errors import InfeasibleController
     res = pbh(A, B2, C2, tol=tol)
     _, VR = sla.eig(np.asarray(A, dtype=float))
     names = list(state_names) if state_names is not None else [f"x{i + 1}" for i in range(len(VR))]
