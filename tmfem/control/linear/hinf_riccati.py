@@ -199,7 +199,7 @@ def check_regular(P, *, alpha: float = 0.0) -> None:
     """
     import control
     nu, ny = P.B2.shape[1], P.C2.shape[0]
-    r12, r21 = _rank(P.D12), _rank(P.D21)
+    r12, r21 = numerical_rank(P.D12), numerical_rank(P.D21)
     if r12 < nu or r21 < ny:
         raise InputError(f"Riccati route: expected a regular plant (D12 full column rank {nu}, "
                          f"D21 full row rank {ny}), found ranks {r12} and {r21}: use the LMI "
@@ -217,7 +217,9 @@ def check_regular(P, *, alpha: float = 0.0) -> None:
                              "(method='lmi')")
 
 
-def _rank(D: np.ndarray, rtol: float = 1e-9) -> int:
+def numerical_rank(D: np.ndarray, rtol: float = 1e-9) -> int:
+    """Number of singular values of D above ``rtol`` times the largest (the rank test of
+    :func:`check_regular`)."""
     if D.size == 0:
         return 0
     s = np.linalg.svd(D, compute_uv=False)

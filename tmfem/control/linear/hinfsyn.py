@@ -46,7 +46,8 @@ from tmfem.control.linear.closed_loop import HinfDesign, check_loop, closed_loop
 from tmfem.control.linear.hinf_central import hinf_central
 from tmfem.control.linear.hinf_lmi import hinf_gamma, hinf_lmi, hinf_state_feedback
 from tmfem.control.linear.hinf_riccati import (bisect_verified, check_regular, gamma_lower_bound,
-                                               state_feedback_gain, state_feedback_verdict)
+                                               numerical_rank, state_feedback_gain,
+                                               state_feedback_verdict)
 from tmfem.control.linear.hinf_slicot import hinf_slicot
 from tmfem.control.linear.lmi import SolverReport
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
@@ -204,13 +205,13 @@ def regularized(G0: GeneralizedPlant, rel: float) -> GeneralizedPlant:
     n, nw, nu, np_, ny = (G0.sizes[k] for k in ("n", "nw", "nu", "np", "ny"))
     A, B1, C1, C2, D11, D12, D21 = G0.A, G0.B1, G0.C1, G0.C2, G0.D11, G0.D12, G0.D21
     p_names, w_names = list(G0.p_names), list(G0.w_names)
-    if np.linalg.matrix_rank(D12) < nu:
+    if numerical_rank(D12) < nu:
         e = rel * max(np.linalg.norm(C1, 2), np.linalg.norm(D12, 2), 1e-300)
         C1 = np.vstack([C1, np.zeros((nu, n))])
         D11 = np.vstack([D11, np.zeros((nu, D11.shape[1]))])
         D12 = np.vstack([D12, e * np.eye(nu)])
         p_names += [f"reg_{s}" for s in G0.u_names]
-    if np.linalg.matrix_rank(D21) < ny:
+    if numerical_rank(D21) < ny:
         e = rel * max(np.linalg.norm(B1, 2), np.linalg.norm(D21, 2), 1e-300)
         B1 = np.hstack([B1, np.zeros((n, ny))])
         D11 = np.hstack([D11, np.zeros((D11.shape[0], ny))])
@@ -383,7 +384,7 @@ def hinfsyn_state(P, ncon: int, *, method: str = "auto", alpha: float = 0.0,
                          f"found {type(P).__name__}")
     require_stabilizable_detectable(G.A, G.B2, np.eye(G.A.shape[0]), alpha=alpha,
                                     state_names=G.state_names)
-    full_rank = np.linalg.matrix_rank(G.D12) == G.B2.shape[1]
+    full_rank = numerical_rank(G.D12) == G.B2.shape[1]
     route = method if method != "auto" else ("riccati" if full_rank else "lmi")
     reason = "requested" if method != "auto" else ("D12 full column rank" if full_rank else
                                                     "D12 rank deficient")
@@ -393,9 +394,15 @@ def hinfsyn_state(P, ncon: int, *, method: str = "auto", alpha: float = 0.0,
     else:
         if not full_rank:
             raise InputError(f"hinfsyn_state: the Riccati route expects D12 of full column rank "
-                             f"{G.B2.shape[1]}, found rank {np.linalg.matrix_rank(G.D12)}: use "
+                             f"{G.B2.shape[1]}, found rank {numerical_rank(G.D12)}: use "
                              "method='lmi'")
-        design = _state_feedback_riccati(G, alpha=alpha, gamma_tol=gamma_tol)
+        try:
+            design = _state_feedback_riccati(G, alpha=alpha, gamma_tol=gamma_tol)
+        except InfeasibleController as exc:
+            if method != "auto":
+                raise
+            route, reason = "lmi", f"Riccati route failed ({exc})"
+            design = hinf_state_feedback(G, alpha=alpha, solver=solver, gamma_relax=gamma_tol)
     times = {route: time.perf_counter() - t1}
     return _result(G, design, design.controller, design.closed_loop, route, reason, times, t0,
                    alpha=alpha, gamma_tol=gamma_tol)

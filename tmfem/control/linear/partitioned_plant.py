@@ -16,7 +16,8 @@ from tmfem.errors import InputError
 
 @dataclass
 class GeneralizedPlant:
-    """Partitioned plant of eq. 5.62 with named signals (D22 = 0 assumed, as in 7.3)."""
+    """Partitioned plant of eq. 5.62 with named signals. The synthesis routes assume D22 = 0
+    (7.3); :func:`tmfem.control.linear.hinfsyn.hinfsyn` removes a D22 != 0 by loop shifting."""
 
     A: np.ndarray
     B1: np.ndarray
