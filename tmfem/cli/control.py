@@ -34,13 +34,15 @@ def configure(parser) -> None:
     parser.add_argument("--u-m", type=float, default=None,
                         help="u_m [m] of W_u = I/u_m (default 7.4's: 0.01, 0.02 for 1-6D)")
     parser.add_argument("--solver", choices=("ARE", "CLARABEL", "SCS", "EIGOPT"), default=None,
-                        help="hinf: how the eliminated LMIs are solved: ARE (default; their Riccati "
+                        help="hinf --method lmi: how the eliminated LMIs are solved: ARE (default; their Riccati "
                              "characterisation, bisection on gamma, LMIs re-checked), or the SDP "
                              "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
                              "docs/guides/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (eigenvalue "
                              "optimisation: bisection on gamma, or one level with --fixed-gamma; docs/guides/lpv.md)")
-    parser.add_argument("--method", choices=("lmi", "riccati", "central"), default=None,
-                        help="lmi (default): eliminated LMIs of eq. 5.65; riccati: python-control "
+    parser.add_argument("--method", choices=("auto", "lmi", "riccati", "central"), default=None,
+                        help="auto (default): tmfem.control.hinfsyn's verified route (Riccati "
+                             "bisection with the central controller on regular plants, else the "
+                             "LMIs; docs/guides/hinf.md); lmi: eliminated LMIs of eq. 5.65; riccati: python-control "
                              "hinfsyn (SLICOT SB10AD) on the alpha-shifted plant; central: the "
                              "central (minimum-entropy) controller at 1.01 gamma_opt, solver-"
                              "independent, the one `tmfem deploy` uses (docs/guides/control.md)")
@@ -94,7 +96,7 @@ def run(args) -> dict:
         if given:
             raise InputError(f"recheck: options {given} do not apply")
         return {"action": "recheck", "file": args.spec, **recheck(args.spec)}
-    from tmfem.control.linear.deployed_design import deployed_hinf, save_design
+    from tmfem.control.linear.deployed_design import DEFAULT_METHOD, deployed_hinf, save_design
     if args.action == "pbh":
         given = [k for k in _HINF_ONLY if getattr(args, k) is not None]
         if given:
@@ -103,16 +105,17 @@ def run(args) -> dict:
     if args.solver == "EIGOPT":
         raise InputError("--solver EIGOPT: applies to `tmfem control lpv` only")
     if args.method in ("riccati", "central") and args.solver is not None:
-        raise InputError(f"--solver {args.solver}: applies to --method lmi only, found --method "
-                         f"{args.method}")
+        raise InputError(f"--solver {args.solver}: applies to --method lmi only (or to the LMI fallback "
+                         f"of --method auto), found --method {args.method}")
     output_file(args.save, option="--save", suffixes=(".npz",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
     system = system_from_args(args)
     check_control_modes(system, args.membrane_modes)
     print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
-                        solver=args.solver or "ARE", synthesize=args.action == "hinf",
-                        pbh_tol=args.pbh_tol, method=args.method or "lmi")
+                        solver=args.solver, synthesize=args.action == "hinf",
+                        pbh_tol=args.pbh_tol,
+                        method=args.method or ("lmi" if args.solver else DEFAULT_METHOD))
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
         from tmfem.control.linear.loop_plots import damping_table

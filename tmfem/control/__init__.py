@@ -19,4 +19,10 @@ See docs/guides/control.md.
 """
 from tmfem._lazy import lazy_exports
 
-__getattr__, __dir__, __all__ = lazy_exports(__name__, {}, subpackages=("deployment", "fe_plant", "linear", "lpv"))
+# the python-control-style synthesis entry points, one attribute away
+__getattr__, __dir__, __all__ = lazy_exports(__name__, {
+    "GeneralizedPlant": "tmfem.control.linear.partitioned_plant",
+    "HinfResult": "tmfem.control.linear.hinf_synthesis",
+    "hinfsyn": "tmfem.control.linear.hinf_synthesis",
+    "hinfsyn_state": "tmfem.control.linear.hinf_synthesis",
+}, subpackages=("deployment", "fe_plant", "linear", "lpv"))

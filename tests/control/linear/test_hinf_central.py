@@ -11,13 +11,14 @@ import control
 import numpy as np
 import pytest
 
-from tmfem.control.linear.hinf_lmi import GeneralizedPlant, _controller_ss, check_loop, closed_loop
-from tmfem.control.linear.hinf_riccati import game_riccati, minimise_gamma
-from tmfem.control.linear.hinf_central import central_matrices, entropy, hinf_central
+from tmfem.control.linear.verification import check_loop, closed_loop, controller_ss
+from tmfem.control.linear.hinf_riccati import game_riccati
+from tmfem.control.linear.hinf_central import central_matrices, entropy, hinf_central, verified_gamma
+from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.errors import InputError
 
 
-def _normalised_plant(seed, n=4, m1=2, p1=2):
+def _normalized_plant(seed, n=4, m1=2, p1=2):
     """A random plant of the DGKF normalised form: D11 = 0, D12 = [0; I], D21 = [0, I],
     D12^T C1 = 0, B1 D21^T = 0 (one control input, one measurement)."""
     rng = np.random.default_rng(seed)
@@ -50,8 +51,8 @@ def _dgkf_central(P, gamma):
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_sb10fd_is_the_dgkf_central_controller(seed):
-    P = _normalised_plant(seed)
-    g_opt, _, _ = minimise_gamma(P, alpha=0.0)
+    P = _normalized_plant(seed)
+    g_opt = verified_gamma(P).gamma
     gamma = 1.2 * g_opt
     Ak, Bk, Ck, Dk = central_matrices(P, gamma)
     K = control.ss(Ak, Bk, Ck, Dk)
@@ -59,16 +60,16 @@ def test_sb10fd_is_the_dgkf_central_controller(seed):
     assert control.norm(K - Kr, p="inf") < 1e-7 * control.norm(Kr, p="inf")
 
 
-def test_central_minimises_the_entropy():
+def test_central_minimizes_the_entropy():
     # Mustafa & Glover: among the gamma-suboptimal controllers the central one has the
     # smallest entropy; two other admissible ones at gamma = 1.5 gamma_opt: the central
     # controllers at 1.02 and 1.2 gamma_opt (||T|| < gamma, checked)
-    P = _normalised_plant(2)
-    g_opt, _, _ = minimise_gamma(P, alpha=0.0)
+    P = _normalized_plant(2)
+    g_opt = verified_gamma(P).gamma
     gamma = 1.5 * g_opt
     ent = {}
     for g in (gamma, 1.02 * g_opt, 1.2 * g_opt):
-        T = closed_loop(P, _controller_ss(P, *central_matrices(P, g)))
+        T = closed_loop(P, controller_ss(P, *central_matrices(P, g)))
         nrm, _ = check_loop(T, gamma=gamma, alpha=0.0, rtol=0.0, what="test")
         ent[g] = entropy(T, gamma)
         assert ent[g] >= control.norm(T, p=2) ** 2 * (1 - 1e-3)        # I >= ||T||_2^2
@@ -83,7 +84,7 @@ def test_entropy_refuses_what_it_does_not_apply_to():
     with pytest.raises(InputError, match="gamma"):
         entropy(control.ss([[-1.0]], [[1.0]], [[2.0]], [[0.0]]), 1.0)
     with pytest.raises(InputError, match="tol"):
-        hinf_central(_normalised_plant(1), tol=0.0)
+        hinf_central(_normalized_plant(1), tol=0.0)
 
 
 @pytest.fixture(scope="module")

@@ -216,7 +216,7 @@ def test_state_feedback_equals_output_feedback_with_state_measurement():
     assert d5.closed_loop_max_real_part < -0.5
 
 
-def test_unstabilisable_plant_is_refused():
+def test_unstabilizable_plant_is_refused():
     # the mode at +1 has no input (B2 row 0) and is not seen by y: no stabilising controller
     P = _plant(np.diag([1.0, -1.0]), [[0.0], [1.0]], [[0.0], [1.0]], [[1.0, 1.0], [0, 0]],
                [[0.0, 1.0]], np.zeros((2, 1)), np.array([[0.0], [1.0]]), np.array([[1.0]]))
@@ -263,19 +263,31 @@ def test_generalized_plant_matches_figure_7_1_reading(design_1_4D):
 
 
 def test_1_4D_hinf_design(design_1_4D):
+    # the default route (tmfem.control.hinfsyn "auto": verified Riccati bisection and the
+    # central controller on this regular plant)
     d = design_1_4D.design
     assert d.closed_loop_max_real_part < -0.5                        # alpha_1 of 7.4
     assert control.norm(d.closed_loop, p="inf") <= d.gamma * (1 + 1e-6)
-    # gamma >= ||D11|| = W_e = 0.5, and the LMI reaches it (the shifted Riccati optimum is 0.5)
-    assert 0.5 <= d.gamma <= 0.5 * 1.02
-    assert d.solver.solver == "ARE" and 0.5 <= d.gamma_lmi <= 0.5 * (1 + 1e-5)
+    # gamma >= ||D11|| = W_e = 0.5 (certified: the feedthrough bound), and the route reaches it
+    assert d.gamma_lower == pytest.approx(0.5, rel=1e-9)
+    assert 0.5 <= d.gamma <= 0.5 * (1 + 2e-3)
+    assert d.info["route"]["method"] == "riccati" and d.info["route"]["feedthrough_sets_gamma"]
     # the SDP (Clarabel) on the same LMIs: the same optimum
     g_sdp, _ = hinf_gamma(design_1_4D.generalized, alpha=0.5)
-    assert g_sdp == pytest.approx(d.gamma_lmi, rel=1e-4)
+    assert g_sdp == pytest.approx(d.gamma_lmi, rel=1e-3)
     assert list(d.controller.input_labels) == list(design_1_4D.generalized.y_names)
     assert list(d.controller.output_labels)[0] == "r_SL_1"
     assert d.operating_point["u_e"].shape == (8,)
     assert d.operating_point["q_e"].shape == (8,)
+
+
+def test_1_4D_lmi_route_through_the_riccati_test(design_1_4D):
+    # the eliminated LMIs solved through their verified Riccati test, controller by eq. 5.67
+    d = hinf_lmi(design_1_4D.generalized, alpha=0.5, solver="ARE")
+    assert d.closed_loop_max_real_part < -0.5
+    assert control.norm(d.closed_loop, p="inf") <= d.gamma * (1 + 1e-6)
+    assert 0.5 <= d.gamma <= 0.5 * 1.02
+    assert d.solver.solver == "ARE" and 0.5 <= d.gamma_lmi <= 0.5 * (1 + 1e-5)
 
 
 def test_save_and_recheck(design_1_4D, tmp_path):
@@ -335,7 +347,7 @@ def test_1_6D_open_loop_facts_and_design():
 def design_2_3():
     from tmfem.control.linear.deployed_design import deployed_hinf
     from tmfem.system import load_preset
-    return deployed_hinf(load_preset("2-3-deploy"))
+    return deployed_hinf(load_preset("2-3-deploy"), method="lmi")
 
 
 def test_2_3_open_loop_facts(design_2_3):

@@ -14,8 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.linear.hinf_lmi import GeneralizedPlant, HinfDesign, hinf_lmi, hinf_riccati, verify
+from tmfem.control.linear.verification import HinfDesign, verify
 from tmfem.control.linear.hinf_central import hinf_central
+from tmfem.control.linear.hinf_lmi import hinf_lmi
+from tmfem.control.linear.hinf_slicot import hinf_slicot
+from tmfem.control.linear.hinf_synthesis import hinfsyn
+from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.control.linear.pbh import PBHResult, pbh_ss
 from tmfem.control.linear.generalized_plant import DEPLOYED, DeployedPlant, deployed_plant, generalized_plant
 from tmfem.errors import InputError
@@ -23,7 +27,12 @@ from tmfem.errors import InputError
 log = logging.getLogger(__name__)
 
 #: synthesis methods of :func:`deployed_hinf`
-METHODS = ("lmi", "riccati", "central")
+METHODS = ("auto", "lmi", "riccati", "central")
+#: default synthesis method of :func:`deployed_hinf` and ``tmfem control hinf``: the route of
+#: :func:`tmfem.control.linear.hinf_synthesis.hinfsyn` that is right on the whole regression family
+DEFAULT_METHOD = "auto"
+#: default solver of the eliminated LMIs for ``method="lmi"`` (their verified Riccati test)
+DEFAULT_SOLVER = "ARE"
 
 
 @dataclass
@@ -54,9 +63,9 @@ class DeployedDesign:
 
 
 def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = None,
-                  membrane_modes: int | None = None, solver: str = "ARE",
+                  membrane_modes: int | None = None, solver: str | None = None,
                   synthesize: bool = True, pbh_tol: float | None = None,
-                  method: str = "lmi") -> DeployedDesign:
+                  method: str = DEFAULT_METHOD) -> DeployedDesign:
     """Plant, PBH and H-infinity controller of a deployed system (7.3-7.4).
 
     Parameters
@@ -64,22 +73,30 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     alpha, u_m, membrane_modes : optional
         alpha_1, u_m of W_u = I/u_m, and K; defaults: 7.4's values for the system
         (:data:`tmfem.control.linear.generalized_plant.DEPLOYED`), required for other systems.
-    solver : {"ARE", "CLARABEL", "SCS"}
-        How the eliminated LMIs are solved (:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi`); default
-        their Riccati characterisation (the plants of Fig. 7.1 are regular: D12 = [0; W_u],
-        D21 = [-[I; 0], W_d I]), 0.3-3 s for the three systems against 3 s, 30 s and a
-        failure with Clarabel (docs/guides/control.md).
+    solver : {"ARE", "CLARABEL", "SCS"}, optional
+        How the eliminated LMIs are solved with ``method="lmi"``
+        (:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi`); default :data:`DEFAULT_SOLVER`,
+        their Riccati characterisation with a verified bisection (the plants of Fig. 7.1 are
+        regular: D12 = [0; W_u], D21 = [-[I; 0], W_d I]). With ``method="auto"`` the SDP
+        solver of a fallback to the LMIs (CLARABEL or SCS).
     synthesize : bool
         False: plant and PBH only (``tmfem control pbh``).
-    method : {"lmi", "riccati", "central"}
-        Eliminated LMIs (:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi`), the Riccati route on the
-        alpha-shifted plant (:func:`~tmfem.control.linear.hinf_lmi.hinf_riccati`) or the central
+    method : {"auto", "lmi", "riccati", "central"}
+        ``"auto"`` (default): :func:`~tmfem.control.linear.hinf_synthesis.hinfsyn`'s default route
+        (the verified Riccati bisection with the central controller on regular plants, the
+        LMIs otherwise); the eliminated LMIs (:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi`),
+        python-control's hinfsyn on the alpha-shifted plant
+        (:func:`~tmfem.control.linear.hinf_slicot.hinf_slicot`) or the central
         (minimum-entropy) controller at 1.01 gamma_opt
-        (:func:`~tmfem.control.linear.hinf_central.hinf_central`: solver-independent; the default
-        of the deployments, docs/guides/control.md).
+        (:func:`~tmfem.control.linear.hinf_central.hinf_central`: the deployments' controller).
     """
     if method not in METHODS:
         raise InputError(f"method: expected one of {METHODS}, found {method!r}")
+    if solver is not None and method not in ("lmi", "auto"):
+        raise InputError(f"solver: applies to method 'lmi' or 'auto', found method {method!r}")
+    if method == "auto" and solver not in (None, "CLARABEL", "SCS"):
+        raise InputError(f"solver: expected CLARABEL or SCS with method 'auto' (the SDP solver of "
+                         f"its LMI fallback), found {solver!r}")
     d = DEPLOYED.get(system.name, {})
     alpha = d.get("alpha") if alpha is None else alpha
     u_m = d.get("u_m") if u_m is None else u_m
@@ -92,12 +109,19 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     gen = generalized_plant(plant, u_m=u_m if u_m is not None else 1.0)
     design = None
     if synthesize:
-        if method == "lmi":
-            design = hinf_lmi(gen, alpha=alpha, solver=solver, operating_point=plant.operating_point)
+        if method == "auto":
+            syn = hinfsyn(gen, gen.C2.shape[0], gen.B2.shape[1], alpha=alpha, solver=solver or "CLARABEL")
+            design = syn.design
+            design.operating_point = dict(plant.operating_point)
+            design.info["route"] = {k: syn.info[k] for k in ("method", "route_reason", "feedthrough_bound",
+                                                             "feedthrough_sets_gamma", "solver_times_s")}
+        elif method == "lmi":
+            design = hinf_lmi(gen, alpha=alpha, solver=solver or DEFAULT_SOLVER,
+                              operating_point=plant.operating_point)
         elif method == "central":
             design = hinf_central(gen, alpha=alpha, operating_point=plant.operating_point)
         else:
-            design = hinf_riccati(gen, alpha=alpha, operating_point=plant.operating_point)
+            design = hinf_slicot(gen, alpha=alpha, operating_point=plant.operating_point)
     return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design,
                           u_m=float(u_m) if u_m is not None else None)
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.linear.hinf_lmi import GeneralizedPlant
+from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.errors import InputError
 
 log = logging.getLogger(__name__)

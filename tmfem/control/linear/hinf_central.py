@@ -5,8 +5,10 @@ With the constant weights of 7.4 the optimum of eqs. 5.63-5.67 is the degenerate
 returns one of them, solver-dependent. This module picks one member by a stated secondary
 objective, independent of any solver:
 
-* **gamma**: gamma_opt from the Riccati test of the eliminated LMIs
-  (:func:`tmfem.control.linear.hinf_riccati.minimise_gamma`, the optimum of eq. 5.65 for the
+* **gamma**: gamma_opt from the Riccati test of the eliminated LMIs by a bisection that moves
+  down only where the central controller at that level was built and its closed loop with
+  the alpha-shifted plant verified (:func:`verified_gamma`,
+  :func:`tmfem.control.linear.hinf_riccati.minimize_gamma`: the optimum of eq. 5.65 for the
   alpha-shifted plant A + alpha_1 I), then gamma = (1 + ``tol``) gamma_opt.
 * **the controller**: the *central* controller at that gamma, i.e. the member Q = 0 of the
   parametrisation of all gamma-suboptimal controllers K = F_l(M_inf, Q), ||Q||_inf < gamma,
@@ -38,8 +40,10 @@ import time
 
 import numpy as np
 
-from tmfem.control.linear.hinf_lmi import GeneralizedPlant, HinfDesign, _controller_ss, verify
+from tmfem.control.linear.verification import HinfDesign, check_loop, closed_loop, controller_ss, verify
+from tmfem.control.linear.hinf_riccati import GammaIteration, minimize_gamma
 from tmfem.control.linear.lmi import SolverReport
+from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
@@ -75,7 +79,7 @@ def central_matrices(plant: GeneralizedPlant, gamma: float, *, alpha: float = 0.
 
 
 def hinf_central(plant: GeneralizedPlant, *, alpha: float = 0.0, tol: float = TOL,
-                 verify_rtol: float = 1e-3, operating_point=None) -> HinfDesign:
+                 rtol: float = 1e-6, verify_rtol: float = 1e-3, operating_point=None) -> HinfDesign:
     """The central H-infinity controller at gamma = (1 + ``tol``) gamma_opt with
     alpha-stability (module docstring), verified on the closed loop (poles left of
     -alpha_1, ``control.norm(T_pw, 'inf') <= gamma``).
@@ -88,6 +92,8 @@ def hinf_central(plant: GeneralizedPlant, *, alpha: float = 0.0, tol: float = TO
         alpha_1 >= 0 (7.3).
     tol : float
         > 0: the level above the optimum, gamma = (1 + tol) gamma_opt.
+    rtol : float
+        Relative bracket of the verified bisection for gamma_opt (:func:`verified_gamma`).
 
     Raises
     ------
@@ -96,7 +102,6 @@ def hinf_central(plant: GeneralizedPlant, *, alpha: float = 0.0, tol: float = TO
     InfeasibleController
         No admissible controller, or the closed-loop checks fail.
     """
-    from tmfem.control.linear import hinf_riccati as hinf_are
     if not (np.isfinite(alpha) and alpha >= 0):
         raise InputError(f"alpha_1: expected a finite value >= 0, found {alpha!r}")
     if not (np.isfinite(tol) and tol > 0):
@@ -106,21 +111,45 @@ def hinf_central(plant: GeneralizedPlant, *, alpha: float = 0.0, tol: float = TO
                          f"{np.max(np.abs(plant.D22)):.3g}")
     t0 = time.perf_counter()
     Ps, _ = plant.scaled()
-    g_opt, steps, _ = hinf_are.minimise_gamma(Ps, alpha=alpha)
+    it = verified_gamma(Ps, alpha=alpha, rtol=rtol)
+    g_opt = it.gamma
     gamma = (1 + tol) * g_opt
     Ak, Bk, Ck, Dk = central_matrices(plant, gamma, alpha=alpha)
     dt = time.perf_counter() - t0
-    K = _controller_ss(plant, Ak, Bk, Ck, Dk)
+    K = controller_ss(plant, Ak, Bk, Ck, Dk)
     T, nrm, re = verify(plant, K, gamma=gamma, alpha=alpha, rtol=verify_rtol)
-    rep = SolverReport(solver="ARE + SB10FD", status=f"gamma_opt by Riccati bisection ({steps} "
-                       f"steps), central controller at (1 + {tol:g}) gamma_opt",
-                       solve_time_s=dt, n_variables=0, lmi_sizes={}, iterations=steps)
+    rep = SolverReport(solver="ARE + SB10FD", status=f"gamma_opt by verified Riccati bisection "
+                       f"({it.steps} steps, certified lower bound {it.lower:.6g}), central "
+                       f"controller at (1 + {tol:g}) gamma_opt",
+                       solve_time_s=dt, n_variables=0, lmi_sizes={}, iterations=it.steps)
     log.info("central H-infinity controller: gamma_opt %.8g, gamma %.6g, ||T|| %.8g, max Re %.4g, "
              "%.2f s", g_opt, gamma, nrm, re, dt)
     return HinfDesign(controller=K, gamma=gamma, alpha=float(alpha), closed_loop=T,
                       closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep,
                       plant=plant, kind="output feedback (central, minimum entropy)",
-                      operating_point=dict(operating_point or {}), gamma_lmi=g_opt)
+                      operating_point=dict(operating_point or {}), gamma_lmi=g_opt,
+                      gamma_lower=it.lower, info={"unknown_levels": it.unknown})
+
+
+def verified_gamma(plant: GeneralizedPlant, *, alpha: float = 0.0, rtol: float = 1e-6,
+                   check_rtol: float = 1e-6) -> GammaIteration:
+    """Optimal level of the alpha-shifted plant by the Riccati bisection whose every step
+    down is verified (:func:`tmfem.control.linear.hinf_riccati.minimize_gamma`): the central
+    controller at that level (:func:`central_matrices`, unshifted) in closed loop with the
+    shifted plant A + alpha_1 I must be stable with ||T_pw||_inf <= gamma (1 + check_rtol).
+    ``evidence`` of the result is (controller, closed loop, norm) of the shifted problem."""
+    Pa = plant.shifted(alpha)
+
+    def certify(gamma):
+        try:
+            K = controller_ss(Pa, *central_matrices(Pa, gamma))
+            T = closed_loop(Pa, K)
+            nrm, _ = check_loop(T, gamma=gamma, alpha=0.0, rtol=check_rtol, sweep=False,
+                                what=f"central controller at gamma = {gamma:.8g}")
+        except InfeasibleController as exc:
+            return False, None, str(exc)
+        return True, (K, T, nrm), ""
+    return minimize_gamma(plant, alpha=alpha, certify=certify, rtol=rtol)
 
 
 def entropy(T, gamma: float, *, w_min: float = 1e-4, w_max: float = 1e6, n: int = 4000) -> float:

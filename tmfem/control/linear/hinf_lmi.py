@@ -38,141 +38,19 @@ All results are verified on the assembled closed loop (poles, ``control.norm(...
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
-
 import numpy as np
 
-from tmfem.control.linear.lmi import SolverReport, max_eig, null_basis, solve, sym
+from tmfem.control.linear.verification import (HinfDesign, check_loop, closed_loop, controller_ss,
+                                              verify)
+from tmfem.control.linear.hinf_central import verified_gamma
+from tmfem.control.linear.hinf_riccati import strict_point
+from tmfem.control.linear.lmi import (SolverReport, max_eig, null_basis, projection_solution, solve,
+                                      sym)
+from tmfem.control.linear.partitioned_plant import GeneralizedPlant
+from tmfem.control.linear.pbh import require_stabilizable_detectable
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
-
-
-@dataclass
-class GeneralizedPlant:
-    """Partitioned plant of eq. 5.62 with named signals (D22 = 0 assumed, as in 7.3)."""
-
-    A: np.ndarray
-    B1: np.ndarray
-    B2: np.ndarray
-    C1: np.ndarray
-    C2: np.ndarray
-    D11: np.ndarray
-    D12: np.ndarray
-    D21: np.ndarray
-    D22: np.ndarray
-    state_names: list
-    w_names: list
-    u_names: list
-    p_names: list
-    y_names: list
-
-    def __post_init__(self):
-        for k in ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22"):
-            setattr(self, k, np.atleast_2d(np.asarray(getattr(self, k), dtype=float)))
-        n = self.A.shape[0]
-        nw, nu, np_, ny = self.B1.shape[1], self.B2.shape[1], self.C1.shape[0], self.C2.shape[0]
-        want = {"A": (n, n), "B1": (n, nw), "B2": (n, nu), "C1": (np_, n), "C2": (ny, n),
-                "D11": (np_, nw), "D12": (np_, nu), "D21": (ny, nw), "D22": (ny, nu)}
-        for k, shp in want.items():
-            if getattr(self, k).shape != shp:
-                raise InputError(f"generalised plant: expected {k} of shape {shp}, found "
-                                 f"{getattr(self, k).shape}")
-        for k, m in (("state_names", n), ("w_names", nw), ("u_names", nu), ("p_names", np_),
-                     ("y_names", ny)):
-            if len(getattr(self, k)) != m:
-                raise InputError(f"generalised plant: expected {m} {k}, found {len(getattr(self, k))}")
-        if not np.all(np.isfinite(np.concatenate([getattr(self, k).ravel() for k in want]))):
-            raise InputError("generalised plant: expected finite matrices, found NaN or inf")
-
-    @property
-    def sizes(self) -> dict:
-        return {"n": self.A.shape[0], "nw": self.B1.shape[1], "nu": self.B2.shape[1],
-                "np": self.C1.shape[0], "ny": self.C2.shape[0]}
-
-    def to_ss(self, name: str = "P"):
-        """python-control ``StateSpace``: inputs [w, u], outputs [p, y] (hinfsyn's order)."""
-        import control
-        B = np.hstack([self.B1, self.B2])
-        C = np.vstack([self.C1, self.C2])
-        D = np.block([[self.D11, self.D12], [self.D21, self.D22]])
-        return control.ss(self.A, B, C, D, states=list(self.state_names),
-                          inputs=list(self.w_names) + list(self.u_names),
-                          outputs=list(self.p_names) + list(self.y_names), name=name)
-
-    @classmethod
-    def from_ss(cls, sys, *, nw: int, ny: int) -> "GeneralizedPlant":
-        """Split a ``StateSpace`` with inputs [w, u] and outputs [p, y]."""
-        A, B, C, D = (np.asarray(M, dtype=float) for M in (sys.A, sys.B, sys.C, sys.D))
-        np_ = C.shape[0] - ny
-        if not (0 < nw < B.shape[1] and 0 < ny < C.shape[0]):
-            raise InputError(f"generalised plant: expected 0 < nw < {B.shape[1]} and 0 < ny < "
-                             f"{C.shape[0]}, found nw = {nw}, ny = {ny}")
-        names = lambda lab: list(lab)  # noqa: E731
-        return cls(A=A, B1=B[:, :nw], B2=B[:, nw:], C1=C[:np_], C2=C[np_:], D11=D[:np_, :nw],
-                   D12=D[:np_, nw:], D21=D[np_:, :nw], D22=D[np_:, nw:],
-                   state_names=names(sys.state_labels), w_names=names(sys.input_labels[:nw]),
-                   u_names=names(sys.input_labels[nw:]), p_names=names(sys.output_labels[:np_]),
-                   y_names=names(sys.output_labels[np_:]))
-
-    def scaled(self) -> tuple["GeneralizedPlant", np.ndarray]:
-        """Plant in balanced state coordinates x = T x_b, T diagonal (LAPACK gebal via
-        ``scipy.linalg.matrix_balance`` on [[A, B], [C, 0]] restricted to the states).
-        The input-output map, and hence any controller, is unchanged."""
-        import scipy.linalg as sla
-        n = self.A.shape[0]
-        B = np.hstack([self.B1, self.B2])
-        C = np.vstack([self.C1, self.C2])
-        big = np.zeros((n + C.shape[0], n + B.shape[1]))
-        big[:n, :n], big[:n, n:], big[n:, :n] = self.A, B, C
-        sq = max(big.shape)
-        Z = np.zeros((sq, sq))
-        Z[: big.shape[0], : big.shape[1]] = big
-        _, (s, _) = sla.matrix_balance(Z, permute=False, separate=True)
-        t = s[:n] / np.exp2(np.round(np.mean(np.log2(s[:n]))))
-        Ti = 1.0 / t
-        sp = GeneralizedPlant(A=Ti[:, None] * self.A * t[None, :], B1=Ti[:, None] * self.B1,
-                              B2=Ti[:, None] * self.B2, C1=self.C1 * t[None, :],
-                              C2=self.C2 * t[None, :], D11=self.D11, D12=self.D12, D21=self.D21,
-                              D22=self.D22, state_names=self.state_names, w_names=self.w_names,
-                              u_names=self.u_names, p_names=self.p_names, y_names=self.y_names)
-        return sp, t
-
-
-@dataclass
-class HinfDesign:
-    """An H-infinity controller and its certificate.
-
-    ``gamma`` is the level the controller is certified for (the LMI optimum ``gamma_lmi``
-    relaxed by ``gamma_relax``); ``closed_loop_norm`` the measured ||T_pw||_inf <= gamma.
-
-    ``controller`` is a python-control ``StateSpace`` from the measured outputs y (inputs,
-    named as the plant's y) to the control inputs u (outputs, named as the plant's u).
-    ``operating_point`` holds what the design is linearised about (e.g. q_e, u_e): the
-    applied input is u_e + controller output (7.3: the plant describes perturbations).
-    """
-
-    controller: object
-    gamma: float
-    alpha: float
-    closed_loop: object
-    closed_loop_norm: float
-    closed_loop_max_real_part: float
-    solver: SolverReport
-    plant: GeneralizedPlant
-    kind: str
-    R: np.ndarray | None = None
-    S: np.ndarray | None = None
-    cond_I_minus_RS: float | None = None
-    operating_point: dict = field(default_factory=dict)
-    gamma_lmi: float | None = None
-
-    def summary(self) -> dict:
-        return {"kind": self.kind, "gamma": self.gamma, "gamma_lmi": self.gamma_lmi, "alpha": self.alpha,
-                "closed_loop_hinf_norm": self.closed_loop_norm,
-                "closed_loop_max_real_part": self.closed_loop_max_real_part,
-                "controller_order": int(self.controller.nstates),
-                "cond_I_minus_RS": self.cond_I_minus_RS, "solver": self.solver.as_dict()}
 
 
 # ---------------------------------------------------------------------------- LMIs
@@ -330,7 +208,7 @@ def _controller_from_RS(P: GeneralizedPlant, alpha: float, R, S, gamma: float):
                     [C0, P.D11, -gamma * np.eye(np_)]])
     Ug = np.vstack([X @ Bt, np.zeros((nw, n + nu)), D12t])      # Gamma (full column rank)
     Vl = np.hstack([Ct, D21t, np.zeros((n + ny, np_))])         # Lambda (full row rank)
-    Th, lam = _projection_solution(Psi, Ug, Vl)
+    Th, lam = projection_solution(Psi, Ug, Vl)
     if Th is None:
         return (None, None, None, None), cond, lam
     Ak, Bk = Th[:n, :n], Th[:n, n:]
@@ -338,100 +216,18 @@ def _controller_from_RS(P: GeneralizedPlant, alpha: float, R, S, gamma: float):
     return (Ak, Bk, Ck, Dk), cond, lam
 
 
-def _projection_solution(Psi, G, L, *, factor: float = 2.0):
-    """One solution Theta of  Psi + G Theta L + (G Theta L)^T < 0  (G full column rank, L full
-    row rank), by the explicit formula of Skelton, Iwasaki & Grigoriadis (1998, Thm. 2.3.12)
-    with the free contraction L = 0:
-
-        Theta = -Rs^-1 G^T Phi L^T (L Phi L^T)^-1,   Phi = (G Rs^-1 G^T - Psi)^-1 > 0.
-
-    The free weight is chosen in the coordinates of a QR factorisation G = Q [G1; 0]:
-    Rs^-1 = rho G1^-1 G1^-T, so that G Rs^-1 G^T = rho Q diag(I, 0) Q^T and rho is compared
-    with Psi itself (rho = ``factor`` x the largest eigenvalue of the Schur complement of
-    Q^T Psi Q on the range of G), not with Psi seen through an ill-conditioned G (a weight
-    rho I makes rho G G^T swamp Psi in floating point when G is badly scaled). Returns
-    (Theta, max eigenvalue of the LMI); (None, inf) when Psi is not negative definite on the
-    null space of G^T (the elimination condition fails in floating point).
-    """
-    import scipy.linalg as sla
-    m = G.shape[1]
-    Q, Rg = np.linalg.qr(G, mode="complete")
-    G1 = Rg[:m]
-    Pt = Q.T @ Psi @ Q
-    Pt = (Pt + Pt.T) / 2
-    P22 = Pt[m:, m:]
-    if P22.size and np.linalg.eigvalsh(P22)[-1] >= 0:
-        return None, np.inf
-    Z = Pt[:m, :m] - (Pt[:m, m:] @ np.linalg.solve(P22, Pt[m:, :m]) if P22.size else 0.0)
-    ez = np.linalg.eigvalsh((Z + Z.T) / 2)
-    rho = factor * max(float(ez[-1]), 0.0) + 1e-6 * max(float(np.abs(ez).max()), 1e-300)
-    Mt = -Pt.copy()
-    Mt[:m, :m] += rho * np.eye(m)
-    try:
-        Lc = sla.cho_factor(Mt)
-    except np.linalg.LinAlgError:
-        return None, np.inf
-    Lq = L @ Q                                                   # L in the QR coordinates
-    PhiLt = sla.cho_solve(Lc, Lq.T)                              # Phi_q L_q^T
-    Th = -rho * sla.solve_triangular(G1, np.linalg.solve(Lq @ PhiLt, PhiLt[:m].T).T)
-    GTL = G @ Th @ L
-    lam = max_eig(Psi + GTL + GTL.T)
-    return Th, lam
-
-
-def closed_loop(plant: GeneralizedPlant, controller):
-    """Lower LFT of the plant with the controller (u = K y): the ``StateSpace`` from w to
-    p, with python-control ``interconnect`` on the named signals."""
-    import control
-    P = plant.to_ss(name="P")
-    w, p = list(plant.w_names), list(plant.p_names)
-    return control.interconnect([P, controller], inplist=w, outlist=p, inputs=w, outputs=p,
-                                name="T_pw")
-
-
-def verify(plant: GeneralizedPlant, controller, *, gamma: float, alpha: float,
-           rtol: float = 1e-3) -> tuple:
-    """Closed-loop check: all poles with Re < -alpha (within ``rtol`` alpha + 1e-9) and
-    ``control.norm(T_pw, 'inf') <= gamma (1 + rtol)``. Returns (T_pw, norm, max Re).
-
-    Raises
-    ------
-    InfeasibleController
-        when either check fails (poles first: ``control.norm`` does not check stability).
-    """
-    T = closed_loop(plant, controller)
-    nrm, re = check_loop(T, gamma=gamma, alpha=alpha, rtol=rtol, what="closed loop")
-    return T, nrm, re
-
-
-def check_loop(T, *, gamma: float, alpha: float, rtol: float, what: str) -> tuple:
-    """(||T||_inf, max Re of its poles) of a closed loop T, or :class:`InfeasibleController`
-    when a pole lies right of -alpha (within ``rtol`` alpha + 1e-9) or the norm exceeds
-    gamma (1 + rtol); poles first: ``control.norm`` does not check stability."""
-    import control
-    re = float(np.max(np.real(T.poles())))
-    if not re < -alpha + rtol * max(alpha, 1e-6) + 1e-9:
-        raise InfeasibleController(f"{what}: expected all poles with Re < -alpha_1 = "
-                                   f"{-alpha:g}, found max Re = {re:.6g}")
-    nrm = float(control.norm(T, p="inf"))
-    if not nrm <= gamma * (1 + rtol):
-        raise InfeasibleController(f"{what}: expected ||T_pw||_inf <= gamma = {gamma:.6g}, "
-                                   f"found {nrm:.6g}")
-    return nrm, re
-
-
-def _minimise_gamma(plant, *, alpha, solver, eps, regularization, scale, residual_tol):
+def _minimize_gamma(plant, *, alpha, solver, eps, regularization, scale, residual_tol):
     """Stage 1 of :func:`hinf_lmi`: minimise gamma over the eliminated LMIs (eq. 5.65 form)."""
     Ps, t = plant.scaled() if scale else (plant, np.ones(plant.A.shape[0]))
     if solver.upper() == "ARE":
-        from tmfem.control.linear import hinf_riccati as hinf_are
         NR, NS, _, _, sizes = _elimination_bases(Ps)
-        g_opt, steps, dt = hinf_are.minimise_gamma(Ps, alpha=alpha)
+        it = verified_gamma(Ps, alpha=alpha)
         n = Ps.A.shape[0]
-        rep = SolverReport(solver="ARE", status=f"optimal (Riccati bisection, {steps} steps)",
-                           solve_time_s=dt, n_variables=n * (n + 1) + 1, lmi_sizes=sizes,
-                           iterations=steps)
-        return g_opt, rep, (Ps, None, None, sizes, NR, NS, max(1.0, g_opt))
+        rep = SolverReport(solver="ARE", status=f"optimal (verified Riccati bisection, {it.steps} "
+                           f"steps, certified lower bound {it.lower:.8g})",
+                           solve_time_s=it.time_s, n_variables=n * (n + 1) + 1, lmi_sizes=sizes,
+                           iterations=it.steps)
+        return it.gamma, rep, (Ps, None, None, sizes, NR, NS, max(1.0, it.gamma))
     prob, R, S, g, sizes, (NR, NS) = _elimination_problem(Ps, alpha, eps, regularization=regularization)
     rep = solve(prob, solver=solver, what="H-infinity LMIs (eliminated, eq. 5.65)",
                 lmi_sizes=sizes, accept_inaccurate=True)
@@ -458,7 +254,7 @@ def hinf_gamma(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CL
     """
     if not (np.isfinite(alpha) and alpha >= 0):
         raise InputError(f"alpha_1: expected a finite value >= 0, found {alpha!r}")
-    g, rep, _ = _minimise_gamma(plant, alpha=alpha, solver=solver, eps=eps,
+    g, rep, _ = _minimize_gamma(plant, alpha=alpha, solver=solver, eps=eps,
                                 regularization=regularization, scale=scale, residual_tol=residual_tol)
     return g, rep
 
@@ -466,7 +262,7 @@ def hinf_gamma(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CL
 def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLARABEL",
              eps: float = 1e-7, gamma_relax: float = 1e-2, max_cond: float = 1e6,
              scale: bool = True, verify_rtol: float = 1e-3, residual_tol: float = 1e-6,
-             trace_budget: float = 2.0, regularization: float = 1e-6,
+             trace_budget: float = 2.0, regularization: float = 0.0,
              operating_point=None) -> HinfDesign:
     """Full-order H-infinity output feedback with alpha-stability (eqs. 5.63-5.67).
 
@@ -488,8 +284,10 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
     max_cond : float
         Largest accepted cond(I - R S) before the conditioning re-solve.
     regularization : float
-        mu of the objective gamma + mu (tr R + tr S) / 2n (a bounded R, S where the LMIs
-        leave them free; it moves gamma by at most mu times the mean eigenvalue).
+        mu of the objective gamma + mu (tr R + tr S) / 2n. Default 0: the optimum itself
+        (a penalty trades gamma for the size of R, S; 1e-6 made a controller 4 times
+        suboptimal on an ill-conditioned plant). A bounded, well-conditioned R, S comes from
+        the conditioning re-solve at the relaxed gamma instead.
     trace_budget : float
         Re-solve bound tr R + tr S <= trace_budget x (its value at the gamma optimum).
     residual_tol : float
@@ -508,7 +306,9 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
     if np.any(plant.D22 != 0):
         raise InputError(f"generalised plant: expected D22 = 0 (7.3), found max |D22| = "
                          f"{np.max(np.abs(plant.D22)):.3g}")
-    g_opt, rep, (Ps, Rv, Sv, sizes, NR, NS, scale_RS) = _minimise_gamma(
+    require_stabilizable_detectable(plant.A, plant.B2, plant.C2, alpha=alpha,
+                                    state_names=plant.state_names)
+    g_opt, rep, (Ps, Rv, Sv, sizes, NR, NS, scale_RS) = _minimize_gamma(
         plant, alpha=alpha, solver=solver, eps=eps, regularization=regularization, scale=scale,
         residual_tol=residual_tol)
     gamma = g_opt * (1 + gamma_relax)
@@ -541,13 +341,24 @@ def hinf_lmi(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLAR
                                        f"found residuals {rep.residuals} (status {rep2.status!r})")
         (Ak, Bk, Ck, Dk), cond, lam = _controller_from_RS(Ps, alpha, Rv, Sv, gamma)
     rep.residuals["closed-loop bounded real lemma"] = lam
-    if not lam < 0:
+    if Ak is None:
         raise InfeasibleController(f"controller recovery (eq. 5.67): expected the closed-loop "
-                                   f"bounded real lemma < 0, found max eigenvalue {lam:.3e} "
-                                   f"(cond(I - RS) = {cond:.3e})")
+                                   f"bounded real lemma solvable for the controller, found it "
+                                   f"not negative on the null space (cond(I - RS) = {cond:.3e})")
+    if not lam < 0:
+        # the LMI in floating point is only a sufficient test: the assembled closed loop decides
+        log.info("controller recovery: closed-loop bounded real lemma %.3e >= 0 in floating point "
+                 "(cond(I - RS) = %.3e); checking the closed loop itself", lam, cond)
     Ak = Ak - alpha * np.eye(Ak.shape[0])
-    K = _controller_ss(plant, Ak, Bk, Ck, Dk)
-    T, nrm, re = verify(plant, K, gamma=gamma, alpha=alpha, rtol=verify_rtol)
+    K = controller_ss(plant, Ak, Bk, Ck, Dk)
+    try:
+        T, nrm, re = verify(plant, K, gamma=gamma, alpha=alpha, rtol=verify_rtol)
+    except InfeasibleController as exc:
+        hint = (" (SCS is a first-order solver: its R, S are too inaccurate for the recovery of "
+                "eq. 5.67; use CLARABEL)") if rep.solver == "SCS" else ""
+        raise InfeasibleController(f"H-infinity LMIs ({rep.solver}, status {rep.status!r}): the "
+                                   f"recovered controller (cond(I - RS) = {cond:.3g}, bounded real "
+                                   f"lemma {lam:.3g}) fails its closed-loop check: {exc}{hint}") from None
     return HinfDesign(controller=K, gamma=gamma, alpha=float(alpha), closed_loop=T,
                       closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep,
                       plant=plant, kind="output feedback (eliminated LMIs)", R=Rv, S=Sv,
@@ -561,7 +372,6 @@ def _are_point(P, alpha, gamma, max_cond, eps_ladder=(1e-3, 1e-4, 1e-5, 1e-6, 1e
     gives a negative closed-loop bounded real lemma with cond(I - RS) <= ``max_cond``, else
     the first with a negative one. Returns (R, S, (A_k, B_k, C_k, D_k), cond, lam), R and S
     in the coordinates of ``P``."""
-    from tmfem.control.linear.hinf_riccati import strict_point
     found, why = [], []
     for e in eps_ladder:
         try:
@@ -587,13 +397,6 @@ def _are_point(P, alpha, gamma, max_cond, eps_ladder=(1e-3, 1e-4, 1e-5, 1e-6, 1e
     return ok[0] if ok else min(found, key=lambda f: f[3])
 
 
-def _controller_ss(plant, Ak, Bk, Ck, Dk):
-    import control
-    nk = Ak.shape[0]
-    return control.ss(Ak, Bk, Ck, Dk, inputs=list(plant.y_names), outputs=list(plant.u_names),
-                      states=[f"xk_{i + 1}" for i in range(nk)], name="K")
-
-
 def hinf_state_feedback(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLARABEL",
                         eps: float = 1e-7, gamma_relax: float = 1e-3, scale: bool = True,
                         verify_rtol: float = 1e-3, operating_point=None) -> HinfDesign:
@@ -610,6 +413,8 @@ def hinf_state_feedback(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: 
     import cvxpy as cp
     if not (np.isfinite(alpha) and alpha >= 0):
         raise InputError(f"alpha_1: expected a finite value >= 0, found {alpha!r}")
+    require_stabilizable_detectable(plant.A, plant.B2, np.eye(plant.A.shape[0]), alpha=alpha,
+                                    state_names=plant.state_names)
     Ps, t = plant.scaled() if scale else (plant, np.ones(plant.A.shape[0]))
     n, nw, nu, np_ = (Ps.sizes[k] for k in ("n", "nw", "nu", "np"))
     Aa = Ps.A + alpha * np.eye(n)
@@ -656,40 +461,3 @@ def hinf_state_feedback(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: 
                       closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep, plant=plant,
                       kind="state feedback", operating_point=dict(operating_point or {}),
                       gamma_lmi=g_opt)
-
-
-def hinf_riccati(plant: GeneralizedPlant, *, alpha: float = 0.0, verify_rtol: float = 1e-3,
-                 operating_point=None) -> HinfDesign:
-    """Riccati route (Glover-Doyle, python-control ``hinfsyn`` / SLICOT SB10AD) on the
-    alpha-shifted plant A + alpha_1 I, shifted back (A_k - alpha_1 I) as in :func:`hinf_lmi`.
-
-    For regular problems (D12 full column rank, D21 full row rank) only; used where the
-    LMI solver fails numerically (the 50-state 2-3 plant, docs/guides/control.md). hinfsyn's own
-    gamma is not trusted: the returned ``gamma`` is the verified closed-loop norm.
-    """
-    import control
-    if not (np.isfinite(alpha) and alpha >= 0):
-        raise InputError(f"alpha_1: expected a finite value >= 0, found {alpha!r}")
-    n = plant.A.shape[0]
-    Pa = GeneralizedPlant(**{**plant.__dict__, "A": plant.A + alpha * np.eye(n)})
-    import time
-    t0 = time.perf_counter()
-    try:
-        K, _, g, _ = control.hinfsyn(Pa.to_ss(), len(plant.y_names), len(plant.u_names))
-    except Exception as exc:    # slycot raises its own error types
-        raise InfeasibleController(f"hinfsyn (Riccati) on the alpha-shifted plant: expected a "
-                                   f"controller, found the error: {exc}") from None
-    dt = time.perf_counter() - t0
-    Kss = _controller_ss(plant, np.asarray(K.A) - alpha * np.eye(K.nstates), K.B, K.C, K.D)
-    T = closed_loop(plant, Kss)
-    re = float(np.max(np.real(T.poles())))
-    if not re < -alpha + verify_rtol * max(alpha, 1e-6) + 1e-9:
-        raise InfeasibleController(f"closed loop (Riccati): expected all poles with Re < "
-                                   f"{-alpha:g}, found max Re = {re:.6g}")
-    nrm = float(control.norm(T, p="inf"))
-    rep = SolverReport(solver="hinfsyn (SLICOT SB10AD)", status=f"gamma reported {float(g):.6g}",
-                       solve_time_s=dt, n_variables=0, lmi_sizes={})
-    return HinfDesign(controller=Kss, gamma=nrm, alpha=float(alpha), closed_loop=T,
-                      closed_loop_norm=nrm, closed_loop_max_real_part=re, solver=rep, plant=plant,
-                      kind="output feedback (Riccati, shifted plant)",
-                      operating_point=dict(operating_point or {}))

@@ -19,6 +19,16 @@ Riccati characterisation (Gahinet & Apkarian, Int. J. Robust Nonlinear Control 4
   D11^T, D21^T), so S = gamma Y^-1 with Y the dual game solution;
 * [[R, I], [I, S]] > 0 is then rho(X Y) < gamma^2.
 
+The test at one gamma (:func:`riccati_test`) has three outcomes: "feasible", "infeasible"
+with a certificate (gamma at or below the feedthrough bound, a stabilising solution that is
+indefinite, rho(XY) >= gamma^2, a Hamiltonian eigenvalue on the imaginary axis) or
+"unknown" (no Riccati solver found a stabilising solution, and no certificate either: a
+numerical failure, never read as infeasibility). Each Riccati equation is solved by scipy
+and, if that fails, by SLICOT SG02AD, and a solution counts only if its closed-loop matrix is
+Hurwitz. The bisection (:func:`bisect_verified`) moves its upper end only where a
+controller built at that level has a verified closed loop, and its certified lower end
+only on a certificate.
+
 So the LMI optimum gamma is found by bisection on these tests (two Riccati equations of
 order n per step, against an SDP whose interior-point iterations cost O(n^6) for a dense
 Schur complement), and a strictly feasible LMI point for a gamma above the optimum comes from
@@ -31,10 +41,12 @@ from __future__ import annotations
 
 import logging
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
 
+from tmfem.control.linear.lmi import projection_solution
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
@@ -57,91 +69,275 @@ def gamma_lower_bound(P) -> float:
     return float(max(a, b))
 
 
-def game_riccati(A, B1, B2, C1, D11, D12, gamma: float, *, eps: float = 0.0):
-    """Stabilising solution X of the full-information game Riccati equation (module
-    docstring) with C1^T C1 + eps I, or None when it does not exist or is not >= 0."""
+def _stabilizing_care(A, B, Q, Rm, S) -> tuple:
+    """(X, None) with X the stabilising solution of A^T X + X A + Q - (X B + S) Rm^-1
+    (B^T X + S^T) = 0, or (None, reason). Two independent solvers are tried: scipy's
+    (extended Hamiltonian pencil, QZ with the left half plane first; balanced, then
+    unbalanced) and SLICOT SG02AD (python-control ``care``), which does not share scipy's
+    symmetry test that rejects defective (repeated) eigenvalues. A result is accepted only
+    if it is finite and A - B Rm^-1 (B^T X + S^T) is Hurwitz (scipy does not check that the
+    ordered pencil has n stable eigenvalues, so a non-stabilising X can come back)."""
+    import control
+    reasons = []
+
+    def solvers():
+        for balanced in (True, False):
+            yield (f"scipy (balanced={balanced})",
+                   lambda b=balanced: sla.solve_continuous_are(A, B, Q, Rm, s=S, balanced=b))
+        yield "SLICOT SG02AD", lambda: np.asarray(control.care(A, B, Q, Rm, S, np.eye(A.shape[0]))[0])
+
+    for name, fn in solvers():
+        try:
+            X = fn()
+        except Exception as exc:     # LinAlgError, ValueError, slycot's own error types
+            reasons.append(f"{name}: {exc}")
+            continue
+        X = (X + X.T) / 2
+        if not np.all(np.isfinite(X)):
+            reasons.append(f"{name}: non-finite solution")
+            continue
+        F = np.linalg.solve(Rm, B.T @ X + S.T)
+        re = float(np.max(np.linalg.eigvals(A - B @ F).real))
+        if re < 0:
+            return X, None
+        reasons.append(f"{name}: solution not stabilising (closed-loop eigenvalue with Re = {re:.3g})")
+    return None, "; ".join(r.splitlines()[0][:160] for r in reasons)
+
+
+def _axis_eigenvalue(A, B, Q, Rm, S) -> float | None:
+    """Frequency (rad/s) of an eigenvalue of the Riccati equation's Hamiltonian pencil that
+    lies on the imaginary axis (|Re| <= 1e-10 ||H||, |Im| >= 1e-6 ||H||: a genuine crossing,
+    not a pole near the origin), or None."""
+    n, m = A.shape[0], B.shape[1]
+    H = np.block([[A, np.zeros((n, n)), B], [-Q, -A.T, -S], [S.T, B.T, Rm]])
+    J = np.zeros_like(H)
+    J[: 2 * n, : 2 * n] = np.eye(2 * n)
+    q, _ = np.linalg.qr(H[:, -m:], mode="complete")
+    Hd = q[:, m:].T @ H[:, : 2 * n]
+    Jd = q[:2 * n, m:].T @ J[: 2 * n, : 2 * n]
+    lam = sla.eigvals(Hd, Jd)
+    lam = lam[np.isfinite(lam)]
+    nh = max(np.linalg.norm(H, 1), 1e-300)
+    on = lam[(np.abs(lam.real) <= 1e-10 * nh) & (np.abs(lam.imag) >= 1e-6 * nh)]
+    return float(np.abs(on[0].imag)) if on.size else None
+
+
+def game_riccati_verdict(A, B1, B2, C1, D11, D12, gamma: float, *, eps: float = 0.0) -> tuple:
+    """The full-information game Riccati equation of the module docstring (with C1^T C1 +
+    eps I) at ``gamma``: (X, status, reason) with status "feasible" (stabilising X >= 0),
+    "infeasible" (a certificate: the stabilising solution is indefinite, or the
+    Hamiltonian has an eigenvalue on the imaginary axis) or "unknown" (numerical failure)."""
     n, nw = A.shape[0], B1.shape[1]
     B = np.hstack([B1, B2])
     D = np.hstack([D11, D12])
     Rm = D.T @ D
     Rm[:nw, :nw] -= gamma ** 2 * np.eye(nw)
     Q = C1.T @ C1 + eps * np.eye(n)
-    try:
-        X = sla.solve_continuous_are(A, B, Q, Rm, s=C1.T @ D)
-    except (np.linalg.LinAlgError, ValueError):
-        return None
-    X = (X + X.T) / 2
-    if not np.all(np.isfinite(X)):
-        return None
-    # stabilising: A - B Rm^-1 (B^T X + D^T C1) Hurwitz (scipy checks it through the pencil)
+    S = C1.T @ D
+    X, reason = _stabilizing_care(A, B, Q, Rm, S)
+    if X is None:
+        w = _axis_eigenvalue(A, B, Q, Rm, S)
+        if w is not None:
+            return None, "infeasible", f"Hamiltonian eigenvalue on the imaginary axis at {w:.4g} rad/s"
+        return None, "unknown", reason
     ev = np.linalg.eigvalsh(X)
-    if ev[0] < -1e-9 * max(1.0, abs(ev[-1])):
-        return None
-    return X
+    if ev[0] < -1e-8 * max(1.0, abs(ev[-1])):
+        return None, "infeasible", f"stabilising solution indefinite (eigenvalue {ev[0]:.3g})"
+    return X, "feasible", ""
 
 
-def _solutions(P, alpha: float, gamma: float, eps: float):
+def game_riccati(A, B1, B2, C1, D11, D12, gamma: float, *, eps: float = 0.0):
+    """Stabilising solution X >= 0 of the full-information game Riccati equation (module
+    docstring) with C1^T C1 + eps I, or None (:func:`game_riccati_verdict` says why)."""
+    return game_riccati_verdict(A, B1, B2, C1, D11, D12, gamma, eps=eps)[0]
+
+
+@dataclass
+class Verdict:
+    """Outcome of the Riccati test at one gamma: ``status`` "feasible", "infeasible" (with a
+    certificate named in ``reason``) or "unknown" (numerical failure, named in ``reason``)."""
+
+    status: str
+    reason: str = ""
+    X: np.ndarray | None = None
+    Y: np.ndarray | None = None
+
+
+def riccati_test(P, alpha: float, gamma: float, *, eps: float = 0.0) -> Verdict:
+    """The three Riccati conditions of the module docstring for the plant shifted by alpha_1:
+    gamma above the feedthrough bound, stabilising X >= 0 and Y >= 0, rho(X Y) < gamma^2."""
     n = P.A.shape[0]
     Aa = P.A + alpha * np.eye(n)
-    if gamma <= gamma_lower_bound(P):
-        return None, None
-    X = game_riccati(Aa, P.B1, P.B2, P.C1, P.D11, P.D12, gamma, eps=eps)
+    lb = gamma_lower_bound(P)
+    if gamma <= lb:
+        return Verdict("infeasible", f"gamma <= max(||Pi_12 D11||, ||D11 Pi_21||) = {lb:.6g}")
+    X, st, why = game_riccati_verdict(Aa, P.B1, P.B2, P.C1, P.D11, P.D12, gamma, eps=eps)
     if X is None:
-        return None, None
-    Y = game_riccati(Aa.T, P.C1.T, P.C2.T, P.B1.T, P.D11.T, P.D21.T, gamma, eps=eps)
-    return X, Y
-
-
-def feasible(P, alpha: float, gamma: float, *, eps: float = 0.0) -> bool:
-    """Whether the eliminated LMIs of the alpha-shifted plant are feasible at ``gamma``
-    (the three Riccati conditions of the module docstring)."""
-    X, Y = _solutions(P, alpha, gamma, eps)
-    if X is None or Y is None:
-        return False
+        return Verdict(st, f"X: {why}")
+    Y, st, why = game_riccati_verdict(Aa.T, P.C1.T, P.C2.T, P.B1.T, P.D11.T, P.D21.T, gamma, eps=eps)
+    if Y is None:
+        return Verdict(st, f"Y: {why}")
     rho = float(np.max(np.abs(np.linalg.eigvals(X @ Y))))
-    return rho < gamma ** 2
+    if rho >= gamma ** 2 * (1 + 1e-8):
+        return Verdict("infeasible", f"coupling rho(X Y) = {rho:.6g} >= gamma^2 = {gamma ** 2:.6g}", X, Y)
+    if rho >= gamma ** 2:
+        return Verdict("unknown", f"coupling rho(X Y) = {rho:.8g} at gamma^2 = {gamma ** 2:.8g}", X, Y)
+    return Verdict("feasible", "", X, Y)
 
 
-def _check_regular(P):
+def check_regular(P, *, alpha: float = 0.0) -> None:
+    """Refuse a plant outside the Riccati characterisation: D12 of full column rank, D21 of
+    full row rank (relative to their largest singular value, 1e-9), and no invariant zeros
+    of (A + alpha_1 I, B2, C1, D12) or (A + alpha_1 I, B1, C2, D21) on the imaginary axis
+    (the rank conditions of Doyle, Glover, Khargonekar & Francis 1989, for the shifted
+    plant).
+
+    Raises
+    ------
+    InputError
+        naming the failed condition (such plants go to the LMI route).
+    """
+    import control
     nu, ny = P.B2.shape[1], P.C2.shape[0]
-    if np.linalg.matrix_rank(P.D12) < nu or np.linalg.matrix_rank(P.D21) < ny:
-        raise InputError(f"Riccati solution of the eliminated LMIs: expected a regular plant "
-                         f"(D12 full column rank {nu}, D21 full row rank {ny}), found ranks "
-                         f"{np.linalg.matrix_rank(P.D12)} and {np.linalg.matrix_rank(P.D21)}: "
-                         "use an SDP solver (CLARABEL)")
+    r12, r21 = numerical_rank(P.D12), numerical_rank(P.D21)
+    if r12 < nu or r21 < ny:
+        raise InputError(f"Riccati route: expected a regular plant (D12 full column rank {nu}, "
+                         f"D21 full row rank {ny}), found ranks {r12} and {r21}: use the LMI "
+                         "route (method='lmi')")
+    Aa = P.A + alpha * np.eye(P.A.shape[0])
+    for name, sys in (("(A, B2, C1, D12)", control.ss(Aa, P.B2, P.C1, P.D12)),
+                      ("(A, B1, C2, D21)", control.ss(Aa, P.B1, P.C2, P.D21))):
+        z = np.atleast_1d(control.zeros(sys)) if P.A.shape[0] else np.zeros(0)
+        z = z[np.isfinite(z)]
+        scale = max(1.0, float(np.linalg.norm(P.A, 1)))
+        on = z[np.abs(z.real) <= 1e-9 * scale]
+        if on.size:
+            raise InputError(f"Riccati route: expected no invariant zero of {name} on the "
+                             f"imaginary axis, found one at {on[0]:.4g}: use the LMI route "
+                             "(method='lmi')")
 
 
-def minimise_gamma(P, *, alpha: float, rtol: float = 1e-6, gamma_max: float = 1e8) -> tuple:
-    """Smallest gamma with feasible eliminated LMIs (bisection to ``rtol``): (gamma, steps, s).
+def numerical_rank(D: np.ndarray, rtol: float = 1e-9) -> int:
+    """Number of singular values of D above ``rtol`` times the largest (the rank test of
+    :func:`check_regular`)."""
+    if D.size == 0:
+        return 0
+    s = np.linalg.svd(D, compute_uv=False)
+    return int(np.sum(s > rtol * max(s[0], 1e-300)))
+
+
+@dataclass
+class GammaIteration:
+    """Result of :func:`minimize_gamma`: ``gamma`` is the smallest level with verified
+    evidence (``evidence``, what ``certify`` returned there); ``lower`` the largest level
+    certified infeasible; ``unknown`` the levels where the test failed numerically, with
+    the reasons (the bisection treated them as infeasible, but they certify nothing)."""
+
+    gamma: float
+    lower: float
+    evidence: object
+    steps: int
+    time_s: float
+    unknown: list = field(default_factory=list)
+
+
+def minimize_gamma(P, *, alpha: float, certify, rtol: float = 1e-6,
+                   gamma_max: float = 1e8) -> GammaIteration:
+    """Smallest gamma of the eliminated LMIs (:func:`riccati_test` of the plant shifted by
+    alpha_1) by :func:`bisect_verified` with ``certify``.
+
+    Raises
+    ------
+    InputError
+        A plant outside the Riccati characterisation (:func:`check_regular`).
+    InfeasibleController
+        No verified level up to ``gamma_max``, with the last reason.
+    """
+    check_regular(P, alpha=alpha)
+    return bisect_verified(lambda g: riccati_test(P, alpha, g), certify,
+                           lower=gamma_lower_bound(P), rtol=rtol, gamma_max=gamma_max,
+                           what=f"Riccati test, alpha_1 = {alpha:g}")
+
+
+def bisect_verified(test, certify, *, lower: float, rtol: float, gamma_max: float,
+                    what: str) -> GammaIteration:
+    """Bisection on gamma that moves only on verified evidence: the upper end moves to gamma
+    only when ``test(gamma)`` (a :class:`Verdict`) is feasible there *and*
+    ``certify(gamma)`` returns ``(True, evidence, "")`` (a controller whose closed loop was
+    checked); the certified lower end moves on an infeasibility certificate; a numerical
+    failure ("unknown", or a feasible test whose controller fails its check) moves the
+    search bracket but not the certified bound. ``lower`` is a level known infeasible (or
+    0). Stops when the bracket is below ``rtol`` relative.
 
     Raises
     ------
     InfeasibleController
-        No gamma up to ``gamma_max`` (the shifted plant is not stabilisable/detectable).
+        No verified level up to ``gamma_max``, with the last reason.
     """
-    _check_regular(P)
     t0 = time.perf_counter()
-    lo = gamma_lower_bound(P)
+    lo = lower
+    steps, unknown = 0, []
+
+    def attempt(g):
+        v = test(g)
+        if v.status != "feasible":
+            return v.status, None, v.reason
+        ok, evidence, why = certify(g)
+        return ("verified", evidence, "") if ok else ("unknown", None, f"test feasible, {why}")
+
     hi = max(2.0 * lo, 1e-3)
-    steps = 0
-    while not feasible(P, alpha, hi):
+    if lo > 0:
+        # the optimum is often the known lower bound itself (a feedthrough sets gamma): one
+        # verified step at lower (1 + rtol) settles it
         steps += 1
+        st, ev, why = attempt(lo * (1 + rtol))
+        if st == "verified":
+            dt = time.perf_counter() - t0
+            log.info("verified gamma iteration (%s): gamma = %.8g = the lower bound (1 + %g), "
+                     "%.2f s", what, lo * (1 + rtol), rtol, dt)
+            return GammaIteration(gamma=float(lo * (1 + rtol)), lower=float(lower), evidence=ev,
+                                  steps=steps, time_s=dt, unknown=[])
+    while True:
+        steps += 1
+        st, ev, why = attempt(hi)
+        if st == "verified":
+            break
+        if st == "infeasible":
+            lower = hi
+        else:
+            unknown.append((hi, why))
         lo, hi = hi, 4.0 * hi
         if hi > gamma_max:
-            raise InfeasibleController(f"eliminated H-infinity LMIs (Riccati test): expected a "
-                                       f"feasible gamma <= {gamma_max:g}, found none (the plant "
-                                       f"shifted by alpha_1 = {alpha:g} is not stabilisable "
-                                       "or not detectable)")
+            raise InfeasibleController(f"H-infinity gamma iteration ({what}): expected a verified "
+                                       f"level gamma <= {gamma_max:g}, found none (last: {why})")
+    evidence = ev
     while hi - lo > rtol * hi:
         mid = np.sqrt(lo * hi) if lo > 0 else hi / 2
         steps += 1
-        if feasible(P, alpha, mid):
-            hi = mid
+        st, ev, why = attempt(mid)
+        if st == "verified":
+            hi, evidence = mid, ev
         else:
             lo = mid
+            if st == "infeasible":
+                lower = mid
+            else:
+                unknown.append((mid, why))
     dt = time.perf_counter() - t0
-    log.info("eliminated LMIs by Riccati bisection: gamma = %.8g in %d steps, %.2f s", hi, steps, dt)
-    return float(hi), steps, dt
+    log.info("verified gamma iteration (%s): gamma = %.8g, certified lower bound %.8g, %d steps "
+             "(%d unknown), %.2f s", what, hi, lower, steps, len(unknown), dt)
+    return GammaIteration(gamma=float(hi), lower=float(lower), evidence=evidence, steps=steps,
+                          time_s=dt, unknown=unknown)
+
+
+def state_feedback_verdict(A, B1, B2, C1, D11, D12, gamma: float, *, eps: float = 0.0) -> Verdict:
+    """Riccati test of static state feedback at ``gamma``: gamma > ||D11|| (the feedthrough
+    no gain changes) and a stabilising solution X >= 0 of the game Riccati equation."""
+    d = float(np.linalg.norm(D11, 2)) if D11.size else 0.0
+    if gamma <= d:
+        return Verdict("infeasible", f"gamma <= ||D11|| = {d:.6g}")
+    X, st, why = game_riccati_verdict(A, B1, B2, C1, D11, D12, gamma, eps=eps)
+    return Verdict(st, why, X)
 
 
 def strict_point(P, *, alpha: float, gamma: float, eps_rel: float = 1e-6):
@@ -155,16 +351,15 @@ def strict_point(P, *, alpha: float, gamma: float, eps_rel: float = 1e-6):
         When the perturbed Riccati equations have no admissible solution or rho(X Y) >=
         gamma^2 (gamma too close to the optimum for this eps).
     """
-    _check_regular(P)
+    check_regular(P, alpha=alpha)
     scale = max(np.linalg.norm(P.C1, 2) ** 2, np.linalg.norm(P.B1, 2) ** 2, 1e-12)
-    X, Y = _solutions(P, alpha, gamma, eps_rel * scale)
-    if X is None or Y is None:
-        raise InfeasibleController(f"eliminated LMIs (Riccati): expected stabilising solutions "
-                                   f">= 0 at gamma = {gamma:.6g}, found none")
+    v = riccati_test(P, alpha, gamma, eps=eps_rel * scale)
+    if v.status != "feasible":
+        raise InfeasibleController(f"eliminated LMIs (Riccati) at gamma = {gamma:.6g}: expected "
+                                   f"stabilising X, Y >= 0 with rho(X Y) < gamma^2, found "
+                                   f"{v.status}: {v.reason}")
+    X, Y = v.X, v.Y
     rho = float(np.max(np.abs(np.linalg.eigvals(X @ Y))))
-    if not rho < gamma ** 2:
-        raise InfeasibleController(f"eliminated LMIs (Riccati): expected rho(X Y) < gamma^2 = "
-                                   f"{gamma ** 2:.6g}, found {rho:.6g}")
     R = gamma * np.linalg.inv(X)
     S = gamma * np.linalg.inv(Y)
     return (R + R.T) / 2, (S + S.T) / 2, rho
@@ -190,8 +385,7 @@ def state_feedback_gamma(A, B1, B2, C1, D11, D12, *, eps: float = 1e-8, rtol: fl
                          f"{D12.shape[1]}, found rank {np.linalg.matrix_rank(D12)}")
 
     def ok(g):
-        return (g > np.linalg.norm(D11, 2) and g > np.linalg.norm(_projector_off(D12) @ D11, 2)
-                and game_riccati(A, B1, B2, C1, D11, D12, g, eps=eps) is not None)
+        return state_feedback_verdict(A, B1, B2, C1, D11, D12, g, eps=eps).status == "feasible"
 
     lo = float(np.linalg.norm(D11, 2)) if D11.size else 0.0
     hi = max(2.0 * lo, 1e-3)
@@ -209,14 +403,13 @@ def state_feedback_gamma(A, B1, B2, C1, D11, D12, *, eps: float = 1e-8, rtol: fl
 def state_feedback_gain(A, B1, B2, C1, D11, D12, gamma: float, *, eps: float = 1e-8) -> np.ndarray:
     """A static gain K (u = K x) meeting the state-feedback LMI at ``gamma`` (above the
     optimum): Y = gamma X^-1 from the game Riccati equation, W from the projection formula
-    of :func:`tmfem.control.linear.hinf_lmi._projection_solution` applied to the LMI in W, K = W Y^-1.
+    of :func:`tmfem.control.linear.lmi.projection_solution` applied to the LMI in W, K = W Y^-1.
 
     Raises
     ------
     InfeasibleController
         When the Riccati equation has no admissible solution or the LMI in W fails.
     """
-    from tmfem.control.linear.hinf_lmi import _projection_solution
     n, nw, npp = A.shape[0], B1.shape[1], C1.shape[0]
     X = game_riccati(A, B1, B2, C1, D11, D12, gamma, eps=eps)
     if X is None:
@@ -228,7 +421,7 @@ def state_feedback_gain(A, B1, B2, C1, D11, D12, gamma: float, *, eps: float = 1
                     [C1 @ Y, D11, -gamma * np.eye(npp)]])
     G = np.vstack([B2, np.zeros((nw, B2.shape[1])), D12])
     L = np.hstack([np.eye(n), np.zeros((n, nw + npp))])
-    W, lam = _projection_solution(Psi, G, L)
+    W, lam = projection_solution(Psi, G, L)
     if W is None or not lam < 0:
         raise InfeasibleController(f"state-feedback LMI at gamma = {gamma:.6g}: expected a gain, found "
                                    f"largest eigenvalue {lam:.3g}")

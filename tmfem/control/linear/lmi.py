@@ -108,3 +108,44 @@ def null_basis(M: np.ndarray, *, rtol: float = 1e-10) -> np.ndarray:
     threshold ``rtol * sigma_max``."""
     import scipy.linalg as sla
     return sla.null_space(np.asarray(M, dtype=float), rcond=rtol)
+
+
+def projection_solution(Psi, G, L, *, factor: float = 2.0):
+    """One solution Theta of  Psi + G Theta L + (G Theta L)^T < 0  (G full column rank, L full
+    row rank), by the explicit formula of Skelton, Iwasaki & Grigoriadis (1998, Thm. 2.3.12)
+    with the free contraction L = 0:
+
+        Theta = -Rs^-1 G^T Phi L^T (L Phi L^T)^-1,   Phi = (G Rs^-1 G^T - Psi)^-1 > 0.
+
+    The free weight is chosen in the coordinates of a QR factorisation G = Q [G1; 0]:
+    Rs^-1 = rho G1^-1 G1^-T, so that G Rs^-1 G^T = rho Q diag(I, 0) Q^T and rho is compared
+    with Psi itself (rho = ``factor`` x the largest eigenvalue of the Schur complement of
+    Q^T Psi Q on the range of G), not with Psi seen through an ill-conditioned G (a weight
+    rho I makes rho G G^T swamp Psi in floating point when G is badly scaled). Returns
+    (Theta, max eigenvalue of the LMI); (None, inf) when Psi is not negative definite on the
+    null space of G^T (the elimination condition fails in floating point).
+    """
+    import scipy.linalg as sla
+    m = G.shape[1]
+    Q, Rg = np.linalg.qr(G, mode="complete")
+    G1 = Rg[:m]
+    Pt = Q.T @ Psi @ Q
+    Pt = (Pt + Pt.T) / 2
+    P22 = Pt[m:, m:]
+    if P22.size and np.linalg.eigvalsh(P22)[-1] >= 0:
+        return None, np.inf
+    Z = Pt[:m, :m] - (Pt[:m, m:] @ np.linalg.solve(P22, Pt[m:, :m]) if P22.size else 0.0)
+    ez = np.linalg.eigvalsh((Z + Z.T) / 2)
+    rho = factor * max(float(ez[-1]), 0.0) + 1e-6 * max(float(np.abs(ez).max()), 1e-300)
+    Mt = -Pt.copy()
+    Mt[:m, :m] += rho * np.eye(m)
+    try:
+        Lc = sla.cho_factor(Mt)
+    except np.linalg.LinAlgError:
+        return None, np.inf
+    Lq = L @ Q                                                   # L in the QR coordinates
+    PhiLt = sla.cho_solve(Lc, Lq.T)                              # Phi_q L_q^T
+    Th = -rho * sla.solve_triangular(G1, np.linalg.solve(Lq @ PhiLt, PhiLt[:m].T).T)
+    GTL = G @ Th @ L
+    lam = max_eig(Psi + GTL + GTL.T)
+    return Th, lam

@@ -1,12 +1,26 @@
 """Closed-loop linear analysis plots of an H-infinity design (7.3-7.4).
 
-One PNG with four panels: open- and closed-loop poles (with the line Re = -alpha_1),
-singular values of T_pw(j omega) with gamma, and the step and impulse responses of the
-linear closed loop from the first reference and the first noise channel.
+One PNG with four panels:
+
+* poles of the open and the closed loop, with the line Re s = -alpha_1;
+* singular values: sigma_max of the closed loop T_pw and of each group of performance
+  channels (outputs named ``<group>_<signal>``, e.g. ``ed_`` tracking errors and ``eu_``
+  control efforts), of the open-loop channel w -> p (u = 0) and of the plant u -> y, with
+  gamma and, where the feedthrough bound max(||Pi_12 D11||, ||D11 Pi_21||) sets gamma (no
+  controller can go below it), that bound drawn and named;
+* step responses of the tracked coordinates: for each reference input ``ref_<s>`` with a
+  tracking error ``ed_<s> = W (ref - s)``, the coordinate s = ref - ed / W for a unit step of
+  the reference (otherwise the performance outputs for a step of the first exogenous input);
+* the level gamma and the verified closed-loop norm of each synthesis route on the same
+  plant (or the reason a route refused it).
 """
 from __future__ import annotations
 
 import numpy as np
+
+from tmfem.control.linear.hinf_riccati import gamma_lower_bound
+from tmfem.control.linear.hinf_synthesis import hinfsyn
+from tmfem.errors import TmfemError
 
 
 def damping_table(sys) -> list:
@@ -18,55 +32,152 @@ def damping_table(sys) -> list:
     return sorted(rows)
 
 
-def plot_design(design, *, open_loop=None, path, title: str = "") -> None:
-    """Write the four-panel closed-loop analysis figure of ``design`` (HinfDesign) to ``path``."""
+def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot")) -> dict:
+    """gamma and verified norm of each route of :func:`tmfem.control.linear.hinf_synthesis.hinfsyn`
+    on ``plant`` (GeneralizedPlant): name -> (gamma, norm) or the refusal's message."""
+    out = {}
+    for r in routes:
+        try:
+            res = hinfsyn(plant, plant.C2.shape[0], plant.B2.shape[1], method=r, alpha=alpha)
+            out[r] = (res.gamma, res.info["verified_norm"])
+        except TmfemError as exc:
+            out[r] = str(exc)
+    return out
+
+
+def _sigma_max(sys, w):
+    H = np.asarray(sys(1j * w)).reshape(sys.noutputs, sys.ninputs, w.size)
+    return np.linalg.svd(np.moveaxis(H, 2, 0), compute_uv=False)
+
+
+def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -> None:
+    """Write the four-panel closed-loop analysis figure of ``design`` (HinfDesign) to ``path``.
+
+    ``open_loop``: the GeneralizedPlant (open-loop poles and singular values); ``routes``:
+    the result of :func:`route_levels` (computed here when None and ``open_loop`` is given).
+    """
     import control
     from tmfem.post.plots import new_figure, save_figure
     T = design.closed_loop
-    fig = new_figure(figsize=(12, 9))
+    P = open_loop if open_loop is not None else design.plant
+    if routes is None and open_loop is not None:
+        routes = route_levels(P, alpha=design.alpha)
+    fig = new_figure(figsize=(13, 9.5))
     ax = fig.subplots(2, 2)
     # poles
     a = ax[0, 0]
-    if open_loop is not None:
-        pol = np.linalg.eigvals(open_loop.A)
-        a.plot(pol.real, pol.imag, "x", color="0.5", label="open loop")
+    pol = np.linalg.eigvals(P.A)
+    a.plot(pol.real, pol.imag, "x", color="0.5", label="open loop")
     pcl = T.poles()
     a.plot(pcl.real, pcl.imag, ".", color="C0", label="closed loop")
-    a.axvline(-design.alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-design.alpha:g}")
+    a.axvline(-design.alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-design.alpha:g}"
+              if design.alpha else "Re s = 0")
     a.set_xlabel("Re s [1/s]")
     a.set_ylabel("Im s [rad/s]")
     a.set_xscale("symlog", linthresh=1.0)
     a.legend(loc="best", fontsize=8)
     a.set_title("poles")
-    # sigma plot of T_pw
+    # singular values
     a = ax[0, 1]
-    w = np.logspace(-2, 3, 400)
-    sv = np.linalg.svd(np.moveaxis(T(1j * w), -1, 0), compute_uv=False)
-    a.semilogx(w / (2 * np.pi), sv[:, 0], color="C0", label="sigma_max T_pw")
-    a.semilogx(w / (2 * np.pi), sv[:, -1], color="C0", ls=":", label="sigma_min T_pw")
-    a.axhline(design.gamma, color="C3", ls="--", label=f"gamma = {design.gamma:.4g}")
+    lam = np.abs(np.concatenate([pol, pcl]))
+    lam = lam[lam > 0]
+    w = np.logspace(np.log10(max(lam.min() / 30, 1e-4)), np.log10(lam.max() * 30), 500)
+    f = w / (2 * np.pi)
+    sv = _sigma_max(T, w)
+    a.loglog(f, sv[:, 0], color="C0", lw=2, label="closed loop T_pw: sigma_max")
+    outs = list(T.output_labels)
+    groups = {}
+    for i, s in enumerate(outs):
+        groups.setdefault(s.split("_")[0] if "_" in s else s, []).append(i)
+    if 1 < len(groups) <= 6:
+        for k, (g, idx) in enumerate(groups.items()):
+            a.loglog(f, _sigma_max(T[idx, :], w)[:, 0], color=f"C{k + 2}", lw=1, ls="--",
+                     label=f"T_pw, outputs {g}_*" if len(idx) > 1 else f"T_pw, output {outs[idx[0]]}")
+    P11 = control.ss(P.A, P.B1, P.C1, P.D11)
+    if np.any(P.B1) or np.any(P.D11):
+        a.loglog(f, np.maximum(_sigma_max(P11, w)[:, 0], 1e-300), color="0.5", ls="--",
+                 label="open loop w -> p (u = 0)")
+    P22 = control.ss(P.A, P.B2, P.C2, P.D22)
+    a.loglog(f, _sigma_max(P22, w)[:, 0], color="0.7", ls=":", label="plant u -> y")
+    a.axhline(design.gamma, color="C3", ls="--", label=f"gamma = {design.gamma:.5g}")
+    bound = gamma_lower_bound(P)
+    sets = bound > 0 and design.gamma <= bound * (1 + 2e-2)
+    if sets:
+        a.axhline(bound, color="k", ls="-.", lw=1,
+                  label=f"feedthrough bound ||D11|| part = {bound:.4g}")
+        a.text(0.02, 0.02, f"gamma is set by the feedthrough w -> p (||Pi D11|| = {bound:.4g}):\n"
+               "no controller can lower it; the dynamics stay below it", transform=a.transAxes,
+               fontsize=8, va="bottom", bbox=dict(fc="w", ec="k", alpha=0.85))
     a.set_xlabel("frequency [Hz]")
     a.set_ylabel("singular value [-]")
-    a.set_title(f"T_pw: ||T_pw||_inf = {design.closed_loop_norm:.4g}")
-    a.legend(loc="best", fontsize=8)
-    # step / impulse from the first reference and the first noise channel
-    tf = 5.0 / max(design.alpha, 0.2)
-    t = np.linspace(0, tf, 1500)
-    outs = list(T.output_labels)
-    wn = list(T.input_labels)
-    ied = [i for i, s in enumerate(outs) if s.startswith("ed_")][:4]
-    ieu = [i for i, s in enumerate(outs) if s.startswith("eu_")][:2]
-    jn = next((i for i, s in enumerate(wn) if s.startswith("n_")), len(wn) - 1)
-    for a, kind, j, show in ((ax[1, 0], "step", 0, ied + ieu), (ax[1, 1], "impulse", jn, ied)):
-        # impulse: e_d only (no feedthrough from the noise, so no Dirac at t = 0)
-        sub = T[show, j]
-        r = (control.step_response if kind == "step" else control.impulse_response)(sub, T=t)
-        y = np.atleast_2d(np.squeeze(r.outputs))
-        for k, i in enumerate(show):
-            a.plot(r.time, y[k], label=outs[i])
-        a.set_xlabel("t [s]")
-        a.set_ylabel("weighted output [-]" + (" per unit step" if kind == "step" else " per unit impulse [1/s]"))
-        a.set_title(f"{kind} response from {wn[j]}")
-        a.legend(loc="best", fontsize=7)
+    a.set_title(f"singular values: ||T_pw||_inf = {design.closed_loop_norm:.5g}")
+    a.legend(loc="upper right", fontsize=7)
+    # step responses of the tracked coordinates
+    a = ax[1, 0]
+    _steps(a, T, design)
+    if sets:
+        a.text(0.02, 0.5, "gamma is the feedthrough bound: the H-infinity objective does not ask\n"
+               "this loop to track (its tracking is whatever the chosen controller does)",
+               transform=a.transAxes, fontsize=8, bbox=dict(fc="w", ec="k", alpha=0.85))
+    # gamma of each route
+    a = ax[1, 1]
+    _routes(a, routes or {}, design, bound, sets)
     fig.suptitle(title)
     save_figure(fig, path)
+
+
+def _steps(a, T, design) -> None:
+    import control
+    tf = 8.0 / max(design.alpha, max(-np.max(T.poles().real), 0.1))
+    t = np.linspace(0, tf, 1500)
+    ins, outs = list(T.input_labels), list(T.output_labels)
+    D = np.asarray(T.D)
+    pairs = []
+    for j, s in enumerate(ins):
+        if s.startswith("ref_") and f"ed_{s[4:]}" in outs:
+            i = outs.index(f"ed_{s[4:]}")
+            if D[i, j] != 0:
+                pairs.append((j, i, s[4:]))
+    if pairs:
+        for j, i, name in pairs[:4]:
+            r = control.step_response(T[i, j], T=t)
+            a.plot(r.time, 1.0 - np.squeeze(r.outputs) / D[i, j], label=f"{name} (ref_{name} = 1)")
+        a.axhline(1.0, color="0.5", ls=":")
+        a.set_ylabel("tracked coordinate per unit reference step [-]")
+        a.set_title("step responses of the tracked coordinates (linear closed loop)")
+    else:
+        r = control.step_response(T[: min(4, T.noutputs), 0], T=t)
+        y = np.atleast_2d(np.squeeze(r.outputs))
+        for k in range(y.shape[0]):
+            a.plot(r.time, y[k], label=outs[k])
+        a.set_ylabel("performance output per unit step [-]")
+        a.set_title(f"step responses from {ins[0]}")
+    a.set_xlabel("t [s]")
+    a.legend(loc="best", fontsize=7)
+
+
+def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
+    names = list(routes)
+    ok = [(k, v) for k, v in routes.items() if not isinstance(v, str)]
+    x = np.arange(len(names))
+    for k, name in enumerate(names):
+        v = routes[name]
+        if isinstance(v, str):
+            a.text(k, 0.0, "refused:\n" + "\n".join(v[i:i + 28] for i in range(0, min(len(v), 112), 28)),
+                   ha="center", va="bottom", fontsize=6, rotation=0)
+            continue
+        a.bar(k - 0.18, v[0], width=0.36, color="C0", label="gamma" if k == 0 else None)
+        a.bar(k + 0.18, v[1], width=0.36, color="C1", label="verified ||T_pw||_inf" if k == 0 else None)
+        a.text(k, v[0], f"{v[0]:.5g}", ha="center", va="bottom", fontsize=7)
+    a.axhline(design.gamma, color="C3", ls="--", lw=1, label=f"this design: {design.gamma:.5g}")
+    if bound > 0:
+        a.axhline(bound, color="k", ls="-.", lw=1, label=f"feedthrough bound {bound:.4g}"
+                  + (" (sets gamma)" if sets else ""))
+    if ok:
+        top = max(max(v) for _, v in ok)
+        lo = min(min(v) for _, v in ok)
+        a.set_ylim(max(0.0, lo - 0.6 * (top - lo) - 0.02 * top), top + 0.3 * (top - lo) + 0.02 * top)
+    a.set_xticks(x, names)
+    a.set_ylabel("level [-]")
+    a.set_title("gamma of each synthesis route (same plant, same alpha_1)")
+    a.legend(loc="best", fontsize=7)

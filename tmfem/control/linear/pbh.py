@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.errors import InfeasibleController, InputError
 
 DEFAULT_TOL = 1e-8
 
@@ -117,3 +117,34 @@ def pbh(A, B, C, *, tol: float = DEFAULT_TOL, cluster_rtol: float = 1e-8,
 def pbh_ss(sys, *, tol: float = DEFAULT_TOL) -> PBHResult:
     """:func:`pbh` of a python-control ``StateSpace``."""
     return pbh(sys.A, sys.B, sys.C, tol=tol, state_names=list(sys.state_labels))
+
+
+def require_stabilizable_detectable(A, B2, C2, *, alpha: float = 0.0, tol: float = DEFAULT_TOL,
+                                    state_names=None) -> None:
+    """Refuse a plant that no output feedback u = K(s) y can stabilise with all poles left of
+    -alpha_1: a mode with Re(lambda) >= -alpha_1 that is uncontrollable from u (PBH margin of
+    (A, B2) <= ``tol``) or unobservable from y (margin of (A, C2) <= ``tol``).
+
+    Raises
+    ------
+    InfeasibleController
+        naming the mode (eigenvalue, the state with the largest eigenvector component) and
+        its margin.
+    """
+    import scipy.linalg as sla
+    res = pbh(A, B2, C2, tol=tol)
+    _, VR = sla.eig(np.asarray(A, dtype=float))
+    names = list(state_names) if state_names is not None else [f"x{i + 1}" for i in range(len(VR))]
+    bad = res.eigenvalues.real >= -alpha
+    for what, margin, pair in (("stabilisable", res.controllability_margin, "(A, B2)"),
+                               ("detectable", res.observability_margin, "(A, C2)")):
+        hit = np.flatnonzero(bad & (margin <= tol))
+        if hit.size:
+            i = int(hit[0])
+            lam = res.eigenvalues[i]
+            state = names[int(np.argmax(np.abs(VR[:, i])))]
+            raise InfeasibleController(
+                f"plant: expected {pair} {what}{f' with alpha_1 = {alpha:g}' if alpha else ''}, "
+                f"found the mode at lambda = {lam.real:.6g}{lam.imag:+.6g}j (mostly state "
+                f"{state!r}) {'uncontrollable from u' if what == 'stabilisable' else 'unobservable from y'} "
+                f"(PBH margin {margin[i]:.2g} <= {tol:g})")

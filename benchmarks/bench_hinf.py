@@ -1,0 +1,62 @@
+"""H-infinity synthesis routes on the regression family and the 2-3 design: gamma, verified
+norm and time per plant and route.
+
+    PYTHONPATH=. OPENBLAS_NUM_THREADS=1 python benchmarks/bench_hinf.py [--skip-slicot] [--no-2-3]
+
+The family is tests/control/linear/family.py (random plants of several kinds and sizes,
+closed-form and published examples). "verified" is python-control's norm(CL, "inf") of the
+returned closed loop; "lower" the certified lower bound of the Riccati route. The last line
+is the H-infinity design of the 50-state 2-3 plant by the default route (``tmfem control
+hinf --preset 2-3-deploy``), whose target is under 30 s.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import control
+
+from tests.control.linear.family import family
+from tmfem.control import hinfsyn
+from tmfem.errors import TmfemError
+
+ROUTES = ("auto", "riccati", "lmi", "slicot")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--skip-slicot", action="store_true", help="leave out python-control's hinfsyn")
+    ap.add_argument("--no-2-3", action="store_true", help="leave out the 2-3 design")
+    args = ap.parse_args()
+    routes = [r for r in ROUTES if not (args.skip_slicot and r == "slicot")]
+    print(f"{'plant':26s} {'n':>3s} {'route':8s} {'gamma':>12s} {'verified':>12s} {'lower':>12s} "
+          f"{'time s':>7s}  chosen / refusal")
+    for name, (P, ny, nu, ref) in family().items():
+        for r in routes:
+            t0 = time.perf_counter()
+            try:
+                res = hinfsyn(P, ny, nu, method=r)
+            except TmfemError as exc:
+                print(f"{name:26s} {P.nstates:3d} {r:8s} {'-':>12s} {'-':>12s} {'-':>12s} "
+                      f"{time.perf_counter() - t0:7.2f}  refused: {str(exc)[:90]}")
+                continue
+            dt = time.perf_counter() - t0
+            low = res.info["gamma_lower"]
+            print(f"{name:26s} {P.nstates:3d} {r:8s} {res.gamma:12.6g} "
+                  f"{float(control.norm(res.CL, p='inf')):12.6g} "
+                  f"{'-' if low is None else format(low, '12.6g'):>12s} {dt:7.2f}  "
+                  f"{res.info['method']}" + (f" (published/closed form {ref:g})" if ref else ""))
+    if not args.no_2_3:
+        from tmfem.control.linear.deployed_design import deployed_hinf
+        from tmfem.system import load_preset
+        t0 = time.perf_counter()
+        d = deployed_hinf(load_preset("2-3-deploy"))
+        dt = time.perf_counter() - t0
+        g = d.design
+        print(f"\n2-3-deploy (n = {d.plant.ss.nstates}, alpha_1 = {g.alpha:g}): gamma {g.gamma:.6g}, "
+              f"verified {g.closed_loop_norm:.6g}, lower {g.gamma_lower}, route "
+              f"{g.info['route']['method']}, design {dt:.1f} s (plant build included)")
+
+
+if __name__ == "__main__":
+    main()
