@@ -1,6 +1,8 @@
-"""``tmfem deploy``: closed-loop deployment of a 1-N(D) or 2-3 system (dissertation 7.4).
+"""``tmfem deploy``: closed-loop deployment of a system from its packaged to its deployed
+configuration (dissertation 7.4, 8.4).
 
-The 7.4 parameters of each deployment are :data:`tmfem.reference.deployments.DEPLOYMENTS`.
+The parameters of a deployment are the system file's (``[packaged]``, ``[deployment]``,
+``[control]``, ``[lpv]``: :mod:`tmfem.reference.deployments`, docs/guides/system-file.md).
 Every option and output path is checked before the controller design (docs/cli.md).
 """
 from __future__ import annotations
@@ -12,14 +14,17 @@ from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_time_steps, output_dir, output_file, positive_float,
                               progress_bar)
 from tmfem.errors import InputError
-from tmfem.reference.deployments import (CONTROLLERS, DEPLOYMENTS, LPV_CONTROLLERS, LPV_DEPLOYMENTS,
-                                         UNCERTAINTIES, check_choices, setup, write_outputs)
+from tmfem.reference.deployments import (CONTROLLERS, LPV_CONTROLLERS, UNCERTAINTIES, check_choices,
+                                         own_path, setup, write_outputs)
 
 NAME = "deploy"
 HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
 
 def configure(parser) -> None:
-    parser.add_argument("--preset", required=True, choices=sorted(DEPLOYMENTS) + sorted(LPV_DEPLOYMENTS))
+    parser.add_argument("spec", nargs="?", help="system file (TOML) with [packaged] and "
+                                                "[deployment] tables; or use --preset")
+    parser.add_argument("--preset", help="built-in system with a deployment (1-4D, 1-6D, "
+                                         "2-3-deploy; 2-3-lpv: the LPV deployment of 8.4)")
     parser.add_argument("--controller", default=None, choices=sorted(CONTROLLERS) + list(LPV_CONTROLLERS),
                         help="7.4 presets: adaptive PFL then a linear controller about the final equilibrium: "
                              "adaptive-hinf (default; the H-infinity controller of 7.3: the central one at "
@@ -108,6 +113,20 @@ def configure(parser) -> None:
     deploy_lpv.configure(parser)
 
 
+def deployed_system(args):
+    """``args.system``: the System of ``spec`` or ``--preset`` (exactly one); ``args.preset``
+    becomes its label in titles and the JSON (the preset name, or the file's system name)."""
+    from tmfem.cli.common import system_from_args
+    args.as_printed = False
+    args.system = system_from_args(args)
+    if args.preset is None:
+        args.preset = args.system.name
+    pr = args.system.problem
+    if pr.lpv is None and (pr.packaged is None or pr.deployment is None):
+        check_choices(args.system)                   # names the missing tables
+    return args.system
+
+
 def pfl_gains(text: str) -> tuple:
     """argparse ``type`` of ``--gains``: four comma-separated numbers omega_0, omega_e, tau,
     d_c (checked by :class:`tmfem.control.deployment.adaptive.Gains`)."""
@@ -137,20 +156,25 @@ def run(args) -> dict:
     output_dir(args.vtk, option="--vtk")
     output_file(args.compare_plot, option="--compare-plot", suffixes=(".png",))
     output_file(args.compare_csv, option="--compare-csv", suffixes=(".csv",))
-    lpv = args.preset in LPV_DEPLOYMENTS
+    deployed_system(args)
+    lpv = args.system.problem.lpv is not None and args.system.problem.deployment is None
     args.controller = args.controller or ("lpv" if lpv else "adaptive-hinf")
     if lpv != (args.controller in LPV_CONTROLLERS):
         raise InputError(f"--controller {args.controller}: expected one of "
                          f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
+        if args.spec is not None:
+            raise InputError(f"tmfem deploy {args.spec}: the LPV deployment (8.4) runs on the preset "
+                             "2-3-lpv only (--preset 2-3-lpv); a system file deploys with its "
+                             "[packaged] and [deployment] tables (7.4)")
         return deploy_lpv.run(args)
     lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise", "estimator_interpolation",
                                        "estimator_refine") + deploy_lpv.SYNTHESIS)
     if lpv_opts:
         raise InputError(f"options {lpv_opts} apply to --controller lpv only, found --controller {args.controller}")
     args.allocation = args.allocation or "bounded"
-    check_choices(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+    check_choices(args.system, controller=args.controller, uncertainty=args.uncertainty,
                   path=args.path)
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
@@ -159,9 +183,9 @@ def run(args) -> dict:
     # except under eq. 5.72, whose F_q is frozen with the fixed rates of eq. 5.19
     fe = args.plant != "com" or args.compare_plant not in (None, "com")
     pfl_at = args.pfl_at or ("reference" if fe else "state")
-    frozen = (args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"]) == "initial"
+    frozen = (args.uncertainty or args.system.problem.deployment.uncertainty) == "initial"
     tendons = fe_tendon_model(args) if fe and not frozen else "fixed-rate"
-    s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+    s = setup(args.system, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path, evaluation=pfl_at,
               tendon_law=tendons, gains=args.gains)
     warnings = tendon_model_warnings(args, tendons)
@@ -171,7 +195,7 @@ def run(args) -> dict:
             "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons,
             "pfl_gains": list(astuple(s.adaptive.gains))}
     out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
-           **ctrl, "path": args.path or DEPLOYMENTS[args.preset]["path"],
+           **ctrl, "path": args.path or own_path(args.system),
            **r.summary(), **s.info}
     title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
              f"uncertainty {s.adaptive.uncertainty}")
@@ -180,7 +204,7 @@ def run(args) -> dict:
     out["warnings"] = warnings
     if args.compare_plant:
         def rerun(kind):
-            s2 = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+            s2 = setup(args.system, controller=args.controller, uncertainty=args.uncertainty,
                        allocation=args.allocation, path=args.path, evaluation=pfl_at,
                        tendon_law=tendons, gains=args.gains)
             return _run_on(args, s2, kind, mesh_n), {}
@@ -286,8 +310,7 @@ def _run_on(args, s, plant_kind: str, mesh_n):
     its record up to the failure (``failure``)."""
     from tmfem.control.deployment.run import run_deployment
     from tmfem.control.fe_plant.state_estimate import deployment_plant
-    from tmfem.system.presets import load_preset
-    plant = deployment_plant(plant_kind, s.model, load_preset(args.preset + "-initial"),
+    plant = deployment_plant(plant_kind, s.model, args.system.problem.packaged,
                              mesh_n=mesh_n or 10, **plant_arguments(args, plant_kind))
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
         return run_deployment(model=s.model, reference=s.reference, controller=s.controller,
@@ -336,7 +359,6 @@ def check_plant(args) -> int | None:
     from ``--plant`` and ``--compare-plot``/``--compare-csv`` need it; the mesh within the
     machine's budget. Returns the plant mesh (None without an FE plant)."""
     from tmfem.cli.common import check_mesh_budget
-    from tmfem.system.presets import load_preset
     plants = [args.plant] + ([args.compare_plant] if args.compare_plant else [])
     for opt in ("--compare-plot", "--compare-csv"):
         if getattr(args, opt[2:].replace("-", "_")) and not args.compare_plant:
@@ -376,7 +398,7 @@ def check_plant(args) -> int | None:
         raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "
                          f"law only (EA fixed, k = EA / r); expected no --plant-tendons with "
                          f"--plant sbc, found --plant-tendons {args.plant_tendons}")
-    system = load_preset(args.preset)
+    system = args.system
     if system.deployable and "mtc" in fe:
         raise InputError(f"--plant mtc: {args.preset} is a 1-N(D) system (tendons attached at "
                          "H_1j along the bars), which the MTC model cannot represent; expected a "

@@ -55,9 +55,8 @@ def check(args) -> int | None:
     """Refusals before any work: options of the 7.4 deployments, the FE plant's options (those
     of the 7.4 deployments, :func:`tmfem.cli.deploy.check_plant`), the paths. Returns the FE
     plant's mesh (None on the COM plant)."""
-    from tmfem.reference.deployments import LPV_DEPLOYMENTS
     bad = given(args, NOT_LPV)
-    own = LPV_DEPLOYMENTS[args.preset]["path"]
+    own = args.system.problem.lpv.path
     if args.path not in (None, own):
         bad.append(f"--path {args.path}")
     if bad:
@@ -188,13 +187,13 @@ def run(args) -> dict:
     design's; with ``--compare-plant`` the same design (a fresh controller) on the second
     plant (:func:`tmfem.cli.deploy.compare_plants`)."""
     from tmfem.cli.deploy import compare_plants, diverged, plant_options
-    from tmfem.reference.deployments import LPV_DEPLOYMENTS, lpv_setup, write_outputs
+    from tmfem.reference.deployments import lpv_setup, write_outputs
     mesh_n = check(args)
     if args.noise is not None and not (np.isfinite(args.noise) and args.noise >= 0):
         raise InputError(f"--noise: expected a standard deviation >= 0, found {args.noise}")
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
-    dep = lpv_setup(args.preset, plant)
+    dep = lpv_setup(args.system, plant)
     est = {}          # the output feedback's estimator options (check: lpv-output only)
     if args.estimator_interpolation:
         est["interpolation"] = args.estimator_interpolation
@@ -211,7 +210,7 @@ def run(args) -> dict:
             if args.controller == "lpv-output" else None,
             "estimator_refine": (args.estimator_refine or 1) if args.controller == "lpv-output" else None}
     out = {"preset": args.preset, "plant": args.plant, **plant_options(args, args.plant, mesh_n),
-           **ctrl, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(), **s.info,
+           **ctrl, "path": args.system.problem.lpv.path, **r.summary(), **s.info,
            **_figures(r), **info}
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
                              vtk=args.vtk, title=f"{args.preset} deployment on the {args.plant} plant: {args.controller} "

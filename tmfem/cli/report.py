@@ -19,8 +19,8 @@ from tmfem.errors import InputError
 
 NAME = "report"
 HELP = ("complete analysis of a system (design, FE statics, 12 modes of the MTC, SBC and COM "
-        "models beside the dissertation, free vibration, deployment) as a report directory "
-        "with index.md")
+        "models beside the printed ones when the file has them, free vibration, deployment) as a "
+        "report directory with index.md")
 
 
 def configure(parser) -> None:
@@ -38,21 +38,23 @@ def configure(parser) -> None:
     parser.add_argument("--no-render", action="store_true",
                         help="skip the pyvista renders (default: render)")
     parser.add_argument("--no-deploy", action="store_true",
-                        help="skip the deployment of 7.4 (default: run it when the system has "
-                             "one, 1-4 -> 1-4D)")
+                        help="skip the deployment of 7.4 (default: run it when the system file "
+                             "declares one: [report] deployment, or [packaged] with [deployment]; "
+                             "the preset 1-4 runs 1-4D)")
 
 
 def run(args) -> dict:
-    from tmfem.reference.report import REPORT_DEPLOYMENT, STEPS, write_report
+    from tmfem.reference.report import STEPS, report_deployment, write_report
 
     system = system_from_args(args)
     check_model_budget(system, mesh=args.mesh, tendon_elements=3, modes=args.modes)
     check_com_modes(system, modes=args.modes)
     check_time_steps(t_end=args.t_end, dt=args.dt)
-    deployment = REPORT_DEPLOYMENT.get(system.name)
+    deployment = report_deployment(system)
     if deployment is None and args.no_deploy:
         raise InputError(f"--no-deploy: option does not apply: system {system.name!r} has no "
-                         f"deployment in the report (those that have: {sorted(REPORT_DEPLOYMENT)})")
+                         "deployment in the report (its file has no [report] deployment and no "
+                         "[packaged] with [deployment])")
     if deployment is not None and not args.no_deploy:
         check_time_steps(t_end=deployment["t_end"], dt=args.dt)
     out = output_dir(args.out, option="--out")
@@ -91,13 +93,13 @@ def format_text(r: dict) -> str:
              f"index: {r['out']}/index.md ({len(r['files'])} files)"]
     d = r.get("deployment")
     if d:
-        lines.insert(-1, f"deployment {d['preset']} ({d['controller']}, uncertainty "
+        lines.insert(-1, f"deployment {d['system']} ({d['controller']}, uncertainty "
                          f"{d['uncertainty']}): switch at {d['switch_time_s']} s, max w "
                          f"{1e3 * d['max_membrane_deflection_m']:.2f} mm, final tracking error "
                          f"{d['final_tracking_error']:.2g}")
         lines.insert(-1, "")
     if r.get("notes"):
-        lines += ["", "why ours and the printed values differ (docs/errata.md):"]
+        lines += ["", "notes of the system file:"]
         lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
                   for n in r["notes"]]
     return "\n".join(lines)

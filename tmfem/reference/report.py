@@ -4,13 +4,15 @@
 
 1. the equilibrium design of ch. 3 beside the printed Tables 6.2-6.3 (:mod:`tmfem.reference.study`);
 2. the static equilibrium of the membrane-truss-cable (MTC) FE model (4.4, 6.2) for the
-   designed rest lengths *and* for the prestress the dissertation's own results imply
-   (:data:`IMPLIED_PRESTRESS`, docs/errata.md);
+   designed rest lengths and, when the file gives one (``[report] implied_rest_lengths``: the
+   prestress the dissertation's own results imply for the preset 1-4, docs/errata.md), for a
+   second set of rest lengths;
 3. the 12 lowest modes of the MTC model, the shell-beam-cable (SBC) model and the
-   control-oriented model (COM, ch. 5) at both prestress levels, beside Table 6.6 (eq. 5.32);
+   control-oriented model (COM, ch. 5) at both prestress levels, beside the printed ones when
+   the file carries them (``[printed.frequencies_hz]``, Table 6.6 for 1-4; eq. 5.32);
 4. free vibration of both models after the perturbation of 6.5 (Park's method, eq. 5.34-5.35);
-5. the closed-loop deployment of its deployable variant (7.4, :data:`REPORT_DEPLOYMENT`:
-   1-4 -> 1-4(D)), with its plot, animation and ParaView series;
+5. the closed-loop deployment of :func:`report_deployment` (7.4; the preset 1-4 runs 1-4(D)),
+   with its plot, animation and ParaView series;
 
 and writes every table (CSV with units in the headers, Markdown), plot (PNG), ParaView file
 (VTU/PVD) and an ``index.md`` that links them and explains where and why the numbers differ
@@ -28,49 +30,33 @@ from tabulate import tabulate
 
 log = logging.getLogger(__name__)
 
-#: Rest lengths [m] that the dissertation's printed results imply where its printed rest
-#: length contradicts them (docs/errata.md, "1-4 prestress"): Table 6.3's tendon stress and
-#: bar load and the 12 frequencies of Table 6.6 all give r_1^S = 1.5025 m, not 1.529 m.
-IMPLIED_PRESTRESS = {"1-4": {"rest_lengths": {"S1": 1.5025},
-                             "source": "docs/errata.md, 1-4 prestress (Tables 6.3, 6.6)"}}
-
-#: Perturbation of the free-vibration runs of 6.5 (initial rate [rad/s] of one coordinate).
-VIBRATION_PERTURBATION = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}
-
-#: What the study and the report say beside their tables (reasons in docs/errata.md):
-#: ``design`` beside the equilibrium table, ``models`` beside the MTC/COM results.
-EXPLANATIONS = {
-    "1-4": {"design": [
-        "The tendon stress, bar load and membrane stresses of the design are 22-34 % below "
-        "Tables 6.3: the design of ch. 3 on the 4 x 10 x 10 mesh gives r_1^S = 1.5089 m and "
-        "less prestress than the dissertation's results imply. The printed r_1^S = 1.529 m "
-        "contradicts the dissertation's other tables: Table 6.3's tendon stress (37.98 MPa) "
-        "and bar load (14.53 N) and all 12 frequencies of Table 6.6 agree on r_1^S = "
-        "1.5025 m (docs/errata.md, '1-4 prestress'); `tmfem report` runs the models at it.",
-        "Membrane peak stresses sit in the elements at the point-attached corners: they "
-        "grow like 1/h under mesh refinement and are a property of the mesh, not of the "
-        "membrane (docs/errata.md, 'F_Delta and the membrane peak stresses are properties "
-        "of the mesh'); the renders show element values.",
-    ], "models": [
-        "At the implied prestress the MTC frequencies match Table 6.6 to < 0.1 %; the COM "
-        "matches the printed COM column at 1.29 x the designed prestress (docs/errata.md, "
-        "'COM frequencies').",
-        "The MTC tendon stress at the implied prestress is ~2.6 % above the printed 37.98 "
-        "MPa: the total-Lagrangian truss uses Green strain, eq. 3.8 the linear strain.",
-    ]},
-}
+def explanations(system, part: str) -> list[str]:
+    """The notes the system's file gives beside its results (``[report] notes_design`` or
+    ``notes_models``; ``part``: design or models); none unless the file carries them."""
+    r = system.problem.report
+    return list(r.notes_design if part == "design" else r.notes_models)
 
 
-def explanations(name: str, part: str) -> list[str]:
-    """The notes of :data:`EXPLANATIONS` for system ``name`` (``part``: design or models)."""
-    return list(EXPLANATIONS.get(name, {}).get(part, []))
+def report_deployment(system) -> dict | None:
+    """The deployment the report of ``system`` runs: the file's ``[report] deployment``
+    (``system``: a preset name or a system file; 1-4 -> 1-4D for the preset), else the
+    system's own when it declares one (``[packaged]`` and ``[deployment]``: the H-infinity
+    switch with the exact model, 20 s), else None. ``spec["system"]`` is the System deployed."""
+    d = system.problem.report.deployment
+    if d is not None:
+        target = d["system"]
+        if Path(target).suffix == ".toml":
+            from tmfem.system.spec import load_system
+            deployed = load_system(target)
+        else:
+            from tmfem.system.presets import load_preset
+            deployed = load_preset(target)
+        return {**d, "system": deployed, "source": target}
+    if system.problem.packaged is not None and system.problem.deployment is not None:
+        return {"system": system, "uncertainty": "exact", "t_end": 20.0,
+                "controller": "adaptive-hinf"}
+    return None
 
-#: The deployment (7.4) that the report of a system runs: the deployable variant, the
-#: controller's model error and the duration. 1-4(D) with the exact model switches to the
-#: H-infinity controller within 10 s; with the 7.4 choice (eq. 5.72) it does not switch within
-#: 20 s (docs/deployment.md, "Results"), so the report shows the switch with the exact model.
-REPORT_DEPLOYMENT = {"1-4": {"preset": "1-4D", "uncertainty": "exact", "t_end": 16.0,
-                             "controller": "adaptive-hinf"}}
 
 #: Steps of :func:`write_report`, for a progress bar.
 STEPS = ("equilibrium design", "MTC statics (designed)", "MTC statics (implied)",
@@ -100,7 +86,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     Parameters
     ----------
     system : System
-        A preset with printed values (``1-4`` reproduces 6.2-6.5 in full).
+        Any system; its file's printed values and ``[report]`` table are shown where given
+        (the preset ``1-4`` reproduces 6.2-6.5 in full).
     out : Path
         Output directory (must exist and be writable; the CLI checks it first).
     mesh_n : int
@@ -112,7 +99,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     render : bool
         Draw the pyvista renders.
     deploy : bool
-        Run the deployment of :data:`REPORT_DEPLOYMENT` (when the system has one).
+        Run the deployment of :func:`report_deployment` (when the system has one).
     progress : callable, optional
         ``progress(step_name)`` after each entry of :data:`STEPS`.
     run_progress : callable, optional
@@ -135,23 +122,25 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     from tmfem.reference.com_modal import modal_summary
     from tmfem.reference.study import plot_configuration, plot_membrane_stress as plot_design_stress
     from tmfem.reference.study import write_tables
-    from tmfem.reference.tables import FREQUENCIES
+    from tmfem.reference.tables import printed_frequencies
     from tmfem.simulation.vibration import free_vibration, mtc_free_vibration
 
     out = Path(out)
     name = system.name
     step = progress or (lambda s: None)
     files: dict[str, str] = {}
-    notes = explanations(name, "design") + explanations(name, "models")
-    implied = IMPLIED_PRESTRESS.get(name)
-    perturb = VIBRATION_PERTURBATION.get(name, {"theta_11_dot": 0.01})
+    notes = explanations(system, "design") + explanations(system, "models")
+    rep = system.problem.report
+    implied = (None if rep.implied_rest_lengths is None else
+               {"rest_lengths": dict(rep.implied_rest_lengths), "source": rep.implied_source})
+    perturb = dict(rep.perturbation)
 
     def add(key, path):
         files[key] = str(Path(path).relative_to(out))
 
     # 1. design (ch. 3) ------------------------------------------------------------------
     d = design_equilibrium(system, mesh_n=mesh_n)
-    tables = write_tables(out, d, system, notes=explanations(name, "design"))
+    tables = write_tables(out, d, system, notes=explanations(system, "design"))
     for f in ("equilibrium.md", "equilibrium.csv", "tendons.csv"):
         add(f, out / f)
     add("configuration.png", plot_configuration(out / "configuration.png", d, system))
@@ -231,7 +220,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale)
         freqs[f"COM x{scale:.4f}"] = np.array(com_implied["freq_hz"])
     step(STEPS[5])
-    printed = FREQUENCIES.get(name)
+    printed = printed_frequencies(system)
     add("frequencies.csv", _frequency_table(out / "frequencies.csv", freqs, printed, modes))
     add("frequencies.png", _frequency_plot(out / "frequencies.png", freqs, printed, modes, name))
 
@@ -258,8 +247,9 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         title=f"{name} MTC free vibration, mesh {mesh_n}, " + _perturbation_text(perturb)))
     step(STEPS[7])
     deployment = None
-    if deploy and name in REPORT_DEPLOYMENT:
-        deployment = _deployment(out, REPORT_DEPLOYMENT[name], dt=dt, add=add,
+    spec = report_deployment(system) if deploy else None
+    if spec is not None:
+        deployment = _deployment(out, spec, dt=dt, add=add,
                                  progress=_run_progress(run_progress, "deployment"))
     step(STEPS[8])
 
@@ -289,13 +279,14 @@ def _run_progress(factory, label):
 
 
 def _deployment(out: Path, spec: dict, *, dt: float, add, progress) -> dict:
-    """Run the deployment ``spec`` (:data:`REPORT_DEPLOYMENT`) and write its CSV, plot, GIF and
+    """Run the deployment ``spec`` (:func:`report_deployment`) and write its CSV, plot, GIF and
     ParaView series into ``out`` (:func:`tmfem.reference.deployments.write_outputs`)."""
     from tmfem.control.deployment.run import run_deployment
     from tmfem.reference.deployments import setup, write_outputs
 
-    p = spec["preset"]
-    s = setup(p, controller=spec["controller"], uncertainty=spec["uncertainty"])
+    deployed = spec["system"]
+    p = file_stem(deployed.name)
+    s = setup(deployed, controller=spec["controller"], uncertainty=spec["uncertainty"])
     r = run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
                        t_end=spec["t_end"], dt=dt, progress=progress)
     files = write_outputs(s, r, preset=p, csv_path=out / f"deploy-{p}.csv",
@@ -309,7 +300,14 @@ def _deployment(out: Path, spec: dict, *, dt: float, add, progress) -> dict:
     scalars = {k: float(v) for k, v in s.info.items() if np.isscalar(v)}
     ys = [s.model.system.tendon_section(t).yield_stress for t in s.model.system.tendons]
     yield_mpa = min(ys) / 1e6 if all(ys) else None
-    return {**spec, "dt_s": dt, **r.summary(), **scalars, "tendon_yield_MPa": yield_mpa}
+    return {**spec, "system": deployed.name, "file_stem": p, "dt_s": dt, **r.summary(), **scalars,
+            "tendon_yield_MPa": yield_mpa}
+
+
+def file_stem(name: str) -> str:
+    """``name`` as a file-name stem (letters, digits, ``-``, ``_`` and ``.``; others become ``_``)."""
+    import re
+    return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("_") or "system"
 
 
 def _perturbation_text(perturb: dict) -> str:
@@ -438,37 +436,37 @@ def _largest_differences(freqs: dict, printed) -> str:
 
 
 def _deployment_section(d, link, img) -> list[str]:
-    """Section 5 of the index: the deployment run of :data:`REPORT_DEPLOYMENT`."""
+    """Section 5 of the index: the deployment run of :func:`report_deployment`."""
     if not d:
         return []
-    p = d["preset"]
+    p = d["file_stem"]
     rows = [("switching time to the linear controller", "s", d["switch_time_s"]),
             ("largest membrane deflection w", "mm", 1e3 * d["max_membrane_deflection_m"]),
             ("peak bar compression", "N", d["peak_bar_compression_N"]),
             ("bar Euler load (eq. 5.31)", "N", d["bar_critical_load_N"]),
             ("largest membrane von Mises stress", "MPa", 1e-6 * d["max_von_mises_Pa"]),
             ("largest tendon stress", "MPa", 1e-6 * d["max_tendon_stress_Pa"]),
-            ("tendon yield stress (7.4.1)", "MPa", d.get("tendon_yield_MPa")),
+            ("tendon yield stress", "MPa", d.get("tendon_yield_MPa")),
             ("rest lengths at a limit", "s", d["limits_active_s"]),
             ("relative tracking error at the end", "-", d["final_tracking_error"]),
             ("wall time", "s", d["wall_time_s"])]
+    how = (f"--preset {d['source']}" if d.get("source") and not d["source"].endswith(".toml")
+           else "SYSTEM.toml")
     return ["## 5. Deployment (7.4)", "",
-            f"`{p}` from its packaged configuration (Table 7.3) to the deployed one: adaptive "
-            "partial feedback linearisation (Table 7.1 gains, eq. 5.68 reference), then the "
+            f"`{d['system']}` from its packaged configuration to the deployed one: adaptive "
+            "partial feedback linearisation (the gains of the file's [deployment] table, eq. 5.69; "
+            "eq. 5.68 reference), then the "
             f"switch to the linear controller of `--controller {d['controller']}` (adaptive-hinf: "
             "the H-infinity controller of 7.3: the central one at 1.01 gamma_opt), "
-            f"{d['t_end']:g} s at dt = {d['dt_s']:g} s. The controller's model has no error "
-            f"(`--uncertainty {d['uncertainty']}`): with the 7.4 model error (eq. 5.72) it does "
-            "not switch within 20 s (docs/deployment.md, 'Results'). Same run: `tmfem deploy "
-            f"--preset {p} --uncertainty {d['uncertainty']} --t-end {d['t_end']:g}`.", "",
+            f"{d['t_end']:g} s at dt = {d['dt_s']:g} s, the controller's model error "
+            f"`--uncertainty {d['uncertainty']}`. Same run: `tmfem deploy "
+            f"{how} --uncertainty {d['uncertainty']} --t-end {d['t_end']:g}`.", "",
             f"Files: {link(f'deploy-{p}.csv')} (every signal, units in the header), "
             f"{link(f'deploy-{p}.png')}, {link(f'deploy-{p}.gif')} (animation), "
             f"{link(f'deploy-{p}.pvd')} (ParaView series).", "",
             tabulate([[q, u, _num(v)] for q, u, v in rows], headers=["quantity", "unit", "value"],
                      tablefmt="github", disable_numparse=True), "",
-            *([("The largest tendon stress exceeds the yield stress: a start-up transient of "
-                "the rest-length commands (the printed 83 MPa is not reproduced; "
-                "docs/reproduction.md, 'Deployment (7.4)')."), ""]
+            *([("The largest tendon stress exceeds the tendons' yield stress."), ""]
               if d.get("tendon_yield_MPa") and 1e-6 * d["max_tendon_stress_Pa"] > d["tendon_yield_MPa"]
               else []),
             img(f"deploy-{p}.png", "deployment"), "", img(f"deploy-{p}.gif", "deployment animation"),
@@ -485,7 +483,7 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
     L = [f"# Report: the {name} system", "", system.description, "",
          f"Membrane mesh {system.N} x {summary['mesh_n']} x {summary['mesh_n']}, 3 truss elements "
          f"per tendon, {summary['modes']} modes, free vibration for {summary['t_end_s']:g} s in "
-         f"steps of {summary['dt_s']:g} s. Made by `tmfem report --preset {name}`; every number "
+         f"steps of {summary['dt_s']:g} s. Made by `tmfem report`; every number "
          "below is in the linked CSV files (units in the headers). Printed values: "
          f"{system.printed.get('source', 'none')}.", ""]
     if notes:

@@ -17,8 +17,9 @@ import numpy as np
 from tmfem.control.linear.hinf_lmi import GeneralizedPlant, HinfDesign, hinf_lmi, hinf_riccati, verify
 from tmfem.control.linear.hinf_central import hinf_central
 from tmfem.control.linear.pbh import PBHResult, pbh_ss
-from tmfem.control.linear.generalized_plant import DEPLOYED, DeployedPlant, deployed_plant, generalized_plant
+from tmfem.control.linear.generalized_plant import DeployedPlant, deployed_plant, generalized_plant
 from tmfem.errors import InputError
+from tmfem.system.problem import default_u_m
 
 log = logging.getLogger(__name__)
 
@@ -39,7 +40,7 @@ class DeployedDesign:
     def summary(self) -> dict:
         out = {"system": self.plant.model.system.name,
                "open_loop_f_max_hz": self.plant.f_max_hz,
-               "open_loop_f_max_printed_hz": DEPLOYED.get(self.plant.model.system.name, {}).get("f_max_hz"),
+               "open_loop_f_max_printed_hz": self.plant.model.system.printed.get("f_max_hz"),
                "n_states": int(self.plant.ss.nstates), "n_inputs": int(self.plant.ss.ninputs),
                "membrane_points": [list(p) for p in self.plant.points],
                "u_m": self.u_m, "pbh": self.pbh.as_dict()}
@@ -62,8 +63,10 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     Parameters
     ----------
     alpha, u_m, membrane_modes : optional
-        alpha_1, u_m of W_u = I/u_m, and K; defaults: 7.4's values for the system
-        (:data:`tmfem.control.linear.generalized_plant.DEPLOYED`), required for other systems.
+        alpha_1 [1/s], u_m [m] of W_u = I/u_m, and K; defaults: the system file's ``[control]``
+        alpha and u_m (7.4's values for the deployed presets), else :func:`default_alpha` and
+        :func:`tmfem.system.problem.default_u_m` (the system's own scales); K from
+        ``[models.com]``.
     solver : {"ARE", "CLARABEL", "SCS"}
         How the eliminated LMIs are solved (:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi`); default
         their Riccati characterisation (the plants of Fig. 7.1 are regular: D12 = [0; W_u],
@@ -80,16 +83,14 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     """
     if method not in METHODS:
         raise InputError(f"method: expected one of {METHODS}, found {method!r}")
-    d = DEPLOYED.get(system.name, {})
-    alpha = d.get("alpha") if alpha is None else alpha
-    u_m = d.get("u_m") if u_m is None else u_m
-    if synthesize and (alpha is None or u_m is None):
-        raise InputError(f"system {system.name!r} has no 7.4 defaults: expected alpha and u_m, "
-                         f"found alpha = {alpha}, u_m = {u_m}")
+    w = system.problem.control
+    u_m = (w.u_m if w.u_m is not None else default_u_m(system)) if u_m is None else u_m
     plant = deployed_plant(system, membrane_modes=membrane_modes)
+    if alpha is None:
+        alpha = w.alpha if w.alpha is not None else default_alpha(plant)
     kw = {} if pbh_tol is None else {"tol": pbh_tol}
     res = pbh_ss(plant.ss, **kw)
-    gen = generalized_plant(plant, u_m=u_m if u_m is not None else 1.0)
+    gen = generalized_plant(plant, u_m=u_m, W_e=w.W_e, W_d=w.W_d)
     design = None
     if synthesize:
         if method == "lmi":
@@ -98,8 +99,20 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
             design = hinf_central(gen, alpha=alpha, operating_point=plant.operating_point)
         else:
             design = hinf_riccati(gen, alpha=alpha, operating_point=plant.operating_point)
-    return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design,
-                          u_m=float(u_m) if u_m is not None else None)
+    return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design, u_m=float(u_m))
+
+
+def default_alpha(plant: DeployedPlant) -> float:
+    """alpha_1 of eq. 5.66 [1/s] when the file gives none: the system's own scale, 0.1 x 2 pi
+    f_1 with f_1 the lowest open-loop natural frequency of the deployed plant [Hz] (a decay
+    rate of a tenth of the slowest mode's angular frequency; 7.4's 0.5, 0.4, 0.4 for 1-4(D),
+    1-6(D), 2-3 are 0.07-0.14 of theirs: f_1 = 1.07, 0.46, 0.56 Hz)."""
+    f = np.asarray(plant.frequencies_hz, dtype=float)
+    f = f[np.isfinite(f) & (f > 0)]
+    if f.size == 0:
+        raise InputError(f"alpha_1: the deployed plant of {plant.model.system.name} has no positive "
+                         "natural frequency to scale it with; expected --alpha (or [control] alpha)")
+    return float(0.1 * 2 * np.pi * f.min())
 
 
 def save_design(design: HinfDesign, path) -> None:
