@@ -310,7 +310,7 @@ def _run_on(args, s, plant_kind: str, mesh_n):
     its record up to the failure (``failure``)."""
     from tmfem.control.deployment.run import run_deployment
     from tmfem.control.fe_plant.state_estimate import deployment_plant
-    plant = deployment_plant(plant_kind, s.model, args.system.problem.packaged,
+    plant = deployment_plant(plant_kind, s.model, s.model.system.problem.packaged,
                              mesh_n=mesh_n or 10, **plant_arguments(args, plant_kind))
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
         return run_deployment(model=s.model, reference=s.reference, controller=s.controller,

@@ -57,6 +57,32 @@ def deployable_system(system):
     return system
 
 
+def with_designed_rest_lengths(system, *, what: str):
+    """``system`` with rest lengths: its own, else those of its equilibrium design (ch. 3,
+    :func:`tmfem.equilibrium.design.design_equilibrium`, strict: a slack tendon or membrane
+    is refused with the design's message, naming ``what`` configuration)."""
+    if system.rest_lengths is not None:
+        return system
+    from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.errors import InfeasibleDesign
+    try:
+        d = design_equilibrium(system)
+    except InfeasibleDesign as exc:
+        raise type(exc)(f"deploy {system.name}: the {what} configuration is not a feasible "
+                        f"equilibrium: {exc}") from None
+    return system.with_rest_lengths(d.rest_lengths)
+
+
+def checked_configurations(system):
+    """The deployed ``system`` and its packaged configuration, both checked to be feasible
+    equilibria with rest lengths (the file's, else designed: :func:`with_designed_rest_lengths`),
+    before any controller design; the packaged one is ``result.problem.packaged``."""
+    import dataclasses
+    final = with_designed_rest_lengths(system, what="deployed")
+    packaged = with_designed_rest_lengths(system.problem.packaged, what="packaged")
+    return final.replace(problem=dataclasses.replace(final.problem, packaged=packaged))
+
+
 def own_path(system) -> str:
     """The deployment path of ``system``: its ``[deployment] path``, else ``"delta"`` for a
     1-N(D) system and ``"linear"`` otherwise."""
@@ -82,6 +108,7 @@ def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None 
     from tmfem.reference.tables import deployment_bases
     final = deployable_system(system)
     check_choices(final, controller=controller, uncertainty=uncertainty, path=path)
+    final = checked_configurations(final)
     p = final.problem.deployment
     path = path or own_path(final)
     w0, we, tau, dc = p.gains if gains is None else gains

@@ -25,11 +25,30 @@ W_D = 0.001      # W_d1..4 = 0.001 I (7.4, item 2)
 
 
 def measured_points(system) -> list:
-    """The measured membrane points (x_f, y_f) [m] of eq. 5.18 that ``system`` declares: its
-    file's ``[control] points`` (eqs. 5.73-5.75 for the deployed presets), else its
-    ``[monitor] points``; none: :func:`point_coordinates` chooses them all."""
+    """The measured membrane points (x_f, y_f) [m] of eq. 5.18 of ``system``: its file's
+    ``[control] points`` (eqs. 5.73-5.75 for the deployed presets), else its ``[monitor]
+    points``, else :func:`interior_points`."""
     pts = system.problem.control.points
-    return list(pts) if pts is not None else [tuple(p) for p in system.monitor_points.T.tolist()]
+    if pts is not None:
+        return list(pts)
+    if system.monitor_points.size:
+        return [tuple(p) for p in system.monitor_points.T.tolist()]
+    return interior_points(system)
+
+
+def interior_points(system, *, count: int = 3) -> list:
+    """``count`` membrane points inside the membrane, away from its edges, corners and the
+    patch boundaries of the mesh (centroid to edge midpoints): for the first ``count`` edges
+    j, half-way from the centroid c to the point between corner j and the midpoint of edge
+    (j, j+1), i.e. c + (p_j + m_j - 2 c) / 4 (x_f, y_f in m)."""
+    P = np.asarray(system.membrane_corners, dtype=float)
+    c = P.mean(axis=1)
+    out = []
+    for j in range(min(count, P.shape[1])):
+        m = 0.5 * (P[:, j] + P[:, (j + 1) % P.shape[1]])
+        x, y = c + (P[:, j] + m - 2 * c) / 4
+        out.append((float(x), float(y)))
+    return out
 
 
 def point_coordinates(basis, *, K: int, points) -> list:
