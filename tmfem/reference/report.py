@@ -225,9 +225,10 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     add("frequencies.png", _frequency_plot(out / "frequencies.png", freqs, printed, modes, name))
 
     # 4. free vibration -----------------------------------------------------------------------
-    com = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n)
+    pts, nodes = monitored(system)
+    com = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, output_points=pts)
     vdir = out / "vibration_com"
-    r_com = free_vibration(com, t_end=t_end, dt=dt, perturb=perturb,
+    r_com = free_vibration(com, t_end=t_end, dt=dt, perturb=perturb, monitor_nodes=nodes,
                            csv_path=out / "vibration_com.csv", jacobian="reuse",
                            vtk_dir=vdir, vtk_every=max(1, int(round(0.1 / dt))),
                            progress=_run_progress(run_progress, "COM free vibration"))
@@ -239,6 +240,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     step(STEPS[6])
     model, res = mtc["designed"]
     r_mtc = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
+                               output_points=pts, monitor_nodes=nodes,
                                csv_path=out / "vibration_mtc.csv",
                                progress=_run_progress(run_progress, "MTC free vibration"))
     add("vibration_mtc.csv", out / "vibration_mtc.csv")
@@ -272,6 +274,18 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     summary["out"] = str(out)
     summary["ok"] = bool(d.ok)
     return summary
+
+
+def monitored(system) -> tuple:
+    """(membrane points (x_f, y_f) [m], node labels) the free vibration records: the file's
+    ``[monitor]`` points and nodes, else points inside the membrane
+    (:func:`tmfem.control.linear.generalized_plant.interior_points`) and the upper end of the
+    first bar of the top stage."""
+    from tmfem.control.linear.generalized_plant import interior_points
+    pts = ([tuple(p) for p in system.monitor_points.T.tolist()] if system.monitor_points.size
+           else interior_points(system))
+    nodes = list(system.monitor_nodes) or [f"B_{system.M}1"]
+    return pts, nodes
 
 
 def _run_progress(factory, label):
@@ -500,11 +514,11 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
                                                                 "design membrane stress"), ""]
     L += ["## 2. Statics of the membrane-truss-cable model (6.2)", "",
           "From the undeformed membrane the rest lengths pull the system into equilibrium. "
-          "'designed': the rest lengths of the design above; 'implied': "
-          + ("rest lengths " + ", ".join(f"{g} = {v} m" for g, v in
-                                         summary['implied_prestress']['rest_lengths'].items())
+          "'designed': the rest lengths of the design above"
+          + ("; 'implied': rest lengths " + ", ".join(
+              f"{g} = {v} m" for g, v in summary['implied_prestress']['rest_lengths'].items())
              + f" ({summary['implied_prestress']['source']})."
-             if summary["implied_prestress"] else "not available for this system."), "",
+             if summary["implied_prestress"] else "."), "",
           f"Files: {link('statics.csv')}, " + ", ".join(
               link(f"static_{k}.vtu") for k in statics) + ".", ""]
     rows = _statics_rows(system, statics)
@@ -534,8 +548,9 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
     L += [tabulate(body, headers=head, tablefmt="github", disable_numparse=True), "",
           f"Printed: {printed['source'] if printed else 'none'}. MTC: membrane-truss-cable "
           "(4.4), SBC: shell-beam-cable (4.3, MITC4 shell and beam bars), both on the mesh "
-          "above; COM: control-oriented model (ch. 5) with K membrane modes; 'x1.29' scales "
-          "the designed membrane prestress (docs/errata.md, 'COM frequencies').", "",
+          "above; COM: control-oriented model (ch. 5) with K membrane modes"
+          + ("; 'x<s>' scales the designed membrane prestress to the printed tendon stress."
+             if any(k.startswith("COM x") for k in freqs) else "."), "",
           _largest_differences(freqs, printed), "",
           img("frequencies.png", "frequencies"), "", img("modes.png", "mode shapes"), ""]
     v = summary["vibration"]

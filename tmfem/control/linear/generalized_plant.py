@@ -129,7 +129,7 @@ class DeployedPlant:
 
 
 def deployed_plant(system, *, membrane_modes: int | None = None, points=None, mesh_n: int = 10,
-                   rest_lengths="system", damping: float = 0.0) -> DeployedPlant:
+                   rest_lengths=None, damping: float = 0.0) -> DeployedPlant:
     """Linear plant at the deployed configuration (eqs. 5.17-5.18, 5.33, 5.62).
 
     Parameters
@@ -142,8 +142,10 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
     points : list of (x_f, y_f), optional
         Membrane points of the coordinates v (eq. 5.18); default :func:`measured_points`
         (eqs. 5.73-5.75 for the presets) completed to K by :func:`point_coordinates`.
-    rest_lengths : {"system", "design"} or array
-        u_e; "system": the printed rest lengths of the preset (Tables 7.3, 7.5, 7.7).
+    rest_lengths : {"system", "design"} or array, optional
+        u_e; "system": the file's rest lengths (the printed ones of Tables 7.3, 7.5, 7.7 for
+        the presets), "design": those of the equilibrium design (ch. 3); default the file's
+        when it gives them, else the design's.
     damping : float
         Modal damping c_m of eq. 5.13 (7.4 states none: default 0).
     """
@@ -151,6 +153,8 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     import control
     K = membrane_modes if membrane_modes is not None else default_membrane_modes(system)
+    if rest_lengths is None:
+        rest_lengths = "system" if system.rest_lengths is not None else "design"
     modal = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, rest_lengths=rest_lengths,
                                  damping=damping, output_points=[])
     pts = points if points is not None else measured_points(system)
