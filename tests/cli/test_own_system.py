@@ -127,3 +127,36 @@ def test_deploy_refuses_a_file_without_a_packaged_configuration(capsys):
     rc = main(["deploy", str(SYSTEMS / "pentagon-1-5.toml")])
     err = capsys.readouterr().err
     assert rc != 0 and "[packaged]" in err and "[deployment]" in err
+
+
+def test_report_of_a_1_3_takes_the_modes_its_com_has(tmp_path, capsys):
+    """`report` on the 1-3: its COM has n_q + K = 6 + 4 coordinates, so the default 12 modes
+    become 10 (said on stderr), rc 0."""
+    rc = main(["report", str(SYSTEMS / "triangle-1-3.toml"), "--out", str(tmp_path / "r"),
+               "--mesh", "4", "--t-end", "0.1", "--no-render", "--json"])
+    out, err = capsys.readouterr()
+    assert rc == 0, err
+    r = json.loads(out)
+    assert r["modes"] == 10 and "10 coordinates" in err
+    assert all(len(f) == 10 for f in r["frequencies_hz"].values())
+
+
+def test_report_of_a_deployable_uses_sbc_com_and_its_own_deployment(tmp_path, capsys):
+    """`report` on the 1-5(D): the SBC model in place of the MTC (no H_1j nodes), the COM, and
+    the system's own deployment ([packaged], [deployment]), shortened here."""
+    from tmfem.reference import report as rep
+    with pytest.MonkeyPatch.context() as mp:
+        own = rep.report_deployment
+        mp.setattr(rep, "report_deployment",
+                   lambda s: {**own(s), "t_end": 0.3, "controller": "adaptive-lqr"})
+        r, text = run(["report", str(SYSTEMS / "pentagon-1-5D.toml"), "--out", str(tmp_path / "r"),
+                       "--mesh", "4", "--modes", "6", "--t-end", "0.1", "--no-render"], capsys)
+    assert r["fe_model"] == "SBC" and set(r["vibration"]) == {"COM", "SBC"}
+    assert set(r["frequencies_hz"]) == {"SBC designed", "COM designed"}
+    # the SBC and the COM of the same structure: lowest mode within 5 % (0.713 / 0.718 Hz)
+    f = r["frequencies_hz"]
+    assert f["COM designed"][0] == pytest.approx(f["SBC designed"][0], rel=0.05)
+    assert r["deployment"]["system"] == "pentagon-D" and r["deployment"]["failure"] is None
+    index = (tmp_path / "r" / "index.md").read_text()
+    assert "shell-beam-cable model (6.2)" in index
+    assert_no_dissertation(text.replace('"implied_prestress": null', "") + index)

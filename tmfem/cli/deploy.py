@@ -23,8 +23,10 @@ HELP = "deploy a system from its packaged to its deployed configuration (adaptiv
 def configure(parser) -> None:
     parser.add_argument("spec", nargs="?", help="system file (TOML) with [packaged] and "
                                                 "[deployment] tables; or use --preset")
-    parser.add_argument("--preset", help="built-in system with a deployment (1-4D, 1-6D, "
-                                         "2-3-deploy; 2-3-lpv: the LPV deployment of 8.4)")
+    from tmfem.system.presets import list_presets
+    parser.add_argument("--preset", choices=list_presets(),
+                        help="built-in system with a deployment (1-4D, 1-6D, 2-3-deploy; "
+                             "2-3-lpv: the LPV deployment of 8.4)")
     parser.add_argument("--controller", default=None, choices=sorted(CONTROLLERS) + list(LPV_CONTROLLERS),
                         help="7.4 presets: adaptive PFL then a linear controller about the final equilibrium: "
                              "adaptive-hinf (default; the H-infinity controller of 7.3: the central one at "

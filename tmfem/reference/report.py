@@ -58,6 +58,9 @@ def report_deployment(system) -> dict | None:
     return None
 
 
+#: the finite-element models of the report by key
+FE_NAMES = {"MTC": "membrane-truss-cable", "SBC": "shell-beam-cable"}
+
 #: Steps of :func:`write_report`, for a progress bar.
 STEPS = ("equilibrium design", "MTC statics (designed)", "MTC statics (implied)",
          "MTC modes", "SBC modes", "COM modes", "COM free vibration", "MTC free vibration",
@@ -157,12 +160,22 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                                                title=f"{name}: equilibrium design (ch. 3)"))
     step(STEPS[0])
 
-    # 2. MTC statics at both prestress levels --------------------------------------------
+    # 2. FE statics (MTC; SBC for 1-N(D)) at both prestress levels ----------------------------------------
     cases = {"designed": ("design", system)}
     if implied is not None:
         cases["implied"] = ("system", system.with_rest_lengths(implied["rest_lengths"]))
-    mtc, statics = {}, {}
+    mtc, sbc_runs, statics = {}, {}, {}
+    fe = "SBC" if system.deployable else "MTC"      # the MTC model has no H_1j nodes (1-N(D))
     for k, (label, (rest, sys_k)) in enumerate(cases.items()):
+        if system.deployable:
+            from tmfem.models.sbc.model import SBCModel
+            from tmfem.models.sbc.post import static_summary as sbc_static_summary
+            sbc = SBCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
+            st = sbc.solve_static()
+            sbc_runs[label] = (sbc, st)
+            statics[label] = sbc_static_summary(sbc, st)
+            step(STEPS[1 + k])
+            continue
         model = MTCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
         res = model.solve_static(start="undeformed")
         mtc[label] = (model, res)
@@ -186,7 +199,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         step(STEPS[1 + k])
     if implied is None:
         step(STEPS[2])
-    add("statics.csv", _statics_table(out / "statics.csv", system, statics))
+    add("statics.csv", _statics_table(out / "statics.csv", system, statics, fe))
 
     # 3. modes -------------------------------------------------------------------------------
     freqs = {}
@@ -205,6 +218,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                                               k=min(modes, 12),
                                               title=f"{name} MTC modes, designed prestress"))
     step(STEPS[3])
+    for label, (sbc, st) in sbc_runs.items():
+        freqs[f"SBC {label}"] = sbc.modes(st.state, k=modes, tangent=st.tangent).freq_hz
     if not system.deployable:
         from tmfem.models.sbc.model import SBCModel
         for label, (rest, sys_k) in cases.items():
@@ -238,15 +253,24 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         r_com, out / "vibration_com.png",
         title=f"{name} COM free vibration, K = {K}, " + _perturbation_text(perturb)))
     step(STEPS[6])
-    model, res = mtc["designed"]
-    r_mtc = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
-                               output_points=pts, monitor_nodes=nodes,
-                               csv_path=out / "vibration_mtc.csv",
-                               progress=_run_progress(run_progress, "MTC free vibration"))
-    add("vibration_mtc.csv", out / "vibration_mtc.csv")
-    add("vibration_mtc.png", plot_free_vibration(
-        r_mtc, out / "vibration_mtc.png",
-        title=f"{name} MTC free vibration, mesh {mesh_n}, " + _perturbation_text(perturb)))
+    lo = fe.lower()
+    if system.deployable:
+        from tmfem.simulation.vibration import sbc_free_vibration
+        model, res = sbc_runs["designed"]
+        r_fe = sbc_free_vibration(model, res.state, t_end=t_end, dt=dt, perturb=perturb,
+                                  output_points=pts, monitor_nodes=nodes,
+                                  csv_path=out / f"vibration_{lo}.csv",
+                                  progress=_run_progress(run_progress, f"{fe} free vibration"))
+    else:
+        model, res = mtc["designed"]
+        r_fe = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
+                                  output_points=pts, monitor_nodes=nodes,
+                                  csv_path=out / f"vibration_{lo}.csv",
+                                  progress=_run_progress(run_progress, f"{fe} free vibration"))
+    add(f"vibration_{lo}.csv", out / f"vibration_{lo}.csv")
+    add(f"vibration_{lo}.png", plot_free_vibration(
+        r_fe, out / f"vibration_{lo}.png",
+        title=f"{name} {fe} free vibration, mesh {mesh_n}, " + _perturbation_text(perturb)))
     step(STEPS[7])
     deployment = None
     spec = report_deployment(system) if deploy else None
@@ -255,8 +279,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                                  progress=_run_progress(run_progress, "deployment"))
     step(STEPS[8])
 
-    vibration = {"COM": _vibration_summary(r_com), "MTC": _vibration_summary(r_mtc)}
-    summary = {"system": name, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
+    vibration = {"COM": _vibration_summary(r_com), fe: _vibration_summary(r_fe)}
+    summary = {"system": name, "fe_model": fe, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
                "perturbation": perturb, "design_ok": bool(d.ok),
                "failed_checks": [c.name for c in d.failed],
                "implied_prestress": implied,
@@ -367,16 +391,16 @@ def _statics_rows(system, statics: dict) -> list:
     return rows
 
 
-def _statics_header(statics: dict) -> list:
+def _statics_header(statics: dict, fe: str = "MTC") -> list:
     h = ["quantity", "unit", "printed"]
     for label in statics:
-        h += [f"MTC {label}", f"rel_diff {label}"]
+        h += [f"{fe} {label}", f"rel_diff {label}"]
     return h
 
 
-def _statics_table(path: Path, system, statics: dict) -> Path:
+def _statics_table(path: Path, system, statics: dict, fe: str) -> Path:
     rows = _statics_rows(system, statics)
-    return _csv(path, _statics_header(statics),
+    return _csv(path, _statics_header(statics, fe),
                 [[r[0], r[1]] + [_num(v, 6) for v in r[2:]] for r in rows])
 
 
@@ -512,7 +536,12 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
           img("render.png", "design render"), "",
           img("configuration.png", "design configuration"), img("membrane_stress.png",
                                                                 "design membrane stress"), ""]
-    L += ["## 2. Statics of the membrane-truss-cable model (6.2)", "",
+    fe = summary["fe_model"]
+    lo = fe.lower()
+    L += [f"## 2. Statics of the {FE_NAMES[fe]} model (6.2)", "",
+          *([("The membrane-truss-cable model has no nodes along its bars, so a 1-N(D) system "
+              "(tendons attached at H_1j along the bars) is analysed with the shell-beam-cable "
+              "model here."), ""] if fe == "SBC" else []),
           "From the undeformed membrane the rest lengths pull the system into equilibrium. "
           "'designed': the rest lengths of the design above"
           + ("; 'implied': rest lengths " + ", ".join(
@@ -525,14 +554,14 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
     L.append(tabulate([[r[0], r[1]] + [_num(v) if j % 2 == 1 or j == 0 else
                                         ("" if v is None else f"{100 * v:+.1f} %")
                                         for j, v in enumerate(r[2:])] for r in rows],
-                      headers=_statics_header(statics), tablefmt="github",
+                      headers=_statics_header(statics, fe), tablefmt="github",
                       disable_numparse=True))
     L += ["", "Membrane stresses are element values (means over the Gauss points in the "
           "stress maps, maxima over Gauss points in the table); the peaks sit at the "
           "point-attached corners.", ""]
     for k in statics:
-        L += [img(f"static_{k}.png", f"MTC equilibrium {k}"), "",
-              img(f"static_{k}_stress.png", f"MTC membrane stress {k}"), ""]
+        L += [img(f"static_{k}.png", f"{fe} equilibrium {k}"), "",
+              img(f"static_{k}_stress.png", f"{fe} membrane stress {k}"), ""]
     L += ["## 3. Natural frequencies and mode shapes (6.4, eq. 5.32)", "",
           f"Files: {link('frequencies.csv')}, {link('modes.vtu')} (ParaView: Warp By Vector "
           "with `mode_k`; field data `mode_k_hz`; cell data `kind`).", ""]
@@ -558,7 +587,7 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
           f"Perturbation `{_perturbation_text(summary['perturbation'])}`, Park's method, "
           f"dt = {summary['dt_s']:g} s, designed prestress.", "",
           f"Files: {link('vibration_com.csv')}, {link('vibration_com.pvd')} (ParaView series), "
-          f"{link('vibration_mtc.csv')}.", ""]
+          f"{link(f'vibration_{lo}.csv')}.", ""]
     body = [[m, s["steps"], f"{s['wall_time_s']:.1f}", f"{s['min_tendon_force_N']:.4g} "
              f"({s['min_tendon_force_tendon']})",
              "; ".join(f"{n}: " + ", ".join(f"{a:.3f}" for a in p) for n, p in s["peak_to_peak_mm"].items())]
@@ -567,7 +596,7 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
                                   "peak-to-peak x, y, z [mm]"], tablefmt="github",
                    disable_numparse=True), "",
           img("vibration_com.png", "COM free vibration"), "",
-          img("vibration_mtc.png", "MTC free vibration"), ""]
+          img(f"vibration_{lo}.png", f"{fe} free vibration"), ""]
     L += _deployment_section(summary.get("deployment"), link, img)
     L += ["## All files", ""] + [f"- [{k}]({p})" for k, p in sorted(files.items())]
     (out / "index.md").write_text("\n".join(L) + "\n")
