@@ -160,3 +160,33 @@ def test_report_of_a_deployable_uses_sbc_com_and_its_own_deployment(tmp_path, ca
     index = (tmp_path / "r" / "index.md").read_text()
     assert "shell-beam-cable model (6.2)" in index
     assert_no_dissertation(text.replace('"implied_prestress": null', "") + index)
+
+
+def test_report_with_a_failed_check_does_not_say_passed(tmp_path, capsys):
+    """The 1-5 with a tendon yield stress of 1 MPa (its design stresses the tendons to ~52 MPa):
+    the FE statics' yield check fails, so the report lists it, exits 1 and never says
+    'passed'."""
+    import tomllib
+    d = tomllib.loads((SYSTEMS / "pentagon-1-5.toml").read_text())
+    d["tendons"]["S"]["yield_stress"] = 1e6
+    f = tmp_path / "weak.toml"
+    f.write_bytes(tomli_w.dumps(d).encode())
+    rc = main(["report", str(f), "--out", str(tmp_path / "r"), "--mesh", "4", "--modes", "4",
+               "--t-end", "0.1", "--no-render"])
+    out, err = capsys.readouterr()
+    assert rc == 1
+    assert "checks FAILED" in out and "MTC designed: tendon stress <= yield" in out
+    assert "passed" not in out and "all passed" not in (tmp_path / "r" / "index.md").read_text()
+
+
+@pytest.mark.parametrize("freqs, unstable", [
+    ({"SBC implied": [-85.0, 0.3, 1.2]}, {"SBC implied": [1]}),
+    ({"MTC designed": [0.1, 0.3]}, {}),
+])
+def test_an_unstable_mode_is_named_not_printed_as_a_frequency(freqs, unstable):
+    """omega^2 < 0 (eq. 5.32, a signed frequency < 0): the mode is listed as unstable and its
+    table cell reads 'unstable'."""
+    from tmfem.reference.report import frequency_cell, unstable_modes
+    assert unstable_modes(freqs) == unstable
+    cells = [frequency_cell(f) for v in freqs.values() for f in v]
+    assert ("unstable" in cells) == bool(unstable) and not any(c.startswith("-") for c in cells)

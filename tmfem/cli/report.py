@@ -90,19 +90,23 @@ def format_text(r: dict) -> str:
     head = ["mode"] + [f"{k} [Hz]" for k in f] + ([f"{m} printed" for m in printed_cols] if pr else [])
     rows = []
     for i in range(r["modes"]):
-        row = [i + 1] + [f"{v[i]:.4f}" if i < len(v) else "-" for v in f.values()]
+        row = [i + 1] + [("unstable" if v[i] < 0 else f"{v[i]:.4f}") if i < len(v) else "-"
+                         for v in f.values()]
         if pr:
             row += [f"{pr[m][i]:.4f}" if i < len(pr[m]) else "-" for m in printed_cols]
         rows.append(row)
     st = r["statics"]
     srows = [[k, f"{v['tendon_stress_max_MPa']:.2f}", f"{v['bar_load_max_N']:.3f}",
               f"{v['membrane_max_von_mises_MPa']:.3f}"] for k, v in st.items()]
-    lines = [f"report of {r['system']}: design checks "
-             + ("passed" if r["design_ok"] else "FAILED: " + ", ".join(r["failed_checks"])), "",
+    unstable = r.get("unstable_modes") or {}
+    lines = [f"report of {r['system']}: checks "
+             + ("passed" if not r["failed_checks"] else "FAILED: " + ", ".join(r["failed_checks"])), "",
              tabulate(srows, headers=[f"{r.get('fe_model', 'MTC')} statics", "tendon stress [MPa]", "bar load [N]",
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
              f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+    for k, m in unstable.items():
+        lines.insert(-1, f"{k}: the equilibrium is unstable in mode(s) {m} (omega^2 < 0, eq. 5.32)")
     d = r.get("deployment")
     if d:
         lines.insert(-1, f"deployment {d['system']} ({d['controller']}, uncertainty "

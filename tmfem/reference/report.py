@@ -75,6 +75,19 @@ def _csv(path: Path, header: list, rows: list) -> Path:
     return path
 
 
+def frequency_cell(f, nd=5) -> str:
+    """A natural frequency [Hz] for a table; a negative one (omega^2 < 0 in eq. 5.32: the
+    equilibrium is unstable in that mode) is written ``unstable``, never as a frequency."""
+    f = float(f)
+    return "unstable" if f < 0 else _num(f, nd)
+
+
+def unstable_modes(freqs: dict) -> dict:
+    """{column: [mode numbers with omega^2 < 0]} of the frequency columns that have any."""
+    out = {k: [i + 1 for i, f in enumerate(v) if f < 0] for k, v in freqs.items()}
+    return {k: v for k, v in out.items() if v}
+
+
 def _num(v, nd=5):
     if v is None or (isinstance(v, float) and not np.isfinite(v)):
         return "-"
@@ -282,10 +295,11 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     vibration = {"COM": _vibration_summary(r_com), fe: _vibration_summary(r_fe)}
     summary = {"system": name, "fe_model": fe, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
                "perturbation": perturb, "design_ok": bool(d.ok),
-               "failed_checks": [c.name for c in d.failed],
+               "failed_checks": [c.name for c in d.failed] + _result_failures(statics, freqs, fe),
                "implied_prestress": implied,
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
+               "unstable_modes": unstable_modes(freqs),
                "printed_frequencies_hz": printed, "vibration": vibration,
                "deployment": deployment}
     (out / "report.json").write_text(json.dumps(with_units(summary), indent=1))
@@ -296,7 +310,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     summary["files"] = files
     summary["notes"] = notes
     summary["out"] = str(out)
-    summary["ok"] = bool(d.ok)
+    summary["ok"] = not summary["failed_checks"]
     return summary
 
 
@@ -310,6 +324,16 @@ def monitored(system) -> tuple:
            else interior_points(system))
     nodes = list(system.monitor_nodes) or [f"B_{system.M}1"]
     return pts, nodes
+
+
+def _result_failures(statics: dict, freqs: dict, fe: str) -> list[str]:
+    """Failed checks of the model results: the FE statics' checks (yield, slack tendons,
+    buckling: :func:`tmfem.models.mtc.post.design_checks`) per prestress case, and an unstable
+    equilibrium (omega^2 < 0) per frequency column, with its modes."""
+    out = [f"{fe} {label}: {c['check']}" for label, st in statics.items()
+           for c in st.get("checks", []) if not c["ok"]]
+    out += [f"{col}: unstable equilibrium (modes {m})" for col, m in unstable_modes(freqs).items()]
+    return out
 
 
 def _run_progress(factory, label):
@@ -411,7 +435,7 @@ def _frequency_table(path: Path, freqs: dict, printed, modes: int) -> Path:
         head += [f"{m} {printed['source'].split()[-1]} printed [Hz]" for m in ("MTC", "SBC", "COM")]
     rows = []
     for i in range(modes):
-        row = [i + 1] + [_num(float(freqs[c][i]), 6) if i < len(freqs[c]) else "-" for c in cols]
+        row = [i + 1] + [frequency_cell(freqs[c][i], 6) if i < len(freqs[c]) else "-" for c in cols]
         if printed:
             row += [_num(printed[m][i], 6) if i < len(printed[m]) else "-" for m in ("MTC", "SBC", "COM")]
         rows.append(row)
@@ -419,21 +443,29 @@ def _frequency_table(path: Path, freqs: dict, printed, modes: int) -> Path:
 
 
 def _frequency_plot(png: Path, freqs: dict, printed, modes: int, name: str) -> Path:
-    """Two panels: our frequencies with the printed ones (black open markers), and the
-    relative difference of each of our columns to the printed column of its model."""
+    """Our frequencies with the printed ones (black open markers) and, when the system has
+    printed ones, a second panel with the relative difference of each of our columns to the
+    printed column of its model. Unstable modes (omega^2 < 0) have no point."""
     from tmfem.post.plots import mode_styles, new_figure, save_figure
 
-    fig = new_figure(figsize=(7.5, 7.2))
-    ax, dx = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
+    if printed:
+        fig = new_figure(figsize=(7.5, 7.2))
+        ax, dx = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [3, 2]})
+    else:
+        fig = new_figure(figsize=(7.5, 4.5))
+        ax, dx = fig.subplots(1, 1), None
     k = np.arange(1, modes + 1)
     styles = mode_styles(len(freqs))
     for (label, f), style in zip(freqs.items(), styles):
         n = min(modes, len(f))
-        ax.plot(k[:n], f[:n], label=label, ms=4, lw=1.0, **style)
+        f = np.asarray(f[:n], dtype=float)
+        ok = f >= 0                                   # unstable modes have no frequency
+        ax.plot(k[:n][ok], f[ok], label=label, ms=4, lw=1.0, **style)
         ref = np.asarray((printed or {}).get(label.split()[0], []), dtype=float)
         m = min(n, ref.size)
         if m:
-            dx.plot(k[:m], 100 * (np.asarray(f[:m]) / ref[:m] - 1), ms=4, lw=1.0, label=label, **style)
+            j = ok[:m]
+            dx.plot(k[:m][j], 100 * (f[:m][j] / ref[:m][j] - 1), ms=4, lw=1.0, label=label, **style)
     if printed:
         src = printed["source"].split("dissertation ")[-1]
         for m, mk in (("MTC", "o"), ("SBC", "s"), ("COM", "^")):
@@ -441,14 +473,18 @@ def _frequency_plot(png: Path, freqs: dict, printed, modes: int, name: str) -> P
             ax.plot(k[:ref.size], ref, mk, mfc="none", mec="k", ms=8, mew=0.8,
                     label=f"{m} printed ({src})")
     ax.set_ylabel("natural frequency [Hz]")
-    ax.set_title(f"{name}: natural frequencies (eq. 5.32) beside the printed table", fontsize=10)
+    ax.set_title(f"{name}: natural frequencies (eq. 5.32)"
+                 + (" beside the printed table" if printed else ""), fontsize=10)
     ax.legend(fontsize=7, loc="upper left", ncol=2)
-    dx.axhline(0.0, color="k", lw=0.6)
-    dx.set_ylabel("difference to the printed\ncolumn of the model [%]")
-    dx.set_xlabel("mode number")
-    dx.set_xticks(k)
+    if dx is not None:
+        dx.axhline(0.0, color="k", lw=0.6)
+        dx.set_ylabel("difference to the printed\ncolumn of the model [%]")
+    bottom = dx if dx is not None else ax
+    bottom.set_xlabel("mode number")
+    bottom.set_xticks(k)
     for a in (ax, dx):
-        a.grid(True, alpha=0.3)
+        if a is not None:
+            a.grid(True, alpha=0.3)
     return save_figure(fig, png)
 
 
@@ -531,7 +567,7 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
           f"{link('configuration.vtu')} (ParaView: bars, tendons with forces, membrane with "
           "stresses; cell data `kind` 0 bar, 1 tendon, 2 membrane).", "",
           markdown_table(design_rows), "",
-          "Checks: " + ("all passed." if summary["design_ok"] else
+          "Checks: " + ("all passed." if not summary["failed_checks"] else
                         "FAILED: " + ", ".join(summary["failed_checks"])), "",
           img("render.png", "design render"), "",
           img("configuration.png", "design configuration"), img("membrane_stress.png",
@@ -570,7 +606,7 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
         head += [f"{m} printed [Hz]" for m in ("MTC", "SBC", "COM")]
     body = []
     for i in range(summary["modes"]):
-        row = [i + 1] + [_num(float(f[i]), 5) if i < len(f) else "-" for f in freqs.values()]
+        row = [i + 1] + [frequency_cell(f[i], 5) if i < len(f) else "-" for f in freqs.values()]
         if printed:
             row += [_num(printed[m][i], 5) if i < len(printed[m]) else "-" for m in ("MTC", "SBC", "COM")]
         body.append(row)
