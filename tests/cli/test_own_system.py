@@ -190,3 +190,13 @@ def test_an_unstable_mode_is_named_not_printed_as_a_frequency(freqs, unstable):
     assert unstable_modes(freqs) == unstable
     cells = [frequency_cell(f) for v in freqs.values() for f in v]
     assert ("unstable" in cells) == bool(unstable) and not any(c.startswith("-") for c in cells)
+
+
+def test_com_disagreement_names_the_modes():
+    """The report's warning when the COM leaves the FE model by more than 5 % (6.4: < 3 % for
+    1-4): the modes named, K in the message; none when they agree."""
+    from tmfem.reference.report import com_disagreement
+    freqs = {"MTC designed": np.array([0.47, 3.51, 5.45]), "COM designed": np.array([0.46, 3.47, 7.34])}
+    d = com_disagreement(freqs, "MTC", 4)
+    assert d["modes"] == [3] and "K = 4" in d["message"]
+    assert com_disagreement({k: v[:2] for k, v in freqs.items()}, "MTC", 4) is None

@@ -105,6 +105,8 @@ def format_text(r: dict) -> str:
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
              f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+    if r.get("com_disagreement"):
+        lines.insert(-1, f"warning: {r['com_disagreement']['message']}")
     for k, m in unstable.items():
         lines.insert(-1, f"{k}: the equilibrium is unstable in mode(s) {m} (omega^2 < 0, eq. 5.32)")
     d = r.get("deployment")

@@ -248,6 +248,9 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale)
         freqs[f"COM x{scale:.4f}"] = np.array(com_implied["freq_hz"])
     step(STEPS[5])
+    disagreement = com_disagreement(freqs, fe, K)
+    if disagreement:
+        log.warning("%s: %s", name, disagreement["message"])
     printed = printed_frequencies(system)
     add("frequencies.csv", _frequency_table(out / "frequencies.csv", freqs, printed, modes))
     add("frequencies.png", _frequency_plot(out / "frequencies.png", freqs, printed, modes, name))
@@ -299,7 +302,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                "implied_prestress": implied,
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
-               "unstable_modes": unstable_modes(freqs),
+               "unstable_modes": unstable_modes(freqs), "com_disagreement": disagreement,
                "printed_frequencies_hz": printed, "vibration": vibration,
                "deployment": deployment}
     (out / "report.json").write_text(json.dumps(with_units(summary), indent=1))
@@ -324,6 +327,35 @@ def monitored(system) -> tuple:
            else interior_points(system))
     nodes = list(system.monitor_nodes) or [f"B_{system.M}1"]
     return pts, nodes
+
+
+#: relative difference of a COM frequency to the FE model's above which the report names the
+#: mode (6.4 finds < 3 % for 1-4 and < 1 % for 2-3 with the dissertation's K)
+COM_TOLERANCE = 0.05
+
+
+def com_disagreement(freqs: dict, fe: str, K: int) -> dict | None:
+    """Modes whose COM frequency (designed prestress) differs from the FE model's by more than
+    :data:`COM_TOLERANCE`, with a hint: the K membrane modes of the COM (``[models.com]
+    membrane_modes``) limit the membrane modes it represents (the 3 m Kapton 1-4 of the tests:
+    modes 8-12 at K = 4 differ by up to 35 %, at K = 8 by up to 7 %). None when all agree."""
+    com, ref = freqs.get("COM designed"), freqs.get(f"{fe} designed")
+    if com is None or ref is None:
+        return None
+    n = min(len(com), len(ref))
+    c, r = np.asarray(com[:n], dtype=float), np.asarray(ref[:n], dtype=float)
+    ok = (c > 0) & (r > 0)
+    rel = np.where(ok, c / np.where(ok, r, 1.0) - 1, 0.0)
+    bad = [int(i) + 1 for i in np.flatnonzero(ok & (np.abs(rel) > COM_TOLERANCE))]
+    if not bad:
+        return None
+    msg = (f"COM frequencies of modes {bad} differ from the {fe} model's by more than "
+           f"{100 * COM_TOLERANCE:g} % (largest {100 * np.max(np.abs(rel)):.1f} %): the COM has K = "
+           f"{K} membrane modes ([models.com] membrane_modes in the system file): more modes bring "
+           "its higher membrane modes closer; what remains is the COM's own approximation "
+           "(rigid bars, membrane modes about the designed prestress, ch. 5)")
+    return {"modes": bad, "relative_difference": rel.tolist(), "tolerance": COM_TOLERANCE,
+            "message": msg}
 
 
 def _result_failures(statics: dict, freqs: dict, fe: str) -> list[str]:
@@ -617,6 +649,8 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
           + ("; 'x<s>' scales the designed membrane prestress to the printed tendon stress."
              if any(k.startswith("COM x") for k in freqs) else "."), "",
           _largest_differences(freqs, printed), "",
+          *([f"Warning: {summary['com_disagreement']['message']}.", ""]
+            if summary.get("com_disagreement") else []),
           img("frequencies.png", "frequencies"), "", img("modes.png", "mode shapes"), ""]
     v = summary["vibration"]
     L += ["## 4. Free vibration (6.5)", "",
