@@ -35,12 +35,13 @@ KEYS = {
                    "gamma", "r_min"},
     "lpv": {"omega_r", "membrane_modes", "points", "path"},
     "report": {"perturbation", "implied_rest_lengths", "implied_source", "notes_design",
-               "notes_models", "deployment"},
+               "notes_models", "deployment", "com_prestress"},
     "report.deployment": {"system", "uncertainty", "t_end", "controller"},
 }
 GAIN_KEYS = ("omega_0", "omega_e", "tau", "d_c")
 UNCERTAINTIES = ("initial", "no-MG", "exact")
 PATHS = ("delta", "table-7-7-bases", "linear")
+COM_PRESTRESS = ("designed", "printed-tendon-stress")
 
 
 def _keys(t, kind: str, where: str) -> dict:
@@ -161,6 +162,8 @@ class ReportSettings:
     deployment : {system, uncertainty, t_end, controller}: a deployment the report runs (a
         preset name or a file path in ``system``); none by default (a deployable system with
         ``[packaged]`` runs its own).
+    com_prestress : "designed" (default) or "printed-tendon-stress": the COM of ``tmfem
+        compare`` at the designed prestress or scaled to the printed tendon stress.
     """
 
     perturbation: dict = field(default_factory=lambda: {"theta_11_dot": 0.01})
@@ -169,6 +172,7 @@ class ReportSettings:
     notes_design: tuple = ()
     notes_models: tuple = ()
     deployment: dict | None = None
+    com_prestress: str = "designed"
 
 
 @dataclass(frozen=True)
@@ -269,7 +273,8 @@ def _report(t: dict, where: str) -> ReportSettings:
     return ReportSettings(perturbation={k: float(v) for k, v in pert.items()},
                           implied_rest_lengths=dict(implied) if implied else None,
                           implied_source=src, notes_design=_strings(t, "notes_design", w),
-                          notes_models=_strings(t, "notes_models", w), deployment=dep)
+                          notes_models=_strings(t, "notes_models", w), deployment=dep,
+                          com_prestress=_choice(t, "com_prestress", w, COM_PRESTRESS, "designed"))
 
 
 #: top-level tables read here
