@@ -221,3 +221,12 @@ def test_compare_refuses_a_deployable_and_a_plot_without_printed_values(capsys):
     assert "1-N(D)" in capsys.readouterr().err
     assert main(["compare", str(SYSTEMS / "triangle-1-3.toml"), "--plot", "/tmp/x.png"]) == 2
     assert "printed frequencies" in capsys.readouterr().err
+
+
+def test_converge_sbc_of_a_deployable_user_system(capsys):
+    """`converge --model sbc` on the 1-5(D) (the MTC model cannot represent it, the SBC model
+    can): rc 0, the lowest frequency settles with the mesh (n = 2 -> 4 within 1 %)."""
+    r, _ = run(["converge", str(SYSTEMS / "pentagon-1-5D.toml"), "--model", "sbc", "--mesh", "2,4",
+                "--modes", "3"], capsys)
+    f1 = [row["f1"] for row in r["rows"]]
+    assert f1[1] == pytest.approx(f1[0], rel=0.01)
