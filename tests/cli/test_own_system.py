@@ -230,3 +230,9 @@ def test_converge_sbc_of_a_deployable_user_system(capsys):
                 "--modes", "3"], capsys)
     f1 = [row["f1"] for row in r["rows"]]
     assert f1[1] == pytest.approx(f1[0], rel=0.01)
+
+
+def test_report_values_that_could_not_be_computed_are_absent_not_nan():
+    from tmfem.reference.report import finite_or_none
+    assert finite_or_none({"a": [1.0, float("nan")], "b": np.inf, "c": (2, np.float64("nan"))}) == \
+        {"a": [1.0, None], "b": None, "c": [2, None]}

@@ -75,6 +75,18 @@ def _csv(path: Path, header: list, rows: list) -> Path:
     return path
 
 
+def finite_or_none(obj):
+    """``obj`` (nested dicts, lists, numbers) with every NaN or infinite float replaced by
+    None: a value that could not be computed is absent, never a NaN in a file."""
+    if isinstance(obj, dict):
+        return {k: finite_or_none(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [finite_or_none(v) for v in obj]
+    if isinstance(obj, (float, np.floating)) and not np.isfinite(obj):
+        return None
+    return obj
+
+
 def frequency_cell(f, nd=5) -> str:
     """A natural frequency [Hz] for a table; a negative one (omega^2 < 0 in eq. 5.32: the
     equilibrium is unstable in that mode) is written ``unstable``, never as a frequency."""
@@ -305,7 +317,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                "unstable_modes": unstable_modes(freqs), "com_disagreement": disagreement,
                "printed_frequencies_hz": printed, "vibration": vibration,
                "deployment": deployment}
-    (out / "report.json").write_text(json.dumps(with_units(summary), indent=1))
+    summary = finite_or_none(summary)
+    (out / "report.json").write_text(json.dumps(with_units(summary), indent=1, allow_nan=False))
     add("report.json", out / "report.json")
     _index(out, system, summary, files, tables["rows"], notes, freqs, printed, statics)
     add("index.md", out / "index.md")
