@@ -89,7 +89,8 @@ def test_hinf_of_a_deployable_named_like_a_preset_uses_its_own_scales(impostors,
     r, out = run(["control", "hinf", str(impostors[2])], capsys)
     assert r["open_loop_f_max_printed_hz"] is None
     assert r["u_m"] == pytest.approx(0.005 * 2.2)
-    r_pbh, _ = run(["control", "pbh", str(impostors[2])], capsys)
+    pbh, _ = run(["control", "pbh", str(impostors[2])], capsys)
+    assert pbh["open_loop_f_max_printed_hz"] is None and pbh["pbh"]["controllable"]
     assert r["alpha"] != 0.5 and r["closed_loop_max_real_part"] < -r["alpha"]
     assert_no_dissertation(out)
 

@@ -43,14 +43,13 @@ def name_lookups(tree) -> list:
             if isinstance(n, ast.Assign) and _is_system_name(n.value):
                 names |= {t.id for t in n.targets if isinstance(t, ast.Name)}
         for n in ast.walk(scope):
-            if isinstance(n, ast.Subscript) and tainted(n.slice, names):
-                found.append((n.lineno, ast.unparse(n)))
-            elif (isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)
-                  and n.func.attr in ("get", "pop", "setdefault") and n.args
-                  and tainted(n.args[0], names)):
-                found.append((n.lineno, ast.unparse(n)))
-            elif isinstance(n, ast.Compare) and (
-                    tainted(n.left, names) or any(tainted(c, names) for c in n.comparators)):
+            subscript = isinstance(n, ast.Subscript) and tainted(n.slice, names)
+            getter = (isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)
+                      and n.func.attr in ("get", "pop", "setdefault") and bool(n.args)
+                      and tainted(n.args[0], names))
+            compare = isinstance(n, ast.Compare) and (
+                tainted(n.left, names) or any(tainted(c, names) for c in n.comparators))
+            if subscript or getter or compare:
                 found.append((n.lineno, ast.unparse(n)))
     return sorted(set(found))
 

@@ -108,11 +108,11 @@ def format_assist(r: dict) -> str:
         head = (f"{r['system']}: stage bases at theta = {s['theta_deg'][0]:g} deg, psi_1 = "
                 f"{s['psi_deg'][0]:g} deg: " + ("feasible" if r["feasible"] else "NOT feasible")
                 + f" (null-vector margin {r['margin']:.3g}, Delta = {1e3 * r['Delta']:.4g} mm)")
-        tail = ([f"Delta is small: set r_mb with `--target-delta` after writing these bases "
-                 f"(R_M - r_mb = Delta, eq. 3.22)"] if r["feasible"] and r["Delta"] < 1e-4 else [])
+        tail = (["Delta is small: set r_mb with `--target-delta` after writing these bases "
+                 "(R_M - r_mb = Delta, eq. 3.22)"] if r["feasible"] and r["Delta"] < 1e-4 else [])
         if r.get("r_mb") is not None:
-            tail = [f"no bases stretch the file's membrane; with these the membrane radius "
-                    f"[membrane] r_mb = {r['r_mb']:.6g} m gives Delta = {1e3 * r['Delta']:.4g} mm"]
+            tail = [(f"no bases stretch the file's membrane; with these the membrane radius "
+                     f"[membrane] r_mb = {r['r_mb']:.6g} m gives Delta = {1e3 * r['Delta']:.4g} mm")]
         return "\n".join([head, "[symmetric]"] + [f"{k} = {v}" for k, v in s.items()] + tail)
     bands = ", ".join(f"[{a:g}, {b:g}]" for a, b in r["psi_deg_bands"])
     return (f"{r['system']}: at theta = {r['theta_deg']:g} deg the system is a feasible 1-N(D) "

@@ -253,10 +253,9 @@ def _report(t: dict, where: str) -> ReportSettings:
             for v in pert.values())):
         raise InputError(f"{w}: expected 'perturbation' as a table coordinate = number, found {pert!r}")
     implied = t.get("implied_rest_lengths")
-    if implied is not None:
-        if not (isinstance(implied, dict) and implied and all(
-                _positive({k: v}, k, w) for k, v in implied.items())):
-            raise InputError(f"{w}: expected 'implied_rest_lengths' as a table of rest lengths, "
+    if implied is not None and not (isinstance(implied, dict) and implied and all(
+            _positive({k: v}, k, w) for k, v in implied.items())):
+        raise InputError(f"{w}: expected 'implied_rest_lengths' as a table of rest lengths, "
                              f"found {implied!r}")
     dep = t.get("deployment")
     if dep is not None:
