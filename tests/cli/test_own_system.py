@@ -237,3 +237,12 @@ def test_report_values_that_could_not_be_computed_are_absent_not_nan():
     from tmfem.reference.report import finite_or_none
     assert finite_or_none({"a": [1.0, float("nan")], "b": np.inf, "c": (2, np.float64("nan"))}) == \
         {"a": [1.0, None], "b": None, "c": [2, None]}
+
+
+def test_vibrate_without_perturb_starts_from_the_files_perturbation(capsys):
+    """`vibrate FILE` without --perturb: the default theta_11_dot = 0.01 rad/s (a run from the
+    equilibrium itself would stay there): the symmetric equilibrium (all theta_1j equal, eq.
+    3.19) is left, theta_11 and theta_12 differ at the end."""
+    r, _ = run(["vibrate", str(SYSTEMS / "triangle-1-3.toml"), "--t-end", "0.5"], capsys)
+    assert r["perturbation"] == {"theta_11_dot": 0.01}
+    assert abs(r["final"]["theta_11"] - r["final"]["theta_12"]) > 1e-4
