@@ -14,9 +14,8 @@ from __future__ import annotations
 import argparse
 
 from tmfem.errors import TmfemError
-from tmfem.reference.tables import HIGHEST_COM_FREQUENCY
 from tmfem.models.com.model import default_membrane_modes
-from tmfem.reference.com_modal import (                                 dissertation_com_frequencies, frequency_study, modal_summary)
+from tmfem.reference.com_modal import (dissertation_com_frequencies, frequency_study, modal_summary)
 from tmfem.system import load_preset
 
 
@@ -48,7 +47,7 @@ def table(name: str, k_study, plot_dir=None) -> None:
     r2 = modal_summary(system, modes=12, membrane_modes=K, prestress_scale=s) if s else None
     sb = r1.get("printed_bar_load_prestress_scale")
     r3 = modal_summary(system, modes=12, membrane_modes=K, prestress_scale=sb) if sb else None
-    ref = dissertation_com_frequencies(name)
+    ref = dissertation_com_frequencies(system)
     print(f"\n{name}: COM with K = {K} membrane modes, {r1['sizes']['n_z']} coordinates")
     forces = sorted({round(float(v), 4) for v in r1['design_tendon_forces'].values()})
     print(f"designed prestress: tendon forces {forces} N")
@@ -74,7 +73,7 @@ def table(name: str, k_study, plot_dir=None) -> None:
             f3 = r3["freq_hz"][i]
             line += f" {f3:>12.4f} {f3 / p - 1:>+7.2%}"
         print(line)
-    hp = HIGHEST_COM_FREQUENCY.get(name)
+    hp = ref[2] if ref else None
     print(f"highest COM frequency: printed {hp}, designed {r1['highest_hz']:.4f}"
           + (f", printed-stress {r2['highest_hz']:.4f}" if r2 else "")
           + (f", printed-load {r3['highest_hz']:.4f}" if r3 else ""))

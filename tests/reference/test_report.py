@@ -15,8 +15,9 @@ def report(tmp_path_factory):
     from tmfem.reference import report as rep
     out = tmp_path_factory.mktemp("report") / "1-4"
     with pytest.MonkeyPatch.context() as mp:
-        mp.setitem(rep.REPORT_DEPLOYMENT, "1-4", {**rep.REPORT_DEPLOYMENT["1-4"], "t_end": 0.3,
-                                                  "controller": "adaptive-lqr"})
+        own = rep.report_deployment
+        mp.setattr(rep, "report_deployment",
+                   lambda s: {**own(s), "t_end": 0.3, "controller": "adaptive-lqr"})
         rc = main(["report", "--preset", "1-4", "--out", str(out), "--mesh", "4", "--t-end", "0.2",
                    "--modes", "6", "--no-render", "--json"])
     assert rc == 0
@@ -58,7 +59,7 @@ def test_tables_carry_units_and_both_prestress_levels(report):
     f = r["frequencies_hz"]
     assert f["SBC implied"][0] == pytest.approx(f["MTC implied"][0], rel=5e-3)
     d = r["deployment"]
-    assert d["preset"] == "1-4D" and d["t_end_s"] == pytest.approx(0.3)
+    assert d["system"] == "1-4D" and d["t_end_s"] == pytest.approx(0.3)
     head = next(csv.reader(open(report / "deploy-1-4D.csv")))
     assert head[0] == "t [s]" and "w_1 [m]" in head and "eta_energy [J]" in head
     assert all("[" in h for h in head) and head[-1] == "controller [-]"

@@ -1,17 +1,18 @@
-"""``tmfem compare``: the SBC, MTC and COM models side by side -- natural frequencies beside
-Tables 6.6/6.7 (6.4), or with ``--vibrate`` free vibration from the same perturbation (6.5)."""
+"""``tmfem compare``: the SBC, MTC and COM models side by side -- natural frequencies (beside
+the printed ones when the file has them: Tables 6.6/6.7 for 1-4 and 2-3, 6.4), or with
+``--vibrate`` free vibration from the same perturbation (6.5)."""
 from __future__ import annotations
 
 import sys
 
-from tmfem.cli.common import (Progress, check_time_steps, finite_float, output_file,
-                              parse_perturbation, positive_int)
+from tmfem.cli.common import (Progress, add_system_args, check_time_steps, finite_float,
+                              output_file, parse_perturbation, positive_int, system_from_args)
 from tmfem.errors import InputError
 from tmfem.solvers.backends import backend_names
 
 NAME = "compare"
-HELP = ("the three models (SBC, MTC, COM) side by side: frequencies beside Tables 6.6/6.7, or "
-        "free vibration from one perturbation (--vibrate)")
+HELP = ("the three models (SBC, MTC, COM) side by side: frequencies (beside the printed ones, "
+        "Tables 6.6/6.7 for 1-4 and 2-3), or free vibration from one perturbation (--vibrate)")
 
 #: options of each mode, refused in the other
 FREQUENCY_ONLY = ("modes",)
@@ -19,7 +20,7 @@ VIBRATE_ONLY = ("t_end", "dt", "perturb")
 
 
 def configure(parser) -> None:
-    parser.add_argument("--preset", required=True, help="system of Tables 6.6/6.7: 1-4 or 2-3")
+    add_system_args(parser)
     parser.add_argument("--mesh", type=positive_int, default=10,
                         help="FE membrane elements per side of each quadrilateral (6.4: 10; "
                              "6.5: 10, the '20 x 20' square of 6.5.1 is 4 x 10 x 10)")
@@ -36,15 +37,20 @@ def configure(parser) -> None:
     parser.add_argument("--dt", type=finite_float, default=None,
                         help="--vibrate: time step [s] (default 0.01, as 6.5)")
     parser.add_argument("--perturb", action="append", default=None, metavar="STATE=VALUE",
-                        help="--vibrate: initial perturbation (default 6.5's: theta_12_dot=0.01 "
-                             "for 1-4, theta_11_dot=0.01 for 2-3; repeatable)")
+                        help="--vibrate: initial perturbation (default the file's [report] "
+                             "perturbation: 6.5's theta_12_dot=0.01 for 1-4, theta_11_dot=0.01 "
+                             "otherwise; repeatable)")
     parser.add_argument("--csv", help="write the table (frequencies) or the histories to this CSV")
     parser.add_argument("--plot", help="PNG: frequencies and differences, or the overlaid histories")
 
 
 def run(args) -> dict:
-    from tmfem.reference.model_compare import paper_state
-    paper_state(args.preset)
+    from tmfem.reference.model_compare import compared_system
+    if args.as_printed:
+        raise InputError("--as-printed: option does not apply: each model is taken at the "
+                         "prestress the file names (docs/guides/system-file.md, [report])")
+    args.system = compared_system(system_from_args(args))
+    args.preset = args.system.name
     mine, other = (VIBRATE_ONLY, FREQUENCY_ONLY) if args.vibrate else (FREQUENCY_ONLY, VIBRATE_ONLY)
     wrong = [d for d in other if getattr(args, d) is not None]
     if wrong:
@@ -53,13 +59,17 @@ def run(args) -> dict:
                          f"{flags} ({'without' if args.vibrate is False else 'with'} --vibrate)")
     output_file(args.csv, option="--csv", suffixes=(".csv",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
+    if args.plot and not args.vibrate and "frequencies_hz" not in args.system.printed:
+        raise InputError(f"--plot: option does not apply: the plot sets the three models beside "
+                         f"printed frequencies, and {args.preset} has none ([printed."
+                         "frequencies_hz]); use --csv")
     return run_vibration(args) if args.vibrate else run_frequencies(args)
 
 
 def run_frequencies(args) -> dict:
     from tmfem.reference.model_compare import compare_frequencies, write_compare_csv
     with Progress(total=3, desc=f"compare {args.preset}") as bar:
-        r = compare_frequencies(args.preset, modes=args.modes or 12, mesh_n=args.mesh,
+        r = compare_frequencies(args.system, modes=args.modes or 12, mesh_n=args.mesh,
                                 tendon_elements=args.tendon_elements, backend=args.backend,
                                 progress=bar.step)
     if args.csv:
@@ -78,7 +88,7 @@ def run_vibration(args) -> dict:
     t_end = 10.0 if args.t_end is None else args.t_end
     dt = 0.01 if args.dt is None else args.dt
     check_time_steps(t_end=t_end, dt=dt)
-    system = fe_system(args.preset)
+    system = fe_system(args.system)
     pert = parse_perturbation(args.perturb, perturbation_names(system)) if args.perturb else None
     print(f"tmfem compare --vibrate: {args.preset}, {t_end:g} s at dt = {dt:g} s, FE mesh "
           f"{args.mesh}", file=sys.stderr)
@@ -86,7 +96,7 @@ def run_vibration(args) -> dict:
         def progress(model):
             bar.step(model)
             return bar.callback(f"{model} steps")
-        r = three_model_vibration(args.preset, t_end=t_end, dt=dt, perturb=pert, mesh_n=args.mesh,
+        r = three_model_vibration(args.system, t_end=t_end, dt=dt, perturb=pert, mesh_n=args.mesh,
                                   tendon_elements=args.tendon_elements, backend=args.backend,
                                   progress=progress)
     out = dict(r["comparison"])

@@ -141,7 +141,9 @@ def format_text(r: dict) -> str:
                 f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} (alpha_1 = {r['alpha']:g}): ok")
     p = r["pbh"]
     lines = [f"system {r['system']}: {r['n_states']} states, {r['n_inputs']} inputs",
-             f"open-loop f_max = {r['open_loop_f_max_hz']:.4f} Hz (printed {r['open_loop_f_max_printed_hz']})",
+             f"open-loop f_max = {r['open_loop_f_max_hz']:.4f} Hz"
+             + ("" if r['open_loop_f_max_printed_hz'] is None else
+                f" (printed {r['open_loop_f_max_printed_hz']})"),
              f"PBH (tol {p['tol']:g}): controllable {p['controllable']} (least margin "
              f"{p['least_controllable']['margin']:.3g} at {p['least_controllable']['frequency_hz']:.3f} Hz), "
              f"observable {p['observable']} (least margin {p['least_observable']['margin']:.3g})"]
@@ -157,4 +159,5 @@ def format_text(r: dict) -> str:
             lines.append(f"saved {r['saved']}")
         if "plot" in r:
             lines.append(f"plot {r['plot']}")
+    lines += [f"note: {n}" for n in r.get("notes", [])]
     return "\n".join(lines)

@@ -1,6 +1,8 @@
-"""``tmfem deploy``: closed-loop deployment of a 1-N(D) or 2-3 system (dissertation 7.4).
+"""``tmfem deploy``: closed-loop deployment of a system from its packaged to its deployed
+configuration (dissertation 7.4, 8.4).
 
-The 7.4 parameters of each deployment are :data:`tmfem.reference.deployments.DEPLOYMENTS`.
+The parameters of a deployment are the system file's (``[packaged]``, ``[deployment]``,
+``[control]``, ``[lpv]``: :mod:`tmfem.reference.deployments`, docs/guides/system-file.md).
 Every option and output path is checked before the controller design (docs/guides/cli.md).
 """
 from __future__ import annotations
@@ -14,15 +16,19 @@ from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_mesh_budget, check_time_steps, output_dir, output_file,
                               positive_float, progress_bar)
 from tmfem.errors import InputError
-from tmfem.reference.deployments import (CONTROLLERS, DEPLOYMENTS, LPV_CONTROLLERS, LPV_DEPLOYMENTS,
-                                         UNCERTAINTIES, check_choices, setup, write_outputs)
-from tmfem.system.presets import load_preset
+from tmfem.reference.deployments import (CONTROLLERS, LPV_CONTROLLERS, UNCERTAINTIES, check_choices,
+                                         own_path, setup, write_outputs)
 
 NAME = "deploy"
 HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
 
 def configure(parser) -> None:
-    parser.add_argument("--preset", required=True, choices=sorted(DEPLOYMENTS) + sorted(LPV_DEPLOYMENTS))
+    parser.add_argument("spec", nargs="?", help="system file (TOML) with [packaged] and "
+                                                "[deployment] tables; or use --preset")
+    from tmfem.system.presets import list_presets
+    parser.add_argument("--preset", choices=list_presets(),
+                        help="built-in system with a deployment (1-4D, 1-6D, 2-3-deploy; "
+                             "2-3-lpv: the LPV deployment of 8.4)")
     parser.add_argument("--controller", default=None, choices=sorted(CONTROLLERS) + list(LPV_CONTROLLERS),
                         help="7.4 presets: adaptive PFL then a linear controller about the final equilibrium: "
                              "adaptive-hinf (default; the H-infinity controller of 7.3: the central one at "
@@ -111,6 +117,20 @@ def configure(parser) -> None:
     deploy_lpv.configure(parser)
 
 
+def deployed_system(args):
+    """``args.system``: the System of ``spec`` or ``--preset`` (exactly one); ``args.preset``
+    becomes its label in titles and the JSON (the preset name, or the file's system name)."""
+    from tmfem.cli.common import system_from_args
+    args.as_printed = False
+    args.system = system_from_args(args)
+    if args.preset is None:
+        args.preset = args.system.name
+    pr = args.system.problem
+    if pr.lpv is None and (pr.packaged is None or pr.deployment is None):
+        check_choices(args.system)                   # names the missing tables
+    return args.system
+
+
 def pfl_gains(text: str) -> tuple:
     """argparse ``type`` of ``--gains``: four comma-separated numbers omega_0, omega_e, tau,
     d_c (checked by :class:`tmfem.control.deployment.adaptive.Gains`)."""
@@ -140,13 +160,18 @@ def run(args) -> dict:
     output_dir(args.vtk, option="--vtk")
     output_file(args.compare_plot, option="--compare-plot", suffixes=(".png",))
     output_file(args.compare_csv, option="--compare-csv", suffixes=(".csv",))
-    lpv = args.preset in LPV_DEPLOYMENTS
+    deployed_system(args)
+    lpv = args.system.problem.lpv is not None and args.system.problem.deployment is None
     args.controller = args.controller or ("lpv" if lpv else "adaptive-hinf")
     if lpv != (args.controller in LPV_CONTROLLERS):
         raise InputError(f"--controller {args.controller}: expected one of "
                          f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
+        if args.spec is not None:
+            raise InputError(f"tmfem deploy {args.spec}: the LPV deployment (8.4) runs on the preset "
+                             "2-3-lpv only (--preset 2-3-lpv); a system file deploys with its "
+                             "[packaged] and [deployment] tables (7.4)")
         deploy_lpv.check(args)
         return deploy_lpv.run(args, mesh_n=check_plant(args))
     lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise", "estimator_interpolation",
@@ -154,14 +179,14 @@ def run(args) -> dict:
     if lpv_opts:
         raise InputError(f"options {lpv_opts} apply to --controller lpv only, found --controller {args.controller}")
     args.allocation = args.allocation or "bounded"
-    check_choices(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+    check_choices(args.system, controller=args.controller, uncertainty=args.uncertainty,
                   path=args.path)
     mesh_n = check_plant(args)
     t0 = time.perf_counter()
     plants = reference.FEPlantOptions.of(args)
     pfl_at = plants.pfl_evaluation(args.pfl_at)
-    tendons = plants.pfl_tendon_model(args.uncertainty or DEPLOYMENTS[args.preset]["uncertainty"])
-    s = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+    tendons = plants.pfl_tendon_model(args.uncertainty or args.system.problem.deployment.uncertainty)
+    s = setup(args.system, controller=args.controller, uncertainty=args.uncertainty,
               allocation=args.allocation, path=args.path, evaluation=pfl_at,
               tendon_law=tendons, gains=args.gains)
     warnings = plants.tendon_model_warnings(tendons)
@@ -173,7 +198,7 @@ def run(args) -> dict:
             "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons,
             "pfl_gains": list(astuple(s.adaptive.gains))}
     out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
-           **ctrl, "path": args.path or DEPLOYMENTS[args.preset]["path"],
+           **ctrl, "path": args.path or own_path(args.system),
            **r.summary(), **s.info}
     title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
              f"uncertainty {s.adaptive.uncertainty}")
@@ -182,7 +207,7 @@ def run(args) -> dict:
     out["warnings"] = warnings
     if args.compare_plant:
         def rerun(kind):
-            s2 = setup(args.preset, controller=args.controller, uncertainty=args.uncertainty,
+            s2 = setup(args.system, controller=args.controller, uncertainty=args.uncertainty,
                        allocation=args.allocation, path=args.path, evaluation=pfl_at,
                        tendon_law=tendons, gains=args.gains)
             return _run_on(args, s2, kind, mesh_n), {}
@@ -204,7 +229,7 @@ def _run_on(args, s, plant_kind: str, mesh_n):
     (:func:`tmfem.reference.deployment_plants.run_on_plant`)."""
     with progress_bar(args.t_end, args.dt, f"deploy {args.preset} on {plant_kind}") as bar:
         return reference.run_on_plant(s, kind=plant_kind, options=reference.FEPlantOptions.of(args),
-                                      initial=reference.packaged_system(args.preset), mesh_n=mesh_n,
+                                      initial=s.model.system.problem.packaged, mesh_n=mesh_n,
                                       t_end=args.t_end, dt=args.dt, progress=bar)
 
 
@@ -256,7 +281,7 @@ def check_plant(args) -> int | None:
         raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "
                          f"law only (EA fixed, k = EA / r); expected no --plant-tendons with "
                          f"--plant sbc, found --plant-tendons {args.plant_tendons}")
-    system = load_preset(args.preset)
+    system = args.system
     if system.deployable and "mtc" in fe:
         raise InputError(f"--plant mtc: {args.preset} is a 1-N(D) system (tendons attached at "
                          "H_1j along the bars), which the MTC model cannot represent; expected a "

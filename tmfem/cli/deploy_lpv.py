@@ -23,9 +23,7 @@ from tmfem.cli import lpv_options
 from tmfem.cli.common import progress_bar
 from tmfem.control import lpv
 from tmfem.errors import InfeasibleController, InputError
-from tmfem.reference.deployments import LPV_DEPLOYMENTS
 from tmfem.reference.tables import deployment_bases
-from tmfem.system import load_preset
 
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
 SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
@@ -62,7 +60,7 @@ def check(args) -> None:
     """Refusals before any work: options of the 7.4 deployments, the paths (the FE plant's
     options are those of the 7.4 deployments, checked by :mod:`tmfem.cli.deploy`)."""
     bad = given(args, NOT_LPV)
-    own = LPV_DEPLOYMENTS[args.preset]["path"]
+    own = args.system.problem.lpv.path
     if args.path not in (None, own):
         bad.append(f"--path {args.path}")
     if bad:
@@ -89,7 +87,7 @@ def design(args, preset: str):
     (sampled at --dt), or synthesized and verified on the finer grid."""
     if args.lpv_controller is not None:
         d = lpv.LPVStateFeedback.load(args.lpv_controller)
-        s = load_preset(preset)
+        s = args.system
         n = int(np.prod([a.size for a in d.axes]))
         print(f"tmfem deploy: {preset}: rebuilding the design plant at its {n} grid points", file=sys.stderr)
         try:
@@ -151,7 +149,7 @@ def run(args, *, mesh_n) -> dict:
         raise InputError(f"--noise: expected a standard deviation >= 0, found {args.noise}")
     t0 = time.perf_counter()
     plant, d, info = DESIGNS[args.controller](args, args.preset)
-    dep = reference.lpv_setup(args.preset, plant)
+    dep = reference.lpv_setup(args.system, plant)
     est = {}          # the output feedback's estimator options (check: lpv-output only)
     if args.estimator_interpolation:
         est["interpolation"] = args.estimator_interpolation
@@ -169,7 +167,7 @@ def run(args, *, mesh_n) -> dict:
             "estimator_refine": (args.estimator_refine or 1) if args.controller == "lpv-output" else None}
     plants = reference.FEPlantOptions.of(args)
     out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
-           **ctrl, "path": LPV_DEPLOYMENTS[args.preset]["path"], **r.summary(), **s.info,
+           **ctrl, "path": args.system.problem.lpv.path, **r.summary(), **s.info,
            **_figures(r), **info}
     title = f"{args.preset} deployment on the {args.plant} plant: {args.controller} (gamma = {d.gamma:.4g}), eq. 5.100"
     out.update(reference.write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,

@@ -26,6 +26,18 @@ def configure(parser) -> None:
                         help="print the design even when an equilibrium condition is violated")
     add_attachment_args(parser)
     add_membrane_law_arg(parser)
+    g = parser.add_argument_group("design assistance (symmetric systems, docs/guides/system-file.md)")
+    g.add_argument("--target-delta", type=float, metavar="MM",
+                   help="solve for the membrane radius r_mb that gives this corner displacement "
+                        "Delta [mm] (eq. 3.22), print it with the feasible range, and design with it")
+    g.add_argument("--bases", action="store_true",
+                   help="M >= 2: search stage bases (r_i, z_i, sigma_i) with a positive null vector "
+                        "and Delta > 0 at the file's theta, psi; print them as [symmetric] entries "
+                        "(degrees, metres)")
+    g.add_argument("--packaged", type=float, metavar="THETA_DEG",
+                   help="1-N(D): the band of psi at this theta [deg] where the system is a feasible "
+                        "equilibrium, and the psi whose Delta matches the deployed one (a "
+                        "[packaged] configuration)")
 
 
 def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point",
@@ -58,12 +70,56 @@ def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point
 
 
 def run(args) -> dict:
+    from tmfem.equilibrium import assist
+    from tmfem.errors import InfeasibleDesign
     system = system_from_args(args)
-    out, _ = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible,
-                           attachment=args.attachment, patch=args.patch,
-                              membrane_law=args.membrane_law)
+    chosen = [o for o, v in (("--target-delta", args.target_delta), ("--bases", args.bases or None),
+                             ("--packaged", args.packaged)) if v is not None]
+    if len(chosen) > 1:
+        raise InputError(f"expected at most one of --target-delta, --bases, --packaged, found {chosen}")
+    if args.bases:
+        return {"system": system.name, "assist": "bases", **assist.feasible_bases(system)}
+    if args.packaged is not None:
+        return {"system": system.name, "assist": "packaged",
+                **assist.packaged_configurations(system, theta_deg=args.packaged)}
+    radius = None
+    if args.target_delta is not None:
+        radius = assist.membrane_radius_for_delta(system, delta=args.target_delta * 1e-3)
+        system = assist.with_membrane_radius(system, radius["r_mb"])
+    try:
+        out, _ = design_result(system, mesh_n=args.mesh, strict=not args.allow_infeasible,
+                               attachment=args.attachment, patch=args.patch,
+                               membrane_law=args.membrane_law)
+    except InfeasibleDesign as exc:
+        hint = assist.infeasibility_hint(system, exc)
+        if not hint:
+            raise
+        raise type(exc)(f"{exc}; {hint}") from None
     out["as_printed"] = bool(args.as_printed)
+    if radius is not None:
+        out["membrane_radius"] = radius
     return out
+
+
+def format_assist(r: dict) -> str:
+    """Text of ``--bases`` and ``--packaged``."""
+    if r["assist"] == "bases":
+        s = r["symmetric"]
+        head = (f"{r['system']}: stage bases at theta = {s['theta_deg'][0]:g} deg, psi_1 = "
+                f"{s['psi_deg'][0]:g} deg: " + ("feasible" if r["feasible"] else "NOT feasible")
+                + f" (null-vector margin {r['margin']:.3g}, Delta = {1e3 * r['Delta']:.4g} mm)")
+        tail = (["Delta is small: set r_mb with `--target-delta` after writing these bases "
+                 "(R_M - r_mb = Delta, eq. 3.22)"] if r["feasible"] and r["Delta"] < 1e-4 else [])
+        if r.get("r_mb") is not None:
+            tail = [(f"no bases stretch the file's membrane; with these the membrane radius "
+                     f"[membrane] r_mb = {r['r_mb']:.6g} m gives Delta = {1e3 * r['Delta']:.4g} mm")]
+        return "\n".join([head, "[symmetric]"] + [f"{k} = {v}" for k, v in s.items()] + tail)
+    bands = ", ".join(f"[{a:g}, {b:g}]" for a, b in r["psi_deg_bands"])
+    return (f"{r['system']}: at theta = {r['theta_deg']:g} deg the system is a feasible 1-N(D) "
+            f"equilibrium for psi in {bands} deg (steps of {r['step_deg']:g} deg)"
+            + f"; psi = {r['psi_deg']:g} deg gives Delta = {1e3 * r['Delta']:.4g} mm (deployed "
+            f"{1e3 * r['Delta_deployed']:.4g} mm):\n[packaged]\nsymmetric = {{ theta_deg = "
+            f"[{r['theta_deg']:g}], psi_deg = [{r['psi_deg']:g}] }}")
 
 
 def _groups(r: dict) -> dict:
@@ -75,6 +131,8 @@ def _groups(r: dict) -> dict:
 
 
 def format_text(r: dict) -> str:
+    if "assist" in r:
+        return format_assist(r)
     L = [f"system {r['system']} ({r['M']}-{r['N']}{'(D)' if r['deployable'] else ''}), "
          f"membrane mesh {r['mesh_n']}x{r['mesh_n']} per patch"
          + (f", distributed corners (patch radius {r['patch']:.4g} m)"
@@ -87,6 +145,11 @@ def format_text(r: dict) -> str:
     for lab, x in r["nodes"].items():
         L.append(f"  {lab:<6} {x[0]:10.5f} {x[1]:10.5f} {x[2]:10.5f}")
     L.append("")
+    if r.get("membrane_radius"):
+        m = r["membrane_radius"]
+        L.append(f"membrane radius r_mb = {m['r_mb']:.6g} m for Delta = {1e3 * m['Delta']:.4g} mm "
+                 f"(eq. 3.22; the membrane is stretched for r_mb < {m['r_mb_max']:.6g} m; the "
+                 f"file's r_mb = {m['r_mb_file']:.6g} m gives Delta = {1e3 * m['Delta_file']:.4g} mm)")
     if r["Delta"] is not None:
         L.append(f"membrane corner displacement Delta (eq. 3.22) = {r['Delta'] * 1e3:.5g} mm")
     L.append(f"membrane corner force F_Delta (mean radial)   = {r['F_Delta']:.5g} N")

@@ -51,7 +51,7 @@ def run(args) -> dict:
         return modal_summary(system, modes=args.modes, membrane_modes=K,
                              prestress_scale=options["prestress_scale"], mesh_n=options["mesh"],
                              membrane_law=options["membrane_law"])
-    from tmfem.reference.tables import FREQUENCIES
+    from tmfem.reference.tables import printed_frequencies
     from tmfem.models.mtc.post import static_summary
     from tmfem.post.mtc import model_cells
     model, options = model_from_args(args, NAME)
@@ -59,7 +59,7 @@ def run(args) -> dict:
         raise InputError(f"--modes {args.modes}: expected fewer modes than the model's "
                          f"{model.ndof} free DOFs")
     if args.model == "sbc":
-        return with_eig_solver(sbc_modal(args, model, FREQUENCIES), model)
+        return with_eig_solver(sbc_modal(args, model, printed_frequencies(model.system)), model)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
     res, modes = mtc_modes(model, k=args.modes, start=options["start"],
@@ -73,10 +73,10 @@ def run(args) -> dict:
            "tendon_stress_max": st["tendon_stress_max"], "bar_load_max": st["bar_load_max"],
            "Delta_mean": float(np.mean(st["Delta"])),
            "freq_hz": modes.freq_hz.tolist()}
-    ref = FREQUENCIES.get(system_name)
-    if ref is not None:
+    ref = printed_frequencies(model.system)
+    if ref is not None and "MTC" in ref:
         n = min(len(ref["MTC"]), args.modes)
-        out["dissertation"] = {"source": ref["source"], "MTC": ref["MTC"][:n], "SBC": ref["SBC"][:n]}
+        out["dissertation"] = {"source": ref.get("source", "printed"), "MTC": ref.get("MTC", [])[:n], "SBC": ref.get("SBC", [])[:n]}
         out["relative_difference_to_MTC"] = (modes.freq_hz[:n] / np.array(ref["MTC"][:n]) - 1).tolist()
     if args.vtk or args.png:
         shapes = model.topology.T @ modes.shapes
@@ -101,9 +101,10 @@ def with_eig_solver(out: dict, model) -> dict:
     return out if ran is None else {**out, "eig_solver": ran}
 
 
-def sbc_modal(args, model, tables) -> dict:
+def sbc_modal(args, model, ref) -> dict:
     """``tmfem modal --model sbc``: equilibrium from the undeformed membrane, modes, and the
-    printed SBC column of Tables 6.6/6.7 (``tables``) when the system has one."""
+    printed columns ``ref`` (the file's ``[printed.frequencies_hz]``, Tables 6.6/6.7 for the
+    presets) when the system has them."""
     from tmfem.models.sbc.post import modal_summary
     print(f"tmfem modal: {model.system.name} SBC, {model.ndof} free dofs", file=sys.stderr)
     res = model.solve_static(monitor=default_monitor(model.system))
@@ -123,10 +124,9 @@ def sbc_modal(args, model, tables) -> dict:
             out["png"] = str(render_modes(args.png, points=res.state.x, cells=cells, shapes=shapes,
                                           freq_hz=modes.freq_hz, k=min(6, args.modes),
                                           title=f"{model.system.name} SBC modes"))
-    ref = tables.get(model.system.name)
-    if ref is not None:
+    if ref is not None and "SBC" in ref:
         n = min(len(ref["SBC"]), args.modes)
-        out["dissertation"] = {"source": ref["source"], "MTC": ref["MTC"][:n], "SBC": ref["SBC"][:n]}
+        out["dissertation"] = {"source": ref.get("source", "printed"), "MTC": ref.get("MTC", [])[:n], "SBC": ref.get("SBC", [])[:n]}
     return out
 
 

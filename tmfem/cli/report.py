@@ -19,8 +19,8 @@ from tmfem.errors import InputError
 
 NAME = "report"
 HELP = ("complete analysis of a system (design, FE statics, 12 modes of the MTC, SBC and COM "
-        "models beside the dissertation, free vibration, deployment) as a report directory "
-        "with index.md")
+        "models beside the printed ones when the file has them, free vibration, deployment) as a "
+        "report directory with index.md")
 
 
 def configure(parser) -> None:
@@ -29,8 +29,9 @@ def configure(parser) -> None:
                         help="output directory (created; checked writable before any work)")
     parser.add_argument("--mesh", type=positive_int, default=10, metavar="n",
                         help="membrane mesh n x n per quadrilateral patch (default 10, as in 6.2)")
-    parser.add_argument("--modes", type=positive_int, default=12,
-                        help="number of modes (default 12, as in Table 6.6)")
+    parser.add_argument("--modes", type=positive_int, default=None,
+                        help="number of modes (default 12, as in Table 6.6, or all the "
+                             "coordinates of the control-oriented model when it has fewer)")
     parser.add_argument("--t-end", type=positive_float, default=10.0,
                         help="free-vibration duration [s] (default 10)")
     parser.add_argument("--dt", type=positive_float, default=0.01,
@@ -38,21 +39,28 @@ def configure(parser) -> None:
     parser.add_argument("--no-render", action="store_true",
                         help="skip the pyvista renders (default: render)")
     parser.add_argument("--no-deploy", action="store_true",
-                        help="skip the deployment of 7.4 (default: run it when the system has "
-                             "one, 1-4 -> 1-4D)")
+                        help="skip the deployment of 7.4 (default: run it when the system file "
+                             "declares one: [report] deployment, or [packaged] with [deployment]; "
+                             "the preset 1-4 runs 1-4D)")
 
 
 def run(args) -> dict:
-    from tmfem.reference.report import REPORT_DEPLOYMENT, STEPS, write_report
+    from tmfem.reference.report import STEPS, report_deployment, write_report
 
     system = system_from_args(args)
+    if args.modes is None:
+        args.modes = min(12, com_coordinates(system))
+        if args.modes < 12:
+            print(f"tmfem report: {args.modes} modes: the control-oriented model of {system.name} "
+                  f"has {args.modes} coordinates", file=sys.stderr)
     check_model_budget(system, mesh=args.mesh, tendon_elements=3, modes=args.modes)
     check_com_modes(system, modes=args.modes)
     check_time_steps(t_end=args.t_end, dt=args.dt)
-    deployment = REPORT_DEPLOYMENT.get(system.name)
+    deployment = report_deployment(system)
     if deployment is None and args.no_deploy:
         raise InputError(f"--no-deploy: option does not apply: system {system.name!r} has no "
-                         f"deployment in the report (those that have: {sorted(REPORT_DEPLOYMENT)})")
+                         "deployment in the report (its file has no [report] deployment and no "
+                         "[packaged] with [deployment])")
     if deployment is not None and not args.no_deploy:
         check_time_steps(t_end=deployment["t_end"], dt=args.dt)
     out = output_dir(args.out, option="--out")
@@ -67,6 +75,12 @@ def run(args) -> dict:
     return result
 
 
+def com_coordinates(system) -> int:
+    """n_q + K: the coordinates of the system's control-oriented model (K of ``[models.com]``)."""
+    from tmfem.models.com.model import default_membrane_modes
+    return len(system.q_names) + default_membrane_modes(system)
+
+
 def format_text(r: dict) -> str:
     from tabulate import tabulate
 
@@ -76,28 +90,34 @@ def format_text(r: dict) -> str:
     head = ["mode"] + [f"{k} [Hz]" for k in f] + ([f"{m} printed" for m in printed_cols] if pr else [])
     rows = []
     for i in range(r["modes"]):
-        row = [i + 1] + [f"{v[i]:.4f}" if i < len(v) else "-" for v in f.values()]
+        row = [i + 1] + [("unstable" if v[i] < 0 else f"{v[i]:.4f}") if i < len(v) else "-"
+                         for v in f.values()]
         if pr:
             row += [f"{pr[m][i]:.4f}" if i < len(pr[m]) else "-" for m in printed_cols]
         rows.append(row)
     st = r["statics"]
     srows = [[k, f"{v['tendon_stress_max_MPa']:.2f}", f"{v['bar_load_max_N']:.3f}",
               f"{v['membrane_max_von_mises_MPa']:.3f}"] for k, v in st.items()]
-    lines = [f"report of {r['system']}: design checks "
-             + ("passed" if r["design_ok"] else "FAILED: " + ", ".join(r["failed_checks"])), "",
-             tabulate(srows, headers=["MTC statics", "tendon stress [MPa]", "bar load [N]",
+    unstable = r.get("unstable_modes") or {}
+    lines = [f"report of {r['system']}: checks "
+             + ("passed" if not r["failed_checks"] else "FAILED: " + ", ".join(r["failed_checks"])), "",
+             tabulate(srows, headers=[f"{r.get('fe_model', 'MTC')} statics", "tendon stress [MPa]", "bar load [N]",
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
              f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+    if r.get("com_disagreement"):
+        lines.insert(-1, f"warning: {r['com_disagreement']['message']}")
+    for k, m in unstable.items():
+        lines.insert(-1, f"{k}: the equilibrium is unstable in mode(s) {m} (omega^2 < 0, eq. 5.32)")
     d = r.get("deployment")
     if d:
-        lines.insert(-1, f"deployment {d['preset']} ({d['controller']}, uncertainty "
+        lines.insert(-1, f"deployment {d['system']} ({d['controller']}, uncertainty "
                          f"{d['uncertainty']}): switch at {d['switch_time_s']} s, max w "
                          f"{1e3 * d['max_membrane_deflection_m']:.2f} mm, final tracking error "
                          f"{d['final_tracking_error']:.2g}")
         lines.insert(-1, "")
     if r.get("notes"):
-        lines += ["", "why ours and the printed values differ (docs/validation/errata.md):"]
+        lines += ["", "notes of the system file:"]
         lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
                   for n in r["notes"]]
     return "\n".join(lines)

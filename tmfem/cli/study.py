@@ -81,7 +81,8 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
                               membrane_law=args.membrane_law)
     files = {}
     bar.step("tables")
-    tables = write_tables(out, d, system, notes=explanations(system.name, "design"))
+    notes = explanations(system, "design")
+    tables = write_tables(out, d, system, notes=notes)
     for f in ("equilibrium.csv", "tendons.csv", "equilibrium.md"):
         files[f] = str(out / f)
     (out / "design.json").write_text(json.dumps(with_units(result), default=json_default))
@@ -126,14 +127,14 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
         result["map_feasible_points"] = int(emap.feasible.sum())
     bar.step("done")
     return {"system": system.name, "ok": d.ok, "out": str(out), "files": files,
-            "failed_checks": [c.name for c in d.failed], "table": tables["rows"]}
+            "failed_checks": [c.name for c in d.failed], "table": tables["rows"], "notes": notes}
 
 
 def format_text(r: dict) -> str:
     lines = [text_table(r["table"]), ""]
-    notes = explanations(r["system"], "design")
+    notes = r.get("notes", [])
     if notes:
-        lines += ["why ours and the printed values differ (docs/validation/errata.md):"]
+        lines += ["notes of the system file:"]
         lines += [textwrap.fill(n, width=96, initial_indent="- ", subsequent_indent="  ")
                   for n in notes] + [""]
     lines.append("checks: " + ("all passed" if r["ok"] else "FAILED: " + ", ".join(r["failed_checks"])))

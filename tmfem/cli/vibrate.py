@@ -22,7 +22,9 @@ def configure(parser) -> None:
     parser.add_argument("--dt", type=finite_float, default=0.01,
                         help="time step [s] (default 0.01, as in 6.5)")
     parser.add_argument("--perturb", action="append", default=[], metavar="STATE=VALUE",
-                        help="initial perturbation, e.g. theta_11_dot=0.01 (repeatable)")
+                        help="initial perturbation, e.g. theta_11_dot=0.01 (repeatable; default the "
+                             "system file's [report] perturbation: theta_11_dot=0.01 unless it "
+                             "says otherwise, theta_12_dot=0.01 for the preset 1-4)")
     parser.add_argument("--scheme", choices=("park", "trapezoidal"), default="park",
                         help="time integrator: Park's stiffly stable method (eqs. 5.34-5.35) or "
                              "the trapezoidal rule")
@@ -47,7 +49,7 @@ def run(args) -> dict:
 
     system = model.system
     print(f"tmfem vibrate: {system.name} COM, K = {model.K}", file=sys.stderr)
-    pert = parse_perturbation(args.perturb, model.state_names)
+    pert = parse_perturbation(default_perturbation(args, system), model.state_names)
     with progress_bar(args.t_end, args.dt, f"vibrate {system.name}") as bar:
         res = free_vibration(model, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
                              scheme=args.scheme, jacobian="reuse", progress=bar,
@@ -80,13 +82,19 @@ def _run_summary(res, args, *, title: str) -> dict:
     return out
 
 
+def default_perturbation(args, system) -> list:
+    """``--perturb``, else the file's ``[report] perturbation`` (a free vibration from the
+    equilibrium without one would stay there)."""
+    return args.perturb or [f"{k}={v!r}" for k, v in system.problem.report.perturbation.items()]
+
+
 def run_fe(args, model, options) -> dict:
     """Free vibration of a finite-element model (MTC or SBC) about its static equilibrium."""
     from tmfem.models.fe_plant import perturbation_names
     from tmfem.simulation.vibration import mtc_free_vibration, sbc_free_vibration
 
     system, name = model.system, args.model.upper()
-    pert = parse_perturbation(args.perturb, perturbation_names(system))
+    pert = parse_perturbation(default_perturbation(args, system), perturbation_names(system))
     rayleigh = options["rayleigh"] or (0.0, 0.0)
     print(f"tmfem vibrate: {system.name} {name}, mesh {system.N}x{options['mesh']}x{options['mesh']}, "
           f"{model.ndof} DOFs, static equilibrium", file=sys.stderr)

@@ -15,6 +15,5 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "FEPlantOptions": "tmfem.reference.deployment_plants",
     "compare_plants": "tmfem.reference.deployment_plants",
     "diverged": "tmfem.reference.deployment_plants",
-    "packaged_system": "tmfem.reference.deployment_plants",
     "run_on_plant": "tmfem.reference.deployment_plants"
 })

@@ -1,9 +1,9 @@
 """Natural frequencies of the control-oriented model (6.4, eq. 5.33) and studies.
 
 The COM is linearised about its equilibrium (eq. 5.33); the undamped natural frequencies
-are sqrt(eig(M_hat^-1 K)) / 2 pi. The dissertation's COM columns (Tables 6.6, 6.7) and the
-highest COM frequencies quoted in 6.5 (2.4322 Hz for 1-4 with 13 coordinates, 4.4607 Hz
-for 2-3) are printed beside ours.
+are sqrt(eig(M_hat^-1 K)) / 2 pi. The printed COM column and highest COM frequency of the
+system's file (``[printed.frequencies_hz]``: Tables 6.6, 6.7 and 6.5 for the presets 1-4 and
+2-3) are printed beside ours when the file carries them.
 """
 from __future__ import annotations
 
@@ -14,14 +14,18 @@ import numpy as np
 from tmfem.errors import InputError
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
-from tmfem.reference.tables import FREQUENCIES, HIGHEST_COM_FREQUENCY
+from tmfem.reference.tables import printed_frequencies
 
 log = logging.getLogger(__name__)
 
-def dissertation_com_frequencies(name: str):
-    """COM column of Table 6.6 (1-4) or 6.7 (2-3), or None."""
-    ref = FREQUENCIES.get(name)
-    return None if ref is None else (ref["source"], list(ref["COM"]))
+
+def dissertation_com_frequencies(system):
+    """(source, COM column, highest COM frequency or None) printed for ``system`` (its file's
+    ``[printed.frequencies_hz]``: Table 6.6 for the preset 1-4, 6.7 for 2-3), or None."""
+    ref = printed_frequencies(system)
+    if ref is None or "COM" not in ref:
+        return None
+    return ref.get("source", "printed"), list(ref["COM"]), ref.get("COM_highest")
 
 
 def printed_prestress_scale(model) -> float | None:
@@ -106,12 +110,11 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
     s_bar = printed_bar_load_prestress_scale(m, mesh_n=mesh_n)
     if s_bar is not None:
         out["printed_bar_load_prestress_scale"] = s_bar
-    ref = dissertation_com_frequencies(system.name)
+    ref = dissertation_com_frequencies(system)
     if ref is not None and K == default_membrane_modes(system):
-        src, com = ref
+        src, com, highest = ref
         k = min(n, len(com))
-        out["dissertation"] = {"source": src, "COM": com[:k],
-                               "highest_hz": HIGHEST_COM_FREQUENCY.get(system.name)}
+        out["dissertation"] = {"source": src, "COM": com[:k], "highest_hz": highest}
         out["relative_difference"] = (f[:k] / np.array(com[:k]) - 1).tolist()
     return out
 

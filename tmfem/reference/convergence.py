@@ -49,8 +49,16 @@ def resolve_rest_lengths(system, *, rest_lengths):
     n = design_mesh_of(rest_lengths)
     if n is not None:
         return design_rest_lengths_at(system, n), rest_lengths
-    m = MTCModel(system, mesh_n=2, tendon_elements=1, rest_lengths=rest_lengths)   # checks
-    return m.rest_lengths.copy(), rest_lengths if isinstance(rest_lengths, str) else "given"
+    if isinstance(rest_lengths, str):
+        if rest_lengths != "system":
+            raise InputError(f"rest_lengths: expected an array or one of 'system', 'design', "
+                             f"'design@n' (n >= 1), 'mtc', found {rest_lengths!r}")
+        if system.rest_lengths is None:
+            raise InputError(f"rest_lengths='system': expected rest lengths in system "
+                             f"{system.name!r}, found none (use 'design' or 'mtc')")
+        return system.rest_lengths.copy(), "system"
+    from tmfem.system.system import rest_length_array
+    return rest_length_array(rest_lengths, len(system.tendons)), "given"
 
 
 def _mtc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_law):

@@ -17,7 +17,6 @@ from tmfem.control.fe_plant.compare import deviation_summary, plant_deviation
 from tmfem.control.fe_plant.state_estimate import DEPLOYMENT_DAMPING_TANGENT, deployment_plant
 from tmfem.post.plant_compare_plot import plot_plant_comparison
 from tmfem.reference.deployments import write_csv
-from tmfem.system.presets import load_preset
 
 
 @dataclass
@@ -144,11 +143,6 @@ def run_on_plant(s, *, kind: str, options: FEPlantOptions, initial, mesh_n, t_en
     return run_deployment(model=s.model, reference=s.reference, controller=s.controller, z0=s.z0,
                           t_end=t_end, dt=dt, progress=progress, plant=plant,
                           jacobian="reuse" if plant is None else "step", partial=plant is not None)
-
-
-def packaged_system(preset: str):
-    """The packaged configuration a 7.4 deployment of ``preset`` starts from."""
-    return load_preset(preset + "-initial")
 
 
 def compare_plants(r, rerun, *, options: FEPlantOptions, preset: str, mesh_n, controller: dict, about: str,

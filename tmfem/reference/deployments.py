@@ -1,11 +1,13 @@
-"""The deployments of dissertation 7.4 and what a deployment run writes.
+"""Deployments (7.4, 8.4) set up from a system file, and what a deployment run writes.
 
-The dissertation's parameters per deployment (7.4): omega_r of eq. 5.68, the gains of
-Table 7.1 (eq. 5.69), the uncertainty model of the controller (eq. 5.72 for 1-4(D), M G
-ignored for 1-6(D) and 2-3) and the monitored membrane points of eqs. 5.73-5.75. The
-printed points lie on the membrane edges (mid-edge points of the polygon); they are moved
-1 mm toward the centroid so that they fall inside the mesh (docs/validation/errata.md).
-``tmfem deploy`` and ``tmfem report`` run them (:func:`setup`, :func:`write_outputs`).
+The parameters of a deployment are the deployed system's own (:mod:`tmfem.system.problem`):
+its ``[packaged]`` configuration, ``[deployment]`` (omega_r of eq. 5.68, the gains of Table
+7.1, eq. 5.69, the controller's model error, the path), ``[control]`` (the H-infinity weights
+and the measured membrane points of eqs. 5.73-5.75) and ``[lpv]`` (8.4). The presets 1-4D,
+1-6D, 2-3-deploy and 2-3-lpv carry the dissertation's. The printed points lie on the membrane
+edges (mid-edge points of the polygon); they are moved 1 mm toward the centroid so that they
+fall inside the mesh (docs/validation/errata.md). ``tmfem deploy`` and ``tmfem report`` run them
+(:func:`setup`, :func:`write_outputs`).
 """
 from __future__ import annotations
 
@@ -14,18 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
+from tmfem.control.linear.generalized_plant import measured_points
 from tmfem.errors import InputError
 
-#: 7.4: omega_r (eq. 5.68), Table 7.1 (omega_0, omega_e, tau, d_c), uncertainty, points (5.73-5.75)
-DEPLOYMENTS = {
-    "1-4D": {"omega_r": 0.7, "table_7_1": (15.0, 150.0, 20.0, 1.5), "uncertainty": "initial",
-             "points": [(1.0, 1.0), (2.0, 1.0), (1.0, 2.0)], "u_m": 0.01, "path": "delta"},
-    "1-6D": {"omega_r": 0.35, "table_7_1": (4.0, 10.0, 20.0, 0.7), "uncertainty": "no-MG",
-             "points": [(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], "u_m": 0.02, "path": "delta"},
-    "2-3-deploy": {"omega_r": 0.5, "table_7_1": (1.0, 24.0, 5.0, 0.9), "uncertainty": "no-MG",
-                   "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], "u_m": 0.01,
-                   "path": "table-7-7-bases"},
-}
 CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
                "adaptive": "none"}
 UNCERTAINTIES = ("initial", "no-MG", "exact")
@@ -45,13 +38,66 @@ def inside_points(system, points, *, inset: float = 1e-3):
     return out
 
 
-def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
+def deployable_system(system):
+    """``system`` (a System, or a preset name: the preset loader) checked to carry a
+    deployment: a ``[packaged]`` configuration and a ``[deployment]`` table."""
+    if isinstance(system, str):
+        from tmfem.system.presets import load_preset
+        system = load_preset(system)
+    pr = system.problem
+    missing = [t for t, v in (("[packaged]", pr.packaged), ("[deployment]", pr.deployment)) if v is None]
+    if missing:
+        raise InputError(f"deploy {system.name}: expected the tables [packaged] (the packaged "
+                         f"configuration) and [deployment] (omega_r, gains) in the system file, "
+                         f"missing {' and '.join(missing)} (docs/guides/system-file.md)")
+    if system.symmetric is None or pr.packaged.symmetric is None:
+        raise InputError(f"deploy {system.name}: expected a symmetric system ([symmetric]) with a "
+                         "symmetric packaged configuration: the reference of eq. 5.68 runs through "
+                         "the symmetric configurations")
+    return system
+
+
+def with_designed_rest_lengths(system, *, what: str):
+    """``system`` with rest lengths: its own, else those of its equilibrium design (ch. 3,
+    :func:`tmfem.equilibrium.design.design_equilibrium`, strict: a slack tendon or membrane
+    is refused with the design's message, naming ``what`` configuration)."""
+    if system.rest_lengths is not None:
+        return system
+    from tmfem.equilibrium.design import design_equilibrium
+    from tmfem.errors import InfeasibleDesign
+    try:
+        d = design_equilibrium(system)
+    except InfeasibleDesign as exc:
+        raise type(exc)(f"deploy {system.name}: the {what} configuration is not a feasible "
+                        f"equilibrium: {exc}") from None
+    return system.with_rest_lengths(d.rest_lengths)
+
+
+def checked_configurations(system):
+    """The deployed ``system`` and its packaged configuration, both checked to be feasible
+    equilibria with rest lengths (the file's, else designed: :func:`with_designed_rest_lengths`),
+    before any controller design; the packaged one is ``result.problem.packaged``."""
+    import dataclasses
+    final = with_designed_rest_lengths(system, what="deployed")
+    packaged = with_designed_rest_lengths(system.problem.packaged, what="packaged")
+    return final.replace(problem=dataclasses.replace(final.problem, packaged=packaged))
+
+
+def own_path(system) -> str:
+    """The deployment path of ``system``: its ``[deployment] path``, else ``"delta"`` for a
+    1-N(D) system and ``"linear"`` otherwise."""
+    p = system.problem.deployment.path
+    return p if p is not None else ("delta" if system.deployable else "linear")
+
+
+def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
           allocation: str = "bounded", path: str | None = None, evaluation: str = "state",
           tendon_law: str = "fixed-rate", gains=None):
-    """The deployment of ``preset`` with the 7.4 parameters (:func:`build_deployment`).
+    """The deployment of ``system`` (a System with ``[packaged]`` and ``[deployment]``, or a
+    preset name) from its packaged to its deployed configuration (:func:`build_deployment`).
     ``gains``: the PFL's (omega_0, omega_e, tau, d_c) of eq. 5.69 in rad/s, rad/s, s and -
-    (default: the preset's Table 7.1 row).
-    ``path`` (default the preset's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
+    (default: the file's ``[deployment] gains``, Table 7.1 for the presets).
+    ``path`` (default the file's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
     membrane stretch Delta linear in s), ``"table-7-7-bases"`` (2-3: the stage-2 base on the
     reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
     ``"linear"`` (every symmetric parameter linear in s). ``evaluation``: where the PFL
@@ -60,31 +106,33 @@ def setup(preset: str, *, controller: str = "adaptive-hinf", uncertainty: str | 
     from tmfem.control.deployment.adaptive import Gains
     from tmfem.control.deployment.run import build_deployment
     from tmfem.reference.tables import deployment_bases
-    from tmfem.system.presets import load_preset
-    check_choices(preset, controller=controller, uncertainty=uncertainty, path=path)
-    p = DEPLOYMENTS[preset]
-    path = path or p["path"]
-    final, initial = load_preset(preset), load_preset(preset + "-initial")
-    w0, we, tau, dc = p["table_7_1"] if gains is None else gains
-    return build_deployment(final=final, initial=initial, omega_r=p["omega_r"],
+    final = deployable_system(system)
+    check_choices(final, controller=controller, uncertainty=uncertainty, path=path)
+    final = checked_configurations(final)
+    p = final.problem.deployment
+    path = path or own_path(final)
+    w0, we, tau, dc = p.gains if gains is None else gains
+    u_m = final.problem.control.u_m
+    return build_deployment(final=final, initial=final.problem.packaged, omega_r=p.omega_r,
                             gains=Gains(omega_0=w0, omega_e=we, tau=tau, d_c=dc),
-                            uncertainty=uncertainty or p["uncertainty"],
-                            output_points=inside_points(final, p["points"]),
-                            linear=CONTROLLERS[controller], u_m=p["u_m"],
+                            uncertainty=uncertainty or p.uncertainty,
+                            output_points=inside_points(final, measured_points(final)) or None,
+                            linear=CONTROLLERS[controller],
+                            **({} if u_m is None else {"u_m": u_m}),
                             bases=deployment_bases(final) if path == "table-7-7-bases" else None,
                             delta_path=path == "delta", allocation=allocation,
-                            evaluation=evaluation, tendon_law=tendon_law)
+                            evaluation=evaluation, tendon_law=tendon_law,
+                            n_centres=p.rbf_centres, w_bar=p.w_bar, gamma=p.gamma, r_min=p.r_min)
 
 
-def check_choices(preset: str, *, controller: str = "adaptive-hinf", uncertainty=None,
+def check_choices(system, *, controller: str = "adaptive-hinf", uncertainty=None,
                   path=None) -> None:
-    """Refuse an unknown deployment preset, controller, uncertainty model or path (before
-    any work: ``tmfem deploy`` calls it first)."""
-    if preset not in DEPLOYMENTS:
-        raise InputError(f"deploy: expected a preset among {sorted(DEPLOYMENTS)}, found {preset!r}")
-    own = DEPLOYMENTS[preset]["path"]
+    """Refuse a system without a deployment, an unknown controller, uncertainty model or path
+    (before any work: ``tmfem deploy`` calls it first)."""
+    system = deployable_system(system)
+    own = own_path(system)
     if path is not None and path not in ("linear", own):
-        raise InputError(f"--path for {preset}: expected 'linear' or {own!r}, found {path!r}")
+        raise InputError(f"--path for {system.name}: expected 'linear' or {own!r}, found {path!r}")
     if controller not in CONTROLLERS:
         raise InputError(f"--controller: expected one of {sorted(CONTROLLERS)}, found {controller!r}")
     if uncertainty is not None and uncertainty not in UNCERTAINTIES:
@@ -132,16 +180,19 @@ def write_csv(path, r) -> str:
 
 
 def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gif=None,
-                  vtk=None) -> dict:
+                  vtk=None, lpv: bool | None = None) -> dict:
     """Write the files of deployment run ``r`` of set-up ``s``: CSV, plot (Figures 7.2-7.4, or
-    8.2-8.4 for an LPV preset), GIF (Figures 7.5, 8.5) and ParaView series (a frame every
-    :data:`VTK_EVERY` samples); returns {kind: path} of those written."""
+    8.2-8.4 for an LPV deployment: ``lpv``, default whether the deployed system has an
+    ``[lpv]`` table), GIF (Figures 7.5, 8.5) and ParaView series (a frame every
+    :data:`VTK_EVERY` samples, series named ``preset``); returns {kind: path} of those written."""
     out = {}
     if csv_path:
         out["csv"] = write_csv(csv_path, r)
     if plot:
         from tmfem.post.deploy_plots import plot_deployment, plot_lpv_deployment
-        draw = plot_lpv_deployment if preset in LPV_DEPLOYMENTS else plot_deployment
+        if lpv is None:
+            lpv = s.model.system.problem.lpv is not None
+        draw = plot_lpv_deployment if lpv else plot_deployment
         out["plot"] = str(draw(plot, r, title=title))
     if gif:
         from tmfem.post.deploy_plots import animate_deployment
@@ -157,31 +208,36 @@ def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gi
     return out
 
 
-#: 8.4: eq. 5.100 (xi_r = 1, omega_r; theta_0, theta_e, psi_0 from the preset's printed
-#: section) and the monitored points of eq. 5.101 (moved 1 mm inside as the 7.4 points)
-LPV_DEPLOYMENTS = {
-    "2-3-lpv": {"omega_r": 0.3, "points": [(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)],
-                "membrane_modes": 4, "path": "table-7-7-bases"},
-}
 #: controllers of an LPV deployment (``tmfem deploy --controller``)
 LPV_CONTROLLERS = ("lpv", "lpv-output")
 
 
-def lpv_setup(preset: str, plant, *, model_at: str = "final", system=None):
-    """The deployment of 8.4 of ``preset`` for the design plant ``plant`` (its grid built with
+def lpv_setup(system, plant, *, model_at: str = "final"):
+    """The deployment of 8.4 of ``system`` (a System with an ``[lpv]`` table and the
+    scheduling values theta0_deg, theta_e_deg, psi0_deg of eq. 5.100 in ``[printed]``, or a
+    preset name) for the design plant ``plant`` (its grid built with
     :func:`tmfem.reference.tables.deployment_bases`, as ``tmfem control lpv``):
-    :func:`tmfem.control.lpv.deployment.lpv_deployment` with the parameters of
-    :data:`LPV_DEPLOYMENTS`; ``system``: the System deployed, default the preset's (another
-    one, e.g. with stiffer bars, for a perturbation study of an FE plant)."""
+    :func:`tmfem.control.lpv.deployment.lpv_deployment` with the file's ``[lpv]`` parameters
+    (another System, e.g. with stiffer bars, for a perturbation study of an FE plant)."""
     from tmfem.control.lpv.deployment import lpv_deployment
+    from tmfem.models.com.model import default_membrane_modes
     from tmfem.reference.tables import deployment_bases
-    from tmfem.system.presets import load_preset
-    if preset not in LPV_DEPLOYMENTS:
-        raise InputError(f"LPV deployment: expected a preset among {sorted(LPV_DEPLOYMENTS)}, found {preset!r}")
-    p = LPV_DEPLOYMENTS[preset]
-    s = load_preset(preset) if system is None else system
-    pr = s.printed
-    return lpv_deployment(s, plant, theta_0=np.radians(pr["theta0_deg"]), theta_e=np.radians(pr["theta_e_deg"]),
-                          psi_0=np.radians(pr["psi0_deg"]), omega_r=p["omega_r"], bases=deployment_bases(s),
-                          output_points=inside_points(s, p["points"]), membrane_modes=p["membrane_modes"],
+    if isinstance(system, str):
+        from tmfem.system.presets import load_preset
+        system = load_preset(system)
+    p = system.problem.lpv
+    if p is None:
+        raise InputError(f"LPV deployment of {system.name}: expected an [lpv] table in the system "
+                         "file (omega_r, membrane_modes, points, path; docs/guides/system-file.md)")
+    pr = system.printed
+    missing = [k for k in ("theta0_deg", "theta_e_deg", "psi0_deg") if k not in pr]
+    if missing:
+        raise InputError(f"LPV deployment of {system.name}: expected {missing} (eq. 5.100) in the "
+                         "system file's [printed] table")
+    pts = p.points if p.points is not None else measured_points(system)
+    return lpv_deployment(system, plant, theta_0=np.radians(pr["theta0_deg"]),
+                          theta_e=np.radians(pr["theta_e_deg"]), psi_0=np.radians(pr["psi0_deg"]),
+                          omega_r=p.omega_r,
+                          bases=deployment_bases(system), output_points=inside_points(system, pts),
+                          membrane_modes=p.membrane_modes or default_membrane_modes(system),
                           model_at=model_at)

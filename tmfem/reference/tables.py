@@ -1,7 +1,8 @@
 """The dissertation's equilibrium tables and their reconstruction (Tables 6.2-6.5, 7.2-7.7, 8.1).
 
-The printed values are collected in :data:`PRINTED` (tables of parameters and stresses) and
-:data:`FREQUENCIES` (Tables 6.6, 6.7). The functions below evaluate the
+The printed values are collected in :data:`PRINTED` (tables of parameters and stresses); the
+printed frequencies (Tables 6.6, 6.7) live in the preset files (``[printed.frequencies_hz]``,
+:func:`printed_frequencies`). The functions below evaluate the
 symmetric prestress design of chapter 3 fast enough to *fit* unprinted parameters to the
 printed rest lengths:
 
@@ -83,30 +84,23 @@ def corner_force_per_Delta(system, *, mesh_n: int = 10) -> float:
     return _k_delta(system.N, float(system.r_mb), m.E, m.nu, m.h, int(mesh_n))
 
 
-# Natural frequencies [Hz] printed in the dissertation, Tables 6.6 (1-4) and 6.7 (2-3):
-# shell-beam-cable (SBC), membrane-truss-cable (MTC) and control-oriented (COM) models.
-FREQUENCIES = {
-    "1-4": {
-        "source": "dissertation Table 6.6",
-        "SBC": [0.1386, 0.3076, 0.3076, 1.5598, 1.8590, 2.0571, 2.0571, 2.0770, 2.1793, 2.2130,
-                2.2130, 2.2523],
-        "MTC": [0.1386, 0.3076, 0.3076, 1.5599, 1.8679, 2.0569, 2.0569, 2.0763, 2.1803, 2.2277,
-                2.2277, 2.2653],
-        "COM": [0.1367, 0.2997, 0.2997, 1.5401, 1.8552, 2.0288, 2.0289, 2.0471, 2.1507, 2.2062,
-                2.2119, 2.2479],
-    },
-    "2-3": {
-        "source": "dissertation Table 6.7",
-        "SBC": [0.2527, 0.4116, 0.4116, 1.0942, 1.3164, 1.3164, 1.5230, 1.5230, 1.7399, 1.8186,
-                1.9834, 1.9834],
-        "MTC": [0.2527, 0.4116, 0.4116, 1.0953, 1.3174, 1.3174, 1.5264, 1.5264, 1.7404, 1.8224,
-                1.9876, 1.9876],
-        "COM": [0.2503, 0.4076, 0.4076, 1.0843, 1.3020, 1.3020, 1.5110, 1.5121, 1.7258, 1.8053,
-                1.9712, 1.9720],
-    },
-}
-# Highest COM frequency quoted in 6.5.1 / 6.5.2 (all coordinates of the COM).
-HIGHEST_COM_FREQUENCY = {"1-4": 2.4322, "2-3": 4.4607}
+def printed_frequencies(system) -> dict | None:
+    """The natural frequencies [Hz] printed for ``system`` (its file's
+    ``[printed.frequencies_hz]``: ``source`` and the columns ``SBC``, ``MTC``, ``COM``, optional
+    ``COM_highest``), or None when the file prints none."""
+    f = system.printed.get("frequencies_hz")
+    return dict(f) if isinstance(f, dict) else None
+
+
+def __getattr__(name: str):
+    """``FREQUENCIES``: the printed frequencies of the presets that carry them, by preset name
+    (Tables 6.6 for ``1-4``, 6.7 for ``2-3``; read from the preset files, for tests and demos)."""
+    if name == "FREQUENCIES":
+        from tmfem.system.presets import list_presets, load_preset
+        out = {n: printed_frequencies(load_preset(n)) for n in list_presets()}
+        return {n: f for n, f in out.items() if f is not None}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 @dataclass(frozen=True)
 class SymmetricPrestress:

@@ -28,15 +28,12 @@ import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.models.mtc.dynamics import fit_frequency
-from tmfem.reference.model_compare import MODELS, com_model, fe_models, paper_state
+from tmfem.reference.model_compare import MODELS, com_model, compared_system, fe_models
 
 log = logging.getLogger(__name__)
 
 #: length [s] of the early window of the rms differences (module docstring)
 EARLY = 2.0
-
-#: the initial perturbations of 6.5.1 (1-4) and 6.5.2 (2-3)
-PERTURBATION = {"1-4": {"theta_12_dot": 0.01}, "2-3": {"theta_11_dot": 0.01}}
 
 
 def _signals(system, res, name: str) -> dict:
@@ -56,18 +53,20 @@ def _signals(system, res, name: str) -> dict:
     return out
 
 
-def three_model_vibration(name: str, *, t_end: float, dt: float = 0.01, perturb=None,
+def three_model_vibration(system, *, t_end: float, dt: float = 0.01, perturb=None,
                           mesh_n: int = 10, tendon_elements: int = 3, backend="scipy",
                           progress=None) -> dict:
-    """Free vibration of system ``name`` in the SBC, MTC and COM models (module docstring).
+    """Free vibration of ``system`` in the SBC, MTC and COM models (module docstring).
 
     Parameters
     ----------
-    name : {"1-4", "2-3"}
+    system : System or preset name
     t_end, dt : float
         Duration and step [s] (6.5: dt = 0.01 s).
     perturb : dict, optional
-        Initial perturbation by coordinate name (default :data:`PERTURBATION`).
+        Initial perturbation by coordinate name (default the file's ``[report] perturbation``:
+        6.5.1's theta_12' = 0.01 rad/s for 1-4, 6.5.2's theta_11' for 2-3; theta_11' = 0.01 rad/s
+        otherwise).
     mesh_n, tendon_elements : int
         Membrane mesh (6.5: 10; the "20 x 20 mesh for the square membrane" of 6.5.1 is
         4 x 10 x 10) and truss elements per tendon
@@ -82,9 +81,10 @@ def three_model_vibration(name: str, *, t_end: float, dt: float = 0.01, perturb=
     ``comparison`` (JSON-able: differences, amplitudes, frequencies, wall times).
     """
     from tmfem.simulation.vibration import free_vibration, mtc_free_vibration, sbc_free_vibration
-    paper_state(name)
-    pert = dict(PERTURBATION[name] if perturb is None else perturb)
-    fe = fe_models(name, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend)
+    given = compared_system(system)
+    name = given.name
+    pert = dict(given.problem.report.perturbation if perturb is None else perturb)
+    fe = fe_models(given, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend)
     system = fe["MTC"].system
     results, static = {}, {}
     for key, run in (("SBC", sbc_free_vibration), ("MTC", mtc_free_vibration)):
@@ -96,7 +96,7 @@ def three_model_vibration(name: str, *, t_end: float, dt: float = 0.01, perturb=
                                perturb=pert, progress=steps)
     steps = progress("COM") if progress else None
     with named_model("COM", name, mesh_n):
-        com = com_model(name, mesh_n=mesh_n)
+        com = com_model(given, mesh_n=mesh_n)
         results["COM"] = free_vibration(com, t_end=t_end, dt=dt, perturb=pert, jacobian="reuse",
                                         progress=steps)
     t = results["SBC"].t

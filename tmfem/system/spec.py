@@ -43,12 +43,13 @@ from tmfem.errors import InputError
 from tmfem.system.coordinates import q_stages
 from tmfem.system.geometry import SymmetricConfig, membrane_corners_regular
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
+from tmfem.system.problem import problem_from_dict
 from tmfem.system.system import System
 from tmfem.system.topology import Tendon
 
 _TOP_KEYS = {"name", "description", "N", "deployable", "k_H", "notes", "symmetric", "general",
              "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed",
-             "monitor", "models"}
+             "monitor", "models", "control", "deployment", "lpv", "report", "packaged"}
 # Keys accepted inside each sub-table ([printed] and [rest_lengths] are free-form;
 # [as_printed] is merged in before validation, see tmfem.system.presets.preset_dict).
 _TABLE_KEYS = {
@@ -256,7 +257,8 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     common = dict(name=_string(d, "name", where, where),
                   description=_string(d, "description", where),
                   notes=tuple(notes), printed=_printed(d, where),
-                  **_monitor(d, where), model_defaults=_model_defaults(d, where))
+                  **_monitor(d, where), model_defaults=_model_defaults(d, where),
+                  problem=problem_from_dict(d, where, system_from_dict))
     for k, t in enumerate(d.get("tendon", ())):
         wt = f"{where} [[tendon]] entry {k + 1}"
         if not isinstance(t, dict):
@@ -368,6 +370,7 @@ def system_to_dict(system: System) -> dict:
         d["printed"] = system.printed
     if system.model_defaults:
         d["models"] = {k: dict(v) for k, v in system.model_defaults.items()}
+    d.update(system.problem.raw)
     if system.monitor_nodes or system.monitor_points.size:
         d["monitor"] = {k: v for k, v in (("nodes", list(system.monitor_nodes)),
                                           ("points", system.monitor_points.T.tolist())) if v}

@@ -17,6 +17,7 @@ from tmfem.system.coordinates import q_index, q_size, split_q
 from tmfem.system.geometry import (SymmetricConfig, bar_direction, base_centre, beta,
                                    floating_frame, membrane_corners_regular, wrap_angle)
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
+from tmfem.system.problem import Problem
 from tmfem.system.topology import Tendon, label, node_labels, tendon_topology
 
 
@@ -73,6 +74,9 @@ class System:
         Default options of the models for this system, ``{model: {option: value}}`` (file
         table ``[models.<name>]``; the presets carry the dissertation's membrane modes K of
         the control-oriented model).
+    problem : Problem
+        What the file declares beyond the structure: the packaged configuration, the control,
+        deployment, LPV and report tables (:mod:`tmfem.system.problem`).
     """
 
     name: str
@@ -97,6 +101,7 @@ class System:
     monitor_nodes: tuple = ()
     monitor_points: np.ndarray = field(default_factory=lambda: np.zeros((2, 0)))
     model_defaults: dict = field(default_factory=dict)
+    problem: Problem = field(default_factory=Problem)
 
     def __post_init__(self):
         M, N = self.M, self.N
@@ -165,7 +170,8 @@ class System:
                          deployable: bool = False, k_H: float | None = None,
                          rest_lengths: dict | None = None, description: str = "",
                          notes=(), printed: dict | None = None, monitor_nodes=(),
-                         monitor_points=None, model_defaults: dict | None = None) -> "System":
+                         monitor_points=None, model_defaults: dict | None = None,
+                         problem: Problem | None = None) -> "System":
         """Build a symmetric system (3.3.1) from its parametrisation.
 
         ``rest_lengths`` may be given per group (``{"S1": 1.5}``) or per tendon name.
@@ -177,7 +183,8 @@ class System:
                   tendon_sections=dict(tendon_sections), k_H=k_H, symmetric=config, r_mb=r_mb,
                   description=description, notes=tuple(notes), printed=dict(printed or {}),
                   monitor_nodes=tuple(monitor_nodes), model_defaults=dict(model_defaults or {}),
-                  monitor_points=np.zeros((2, 0)) if monitor_points is None else monitor_points)
+                  monitor_points=np.zeros((2, 0)) if monitor_points is None else monitor_points,
+                  problem=problem or Problem())
         if rest_lengths:
             sys = sys.with_rest_lengths(rest_lengths)
         return sys

@@ -93,7 +93,6 @@ def test_1_4D_post_switch_transient_is_route_independent():
     # 1 kPa, where the eliminated LMIs gave 14.1 mm (Riccati point) and 7.5 mm (Clarabel)
     import control
     from tmfem.control.linear.hinf_central import central_matrices
-    from tmfem.control.linear.generalized_plant import DEPLOYED
     from tmfem.simulation.controllers import LinearController
     runs = []
     for balanced in (False, True):
@@ -103,7 +102,7 @@ def test_1_4D_post_switch_transient_is_route_independent():
             from tmfem.system import load_preset
             d = deployed_hinf(load_preset("1-4D"), synthesize=False)
             Ps, t = d.generalized.scaled()
-            Ak, Bk, Ck, Dk = central_matrices(Ps, runs[0][1], alpha=DEPLOYED["1-4D"]["alpha"])
+            Ak, Bk, Ck, Dk = central_matrices(Ps, runs[0][1], alpha=load_preset("1-4D").problem.control.alpha)
             K = control.ss(t[:, None] * Ak / t[None, :], t[:, None] * Bk, Ck / t[None, :], Dk)
             old = s.controller.second
             s.controller.second = LinearController(K, u_e=old.u_e, y_e=old.y_e, name=old.name)

@@ -61,7 +61,7 @@ def _start_radius(design, plant_kind, bar_factor=None, bars=None):
     if bar_factor is not None:
         s = s.replace(bar=dataclasses.replace(s.bar, E=s.bar.E * bar_factor))
     pl, d, _ = design
-    dep = lpv_setup("2-3-lpv", pl, system=s)
+    dep = lpv_setup(s, pl)
     plant = deployment_plant(plant_kind, dep.model, dep.packaged(), mesh_n=2, bars=bars)
     return dominant_eigenvalues(lpv_start_loop(dep, d, plant, dt=0.01), 0.01, k=1)[0]
 

@@ -90,10 +90,10 @@ def test_entropy_refuses_what_it_does_not_apply_to():
 @pytest.fixture(scope="module")
 def plant14():
     from tmfem.control.linear.deployed_design import deployed_hinf
-    from tmfem.control.linear.generalized_plant import DEPLOYED
     from tmfem.system import load_preset
-    d = deployed_hinf(load_preset("1-4D"), method="central")
-    return d, DEPLOYED["1-4D"]["alpha"]
+    s = load_preset("1-4D")
+    d = deployed_hinf(s, method="central")
+    return d, s.problem.control.alpha
 
 
 def test_1_4D_central_design(plant14):

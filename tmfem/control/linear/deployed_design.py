@@ -21,8 +21,9 @@ from tmfem.control.linear.hinf_slicot import hinf_slicot
 from tmfem.control.linear.hinf_synthesis import hinfsyn
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.control.linear.pbh import PBHResult, pbh_ss
-from tmfem.control.linear.generalized_plant import DEPLOYED, DeployedPlant, deployed_plant, generalized_plant
+from tmfem.control.linear.generalized_plant import DeployedPlant, deployed_plant, generalized_plant
 from tmfem.errors import InputError
+from tmfem.system.problem import default_u_m
 
 log = logging.getLogger(__name__)
 
@@ -44,14 +45,16 @@ class DeployedDesign:
     pbh: PBHResult
     design: HinfDesign | None
     u_m: float
+    notes: tuple = ()
 
     def summary(self) -> dict:
         out = {"system": self.plant.model.system.name,
                "open_loop_f_max_hz": self.plant.f_max_hz,
-               "open_loop_f_max_printed_hz": DEPLOYED.get(self.plant.model.system.name, {}).get("f_max_hz"),
+               "open_loop_f_max_printed_hz": self.plant.model.system.printed.get("f_max_hz"),
                "n_states": int(self.plant.ss.nstates), "n_inputs": int(self.plant.ss.ninputs),
                "membrane_points": [list(p) for p in self.plant.points],
                "u_m": self.u_m, "pbh": self.pbh.as_dict()}
+        notes = list(self.notes)
         if self.design is not None:
             d = self.design.summary()
             out.update({"gamma": d["gamma"], "alpha": d["alpha"],
@@ -59,6 +62,15 @@ class DeployedDesign:
                         "closed_loop_hinf_norm": d["closed_loop_hinf_norm"],
                         "controller_order": d["controller_order"], "method": d["kind"],
                         "cond_I_minus_RS": d["cond_I_minus_RS"], "solver": d["solver"]})
+            nrm = d["closed_loop_hinf_norm"]
+            if np.isfinite(nrm) and nrm < 0.9 * d["gamma"]:
+                notes.append(
+                    f"gamma = {d['gamma']:.4g} bounds the closed loop's gain on the line Re s = "
+                    f"-alpha_1 = -{d['alpha']:g} (the alpha_1-shifted plant of eqs. 5.64-5.65, "
+                    "which places the poles left of -alpha_1); on the imaginary axis the loop "
+                    f"achieves ||T_pw||_inf = {nrm:.4g}: the shift makes gamma a conservative "
+                    "bound, the norm is the loop's")
+        out["notes"] = notes
         return out
 
 
@@ -71,8 +83,10 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     Parameters
     ----------
     alpha, u_m, membrane_modes : optional
-        alpha_1, u_m of W_u = I/u_m, and K; defaults: 7.4's values for the system
-        (:data:`tmfem.control.linear.generalized_plant.DEPLOYED`), required for other systems.
+        alpha_1 [1/s], u_m [m] of W_u = I/u_m, and K; defaults: the system file's ``[control]``
+        alpha and u_m (7.4's values for the deployed presets), else :func:`default_alpha` and
+        :func:`tmfem.system.problem.default_u_m` (the system's own scales); K from
+        ``[models.com]``.
     solver : {"ARE", "CLARABEL", "SCS"}, optional
         How the eliminated LMIs are solved with ``method="lmi"``
         (:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi`); default :data:`DEFAULT_SOLVER`,
@@ -97,16 +111,25 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     if method == "auto" and solver not in (None, "CLARABEL", "SCS"):
         raise InputError(f"solver: expected CLARABEL or SCS with method 'auto' (the SDP solver of "
                          f"its LMI fallback), found {solver!r}")
-    d = DEPLOYED.get(system.name, {})
-    alpha = d.get("alpha") if alpha is None else alpha
-    u_m = d.get("u_m") if u_m is None else u_m
-    if synthesize and (alpha is None or u_m is None):
-        raise InputError(f"system {system.name!r} has no 7.4 defaults: expected alpha and u_m, "
-                         f"found alpha = {alpha}, u_m = {u_m}")
+    w = system.problem.control
+    notes = []
+    if u_m is None and w.u_m is None:
+        u_m = default_u_m(system)
+        notes.append(f"u_m = {u_m:.4g} m from the system's scale (0.5 % of the mean bar length; "
+                     "set [control] u_m in the file or --u-m)")
+    elif u_m is None:
+        u_m = w.u_m
     plant = deployed_plant(system, membrane_modes=membrane_modes)
+    if alpha is None and w.alpha is None:
+        alpha = default_alpha(plant)
+        notes.append(f"alpha_1 = {alpha:.4g} 1/s from the system's scale (0.1 x 2 pi f_1, f_1 = "
+                     f"{np.min(plant.frequencies_hz):.4g} Hz the lowest open-loop frequency; set "
+                     "[control] alpha in the file or --alpha)")
+    elif alpha is None:
+        alpha = w.alpha
     kw = {} if pbh_tol is None else {"tol": pbh_tol}
     res = pbh_ss(plant.ss, **kw)
-    gen = generalized_plant(plant, u_m=u_m if u_m is not None else 1.0)
+    gen = generalized_plant(plant, u_m=u_m, W_e=w.W_e, W_d=w.W_d)
     design = None
     if synthesize:
         if method == "auto":
@@ -122,8 +145,21 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
             design = hinf_central(gen, alpha=alpha, operating_point=plant.operating_point)
         else:
             design = hinf_slicot(gen, alpha=alpha, operating_point=plant.operating_point)
-    return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design,
-                          u_m=float(u_m) if u_m is not None else None)
+    return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design, u_m=float(u_m),
+                          notes=tuple(notes))
+
+
+def default_alpha(plant: DeployedPlant) -> float:
+    """alpha_1 of eq. 5.66 [1/s] when the file gives none: the system's own scale, 0.1 x 2 pi
+    f_1 with f_1 the lowest open-loop natural frequency of the deployed plant [Hz] (a decay
+    rate of a tenth of the slowest mode's angular frequency; 7.4's 0.5, 0.4, 0.4 for 1-4(D),
+    1-6(D), 2-3 are 0.07-0.14 of theirs: f_1 = 1.07, 0.46, 0.56 Hz)."""
+    f = np.asarray(plant.frequencies_hz, dtype=float)
+    f = f[np.isfinite(f) & (f > 0)]
+    if f.size == 0:
+        raise InputError(f"alpha_1: the deployed plant of {plant.model.system.name} has no positive "
+                         "natural frequency to scale it with; expected --alpha (or [control] alpha)")
+    return float(0.1 * 2 * np.pi * f.min())
 
 
 def save_design(design: HinfDesign, path) -> None:

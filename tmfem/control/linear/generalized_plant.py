@@ -20,25 +20,35 @@ from tmfem.errors import InputError
 
 log = logging.getLogger(__name__)
 
-# Monitored membrane points of 7.4 (eqs. 5.73-5.75), (x_f, y_f) in m, and the design data of
-# 7.4 per system: K membrane modes, u_m of W_u, alpha_1 and the printed f_max.
-DEPLOYED = {
-    "1-4D": dict(points=[(1.0, 1.0), (2.0, 1.0), (1.0, 2.0)], K=3, u_m=0.01, alpha=0.5,
-                 f_max_hz=7.32, source="7.4.1, eq. 5.73"),
-    "1-6D": dict(points=[(1.0, 1.732), (2.5, 0.866), (2.5, 2.598)], K=5, u_m=0.02, alpha=0.4,
-                 f_max_hz=8.59, source="7.4.2, eq. 5.74"),
-    "2-3-deploy": dict(points=[(0.866, 0.5), (1.30, 0.75), (0.433, 0.75)], K=4, u_m=0.01,
-                       alpha=0.4, f_max_hz=9.83, source="7.4.3, eq. 5.75"),
-}
 W_E = 0.5        # W_e = 0.5 I (7.4, item 1)
 W_D = 0.001      # W_d1..4 = 0.001 I (7.4, item 2)
 
 
-def deployed_defaults(name: str) -> dict:
-    """The 7.4 design data (K, u_m, alpha_1, points, printed f_max) of a deployed preset."""
-    if name not in DEPLOYED:
-        raise InputError(f"deployed system: expected one of {sorted(DEPLOYED)}, found {name!r}")
-    return dict(DEPLOYED[name])
+def measured_points(system) -> list:
+    """The measured membrane points (x_f, y_f) [m] of eq. 5.18 of ``system``: its file's
+    ``[control] points`` (eqs. 5.73-5.75 for the deployed presets), else its ``[monitor]
+    points``, else :func:`interior_points`."""
+    pts = system.problem.control.points
+    if pts is not None:
+        return list(pts)
+    if system.monitor_points.size:
+        return [tuple(p) for p in system.monitor_points.T.tolist()]
+    return interior_points(system)
+
+
+def interior_points(system, *, count: int = 3) -> list:
+    """``count`` membrane points inside the membrane, away from its edges, corners and the
+    patch boundaries of the mesh (centroid to edge midpoints): for the first ``count`` edges
+    j, half-way from the centroid c to the point between corner j and the midpoint of edge
+    (j, j+1), i.e. c + (p_j + m_j - 2 c) / 4 (x_f, y_f in m)."""
+    P = np.asarray(system.membrane_corners, dtype=float)
+    c = P.mean(axis=1)
+    out = []
+    for j in range(min(count, P.shape[1])):
+        m = 0.5 * (P[:, j] + P[:, (j + 1) % P.shape[1]])
+        x, y = c + (P[:, j] + m - 2 * c) / 4
+        out.append((float(x), float(y)))
+    return out
 
 
 def point_coordinates(basis, *, K: int, points) -> list:
@@ -119,7 +129,7 @@ class DeployedPlant:
 
 
 def deployed_plant(system, *, membrane_modes: int | None = None, points=None, mesh_n: int = 10,
-                   rest_lengths="system", damping: float = 0.0) -> DeployedPlant:
+                   rest_lengths=None, damping: float = 0.0) -> DeployedPlant:
     """Linear plant at the deployed configuration (eqs. 5.17-5.18, 5.33, 5.62).
 
     Parameters
@@ -127,25 +137,27 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
     system : System
         The deployed (final) configuration, e.g. ``load_preset("1-4D")``.
     membrane_modes : int, optional
-        K (7.4: 3 for 1-4(D), 5 for 1-6(D), 4 for 2-3); default from :data:`DEPLOYED`.
+        K (7.4: 3 for 1-4(D), 5 for 1-6(D), 4 for 2-3); default the file's ``[models.com]
+        membrane_modes`` (:func:`tmfem.models.com.model.default_membrane_modes`).
     points : list of (x_f, y_f), optional
-        Membrane points of the coordinates v (eq. 5.18); default: the monitored points of
-        eqs. 5.73-5.75 completed to K by :func:`point_coordinates`.
-    rest_lengths : {"system", "design"} or array
-        u_e; "system": the printed rest lengths of the preset (Tables 7.3, 7.5, 7.7).
+        Membrane points of the coordinates v (eq. 5.18); default :func:`measured_points`
+        (eqs. 5.73-5.75 for the presets) completed to K by :func:`point_coordinates`.
+    rest_lengths : {"system", "design"} or array, optional
+        u_e; "system": the file's rest lengths (the printed ones of Tables 7.3, 7.5, 7.7 for
+        the presets), "design": those of the equilibrium design (ch. 3); default the file's
+        when it gives them, else the design's.
     damping : float
         Modal damping c_m of eq. 5.13 (7.4 states none: default 0).
     """
     from tmfem.models.com.linearize import linearize
-    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     import control
-    d = DEPLOYED.get(system.name, {})
-    K = membrane_modes if membrane_modes is not None else d.get("K")
-    if K is None:
-        raise InputError(f"membrane_modes: expected K for system {system.name!r} (no 7.4 default), found None")
+    K = membrane_modes if membrane_modes is not None else default_membrane_modes(system)
+    if rest_lengths is None:
+        rest_lengths = "system" if system.rest_lengths is not None else "design"
     modal = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, rest_lengths=rest_lengths,
                                  damping=damping, output_points=[])
-    pts = points if points is not None else d.get("points", [])
+    pts = points if points is not None else measured_points(system)
     pts = point_coordinates(modal.membrane, K=K, points=pts)
     model = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, rest_lengths=modal.u0,
                                  damping=damping, output_points=[],

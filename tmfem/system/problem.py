@@ -1,0 +1,311 @@
+"""What a system file declares beyond the structure: the control, deployment and report data.
+
+A system file describes the whole problem (docs/guides/system-file.md). Besides the structure
+(``[symmetric]``/``[general]``, materials, rest lengths, ``[monitor]``, ``[models.com]``) it
+may carry:
+
+* ``[packaged]``: the packaged (initial) configuration of a deployment, as overrides of the
+  file's own tables (``symmetric``, ``rest_lengths``, ...), merged like ``[as_printed]``;
+* ``[control]``: the H-infinity design at the (deployed) configuration (7.3-7.4, Fig. 7.1):
+  alpha_1 of eq. 5.66, u_m of W_u = I / u_m, W_e, W_d and the measured membrane points of
+  eq. 5.18;
+* ``[deployment]``: the deployment of 7.4: omega_r, xi_r of eq. 5.68, the PFL gains of
+  Table 7.1 (eq. 5.69), the RBF and adaptation parameters, the controller's model error, the
+  path and the rest-length limit;
+* ``[lpv]``: the LPV deployment of 8.4 (omega_r of eq. 5.100, K, points, path);
+* ``[report]``: what ``tmfem report`` adds for this system: the free-vibration perturbation,
+  a second prestress case with its source, explanatory notes, and the deployment it runs.
+
+Everything is read from the :class:`System` the library is given (``system.problem``); a file
+that does not declare a table gets the documented defaults, which depend on the system only.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tmfem.errors import InputError
+
+#: keys of each table (anything else is refused)
+KEYS = {
+    "control": {"alpha", "u_m", "W_e", "W_d", "points"},
+    "deployment": {"omega_r", "xi_r", "gains", "uncertainty", "path", "rbf_centres", "w_bar",
+                   "gamma", "r_min"},
+    "lpv": {"omega_r", "membrane_modes", "points", "path"},
+    "report": {"perturbation", "implied_rest_lengths", "implied_source", "notes_design",
+               "notes_models", "deployment", "com_prestress"},
+    "report.deployment": {"system", "uncertainty", "t_end", "controller"},
+}
+GAIN_KEYS = ("omega_0", "omega_e", "tau", "d_c")
+UNCERTAINTIES = ("initial", "no-MG", "exact")
+PATHS = ("delta", "table-7-7-bases", "linear")
+COM_PRESTRESS = ("designed", "printed-tendon-stress")
+
+
+def _keys(t, kind: str, where: str) -> dict:
+    if not isinstance(t, dict):
+        raise InputError(f"{where}: expected [{kind}] to be a table, found {t!r}")
+    unknown = set(t) - KEYS[kind]
+    if unknown:
+        raise InputError(f"{where} [{kind}]: unknown keys {sorted(unknown)}; expected some of "
+                         f"{sorted(KEYS[kind])}")
+    return t
+
+
+def _positive(t: dict, key: str, where: str, default=None, *, zero: bool = False):
+    if key not in t:
+        return default
+    v = t[key]
+    ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    if not ok or v < 0 or (v == 0 and not zero):
+        raise InputError(f"{where}: expected '{key}' to be a finite number {'>=' if zero else '>'} 0, "
+                         f"found {v!r}")
+    return float(v)
+
+
+def _points(t: dict, key: str, where: str):
+    if key not in t:
+        return None
+    v = t[key]
+    ok = isinstance(v, list) and all(
+        isinstance(p, list) and len(p) == 2 and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                    and math.isfinite(x) for x in p) for p in v)
+    if not ok:
+        raise InputError(f"{where}: expected '{key}' as rows [x_f, y_f] in m, found {v!r}")
+    return tuple((float(x), float(y)) for x, y in v)
+
+
+def _choice(t: dict, key: str, where: str, choices, default=None):
+    v = t.get(key, default)
+    if v is not None and v not in choices:
+        raise InputError(f"{where}: expected '{key}' to be one of {list(choices)}, found {v!r}")
+    return v
+
+
+def _strings(t: dict, key: str, where: str) -> tuple:
+    v = t.get(key, [])
+    if not (isinstance(v, list) and all(isinstance(s, str) for s in v)):
+        raise InputError(f"{where}: expected '{key}' to be a list of strings, found {v!r}")
+    return tuple(v)
+
+
+@dataclass(frozen=True)
+class HinfWeights:
+    """``[control]``: the H-infinity design of 7.3-7.4 (Fig. 7.1).
+
+    alpha : float or None
+        alpha_1 of eq. 5.66 [1/s]: closed-loop poles left of -alpha_1. None: the default of
+        :func:`tmfem.control.linear.deployed_design.default_alpha` (the system's own scale).
+    u_m : float or None
+        Rest-length scale of W_u = I / u_m [m]; None: :func:`default_u_m`.
+    W_e, W_d : float
+        Tracking-error weight (7.4: 0.5) and noise weight (7.4: 0.001).
+    points : tuple of (x_f, y_f) or None
+        Measured membrane points of eq. 5.18 [m]; None: ``[monitor] points``, else chosen
+        inside the membrane (:func:`tmfem.control.linear.generalized_plant.point_coordinates`).
+    """
+
+    alpha: float | None = None
+    u_m: float | None = None
+    W_e: float = 0.5
+    W_d: float = 0.001
+    points: tuple | None = None
+
+
+@dataclass(frozen=True)
+class DeploymentParameters:
+    """``[deployment]``: the deployment of 7.4 (adaptive PFL, then the switch).
+
+    omega_r, xi_r : reference trajectory of eq. 5.68 [rad/s] and its damping (only 1 is
+        implemented: the critically damped closed form).
+    gains : (omega_0, omega_e, tau, d_c) of eq. 5.69 (Table 7.1) [rad/s, rad/s, s, -].
+    uncertainty : the controller's model error ("initial": eq. 5.72, "no-MG", "exact").
+    path : "delta" (1-N(D): eq. 3.22 with Delta linear), "table-7-7-bases" (M = 2 with the
+        stage-2 base rule of Table 7.7) or "linear"; None: "delta" for 1-N(D), else "linear".
+    rbf_centres, w_bar, gamma : RBF centres along the reference, the bound of the weights and
+        the adaptation gain (eq. 5.58-5.60).
+    r_min : smallest admissible rest length [m] (the rest-length limit of the PFL).
+    """
+
+    omega_r: float = 0.5
+    xi_r: float = 1.0
+    gains: tuple = (4.0, 10.0, 20.0, 0.9)
+    uncertainty: str = "no-MG"
+    path: str | None = None
+    rbf_centres: int = 10
+    w_bar: float = 100.0
+    gamma: float = 0.01
+    r_min: float = 1e-3
+
+
+@dataclass(frozen=True)
+class LPVParameters:
+    """``[lpv]``: the LPV deployment of 8.4 (eq. 5.100)."""
+
+    omega_r: float = 0.3
+    membrane_modes: int | None = None
+    points: tuple | None = None
+    path: str = "linear"
+
+
+@dataclass(frozen=True)
+class ReportSettings:
+    """``[report]``: what ``tmfem report`` adds for this system.
+
+    perturbation : {coordinate rate: value}, the free-vibration start (default
+        ``theta_11_dot = 0.01`` rad/s).
+    implied_rest_lengths, implied_source : a second prestress case (rest lengths per group or
+        tendon [m]) and where it comes from; none by default.
+    notes_design, notes_models : notes printed beside the design and the model results.
+    deployment : {system, uncertainty, t_end, controller}: a deployment the report runs (a
+        preset name or a file path in ``system``); none by default (a deployable system with
+        ``[packaged]`` runs its own).
+    com_prestress : "designed" (default) or "printed-tendon-stress": the COM of ``tmfem
+        compare`` at the designed prestress or scaled to the printed tendon stress.
+    """
+
+    perturbation: dict = field(default_factory=lambda: {"theta_11_dot": 0.01})
+    implied_rest_lengths: dict | None = None
+    implied_source: str = ""
+    notes_design: tuple = ()
+    notes_models: tuple = ()
+    deployment: dict | None = None
+    com_prestress: str = "designed"
+
+
+@dataclass(frozen=True)
+class Problem:
+    """The tables of a system file beyond the structure (module docstring); ``raw`` keeps them
+    as read, for writing the file back."""
+
+    control: HinfWeights = field(default_factory=HinfWeights)
+    deployment: DeploymentParameters | None = None
+    lpv: LPVParameters | None = None
+    report: ReportSettings = field(default_factory=ReportSettings)
+    packaged: object = None
+    raw: dict = field(default_factory=dict)
+
+
+def _control(t: dict, where: str) -> HinfWeights:
+    w = f"{where} [control]"
+    _keys(t, "control", where)
+    d = HinfWeights()
+    return HinfWeights(alpha=_positive(t, "alpha", w), u_m=_positive(t, "u_m", w),
+                       W_e=_positive(t, "W_e", w, d.W_e), W_d=_positive(t, "W_d", w, d.W_d),
+                       points=_points(t, "points", w))
+
+
+def _gains(v, where: str) -> tuple:
+    if isinstance(v, dict):
+        missing = set(GAIN_KEYS) - set(v)
+        extra = set(v) - set(GAIN_KEYS)
+        if missing or extra:
+            raise InputError(f"{where}: expected 'gains' with keys {list(GAIN_KEYS)} (Table 7.1), "
+                             f"found {sorted(v)}")
+        v = [v[k] for k in GAIN_KEYS]
+    if not (isinstance(v, list) and len(v) == 4):
+        raise InputError(f"{where}: expected 'gains' as {{omega_0, omega_e, tau, d_c}} "
+                         f"(Table 7.1), found {v!r}")
+    from tmfem.control.deployment.adaptive import Gains
+    g = tuple(_positive({k: x}, k, where, zero=k == "omega_e") for k, x in zip(GAIN_KEYS, v))
+    Gains(*g)
+    return g
+
+
+def _deployment(t: dict, where: str) -> DeploymentParameters:
+    w = f"{where} [deployment]"
+    _keys(t, "deployment", where)
+    d = DeploymentParameters()
+    xi = _positive(t, "xi_r", w, d.xi_r)
+    if xi != 1.0:
+        raise InputError(f"{w}: expected xi_r = 1 (eq. 5.68 critically damped, the reference "
+                         f"implemented), found {xi}")
+    n = t.get("rbf_centres", d.rbf_centres)
+    if not (isinstance(n, int) and not isinstance(n, bool) and n >= 2):
+        raise InputError(f"{w}: expected 'rbf_centres' to be an integer >= 2, found {n!r}")
+    return DeploymentParameters(
+        omega_r=_positive(t, "omega_r", w, d.omega_r), xi_r=xi,
+        gains=_gains(t["gains"], w) if "gains" in t else d.gains,
+        uncertainty=_choice(t, "uncertainty", w, UNCERTAINTIES, d.uncertainty),
+        path=_choice(t, "path", w, PATHS), rbf_centres=n, w_bar=_positive(t, "w_bar", w, d.w_bar),
+        gamma=_positive(t, "gamma", w, d.gamma), r_min=_positive(t, "r_min", w, d.r_min))
+
+
+def _lpv(t: dict, where: str) -> LPVParameters:
+    w = f"{where} [lpv]"
+    _keys(t, "lpv", where)
+    K = t.get("membrane_modes")
+    if K is not None and not (isinstance(K, int) and not isinstance(K, bool) and K >= 1):
+        raise InputError(f"{w}: expected 'membrane_modes' to be an integer >= 1, found {K!r}")
+    return LPVParameters(omega_r=_positive(t, "omega_r", w, LPVParameters.omega_r),
+                         membrane_modes=K, points=_points(t, "points", w),
+                         path=_choice(t, "path", w, PATHS, "linear"))
+
+
+def _report(t: dict, where: str) -> ReportSettings:
+    w = f"{where} [report]"
+    _keys(t, "report", where)
+    pert = t.get("perturbation", {"theta_11_dot": 0.01})
+    if not (isinstance(pert, dict) and pert and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+            for v in pert.values())):
+        raise InputError(f"{w}: expected 'perturbation' as a table coordinate = number, found {pert!r}")
+    implied = t.get("implied_rest_lengths")
+    if implied is not None and not (isinstance(implied, dict) and implied and all(
+            _positive({k: v}, k, w) for k, v in implied.items())):
+        raise InputError(f"{w}: expected 'implied_rest_lengths' as a table of rest lengths, "
+                             f"found {implied!r}")
+    dep = t.get("deployment")
+    if dep is not None:
+        _keys(dep, "report.deployment", w)
+        if not isinstance(dep.get("system"), str):
+            raise InputError(f"{w} deployment: expected 'system' (a preset name or a system "
+                             f"file), found {dep.get('system')!r}")
+        dep = {"uncertainty": "exact", "t_end": 16.0, "controller": "adaptive-hinf", **dep}
+        _choice(dep, "uncertainty", f"{w} deployment", UNCERTAINTIES)
+        _positive(dep, "t_end", f"{w} deployment")
+    src = t.get("implied_source", "")
+    if not isinstance(src, str):
+        raise InputError(f"{w}: expected 'implied_source' to be a string, found {src!r}")
+    return ReportSettings(perturbation={k: float(v) for k, v in pert.items()},
+                          implied_rest_lengths=dict(implied) if implied else None,
+                          implied_source=src, notes_design=_strings(t, "notes_design", w),
+                          notes_models=_strings(t, "notes_models", w), deployment=dep,
+                          com_prestress=_choice(t, "com_prestress", w, COM_PRESTRESS, "designed"))
+
+
+#: top-level tables read here
+TABLES = ("control", "deployment", "lpv", "report", "packaged")
+
+
+def problem_from_dict(d: dict, where: str, build) -> Problem:
+    """The :class:`Problem` of the parsed file ``d``; ``build(dict, where)`` builds the
+    packaged System from the file with ``[packaged]`` merged in."""
+    raw = {k: d[k] for k in TABLES if k in d}
+    packaged = None
+    if "packaged" in d:
+        from tmfem.system.spec import deep_merge
+        p = d["packaged"]
+        if not isinstance(p, dict):
+            raise InputError(f"{where}: expected [packaged] to be a table of overrides, found {p!r}")
+        rest = {k: v for k, v in d.items() if k not in TABLES}
+        merged = deep_merge(rest, p)
+        if "rest_lengths" in p:                       # rest lengths are replaced, not merged
+            merged["rest_lengths"] = p["rest_lengths"]
+        elif "rest_lengths" in rest:
+            merged.pop("rest_lengths")                 # the deployed ones do not hold there
+        merged["name"] = f"{d.get('name', where)} (packaged)"
+        packaged = build(merged, f"{where} [packaged]")
+    return Problem(control=_control(d["control"], where) if "control" in d else HinfWeights(),
+                   deployment=_deployment(d["deployment"], where) if "deployment" in d else None,
+                   lpv=_lpv(d["lpv"], where) if "lpv" in d else None,
+                   report=_report(d["report"], where) if "report" in d else ReportSettings(),
+                   packaged=packaged, raw=raw)
+
+
+def default_u_m(system) -> float:
+    """u_m of W_u = I / u_m when the file gives none: 0.5 % of the mean bar length [m] (7.4's
+    0.01 m for l = 2.2 m and 1.8 m, 0.02 m for 3 m are 0.46-0.67 % of l)."""
+    return float(0.005 * np.mean(system.l))
