@@ -209,7 +209,7 @@ def test_equilibrium_map_with_a_base_rule():
 
 
 def test_force_ratios_agree_with_mtc_nodal_balance():
-    # independent formulation (helper B2's MTC model): nonlinear membrane with the corners at
+    # independent formulation (the MTC model): nonlinear membrane with the corners at
     # the design bar tops, then force balance at every free node along the member
     # directions. The membrane forces differ (nonlinear vs linear), so compare the tendon
     # forces relative to one of them: they must agree for a 2-3 design (3.3.2)

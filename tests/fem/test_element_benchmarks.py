@@ -70,7 +70,7 @@ def membrane5():
 
 
 def test_square_membrane_inplane_matches_linear_plane_stress():
-    # source: independent formulation -- tmfem.fem.plane_stress (linear, helper A2) with the
+    # source: independent formulation -- tmfem.fem.plane_stress (linear) with the
     # corner displacements of our nonlinear solve gives back the applied corner forces at a
     # load 1000x below 4.5.4's (strains ~1e-7, geometric nonlinearity negligible)
     from tmfem.fem.plane_stress import PlaneStressMembrane

@@ -1,6 +1,6 @@
 """The MTC convergence study with the tension-field membrane (docs/guides/mtc.md, "Wrinkling").
 
-Sources: the issue's convergence target (0.3 % between the two finest meshes) for the global
+Sources: the convergence target (0.3 % between the two finest meshes) for the global
 modes 1-4, the rates of np.polyfit on log h, and the law itself (tension only: the minor
 principal stress of the prestress is at most eta times the major). Full size: meshes
 20, 40, 60 as in the documented command; reduced (TMFEM_SLOW_SCALE=reduced): 20, 25, 30.

@@ -64,7 +64,7 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
     (system, grid axes, refine, EIGOPT bisection or fixed level)."""
     refine = 4 if args.refine is None else args.refine
     if refine < 4:
-        raise InputError(f"--refine: expected >= 4 (the issue's verification standard), found {refine}")
+        raise InputError(f"--refine: expected >= 4 (the verification standard: 4 points between grid points), found {refine}")
     if solver not in ("CLARABEL", "SCS", "EIGOPT"):
         raise InputError(f"--solver {solver}: applies to `tmfem control hinf` only; lpv takes CLARABEL, SCS or EIGOPT")
     eig = {k: getattr(args, k, None) for k in ("gamma_rtol", "time_budget", "fixed_gamma", "start")}

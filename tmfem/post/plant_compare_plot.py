@@ -1,4 +1,4 @@
-"""Plot of the same deployment on two plants (issue 15; deviations from
+"""Plot of the same deployment on two plants (deviations from
 :func:`tmfem.control.fe_plant.compare.plant_deviation`)."""
 from __future__ import annotations
 

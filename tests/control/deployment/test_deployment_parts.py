@@ -1,4 +1,4 @@
-"""Parts of the deployment controller (issue 13): reference (eq. 5.68), PFL partition
+"""Parts of the deployment controller: reference (eq. 5.68), PFL partition
 (eqs. 5.39-5.41), B_q check, RBF and projection (eqs. 5.44, 5.51-5.52), gains (eq. 5.69),
 rest-length saturation and switching (eq. 5.70)."""
 import numpy as np

@@ -73,7 +73,7 @@ def test_1_6D_switch_time():
 
 @pytest.mark.slow
 def test_1_4D_switch_to_lmi_hinf():
-    # the H-infinity controller of 7.3 (issue 12; the central one at 1.01 gamma_opt, issue 13)
+    # the H-infinity controller of 7.3 (the central one at 1.01 gamma_opt)
     # after the switch stabilises the whole system at the deployed equilibrium (7.4.1:
     # "rapidly stabilized"), membrane included
     s = setup("1-4D", controller="adaptive-hinf", uncertainty="exact")

@@ -1,4 +1,4 @@
-"""One deployment on two plants (issue 15, docs/guides/fe-plant.md): the deviation between the runs
+"""One deployment on two plants (docs/guides/fe-plant.md): the deviation between the runs
 (tmfem.control.fe_plant.compare) against its definition on synthetic records, and the layout of
 the comparison plot (tmfem.post.plant_compare_plot)."""
 from types import SimpleNamespace

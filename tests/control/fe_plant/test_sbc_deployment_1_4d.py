@@ -1,4 +1,4 @@
-"""The whole 1-4(D) deployment on the shell-beam-cable plant (issue 15, docs/guides/fe-plant.md "The
+"""The whole 1-4(D) deployment on the shell-beam-cable plant (docs/guides/fe-plant.md "The
 whole 1-4(D) deployment on the SBC plant: a crossover below the bars' bending").
 
 The 7.4 controller (adaptive PFL, switch to the H-infinity controller of 7.3) drives the

@@ -1,4 +1,4 @@
-"""The 2-3 deployments on the SBC plant (issue 15, docs/guides/fe-plant.md "The 2-3 deployments on
+"""The 2-3 deployments on the SBC plant (docs/guides/fe-plant.md "The 2-3 deployments on
 the SBC plant"). Why the LPV deployment of 8.4 diverges there: the linear sampled loop of an
 FE plant under Park's method (:mod:`tmfem.control.fe_plant.sampled_loop`), checked against Park's
 characteristic equation, at the start of the LPV deployment on the SBC, the MTC and a

@@ -1,4 +1,4 @@
-"""The 1-4(D) deployment on the SBC plant (issue 15, docs/guides/fe-plant.md "What was tried"): the
+"""The 1-4(D) deployment on the SBC plant (docs/guides/fe-plant.md "What was tried"): the
 rigid-body measurement of the beam bars, the damped feedback inversion of the PFL and the
 Rayleigh damping of the FE plant, each against a closed form or the COM run."""
 import os

@@ -1,4 +1,4 @@
-"""Tension-controlled tendon actuators on the FE plants (issue 15, docs/guides/fe-plant.md "A
+"""Tension-controlled tendon actuators on the FE plants (docs/guides/fe-plant.md "A
 tension-controlled actuator"): the command u_c of the COM-designed controller becomes the COM's
 tendon tension T_d = max(0, k (|d(q)| - u_c)) at the measured q, realised on the FE tendons
 (:mod:`tmfem.control.fe_plant.tension_actuation`)."""

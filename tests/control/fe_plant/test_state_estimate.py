@@ -1,5 +1,5 @@
 """The MTC finite-element model as the plant of controllers designed on the control-oriented
-model (issue 15): the COM-state estimate (tmfem.control.fe_plant.state_estimate) and a closed loop."""
+model: the COM-state estimate (tmfem.control.fe_plant.state_estimate) and a closed loop."""
 import numpy as np
 import pytest
 

@@ -102,7 +102,7 @@ def test_pointwise_bound_is_below_the_lpv_gamma():
     design = synthesize_state_feedback(gp)
     assert b.gamma.shape == (3,) and b.lower_bound == pytest.approx(b.gamma.max())
     assert b.lower_bound <= design.gamma * (1 + 1e-5)
-    # a single grid point with zero rates: the LPV synthesis is the LTI problem (issue 14)
+    # a single grid point with zero rates: the LPV synthesis is the LTI problem
     one = interconnection_8_1(oscillator(rho=[1.0]), tracked=["x"])
     one.rate_bounds = np.zeros((1, 2))
     assert synthesize_state_feedback(one).gamma == pytest.approx(

@@ -197,7 +197,7 @@ def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
 
 @pytest.mark.slow
 def test_lpv_deployment_on_the_mtc_plant_follows_the_com_run(design21, tmp_path, capsys):
-    """The same scheduled state feedback on the MTC plant (issue 15; 3 x 5 x 5 here, the
+    """The same scheduled state feedback on the MTC plant (3 x 5 x 5 here, the
     3 x 10 x 10 run in docs/guides/fe-plant.md): started in the FE's own equilibrium of the
     packaged configuration, it tracks eq. 5.100, never commands a rest length above a tendon
     length, and its bar coordinates stay within 5 mrad / 5 mm of the COM run (measured on

@@ -73,7 +73,7 @@ def lqr_state_feedback(model, *, u_e, z_e=None, u_m: float = 0.01, q_weight: flo
     linearisation (eq. 5.33) with Q = q_weight I and R = I / u_m^2 (the W_u = I / u_m of
     7.4), python-control ``lqr``, as a :class:`LinearController` on y = [z, z'].
 
-    This is a stand-in for the H-infinity output-feedback controller of issue 12 (any
+    This is a stand-in for the H-infinity output-feedback controller of 7.3 (any
     LinearController about the same point plugs into :class:`SwitchingController`)."""
     import control
     lin = linearize(model, z_e=z_e, u_e=u_e)
@@ -88,7 +88,7 @@ def hinf_output_feedback(model, *, u_e, z_e=None, w_e: float = 0.5, w_n: float =
     """A Riccati H-infinity output-feedback controller (python-control ``hinfsyn``) on the
     measured outputs [q, w] about the final equilibrium, with the weights of 7.4
     (W_e = 0.5 I on the state error, measurement noise 0.001 I, W_u = I / u_m). A stand-in
-    for the LMI synthesis of issue 12 (eq. 5.65: alpha-stability not imposed here)."""
+    for the LMI synthesis of 7.3 (eq. 5.65: alpha-stability not imposed here)."""
     import control
     lin = linearize(model, z_e=z_e, u_e=u_e)
     A, B2 = lin.A, lin.B
@@ -173,7 +173,7 @@ class DeploymentResult:
     actuator: dict = field(default_factory=dict)
 
     def summary(self) -> dict:
-        """The JSON figures of issue 13."""
+        """The figures of the run for its JSON summary."""
         dt = float(self.t[1] - self.t[0]) if self.t.size > 1 else 0.0
         return {"switch_time_s": self.switch_time, "t_end_s": float(self.t[-1]),
                 "max_membrane_deflection_m": float(np.max(np.abs(self.w))) if self.w.size else None,
@@ -325,7 +325,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     ``bases`` when given, psi_r from eq. 3.22 with Delta linear in s when ``delta_path``,
     one-stage systems), the adaptive PFL (eq. 5.58, limits treated by ``allocation``) and,
     unless ``linear="none"``, the switch (eq. 5.70) to a linear controller about the final
-    equilibrium: ``"lmi"`` (issue 12's H-infinity output feedback of 7.3 with alpha-stability,
+    equilibrium: ``"lmi"`` (the H-infinity output feedback of 7.3 with alpha-stability,
     :func:`lmi_hinf_controller`, synthesised by ``hinf_method``, its state at the switch by
     :data:`HINF_STARTS`), ``"lqr"``
     (:func:`lqr_state_feedback`) or ``"hinf"`` (:func:`hinf_output_feedback`, python-control

@@ -9,7 +9,7 @@ and is permanent. q_d of eq. 5.70 is read as the final configuration q_e: with t
 time-varying reference the condition would hold at t = 0, where q = q_d(0) (docs/validation/errata.md).
 
 The linear controller is any :class:`tmfem.simulation.controllers.LinearController` from
-y_lin - y_e to u - u_e (an H-infinity controller of issue 12, an LQR state feedback, ...);
+y_lin - y_e to u - u_e (an H-infinity controller of 7.3, an LQR state feedback, ...);
 ``measure(y)`` maps the plant outputs seen by the switching controller onto its inputs
 y_lin. The linear controller's state x_c at the switch (``start``):
 

@@ -1,4 +1,4 @@
-"""The same deployment on two plants (issue 15): their deviation over time.
+"""The same deployment on two plants: their deviation over time.
 
 Both runs record the same named signals at the same sample times (the COM state read from
 the plant -- the FE plants through :class:`tmfem.control.fe_plant.state_estimate.FEStatePlant` --,

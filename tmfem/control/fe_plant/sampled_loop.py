@@ -1,5 +1,5 @@
 """The sampled closed loop of a finite-element plant under a linear controller, linearised
-(issue 15, docs/guides/fe-plant.md).
+(docs/guides/fe-plant.md).
 
 A deployment integrates the FE plant M a + C v + f_int(x; u) = 0 with Park's method at the
 controller's sample time dt, the input held over each step (the residual of step n -> n+1 is

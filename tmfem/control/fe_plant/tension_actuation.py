@@ -1,4 +1,4 @@
-"""Tension-controlled tendon actuators of a finite-element plant (issue 15, docs/guides/fe-plant.md).
+"""Tension-controlled tendon actuators of a finite-element plant (docs/guides/fe-plant.md).
 
 The dissertation's actuators set rest lengths (eq. 5.19). A deployable tendon reeled by a
 winch can instead be servoed on a load cell: the winch holds the tension it is asked for. The
