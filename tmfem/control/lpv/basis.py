@@ -60,9 +60,9 @@ class Basis:
         return cls(functions=(lambda r: 1.0,), gradients=(lambda r: np.zeros(np.size(r)),), names=("1",))
 
     @classmethod
-    def affine(cls, n_parameters: int, *, centre=None, half_width=None) -> "Basis":
-        """{1, rho_n1, ..., rho_n(n_p)} with rho_nk = (rho_k - centre_k) / half_width_k (eq. 5.99:
-        the same span as {1, rho_k}, better conditioned)."""
+    def affine(cls, n_parameters: int, *, centre=None, half_width=None, parameters=None) -> "Basis":
+        """{1, rho_nk for k in ``parameters`` (default all)} with rho_nk = (rho_k - centre_k) /
+        half_width_k (eq. 5.99: the same span as {1, rho_k}, better conditioned)."""
         if int(n_parameters) != n_parameters or n_parameters < 1:
             raise InputError(f"affine basis: expected n_parameters >= 1, found {n_parameters!r}")
         n = int(n_parameters)
@@ -76,9 +76,12 @@ class Basis:
 
         def g(k):
             return lambda r: np.eye(np.size(r))[k] / h[k]
-        return cls(functions=(lambda r: 1.0,) + tuple(f(k) for k in range(n)),
-                   gradients=(lambda r: np.zeros(np.size(r)),) + tuple(g(k) for k in range(n)),
-                   names=("1",) + tuple(f"rho{k}" for k in range(n)))
+        ks = range(n) if parameters is None else [int(k) for k in parameters]
+        if any(not 0 <= k < n for k in ks):
+            raise InputError(f"affine basis: expected parameter indices in [0, {n}), found {list(ks)}")
+        return cls(functions=(lambda r: 1.0,) + tuple(f(k) for k in ks),
+                   gradients=(lambda r: np.zeros(np.size(r)),) + tuple(g(k) for k in ks),
+                   names=("1",) + tuple(f"rho{k}" for k in ks))
 
     @classmethod
     def trigonometric(cls, *, parameter: int = 0, harmonics: int = 1) -> "Basis":
@@ -110,7 +113,8 @@ class Basis:
     def values(self, points) -> np.ndarray:
         """(m, n_b) values f_i at the rows of ``points`` (m, n_p)."""
         pts = np.atleast_2d(np.asarray(points, dtype=float))
-        return np.array([[float(f(r)) for f in self.functions] for r in pts])
+        with np.errstate(all="ignore"):        # a non-finite value is refused by :meth:`checked`
+            return np.array([[float(f(r)) for f in self.functions] for r in pts])
 
     def derivatives(self, points) -> np.ndarray:
         """(m, n_b, n_p) gradients at the rows of ``points``."""

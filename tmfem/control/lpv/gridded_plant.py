@@ -128,6 +128,9 @@ def plant_function(P, *, axes, interpolation: str = "multilinear") -> PlantFunct
         gp = P
         return PlantFunction(evaluate=gp.at, n=gp.nx, m=gp.nu, p=gp.ny, axes=gp.axes, interpolated=True,
                              rate_bounds=gp.rate_bounds)
+    if interpolation != "multilinear":
+        raise InputError(f"LPV plant: interpolation applies to a plant given on a grid, found "
+                         f"interpolation={interpolation!r} with a {type(P).__name__}")
     if hasattr(P, "A") and hasattr(P, "dt"):
         A, B, C, D = _matrices(P, [])
         return PlantFunction(evaluate=lambda rho: (A, B, C, D), n=A.shape[0], m=B.shape[1], p=C.shape[0],

@@ -336,8 +336,10 @@ def _resolve_basis(basis, n_par: int, axes, what: str) -> Basis:
         return Basis.constant()
     if basis == "affine":
         lo = np.array([a[0] for a in axes]); hi = np.array([a[-1] for a in axes])
-        return Basis.affine(n_par, centre=(lo + hi) / 2, half_width=np.where(hi > lo, (hi - lo) / 2, 1.0))
-    raise InputError(f"{what}: expected a Basis, 'constant' or 'affine', found {basis!r}")
+        return Basis.affine(n_par, centre=(lo + hi) / 2, half_width=np.where(hi > lo, (hi - lo) / 2, 1.0),
+                            parameters=[k for k in range(n_par) if hi[k] > lo[k]])
+    raise InputError(f"{what}: expected a Basis, 'constant' or 'affine' (1 and each parameter with more "
+                     f"than one grid value, eq. 5.99), found {basis!r}")
 
 
 def refined_axes(axes, factor: int) -> list:
