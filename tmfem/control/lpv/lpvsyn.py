@@ -18,10 +18,10 @@ Q; eq. 5.99 is the affine basis)::
 
 **Output feedback**, the linearising change of controller variables of Scherer, Gahinet &
 Chilali (IEEE TAC 42 (1997) 896-911, Sec. IV) with parameter-dependent X(rho), Y(rho) and
-their rates, in the form of Apkarian & Adams (IEEE TCST 6 (1998) 21-32, Sec. III, the
-rate-bounded characterisation with X(theta), Y(theta) and the controller formulas that
-follow it; Wu, Yang, Packard & Becker, IJRNC 6 (1996) 983-998 give the eliminated
-equivalent)::
+their rates: the basic characterisation of Apkarian & Adams (IEEE TCST 6 (1998) 21-32,
+Theorem 2.1, eqs. (7)-(8): (LMI-OF) below is their eq. (7) with the blocks of X and Y in the
+other order, and [[Y, I], [I, X]] > 0 their eq. (8)); Wu, Yang, Packard & Becker (IJRNC 6
+(1996) 983-998) give the eliminated equivalent::
 
     (LMI-OF)
     [[A Y + B2 C^ + (*) - Y',  *,                              *,     *    ],
@@ -613,8 +613,7 @@ class _Problem:
         cons.append(g <= gamma_max)
         self._budget = budget
         prob = cp.Problem(cp.Minimize(g), cons)
-        rep = solve(prob, solver=solver, what="gamma minimisation", lmi_sizes={"lmi": self.lmi_size},
-                    tol=1e-7, accept_inaccurate=True)
+        rep = _solve_relaxing(prob, solver=solver, what="gamma minimisation", lmi_size=self.lmi_size)
         self._bound = {k: self._budget * self._largest(k) for k in self.shapes if k in ("P", "Q", "X", "Y")}
         return float(g.value), rep
 
@@ -642,8 +641,7 @@ class _Problem:
                 cons += [sym(cp.bmat([[Yk - t * np.eye(n), np.eye(n)], [np.eye(n), Xk]])) >> 0,
                          sym(Xk) << self._bound["X"] * np.eye(n), sym(Yk) << self._bound["Y"] * np.eye(n)]
         prob = cp.Problem(cp.Maximize(t), cons)
-        rep = solve(prob, solver=solver, what="conditioning re-solve", lmi_sizes={"lmi": self.lmi_size},
-                    tol=1e-7, accept_inaccurate=True)
+        rep = _solve_relaxing(prob, solver=solver, what="conditioning re-solve", lmi_size=self.lmi_size)
         return rep, self._condition_measures()
 
     def _condition_measures(self) -> dict:
@@ -664,6 +662,20 @@ class _Problem:
         for k, _, off, size in self.blocks:
             out[k].append(sum(zj * E for zj, E in zip(z[off:off + size], self.units[k])))
         return out
+
+
+def _solve_relaxing(prob, *, solver, what, lmi_size, tols=(1e-7, 1e-5)):
+    """:func:`tmfem.control.linear.lmi.solve` at the tolerances ``tols`` in turn: an interior-point
+    solver that stalls short of a tight tolerance (a status other than infeasible) is given a
+    looser one; the point it returns is checked by the verification in any case."""
+    for k, tol in enumerate(tols):
+        try:
+            return solve(prob, solver=solver, what=what, lmi_sizes={"lmi": lmi_size}, tol=tol,
+                         accept_inaccurate=True)
+        except InfeasibleController as exc:
+            if k == len(tols) - 1 or "'infeasible'" in str(exc):
+                raise
+            log.warning("%s: %s; retrying at tolerance %g", what, exc, tols[k + 1])
 
 
 def _likely_cause(pts, design, kind, lyap: Basis, rb) -> str:
