@@ -7,7 +7,7 @@ import pytest
 from tmfem.control.linear.hinf_lmi import GeneralizedPlant, hinf_gamma
 from tmfem.control.lpv.basis import Basis
 from tmfem.control.lpv.examples import rotating_spring
-from tmfem.control.lpv.lpvsyn import lpvsyn
+from tmfem.control.lpv import lpvsyn
 from tmfem.control.lpv.plant import GriddedLPV
 from tmfem.control.lpv.synthesis import GeneralisedLPV, synthesize_state_feedback
 from tmfem.errors import InfeasibleController, InputError
@@ -190,3 +190,18 @@ def test_gridded_arrays_are_interpolated_for_the_verification():
     r2 = lpvsyn((plant.A, plant.B, plant.C, plant.D), 0, 1, grid=gp.axes, rate_bounds=gp.rate_bounds,
                 basis="affine", verify_refine=2)
     assert r2.gamma_min == pytest.approx(r.gamma_min, rel=1e-6)
+
+
+def test_a_design_that_fails_between_grid_points_is_refused():
+    # seven points over a full turn: the certificate holds at the design points (with margin)
+    # but not between them; the refusal names the verification, the report the worst point
+    P = rotating_spring(output_feedback=False, **SADDLE)
+    grid = np.linspace(-np.pi, np.pi, 7)
+    with pytest.raises(InfeasibleController, match="verification failed"):
+        lpvsyn(P, 0, 2, grid=grid, rate_bounds=0.5, basis=Basis.trigonometric(), backoff=0.05)
+    r = lpvsyn(P, 0, 2, grid=grid, rate_bounds=0.5, basis=Basis.trigonometric(), backoff=0.05,
+               require_verified=False)
+    v = r.verification
+    assert not v["passed"] and v["max_lmi_eig"] > 0
+    rho_bad = v["max_lmi_eig_at"][0][0]
+    assert np.min(np.abs(grid - rho_bad)) > 0.1                     # between design points

@@ -1,5 +1,5 @@
 """A small LPV plant whose matrices depend on cos(rho) and sin(rho): the design example of
-:func:`tmfem.control.lpv.lpvsyn.lpvsyn` (docs/guides/lpvsyn.md, its tests and benchmark).
+:func:`tmfem.control.lpv.gridded_synthesis.lpvsyn` (docs/guides/lpvsyn.md, its tests and benchmark).
 
 A unit mass moving in a plane (positions q = (q1, q2)) held by an anisotropic spring whose
 stiff axis turns with the angle rho/2 (a spring on a rotating mount)::

@@ -1,6 +1,6 @@
 """A generalised LPV plant known at any parameter value, from what a user brings.
 
-:func:`plant_function` turns the plant argument of :func:`tmfem.control.lpv.lpvsyn.lpvsyn`
+:func:`plant_function` turns the plant argument of :func:`tmfem.control.lpv.gridded_synthesis.lpvsyn`
 into one callable rho -> (A, B, C, D) with the partition of python-control's ``hinfsyn``
 (inputs [w, u], outputs [p, y]; the last ``ncon`` inputs and the last ``nmeas`` outputs):
 

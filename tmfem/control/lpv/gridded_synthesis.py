@@ -363,7 +363,7 @@ def _vertices(rb: np.ndarray) -> np.ndarray:
 def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gain_basis=None,
            constant: str | None = "X", backoff: float = 0.01, budget: float = 10.0, gamma_max: float = 1e6,
            verify_refine: int = 4, solver: str = "CLARABEL", eps: float = 1e-7, scale: bool = True,
-           interpolation: str = "multilinear", require_verified: bool = False) -> LPVSynthesis:
+           interpolation: str = "multilinear", require_verified: bool = True) -> LPVSynthesis:
     """Gridded LPV H-infinity synthesis (module docstring): minimise gamma, back off to a
     well-conditioned controller, verify off the grid.
 
@@ -400,7 +400,8 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     eps : float
         Strictness margin of the LMIs in the scaled problem.
     require_verified : bool
-        Raise :class:`InfeasibleController` when the off-grid verification fails (default: report).
+        Raise :class:`InfeasibleController` when the off-grid verification fails (default);
+        False returns the design with ``verification["passed"]`` false, to inspect it.
 
     Returns
     -------
@@ -412,7 +413,8 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
         Inconsistent shapes, a grid without the plant's design points, a basis that is not
         finite or smooth or is linearly dependent on the grid, options out of range.
     InfeasibleController
-        Infeasible or failed SDP, with the solver status and the likely cause.
+        Infeasible or failed SDP, with the solver status and the likely cause; a design whose
+        verification failed (with ``require_verified``).
     """
     t_start = time.perf_counter()
     axes = grid_axes(grid)
