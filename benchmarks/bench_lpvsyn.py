@@ -13,9 +13,9 @@ import time
 
 import numpy as np
 
+from tmfem.control.lpv import lpvsyn
 from tmfem.control.lpv.basis import Basis
 from tmfem.control.lpv.examples import rotating_spring
-from tmfem.control.lpv import lpvsyn
 from tmfem.errors import InfeasibleController
 
 
@@ -47,7 +47,7 @@ def main():
                 wall, cpu = time.perf_counter() - t0, time.process_time() - c0
                 s, i, v = r.info["sizes"], r.info, r.verification
                 print(f"{fb:8} {bname:13} {n:6d} {s['decision_variables']:5d} {s['lmis']:5d} {s['lmi_size']:4d} "
-                      f"{r.gamma_min:10.5f} {r.gamma:9.5f} {str(v['passed']):>8} {v['max_lmi_eig']:11.3e} "
+                      f"{r.gamma_min:10.5f} {r.gamma:9.5f} {v['passed']!s:>8} {v['max_lmi_eig']:11.3e} "
                       f"{v['max_frozen_norm']:8.5f} {i['solve_time_gamma_s']:7.2f} {i['solve_time_backoff_s']:7.2f} "
                       f"{i['verify_time_s']:7.2f} {wall:6.1f} {cpu:6.1f}", flush=True)
 

@@ -5,15 +5,15 @@ import numpy as np
 import pytest
 
 from tmfem.control.linear.hinf_lmi import GeneralizedPlant, hinf_gamma
+from tmfem.control.lpv import lpvsyn
 from tmfem.control.lpv.basis import Basis
 from tmfem.control.lpv.examples import rotating_spring
-from tmfem.control.lpv import lpvsyn
 from tmfem.control.lpv.plant import GriddedLPV
 from tmfem.control.lpv.synthesis import GeneralisedLPV, synthesize_state_feedback
 from tmfem.errors import InfeasibleController, InputError
 
 #: the rotating saddle: negative stiffness along an axis that turns with rho/2
-SADDLE = dict(k0=0.2, k1=1.0, r=1.0)
+SADDLE = {"k0": 0.2, "k1": 1.0, "r": 1.0}
 GRID = np.linspace(-np.pi, np.pi, 13)
 
 
@@ -76,7 +76,13 @@ def test_output_feedback_with_the_full_state_measured_is_state_feedback():
                 verify_refine=1)
     assert rs.gamma_min * (1 - 1e-6) <= ro.gamma_min <= rs.gamma_min * (1 + 5e-3)
     assert rs.verification["frozen_passed"] and ro.verification["frozen_passed"]
-    assert rs.controller.at([0.3])[3].shape == (2, 4)          # u = K(rho) x
+    K = rs.controller.at([0.3])[3]                             # u = K(rho) x
+    c = rs.certificate.at([0.3])                               # P, Q in the plant's coordinates
+    np.testing.assert_allclose(K, np.linalg.solve(c["P"], c["Q"].T).T, rtol=1e-8, atol=1e-10)
+    # the coefficients in the user's basis {1, cos, sin} give the same P(rho)
+    Pk = rs.certificate.coefficients_in_user_basis()["P"]
+    P_user = Pk[0] + np.cos(0.3) * Pk[1] + np.sin(0.3) * Pk[2]
+    np.testing.assert_allclose(P_user, rs.certificate.scaled_at([0.3])["P"], rtol=1e-9, atol=1e-12)
 
 
 def oscillator_gp():

@@ -55,12 +55,12 @@ class Basis:
 
     # ------------------------------------------------------------------ constructors
     @classmethod
-    def constant(cls) -> "Basis":
+    def constant(cls) -> Basis:
         """{1}: a parameter-independent matrix (quadratic stability for a Lyapunov matrix)."""
         return cls(functions=(lambda r: 1.0,), gradients=(lambda r: np.zeros(np.size(r)),), names=("1",))
 
     @classmethod
-    def affine(cls, n_parameters: int, *, centre=None, half_width=None, parameters=None) -> "Basis":
+    def affine(cls, n_parameters: int, *, centre=None, half_width=None, parameters=None) -> Basis:
         """{1, rho_nk for k in ``parameters`` (default all)} with rho_nk = (rho_k - centre_k) /
         half_width_k (eq. 5.99: the same span as {1, rho_k}, better conditioned)."""
         if int(n_parameters) != n_parameters or n_parameters < 1:
@@ -84,7 +84,7 @@ class Basis:
                    names=("1",) + tuple(f"rho{k}" for k in ks))
 
     @classmethod
-    def trigonometric(cls, *, parameter: int = 0, harmonics: int = 1) -> "Basis":
+    def trigonometric(cls, *, parameter: int = 0, harmonics: int = 1) -> Basis:
         """{1, cos(h rho_p), sin(h rho_p), h = 1..harmonics} of one parameter (index ``parameter``):
         the dependence of a plant on a rotating angle."""
         if int(harmonics) != harmonics or harmonics < 1 or int(parameter) != parameter or parameter < 0:
@@ -102,7 +102,7 @@ class Basis:
         return cls(functions=tuple(funcs), gradients=tuple(grads), names=tuple(names))
 
     @classmethod
-    def from_functions(cls, functions, *, gradients=None, names=None) -> "Basis":
+    def from_functions(cls, functions, *, gradients=None, names=None) -> Basis:
         """Any smooth functions f_i(rho) (gradients optional: central differences otherwise)."""
         functions = tuple(functions)
         names = tuple(names) if names is not None else tuple(f"f{i}" for i in range(len(functions)))

@@ -97,7 +97,7 @@ class Partitioned:
     D21: np.ndarray
 
     @classmethod
-    def of(cls, plant: PlantFunction, rho, *, ncon: int, nmeas: int, T: np.ndarray) -> "Partitioned":
+    def of(cls, plant: PlantFunction, rho, *, ncon: int, nmeas: int, T: np.ndarray) -> Partitioned:
         A, B, C, D = plant.at(rho)
         nw, npp = B.shape[1] - ncon, C.shape[0] - nmeas
         if nmeas and np.any(D[npp:, nw:] != 0):
@@ -148,7 +148,7 @@ class GridBasis:
     W: np.ndarray
 
     @classmethod
-    def of(cls, basis: Basis, design_points: np.ndarray) -> "GridBasis":
+    def of(cls, basis: Basis, design_points: np.ndarray) -> GridBasis:
         V = basis.values(design_points)
         _, R = np.linalg.qr(V)
         return cls(basis=basis, W=np.linalg.inv(R) * np.sqrt(V.shape[0]))
@@ -180,7 +180,7 @@ class GriddedController:
     """
 
     kind: str
-    certificate: "Certificate"
+    certificate: Certificate
     plant: PlantFunction
     ncon: int
     nmeas: int
