@@ -211,3 +211,41 @@ def test_a_design_that_fails_between_grid_points_is_refused():
     assert not v["passed"] and v["max_lmi_eig"] > 0
     rho_bad = v["max_lmi_eig_at"][0][0]
     assert np.min(np.abs(grid - rho_bad)) > 0.1                     # between design points
+
+
+def test_closed_loop_with_the_parameter_turning_at_its_rate_bound(trig_design):
+    # time domain, independent of the LMIs: rho(t) = 0.5 t (the rate bound), a disturbance
+    # burst w; the L2 gain of this one signal is a lower bound of the induced norm <= gamma,
+    # and the state decays after the burst (stability under the fastest admissible turning)
+    from scipy.integrate import solve_ivp
+    P, ctrl = rotating_spring(**SADDLE), trig_design.controller
+    nw = 4
+
+    def w(t):
+        return np.array([np.sin(1.3 * t), np.cos(0.7 * t), 0.3 * np.sin(5 * t), 0.0]) * (t < 15)
+
+    def rhs(t, z):
+        rho = np.array([0.5 * t - np.pi])
+        A, B, C, D = P(rho)
+        Ak, Bk, Ck, Dk = ctrl.at(rho)
+        x, xk = z[:4], z[4:]
+        y = C[4:] @ x + D[4:, :nw] @ w(t)
+        u = Ck @ xk + Dk @ y
+        return np.concatenate([A @ x + B[:, :nw] @ w(t) + B[:, nw:] @ u, Ak @ xk + Bk @ y])
+
+    ts = np.linspace(0, 40, 801)
+    sol = solve_ivp(rhs, (0, 40), np.zeros(8), t_eval=ts, rtol=1e-6, atol=1e-9)
+    assert sol.success
+    pe, we = 0.0, 0.0
+    for k, t in enumerate(ts):
+        rho = np.array([0.5 * t - np.pi])
+        A, B, C, D = P(rho)
+        Ak, Bk, Ck, Dk = ctrl.at(rho)
+        x, xk = sol.y[:4, k], sol.y[4:, k]
+        y = C[4:] @ x + D[4:, :nw] @ w(t)
+        u = Ck @ xk + Dk @ y
+        p = C[:4] @ x + D[:4, nw:] @ u
+        pe += p @ p                      # rectangle rule on the same grid for both signals
+        we += w(t) @ w(t)
+    assert np.sqrt(pe / we) <= trig_design.gamma
+    assert np.linalg.norm(sol.y[:, -1]) < 1e-2 * np.max(np.linalg.norm(sol.y, axis=0))
