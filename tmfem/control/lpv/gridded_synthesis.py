@@ -71,6 +71,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from tmfem.control.linear.lmi import solve, sym
 from tmfem.control.linear.pbh import pbh
@@ -511,7 +512,7 @@ class _Problem:
     """The gridded LMIs as a cvxpy problem in one vector z of the coefficients' free entries.
 
     Each LMI is affine in z and gamma, so it is assembled numerically as vec(M) = m0 + G z +
-    gamma h (columns: the LMI function of the module docstring at unit coefficients, then
+    gamma h with a sparse G (columns: the LMI function of the module docstring at unit coefficients, then
     combined with the basis values and rate-weighted derivatives of each grid point and rate
     vertex); cvxpy then sees one matrix-vector product per LMI instead of the expression tree
     of the block products.
@@ -562,7 +563,8 @@ class _Problem:
         H = {}
         for k in self.shapes:
             for slot in ((k, "d" + k) if k in ("P", "X", "Y") else (k,)):
-                H[slot] = np.stack([self._lmi(pl, {slot: E}).ravel() - m0 for E in self.units[k]], axis=1)
+                H[slot] = sp.csc_matrix(np.stack([self._lmi(pl, {slot: E}).ravel() - m0 for E in self.units[k]],
+                                                 axis=1))
         return m0, self._lmi(pl, {"g": 1.0}).ravel() - m0, H
 
     def _G(self, H, rho, vert):
@@ -573,7 +575,7 @@ class _Problem:
             if "d" + k in H:
                 col = col + (gb.derivatives(rho)[i] @ vert) * H["d" + k]
             cols.append(col)
-        return np.hstack(cols)
+        return sp.hstack(cols, format="csr")
 
     def value(self, k, rho):
         """M_k(rho) as a cvxpy expression (sum_i f_i(rho) M_k,i)."""
@@ -666,14 +668,17 @@ class _Problem:
         return out
 
 
-def _solve_relaxing(prob, *, solver, what, lmi_size, tols=(1e-7, 1e-5)):
+def _solve_relaxing(prob, *, solver, what, lmi_size, tols=(1e-7, 1e-5, 1e-3)):
     """:func:`tmfem.control.linear.lmi.solve` at the tolerances ``tols`` in turn: an interior-point
     solver that stalls short of a tight tolerance (a status other than infeasible) is given a
-    looser one; the point it returns is checked by the verification in any case."""
+    looser one (the report's ``status`` names the tolerance used); the point it returns is
+    checked by the verification in any case."""
     for k, tol in enumerate(tols):
         try:
-            return solve(prob, solver=solver, what=what, lmi_sizes={"lmi": lmi_size}, tol=tol,
-                         accept_inaccurate=True)
+            rep = solve(prob, solver=solver, what=what, lmi_sizes={"lmi": lmi_size}, tol=tol,
+                        accept_inaccurate=True)
+            rep.status = f"{rep.status} (tolerance {tol:g})"
+            return rep
         except InfeasibleController as exc:
             if k == len(tols) - 1 or "'infeasible'" in str(exc):
                 raise
