@@ -249,3 +249,27 @@ def test_closed_loop_with_the_parameter_turning_at_its_rate_bound(trig_design):
         we += w(t) @ w(t)
     assert np.sqrt(pe / we) <= trig_design.gamma
     assert np.linalg.norm(sol.y[:, -1]) < 1e-2 * np.max(np.linalg.norm(sol.y, axis=0))
+
+
+def wu_1996(rho):
+    """The example of Wu, Yang, Packard & Becker (IJRNC 6 (1996) 983-998, Sec. 5) as coded with
+    the conditions of Apkarian & Adams (1998) in github.com/boranzhao/LPV-demo (main.m): a plant
+    turning with cos(rho), sin(rho), rho in [-pi, pi], first-order weights, cheap control
+    (D12 = 1/280): badly scaled (its X, Y span five decades)."""
+    c, s = np.cos(rho[0]), np.sin(rho[0])
+    A = np.array([[0.75, 2, c, s, 0, 0], [0, 0.5, -s, c, 0, 0], [0, 0, -10, 0, 0, 0], [0, 0, 0, -10, 0, 0],
+                  [0, 0, 0, 0, -0.2, 0], [0, 0, 0, 0, 0, -0.2]])
+    B = np.zeros((6, 4)); B[4, 0] = B[5, 1] = 4.0; B[2, 2] = B[3, 3] = 10.0
+    C1 = np.zeros((4, 6)); C1[0, 0] = C1[1, 1] = 1.0; C1[0, 4] = C1[1, 5] = -5.0
+    D = np.zeros((6, 4)); D[2, 2] = D[3, 3] = 1 / 280
+    return A, B, np.vstack([C1, C1[:2]]), D
+
+
+def test_the_wu_1996_example_certifies_above_its_frozen_optimum():
+    grid = np.arange(-5, 6) * np.pi / 5                                  # the grid of the demo
+    r = lpvsyn(wu_1996, 2, 2, grid=grid, rate_bounds=1.0, basis=Basis.trigonometric(), backoff=0.05)
+    assert r.verification["passed"]
+    frozen = [frozen_lti_optimum(wu_1996, x, 2, 2) for x in grid[::3]]
+    # the frozen plants differ by a rotation of the isotropic actuator states (x3, x4) and of u
+    np.testing.assert_allclose(frozen, frozen[0], rtol=1e-5)
+    assert frozen[0] < r.gamma_min < 2 * frozen[0]
