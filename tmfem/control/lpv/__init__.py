@@ -7,7 +7,9 @@ verification (:mod:`tmfem.control.lpv.verify`), the observer-based output feedba
 rate-bounded certificate, the gain-scheduled controllers and the LPV deployment of 8.4. The
 design workflow of ``tmfem control lpv`` is :mod:`tmfem.control.lpv.workflow`
 (:func:`design_plant`, :func:`synthesize_design`, :func:`refined_plant`, :func:`verify_design`,
-:func:`output_feedback_design`).
+:func:`output_feedback_design`). The general gridded synthesis on any plant, with basis
+functions of one's choice for the parameter dependence, is :func:`lpvsyn`
+(:mod:`tmfem.control.lpv.gridded_synthesis`, docs/guides/lpvsyn.md).
 """
 from tmfem._lazy import lazy_exports
 
@@ -41,5 +43,7 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "refined_plant": "tmfem.control.lpv.workflow",
     "saved_design_plant": "tmfem.control.lpv.workflow",
     "synthesize_design": "tmfem.control.lpv.workflow",
-    "verify_design": "tmfem.control.lpv.workflow"
+    "verify_design": "tmfem.control.lpv.workflow",
+    "Basis": "tmfem.control.lpv.basis",
+    "lpvsyn": "tmfem.control.lpv.gridded_synthesis",
 })
