@@ -77,7 +77,7 @@ from tmfem.control.linear.lmi import solve, sym
 from tmfem.control.linear.pbh import pbh
 from tmfem.control.lpv.basis import Basis
 from tmfem.control.lpv.gridded_plant import PlantFunction, grid_axes, plant_function
-from tmfem.control.lpv.synthesis import _state_scaling
+from tmfem.control.lpv.generalized_plant import state_scaling
 from tmfem.errors import InfeasibleController, InputError
 
 log = logging.getLogger(__name__)
@@ -463,7 +463,7 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
         bases = {"X": gbC if constant == "X" else gbL, "Y": gbC if constant == "Y" else gbL,
                  "A^": gbG, "B^": gbG, "C^": gbG, "D^": gbG}
     centre = tuple((a.size - 1) // 2 for a in axes)
-    T = _state_scaling(plant.at([a[i] for a, i in zip(axes, centre)])[0]) if scale else np.ones(n)
+    T = state_scaling(plant.at([a[i] for a, i in zip(axes, centre)])[0]) if scale else np.ones(n)
     verts = _vertices(rb)
     pts = [Partitioned.of(plant, r, ncon=ncon, nmeas=nmeas, T=T) for r in design]
     t_build = time.perf_counter()
