@@ -3,7 +3,7 @@
 6.3 studies the shell-beam-cable (SBC) model; the membrane-truss-cable (MTC) model runs the
 same study. Each row solves the statics and the modes of one (mesh n, tendon elements k): the
 MTC model from the design, the SBC model from the MTC equilibrium on the same mesh (its MTC
-predictor, :meth:`SBCModel.solve_static`), both with the rest lengths held over the study
+predictor, :meth:`SBCModel.equilibrium`), both with the rest lengths held over the study
 (:func:`resolve_rest_lengths`).
 """
 from __future__ import annotations
@@ -57,9 +57,9 @@ def _mtc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
     """(model, static iterations, frequencies, summary values) of one MTC run."""
     m = MTCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
                  patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
-    res = m.solve_static(start="design")
+    res = m.equilibrium(start="design")
     t1 = time.perf_counter()
-    md = m.modes(res.x, k=modes, tangent=res.tangent)
+    md = m.modes(k=modes, at=res)
     st = static_summary(m, res.x)
     return m, res.iterations, md.freq_hz, t1, {
         "Delta_mm": 1e3 * float(np.mean(st["Delta"])),
@@ -81,9 +81,9 @@ def _sbc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
     from tmfem.models.sbc.post import static_summary as sbc_summary
     m = SBCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
                  patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
-    res = m.solve_static()
+    res = m.equilibrium()
     t1 = time.perf_counter()
-    md = m.modes(res.state, k=modes, tangent=res.tangent)
+    md = m.modes(k=modes, at=res)
     st = sbc_summary(m, res)
     return m.mtc, res.iterations, md.freq_hz, t1, {
         "Delta_mm": 1e3 * st["Delta_mean"], "tendon_stress_max_MPa": st["tendon_stress_max"] / 1e6,

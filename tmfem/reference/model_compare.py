@@ -64,7 +64,7 @@ def fe_system(name: str):
 def com_model(name: str, *, mesh_n: int = 10):
     """The control-oriented model of Tables 6.6/6.7 (:data:`PAPER_STATE`; K the dissertation's)."""
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
-    from tmfem.reference.com_modal import printed_prestress_scale
+    from tmfem.post.com import printed_prestress_scale
     s = load_preset(paper_state(name)["preset"])
     K = default_membrane_modes(s)
     m = ControlOrientedModel(s, membrane_modes=K, mesh_n=mesh_n)
@@ -94,9 +94,8 @@ def model_frequencies(name: str, *, modes: int = 12, mesh_n: int = 10, tendon_el
         if progress:
             progress(key)
         t0 = time.perf_counter()
-        res = m.solve_static()
-        eq = res.state if key == "SBC" else res.x
-        out[key] = m.modes(eq, k=modes, tangent=res.tangent).freq_hz
+        res = m.equilibrium()
+        out[key] = m.modes(k=modes, at=res).freq_hz
         times[key] = time.perf_counter() - t0
     if progress:
         progress("COM")

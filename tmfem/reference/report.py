@@ -128,7 +128,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
-    from tmfem.models.mtc.post import member_state, q_from_positions, static_summary
+    from tmfem.models.fe.outputs import q_from_positions
+    from tmfem.models.mtc.post import member_state, static_summary
     from tmfem.post.fields import placed_membrane_field
     from tmfem.post.mtc import membrane_field, model_cells, plot_membrane_stress
     from tmfem.post.plots import plot_free_vibration
@@ -175,7 +176,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     mtc, statics = {}, {}
     for k, (label, (rest, sys_k)) in enumerate(cases.items()):
         model = MTCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
-        res = model.solve_static(start="undeformed")
+        res = model.equilibrium(start="undeformed")
         mtc[label] = (model, res)
         statics[label] = static_summary(model, res.x, result=res)
         X = res.x[:, model.topology.system_node]
@@ -202,7 +203,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     # 3. modes -------------------------------------------------------------------------------
     freqs = {}
     for label, (model, res) in mtc.items():
-        md = model.modes(res.x, k=modes, tangent=res.tangent)
+        md = model.modes(k=modes, at=res)
         freqs[f"MTC {label}"] = md.freq_hz
         if label == "designed":
             shapes = model.topology.T @ md.shapes
@@ -220,8 +221,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         from tmfem.models.sbc.model import SBCModel
         for label, (rest, sys_k) in cases.items():
             sbc = SBCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
-            st = sbc.solve_static()
-            freqs[f"SBC {label}"] = sbc.modes(st.state, k=modes, tangent=st.tangent).freq_hz
+            st = sbc.equilibrium()
+            freqs[f"SBC {label}"] = sbc.modes(k=modes, at=st).freq_hz
     step(STEPS[4])
     K = default_membrane_modes(system)
     com_design = modal_summary(system, modes=modes, membrane_modes=K)

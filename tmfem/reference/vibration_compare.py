@@ -90,7 +90,7 @@ def three_model_vibration(name: str, *, t_end: float, dt: float = 0.01, perturb=
     for key, run in (("SBC", sbc_free_vibration), ("MTC", mtc_free_vibration)):
         steps = progress(key) if progress else None
         with named_model(key, name, mesh_n):
-            st = fe[key].solve_static()
+            st = fe[key].equilibrium()
             static[key] = st.time
             results[key] = run(fe[key], st.state if key == "SBC" else st.x, t_end=t_end, dt=dt,
                                perturb=pert, progress=steps)

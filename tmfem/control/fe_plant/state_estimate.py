@@ -27,7 +27,7 @@ Where the FE membrane moves exactly as the COM's field (eqs. 5.1, 5.3) the estim
 (test); otherwise it is the COM state closest in the kinetic-energy norm, and what it leaves
 out (modes above K, tendon vibration) is what the controller does not see.
 
-:class:`FEStatePlant` is an FE plant (any :class:`tmfem.models.fe_plant.FEPlant`: the MTC
+:class:`FEStatePlant` is an FE plant (any :class:`tmfem.models.fe.plant.FEPlant`: the MTC
 model's :class:`~tmfem.models.mtc.dynamics.MTCDynamics` or the SBC model's
 :class:`~tmfem.models.sbc.dynamics.SBCDynamics`, the tendon rest lengths as inputs,
 M a + C v + f_int(x; u) = 0) whose outputs are that estimate
@@ -49,8 +49,9 @@ from tmfem.control.fe_plant.tension_actuation import (ACTUATIONS, fe_element_len
                                              rest_length_for_tension, tension_demand)
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
-from tmfem.models.mtc.post import member_state, q_from_positions
-from tmfem.models.mtc.topology import to_floating
+from tmfem.models.fe.outputs import q_from_positions
+from tmfem.models.mtc.post import member_state
+from tmfem.models.fe.outputs import to_floating
 from tmfem.system.coordinates import join_q, q_index
 from tmfem.system.geometry import wrap_angle
 
@@ -254,7 +255,7 @@ class FEStatePlant:
         return tension_demand(self.com, self.estimator.bar_coordinates(x), u)
 
     def sample(self, x, u) -> None:
-        """The FE plant's per-sample hook (:meth:`tmfem.models.fe_plant.FEPlant.sample`) at
+        """The FE plant's per-sample hook (:meth:`tmfem.models.fe.plant.FEPlant.sample`) at
         the sampled state x under the model input u (:meth:`actuate`'s)."""
         self.dyn.sample(x, u)
 
@@ -397,7 +398,7 @@ DEPLOYMENT_DAMPING_TANGENT = "current"
 def deployment_damping_tangent(damping_tangent, beta: float):
     """The damping tangent of a deployment plant: the given one, else
     :data:`DEPLOYMENT_DAMPING_TANGENT` where there is stiffness-proportional damping (beta >
-    0; none without it, :func:`tmfem.models.fe_plant.check_damping_tangent`)."""
+    0; none without it, :func:`tmfem.models.fe.plant.check_damping_tangent`)."""
     if damping_tangent is None and beta:
         return DEPLOYMENT_DAMPING_TANGENT
     return damping_tangent
@@ -416,7 +417,7 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     = 0) the FE statics are solved under :func:`start_rest_lengths` -- the bars take their
     axial strain, the membrane and tendons their FE shapes -- so that the run starts without
     the transient of an FE state out of equilibrium. ``beta``: stiffness-proportional
-    Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe_plant.FEPlant`);
+    Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe.plant.FEPlant`);
     ``damping_tangent``: K_0 (``"initial"``) or the tangent at every sample (``"current"``,
     C_n = beta K_T(x_n)), default :data:`DEPLOYMENT_DAMPING_TANGENT`, only with beta > 0;
     ``actuation``: rest-length or tension-servoed tendons (:class:`FEStatePlant`)."""
@@ -424,10 +425,10 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     from tmfem.models.mtc.model import MTCModel
     fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                   rest_lengths=com.u0, tendon_law=tendon_law)
-    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points, beta=beta,
+    dyn = MTCDynamics(fe, fe.equilibrium().x, output_points=com.output_points, beta=beta,
                       damping_tangent=deployment_damping_tangent(damping_tangent, beta))
     fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
-    st = fe.solve_static(x0=com_positions(com, fe, packaged_state(com, initial)))
+    st = fe.equilibrium(x0=com_positions(com, fe, packaged_state(com, initial)))
     fe.set_tendon_lengths(com.u0)
     return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free], actuation=actuation)
 
@@ -463,8 +464,8 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
                    bar_elements=bar_elements, rest_lengths=com.u0)
     mtc = sbc.mtc
     sbc.set_tendon_lengths(start_rest_lengths(initial, "cable", com.u0))
-    pre = mtc.solve_static(x0=com_positions(com, mtc, packaged_state(com, initial)))
-    st = sbc.solve_static(start=sbc.state_from_mtc(pre.x))
+    pre = mtc.equilibrium(x0=com_positions(com, mtc, packaged_state(com, initial)))
+    st = sbc.equilibrium(start=sbc.state_from_mtc(pre.x))
     sbc.set_tendon_lengths(com.u0)
     dyn = SBCDynamics(sbc, st.state, output_points=com.output_points, beta=beta,
                       damping_tangent=deployment_damping_tangent(damping_tangent, beta))

@@ -22,7 +22,7 @@ Statics (6.2) start from the undeformed membrane exactly as the MTC model's (fla
 in the plane of the design bar tops; bars at the design; the bar tops moved onto the corners)
 and use the same mass-scaled trust-region Newton iteration
 (:func:`tmfem.solvers.trust_region.trust_region_newton`), by default after the MTC model's
-own solve from that start as a predictor (:meth:`SBCModel.solve_static`), through its ``update=`` path: the
+own solve from that start as a predictor (:meth:`SBCModel.equilibrium`), through its ``update=`` path: the
 unknown is a :class:`~tmfem.fem.element.State` and an increment adds translations and composes
 the nodal rotations by the exponential map, which is the update the shell and beam tangents
 differentiate. Modes about the prestressed state solve (K_T - omega^2 M) phi = 0 (eq. 5.32)
@@ -33,8 +33,6 @@ directors; repeated pairs are M-orthonormalised by the Rayleigh-Ritz step of
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
-
 import numpy as np
 import scipy.sparse as sp
 
@@ -44,8 +42,11 @@ from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellSection, nodal_normals
 from tmfem.fem.truss import TrussElement, TrussSet, truss_internal
+from tmfem.models.base import Equilibrium
+from tmfem.models.fe.model import FEModel
+from tmfem.models.fe.options import sequence_of
 from tmfem.models.mtc.model import MTCModel
-from tmfem.models.mtc.spec import sequence_of
+from tmfem.models.sbc.dynamics import SBCDynamics
 from tmfem.models.sbc.topology import SBCNumbering, number_sbc
 from tmfem.solvers.eigen import lowest_modes
 from tmfem.solvers.trust_region import trust_region_newton
@@ -56,28 +57,7 @@ from tmfem.system.topology import label
 BAR_NU = 0.3
 
 
-@dataclass
-class SBCStaticResult:
-    """Equilibrium of an SBC model: the nodal ``state`` (positions ``x`` and rotations), the
-    SBC iterations, residual norms [N] (start first; the predictor's first when there is
-    one), monitored node positions, trust-region mu, the predictor's iterations and the
-    reduced tangent at the equilibrium (:meth:`SBCModel.modes` reuses it)."""
-
-    state: State
-    iterations: int
-    residual_history: list
-    monitor: dict
-    mu_history: list
-    time: float
-    predictor_iterations: int = 0
-    tangent: object = None
-
-    @property
-    def x(self) -> np.ndarray:
-        return self.state.x
-
-
-class SBCModel:
+class SBCModel(FEModel):
     """Shell-beam-cable model of an M-N ``System`` (module docstring).
 
     Parameters
@@ -101,6 +81,9 @@ class SBCModel:
         In-plane law of the shells' lamina (:class:`tmfem.fem.mitc4.MITC4Shell`; the MTC
         model built alongside takes the same).
     """
+
+    name = "sbc"
+    plant_type = SBCDynamics
 
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3, bar_elements: int = 1,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
@@ -179,6 +162,21 @@ class SBCModel:
     @property
     def rest_lengths(self) -> np.ndarray:
         return self.mtc.rest_lengths
+
+    @property
+    def nominal_rest_lengths(self) -> np.ndarray:
+        return self.mtc.nominal_rest_lengths
+
+    @property
+    def topology(self):
+        """The placement (membrane mesh, system nodes, attachment) that the SBC numbering
+        extends (:mod:`tmfem.models.fe.topology`)."""
+        return self.mtc.topology
+
+    def positions_of(self, state: State) -> np.ndarray:
+        """Node positions (3, n) of ``state`` in the placement numbering (membrane, system
+        nodes, tendon internal nodes; without the bar interiors)."""
+        return state.x[:, :self.numbering.n_mtc_nodes]
 
     @property
     def elements(self) -> list:
@@ -281,9 +279,10 @@ class SBCModel:
         R[ch] = turn[:, None]
         return State(x=x, R=R, frames=self.shell.frames)
 
-    def solve_static(self, *, start: State | None = None, predictor: str | None = None,
-                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress=None) -> SBCStaticResult:
-        """Equilibrium reached from the undeformed membrane (6.2) or from ``start``.
+    def equilibrium(self, u=None, *, start: State | None = None, predictor: str | None = None,
+                    tol: float = 1e-9, max_iter: int = 200, monitor=(), progress=None) -> Equilibrium:
+        """Equilibrium reached from the undeformed membrane (6.2) or from ``start``, for the
+        tendon rest lengths u (default the current ones, ``u0`` unless changed).
 
         ``predictor="mtc"`` (the default without ``start``): the MTC model of the same mesh and rest lengths is
         solved first from the same undeformed start (with its mesh sequencing above 20 x 20;
@@ -295,6 +294,8 @@ class SBCModel:
         step (:func:`trust_region_newton`). ``monitor``: node labels recorded every iteration
         (predictor iterations first); ``progress(iteration, rnorm, mu, rho)``.
         """
+        if u is not None:
+            self.set_tendon_lengths(u)
         if predictor not in (None, "mtc", "none"):
             raise InputError(f"predictor: expected 'mtc' or 'none', found {predictor!r}")
         if start is not None and predictor == "mtc":
@@ -306,8 +307,8 @@ class SBCModel:
         if start is not None:
             s0 = start
         elif predictor == "mtc":
-            pre = self.mtc.solve_static(tol=tol, max_iter=max_iter, monitor=monitor, progress=progress,
-                                        sequence=sequence_of(self.mtc.topology.mesh.n, None))
+            pre = self.mtc.equilibrium(tol=tol, max_iter=max_iter, monitor=monitor, progress=progress,
+                                       sequence=sequence_of(self.mtc.topology.mesh.n, None))
             s0 = self.state_from_mtc(pre.x)
         else:
             s0 = self.start_state()
@@ -340,19 +341,23 @@ class SBCModel:
         if pre is not None:
             mon = {k: np.concatenate([pre.monitor[k], v[1:]]) for k, v in mon.items()}
             rh = pre.residual_history + rh[1:]
-        return SBCStaticResult(state=res.u, iterations=res.iterations, residual_history=rh,
-                               monitor=mon, mu_history=res.mu_history,
-                               time=time.perf_counter() - t0,
-                               predictor_iterations=0 if pre is None else pre.iterations,
-                               tangent=res.tangent)
+        return Equilibrium(state=res.u, u=self.rest_lengths.copy(),
+                           outputs=self.named_outputs(res.u), iterations=res.iterations,
+                           residual_history=rh, monitor=mon, mu_history=res.mu_history,
+                           time=time.perf_counter() - t0,
+                           predictor_iterations=0 if pre is None else pre.iterations,
+                           level_iterations=[] if pre is None else [pre.iterations, res.iterations],
+                           tangent=res.tangent)
 
     # ------------------------------------------------------------------ modes
-    def modes(self, state: State, *, k: int = 12, sigma: float = -1.0, tangent=None):
-        """Lowest ``k`` modes about the prestressed ``state`` (eq. 5.32): symmetric part of
-        the reduced tangent, mass at the current directors. ``tangent``: the reduced tangent
-        at ``state`` when already assembled (``SBCStaticResult.tangent``). Shapes are reduced
-        vectors (:meth:`full_shapes`). With distributed assembly the symmetric part is
-        assembled from the element matrices (``tangent`` is not needed)."""
+    def modes(self, *, k: int = 12, at=None, sigma: float = -1.0):
+        """Lowest ``k`` modes about the prestressed equilibrium ``at`` (eq. 5.32): symmetric
+        part of the reduced tangent, mass at the current directors. ``at``: an
+        :class:`~tmfem.models.base.Equilibrium` of this model (its tangent is reused), a
+        ``State``, or None (:meth:`equilibrium`). Shapes are reduced vectors
+        (:meth:`full_shapes`). With distributed assembly the symmetric part is assembled from
+        the element matrices (the equilibrium's tangent is not needed)."""
+        state, tangent = self._at(at)
         dist = self.distributed
         if dist is None:
             K = self.residual(state)[1] if tangent is None else tangent

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.models.mtc.post import (bar_loads, check_lines, design_checks, printed_rows,
-                                   q_from_positions)
+from tmfem.models.fe.outputs import q_from_positions
+from tmfem.models.fe.summary import bar_loads, check_lines, design_checks, printed_rows
 from tmfem.system.coordinates import q_index
 from tmfem.system.topology import label
 
@@ -116,7 +116,7 @@ def static_summary(model, result) -> dict:
 
 def bar_angles(system, x: np.ndarray) -> dict:
     """theta_ij, psi_ij [deg] of the bar chords A_ij -> B_ij at labelled positions x (3.2,
-    :func:`tmfem.models.mtc.post.q_from_positions`) and at the design."""
+    :func:`tmfem.models.fe.outputs.q_from_positions`) and at the design."""
     q = q_from_positions(system, x)
     _, ti, pi_ = q_index(system.M, system.N)
     deg = lambda v: np.degrees(v).ravel().tolist()          # noqa: E731
