@@ -1,17 +1,19 @@
 """``tmfem compare``: the SBC, MTC and COM models side by side -- natural frequencies beside
-Tables 6.6/6.7 (6.4), or with ``--vibrate`` free vibration from the same perturbation (6.5)."""
+Tables 6.6/6.7 (6.4) for their presets or of any system file, or with ``--vibrate`` free
+vibration from the same perturbation (6.5)."""
 from __future__ import annotations
 
 import sys
 
-from tmfem.cli.common import (Progress, check_time_steps, finite_float, output_file,
-                              parse_perturbation, positive_int)
+from tmfem.cli.common import (Progress, check_model_budget, check_time_steps, finite_float,
+                              output_file, parse_perturbation, positive_int)
 from tmfem.errors import InputError
 from tmfem.solvers.backends import backend_names
+from tmfem.system import load_system
 
 NAME = "compare"
-HELP = ("the three models (SBC, MTC, COM) side by side: frequencies beside Tables 6.6/6.7, or "
-        "free vibration from one perturbation (--vibrate)")
+HELP = ("the three models (SBC, MTC, COM) side by side: frequencies beside Tables 6.6/6.7 or of a "
+        "system file, or free vibration from one perturbation (--vibrate)")
 
 #: options of each mode, refused in the other
 FREQUENCY_ONLY = ("modes",)
@@ -19,7 +21,10 @@ VIBRATE_ONLY = ("t_end", "dt", "perturb")
 
 
 def configure(parser) -> None:
-    parser.add_argument("--preset", required=True, help="system of Tables 6.6/6.7: 1-4 or 2-3")
+    parser.add_argument("spec", nargs="?", help="system file (TOML): the frequencies of every "
+                                                "model of it; or use --preset")
+    parser.add_argument("--preset", help="system of Tables 6.6/6.7: 1-4 or 2-3, at the state "
+                                         "the tables belong to")
     parser.add_argument("--mesh", type=positive_int, default=10,
                         help="FE membrane elements per side of each quadrilateral (6.4: 10; "
                              "6.5: 10, the '20 x 20' square of 6.5.1 is 4 x 10 x 10)")
@@ -44,7 +49,13 @@ def configure(parser) -> None:
 
 def run(args) -> dict:
     from tmfem.reference.model_compare import paper_state
-    paper_state(args.preset)
+    if (args.spec is None) == (args.preset is None):
+        raise InputError("compare: expected exactly one of a system file or --preset NAME")
+    if args.preset is not None:
+        paper_state(args.preset)
+    elif args.vibrate:
+        raise InputError("compare --vibrate: expected --preset 1-4 or 2-3 (the histories of 6.5); "
+                         "a system file compares the frequencies")
     mine, other = (VIBRATE_ONLY, FREQUENCY_ONLY) if args.vibrate else (FREQUENCY_ONLY, VIBRATE_ONLY)
     wrong = [d for d in other if getattr(args, d) is not None]
     if wrong:
@@ -53,7 +64,27 @@ def run(args) -> dict:
                          f"{flags} ({'without' if args.vibrate is False else 'with'} --vibrate)")
     output_file(args.csv, option="--csv", suffixes=(".csv",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
+    if args.spec is not None:
+        return run_system(args)
     return run_vibration(args) if args.vibrate else run_frequencies(args)
+
+
+def run_system(args) -> dict:
+    """The frequencies of every registered model of the system file ``args.spec``."""
+    from tmfem.models.compare import compare_model_frequencies
+    system = load_system(args.spec)
+    check_model_budget(system, mesh=args.mesh, tendon_elements=args.tendon_elements,
+                       bar_elements=1, dofs_per_node=6)
+    if args.csv:
+        raise InputError("compare SPEC: option does not apply: --csv (the CSV of the printed "
+                         "tables; the frequencies are in --json)")
+    if args.plot:
+        raise InputError("compare SPEC: option does not apply: --plot (the plot beside the "
+                         "printed tables; the frequencies are in --json)")
+    with Progress(total=3, desc=f"compare {system.name}") as bar:
+        return compare_model_frequencies(system, modes=args.modes or 12, mesh=args.mesh,
+                                         tendon_elements=args.tendon_elements,
+                                         backend=args.backend, progress=bar.step)
 
 
 def run_frequencies(args) -> dict:
@@ -108,6 +139,9 @@ def run_vibration(args) -> dict:
 def format_text(r: dict) -> str:
     if r.get("vibrate"):
         lines = [r["text"]]
+    elif "reference" in r:
+        from tmfem.models.compare import format_model_frequencies
+        lines = [format_model_frequencies(r)]
     else:
         from tmfem.reference.model_compare import format_compare
         lines = [format_compare(r)]

@@ -15,6 +15,7 @@ import numpy as np
 from tmfem.errors import InputError, ResourceLimit
 from tmfem.models.base import Equilibrium
 from tmfem.models.fe.outputs import MeasuredOutputs
+from tmfem.models.fe.plant import perturbation_names
 
 #: largest number of free dofs of a full (unreduced) linearisation: its A is dense
 MAX_FULL_LINEARIZATION = 4000
@@ -62,7 +63,7 @@ class FEModel:
     def perturbation_names(self) -> list[str]:
         """The initial perturbations a plant accepts: the q of 3.2 and their rates
         (``theta_12_dot``, :func:`tmfem.models.fe.plant.initial_state`)."""
-        return list(self.system.q_names) + [n + "_dot" for n in self.system.q_names]
+        return perturbation_names(self.system)
 
     @property
     def max_modes(self) -> int:
