@@ -8,7 +8,7 @@ from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_sys
                               system_from_args)
 from tmfem.errors import InputError
 from tmfem.io.units import unit_of
-from tmfem.models.mtc.design import describe_rule
+from tmfem.models.fe.rest_lengths import describe_rule
 from tmfem.models.fe.rest_lengths import apply_rest_lengths
 from tmfem.models.registry import get_spec, models_with
 from tmfem.post.convergence import plot_convergence_study

@@ -8,7 +8,7 @@ from tmfem.errors import InputError
 from tmfem.models.registry import get_spec
 
 NAME = "static"
-HELP = "static equilibrium of the membrane-truss-cable model (dissertation 6.2)"
+HELP = "static equilibrium of a finite-element model (dissertation 6.2)"
 STAGES = ("equilibrium",)
 #: the file options of the command (each model's report says which it writes)
 FILES = ("vtk", "png", "stress_plot", "wrinkle_plot")

@@ -164,7 +164,7 @@ def format_static(r: dict) -> str:
     """Text of :func:`static_summary`: landing against the design, the printed rows of Tables
     6.3/6.5, tendon forces and the design checks."""
     from tmfem.models.fe.summary import check_lines, printed_rows
-    from tmfem.models.mtc.design import describe_rule
+    from tmfem.models.fe.rest_lengths import describe_rule
     lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
              f"membrane, {r['dofs']} free dofs",
@@ -202,7 +202,7 @@ def format_static(r: dict) -> str:
 def modal_summary(model, result, modes) -> dict:
     """JSON-able summary of the modes ``modes`` about the MTC equilibrium ``result``: the
     model, its prestress and the frequencies (eq. 5.32)."""
-    from tmfem.models.mtc.design import describe_rule
+    from tmfem.models.fe.rest_lengths import describe_rule
     from tmfem.models.mtc.post import static_summary as summary
     st = summary(model, result.x, result=result)
     return {"system": model.system.name, "model": "mtc", "dofs": model.ndof,

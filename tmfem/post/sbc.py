@@ -62,7 +62,7 @@ def shell_field(model, state) -> MembraneField:
     surfaces as cell data (``von_mises_top``, ``sigma_p1_mid``, ...; ``von_mises`` and
     ``sigma_p1`` the largest over the surfaces) with the lamina states of
     :func:`shell_wrinkling`."""
-    topo = model.mtc.topology
+    topo = model.topology
     nm = topo.n_mesh
     xm = state.x[:, :nm]
     xf = to_floating(xm, xm[:, topo.mesh.corners])
@@ -83,7 +83,7 @@ def sbc_cells(model) -> list:
     tendon elements (lines) and shell quads."""
     ch = model.numbering.bar_chain
     seg = np.stack([ch[:, :-1].ravel(), ch[:, 1:].ravel()])
-    return [("line", seg), ("line", model.tendons.conn), ("quad", model.mtc.topology.mesh.t)]
+    return [("line", seg), ("line", model.tendons.conn), ("quad", model.topology.mesh.t)]
 
 
 def _cell_data(model, state, cells) -> dict:

@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.models.mtc.design import design_mesh_of, design_rest_lengths_at
+from tmfem.models.fe.rest_lengths import design_mesh_of, design_rest_lengths_at
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.mtc.post import static_summary
 
@@ -85,7 +85,7 @@ def _sbc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
     t1 = time.perf_counter()
     md = m.modes(k=modes, at=res)
     st = sbc_summary(m, res)
-    return m.mtc, res.iterations, md.freq_hz, t1, {
+    return m, res.iterations, md.freq_hz, t1, {
         "Delta_mm": 1e3 * st["Delta_mean"], "tendon_stress_max_MPa": st["tendon_stress_max"] / 1e6,
         "bar_load_max_N": st["bar_load_max"],
         "sigma_p1_max_MPa": st["membrane_max_sigma_p1"] / 1e6,
@@ -125,7 +125,7 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
             t2 = time.perf_counter()
             ne = m.topology.mesh.t.shape[1]
             row = {"mesh_n": int(n), "tendon_elements": int(k), "attachment": attachment,
-                   "elements": ne, "h": float(np.sqrt(m.membrane.area() / ne)),
+                   "elements": ne, "h": float(np.sqrt(m.membrane_area() / ne)),
                    "dofs": vals.pop("dofs", m.ndof), "iterations": its, "static_s": t1 - t0,
                    "modal_s": t2 - t1, **vals, "model": model}
             for i, f in enumerate(freq):

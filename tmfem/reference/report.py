@@ -137,7 +137,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     from tmfem.reference.study import plot_configuration, plot_membrane_stress as plot_design_stress
     from tmfem.reference.study import write_tables
     from tmfem.reference.tables import FREQUENCIES
-    from tmfem.simulation.vibration import free_vibration, mtc_free_vibration
+    from tmfem.simulation.vibration import free_vibration, model_free_vibration
 
     out = Path(out)
     name = system.name
@@ -250,9 +250,9 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         title=f"{name} COM free vibration, K = {K}, " + _perturbation_text(perturb)))
     step(STEPS[6])
     model, res = mtc["designed"]
-    r_mtc = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
-                               csv_path=out / "vibration_mtc.csv",
-                               progress=_run_progress(run_progress, "MTC free vibration"))
+    r_mtc = model_free_vibration(model, at=res, t_end=t_end, dt=dt, perturb=perturb,
+                                 csv_path=out / "vibration_mtc.csv",
+                                 progress=_run_progress(run_progress, "MTC free vibration"))
     add("vibration_mtc.csv", out / "vibration_mtc.csv")
     add("vibration_mtc.png", plot_free_vibration(
         r_mtc, out / "vibration_mtc.png",

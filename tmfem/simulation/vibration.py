@@ -167,27 +167,6 @@ class FEVibration:
                                     np.ptp(self.q, axis=0).tolist()))}
 
 
-def mtc_free_vibration(model, x_eq, *, alpha: float = 0.0, beta: float = 0.0, perturb=None,
-                       output_points=None, **kwargs) -> FEVibration:
-    """Free vibration of an MTC model from its equilibrium ``x_eq`` (3, n_nodes) (6.5,
-    eqs. 5.34-5.35): :func:`fe_free_vibration` of its :class:`MTCDynamics` plant."""
-    dyn = MTCDynamics(model, x_eq, alpha=alpha, beta=beta, perturb=perturb,
-                      output_points=output_points)
-    return fe_free_vibration(dyn, name="mtc",
-                             membrane=lambda u: membrane_field(model, dyn.positions(u)), **kwargs)
-
-
-def sbc_free_vibration(model, state_eq, *, alpha: float = 0.0, beta: float = 0.0, perturb=None,
-                       output_points=None, **kwargs) -> FEVibration:
-    """Free vibration of an SBC model from its equilibrium ``state_eq`` (a ``State``) (6.5):
-    :func:`fe_free_vibration` of its :class:`~tmfem.models.sbc.dynamics.SBCDynamics` plant;
-    ParaView frames carry the shells with their stresses (:func:`tmfem.post.sbc.shell_field`)."""
-    dyn = SBCDynamics(model, state_eq, alpha=alpha, beta=beta, perturb=perturb,
-                      output_points=output_points)
-    return fe_free_vibration(dyn, name="sbc",
-                             membrane=lambda u: shell_field(model, dyn.configuration(u)), **kwargs)
-
-
 #: the ParaView membrane of a finite-element plant's free-dof state u, by plant type
 FRAME_FIELDS = {
     MTCDynamics: lambda dyn: (lambda u: membrane_field(dyn.model, dyn.positions(u))),
@@ -250,7 +229,7 @@ def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_pat
     transverse deflection (eq. 5.37, relative to the equilibrium), kinetic and strain energy.
     """
     check_time_grid(t_end, dt)
-    mtc = dyn.mtc
+    mtc = dyn.model
     system, topo = mtc.system, mtc.topology
     labels = list(system.monitor_nodes) if monitor_nodes is None else list(monitor_nodes)
     lab_nodes = [topo.system_node[system.node_index(n)] for n in labels]

@@ -12,7 +12,7 @@ from tmfem.errors import InputError
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.fe.plant import initial_state
 from tmfem.models.mtc.dynamics import MTCDynamics, fit_frequency
-from tmfem.simulation.vibration import mtc_free_vibration
+from tmfem.simulation.vibration import model_free_vibration
 from tmfem.solvers.park import park_integrate
 from tmfem.system import load_preset
 
@@ -59,7 +59,8 @@ def test_energy_conserved_without_damping_and_decays_with_mass_damping(mtc_1_4):
     pert = {"theta_12_dot": 0.01}
 
     def run(scheme, dt, **kw):
-        r = mtc_free_vibration(m, x, t_end=2.0, dt=dt, perturb=pert, scheme=scheme, **kw)
+        r = model_free_vibration(m, at=x, t_end=2.0, dt=dt, perturb=pert, scheme=scheme,
+                                 dynamics=kw)
         return r, (r.energy - r.energy[0]) / r.kinetic[0]
 
     # the rigid-bar part alone, (1/2) (m l^2 / 3) theta'^2 (consistent bar mass), is a lower
@@ -132,8 +133,8 @@ def test_mtc_and_com_bar_responses_agree_1_4():
     com = ControlOrientedModel(s, membrane_modes=5, mesh_n=4)
     rc = free_vibration(com, t_end=6.0, dt=0.01, perturb={"theta_12_dot": 0.01}, jacobian="reuse")
     m = MTCModel(s.with_rest_lengths(com.u0), mesh_n=4, tendon_elements=3)
-    rm = mtc_free_vibration(m, m.equilibrium(start="undeformed").x, t_end=6.0, dt=0.01,
-                            perturb={"theta_12_dot": 0.01})
+    rm = model_free_vibration(m, at=m.equilibrium(start="undeformed"), t_end=6.0, dt=0.01,
+                              perturb={"theta_12_dot": 0.01})
     i = s.q_names.index("theta_12")
     a = rc.z[:, i] - rc.z[0, i]
     b = rm.q[:, i] - rm.q[0, i]
@@ -162,8 +163,8 @@ def test_mtc_and_com_bar_responses_agree_2_3():
     com = ControlOrientedModel(s, membrane_modes=4, mesh_n=4)
     rc = free_vibration(com, t_end=4.0, dt=0.01, perturb=pert, jacobian="reuse")
     m = MTCModel(s.with_rest_lengths(com.u0), mesh_n=4, tendon_elements=3)
-    rm = mtc_free_vibration(m, m.equilibrium(start="undeformed").x, t_end=4.0, dt=0.01,
-                            perturb=pert)
+    rm = model_free_vibration(m, at=m.equilibrium(start="undeformed"), t_end=4.0, dt=0.01,
+                              perturb=pert)
     i = s.q_names.index("theta_11")
     a = rc.z[:, i] - rc.z[0, i]
     b = rm.q[:, i] - rm.q[0, i]

@@ -190,7 +190,7 @@ def test_1nd_bars_bend_as_pinned_beams_under_the_tendon_load_at_h():
     ch = m.numbering.bar_chain
     assert np.array_equal(ch[:, 3], [m.node(f"H_1{j}") for j in range(1, 5)])
     st = m.equilibrium().state
-    x = st.x[:, m.mtc.topology.system_node]
+    x = st.x[:, m.topology.system_node]
     N, l, k = s.N, s.l[0, 0], s.k_H
     A, B, H = x[:, :N], x[:, N:2 * N], x[:, 2 * N:]
     c = s.tendon_connectivity
@@ -209,7 +209,7 @@ def test_1nd_bars_bend_as_pinned_beams_under_the_tendon_load_at_h():
     M_cf = np.repeat(P, 2)[:, None] * np.where(sA < a, b * sA, a * (l - sA)) / l
     np.testing.assert_allclose(np.hypot(sec["M1"], sec["M2"]), M_cf, rtol=1.5e-2)
     m2 = SBCModel(s, mesh_n=4, tendon_elements=1, bar_elements=2)
-    x2 = m2.equilibrium().state.x[:, m2.mtc.topology.system_node]
+    x2 = m2.equilibrium().state.x[:, m2.topology.system_node]
     assert bar_bow(s, x2) == pytest.approx(bar_bow(s, x), rel=1e-3)
 
 

@@ -20,7 +20,7 @@ from tmfem.cli import main
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.sbc.model import SBCModel
 from tmfem.reference.tables import FREQUENCIES, PRINTED
-from tmfem.simulation.vibration import mtc_free_vibration, sbc_free_vibration
+from tmfem.simulation.vibration import model_free_vibration
 from tmfem.system import load_preset
 
 REDUCED = os.environ.get("TMFEM_SLOW_SCALE", "") == "reduced"
@@ -36,9 +36,9 @@ def vib_1_4():
     s = paper_1_4()
     pert = {"theta_12_dot": 0.01}
     m = SBCModel(s, mesh_n=4, tendon_elements=3)
-    rs = sbc_free_vibration(m, m.equilibrium().state, t_end=0.5, dt=0.01, perturb=pert)
+    rs = model_free_vibration(m, at=m.equilibrium(), t_end=0.5, dt=0.01, perturb=pert)
     mm = MTCModel(s, mesh_n=4, tendon_elements=3)
-    rm = mtc_free_vibration(mm, mm.equilibrium().x, t_end=0.5, dt=0.01, perturb=pert)
+    rm = model_free_vibration(mm, at=mm.equilibrium(), t_end=0.5, dt=0.01, perturb=pert)
     return s, rs, rm
 
 

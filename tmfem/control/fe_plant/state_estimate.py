@@ -50,7 +50,6 @@ from tmfem.control.fe_plant.tension_actuation import (ACTUATIONS, fe_element_len
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
 from tmfem.models.fe.outputs import q_from_positions
-from tmfem.models.mtc.post import member_state
 from tmfem.models.fe.outputs import to_floating
 from tmfem.system.coordinates import join_q, q_index
 from tmfem.system.geometry import wrap_angle
@@ -132,7 +131,7 @@ class COMStateEstimator:
         The controllers' design model, of the same system as the FE model.
     dyn : FEPlant
         The FE plant: ``positions(x)`` gives the node positions of a free-DOF state in the
-        numbering of its MTC model ``dyn.mtc`` (membrane, system labels, tendon internals).
+        placement numbering of its model ``dyn.model`` (membrane, system labels, tendon internals).
     bars : {"chord", "rigid"}, optional
         q from the bar end nodes, or from the rigid fit of the bar's chain nodes
         (:func:`rigid_bar_fit`; a plant with nodes along its bars, ``dyn.bar_chain_positions``:
@@ -149,7 +148,7 @@ class COMStateEstimator:
                              f"its bars (the SBC model), found the {dyn.name} plant, whose bars "
                              f"are straight trusses (their chord is their rigid fit)")
         self.bars = bars
-        fe = dyn.mtc
+        fe = dyn.model
         if fe.system is not com.system:
             raise InputError("FE plant: expected the FE model and the control-oriented model of "
                              f"the same System, found {fe.system.name!r} and {com.system.name!r}")
@@ -246,7 +245,7 @@ class FEStatePlant:
         (:mod:`tmfem.control.fe_plant.tension_actuation`)."""
         if self.actuation == "rest-length":
             return np.asarray(u, dtype=float)
-        return rest_length_for_tension(self.dyn.mtc, fe_element_lengths(self.dyn, x),
+        return rest_length_for_tension(self.dyn.model, fe_element_lengths(self.dyn, x),
                                        self.tension_demand(x, u))
 
     def tension_demand(self, x, u) -> np.ndarray:
@@ -319,7 +318,7 @@ class FEStatePlant:
                      "min_fe_rest_length_margin_m": float(np.min(np.array(L) - R))}
         return {"w": np.array(w), "tendon_force": T, "actuation": self.actuation, **extra,
                 "model": dyn.name, "free_dofs": int(dyn.x0.size),
-                "max_tendon_stress_Pa": float(np.max(T / dyn.mtc.tendon_area)),
+                "max_tendon_stress_Pa": float(np.max(T / dyn.model.tendon_area)),
                 "min_tendon_force_N": float(np.min(T)),
                 "tendon_slack_samples": int(np.sum(slack > 0)),
                 "tendon_slack_elements_max": int(np.max(slack)),
@@ -349,13 +348,13 @@ def com_positions(com, mtc, z) -> np.ndarray:
 
 def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
     """Free-DOF state and velocity of the FE plant ``dyn`` in the configuration of the COM
-    state (z, z'): :func:`com_positions` on the numbering of ``dyn.mtc``, then
+    state (z, z'): :func:`com_positions` on the placement numbering of ``dyn.model``, then
     ``dyn.state_of`` (the SBC model's bars straight, its rotations those of ``dyn``'s
     reference state); velocities by a central difference of that placement along z'
     (``step`` in the coordinates).
     """
     def place(zz):
-        return dyn.state_of(com_positions(com, dyn.mtc, zz))
+        return dyn.state_of(com_positions(com, dyn.model, zz))
 
     z = np.asarray(z, dtype=float)
     x = place(z)
@@ -462,8 +461,8 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     from tmfem.models.sbc.model import SBCModel
     sbc = SBCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                    bar_elements=bar_elements, rest_lengths=com.u0)
-    mtc = sbc.mtc
     sbc.set_tendon_lengths(start_rest_lengths(initial, "cable", com.u0))
+    mtc = sbc.predictor()
     pre = mtc.equilibrium(x0=com_positions(com, mtc, packaged_state(com, initial)))
     st = sbc.equilibrium(start=sbc.state_from_mtc(pre.x))
     sbc.set_tendon_lengths(com.u0)

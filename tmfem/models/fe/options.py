@@ -18,7 +18,7 @@ MEMBRANE_LAW = Option("membrane_law", str, "svk", choices=MEMBRANE_LAWS, doc=(
     "membrane law (of the shell's lamina in the SBC model): St.Venant-Kirchhoff (svk, eq. 4.9) "
     "or tension-field (wrinkling, docs/wrinkling.md)"))
 RAYLEIGH = Option("rayleigh", float, (0.0, 0.0), nargs=2, metavar=("ALPHA", "BETA"), stage="dynamics",
-                  doc="Rayleigh damping C = ALPHA M + BETA K_0 (default none)")
+                  doc="Rayleigh damping C = ALPHA M + BETA K_0 (0 0: undamped)")
 SEQUENCE = Option("sequence", int, None, stage="equilibrium", doc=(
     "mesh sequencing of the static solve from this coarse n, halving (default: 10 when --mesh "
     "> 20, else none; 0 disables)"))

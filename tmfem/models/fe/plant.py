@@ -64,9 +64,9 @@ class FEPlant(ABC):
     """Shared part of the finite-element plants (module docstring); a
     :class:`tmfem.models.base.Plant`.
 
-    Subclasses set ``model`` (with ``residual``, ``backend``, ``rest_lengths``,
-    ``set_tendon_lengths``), ``mtc`` (the MTC model whose numbering, topology and membrane the
-    positions use: the model itself for MTC), ``dofmap`` and ``constraints`` (the model's
+    Subclasses set ``model`` (an FE model, :mod:`tmfem.models.fe.model`: ``residual``,
+    ``backend``, ``rest_lengths``, ``set_tendon_lengths`` and the placement ``topology`` the
+    positions are numbered on), ``dofmap`` and ``constraints`` (the model's
     :class:`tmfem.fem.constraints.ConstraintMap`) and ``free``, then call :meth:`_setup`; they
     implement :meth:`state0`, :meth:`configuration`, :meth:`positions`,
     :meth:`strain_energy`, :meth:`state_of`, :meth:`member_forces` and
@@ -75,7 +75,6 @@ class FEPlant(ABC):
 
     name = None
     model = None
-    mtc = None
     dofmap = None
     constraints = None
     free = None

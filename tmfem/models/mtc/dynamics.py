@@ -75,7 +75,7 @@ class MTCDynamics(FEPlant):
     def __init__(self, model, x_eq, *, alpha: float = 0.0, beta: float = 0.0,
                  perturb: dict | None = None, output_points=None,
                  damping_tangent: str | None = None):
-        self.model = self.mtc = model
+        self.model = model
         self.dofmap, self.constraints = model.topology.dofmap, model.topology.constraints
         self.free = model.free
         self.xr_eq = model.reduce(np.asarray(x_eq, dtype=float))

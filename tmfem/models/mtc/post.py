@@ -7,7 +7,7 @@ import numpy as np
 
 from tmfem.fem.truss import truss_internal
 from tmfem.models.fe.outputs import q_from_positions
-from tmfem.models.fe.summary import bar_loads, check_lines, design_checks, printed_rows
+from tmfem.models.fe.summary import bar_loads, design_checks
 from tmfem.system.topology import label
 
 def member_state(model, x: np.ndarray) -> dict:

@@ -70,7 +70,7 @@ class SBCDynamics(FEPlant):
     def __init__(self, model, state_eq, *, alpha: float = 0.0, beta: float = 0.0,
                  perturb: dict | None = None, output_points=None,
                  damping_tangent: str | None = None):
-        self.model, self.mtc = model, model.mtc
+        self.model = model
         self.dofmap, self.constraints = model.dofmap, model.constraints
         self.free = model.free
         self.state_eq = state_eq

@@ -72,19 +72,19 @@ def static_summary(model, result) -> dict:
     (:func:`tmfem.models.mtc.post.design_checks`), the printed Table 6.3/6.5 values and, for
     1-N(D) systems, the bars' bending deflection at H_1j."""
     sysm, st = model.system, result.state
-    mt = model.mtc.topology
+    mt = model.topology
     X = sysm.nodes()
     x = st.x[:, mt.system_node]
     f = model.member_forces(st)
     sec = model.beam.section_forces(st)
     c = st.x[:, mt.mesh.corners]
-    stress = f["tendon"] / model.mtc.tendon_area
+    stress = f["tendon"] / model.tendon_area
     slack = f["tendon_element"].reshape(len(sysm.tendons), -1).min(axis=1) <= 0
     peaks = membrane_peaks(model, st)
     out = {"system": sysm.name, "model": "sbc", "dofs": model.ndof, "mesh_n": mt.mesh.n,
            "tendon_elements": mt.tendon_elements, "bar_elements": model.numbering.bar_elements,
            "attachment": mt.attachment, "membrane_law": model.shell.law.name,
-           "rest_lengths_source": model.mtc.rest_lengths_source,
+           "rest_lengths_source": model.rest_lengths_source,
            "rest_lengths": {t.name: float(r) for t, r in zip(sysm.tendons, model.rest_lengths)},
            "iterations": result.iterations, "static_time_s": result.time,
            "residual_history": [float(v) for v in result.residual_history],
@@ -97,7 +97,7 @@ def static_summary(model, result) -> dict:
            **{f"membrane_{k}": v for k, v in peaks.items()},
            "checks": design_checks(sysm, sigma_p1=peaks["max_sigma_p1"],
                                    von_mises=peaks["max_von_mises"], tendon_stress=stress,
-                                   tendon_yield=model.mtc.tendon_yield, tendon_slack=slack,
+                                   tendon_yield=model.tendon_yield, tendon_slack=slack,
                                    bar_force=f["bar"]),
            "printed": dict(sysm.printed),
            "monitor": {k: v.tolist() for k, v in result.monitor.items()}}
