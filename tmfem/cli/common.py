@@ -107,6 +107,27 @@ def model_options_from_args(args, command: str):
     return system, options, spec
 
 
+def default_monitor(system) -> list[str]:
+    """Monitored nodes of Figures 6.1 (B_14 of 1-4) and 6.5-6.7 (B_11, A_21, B_21 of 2-3)."""
+    if system.M == 1:
+        return [f"B_1{system.N}"] if system.N < 10 else [f"B_1,{system.N}"]
+    return ["B_11", "A_21", "B_21"]
+
+
+def requested_files(args, command: str, accepted, names) -> dict:
+    """The file options of ``names`` given in ``args`` (by dest), refused (before any work)
+    where they are not among those the chosen model's report writes (``accepted``)."""
+    given = {k: getattr(args, k) for k in names if getattr(args, k, None)}
+    wrong = [k for k in given if k not in accepted]
+    if wrong:
+        flags = "/".join("--" + k.replace("_", "-") for k in wrong)
+        raise InputError(f"{command} --model {args.model}: option does not apply: {flags} (the "
+                         f"{args.model} model writes "
+                         + (", ".join("--" + k.replace("_", "-") for k in accepted) or "no files")
+                         + ")")
+    return given
+
+
 #: output options of the finite-element commands (static, modal, vibrate, converge) and their
 #: suffixes; ``vibrate --vtk`` names a directory
 OUTPUT_SUFFIXES = {"vtk": (".vtu", ".vtk", ".xdmf"), "png": (".png",), "stress_plot": (".png",),

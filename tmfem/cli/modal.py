@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import sys
 
-from tmfem.cli.common import add_model_args, add_system_args, model_from_args
-from tmfem.cli.static import default_monitor, requested_files
+from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
+                              requested_files)
 from tmfem.errors import InputError
 from tmfem.models.registry import get_spec
 from tmfem.reference.dissertation_modes import with_dissertation
@@ -34,7 +34,7 @@ def run(args) -> dict:
         raise InputError(f"--modes: expected an integer >= 1, found {args.modes!r}")
     model, options, spec = model_from_args(args, NAME)
     report = spec.report()
-    files = requested_files(args, NAME, report, names=("vtk", "png"))
+    files = requested_files(args, NAME, report.MODE_FILES, ("vtk", "png"))
     if args.modes > model.max_modes:              # before the static solve
         raise InputError(f"--modes {args.modes}: expected at most {model.max_modes} modes (the "
                          f"{spec.name} model of {model.system.name} has {model.ndof} free DOFs, the "

@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import sys
 
-from tmfem.cli.common import add_model_args, add_system_args, model_from_args
-from tmfem.errors import InputError
+from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
+                              requested_files)
 from tmfem.models.registry import get_spec
 
 NAME = "static"
@@ -31,13 +31,6 @@ def configure(parser) -> None:
     parser.add_argument("--progress", action="store_true", help="iteration progress on stderr")
 
 
-def default_monitor(system) -> list[str]:
-    """Monitored nodes of Figures 6.1 (B_14 of 1-4) and 6.5-6.7 (B_11, A_21, B_21 of 2-3)."""
-    if system.M == 1:
-        return [f"B_1{system.N}"] if system.N < 10 else [f"B_1,{system.N}"]
-    return ["B_11", "A_21", "B_21"]
-
-
 def static_progress(enabled: bool):
     """A ``progress(iteration, rnorm, [mu, rho])`` callback of the static solve that prints
     one line per iteration on stderr (``--progress``), or None."""
@@ -50,25 +43,10 @@ def static_progress(enabled: bool):
     return show
 
 
-def requested_files(args, command: str, report, names=FILES) -> dict:
-    """The file options of ``names`` given in ``args``, refused (before any work) where the
-    model's ``report`` does not write them."""
-    given = {k: getattr(args, k) for k in names if getattr(args, k, None)}
-    accepted = report.STATIC_FILES if command == NAME else report.MODE_FILES
-    wrong = [k for k in given if k not in accepted]
-    if wrong:
-        flags = "/".join("--" + k.replace("_", "-") for k in wrong)
-        raise InputError(f"{command} --model {args.model}: option does not apply: {flags} (the "
-                         f"{args.model} model writes "
-                         + (", ".join("--" + k.replace("_", "-") for k in accepted) or "no files")
-                         + ")")
-    return given
-
-
 def run(args) -> dict:
     model, options, spec = model_from_args(args, NAME)
     report = spec.report()
-    files = requested_files(args, NAME, report)
+    files = requested_files(args, NAME, report.STATIC_FILES, FILES)
     monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
     print(f"tmfem static: {model.system.name} {spec.name.upper()}, {model.ndof} free dofs",
           file=sys.stderr)
