@@ -158,7 +158,7 @@ class COMStateEstimator:
         self._P0 = basis.shapes[0]
         self._Psi = basis.shapes[1:1 + self._nd]
         # FE nodal field -> values at the COM basis nodes (reference coordinates in O_f)
-        self._I = _probe(fe.membrane.skmesh, self._P0[:2])
+        self._I = _probe(fe.topology.mesh.to_skfem(), self._P0[:2])
         topo = fe.topology
         self._system_node, self._n_mesh = topo.system_node, topo.n_mesh
         self._corners = topo.mesh.corners
