@@ -218,22 +218,10 @@ def modal_summary(model, result, modes) -> dict:
 def write_mode_files(model, result, modes, *, vtk=None, png=None) -> dict:
     """The ParaView file of the mode shapes (point data mode_k) and the PNG of the first six
     that are asked for; returns their paths by kind."""
-    out = {}
-    if not (vtk or png):
-        return out
-    shapes = model.topology.T @ modes.shapes
-    cells = model_cells(model)
-    if vtk:
-        from tmfem.io.codes import kind_cell_data
-        from tmfem.io.writer import write_modes
-        out["vtk"] = str(write_modes(vtk, result.x, cells, shapes, modes.freq_hz,
-                                     cell_data=kind_cell_data(cells)))
-    if png:
-        from tmfem.post.render import render_modes
-        out["png"] = str(render_modes(png, points=result.x, cells=cells, shapes=shapes,
-                                      freq_hz=modes.freq_hz, k=min(6, modes.freq_hz.size),
-                                      title=f"{model.system.name} MTC modes"))
-    return out
+    from tmfem.post.modes import write_mode_shapes
+    return write_mode_shapes(result.x, model_cells(model), model.topology.T @ modes.shapes,
+                             modes.freq_hz, vtk=vtk, png=png,
+                             title=f"{model.system.name} MTC modes")
 
 
 def format_modal(r: dict) -> str:

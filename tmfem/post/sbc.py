@@ -180,22 +180,11 @@ def modal_summary(model, result, modes) -> dict:
 def write_mode_files(model, result, modes, *, vtk=None, png=None) -> dict:
     """The ParaView file of the mode shapes (translations and rotations) and the PNG of the
     first six that are asked for; returns their paths by kind."""
-    out = {}
-    if not (vtk or png):
-        return out
-    st = result.state
-    shapes, rotations = mode_data(model, st, modes)
-    cells = sbc_cells(model)
-    if vtk:
-        from tmfem.io.writer import write_modes
-        out["vtk"] = str(write_modes(vtk, st.x, cells, shapes, modes.freq_hz,
-                                     point_data=rotations, cell_data=kind_cell_data(cells)))
-    if png:
-        from tmfem.post.render import render_modes
-        out["png"] = str(render_modes(png, points=st.x, cells=cells, shapes=shapes,
-                                      freq_hz=modes.freq_hz, k=min(6, modes.freq_hz.size),
-                                      title=f"{model.system.name} SBC modes"))
-    return out
+    from tmfem.post.modes import write_mode_shapes
+    shapes, rotations = mode_data(model, result.state, modes)
+    return write_mode_shapes(result.state.x, sbc_cells(model), shapes, modes.freq_hz, vtk=vtk,
+                             png=png, point_data=rotations,
+                             title=f"{model.system.name} SBC modes")
 
 
 def format_modal(r: dict) -> str:
