@@ -139,13 +139,13 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int, eig_solve
     m = MTCModel(system, mesh_n=mesh, tendon_elements=3, backend=be)
     phases = PhaseTimer()
     t1, c1 = time.perf_counter(), time.process_time()
-    res = m.solve_static(sequence=sequence or None)
+    res = m.equilibrium(sequence=sequence or None)
     t2, c2 = time.perf_counter(), time.process_time()
     cpu_phases, wall_phases = dict(phases.cpu), dict(phases.wall)     # of the static solve
     f_static, c_static, s_static, cs_static = be.t_factor, be.c_factor, be.t_solve, be.c_solve
-    modes = m.modes(res.x, k=12, tangent=res.tangent)
+    modes = m.modes(k=12, at=res)
     t3, c3 = time.perf_counter(), time.process_time()
-    its = (res.newton_iterations_tangent or [res.iterations])[-1]
+    its = (res.level_iterations or [res.iterations])[-1]
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     if comm is not None:
         rss = comm.allreduce(rss, op=__import__("mpi4py").MPI.MAX)

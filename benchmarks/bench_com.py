@@ -78,7 +78,7 @@ def bench(name: str, t_end: float) -> None:
           f"{1e6 * per_call(lambda: matrices_newton(model, z, zd), 100):8.1f} us")
     print(f"one Newton matrix K + cv C + ca M (AD, {model.graphs.newton.n_nodes()} nodes): "
           f"{1e3 * per_call(lambda: model.newton_matrix(z, zd, zd, 0.0, 1.0, 1.0), 10):8.2f} ms")
-    z_e = model.equilibrium()
+    z_e = model.equilibrium().state
     print(f"one linearisation (eq. 5.33, at the equilibrium): "
           f"{1e3 * per_call(lambda: linearize(model, z_e=z_e), 10):8.2f} ms")
     tm = Timed(model)

@@ -4,7 +4,7 @@
     mpiexec -n 2 .venv/bin/python benchmarks/bench_eigen_solvers.py 160 redundant,slepc 2
 
 Solves the static equilibrium from the undeformed membrane once (mesh sequencing from
-n = 10, as ``bench_backends.py``), then ``MTCModel.modes(x, k=12)`` with each eigen solver
+n = 10, as ``bench_backends.py``), then ``MTCModel.modes(k=12, at=x)`` with each eigen solver
 of SOLVERS (``PetscBackend.eig_solver``: redundant, block, slepc; ``name:b`` sets the
 right-hand sides per block, ``EIG_BLOCK`` or ``EIG_BLOCK_REDUNDANT``), ROUNDS times in
 turn, so that the solvers meet the same matrices and nearly the same machine load. Rank 0
@@ -35,7 +35,7 @@ def main(argv=None) -> int:
     comm = comm_world()
     be = tp.PetscBackend()
     m = MTCModel(system_1_4(1.5025), mesh_n=mesh, tendon_elements=3, backend=be)
-    res = m.solve_static(sequence=10)
+    res = m.equilibrium(sequence=10)
     ref, defaults = None, (tp.EIG_BLOCK, tp.EIG_BLOCK_REDUNDANT)
     for _ in range(rounds):
         for spec in solvers:
@@ -44,7 +44,7 @@ def main(argv=None) -> int:
             tp.EIG_BLOCK, tp.EIG_BLOCK_REDUNDANT = (int(b), int(b)) if b else defaults
             comm.Barrier()
             t, cpu = time.perf_counter(), time.process_time()
-            modes = m.modes(res.x, k=12)
+            modes = m.modes(k=12, at=res.x)
             t, cpu = time.perf_counter() - t, time.process_time() - cpu
             cpus = comm.gather(cpu)
             ref = modes.freq_hz if ref is None else ref

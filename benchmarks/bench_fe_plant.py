@@ -102,17 +102,17 @@ def main():
     s = load_preset(a.preset)
     t0 = time.perf_counter()
     com = ControlOrientedModel(s, membrane_modes=default_membrane_modes(s), rest_lengths="system")
-    z_e = com.equilibrium(com.u0, z0=com.z0)
+    z_e = com.equilibrium(com.u0, z0=com.z0).state
     ctrl, _ = lqr_state_feedback(com, u_e=com.u0, z_e=z_e, u_m=0.01)
     t_com = time.perf_counter() - t0
     t0 = time.perf_counter()
     perturb = {"theta_11_dot": 0.02}
     if a.plant == "mtc":
         fe = MTCModel(s, mesh_n=a.mesh, rest_lengths="system")
-        dyn = MTCDynamics(fe, fe.solve_static().x, perturb=perturb)
+        dyn = MTCDynamics(fe, fe.equilibrium().x, perturb=perturb)
     else:
         fe = SBCModel(s, mesh_n=a.mesh, rest_lengths="system")
-        dyn = sbc_dynamics.SBCDynamics(fe, fe.solve_static().state, perturb=perturb)
+        dyn = sbc_dynamics.SBCDynamics(fe, fe.equilibrium().state, perturb=perturb)
     plant = Timed(FEStatePlant(dyn, com, bars="chord"))      # as measured in docs/guides/fe-plant.md
     t_fe = time.perf_counter() - t0
     inner = []

@@ -49,9 +49,9 @@ def main(argv=None) -> int:
         t0 = time.perf_counter()
         m = MTCModel(system, mesh_n=n, tendon_elements=3)
         t1 = time.perf_counter()
-        res = m.solve_static(start=args.start, sequence=args.sequence or None)
+        res = m.equilibrium(start=args.start, sequence=args.sequence or None)
         t2 = time.perf_counter()
-        modes = m.modes(res.x, k=12)
+        modes = m.modes(k=12, at=res.x)
         t3 = time.perf_counter()
         _, traced = tracemalloc.get_traced_memory()
         tracemalloc.stop()
@@ -65,7 +65,7 @@ def main(argv=None) -> int:
         tb = time.perf_counter()
         m.backend.factorize(A)(b)
         tc = time.perf_counter()
-        its = (res.newton_iterations_tangent or [res.iterations])[-1]   # on this mesh
+        its = (res.level_iterations or [res.iterations])[-1]   # on this mesh
         print(f"{'4x%dx%d' % (n, n):>9s} {m.ndof:7d} {t1 - t0:8.2f} {its:4d} "
               f"{(t2 - t1) / res.iterations:7.3f} {t2 - t1:9.2f} {t3 - t2:8.2f} {t3 - t0:8.2f} "
               f"{rss:7.0f} {traced / 2**20:9.0f} {tb - ta:10.3f} {tc - tb:7.3f} "

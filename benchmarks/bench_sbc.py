@@ -22,9 +22,9 @@ def run_sbc(SBCModel, system, n, predictor):
     t0 = time.perf_counter()
     m = SBCModel(system, mesh_n=n, tendon_elements=3)
     tb = time.perf_counter() - t0
-    res = m.solve_static(predictor=predictor)
+    res = m.equilibrium(predictor=predictor)
     t1 = time.perf_counter()
-    modes = m.modes(res.state, k=12, tangent=res.tangent)
+    modes = m.modes(k=12, at=res)
     t2 = time.perf_counter()
     return (m.ndof, tb, f"{res.predictor_iterations}+{res.iterations}", t1 - t0 - tb, t2 - t1,
             t2 - t0, float(modes.freq_hz[0]))
@@ -35,9 +35,9 @@ def run_mtc(MTCModel, system, n, sequence_of):
     t0 = time.perf_counter()
     mtc = MTCModel(system, mesh_n=n, tendon_elements=3)
     t1 = time.perf_counter()
-    rm = mtc.solve_static(sequence=sequence_of(n, None))
+    rm = mtc.equilibrium(sequence=sequence_of(n, None))
     t2 = time.perf_counter()
-    mm = mtc.modes(rm.x, k=12)
+    mm = mtc.modes(k=12, at=rm.x)
     t3 = time.perf_counter()
     return mtc.ndof, t2 - t1, t3 - t2, t3 - t0, float(mm.freq_hz[0])
 

@@ -18,7 +18,7 @@ import numpy as np
 
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.mtc.dynamics import fit_frequency
-from tmfem.simulation.vibration import free_vibration, mtc_free_vibration
+from tmfem.simulation.vibration import free_vibration, model_free_vibration
 from tmfem.models.com.model import default_membrane_modes
 from tmfem.models.com.model import ControlOrientedModel
 from tmfem.system import load_preset
@@ -83,11 +83,11 @@ def main():
         t_com = time.perf_counter() - t0
         t0 = time.perf_counter()
         m = MTCModel(system.with_rest_lengths(com.u0), mesh_n=a.mesh, tendon_elements=3)
-        st = m.solve_static(start="undeformed")
+        st = m.equilibrium(start="undeformed")
         t_static = time.perf_counter() - t0
-        rm = mtc_free_vibration(m, st.x, t_end=a.t_end, dt=0.01, perturb=pert,
-                                csv_path=out / f"mtc_{name}.csv")
-        f_modes = m.modes(st.x, k=4).freq_hz
+        rm = model_free_vibration(m, at=st, t_end=a.t_end, dt=0.01, perturb=pert,
+                                  csv_path=out / f"mtc_{name}.csv")
+        f_modes = m.modes(k=4, at=st.x).freq_hz
         i = system.q_names.index(qname)
         yc, ym = rc.z[:, i] - rc.z[0, i], rm.q[:, i] - rm.q[0, i]
         print(f"\n{name}: perturbation {pert}, {a.t_end:g} s, dt = 0.01 s")

@@ -31,9 +31,9 @@ from tmfem.system import load_preset
 
 def run_case(label, system, *, out=None):
     m = MTCModel(system, mesh_n=10, tendon_elements=3)
-    res = m.solve_static(start="undeformed", monitor=["B_14"])
+    res = m.equilibrium(start="undeformed", monitor=["B_14"])
     st = static_summary(m, res.x, result=res)
-    modes = m.modes(res.x, k=12)
+    modes = m.modes(k=12, at=res.x)
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         h = res.monitor["B_14"]

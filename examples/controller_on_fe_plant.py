@@ -44,7 +44,7 @@ def main(argv=None):
 
     # The FE model in its own static equilibrium under the same rest lengths.
     fe = MTCModel(system, mesh_n=args.mesh)
-    x_eq = fe.solve_static().x
+    x_eq = fe.equilibrium().state
 
     push = "theta_11"
     i = list(com.z_names).index(push)

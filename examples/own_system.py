@@ -42,14 +42,14 @@ def main(argv=None):
     # 3. The MTC model takes the designed rest lengths; its statics start from the flat,
     #    unstretched membrane, and the modes are those of the prestressed equilibrium.
     mtc = MTCModel(system, mesh_n=args.mesh, tendon_elements=3)
-    static = mtc.solve_static()
-    modes = mtc.modes(static.x, k=12, tangent=static.tangent)
+    static = mtc.equilibrium()
+    modes = mtc.modes(k=12, at=static)
     print("MTC frequencies [Hz]:", np.round(modes.freq_hz, 4))
 
     # 4. The mode shapes for ParaView: point data mode_1 .. mode_12 (Warp By Vector).
     args.out.mkdir(parents=True, exist_ok=True)
     cells = model_cells(mtc)
-    path = write_modes(args.out / "modes.vtu", static.x, cells, mtc.topology.T @ modes.shapes,
+    path = write_modes(args.out / "modes.vtu", static.state, cells, mtc.topology.T @ modes.shapes,
                        modes.freq_hz, cell_data=kind_cell_data(cells))
     print("wrote", path)
     return modes.freq_hz

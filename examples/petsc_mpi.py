@@ -25,8 +25,8 @@ def run(mesh: int, as_json: bool) -> str:
     """Static equilibrium from the undeformed membrane and the 12 lowest modes of the 1-4
     system's MTC model with the PETSc backend; the text rank 0 prints."""
     model = MTCModel(load_preset("1-4"), mesh_n=mesh, backend="petsc")
-    static = model.solve_static()
-    modes = model.modes(static.x, k=12, tangent=static.tangent)
+    static = model.equilibrium()
+    modes = model.modes(k=12, at=static)
     from mpi4py import MPI
     out = {"ranks": MPI.COMM_WORLD.size, "mesh": mesh, "free_dofs": int(model.topology.T.shape[1]),
            "eig_solver": model.backend.last_eig_solver, "freq_hz": modes.freq_hz.tolist()}

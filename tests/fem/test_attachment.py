@@ -129,7 +129,7 @@ def test_mtc_distributed_consistent_rest_lengths_agree_with_design(s14):
 
 
 def test_shared_weights_and_bad_input(s14):
-    from tmfem.models.mtc.topology import build_topology
+    from tmfem.models.fe.topology import build_topology
     topo = build_topology(s14, mesh_n=20, tendon_elements=1, attachment="distributed")
     w = attachment_weights(topo.mesh, attachment="distributed",
                            patch=default_patch_radius(s14.membrane_corners, s14.r_mb))

@@ -136,7 +136,7 @@ def test_finite_rotation_update_composes_rotations():
 
 def test_constraint_map_reproduces_the_mtc_attachment_map():
     """ConstraintMap.build equals the node-level map kron I_3 the MTC topology used before."""
-    from tmfem.models.mtc.topology import build_topology
+    from tmfem.models.fe.topology import build_topology
     from tmfem.system import load_preset
     topo = build_topology(load_preset("1-4"), mesh_n=4, tendon_elements=2, attachment="point")
     n, N = topo.n_nodes, topo.top_nodes.size

@@ -22,7 +22,7 @@ THETA = np.deg2rad(15.0)
 def sbc():
     """The 1-4(D) SBC model (2 x 2 x 2 shell) at its static equilibrium."""
     m = SBCModel(load_preset("1-4D"), mesh_n=2)
-    return m, m.solve_static().state
+    return m, m.equilibrium().state
 
 
 def _plant(sbc, tangent, alpha=0.0):

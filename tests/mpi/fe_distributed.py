@@ -61,14 +61,14 @@ def main():
         element.element_arrays = nan
     out = {"ranks": comm.size, "distributed": model.distributed is not None}
     if args.model == "mtc":
-        st = model.solve_static(start=args.start)
-        md = model.modes(st.x, k=12)
+        st = model.equilibrium(start=args.start)
+        md = model.modes(k=12, at=st.x)
         S = md.shapes
         m_orth = np.abs(S.T @ (model.mass() @ S) - np.eye(S.shape[1])).max()
         out.update(x=model.reduce(st.x).tolist(), iterations=st.iterations, m_orth=float(m_orth))
     else:
-        st = model.solve_static()
-        md = model.modes(st.state, k=12, tangent=st.tangent)
+        st = model.equilibrium()
+        md = model.modes(k=12, at=st)
         out.update(x=st.state.x.tolist(), R=st.state.R.tolist(), iterations=st.iterations,
                    predictor_iterations=st.predictor_iterations)
     return json.dumps(dict(out, omega2=md.omega2.tolist(), eig_solver=backend.last_eig_solver))

@@ -3,9 +3,10 @@
 Source of every expected number: an independent formulation -- the scipy backend (SuperLU,
 ARPACK/LAPACK) on the same matrices, the residual of the linear system itself, and the
 serial run for the 2-rank run. The model-level statics use the solver layer's Newton on
-the MTC residual from the design (``MTCModel.solve_static`` has no ``backend=`` yet).
+the MTC residual from the design (``MTCModel.equilibrium`` has no ``backend=`` yet).
 """
 import json
+from dataclasses import replace
 import os
 import shutil
 import subprocess
@@ -49,7 +50,7 @@ def models():
 @pytest.fixture(scope="module")
 def equilibria(models):
     # scipy reference: the model's own static solver from the design
-    return {p: m.solve_static(start="design") for p, m in models.items()}
+    return {p: m.equilibrium(start="design") for p, m in models.items()}
 
 
 @needs_petsc
@@ -146,8 +147,8 @@ def petsc_runs():
     out = {}
     for p, n in (("1-4", 6), ("2-3", 4)):
         m = MTCModel(load_preset(p), mesh_n=n, backend="petsc")
-        st = m.solve_static()
-        out[p] = (m, st, m.modes(st.x, k=12))
+        st = m.equilibrium()
+        out[p] = (m, st, m.modes(k=12, at=st.x))
     return out
 
 
@@ -158,12 +159,12 @@ def test_static_equilibrium_and_frequencies_agree(models, petsc_runs, preset):
     assert m.backend.name == "scipy"
     ms, sts, mds = petsc_runs[preset]
     assert ms.backend.name == "petsc"
-    st = m.solve_static()
+    st = m.equilibrium()
     x0 = m.initial_positions("undeformed")
     u_scipy, u_petsc = st.x - x0, sts.x - x0
     assert np.linalg.norm(u_petsc - u_scipy) <= 1e-9 * np.linalg.norm(u_scipy)
     assert sts.iterations == st.iterations
-    md = m.modes(st.x, k=12)
+    md = m.modes(k=12, at=st.x)
     assert np.allclose(mds.freq_hz, md.freq_hz, rtol=1e-8, atol=0)
 
 
@@ -248,7 +249,7 @@ def test_one_and_two_ranks_agree(models, equilibria):
         assert np.linalg.norm(x - xs) <= 1e-9 * np.linalg.norm(xs - x0)
         assert runs[n]["iterations"] == equilibria["1-4"].iterations
     assert np.allclose(runs[2]["omega2"], runs[1]["omega2"], rtol=2e-8, atol=0)
-    ref = m.modes(equilibria["1-4"].x, k=12)
+    ref = m.modes(k=12, at=equilibria["1-4"].x)
     assert np.allclose(runs[2]["omega2"], ref.omega2, rtol=2e-8, atol=0)
 
 
@@ -260,12 +261,12 @@ def test_model_on_petsc_under_two_ranks_agrees(models):
     assert p.returncode == 0, p.stderr
     run = json.loads(p.stdout.strip())
     m = models["1-4"]
-    st = m.solve_static()
+    st = m.equilibrium()
     x0 = m.reduce(m.initial_positions("undeformed"))
     xs = m.reduce(st.x)
     assert np.linalg.norm(np.array(run["x"]) - xs) <= 1e-9 * np.linalg.norm(xs - x0)
     assert run["iterations"] == st.iterations
-    assert np.allclose(run["omega2"], m.modes(st.x, k=12).omega2, rtol=2e-8, atol=0)
+    assert np.allclose(run["omega2"], m.modes(k=12, at=st.x).omega2, rtol=2e-8, atol=0)
 
 
 @needs_mpi
@@ -392,8 +393,8 @@ def sbc_scipy():
     from tmfem.models.sbc.model import SBCModel
     from tmfem.system import load_preset
     m = SBCModel(load_preset("1-4"), mesh_n=6)
-    st = m.solve_static()
-    return m, st, m.modes(st.state, k=12, tangent=st.tangent)
+    st = m.equilibrium()
+    return m, st, m.modes(k=12, at=st)
 
 
 @needs_petsc
@@ -436,10 +437,10 @@ def test_sbc_one_and_two_ranks_agree_with_scipy(sbc_scipy):
     floor = np.finfo(float).eps * np.einsum("ij,ij->j", phi, abs(K) @ phi) / md.omega2
     rtol = np.maximum(1e-8, floor / 2)
     m1 = SBCModel(m.system, mesh_n=6, backend="petsc")
-    s1 = m1.solve_static()
+    s1 = m1.equilibrium()
     runs = {1: {"ranks": 1, "distributed": m1.distributed is not None, "iterations": s1.iterations,
                 "predictor_iterations": s1.predictor_iterations, "x": s1.state.x, "R": s1.state.R,
-                "omega2": m1.modes(s1.state, k=12).omega2}}
+                "omega2": m1.modes(k=12, at=s1.state).omega2}}
     p = _mpirun(2, "1-4", "6", "--model", "sbc")
     assert p.returncode == 0, p.stderr
     lines = p.stdout.strip().splitlines()
@@ -504,10 +505,10 @@ def test_petsc_block_and_slepc_agree_on_the_mtc_modes():
     from tmfem.system import load_preset
     m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
     assert m.distributed.N >= EIG_BLOCK_MIN_N
-    st = m.solve_static(start="design")
-    block = m.modes(st.x, k=12)
+    st = m.equilibrium(start="design")
+    block = m.modes(k=12, at=st.x)
     m.backend = PetscBackend(eig_solver="slepc")
-    slepc = m.modes(st.x, k=12)
+    slepc = m.modes(k=12, at=st.x)
     assert np.allclose(block.freq_hz, slepc.freq_hz, rtol=1e-10, atol=0)
 
 
@@ -550,7 +551,7 @@ def test_block_solver_under_two_ranks_agrees_with_scipy(models, equilibria):
     run = json.loads(p.stdout.strip())
     m = models["1-4"]
     assert m.free.sum() >= EIG_BLOCK_MIN_N                       # the block solver's size
-    ref = m.modes(equilibria["1-4"].x, k=12)
+    ref = m.modes(k=12, at=equilibria["1-4"].x)
     assert np.allclose(run["omega2"], ref.omega2, rtol=2e-8, atol=0)
 
 
@@ -562,7 +563,7 @@ def test_redundant_block_eigen_agrees_with_scipy(models, equilibria, ranks):
     # factorises the whole K - sigma M sequentially and solves its share of the columns of
     # each block (tmfem.solvers.petsc_redundant), on request; "auto" takes the block solver
     # on the distributed factors under P > 1 ranks too, and "slepc" SLEPc: they agree as well
-    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    ref = models["1-4"].modes(k=12, at=equilibria["1-4"].x)
     for solver, ran in (("redundant", "redundant"), ("auto", "block"), ("slepc", "slepc")):
         p = _mpirun(ranks, "1-4", "6", "--start", "design", "--eig-solver", solver)
         assert p.returncode == 0, p.stderr
@@ -612,13 +613,13 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
     from tmfem.system import load_preset
     PETSc.Log.begin()
     sym, num = PETSc.Log.Event("MatCholFctrSym"), PETSc.Log.Event("MatCholFctrNum")
-    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    ref = models["1-4"].modes(k=12, at=equilibria["1-4"].x)
     for options, analyses in ((None, 0), ("-st_mat_mumps_icntl_14 40", 1)):
         m = MTCModel(load_preset("1-4"), mesh_n=6,
                      backend=PetscBackend(eig_solver=eig_solver, options=options))
-        st = m.solve_static(start="design")
+        st = m.equilibrium(start="design")
         s0, n0 = sym.getPerfInfo()["count"], num.getPerfInfo()["count"]
-        modes = m.modes(st.x, k=12)
+        modes = m.modes(k=12, at=st.x)
         assert sym.getPerfInfo()["count"] - s0 == analyses
         assert num.getPerfInfo()["count"] - n0 == 1
         assert np.allclose(modes.omega2, ref.omega2, rtol=2e-8, atol=0)
@@ -651,16 +652,16 @@ def test_modes_reuse_the_static_distributed_tangent(models, equilibria):
     from tmfem.models.mtc.model import MTCModel
     from tmfem.solvers.petsc import PetscBackend
     from tmfem.system import load_preset
-    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    ref = models["1-4"].modes(k=12, at=equilibria["1-4"].x)
     m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
-    st = m.solve_static(start="design")
-    again = m.modes(st.x, k=12)
-    reused = m.modes(st.x, k=12, tangent=st.tangent)
+    st = m.equilibrium(start="design")
+    again = m.modes(k=12, at=st.x)
+    reused = m.modes(k=12, at=st)
     assert np.allclose(reused.omega2, again.omega2, rtol=1e-10, atol=0)
     assert np.allclose(reused.omega2, ref.omega2, rtol=2e-8, atol=0)
     with pytest.raises(InputError, match=r"expected the tangent of this model's static solve "
                                          r"\(DistributedMatrix"):
-        m.modes(st.x, k=12, tangent=equilibria["1-4"].tangent)
+        m.modes(k=12, at=replace(st, tangent=equilibria["1-4"].tangent))
 
 
 def _modal_cli(*argv):

@@ -37,13 +37,15 @@ def system_from_args(args: argparse.Namespace) -> System:
     return load_system(args.spec)
 
 
-def add_model_args(parser, command: str, *, default: str) -> None:
-    """``--model`` (the registry's models that serve ``command``), ``--backend`` and every
-    model option of ``command``, each saying which models take it; read them with
-    :func:`model_from_args`, which refuses an option the chosen model does not take."""
-    from tmfem.models.base import model_options, models_for
+def add_model_args(parser, command: str, *, default: str, capability: str | None = None,
+                   stages=()) -> None:
+    """``--model`` (the registered models with ``capability``), ``--backend`` and the options
+    of every such model for a run of ``stages`` (:func:`tmfem.models.registry.model_options`),
+    each as an argument made from the option's data and saying which models take it; read them
+    with :func:`model_from_args`, which refuses an option the chosen model does not take."""
+    from tmfem.models.registry import model_options, models_with
     from tmfem.solvers.backends import backend_names
-    specs = models_for(command)
+    specs = models_with(capability)
     parser.add_argument("--model", choices=sorted(specs), default=default,
                         help="; ".join(f"{n}: {s.help}" for n, s in specs.items())
                         + f" (default {default})")
@@ -52,25 +54,36 @@ def add_model_args(parser, command: str, *, default: str) -> None:
                              "petsc: docs/guides/backends.md)")
     options, owners = {}, {}
     for name in specs:
-        for o in model_options(name, command):
-            options.setdefault(o.dest, o)
-            owners.setdefault(o.dest, []).append(name)
+        for o in model_options(name, stages):
+            options.setdefault(o.name, o)
+            owners.setdefault(o.name, []).append(name)
     group = parser.add_argument_group("model options (refused for a model that does not take them)")
-    for dest, o in options.items():
+    for name, o in options.items():
         default_text = "" if o.default is None else f"; default {o.default}"
-        group.add_argument(o.flag, **{**o.kwargs, "default": None,
-                                      "help": f"{o.kwargs.get('help', '')} [--model "
-                                              f"{', '.join(owners[dest])}{default_text}]"})
-    parser.set_defaults(_model_option_dests=tuple(options))
+        kwargs = {"default": None, "help": f"{o.doc.replace('%', '%%')} [--model "
+                                           f"{', '.join(owners[name])}{default_text}]"}
+        if o.choices is not None:
+            kwargs["choices"] = o.choices
+        elif o.type is not str:
+            kwargs["type"] = o.type
+        if o.nargs is not None:
+            kwargs["nargs"] = o.nargs
+        if o.metavar is not None:
+            kwargs["metavar"] = o.metavar
+        group.add_argument(o.flag, **kwargs)
+    parser.set_defaults(_model_options=tuple(options), _model_stages=tuple(stages),
+                        _model_capability=capability)
 
 
 def model_options_from_args(args, command: str):
-    """(system, options): the system and the chosen model's option values
-    (:func:`tmfem.models.base.resolve_options`: an option the model does not take is refused)."""
-    from tmfem.models.base import get_spec, resolve_options
+    """(system, options, spec): the system, the chosen model's option values
+    (:func:`tmfem.models.registry.resolve_options`: an option the model does not take is
+    refused) and its registry entry; the resource checks run here, before any model is built."""
+    from tmfem.models.registry import get_spec, models_with, resolve_options
     spec = get_spec(args.model)
-    given = {d: getattr(args, d) for d in args._model_option_dests}
-    options = resolve_options(args.model, command, given)
+    given = {d: getattr(args, d) for d in args._model_options}
+    options = resolve_options(args.model, given, stages=args._model_stages, command=command,
+                              among=models_with(args._model_capability))
     if args.backend is not None and not spec.uses_backend:
         raise InputError(f"{command} --model {args.model}: option does not apply: --backend "
                          f"(the {args.model} model solves small dense systems; --backend is for "
@@ -85,13 +98,34 @@ def model_options_from_args(args, command: str):
         check_model_budget(system, mesh=options["mesh"],
                            tendon_elements=options.get("tendon_elements") or 1,
                            bar_elements=options.get("bar_elements"),
-                           dofs_per_node=6 if args.model == "sbc" else 3)
+                           dofs_per_node=spec.dofs_per_node)
     if "attachment" in options:
         check_attachment_options(system, attachment=options["attachment"], patch=options["patch"])
     if options.get("membrane_modes") is not None:
         check_membrane_modes(options["membrane_modes"])
     check_outputs(args, command)
-    return system, options
+    return system, options, spec
+
+
+def default_monitor(system) -> list[str]:
+    """Monitored nodes of Figures 6.1 (B_14 of 1-4) and 6.5-6.7 (B_11, A_21, B_21 of 2-3)."""
+    if system.M == 1:
+        return [f"B_1{system.N}"] if system.N < 10 else [f"B_1,{system.N}"]
+    return ["B_11", "A_21", "B_21"]
+
+
+def requested_files(args, command: str, accepted, names) -> dict:
+    """The file options of ``names`` given in ``args`` (by dest), refused (before any work)
+    where they are not among those the chosen model's report writes (``accepted``)."""
+    given = {k: getattr(args, k) for k in names if getattr(args, k, None)}
+    wrong = [k for k in given if k not in accepted]
+    if wrong:
+        flags = "/".join("--" + k.replace("_", "-") for k in wrong)
+        raise InputError(f"{command} --model {args.model}: option does not apply: {flags} (the "
+                         f"{args.model} model writes "
+                         + (", ".join("--" + k.replace("_", "-") for k in accepted) or "no files")
+                         + ")")
+    return given
 
 
 #: output options of the finite-element commands (static, modal, vibrate, converge) and their
@@ -123,15 +157,14 @@ def backend_from_args(args):
 
 
 def model_from_args(args, command: str):
-    """(model, options): the model chosen by ``--model``, built from the system and its
-    options (:func:`model_options_from_args`)."""
-    from tmfem.models.base import get_spec
-    system, options = model_options_from_args(args, command)
-    model = get_spec(args.model).build(system, options, backend_from_args(args))
-    rest = getattr(model, "rest_lengths", None)
-    if rest is not None and np.ndim(rest) == 1 and len(rest) == len(system.tendons):
+    """(model, options, spec): the model chosen by ``--model``, built from the system and its
+    options (:func:`model_options_from_args`), and its registry entry."""
+    system, options, spec = model_options_from_args(args, command)
+    model = spec.build(system, options, backend_from_args(args))
+    rest = model.u0
+    if np.ndim(rest) == 1 and len(rest) == len(system.tendons):
         warn_long_rest_lengths(system, rest)     # all slack: an error before the solve
-    return model, options
+    return model, options, spec
 
 
 def add_attachment_args(parser) -> None:

@@ -81,7 +81,7 @@ def run_frequencies(args) -> dict:
 
 
 def run_vibration(args) -> dict:
-    from tmfem.models.fe_plant import perturbation_names
+    from tmfem.models.fe.plant import perturbation_names
     from tmfem.reference.model_compare import fe_system
     from tmfem.reference.vibration_compare import (format_vibration_compare, key_signals,
                                                    three_model_vibration, write_vibration_csv)

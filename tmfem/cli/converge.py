@@ -8,8 +8,9 @@ from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_sys
                               system_from_args)
 from tmfem.errors import InputError
 from tmfem.io.units import unit_of
-from tmfem.models.mtc.design import describe_rule
-from tmfem.models.mtc.spec import apply_rest_lengths
+from tmfem.models.fe.rest_lengths import describe_rule
+from tmfem.models.fe.rest_lengths import apply_rest_lengths
+from tmfem.models.registry import get_spec, models_with
 from tmfem.post.convergence import plot_convergence_study
 from tmfem.solvers.backends import backend_names
 
@@ -35,9 +36,10 @@ def _ints(text: str, what: str) -> list[int]:
 
 def configure(parser) -> None:
     add_system_args(parser)
-    parser.add_argument("--model", choices=("mtc", "sbc"), default="mtc",
-                        help="finite-element model (mtc: membrane-truss-cable, 4.4; sbc: "
-                             "shell-beam-cable, 4.3, the model of 6.3)")
+    specs = models_with("finite-element")
+    parser.add_argument("--model", choices=sorted(specs), default="mtc",
+                        help="finite-element model (" + "; ".join(
+                            f"{n}: {spec.help}" for n, spec in specs.items()) + ")")
     parser.add_argument("--backend", choices=backend_names(), default="scipy",
                         help="linear-algebra backend (default scipy; docs/guides/backends.md)")
     parser.add_argument("--mesh", default="10",
@@ -71,7 +73,7 @@ def run(args) -> dict:
     for n in meshes:
         for k in tendons:
             check_model_budget(system, mesh=n, tendon_elements=k, modes=args.modes,
-                               dofs_per_node=5 if args.model == "sbc" else 3)
+                               dofs_per_node=get_spec(args.model).dofs_per_node)
     check_outputs(args, NAME)
     rest, rule = resolve_rest_lengths(system, rest_lengths=rest)
     rows = []

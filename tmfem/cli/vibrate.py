@@ -9,15 +9,16 @@ import numpy as np
 from tmfem.cli.common import (add_model_args, add_system_args, check_time_steps, finite_float,
                               model_from_args, parse_perturbation, positive_int, progress_bar)
 from tmfem.errors import InputError
-from tmfem.models.mtc.spec import sequence_of
+from tmfem.simulation.vibration import model_free_vibration
 
 NAME = "vibrate"
 HELP = "free vibration after an initial perturbation (COM, MTC or SBC model, Park's method)"
+STAGES = ("equilibrium", "dynamics")
 
 
 def configure(parser) -> None:
     add_system_args(parser)
-    add_model_args(parser, NAME, default="com")
+    add_model_args(parser, NAME, default="com", stages=STAGES)
     parser.add_argument("--t-end", type=finite_float, default=10.0, help="duration [s] (default 10)")
     parser.add_argument("--dt", type=finite_float, default=0.01,
                         help="time step [s] (default 0.01, as in 6.5)")
@@ -42,23 +43,23 @@ def run(args) -> dict:
         raise InputError("--vtk-every: option does not apply without --vtk DIR (it spaces the "
                          "ParaView frames)")
     args.vtk_every = args.vtk_every or 10
-    model, options = model_from_args(args, NAME)
-    if args.model in ("mtc", "sbc"):
-        return run_fe(args, model, options)
-    from tmfem.simulation.vibration import free_vibration
-
-    system = model.system
-    print(f"tmfem vibrate: {system.name} COM, K = {model.K}", file=sys.stderr)
-    pert = parse_perturbation(default_perturbation(args, system), model.state_names)
-    with progress_bar(args.t_end, args.dt, f"vibrate {system.name}") as bar:
-        res = free_vibration(model, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
-                             scheme=args.scheme, jacobian="reuse", progress=bar,
-                             vtk_dir=args.vtk, vtk_every=args.vtk_every)
-    out = {"system": system.name, "model": "com", "membrane_modes": model.K, "t_end": args.t_end,
-           "dt": args.dt, "perturbation": pert, "scheme": args.scheme,
-           **_run_summary(res, args, title=f"{system.name} COM free vibration, K = {model.K}"),
-           "final": dict(zip(model.state_names, np.concatenate([res.z[-1], res.zd[-1]]).tolist()))}
-    return out
+    model, options, spec = model_from_args(args, NAME)
+    system, name = model.system, spec.name.upper()
+    pert = parse_perturbation(default_perturbation(args, system), model.perturbation_names)
+    size = ", ".join(f"{k} {v}" for k, v in model.describe().items())
+    print(f"tmfem vibrate: {system.name} {name}, {size}, static equilibrium", file=sys.stderr)
+    eq = model.equilibrium(**spec.equilibrium_kwargs(options))
+    dynamics = spec.plant_kwargs(options)
+    with progress_bar(args.t_end, args.dt, f"vibrate {system.name} {name}") as bar:
+        res = model_free_vibration(model, at=eq, perturb=pert, dynamics=dynamics,
+                                   t_end=args.t_end, dt=args.dt, csv_path=args.csv,
+                                   scheme=args.scheme, progress=bar, vtk_dir=args.vtk,
+                                   vtk_every=args.vtk_every)
+    title = f"{system.name} {name} free vibration, {size}"
+    return {"system": system.name, "model": spec.name, **model.describe(), "t_end": args.t_end,
+            "dt": args.dt, "perturbation": pert, "scheme": args.scheme,
+            **{o.name: options[o.name] for o in spec.options if o.stage == "dynamics"},
+            "static_time_s": eq.time, **_run_summary(res, args, title=title), **res.summary()}
 
 
 def _run_summary(res, args, *, title: str) -> dict:
@@ -88,42 +89,8 @@ def default_perturbation(args, system) -> list:
     return args.perturb or [f"{k}={v!r}" for k, v in system.problem.report.perturbation.items()]
 
 
-def run_fe(args, model, options) -> dict:
-    """Free vibration of a finite-element model (MTC or SBC) about its static equilibrium."""
-    from tmfem.models.fe_plant import perturbation_names
-    from tmfem.simulation.vibration import mtc_free_vibration, sbc_free_vibration
-
-    system, name = model.system, args.model.upper()
-    pert = parse_perturbation(default_perturbation(args, system), perturbation_names(system))
-    rayleigh = options["rayleigh"] or (0.0, 0.0)
-    print(f"tmfem vibrate: {system.name} {name}, mesh {system.N}x{options['mesh']}x{options['mesh']}, "
-          f"{model.ndof} DOFs, static equilibrium", file=sys.stderr)
-    if args.model == "mtc":
-        st = model.solve_static(start="undeformed",
-                                sequence=sequence_of(options["mesh"], options["sequence"]))
-        run, eq = mtc_free_vibration, st.x
-    else:
-        st = model.solve_static()
-        run, eq = sbc_free_vibration, st.state
-    with progress_bar(args.t_end, args.dt, f"vibrate {system.name} {name}") as bar:
-        res = run(model, eq, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
-                  scheme=args.scheme, alpha=rayleigh[0], beta=rayleigh[1], progress=bar,
-                  vtk_dir=args.vtk, vtk_every=args.vtk_every)
-    out = {"system": system.name, "model": args.model, "mesh": options["mesh"], "ndof": model.ndof,
-           "tendon_elements": options["tendon_elements"], "t_end": args.t_end, "dt": args.dt,
-           "perturbation": pert, "scheme": args.scheme, "rayleigh": list(rayleigh),
-           "static_time_s": st.time,
-           **_run_summary(res, args, title=f"{system.name} {name} free vibration, mesh {options['mesh']}"),
-           "max_tendon_deflection_m": res.stats["max_tendon_deflection"],
-           "max_tendon_deflection_tendon": res.stats["max_tendon_deflection_tendon"],
-           "energy_drift_J": float(np.max(np.abs(res.energy - res.energy[0]))),
-           "initial_kinetic_energy_J": float(res.kinetic[0]),
-           "q_range": dict(zip(system.q_names, np.ptp(res.q, axis=0).tolist()))}
-    return out
-
-
 def format_text(r: dict) -> str:
-    if r.get("model") in ("mtc", "sbc"):
+    if "energy_drift_J" in r:
         return _format_fe(r)
     lines = [f"{r['system']} COM free vibration: {r['steps']} steps of {r['dt']} s "
              f"({r['scheme']}), {r['wall_time_s']:.2f} s wall, {r['newton_iterations']} Newton "

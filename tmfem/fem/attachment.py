@@ -1,6 +1,6 @@
 """Corner attachments of the membrane: point or distributed (RBE3-type affine fit).
 
-One construction shared by the membrane-truss-cable model (:mod:`tmfem.models.mtc.topology`:
+One construction shared by the membrane-truss-cable model (:mod:`tmfem.models.fe.topology`:
 the bar top B_Mj is a dependent node) and the linear plane-stress membrane of the
 equilibrium design (:class:`tmfem.fem.plane_stress.PlaneStressMembrane`: the corner
 displacement is imposed on the patch). A point attachment (the corner *is* a membrane

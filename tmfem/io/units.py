@@ -30,6 +30,7 @@ _EXACT = {
     "final_tracking_error": "-", "rbf_sigma": "rad", "margin": "-", "tol": "-",
     "min_controllability_margin": "-", "min_observability_margin": "-", "eigenvalue": "1/s",
     "rayleigh": "[1/s, s] (alpha, beta of C = alpha M + beta K_0)",
+    "damping": "1/s (modal damping c_m of eq. 5.13)",
     "pfl_gains": "[rad/s, rad/s, s, -] (omega_0, omega_e, tau, d_c of eq. 5.69)",
     "w_bar": "bound of the RBF weights, unit of the learnt uncertainty (eq. 5.70)",
     "symmetric_null": "- (null vector of eq. 3.16 per unit F_Delta)",

@@ -6,7 +6,7 @@ import numpy as np
 from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 
 from tmfem.io.paths import check_path
-from tmfem.models.mtc.topology import to_floating
+from tmfem.models.fe.outputs import to_floating
 from tmfem.post.plots import new_figure, save_figure
 from tmfem.fem.tension_field import STATE_NAMES, WRINKLED
 
@@ -114,3 +114,138 @@ def plot_wrinkling(png, model, x: np.ndarray, *, title: str | None = None):
               loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2, fontsize=8)
     ax.set_title(title or f"{model.system.name} MTC membrane states ({model.membrane_law} law)")
     return save_figure(fig, png)
+
+
+# ---------------------------------------------------------------------------- reports
+#: files ``tmfem static`` and ``tmfem modal`` can write for this model
+STATIC_FILES = ("vtk", "png", "stress_plot", "wrinkle_plot")
+MODE_FILES = ("vtk", "png")
+
+
+def static_summary(model, result) -> dict:
+    """JSON-able summary of an MTC equilibrium ``result``
+    (:func:`tmfem.models.mtc.post.static_summary`)."""
+    from tmfem.models.mtc.post import static_summary as summary
+    return {"model": "mtc", **summary(model, result.x, result=result)}
+
+
+def write_static_files(model, result, *, vtk=None, png=None, stress_plot=None,
+                       wrinkle_plot=None) -> dict:
+    """The ParaView file (bars, tendons with forces, membrane with displacement and stresses),
+    the PNG, the stress maps (Figs. 6.3-6.4) and the wrinkling map of the equilibrium
+    ``result`` that are asked for; returns their paths by kind."""
+    from tmfem.models.fe.outputs import q_from_positions
+    from tmfem.models.mtc.post import member_state
+    out, x, system = {}, result.x, model.system
+    if stress_plot:
+        out["stress_plot"] = str(plot_membrane_stress(
+            stress_plot, model, x, title=f"{system.name} MTC membrane stresses (O_f frame)"))
+    if wrinkle_plot:
+        out["wrinkle_plot"] = str(plot_wrinkling(wrinkle_plot, model, x))
+    if not (vtk or png):
+        return out
+    q = q_from_positions(system, x[:, model.topology.system_node])
+    ms = member_state(model, x)
+    mf = membrane_field(model, x)
+    if vtk:
+        from tmfem.io.writer import write_configuration
+        out["vtk"] = str(write_configuration(vtk, system, q=q, tendon_forces=ms["tendon_force"],
+                                             rest_lengths=model.rest_lengths, membrane=mf,
+                                             bar_forces=ms["bar_force"]))
+    if png:
+        from tmfem.post.render import render_configuration
+        out["png"] = str(render_configuration(png, system, q=q, tendon_forces=ms["tendon_force"],
+                                              membrane=mf, membrane_field="von_mises",
+                                              title=f"{system.name} MTC equilibrium"))
+    return out
+
+
+def format_static(r: dict) -> str:
+    """Text of :func:`static_summary`: landing against the design, the printed rows of Tables
+    6.3/6.5, tendon forces and the design checks."""
+    from tmfem.models.fe.summary import check_lines, printed_rows
+    from tmfem.models.fe.rest_lengths import describe_rule
+    lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
+             f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
+             f"membrane, {r['dofs']} free dofs",
+             f"rest lengths {r['rest_lengths_source']} ({describe_rule(r['rest_lengths_source'])}): "
+             + ", ".join(f"{k}={v:.5f} m" for k, v in list(r["rest_lengths"].items())[:8])
+             + (" ..." if len(r["rest_lengths"]) > 8 else ""),
+             f"converged in {r.get('iterations')} iterations ({r.get('static_time_s', 0):.2f} s); "
+             f"residual {r['residual_history'][0]:.3e} -> {r['residual_history'][-1]:.3e} N",
+             f"max distance of a node from the design: {r['max_deviation_from_design'] * 1e3:.3f} mm",
+             "theta [deg] (design): " + ", ".join(f"{a:.3f} ({b:.3f})" for a, b in
+                                                   zip(r["theta_deg"], r["theta_design_deg"])),
+             "psi   [deg] (design): " + ", ".join(f"{a:.3f} ({b:.3f})" for a, b in
+                                                   zip(r["psi_deg"], r["psi_design_deg"])),
+             "Delta [mm] (design):  " + ", ".join(f"{a * 1e3:.4f} ({b * 1e3:.4f})" for a, b in
+                                                   zip(r["Delta"], r["Delta_design"]))]
+    for lab, h in r.get("monitor", {}).items():
+        h = np.asarray(h)
+        lines.append(f"history of {lab}: start {np.round(h[0], 5).tolist()} -> "
+                     f"{np.round(h[-1], 5).tolist()} (design {np.round(r['nodes'][lab]['design'], 5).tolist()})")
+    rows = printed_rows(r)
+    lines.append(f"{'':32s} {'MTC':>12s} {'dissertation':>12s}")
+    lines += [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
+              for a, b, c in rows]
+    lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.3f}" for k, v in
+                                                   list(r["tendon_force"].items())[:12]))
+    if r["tendon_slack"]:
+        lines.append(f"SLACK tendons: {r['tendon_slack']}")
+    lines += check_lines(r["checks"])
+    for k in ("vtk", "png", "stress_plot", "wrinkle_plot"):
+        if k in r:
+            lines.append(f"wrote {r[k]}")
+    return "\n".join(lines)
+
+
+def modal_summary(model, result, modes) -> dict:
+    """JSON-able summary of the modes ``modes`` about the MTC equilibrium ``result``: the
+    model, its prestress and the frequencies (eq. 5.32)."""
+    from tmfem.models.fe.rest_lengths import describe_rule
+    from tmfem.models.mtc.post import static_summary as summary
+    st = summary(model, result.x, result=result)
+    return {"system": model.system.name, "model": "mtc", "dofs": model.ndof,
+            "mesh_n": st["mesh_n"], "tendon_elements": st["tendon_elements"],
+            "attachment": st["attachment"], "membrane_law": model.membrane_law,
+            "rest_lengths_source": model.rest_lengths_source,
+            "rest_lengths_note": describe_rule(model.rest_lengths_source),
+            "rest_lengths": st["rest_lengths"], "static_iterations": result.iterations,
+            "tendon_stress_max": st["tendon_stress_max"], "bar_load_max": st["bar_load_max"],
+            "Delta_mean": float(np.mean(st["Delta"])), "freq_hz": modes.freq_hz.tolist()}
+
+
+def write_mode_files(model, result, modes, *, vtk=None, png=None) -> dict:
+    """The ParaView file of the mode shapes (point data mode_k) and the PNG of the first six
+    that are asked for; returns their paths by kind."""
+    from tmfem.post.modes import write_mode_shapes
+    return write_mode_shapes(result.x, model_cells(model), model.topology.T @ modes.shapes,
+                             modes.freq_hz, vtk=vtk, png=png,
+                             title=f"{model.system.name} MTC modes")
+
+
+def format_modal(r: dict) -> str:
+    """Text of :func:`modal_summary`, with the dissertation's columns when present."""
+    lines = [f"MTC modes of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
+             f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
+             f"membrane, {r['dofs']} free dofs",
+             f"rest lengths {r['rest_lengths_source']}: {r['rest_lengths_note']}",
+             "prestress: " + ", ".join(f"{k}={v:.5f} m" for k, v in list(r["rest_lengths"].items())[:4])
+             + f"; max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, bar load "
+               f"{r['bar_load_max']:.3f} N, Delta {r['Delta_mean'] * 1e3:.4f} mm"]
+    d = r.get("dissertation")
+    if d:
+        lines.append(f"{'mode':>4s} {'ours [Hz]':>10s} {'MTC paper':>10s} {'SBC paper':>10s} {'diff':>8s}"
+                     f"   ({d['source']})")
+        for i, f in enumerate(r["freq_hz"]):
+            if i < len(d["MTC"]):
+                lines.append(f"{i + 1:4d} {f:10.4f} {d['MTC'][i]:10.4f} {d['SBC'][i]:10.4f} "
+                             f"{100 * r['relative_difference_to_MTC'][i]:7.2f}%")
+            else:
+                lines.append(f"{i + 1:4d} {f:10.4f}")
+    else:
+        lines += [f"{i + 1:4d} {f:10.4f} Hz" for i, f in enumerate(r["freq_hz"])]
+    for k in ("vtk", "png"):
+        if k in r:
+            lines.append(f"wrote {r[k]}")
+    return "\n".join(lines)

@@ -19,7 +19,7 @@ from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 from tmfem.io.meshes import block_data, to_meshio
 from tmfem.io.paths import check_path
 from tmfem.io.writer import write_mesh
-from tmfem.models.mtc.topology import to_floating
+from tmfem.models.fe.outputs import to_floating
 from tmfem.models.sbc.post import SURFACES, shell_stresses
 
 def rotation_vectors(model, state, d=None) -> np.ndarray:
@@ -62,7 +62,7 @@ def shell_field(model, state) -> MembraneField:
     surfaces as cell data (``von_mises_top``, ``sigma_p1_mid``, ...; ``von_mises`` and
     ``sigma_p1`` the largest over the surfaces) with the lamina states of
     :func:`shell_wrinkling`."""
-    topo = model.mtc.topology
+    topo = model.topology
     nm = topo.n_mesh
     xm = state.x[:, :nm]
     xf = to_floating(xm, xm[:, topo.mesh.corners])
@@ -83,7 +83,7 @@ def sbc_cells(model) -> list:
     tendon elements (lines) and shell quads."""
     ch = model.numbering.bar_chain
     seg = np.stack([ch[:, :-1].ravel(), ch[:, 1:].ravel()])
-    return [("line", seg), ("line", model.tendons.conn), ("quad", model.mtc.topology.mesh.t)]
+    return [("line", seg), ("line", model.tendons.conn), ("quad", model.topology.mesh.t)]
 
 
 def _cell_data(model, state, cells) -> dict:
@@ -133,3 +133,60 @@ def mode_data(model, state, modes):
     rot = {f"rotation_mode_{k + 1}": rotation_vectors(model, state, D[:, k])
            for k in range(D.shape[1])}
     return S.transpose(1, 0, 2).reshape(-1, S.shape[2]), rot
+
+
+# ---------------------------------------------------------------------------- reports
+#: files ``tmfem static`` and ``tmfem modal`` can write for this model (the shell stresses
+#: are in the ParaView file; the stress and wrinkling maps are of the MTC membrane)
+STATIC_FILES = ("vtk", "png")
+MODE_FILES = ("vtk", "png")
+
+
+def static_summary(model, result) -> dict:
+    """JSON-able summary of an SBC equilibrium (:func:`tmfem.models.sbc.post.static_summary`)."""
+    from tmfem.models.sbc.post import static_summary as summary
+    return summary(model, result)
+
+
+def write_static_files(model, result, *, vtk=None, png=None) -> dict:
+    """The ParaView file of the shells, beams and tendons and the PNG of the equilibrium
+    ``result`` that are asked for; returns their paths by kind."""
+    out, st = {}, result.state
+    if vtk:
+        out["vtk"] = write_sbc_state(vtk, model, st)
+    if png:
+        from tmfem.models.fe.outputs import q_from_positions
+        from tmfem.post.render import render_configuration
+        q = q_from_positions(model.system, st.x[:, model.topology.system_node])
+        out["png"] = str(render_configuration(
+            png, model.system, q=q, tendon_forces=model.member_forces(st)["tendon"],
+            membrane=shell_field(model, st), membrane_field="von_mises_top",
+            title=f"{model.system.name} SBC equilibrium (shell von Mises, top surface)"))
+    return out
+
+
+def format_static(r: dict) -> str:
+    """Text of :func:`static_summary` (:func:`tmfem.models.sbc.post.format_static`)."""
+    from tmfem.models.sbc.post import format_static as text
+    return text(r)
+
+
+def modal_summary(model, result, modes) -> dict:
+    """:func:`static_summary` plus the frequencies of ``modes`` (eq. 5.32)."""
+    from tmfem.models.sbc.post import modal_summary as summary
+    return summary(model, result, modes)
+
+
+def write_mode_files(model, result, modes, *, vtk=None, png=None) -> dict:
+    """The ParaView file of the mode shapes (translations and rotations) and the PNG of the
+    first six that are asked for; returns their paths by kind."""
+    from tmfem.post.modes import write_mode_shapes
+    shapes, rotations = mode_data(model, result.state, modes)
+    return write_mode_shapes(result.state.x, sbc_cells(model), shapes, modes.freq_hz, vtk=vtk,
+                             png=png, point_data=rotations,
+                             title=f"{model.system.name} SBC modes")
+
+
+def format_modal(r: dict) -> str:
+    """Text of :func:`modal_summary`: the equilibrium and the frequencies."""
+    return format_static(r)

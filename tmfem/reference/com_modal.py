@@ -14,6 +14,7 @@ import numpy as np
 from tmfem.errors import InputError
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+from tmfem.post import com as post_com
 from tmfem.reference.tables import printed_frequencies
 
 log = logging.getLogger(__name__)
@@ -26,33 +27,6 @@ def dissertation_com_frequencies(system):
     if ref is None or "COM" not in ref:
         return None
     return ref.get("source", "printed"), list(ref["COM"]), ref.get("COM_highest")
-
-
-def printed_prestress_scale(model) -> float | None:
-    """Prestress factor implied by the printed maximum tendon stress (Tables 6.3, 6.5):
-    s = sigma_printed A / max(T_design) for the model's own design tendon forces."""
-    p = model.system.printed.get("tendon_max_stress")
-    if p is None or model.design is None:
-        return None
-    A = np.array([model.system.tendon_section(t).area for t in model.system.tendons])
-    return float(p * A[np.argmax(model.design.tendon_forces / A)] /
-                 np.max(model.design.tendon_forces) / model.prestress_scale)
-
-
-def printed_bar_load_prestress_scale(model, *, mesh_n: int = 10) -> float | None:
-    """Prestress factor implied by the printed stage-1 bar load (Table 6.3 ``bar_load``,
-    Table 6.5 ``bar_load_stage1``): s = F_printed / F_design, the one-number calibration of
-    the MTC comparison (:func:`tmfem.reference.designs.calibrate_on_bar_load`) applied to the
-    COM's design. F_design is the largest stage-1 bar compression of
-    :func:`tmfem.equilibrium.design.design_equilibrium`, whose tendon forces the COM's design
-    reproduces (tests/models/com/test_com_2_3.py); all design loads scale with the prestress (3.2)."""
-    pr = model.system.printed
-    p = pr.get("bar_load_stage1", pr.get("bar_load"))
-    if p is None or model.design is None:
-        return None
-    from tmfem.equilibrium.design import design_equilibrium
-    d = design_equilibrium(model.system, mesh_n=mesh_n)
-    return float(p / np.max(d.bar_loads[0]) / model.prestress_scale)
 
 
 def com_frequencies(system, *, membrane_modes: int, prestress_scale: float = 1.0,
@@ -87,60 +61,28 @@ def modal_summary(system, *, modes: int = 12, membrane_modes: int | None = None,
     if not (isinstance(modes, int) and modes >= 1):
         raise InputError(f"--modes: expected an integer >= 1, found {modes!r}")
     log.info("%s COM, K = %d membrane modes", system.name, K)
-    f, m = com_frequencies(system, membrane_modes=K, prestress_scale=prestress_scale,
-                           membrane_law=membrane_law,
-                           mesh_n=mesh_n)
-    n = min(modes, len(f))
-    names = system.tendon_names()
-    out = {"system": system.name, "model": "com", "membrane_modes": K, "mesh_n": mesh_n,
-           "prestress_scale": prestress_scale, "membrane_law": membrane_law, "sizes": m.summary(),
-           "freq_hz": f[:n].tolist(), "highest_hz": float(f[-1]),
-           "rest_lengths_source": "design" if m.design is not None else "system",
-           "rest_lengths": dict(zip(names, m.u0.tolist()))}
-    if m.design is not None:
-        out["design_tendon_forces"] = dict(zip(names, m.design.tendon_forces.tolist()))
-        out["design_rest_lengths"] = dict(zip(names, m.design.rest_lengths.tolist()))
-    else:
-        z_e = m.equilibrium()
-        out["equilibrium_tendon_forces"] = dict(zip(names, m.tendon_forces(z_e).tolist()))
-        out["equilibrium_shift_max"] = float(np.max(np.abs(z_e - m.z0)))
-    s_pr = printed_prestress_scale(m)
-    if s_pr is not None:
-        out["printed_stress_prestress_scale"] = s_pr
-    s_bar = printed_bar_load_prestress_scale(m, mesh_n=mesh_n)
-    if s_bar is not None:
-        out["printed_bar_load_prestress_scale"] = s_bar
+    rest_lengths = "design" if system.rest_lengths is None else "system"
+    m = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n,
+                             prestress_scale=prestress_scale, rest_lengths=rest_lengths,
+                             membrane_law=membrane_law)
+    res = m.equilibrium()
+    return add_dissertation_com(post_com.modal_summary(m, res, m.modes(k=modes, at=res)),
+                                system=system, modes=modes)
+
+
+def add_dissertation_com(out: dict, *, system, modes: int) -> dict:
+    """``out`` (:func:`tmfem.post.com.modal_summary`) with the printed COM column of
+    ``system``'s file (Table 6.6/6.7 for the presets) and the relative differences, for the
+    file's K."""
     ref = dissertation_com_frequencies(system)
-    if ref is not None and K == default_membrane_modes(system):
+    if ref is not None and out["membrane_modes"] == out["default_membrane_modes"]:
         src, com, highest = ref
-        k = min(n, len(com))
-        out["dissertation"] = {"source": src, "COM": com[:k], "highest_hz": highest}
+        f = np.asarray(out["freq_hz"])
+        k = min(len(f), len(com))
+        out["dissertation"] = {"source": src, "COM": com[:k],
+                               "highest_hz": highest}
         out["relative_difference"] = (f[:k] / np.array(com[:k]) - 1).tolist()
     return out
-
-
-def format_summary(r: dict) -> str:
-    """Text table of a :func:`modal_summary` result: ours beside the printed COM column."""
-    lines = [f"COM of {r['system']}: {r['sizes']['n_z']} coordinates (nq = {r['sizes']['n_q']}, "
-             f"K = {r['membrane_modes']}), prestress x{r['prestress_scale']:g}, rest lengths "
-             f"from the {r.get('rest_lengths_source', 'design')}"]
-    forces = r.get("design_tendon_forces") or r.get("equilibrium_tendon_forces") or {}
-    if forces:
-        lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.4g}" for k, v in list(forces.items())[:6])
-                     + (" ..." if len(forces) > 6 else ""))
-    if "printed_stress_prestress_scale" in r:
-        lines.append(f"prestress implied by the printed tendon stress: x{r['printed_stress_prestress_scale']:.4f}"
-                     " (--prestress-scale in the Python API, docs/guides/com.md)")
-    if "printed_bar_load_prestress_scale" in r:
-        lines.append(f"prestress implied by the printed stage-1 bar load: x{r['printed_bar_load_prestress_scale']:.4f}")
-    ref = r.get("dissertation", {}).get("COM", [])
-    lines.append(f"{'mode':>4} {'ours [Hz]':>10} {'printed':>10} {'rel.diff':>9}")
-    for i, f in enumerate(r["freq_hz"]):
-        if i < len(ref):
-            lines.append(f"{i + 1:>4} {f:>10.4f} {ref[i]:>10.4f} {f / ref[i] - 1:>+9.2%}")
-        else:
-            lines.append(f"{i + 1:>4} {f:>10.4f}")
-    return "\n".join(lines)
 
 
 def frequency_study(system, *, K_values, prestress_scales=(1.0,), modes: int = 12,

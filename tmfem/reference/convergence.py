@@ -3,7 +3,7 @@
 6.3 studies the shell-beam-cable (SBC) model; the membrane-truss-cable (MTC) model runs the
 same study. Each row solves the statics and the modes of one (mesh n, tendon elements k): the
 MTC model from the design, the SBC model from the MTC equilibrium on the same mesh (its MTC
-predictor, :meth:`SBCModel.solve_static`), both with the rest lengths held over the study
+predictor, :meth:`SBCModel.equilibrium`), both with the rest lengths held over the study
 (:func:`resolve_rest_lengths`).
 """
 from __future__ import annotations
@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.models.mtc.design import design_mesh_of, design_rest_lengths_at
+from tmfem.models.fe.rest_lengths import design_mesh_of, design_rest_lengths_at
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.mtc.post import static_summary
 
@@ -65,9 +65,9 @@ def _mtc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
     """(model, static iterations, frequencies, summary values) of one MTC run."""
     m = MTCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
                  patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
-    res = m.solve_static(start="design")
+    res = m.equilibrium(start="design")
     t1 = time.perf_counter()
-    md = m.modes(res.x, k=modes, tangent=res.tangent)
+    md = m.modes(k=modes, at=res)
     st = static_summary(m, res.x)
     return m, res.iterations, md.freq_hz, t1, {
         "Delta_mm": 1e3 * float(np.mean(st["Delta"])),
@@ -89,11 +89,11 @@ def _sbc_row(system, n, k, *, attachment, patch, rest, modes, backend, membrane_
     from tmfem.models.sbc.post import static_summary as sbc_summary
     m = SBCModel(system, mesh_n=int(n), tendon_elements=int(k), attachment=attachment,
                  patch=patch, rest_lengths=rest, backend=backend, membrane_law=membrane_law)
-    res = m.solve_static()
+    res = m.equilibrium()
     t1 = time.perf_counter()
-    md = m.modes(res.state, k=modes, tangent=res.tangent)
+    md = m.modes(k=modes, at=res)
     st = sbc_summary(m, res)
-    return m.mtc, res.iterations, md.freq_hz, t1, {
+    return m, res.iterations, md.freq_hz, t1, {
         "Delta_mm": 1e3 * st["Delta_mean"], "tendon_stress_max_MPa": st["tendon_stress_max"] / 1e6,
         "bar_load_max_N": st["bar_load_max"],
         "sigma_p1_max_MPa": st["membrane_max_sigma_p1"] / 1e6,
@@ -133,7 +133,7 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
             t2 = time.perf_counter()
             ne = m.topology.mesh.t.shape[1]
             row = {"mesh_n": int(n), "tendon_elements": int(k), "attachment": attachment,
-                   "elements": ne, "h": float(np.sqrt(m.membrane.area() / ne)),
+                   "elements": ne, "h": float(np.sqrt(m.membrane_area() / ne)),
                    "dofs": vals.pop("dofs", m.ndof), "iterations": its, "static_s": t1 - t0,
                    "modal_s": t2 - t1, **vals, "model": model}
             for i, f in enumerate(freq):

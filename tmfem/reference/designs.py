@@ -86,7 +86,7 @@ def calibrate_on_bar_load(model, bar_load: float) -> float:
     e.g. 14.48 N of Table 6.5). Solves the design-consistent state, sets
     :func:`scaled_consistent_rest_lengths` with k = bar_load / bar load found, returns k."""
     from tmfem.models.mtc.post import static_summary
-    st = static_summary(model, model.solve_static(start="design").x)
+    st = static_summary(model, model.equilibrium(start="design").x)
     k = float(bar_load / st["bar_load_by_stage"][0])
     model.set_rest_lengths(scaled_consistent_rest_lengths(model, k))
     return k

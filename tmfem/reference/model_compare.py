@@ -58,7 +58,7 @@ def fe_system(system):
 def com_model(system, *, mesh_n: int = 10):
     """The control-oriented model of the comparison (module docstring; K the file's)."""
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
-    from tmfem.reference.com_modal import printed_prestress_scale
+    from tmfem.post.com import printed_prestress_scale
     s = compared_system(system)
     K = default_membrane_modes(s)
     m = ControlOrientedModel(s, membrane_modes=K, mesh_n=mesh_n)
@@ -88,9 +88,8 @@ def model_frequencies(system, *, modes: int = 12, mesh_n: int = 10, tendon_eleme
         if progress:
             progress(key)
         t0 = time.perf_counter()
-        res = m.solve_static()
-        eq = res.state if key == "SBC" else res.x
-        out[key] = m.modes(eq, k=modes, tangent=res.tangent).freq_hz
+        res = m.equilibrium()
+        out[key] = m.modes(k=modes, at=res).freq_hz
         times[key] = time.perf_counter() - t0
     if progress:
         progress("COM")

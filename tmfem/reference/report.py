@@ -143,7 +143,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.models.mtc.model import MTCModel
-    from tmfem.models.mtc.post import member_state, q_from_positions, static_summary
+    from tmfem.models.fe.outputs import q_from_positions
+    from tmfem.models.mtc.post import member_state, static_summary
     from tmfem.post.fields import placed_membrane_field
     from tmfem.post.mtc import membrane_field, model_cells, plot_membrane_stress
     from tmfem.post.plots import plot_free_vibration
@@ -151,7 +152,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     from tmfem.reference.study import plot_configuration, plot_membrane_stress as plot_design_stress
     from tmfem.reference.study import write_tables
     from tmfem.reference.tables import printed_frequencies
-    from tmfem.simulation.vibration import free_vibration, mtc_free_vibration
+    from tmfem.simulation.vibration import free_vibration, model_free_vibration
 
     out = Path(out)
     name = system.name
@@ -196,13 +197,13 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
             from tmfem.models.sbc.model import SBCModel
             from tmfem.models.sbc.post import static_summary as sbc_static_summary
             sbc = SBCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
-            st = sbc.solve_static()
+            st = sbc.equilibrium()
             sbc_runs[label] = (sbc, st)
             statics[label] = sbc_static_summary(sbc, st)
             step(STEPS[1 + k])
             continue
         model = MTCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
-        res = model.solve_static(start="undeformed")
+        res = model.equilibrium(start="undeformed")
         mtc[label] = (model, res)
         statics[label] = static_summary(model, res.x, result=res)
         X = res.x[:, model.topology.system_node]
@@ -229,7 +230,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     # 3. modes -------------------------------------------------------------------------------
     freqs = {}
     for label, (model, res) in mtc.items():
-        md = model.modes(res.x, k=modes, tangent=res.tangent)
+        md = model.modes(k=modes, at=res)
         freqs[f"MTC {label}"] = md.freq_hz
         if label == "designed":
             shapes = model.topology.T @ md.shapes
@@ -249,8 +250,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         from tmfem.models.sbc.model import SBCModel
         for label, (rest, sys_k) in cases.items():
             sbc = SBCModel(sys_k, mesh_n=mesh_n, tendon_elements=3, rest_lengths=rest)
-            st = sbc.solve_static()
-            freqs[f"SBC {label}"] = sbc.modes(st.state, k=modes, tangent=st.tangent).freq_hz
+            st = sbc.equilibrium()
+            freqs[f"SBC {label}"] = sbc.modes(k=modes, at=st).freq_hz
     step(STEPS[4])
     K = default_membrane_modes(system)
     com_design = modal_summary(system, modes=modes, membrane_modes=K)
@@ -282,19 +283,11 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         title=f"{name} COM free vibration, K = {K}, " + _perturbation_text(perturb)))
     step(STEPS[6])
     lo = fe.lower()
-    if system.deployable:
-        from tmfem.simulation.vibration import sbc_free_vibration
-        model, res = sbc_runs["designed"]
-        r_fe = sbc_free_vibration(model, res.state, t_end=t_end, dt=dt, perturb=perturb,
-                                  output_points=pts, monitor_nodes=nodes,
-                                  csv_path=out / f"vibration_{lo}.csv",
-                                  progress=_run_progress(run_progress, f"{fe} free vibration"))
-    else:
-        model, res = mtc["designed"]
-        r_fe = mtc_free_vibration(model, res.x, t_end=t_end, dt=dt, perturb=perturb,
-                                  output_points=pts, monitor_nodes=nodes,
-                                  csv_path=out / f"vibration_{lo}.csv",
-                                  progress=_run_progress(run_progress, f"{fe} free vibration"))
+    model, res = sbc_runs["designed"] if system.deployable else mtc["designed"]
+    r_fe = model_free_vibration(model, at=res, dynamics={"output_points": pts}, t_end=t_end, dt=dt,
+                                perturb=perturb, monitor_nodes=nodes,
+                                csv_path=out / f"vibration_{lo}.csv",
+                                progress=_run_progress(run_progress, f"{fe} free vibration"))
     add(f"vibration_{lo}.csv", out / f"vibration_{lo}.csv")
     add(f"vibration_{lo}.png", plot_free_vibration(
         r_fe, out / f"vibration_{lo}.png",

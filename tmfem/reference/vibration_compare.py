@@ -80,20 +80,20 @@ def three_model_vibration(system, *, t_end: float, dt: float = 0.01, perturb=Non
     dict with ``t`` (nt,), ``signals`` {model: {signal: (nt,)}}, ``results`` {model: result},
     ``comparison`` (JSON-able: differences, amplitudes, frequencies, wall times).
     """
-    from tmfem.simulation.vibration import free_vibration, mtc_free_vibration, sbc_free_vibration
+    from tmfem.simulation.vibration import free_vibration, model_free_vibration
     given = compared_system(system)
     name = given.name
     pert = dict(given.problem.report.perturbation if perturb is None else perturb)
     fe = fe_models(given, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend)
     system = fe["MTC"].system
     results, static = {}, {}
-    for key, run in (("SBC", sbc_free_vibration), ("MTC", mtc_free_vibration)):
+    for key in ("SBC", "MTC"):
         steps = progress(key) if progress else None
         with named_model(key, name, mesh_n):
-            st = fe[key].solve_static()
+            st = fe[key].equilibrium()
             static[key] = st.time
-            results[key] = run(fe[key], st.state if key == "SBC" else st.x, t_end=t_end, dt=dt,
-                               perturb=pert, progress=steps)
+            results[key] = model_free_vibration(fe[key], at=st, t_end=t_end, dt=dt,
+                                                perturb=pert, progress=steps)
     steps = progress("COM") if progress else None
     with named_model("COM", name, mesh_n):
         com = com_model(given, mesh_n=mesh_n)

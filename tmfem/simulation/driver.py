@@ -12,7 +12,7 @@ and the plant stepped from t_n to t_n+1 with u_n held -- or, for a plant with ac
 sampled state x_n held (a tension-servoed tendon, :mod:`tmfem.control.fe_plant.tension_actuation`;
 the record keeps the commanded u_n); a plant with a per-sample hook (``plant.sample(x, u)``)
 is told the sampled state x_n and that held input before the step (an FE plant's damping on
-the current tangent, :meth:`tmfem.models.fe_plant.FEPlant.sample`). Any model's plant serves: the
+the current tangent, :meth:`tmfem.models.fe.plant.FEPlant.sample`). Any model's plant serves: the
 control-oriented model (eq. 5.27) and the finite-element models (M a + C v + f_int(x; u) with
 the tendon rest lengths u as inputs).
 """

@@ -46,11 +46,17 @@ class FreeVibration:
     wall_time: float
     stats: dict = field(default_factory=dict)
 
+    def summary(self) -> dict:
+        """What this run adds to the common report: the final state by name."""
+        n = 2 * self.z.shape[1]
+        return {"final": dict(zip(self.columns[1:1 + n],
+                                  np.concatenate([self.z[-1], self.zd[-1]]).tolist()))}
+
 
 def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | None = None,
                    csv_path=None, scheme: str = "park", jacobian: str = "step",
                    monitor_nodes=None, progress=None, vtk_dir=None,
-                   vtk_every: int = 10, u=None) -> FreeVibration:
+                   vtk_every: int = 10, u=None, plant=None) -> FreeVibration:
     """Free vibration of a :class:`~tmfem.models.com.model.ControlOrientedModel` from its
     equilibrium with an initial perturbation (6.5).
 
@@ -73,13 +79,15 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
         Tendon rest lengths during the run: an array, or ``u(t) -> array`` sampled every step
         (zero-order hold); default the model's nominal ``u0`` (free vibration). The run always
         starts from the equilibrium for ``u0``.
+    plant : COMPlant, optional
+        The plant to integrate (default ``model.plant(perturb=perturb)``).
     vtk_dir : path, optional
         Write every ``vtk_every``-th step as a ParaView frame (bars, tendons with forces,
         deformed membrane with its deflection in O_f) and a ``.pvd`` collection, as the run goes.
     """
     check_time_grid(t_end, dt)
     system = model.system
-    plant = COMPlant(model, perturb=perturb)
+    plant = COMPlant(model, perturb=perturb) if plant is None else plant
     labels = list(system.monitor_nodes) if monitor_nodes is None else list(monitor_nodes)
     idx = [system.node_index(n) for n in labels]
     wnames = [f"w_{i + 1}" for i in range(len(model.output_points))]
@@ -148,40 +156,53 @@ class FEVibration:
     def energy(self) -> np.ndarray:
         return self.kinetic + self.strain
 
+    def summary(self) -> dict:
+        """What this run adds to the common report: the largest tendon deflection, the energy
+        drift and the range of every coordinate q."""
+        return {"max_tendon_deflection_m": self.stats["max_tendon_deflection"],
+                "max_tendon_deflection_tendon": self.stats["max_tendon_deflection_tendon"],
+                "energy_drift_J": float(np.max(np.abs(self.energy - self.energy[0]))),
+                "initial_kinetic_energy_J": float(self.kinetic[0]),
+                "q_range": dict(zip(self.columns[1:1 + self.q.shape[1]],
+                                    np.ptp(self.q, axis=0).tolist()))}
 
-def mtc_free_vibration(model, x_eq, *, alpha: float = 0.0, beta: float = 0.0, perturb=None,
-                       output_points=None, **kwargs) -> FEVibration:
-    """Free vibration of an MTC model from its equilibrium ``x_eq`` (3, n_nodes) (6.5,
-    eqs. 5.34-5.35): :func:`fe_free_vibration` of its :class:`MTCDynamics` plant."""
-    dyn = MTCDynamics(model, x_eq, alpha=alpha, beta=beta, perturb=perturb,
-                      output_points=output_points)
-    return fe_free_vibration(dyn, name="mtc",
-                             membrane=lambda u: membrane_field(model, dyn.positions(u)), **kwargs)
+
+#: the ParaView membrane of a finite-element plant's free-dof state u, by plant type
+FRAME_FIELDS = {
+    MTCDynamics: lambda dyn: (lambda u: membrane_field(dyn.model, dyn.positions(u))),
+    SBCDynamics: lambda dyn: (lambda u: shell_field(dyn.model, dyn.configuration(u))),
+}
 
 
-def sbc_free_vibration(model, state_eq, *, alpha: float = 0.0, beta: float = 0.0, perturb=None,
-                       output_points=None, **kwargs) -> FEVibration:
-    """Free vibration of an SBC model from its equilibrium ``state_eq`` (a ``State``) (6.5):
-    :func:`fe_free_vibration` of its :class:`~tmfem.models.sbc.dynamics.SBCDynamics` plant;
-    ParaView frames carry the shells with their stresses (:func:`tmfem.post.sbc.shell_field`)."""
-    dyn = SBCDynamics(model, state_eq, alpha=alpha, beta=beta, perturb=perturb,
-                      output_points=output_points)
-    return fe_free_vibration(dyn, name="sbc",
-                             membrane=lambda u: shell_field(model, dyn.configuration(u)), **kwargs)
+def model_free_vibration(model, *, at=None, perturb: dict | None = None, dynamics=None,
+                         jacobian: str | None = None, **run):
+    """Free vibration of any model (:mod:`tmfem.models.base`) from its equilibrium ``at``
+    (default ``model.equilibrium()``) with an initial ``perturb``: the plant
+    ``model.plant(at=at, perturb=perturb, **dynamics)`` integrated by :func:`free_vibration`
+    (control-oriented model; ``jacobian`` default ``"reuse"``, its matrices change little) or
+    :func:`fe_free_vibration` (finite-element plants; default ``"step"``). ``run``: the
+    keyword arguments both take (``t_end``, ``dt``, ``csv_path``, ``scheme``, ``progress``,
+    ``vtk_dir``, ``vtk_every``, ``monitor_nodes``)."""
+    plant = model.plant(at=at, perturb=perturb, **(dynamics or {}))
+    if isinstance(plant, COMPlant):
+        return free_vibration(model, plant=plant, jacobian=jacobian or "reuse", **run)
+    frames = FRAME_FIELDS[type(plant)](plant)
+    return fe_free_vibration(plant, name=model.name, membrane=frames,
+                             jacobian=jacobian or "step", **run)
 
 
 def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_path=None,
                       scheme: str = "park", jacobian: str = "step", monitor_nodes=None,
                       progress=None, vtk_dir=None, vtk_every: int = 10, tol: float = 1e-10,
                       membrane=None, line_search: bool = True) -> FEVibration:
-    """Free vibration of a finite-element plant ``dyn`` (:class:`tmfem.models.fe_plant.FEPlant`)
+    """Free vibration of a finite-element plant ``dyn`` (:class:`tmfem.models.fe.plant.FEPlant`)
     from its perturbed equilibrium (6.5, eqs. 5.34-5.35).
 
     Parameters
     ----------
     dyn : MTCDynamics or SBCDynamics
         The plant, built with its perturbation (``{"theta_12_dot": 0.01}`` etc.,
-        :func:`tmfem.models.fe_plant.initial_state`), damping and output points.
+        :func:`tmfem.models.fe.plant.initial_state`), damping and output points.
     name : str
         Model name of the result and the ParaView series.
     t_end, dt : float
@@ -208,7 +229,7 @@ def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_pat
     transverse deflection (eq. 5.37, relative to the equilibrium), kinetic and strain energy.
     """
     check_time_grid(t_end, dt)
-    mtc = dyn.mtc
+    mtc = dyn.model
     system, topo = mtc.system, mtc.topology
     labels = list(system.monitor_nodes) if monitor_nodes is None else list(monitor_nodes)
     lab_nodes = [topo.system_node[system.node_index(n)] for n in labels]

@@ -11,7 +11,7 @@ from tmfem.control.deployment.pfl import PFLTerms, bounded_inversion
 from tmfem.control.fe_plant.state_estimate import (FEStatePlant, rigid_bar_fit, sbc_deployment_plant,
                                           start_rest_lengths)
 from tmfem.errors import InputError
-from tmfem.models.mtc.post import q_from_positions
+from tmfem.models.fe.outputs import q_from_positions
 from tmfem.reference.deployments import setup
 from tmfem.simulation.controllers import OpenLoop
 from tmfem.simulation.driver import simulate

@@ -31,13 +31,13 @@ def _svk_tendon_forces(dyn, x, r):
     """The FE tendon forces [N] at state x under rest lengths r, written out here from the
     positions: the mean of each tendon's k St.Venant-Kirchhoff truss elements (eqs. 4.9,
     4.23; rest length r / k, cable EA), N = EA (l^2 - L^2) l / (2 L^3), zero when slack."""
-    topo = dyn.mtc.topology
+    topo = dyn.model.topology
     xf = dyn.positions(x)
     a, b = topo.tendon_conn
     l = np.linalg.norm(xf[:, b] - xf[:, a], axis=0)
     e, k = topo.tendon_of_element, topo.tendon_elements
     L = r[e] / k
-    EA = dyn.mtc.tendon_EA[e]
+    EA = dyn.model.tendon_EA[e]
     N = np.where(l > L, EA * (l**2 - L**2) * l / (2 * L**3), 0.0)
     return np.bincount(e, weights=N) / k, np.bincount(e, weights=l)
 
@@ -100,15 +100,15 @@ def test_rest_length_for_tension_against_the_mtc_elements(law):
     n_t = len(dyn.model.system.tendons)
     T = np.resize([2.0, 5.0, 20.0, 50.0, 0.0], n_t)
     le = fe_element_lengths(dyn, x)
-    r = rest_length_for_tension(dyn.mtc, le, T)
+    r = rest_length_for_tension(dyn.model, le, T)
     dyn.model.set_tendon_lengths(r)
     got = dyn.member_forces(x)["tendon_force"]
     dyn.model.set_tendon_lengths(dyn.u0)
-    L = np.bincount(dyn.mtc.topology.tendon_of_element, weights=le)
+    L = np.bincount(dyn.model.topology.tendon_of_element, weights=le)
     assert np.all(np.abs(got - T)[T > 0] < 1e-9)
     assert np.all(r[T == 0] == L[T == 0]) and np.all(r <= L)
     with pytest.raises(InputError, match="cannot push"):
-        rest_length_for_tension(dyn.mtc, le, -T - 1.0)
+        rest_length_for_tension(dyn.model, le, -T - 1.0)
 
 
 def test_force_actuated_run_follows_the_com_run(dep):

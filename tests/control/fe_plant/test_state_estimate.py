@@ -19,8 +19,8 @@ def models():
     s = load_preset("2-3-deploy")
     com = ControlOrientedModel(s, membrane_modes=default_membrane_modes(s), rest_lengths="system")
     fe = MTCModel(s, mesh_n=10, rest_lengths="system")
-    x_eq = fe.solve_static().x
-    z_e = com.equilibrium(com.u0, z0=com.z0)
+    x_eq = fe.equilibrium().x
+    z_e = com.equilibrium(com.u0, z0=com.z0).state
     return s, com, fe, x_eq, z_e
 
 
@@ -43,7 +43,7 @@ def test_other_system_refused(models):
     s, com, fe, x_eq, z_e = models
     other = MTCModel(load_preset("2-3-deploy"), mesh_n=4, rest_lengths="system")
     with pytest.raises(InputError, match="same System"):
-        COMStateEstimator(com, MTCDynamics(other, other.solve_static().x))
+        COMStateEstimator(com, MTCDynamics(other, other.equilibrium().x))
 
 
 def test_lqr_designed_on_the_com_damps_the_mtc_plant(models):

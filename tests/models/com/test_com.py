@@ -180,7 +180,7 @@ def test_design_is_equilibrium_and_rest_lengths(m14, sys14):
     # equilibrium of the model with those rest lengths is the design up to the rounding
     # of r_1 = 0.4286 m in Table 6.2 (eq. 3.33 gives 0.428565 m)
     assert m14.design.residual < 1e-3
-    z_e = m14.equilibrium()
+    z_e = m14.equilibrium().state
     assert np.max(np.abs(z_e - m14.z0)) < 1e-3
     assert np.max(np.abs(m14.static_residual(z_e))) < 1e-8
     # A1's 1-N closed form (eq. 3.34) gives the same tendon force for the same F_Delta
@@ -231,7 +231,7 @@ def test_linear_state_space_names(m14, sys14):
 # ---------------------------------------------------------------- energy (5.12-5.13)
 def test_energy_conserved_without_damping(sys14, m14):
     m = m14
-    z0 = m.equilibrium()
+    z0 = m.equilibrium().state
     zd0 = np.zeros(m.nz); zd0[2] = 0.01          # theta_12_dot = 0.01 rad/s (6.5.1)
     E = []
     res = park_integrate(m, x0=z0, v0=zd0, dt=0.005, n_steps=300, scheme="trapezoidal",

@@ -76,7 +76,7 @@ def test_design_tendon_forces_match_equilibrium_design(s23, m23):
 def test_stable_and_energy_conserved(s23, m23):
     f = linearize(m23).frequencies_hz()
     assert np.all(f > 0)                          # a stable equilibrium: no imaginary frequency
-    z0 = m23.equilibrium()
+    z0 = m23.equilibrium().state
     zd0 = np.zeros(m23.nz); zd0[0] = 0.01         # theta_11_dot = 0.01 rad/s (6.5.2)
     E = []
     park_integrate(m23, x0=z0, v0=zd0, dt=0.005, n_steps=200, scheme="trapezoidal",

@@ -1,6 +1,8 @@
 """Membrane-truss-cable model of a System (dissertation 4.4, 6.2-6.4)."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -97,7 +99,7 @@ def test_static_lands_on_design_from_undeformed(exact_model):
     # with the design-consistent rest lengths the equilibrium IS the design (6.2: "the
     # system converges to the designed equilibrium"), reached from the unstressed membrane
     m = exact_model
-    res = m.solve_static(start="undeformed", monitor=["B_14"])
+    res = m.equilibrium(start="undeformed", monitor=["B_14"])
     X = res.x[:, m.topology.system_node]
     Xd = m.system.nodes()
     assert np.abs(X - Xd).max() < 2e-5      # round-off of the corner-force balance above
@@ -108,9 +110,9 @@ def test_static_lands_on_design_from_undeformed(exact_model):
     r = np.array(res.residual_history)
     k = int(np.flatnonzero(r < 1e-2)[0])
     assert r[-1] < 1e-7 and len(r) - 1 - k <= 5
-    assert res.dt2_history[-1] < 1e-6 * res.dt2_history[0]     # regularisation gone
+    assert res.mu_history[-1] < 1e-6 * res.mu_history[0]     # regularisation gone
     # the same state from the other start
-    res2 = m.solve_static(start="design")
+    res2 = m.equilibrium(start="design")
     assert np.abs(res2.x - res.x).max() < 1e-7
 
 
@@ -144,8 +146,8 @@ def paper_prestress_modes():
     # the dissertation's own Tables 6.3 and 6.6 imply (docs/validation/errata.md, "MTC 1-4 prestress")
     s = load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
     m = MTCModel(s, mesh_n=10, tendon_elements=3)
-    res = m.solve_static(start="undeformed")
-    return m, res, m.modes(res.x, k=12)
+    res = m.equilibrium(start="undeformed")
+    return m, res, m.modes(k=12, at=res.x)
 
 
 def test_frequencies_vs_table_6_6(paper_prestress_modes):
@@ -184,7 +186,7 @@ def test_printed_rest_length_contradicts_table_6_3():
     # equilibrium it reaches has a tendon stress < 10 % of the printed 37.98 MPa (Table 6.3)
     s = load_preset("1-4", as_printed=True)
     m = MTCModel(s, mesh_n=6, tendon_elements=1)
-    res = m.solve_static(start="design")
+    res = m.equilibrium(start="design")
     st = static_summary(m, res.x)
     assert st["tendon_stress_max"] < 0.1 * 37.98e6
     assert not st["tendon_slack"]
@@ -196,7 +198,7 @@ def test_tendon_subdivision_does_not_change_frequencies():
     f, ndof = [], []
     for k in (1, 3):
         m = MTCModel(s, mesh_n=4, tendon_elements=k)
-        f.append(m.modes(m.solve_static(start="design").x, k=12).freq_hz)
+        f.append(m.modes(k=12, at=m.equilibrium(start="design").x).freq_hz)
         ndof.append(m.ndof)
     assert ndof[1] == ndof[0] + 4 * 2 * 3          # two models: 2 inner nodes per tendon
     assert f[1] == pytest.approx(f[0], rel=2e-3)
@@ -211,7 +213,7 @@ def test_distributed_attachment_close_to_point():
     f = {}
     for att in ("point", "distributed"):
         m = MTCModel(s, mesh_n=20, tendon_elements=1, attachment=att)
-        f[att] = m.modes(m.solve_static(start="design").x, k=6).freq_hz
+        f[att] = m.modes(k=6, at=m.equilibrium(start="design").x).freq_hz
     assert min(nodes.size for nodes, _ in m.topology.weights) > 3
     assert f["distributed"][:4] == pytest.approx(f["point"][:4], rel=1e-2)
     assert np.max(np.abs(f["distributed"] / f["point"] - 1)) > 1e-3   # not the same model
@@ -276,7 +278,7 @@ def test_2_3_printed_rest_lengths_do_not_fit_printed_geometry():
     assert strain[names.index("V_21")] == pytest.approx(1.1014 / 1.9953 - 1, abs=1e-3)
     m = MTCModel(s, mesh_n=3, tendon_elements=1)
     with pytest.raises(ConvergenceError, match="slack"):
-        m.solve_static(start="design", max_iter=80)
+        m.equilibrium(start="design", max_iter=80)
 
 
 def test_two_stage_system_lands_on_its_design():
@@ -286,13 +288,13 @@ def test_two_stage_system_lands_on_its_design():
     # design (independent formulation, eq. 3.16) lands within 0.1 mm of it.
     s = load_preset("2-3")      # the final 2-3 configuration of Table 7.7 (docs/validation/errata.md)
     m = MTCModel(s, mesh_n=4, tendon_elements=1, rest_lengths="mtc")
-    res = m.solve_static(start="undeformed")
+    res = m.equilibrium(start="undeformed")
     st = static_summary(m, res.x)
     assert st["max_deviation_from_design"] < 1e-5
     assert not st["tendon_slack"]
     assert len(st["bar_load_by_stage"]) == 2 and min(st["bar_load_by_stage"]) > 0
     m2 = MTCModel(s, mesh_n=4, tendon_elements=1, rest_lengths="design")
-    st2 = static_summary(m2, m2.solve_static(start="design").x)
+    st2 = static_summary(m2, m2.equilibrium(start="design").x)
     assert st2["max_deviation_from_design"] < 1e-3
 
 
@@ -332,8 +334,8 @@ def test_modes_reuse_the_static_tangent(paper_prestress_modes):
     m, res, ref = paper_prestress_modes
     _, K = m.residual(m.reduce(res.x))
     assert (res.tangent != K).nnz == 0
-    md = m.modes(res.x, k=12, tangent=res.tangent)
+    md = m.modes(k=12, at=res)
     assert np.allclose(md.omega2, ref.omega2, rtol=1e-9, atol=0)
     for bad in (res.tangent[:-1, :-1], res.tangent.toarray()):
         with pytest.raises(InputError, match="expected the tangent of this model's static solve"):
-            m.modes(res.x, k=12, tangent=bad)
+            m.modes(k=12, at=replace(res, tangent=bad))

@@ -49,8 +49,8 @@ def table_6_7_state():
     # in the calibration.
     m = MTCModel(load_preset("2-3"), mesh_n=10, tendon_elements=3, rest_lengths="mtc")
     k = calibrate_on_bar_load(m, 14.48)
-    res = m.solve_static(start="undeformed", monitor=["B_11", "A_21", "B_21"])
-    return m, res, static_summary(m, res.x, result=res), m.modes(res.x, k=12), k
+    res = m.equilibrium(start="undeformed", monitor=["B_11", "A_21", "B_21"])
+    return m, res, static_summary(m, res.x, result=res), m.modes(k=12, at=res.x), k
 
 
 def test_frequencies_vs_table_6_7(table_6_7_state):
@@ -79,9 +79,9 @@ def test_designed_rest_lengths_reproduce_tables_6_5_and_6_7_without_calibration(
     # model land on the design (< 0.5 mm) with the bar loads of Table 6.5 (14.48 / 5.02 N, we
     # find 14.483 / 5.022) and all 12 MTC frequencies of Table 6.7 within 0.05 % (0.012 %)
     m = MTCModel(load_preset("2-3"), mesh_n=10, tendon_elements=3, rest_lengths="design")
-    res = m.solve_static(start="undeformed")
+    res = m.equilibrium(start="undeformed")
     st = static_summary(m, res.x, result=res)
     assert st["bar_load_by_stage"] == pytest.approx([14.48, 5.02], rel=2e-3)
     assert st["max_deviation_from_design"] < 5e-4 and not st["tendon_slack"]
-    f = m.modes(res.x, k=12).freq_hz
+    f = m.modes(k=12, at=res.x).freq_hz
     assert f == pytest.approx(FREQUENCIES["2-3"]["MTC"], rel=5e-4)

@@ -10,9 +10,9 @@ import pytest
 
 from tmfem.errors import InputError
 from tmfem.models.mtc.model import MTCModel
-from tmfem.models.fe_plant import initial_state
+from tmfem.models.fe.plant import initial_state
 from tmfem.models.mtc.dynamics import MTCDynamics, fit_frequency
-from tmfem.simulation.vibration import mtc_free_vibration
+from tmfem.simulation.vibration import model_free_vibration
 from tmfem.solvers.park import park_integrate
 from tmfem.system import load_preset
 
@@ -20,7 +20,7 @@ from tmfem.system import load_preset
 @pytest.fixture(scope="module")
 def mtc_1_4():
     m = MTCModel(load_preset("1-4"), mesh_n=4, tendon_elements=3)
-    return m, m.solve_static(start="undeformed").x
+    return m, m.equilibrium(start="undeformed").x
 
 
 def test_initial_state_is_the_rigid_bar_rotation(mtc_1_4):
@@ -59,7 +59,8 @@ def test_energy_conserved_without_damping_and_decays_with_mass_damping(mtc_1_4):
     pert = {"theta_12_dot": 0.01}
 
     def run(scheme, dt, **kw):
-        r = mtc_free_vibration(m, x, t_end=2.0, dt=dt, perturb=pert, scheme=scheme, **kw)
+        r = model_free_vibration(m, at=x, t_end=2.0, dt=dt, perturb=pert, scheme=scheme,
+                                 dynamics=kw)
         return r, (r.energy - r.energy[0]) / r.kinetic[0]
 
     # the rigid-bar part alone, (1/2) (m l^2 / 3) theta'^2 (consistent bar mass), is a lower
@@ -102,7 +103,7 @@ def test_small_vibration_frequency_is_the_first_modal_frequency(mtc_1_4):
     # the amplitude-dependent (nonlinear) shift is ~1e-3 at 0.01 rad/s (measured), so
     # ~1e-5 at 0.001 rad/s; measured -5e-7.
     m, x = mtc_1_4
-    md = m.modes(x, k=1)
+    md = m.modes(k=1, at=x)
     dyn = MTCDynamics(m, x)
     u0, v0 = initial_state(dyn, {f"psi_1{j}_dot": 0.001 for j in range(1, 5)})
     r = park_integrate(dyn, x0=u0, v0=v0, dt=0.01, n_steps=1000, jacobian="reuse")
@@ -113,7 +114,7 @@ def test_small_vibration_frequency_is_the_first_modal_frequency(mtc_1_4):
     assert f == pytest.approx(f1, rel=1e-4)
     # the bars' own coordinate shows the same frequency (the 11 % in higher modes blur it
     # slightly: measured 0.09 %)
-    from tmfem.models.mtc.post import q_from_positions
+    from tmfem.models.fe.outputs import q_from_positions
     psi = np.array([q_from_positions(m.system, dyn.positions(u)[:, m.topology.system_node])[1]
                     for u in r.x])
     assert fit_frequency(r.t, psi, f_min=0.5 * f1, f_max=1.5 * f1) == pytest.approx(f1, rel=3e-3)
@@ -132,8 +133,8 @@ def test_mtc_and_com_bar_responses_agree_1_4():
     com = ControlOrientedModel(s, membrane_modes=5, mesh_n=4)
     rc = free_vibration(com, t_end=6.0, dt=0.01, perturb={"theta_12_dot": 0.01}, jacobian="reuse")
     m = MTCModel(s.with_rest_lengths(com.u0), mesh_n=4, tendon_elements=3)
-    rm = mtc_free_vibration(m, m.solve_static(start="undeformed").x, t_end=6.0, dt=0.01,
-                            perturb={"theta_12_dot": 0.01})
+    rm = model_free_vibration(m, at=m.equilibrium(start="undeformed"), t_end=6.0, dt=0.01,
+                              perturb={"theta_12_dot": 0.01})
     i = s.q_names.index("theta_12")
     a = rc.z[:, i] - rc.z[0, i]
     b = rm.q[:, i] - rm.q[0, i]
@@ -162,8 +163,8 @@ def test_mtc_and_com_bar_responses_agree_2_3():
     com = ControlOrientedModel(s, membrane_modes=4, mesh_n=4)
     rc = free_vibration(com, t_end=4.0, dt=0.01, perturb=pert, jacobian="reuse")
     m = MTCModel(s.with_rest_lengths(com.u0), mesh_n=4, tendon_elements=3)
-    rm = mtc_free_vibration(m, m.solve_static(start="undeformed").x, t_end=4.0, dt=0.01,
-                            perturb=pert)
+    rm = model_free_vibration(m, at=m.equilibrium(start="undeformed"), t_end=4.0, dt=0.01,
+                              perturb=pert)
     i = s.q_names.index("theta_11")
     a = rc.z[:, i] - rc.z[0, i]
     b = rm.q[:, i] - rm.q[0, i]
@@ -201,7 +202,7 @@ def test_vibrate_cli_mtc(tmp_path, capsys):
     # (member_state at the equilibrium) and within 2 % of it (small perturbation)
     from tmfem.models.mtc.post import member_state
     m = MTCModel(load_preset("1-4"), mesh_n=4, tendon_elements=3)
-    T_eq = member_state(m, m.solve_static(start="undeformed").x)["tendon_force"].min()
+    T_eq = member_state(m, m.equilibrium(start="undeformed").x)["tendon_force"].min()
     assert 0.98 * T_eq < r["min_tendon_force_N"] < T_eq
     assert main(["vibrate", "--model", "mtc", "--preset", "1-4", "--mesh", "4", "--t-end", "0.1",
                  "--perturb", "eta_1_dot=0.01"]) == 2

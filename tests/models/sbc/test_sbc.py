@@ -24,8 +24,8 @@ def paper_1_4():
 def sbc_1_4():
     # the paper's mesh: 4 x 10 x 10 shells, 3 elements per tendon, one beam per bar (6.2, 6.4.1)
     m = SBCModel(paper_1_4(), mesh_n=10, tendon_elements=3)
-    res = m.solve_static(monitor=["B_14"])
-    return m, res, m.modes(res.state, k=12)
+    res = m.equilibrium(monitor=["B_14"])
+    return m, res, m.modes(k=12, at=res.state)
 
 
 def test_frequencies_vs_table_6_6_sbc(sbc_1_4):
@@ -58,8 +58,8 @@ def test_against_mtc_same_mesh(sbc_1_4):
     # states for 1-4 (6.4: SBC vs MTC)
     m, res, modes = sbc_1_4
     mtc = MTCModel(paper_1_4(), mesh_n=10, tendon_elements=3)
-    rm = mtc.solve_static()
-    fm = mtc.modes(rm.x, k=12).freq_hz
+    rm = mtc.equilibrium()
+    fm = mtc.modes(k=12, at=rm.x).freq_hz
     from tmfem.models.mtc.post import member_state
     ms = member_state(mtc, rm.x)
     f = m.member_forces(res.state)
@@ -79,8 +79,8 @@ def test_frequencies_vs_table_6_7_sbc():
     # Table 6.7, SBC column: the 2-3 preset (the final configuration of Table 7.7, see
     # docs/guides/mtc.md "2-3"), 4 x 10 x 10 shells, 3 elements per tendon
     m = SBCModel(load_preset("2-3"), mesh_n=10, tendon_elements=3)
-    res = m.solve_static()
-    f = m.modes(res.state, k=12).freq_hz
+    res = m.equilibrium()
+    f = m.modes(k=12, at=res.state).freq_hz
     ref = np.array(FREQUENCIES["2-3"]["SBC"])
     assert f[:4] == pytest.approx(ref[:4], rel=5e-3)
     assert f[4:] == pytest.approx(ref[4:], rel=1.5e-2)
@@ -109,7 +109,7 @@ def test_bad_input_refused(capsys):
     with pytest.raises(InputError, match="1-N\\(D\\)"):
         SBCModel(load_preset("1-4D"), mesh_n=2, rest_lengths="mtc")
     with pytest.raises(InputError, match="predictor"):
-        SBCModel(s, mesh_n=2).solve_static(predictor="mtc", start=SBCModel(s, mesh_n=2).start_state())
+        SBCModel(s, mesh_n=2).equilibrium(predictor="mtc", start=SBCModel(s, mesh_n=2).start_state())
     with pytest.raises(InputError, match="bar_elements"):
         SBCModel(s, mesh_n=2, bar_elements=0)
     assert main(["modal", "--model", "sbc", "--preset", "1-4", "--mesh", "2", "--patch", "0.3"]) != 0
@@ -151,7 +151,7 @@ def test_1nd_rigid_bar_limit_lands_on_design_and_matches_com():
     s = load_preset("1-4D")
     d = design_equilibrium(s, mesh_n=n)
     m = SBCModel(_stiff_bars(s), mesh_n=n, tendon_elements=1, rest_lengths="design")
-    res = m.solve_static()
+    res = m.equilibrium()
     out = static_summary(m, res)
     assert out["max_deviation_from_design"] < 0.5e-3          # design Delta: 2.1 mm
     assert out["theta_deg"] == pytest.approx(out["theta_design_deg"], abs=0.01)
@@ -168,13 +168,13 @@ def test_1nd_rigid_bar_limit_lands_on_design_and_matches_com():
     com = ControlOrientedModel(s, membrane_modes=8, mesh_n=n)
     np.testing.assert_allclose(com.u0, m.rest_lengths, rtol=1e-9)
     f_com = linearize(com).frequencies_hz()[:12]
-    f_sbc = m.modes(res.state, k=12, tangent=res.tangent).freq_hz
+    f_sbc = m.modes(k=12, at=res).freq_hz
     ratio = f_com / f_sbc
     assert np.all(ratio > 0.97) and np.all(ratio < 1.005), ratio
     # and the MTC model with rigid bar points (the SBC predictor: membrane elements without
     # bending, truss bars, H_1j constrained to the chord) on the same mesh: within 0.5 %
     mtc = MTCModel(s, mesh_n=n, tendon_elements=1, rest_lengths="design", rigid_bar_points=True)
-    f_mtc = mtc.modes(mtc.solve_static().x, k=12).freq_hz
+    f_mtc = mtc.modes(k=12, at=mtc.equilibrium().x).freq_hz
     np.testing.assert_allclose(f_sbc, f_mtc, rtol=5e-3)
 
 
@@ -189,8 +189,8 @@ def test_1nd_bars_bend_as_pinned_beams_under_the_tendon_load_at_h():
     m = SBCModel(s, mesh_n=4, tendon_elements=1)
     ch = m.numbering.bar_chain
     assert np.array_equal(ch[:, 3], [m.node(f"H_1{j}") for j in range(1, 5)])
-    st = m.solve_static().state
-    x = st.x[:, m.mtc.topology.system_node]
+    st = m.equilibrium().state
+    x = st.x[:, m.topology.system_node]
     N, l, k = s.N, s.l[0, 0], s.k_H
     A, B, H = x[:, :N], x[:, N:2 * N], x[:, 2 * N:]
     c = s.tendon_connectivity
@@ -209,7 +209,7 @@ def test_1nd_bars_bend_as_pinned_beams_under_the_tendon_load_at_h():
     M_cf = np.repeat(P, 2)[:, None] * np.where(sA < a, b * sA, a * (l - sA)) / l
     np.testing.assert_allclose(np.hypot(sec["M1"], sec["M2"]), M_cf, rtol=1.5e-2)
     m2 = SBCModel(s, mesh_n=4, tendon_elements=1, bar_elements=2)
-    x2 = m2.solve_static().state.x[:, m2.mtc.topology.system_node]
+    x2 = m2.equilibrium().state.x[:, m2.topology.system_node]
     assert bar_bow(s, x2) == pytest.approx(bar_bow(s, x), rel=1e-3)
 
 

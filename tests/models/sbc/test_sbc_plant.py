@@ -237,10 +237,10 @@ def test_lqr_designed_on_the_com_damps_the_sbc_plant():
     from tmfem.models.sbc.model import SBCModel
     s = load_preset("1-4D")
     com = ControlOrientedModel(s, membrane_modes=default_membrane_modes(s), rest_lengths="system")
-    ctrl, _ = lqr_state_feedback(com, u_e=com.u0, z_e=com.equilibrium(com.u0, z0=com.z0),
+    ctrl, _ = lqr_state_feedback(com, u_e=com.u0, z_e=com.equilibrium(com.u0, z0=com.z0).state,
                                  u_m=0.01)
     fe = SBCModel(s, mesh_n=4, rest_lengths="system")
-    plant = FEStatePlant(SBCDynamics(fe, fe.solve_static().state,
+    plant = FEStatePlant(SBCDynamics(fe, fe.equilibrium().state,
                                      perturb={"theta_11_dot": 0.02}), com, bars="chord")
     iq = list(s.q_names).index("theta_11")
     d = simulate(plant, t_end=3.0, dt=0.01, controller=ctrl, jacobian="step").y[:, iq]

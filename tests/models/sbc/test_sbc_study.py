@@ -20,7 +20,7 @@ from tmfem.cli import main
 from tmfem.models.mtc.model import MTCModel
 from tmfem.models.sbc.model import SBCModel
 from tmfem.reference.tables import FREQUENCIES, PRINTED
-from tmfem.simulation.vibration import mtc_free_vibration, sbc_free_vibration
+from tmfem.simulation.vibration import model_free_vibration
 from tmfem.system import load_preset
 
 REDUCED = os.environ.get("TMFEM_SLOW_SCALE", "") == "reduced"
@@ -36,9 +36,9 @@ def vib_1_4():
     s = paper_1_4()
     pert = {"theta_12_dot": 0.01}
     m = SBCModel(s, mesh_n=4, tendon_elements=3)
-    rs = sbc_free_vibration(m, m.solve_static().state, t_end=0.5, dt=0.01, perturb=pert)
+    rs = model_free_vibration(m, at=m.equilibrium(), t_end=0.5, dt=0.01, perturb=pert)
     mm = MTCModel(s, mesh_n=4, tendon_elements=3)
-    rm = mtc_free_vibration(mm, mm.solve_static().x, t_end=0.5, dt=0.01, perturb=pert)
+    rm = model_free_vibration(mm, at=mm.equilibrium(), t_end=0.5, dt=0.01, perturb=pert)
     return s, rs, rm
 
 
@@ -136,13 +136,13 @@ def test_sbc_statics_beside_table_6_5():
     from tmfem.models.sbc.post import static_summary
     s = load_preset("2-3")
     m = SBCModel(s, mesh_n=10)
-    r = static_summary(m, m.solve_static())
+    r = static_summary(m, m.equilibrium())
     pr = PRINTED["6.5"]
     assert r["bar_load_by_stage"] == pytest.approx([pr["bar_load_stage1"], pr["bar_load_stage2"]],
                                                    rel=3e-3)
     assert r["tendon_stress_max"] == pytest.approx(pr["tendon_max_stress"], rel=0.03)
     mtc = MTCModel(s, mesh_n=10)
-    rm = mtc_summary(mtc, mtc.solve_static().x)
+    rm = mtc_summary(mtc, mtc.equilibrium().x)
     assert r["membrane_max_sigma_p1"] == pytest.approx(rm["membrane_max_sigma_p1"], rel=0.03)
     assert r["membrane_max_von_mises"] == pytest.approx(rm["membrane_max_von_mises"], rel=0.03)
     # the thin shell carries the prestress as a membrane: top and bottom agree
@@ -203,8 +203,8 @@ def test_convergence_row_from_mtc_start_is_the_sbc_equilibrium():
                                 progress=False))
     from tmfem.models.sbc.post import static_summary
     m = SBCModel(s, mesh_n=4, tendon_elements=1)
-    res = m.solve_static(predictor="none")
-    f = m.modes(res.state, k=6).freq_hz
+    res = m.equilibrium(predictor="none")
+    f = m.modes(k=6, at=res.state).freq_hz
     # both equilibria meet the solver's residual test (1e-9 of the member forces): the soft
     # first mode (0.14 Hz) then agrees to ~1e-6
     assert [row[f"f{i + 1}"] for i in range(6)] == pytest.approx(f, rel=2e-6)
@@ -236,7 +236,7 @@ def test_sbc_plant_newton_matrix_is_the_derivative_of_its_residual():
     # state with finite (0.05 rad) rotations; the spin tangent alone is off by O(|theta|)
     from tmfem.models.sbc.dynamics import SBCDynamics
     m = SBCModel(paper_1_4(), mesh_n=3, tendon_elements=2)
-    d = SBCDynamics(m, m.solve_static().state)
+    d = SBCDynamics(m, m.equilibrium().state)
     rng = np.random.default_rng(0)
     u = 0.05 * rng.standard_normal(int(d.free.sum()))
     z, v, h = np.zeros_like(u), rng.standard_normal(u.size), 1e-6

@@ -351,7 +351,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      w_bar=w_bar, gamma=gamma, uncertainty=uncertainty, allocation=allocation,
                      r_min=r_min, evaluation=evaluation, tendon_law=tendon_law)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
-    z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)]))
+    z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)])).state
     info = {"rbf_centres": n_centers, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
     lin_ctrl = None
     ctrl = ad

@@ -27,7 +27,7 @@ Where the FE membrane moves exactly as the COM's field (eqs. 5.1, 5.3) the estim
 (test); otherwise it is the COM state closest in the kinetic-energy norm, and what it leaves
 out (modes above K, tendon vibration) is what the controller does not see.
 
-:class:`FEStatePlant` is an FE plant (any :class:`tmfem.models.fe_plant.FEPlant`: the MTC
+:class:`FEStatePlant` is an FE plant (any :class:`tmfem.models.fe.plant.FEPlant`: the MTC
 model's :class:`~tmfem.models.mtc.dynamics.MTCDynamics` or the SBC model's
 :class:`~tmfem.models.sbc.dynamics.SBCDynamics`, the tendon rest lengths as inputs,
 M a + C v + f_int(x; u) = 0) whose outputs are that estimate
@@ -49,8 +49,8 @@ from tmfem.control.fe_plant.tension_actuation import (ACTUATIONS, fe_element_len
                                              rest_length_for_tension, tension_demand)
 from tmfem.errors import InputError
 from tmfem.fem.membrane import point_matrix
-from tmfem.models.mtc.post import member_state, q_from_positions
-from tmfem.models.mtc.topology import to_floating
+from tmfem.models.fe.outputs import q_from_positions
+from tmfem.models.fe.outputs import to_floating
 from tmfem.system.coordinates import join_q, q_index
 from tmfem.system.geometry import wrap_angle
 
@@ -131,7 +131,7 @@ class COMStateEstimator:
         The controllers' design model, of the same system as the FE model.
     dyn : FEPlant
         The FE plant: ``positions(x)`` gives the node positions of a free-DOF state in the
-        numbering of its MTC model ``dyn.mtc`` (membrane, system labels, tendon internals).
+        placement numbering of its model ``dyn.model`` (membrane, system labels, tendon internals).
     bars : {"chord", "rigid"}, optional
         q from the bar end nodes, or from the rigid fit of the bar's chain nodes
         (:func:`rigid_bar_fit`; a plant with nodes along its bars, ``dyn.bar_chain_positions``:
@@ -148,7 +148,7 @@ class COMStateEstimator:
                              f"its bars (the SBC model), found the {dyn.name} plant, whose bars "
                              f"are straight trusses (their chord is their rigid fit)")
         self.bars = bars
-        fe = dyn.mtc
+        fe = dyn.model
         if fe.system is not com.system:
             raise InputError("FE plant: expected the FE model and the control-oriented model of "
                              f"the same System, found {fe.system.name!r} and {com.system.name!r}")
@@ -158,7 +158,7 @@ class COMStateEstimator:
         self._P0 = basis.shapes[0]
         self._Psi = basis.shapes[1:1 + self._nd]
         # FE nodal field -> values at the COM basis nodes (reference coordinates in O_f)
-        self._I = _probe(fe.membrane.skmesh, self._P0[:2])
+        self._I = _probe(fe.topology.mesh.to_skfem(), self._P0[:2])
         topo = fe.topology
         self._system_node, self._n_mesh = topo.system_node, topo.n_mesh
         self._corners = topo.mesh.corners
@@ -245,7 +245,7 @@ class FEStatePlant:
         (:mod:`tmfem.control.fe_plant.tension_actuation`)."""
         if self.actuation == "rest-length":
             return np.asarray(u, dtype=float)
-        return rest_length_for_tension(self.dyn.mtc, fe_element_lengths(self.dyn, x),
+        return rest_length_for_tension(self.dyn.model, fe_element_lengths(self.dyn, x),
                                        self.tension_demand(x, u))
 
     def tension_demand(self, x, u) -> np.ndarray:
@@ -254,7 +254,7 @@ class FEStatePlant:
         return tension_demand(self.com, self.estimator.bar_coordinates(x), u)
 
     def sample(self, x, u) -> None:
-        """The FE plant's per-sample hook (:meth:`tmfem.models.fe_plant.FEPlant.sample`) at
+        """The FE plant's per-sample hook (:meth:`tmfem.models.fe.plant.FEPlant.sample`) at
         the sampled state x under the model input u (:meth:`actuate`'s)."""
         self.dyn.sample(x, u)
 
@@ -318,7 +318,7 @@ class FEStatePlant:
                      "min_fe_rest_length_margin_m": float(np.min(np.array(L) - R))}
         return {"w": np.array(w), "tendon_force": T, "actuation": self.actuation, **extra,
                 "model": dyn.name, "free_dofs": int(dyn.x0.size),
-                "max_tendon_stress_Pa": float(np.max(T / dyn.mtc.tendon_area)),
+                "max_tendon_stress_Pa": float(np.max(T / dyn.model.tendon_area)),
                 "min_tendon_force_N": float(np.min(T)),
                 "tendon_slack_samples": int(np.sum(slack > 0)),
                 "tendon_slack_elements_max": int(np.max(slack)),
@@ -348,13 +348,13 @@ def com_positions(com, mtc, z) -> np.ndarray:
 
 def fe_state_of(com, dyn, z, zd=None, *, step: float = 1e-6) -> tuple[np.ndarray, np.ndarray]:
     """Free-DOF state and velocity of the FE plant ``dyn`` in the configuration of the COM
-    state (z, z'): :func:`com_positions` on the numbering of ``dyn.mtc``, then
+    state (z, z'): :func:`com_positions` on the placement numbering of ``dyn.model``, then
     ``dyn.state_of`` (the SBC model's bars straight, its rotations those of ``dyn``'s
     reference state); velocities by a central difference of that placement along z'
     (``step`` in the coordinates).
     """
     def place(zz):
-        return dyn.state_of(com_positions(com, dyn.mtc, zz))
+        return dyn.state_of(com_positions(com, dyn.model, zz))
 
     z = np.asarray(z, dtype=float)
     x = place(z)
@@ -397,7 +397,7 @@ DEPLOYMENT_DAMPING_TANGENT = "current"
 def deployment_damping_tangent(damping_tangent, beta: float):
     """The damping tangent of a deployment plant: the given one, else
     :data:`DEPLOYMENT_DAMPING_TANGENT` where there is stiffness-proportional damping (beta >
-    0; none without it, :func:`tmfem.models.fe_plant.check_damping_tangent`)."""
+    0; none without it, :func:`tmfem.models.fe.plant.check_damping_tangent`)."""
     if damping_tangent is None and beta:
         return DEPLOYMENT_DAMPING_TANGENT
     return damping_tangent
@@ -416,7 +416,7 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     = 0) the FE statics are solved under :func:`start_rest_lengths` -- the bars take their
     axial strain, the membrane and tendons their FE shapes -- so that the run starts without
     the transient of an FE state out of equilibrium. ``beta``: stiffness-proportional
-    Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe_plant.FEPlant`);
+    Rayleigh damping C = beta K_0 of the plant (:class:`tmfem.models.fe.plant.FEPlant`);
     ``damping_tangent``: K_0 (``"initial"``) or the tangent at every sample (``"current"``,
     C_n = beta K_T(x_n)), default :data:`DEPLOYMENT_DAMPING_TANGENT`, only with beta > 0;
     ``actuation``: rest-length or tension-servoed tendons (:class:`FEStatePlant`)."""
@@ -424,10 +424,10 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     from tmfem.models.mtc.model import MTCModel
     fe = MTCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                   rest_lengths=com.u0, tendon_law=tendon_law)
-    dyn = MTCDynamics(fe, fe.solve_static().x, output_points=com.output_points, beta=beta,
+    dyn = MTCDynamics(fe, fe.equilibrium().x, output_points=com.output_points, beta=beta,
                       damping_tangent=deployment_damping_tangent(damping_tangent, beta))
     fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
-    st = fe.solve_static(x0=com_positions(com, fe, packaged_state(com, initial)))
+    st = fe.equilibrium(x0=com_positions(com, fe, packaged_state(com, initial)))
     fe.set_tendon_lengths(com.u0)
     return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free], actuation=actuation)
 
@@ -461,10 +461,10 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     from tmfem.models.sbc.model import SBCModel
     sbc = SBCModel(com.system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                    bar_elements=bar_elements, rest_lengths=com.u0)
-    mtc = sbc.mtc
     sbc.set_tendon_lengths(start_rest_lengths(initial, "cable", com.u0))
-    pre = mtc.solve_static(x0=com_positions(com, mtc, packaged_state(com, initial)))
-    st = sbc.solve_static(start=sbc.state_from_mtc(pre.x))
+    mtc = sbc.predictor()
+    pre = mtc.equilibrium(x0=com_positions(com, mtc, packaged_state(com, initial)))
+    st = sbc.equilibrium(start=sbc.state_from_mtc(pre.x))
     sbc.set_tendon_lengths(com.u0)
     dyn = SBCDynamics(sbc, st.state, output_points=com.output_points, beta=beta,
                       damping_tangent=deployment_damping_tangent(damping_tangent, beta))

@@ -56,14 +56,14 @@ def fe_element_lengths(dyn, x) -> np.ndarray:
     """Lengths [m] of the FE tendon elements (``topology.tendon_conn`` order, k per tendon,
     ``topology.tendon_of_element``) at the free-dof state x of the FE plant ``dyn``."""
     xf = dyn.positions(x)
-    a, b = dyn.mtc.topology.tendon_conn
+    a, b = dyn.model.topology.tendon_conn
     return np.linalg.norm(xf[:, b] - xf[:, a], axis=0)
 
 
 def fe_tendon_lengths(dyn, x) -> np.ndarray:
     """Length [m] of every FE tendon (the sum of its elements' lengths, through its internal
     nodes) at the free-dof state x of the FE plant ``dyn``, in ``system.tendons`` order."""
-    topo = dyn.mtc.topology
+    topo = dyn.model.topology
     return np.bincount(topo.tendon_of_element, weights=fe_element_lengths(dyn, x),
                        minlength=len(dyn.model.system.tendons))
 

@@ -146,7 +146,7 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
     ref = DeploymentReference(initial=initial.symmetric, final=final.symmetric, N=final.N,
                               q_names=list(final.q_names), omega_r=omega_r, bases=bases)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
-    z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)]))
+    z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)])).state
     info = {"omega_r": omega_r, "xi_r": 1.0, "theta_0_deg": float(np.degrees(theta_0)),
             "theta_e_deg": float(np.degrees(theta_e)), "psi_0_deg": float(np.degrees(psi_0)), "K": model.K,
             "lpv_grid": list(plant.grid_shape)}

@@ -83,7 +83,7 @@ def linearize(model, *, z_e=None, u_e=None, find_equilibrium: bool = True) -> Li
     if u_e.shape != (model.n_t,):
         raise InputError(f"rest lengths: expected {model.n_t} values, found shape {u_e.shape}")
     if z_e is None:
-        z_e = model.equilibrium(u_e) if find_equilibrium else model.z0
+        z_e = model.equilibrium(u_e).state if find_equilibrium else model.z0
     z_e = np.asarray(z_e, dtype=float)
     n = model.nz
     zero = np.zeros(n)

@@ -26,6 +26,8 @@ affinely (B(x) u, eq. 5.19) -- see docs/guides/com.md.
 """
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
@@ -33,7 +35,8 @@ from tmfem.models.com.constraints import ConstraintSolver, ZetaLayout
 from tmfem.models.com.coordinates import point_coordinates
 from tmfem.models.com.design import StaticDesign, check_membrane_stretched, design_rest_lengths
 from tmfem.models.com.graphs import BufferedFunction, build_graphs, output_graph, static_graph
-from tmfem.models.com.linearize import linearize
+from tmfem.models.base import Equilibrium
+from tmfem.models.com import linearize as linearization
 from tmfem.models.com.membrane_modes import build_membrane_basis
 from tmfem.models.com.plant import COMPlant
 from tmfem.solvers.newton import newton
@@ -84,6 +87,8 @@ class ControlOrientedModel:
         (:func:`tmfem.models.com.membrane_modes.build_membrane_basis`, docs/guides/wrinkling.md).
     """
 
+    name = "com"
+
     def __init__(self, system, *, membrane_modes: int = 4, mesh_n: int = 10,
                  rest_lengths="design", damping: float = 0.0, prestress_scale: float = 1.0,
                  membrane_points=None, formulation: str = "partitioned", output_points=None,
@@ -95,6 +100,7 @@ class ControlOrientedModel:
         if not (np.isfinite(prestress_scale) and prestress_scale > 0):
             raise InputError(f"prestress_scale: expected > 0, found {prestress_scale!r}")
         self.system = system
+        self.mesh_n, self.membrane_law = mesh_n, membrane_law
         self.formulation = formulation
         self.layout = ZetaLayout.for_polygon(system.N)
         self.constraints = ConstraintSolver(system, self.layout)
@@ -162,6 +168,25 @@ class ControlOrientedModel:
         else:
             eta = [f"{c}r_{i + 1}" for i, (c, _, _) in enumerate(self.membrane_points)]
         return list(self.system.q_names) + eta
+
+    @property
+    def perturbation_names(self) -> list[str]:
+        """The initial perturbations a plant accepts: every state by name."""
+        return self.state_names
+
+    @property
+    def ndof(self) -> int:
+        """Number of coordinates z (n_q + K)."""
+        return self.nz
+
+    @property
+    def max_modes(self) -> int:
+        """The most modes :meth:`modes` can compute: one per coordinate."""
+        return self.nz
+
+    def describe(self) -> dict:
+        """Size of the model, for reports."""
+        return {"membrane_modes": self.K}
 
     @property
     def state_names(self) -> list[str]:
@@ -258,31 +283,74 @@ class ControlOrientedModel:
         u = self.u0 if u is None else u
         return self.residual(z, np.zeros(self.nz), np.zeros(self.nz), 0.0, u)
 
-    def equilibrium(self, u=None, z0=None, *, tol: float = 1e-11, max_iter: int = 50) -> np.ndarray:
-        """Static equilibrium z for rest lengths u by Newton on F_hat(z, 0) + B_hat u = 0
-        (with line search), converged when |F_hat + B_hat u| <= tol |B_hat u| (the tendon
-        forces' generalised load at the start)."""
+    def equilibrium(self, u=None, z0=None, *, tol: float = 1e-11, max_iter: int = 50,
+                    monitor=(), progress=None) -> Equilibrium:
+        """Static equilibrium z for rest lengths u (default ``u0``) by Newton on
+        F_hat(z, 0) + B_hat u = 0 (with line search) from ``z0`` (default the design ``z0``),
+        converged when |F_hat + B_hat u| <= tol |B_hat u| (the tendon forces' generalised load
+        at the start). The result's ``state`` is z and its ``tangent`` dr/dz there;
+        ``monitor``: node labels whose positions X(q) (eqs. 3.1-3.2) are recorded at every
+        iterate; ``progress(iteration, rnorm)`` after every iterate."""
+        t0 = time.perf_counter()
         u = self.u0 if u is None else np.asarray(u, dtype=float)
         z = self.z0 if z0 is None else np.array(z0, dtype=float)
         zero = np.zeros(self.nz)
+        idx = {lab: self.system.node_index(lab) for lab in monitor}
+        hist = {lab: [] for lab in idx}
 
         def residual(zz):
             return self.static_residual(zz, u), self.jacobians(zz, zero, zero, 0.0, u)[0]
+
+        def record(it, zz, rn):
+            X = self.system.nodes((self.P @ zz)[: self.nq]) if idx else None
+            for lab, i in idx.items():
+                hist[lab].append(X[:, i].copy())
+            if callable(progress):
+                progress(it, rn)
         scale = float(np.linalg.norm(self.input_matrix(z) @ u))
         try:
-            return newton(residual, z, tol=tol, scale=scale, max_iter=max_iter).u
+            res = newton(residual, z, tol=tol, scale=scale, max_iter=max_iter, callback=record)
         except ConvergenceError as exc:
             raise ConvergenceError(f"COM static equilibrium: {exc}") from None
+        return Equilibrium(state=res.u, u=np.array(u, dtype=float), tangent=res.K,
+                           outputs=dict(zip(self.output_names, self.outputs(res.u).tolist())),
+                           iterations=res.iterations, residual_history=list(res.residual_history),
+                           monitor={k: np.array(v) for k, v in hist.items()},
+                           time=time.perf_counter() - t0)
 
-    def modes(self, *, k: int = 12, u=None):
-        """The ``k`` lowest undamped modes about the equilibrium for rest lengths u (default
-        ``u0``) of the linearisation (eq. 5.33), :meth:`Linearization.modes`."""
-        return linearize(self, u_e=u).modes(k)
+    def _at(self, at):
+        """(z, u) of ``at``: an :class:`Equilibrium`, coordinates z (at ``u0``) or None (the
+        equilibrium for ``u0``)."""
+        if at is None:
+            at = self.equilibrium()
+        if isinstance(at, Equilibrium):
+            return np.asarray(at.state, dtype=float), at.u
+        return np.asarray(at, dtype=float), self.u0
 
-    def plant(self, *, perturb: dict | None = None) -> COMPlant:
-        """Eq. 5.27 with its inputs as a simulation plant, started at the equilibrium for
-        ``u0`` plus ``perturb`` (by state name, :class:`tmfem.models.com.plant.COMPlant`)."""
-        return COMPlant(self, perturb=perturb)
+    def linearization(self, *, at=None) -> linearization.Linearization:
+        """The second-order and state-space matrices about the equilibrium ``at`` (an
+        :class:`Equilibrium`, coordinates z, or None: the equilibrium for ``u0``), eq. 5.33
+        (:func:`tmfem.models.com.linearize.linearize`)."""
+        z, u = self._at(at)
+        return linearization.linearize(self, z_e=z, u_e=u)
+
+    def linearize(self, *, at=None, name: str = "com"):
+        """The linearisation about ``at`` (eq. 5.33) as a python-control ``StateSpace``:
+        states ``state_names``, inputs ``r_<tendon>``, outputs [q, w_k]
+        (:meth:`linearization`)."""
+        return self.linearization(at=at).to_ss(name=name)
+
+    def modes(self, *, k: int = 12, at=None):
+        """The ``k`` lowest undamped modes about the equilibrium ``at`` (default: for ``u0``)
+        of the linearisation (eq. 5.33), :meth:`Linearization.modes`."""
+        return self.linearization(at=at).modes(k)
+
+    def plant(self, *, at=None, perturb: dict | None = None) -> COMPlant:
+        """Eq. 5.27 with its inputs as a simulation plant, started at the equilibrium ``at``
+        (default: for ``u0``) plus ``perturb`` (by state name,
+        :class:`tmfem.models.com.plant.COMPlant`)."""
+        z, _ = self._at(at)
+        return COMPlant(self, perturb=perturb, z_e=z)
 
     # ------------------------------------------------------------------ outputs
     def fast_outputs(self, z, with_lengths: bool = False):

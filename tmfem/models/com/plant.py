@@ -12,10 +12,10 @@ class COMPlant:
     y = [q, w at the output points], started at the equilibrium for ``u0`` plus a
     perturbation by state name (``theta_11_dot=0.01``, 6.5)."""
 
-    def __init__(self, model, *, perturb: dict | None = None):
+    def __init__(self, model, *, perturb: dict | None = None, z_e=None):
         self.model = model
         dz, dzd = split_perturbation(perturb, model.z_names)
-        self.x_e = model.equilibrium()
+        self.x_e = model.equilibrium().state if z_e is None else np.asarray(z_e, dtype=float)
         self.x0 = self.x_e + dz
         self.v0 = dzd
         self.u0 = np.asarray(model.u0, dtype=float)

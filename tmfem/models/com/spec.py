@@ -2,32 +2,36 @@
 from __future__ import annotations
 
 from tmfem.fem.tension_field import MEMBRANE_LAWS
-from tmfem.models.base import ModelSpec, Option, register
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+from tmfem.models.fe.options import MESH
+from tmfem.models.spec import ModelSpec, Option
 
 
 def build(system, options: dict, backend) -> ControlOrientedModel:
     """The control-oriented model of ``system`` with the registry's option values (its
-    solves are small and dense: the backend does not apply)."""
+    solves are small and dense: the backend does not apply); rest lengths the system's when it
+    has them, else the design (as the finite-element models)."""
     K = options["membrane_modes"]
     return ControlOrientedModel(system, membrane_modes=default_membrane_modes(system) if K is None else K,
+                                rest_lengths="design" if system.rest_lengths is None else "system",
                                 mesh_n=options["mesh"], damping=options.get("damping", 0.0),
                                 prestress_scale=options["prestress_scale"],
                                 membrane_law=options["membrane_law"])
 
 
-SPEC = register(ModelSpec(
+SPEC = ModelSpec(
     name="com", help="control-oriented model (ch. 5): rigid bars, linear tendons, membrane modes",
-    commands=("modal", "vibrate"), build=build, shared=("mesh",), uses_backend=False,
-    own=(
-        Option("--membrane-modes", None, None, dict(type=int, metavar="K", help=(
+    build=build, uses_backend=False, post="tmfem.post.com",
+    options=(
+        MESH,
+        Option("membrane_modes", int, None, metavar="K", doc=(
             "membrane modes K (default: the system's [models.com], the dissertation's for its "
-            "presets: 5 for 1-4, 4 for 2-3)"))),
-        Option("--prestress-scale", 1.0, None, dict(type=float, help=(
+            "presets: 5 for 1-4, 4 for 2-3)")),
+        Option("prestress_scale", float, 1.0, doc=(
             "factor on the designed membrane prestress (1 = designed; 1.2903 gives the printed "
-            "1-4 tendon stress and Table 6.6, docs/validation/errata.md)"))),
-        Option("--membrane-law", "svk", None, dict(choices=MEMBRANE_LAWS, help=(
+            "1-4 tendon stress and Table 6.6, docs/validation/errata.md)")),
+        Option("membrane_law", str, "svk", choices=MEMBRANE_LAWS, doc=(
             "membrane basis about the linear (svk) or the tension-field prestress "
-            "(docs/guides/wrinkling.md)"))),
-        Option("--damping", 0.0, ("vibrate",), dict(type=float, help="modal damping c_m [1/s] (eq. 5.13)")),
-    )))
+            "(docs/guides/wrinkling.md)")),
+        Option("damping", float, 0.0, stage="dynamics", doc="modal damping c_m [1/s] (eq. 5.13)"),
+    ))

@@ -1,63 +1,18 @@
-"""Rest-length rules of the MTC model built on the ch. 3 design.
-
-``"design"`` (the model's own mesh, in :class:`tmfem.models.mtc.model.MTCModel`),
-``"design@n"`` (:func:`design_rest_lengths_at`: the design on one fixed mesh, the same for
-every analysis mesh) and ``"mtc"`` (:func:`consistent_rest_lengths`: an independent
-formulation of the ch. 3 design (3.2) on the model's own nonlinear membrane; the tests
-compare it with the linear design).
+"""The rest-length rule ``"mtc"`` of the finite-element models (:func:`consistent_rest_lengths`:
+an independent formulation of the ch. 3 design (3.2) on the MTC model's own nonlinear
+membrane; the tests compare it with the linear design). The other rules are in
+:mod:`tmfem.models.fe.rest_lengths`.
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
 
-from tmfem.errors import InputError, SlackMembrane, SlackTendon
+from tmfem.errors import SlackMembrane, SlackTendon
 from tmfem.fem.attachment import coupling_matrix
 from tmfem.fem.truss import green_rest_length, linear_rest_length
 from tmfem.solvers.newton import newton
 from tmfem.system.topology import label
-
-
-#: Prefix of the rule ``"design@n"``.
-DESIGN_AT = "design@"
-
-
-def design_mesh_of(rule) -> int | None:
-    """n of a rest-length rule ``"design@n"`` (n >= 1), else None."""
-    if not (isinstance(rule, str) and rule.startswith(DESIGN_AT)):
-        return None
-    n = rule[len(DESIGN_AT):]
-    if not (n.isdigit() and int(n) >= 1):
-        raise InputError(f"rest lengths {rule!r}: expected design@n with an integer n >= 1 "
-                         f"(e.g. design@10), found {rule!r}")
-    return int(n)
-
-
-def design_rest_lengths_at(system, n: int) -> np.ndarray:
-    """Rest lengths (eqs. 3.8-3.9) of the ch. 3 design of ``system`` on the N x n x n membrane
-    mesh with point corners (:func:`tmfem.equilibrium.design.design_equilibrium`; 6.2 uses
-    n = 10). Unlike the rule ``"design"``, which designs on the analysis model's own mesh,
-    these do not depend on the mesh of the model they are given to: one physical structure
-    analysed on several meshes (``tmfem converge``)."""
-    from tmfem.equilibrium.design import design_equilibrium
-    return np.asarray(design_equilibrium(system, mesh_n=int(n)).rest_lengths, dtype=float)
-
-
-def describe_rule(rule: str, *, per_mesh_study: bool = False) -> str:
-    """One line saying what the rest-length rule ``rule`` (``MTCModel.rest_lengths_source``)
-    means, printed beside the results (``per_mesh_study``: in a study over several meshes)."""
-    n = design_mesh_of(rule)
-    if n is not None:
-        return (f"the ch. 3 design (eq. 3.8) on the {n} x {n} mesh per patch with point corners, "
-                "the same on every analysis mesh")
-    return {"design": "the ch. 3 design (eq. 3.8) on "
-                      + ("each analysis mesh, recomputed" if per_mesh_study else
-                         "this model's mesh and attachment (use design@10 for the 6.2 design "
-                         "on any mesh)"),
-            "mtc": "the design made an exact equilibrium of " + ("each mesh" if per_mesh_study
-                                                                 else "this model"),
-            "system": "the system's rest lengths", "given": "given values",
-            }.get(rule, rule)
 
 
 def consistent_rest_lengths(model, *, tol: float = 1e-10) -> dict:

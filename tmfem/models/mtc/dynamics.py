@@ -30,7 +30,7 @@ at zero. Giving the corner alone a velocity would instead excite the mesh-scale 
 ends (``MONITOR_NODES``: B_12, B_14 for 1-4; A_21, B_11, B_21 for 2-3; Figs. 6.21-6.22,
 6.25-6.27), the membrane transverse deflections w_1..w_3 at the material points of eqs.
 5.36 / 5.38 (the ``MONITOR_POINTS`` of the COM, reference coordinates in O_f) measured along z_f
-of the floating frame of the current corners (eq. 3.3, :func:`tmfem.models.mtc.topology.to_floating`),
+of the floating frame of the current corners (eq. 3.3, :func:`tmfem.models.fe.topology.to_floating`),
 and the largest tendon transverse deflection: the internal nodes' offset from the chord in the
 local frame e_t1 (chord), e_t2 = e_t1 x e_z / |.|, e_t3 = e_t1 x e_t2 (eq. 5.37; Figs. 6.24,
 6.29), relative to its value at the equilibrium.
@@ -40,30 +40,30 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.models.fe_plant import FEPlant
+from tmfem.models.fe.plant import FEPlant
 
 
 class MTCDynamics(FEPlant):
     """The MTC equation of motion on the free DOFs as a :class:`tmfem.models.base.Plant`
-    (:class:`tmfem.models.fe_plant.FEPlant`: inputs, outputs, initial state).
+    (:class:`tmfem.models.fe.plant.FEPlant`: inputs, outputs, initial state).
 
     Inputs u: the tendon rest lengths ``r_<tendon>`` (each tendon's k elements get u / k);
     outputs y: the bar coordinates q recovered from the bar nodes (eqs. 3.1-3.2) and the
     transverse deflections w_k in the floating frame at ``output_points`` (eqs. 5.36-5.38),
     as a sensor would measure them. The state is the free independent node positions; the
     start state ``x0, v0`` is the equilibrium with the perturbation of
-    :func:`tmfem.models.fe_plant.initial_state`.
+    :func:`tmfem.models.fe.plant.initial_state`.
 
     Parameters
     ----------
     model : MTCModel
     x_eq : ndarray (3, n_nodes)
-        The static equilibrium (``model.solve_static().x``); the fixed DOFs stay there.
+        The static equilibrium (``model.equilibrium().x``); the fixed DOFs stay there.
     alpha, beta : float
         Rayleigh damping C = alpha M + beta K_0 [1/s, s] (default: undamped).
     damping_tangent : {"initial", "current"}, optional
         The tangent of beta K: K_0 at x_eq (default) or K_T at every sampled state
-        (:meth:`tmfem.models.fe_plant.FEPlant.sample`); only with beta > 0.
+        (:meth:`tmfem.models.fe.plant.FEPlant.sample`); only with beta > 0.
     perturb : dict, optional
         Initial perturbation by coordinate name (``theta_12_dot=0.01``).
     output_points : array (2, n) or list of (x_f, y_f), optional
@@ -75,7 +75,7 @@ class MTCDynamics(FEPlant):
     def __init__(self, model, x_eq, *, alpha: float = 0.0, beta: float = 0.0,
                  perturb: dict | None = None, output_points=None,
                  damping_tangent: str | None = None):
-        self.model = self.mtc = model
+        self.model = model
         self.dofmap, self.constraints = model.topology.dofmap, model.topology.constraints
         self.free = model.free
         self.xr_eq = model.reduce(np.asarray(x_eq, dtype=float))

@@ -1,7 +1,7 @@
 """Free vibration of the shell-beam-cable model about its equilibrium (dissertation 6.5).
 
 The SBC model of :mod:`tmfem.models.sbc.model` as the plant of Park's method (eqs.
-5.34-5.35) through the shared finite-element plant :class:`tmfem.models.fe_plant.FEPlant`:
+5.34-5.35) through the shared finite-element plant :class:`tmfem.models.fe.plant.FEPlant`:
 
     M a + C v + f_int(u; rest) = 0,        C = alpha M + beta K_0,
 
@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.fem.element import assemble, skew
-from tmfem.models.fe_plant import FEPlant
+from tmfem.models.fe.plant import FEPlant
 
 
 def dexp(theta: np.ndarray) -> np.ndarray:
@@ -56,7 +56,7 @@ class SBCDynamics(FEPlant):
     ----------
     model : SBCModel
     state_eq : State
-        The static equilibrium (``model.solve_static().state``).
+        The static equilibrium (``model.equilibrium().state``).
     alpha, beta, perturb, output_points, damping_tangent :
         Rayleigh damping (and its tangent), initial perturbation and monitored points, as for
         :class:`tmfem.models.mtc.dynamics.MTCDynamics`.
@@ -70,7 +70,7 @@ class SBCDynamics(FEPlant):
     def __init__(self, model, state_eq, *, alpha: float = 0.0, beta: float = 0.0,
                  perturb: dict | None = None, output_points=None,
                  damping_tangent: str | None = None):
-        self.model, self.mtc = model, model.mtc
+        self.model = model
         self.dofmap, self.constraints = model.dofmap, model.constraints
         self.free = model.free
         self.state_eq = state_eq

@@ -1,7 +1,8 @@
 """The shell-beam-cable (SBC) model of a tensegrity-membrane system (dissertation 4.3, 6.2-6.4).
 
-Built from the same :class:`~tmfem.system.System` and the same gmsh membrane mesh as the MTC
-model (:mod:`tmfem.models.mtc`), whose numbering, rest lengths and start placement it reuses:
+Built from the same :class:`~tmfem.system.System` and the same membrane mesh as the MTC model
+(:mod:`tmfem.models.mtc`), on the placement, rest-length rules and start both share
+(:mod:`tmfem.models.fe`), whose numbering it extends by the bars' beam nodes:
 
 * **membrane**: MITC4 shells (:class:`tmfem.fem.mitc4.MITC4Shell`, 4.3.1) of thickness
   ``system.membrane.h`` (51 um for the presets; docs/guides/shells.md, "the thin limit");
@@ -22,7 +23,7 @@ Statics (6.2) start from the undeformed membrane exactly as the MTC model's (fla
 in the plane of the design bar tops; bars at the design; the bar tops moved onto the corners)
 and use the same mass-scaled trust-region Newton iteration
 (:func:`tmfem.solvers.trust_region.trust_region_newton`), by default after the MTC model's
-own solve from that start as a predictor (:meth:`SBCModel.solve_static`), through its ``update=`` path: the
+own solve from that start as a predictor (:meth:`SBCModel.equilibrium`), through its ``update=`` path: the
 unknown is a :class:`~tmfem.fem.element.State` and an increment adds translations and composes
 the nodal rotations by the exponential map, which is the update the shell and beam tangents
 differentiate. Modes about the prestressed state solve (K_T - omega^2 M) phi = 0 (eq. 5.32)
@@ -33,8 +34,6 @@ directors; repeated pairs are M-orthonormalised by the Rayleigh-Ritz step of
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
-
 import numpy as np
 import scipy.sparse as sp
 
@@ -43,10 +42,18 @@ from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, spin_constraint
 from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellSection, nodal_normals
-from tmfem.fem.truss import TrussElement, TrussSet, truss_internal
+from tmfem.fem.truss import truss_internal
+from tmfem.models.base import Equilibrium
+from tmfem.models.fe.model import FEModel
+from tmfem.models.fe.placement import Placement
+from tmfem.models.fe.tendons import Tendons
+from tmfem.models.fe.topology import build_topology
+from tmfem.models.fe.options import sequence_of
 from tmfem.models.mtc.model import MTCModel
-from tmfem.models.mtc.spec import sequence_of
+from tmfem.models.sbc.dynamics import SBCDynamics
 from tmfem.models.sbc.topology import SBCNumbering, number_sbc
+from tmfem.fem.tension_field import check_law_name
+from tmfem.solvers.backends import get_backend
 from tmfem.solvers.eigen import lowest_modes
 from tmfem.solvers.trust_region import trust_region_newton
 from tmfem.system.topology import label
@@ -56,28 +63,7 @@ from tmfem.system.topology import label
 BAR_NU = 0.3
 
 
-@dataclass
-class SBCStaticResult:
-    """Equilibrium of an SBC model: the nodal ``state`` (positions ``x`` and rotations), the
-    SBC iterations, residual norms [N] (start first; the predictor's first when there is
-    one), monitored node positions, trust-region mu, the predictor's iterations and the
-    reduced tangent at the equilibrium (:meth:`SBCModel.modes` reuses it)."""
-
-    state: State
-    iterations: int
-    residual_history: list
-    monitor: dict
-    mu_history: list
-    time: float
-    predictor_iterations: int = 0
-    tangent: object = None
-
-    @property
-    def x(self) -> np.ndarray:
-        return self.state.x
-
-
-class SBCModel:
+class SBCModel(FEModel, Tendons, Placement):
     """Shell-beam-cable model of an M-N ``System`` (module docstring).
 
     Parameters
@@ -99,19 +85,22 @@ class SBCModel:
     backend : str or Backend
     membrane_law : {"svk", "tension-field"}
         In-plane law of the shells' lamina (:class:`tmfem.fem.mitc4.MITC4Shell`; the MTC
-        model built alongside takes the same).
+        predictor takes the same).
     """
+
+    name = "sbc"
+    plant_type = SBCDynamics
 
     def __init__(self, system, *, mesh_n: int = 10, tendon_elements: int = 3, bar_elements: int = 1,
                  attachment: str = "point", patch: float | None = None, rest_lengths=None,
                  backend="scipy", membrane_law: str = "svk"):
         self.system = system
-        self.mtc = MTCModel(system, mesh_n=mesh_n, tendon_elements=tendon_elements,
-                            attachment=attachment, patch=patch, rest_lengths=rest_lengths,
-                            backend=backend, rigid_bar_points=system.deployable,
-                            membrane_law=membrane_law)
-        self.backend = self.mtc.backend
-        mt = self.mtc.topology
+        self.membrane_law = check_law_name(membrane_law)
+        self.backend = get_backend(backend)
+        self.mesh_n, self.patch, self.lumped_tendon_mass = mesh_n, patch, False
+        mt = self.topology = build_topology(system, mesh_n=mesh_n, tendon_elements=tendon_elements,
+                                            attachment=attachment, patch=patch,
+                                            rigid_bar_points=system.deployable)
         points = None
         if system.deployable:
             points = np.array([self.node(label("H", 1, j)) for j in range(1, system.N + 1)])
@@ -120,7 +109,7 @@ class SBCModel:
         num = self.numbering
         dm = self.dofmap = num.dofmap
         # reference configuration: the undeformed membrane placed as in 6.2, bars at the design
-        x_start = self.mtc.initial_positions("undeformed")
+        x_start = self.initial_positions("undeformed")
         X = np.zeros((3, dm.n_nodes))
         X[:, :num.n_mtc_nodes] = x_start
         X[:, mt.system_node] = system.nodes()
@@ -129,12 +118,12 @@ class SBCModel:
         mem = system.membrane
         self.shell = MITC4Shell(X=X, conn=mt.mesh.t, dofmap=dm,
                                 section=ShellSection(E=mem.E, nu=mem.nu, thickness=mem.h, rho=mem.rho),
-                                law=self.mtc.membrane_law)
+                                law=self.membrane_law)
         bar = system.bar
         self.beam = BeamElement(BeamSet(conn=num.beam_conn, section=BeamSection.circle(d=bar.d),
                                         E=bar.E, nu=BAR_NU, rho=bar.rho), dm, X=X)
-        self.tendon_element = None
-        self._set_tendons()
+        self._M = self._dist = None
+        self._init_tendons(rest_lengths, "cable")
         spins = [spin_constraint(self.beam, nodes=chain) for chain in num.bar_chain]
         self.constraints = ConstraintMap.build(
             dm, dependent=[(mt.top_nodes[j], nodes, w) for j, (nodes, w) in enumerate(mt.weights)],
@@ -156,29 +145,35 @@ class SBCModel:
         a, b = x[:, ch[:, 0]], x[:, ch[:, -1]]
         return a[:, :, None] + (b - a)[:, :, None] * s[None, None, :]
 
-    def _set_tendons(self) -> None:
-        t = self.mtc.tendons
-        self.tendons = TrussSet(conn=t.conn, L=t.L.copy(), EA=t.EA, rhoA=t.rhoA,
-                                tension_only=t.tension_only)
-        self.tendon_element = TrussElement(self.tendons, self.dofmap)
-        self._M = None
-        self._dist = None
+    def consistent_rest_lengths(self, *, tol: float = 1e-10) -> dict:
+        """The rule ``"mtc"``: the rest lengths for which the design configuration is an
+        equilibrium of the MTC model of this mesh and attachment
+        (:func:`tmfem.models.mtc.design.consistent_rest_lengths`)."""
+        mtc = MTCModel(self.system, mesh_n=self.mesh_n, tendon_elements=self.topology.tendon_elements,
+                       attachment=self.topology.attachment, patch=self.patch,
+                       rest_lengths=np.ones(len(self.system.tendons)), backend=self.backend,
+                       membrane_law=self.membrane_law)
+        return mtc.consistent_rest_lengths(tol=tol)
 
-    def set_rest_lengths(self, rest) -> None:
-        """Tendon rest lengths, as :meth:`MTCModel.set_rest_lengths`."""
-        self.mtc.set_rest_lengths(rest)
-        self._set_tendons()
+    def predictor(self) -> MTCModel:
+        """The MTC model of this mesh, attachment and current rest lengths (1-N(D) systems
+        with rigid bar points, :func:`tmfem.models.fe.topology.build_topology`): the
+        predictor of :meth:`equilibrium`."""
+        return MTCModel(self.system, mesh_n=self.mesh_n, tendon_elements=self.topology.tendon_elements,
+                        attachment=self.topology.attachment, patch=self.patch,
+                        rest_lengths=self.rest_lengths.copy(), backend=self.backend,
+                        rigid_bar_points=self.system.deployable, membrane_law=self.membrane_law)
 
-    def set_tendon_lengths(self, u) -> None:
-        """Tendon rest lengths as time-varying inputs (a plant's u), in place
-        (:meth:`MTCModel.set_tendon_lengths`)."""
-        self.mtc.set_tendon_lengths(u)
-        if not np.array_equal(self.tendons.L, self.mtc.tendons.L):
-            self.tendons.L = self.mtc.tendons.L.copy()
+    def positions_of(self, state: State) -> np.ndarray:
+        """Node positions (3, n) of ``state`` in the placement numbering (membrane, system
+        nodes, tendon internal nodes; without the bar interiors)."""
+        return state.x[:, :self.numbering.n_mtc_nodes]
 
-    @property
-    def rest_lengths(self) -> np.ndarray:
-        return self.mtc.rest_lengths
+    def membrane_area(self) -> float:
+        """Reference area of the membrane [m^2] (the membrane elements' quadrature on the
+        same mesh)."""
+        from tmfem.fem.membrane import MembraneTL
+        return MembraneTL(mesh=self.topology.mesh, material=self.system.membrane).area()
 
     @property
     def elements(self) -> list:
@@ -192,7 +187,7 @@ class SBCModel:
 
     def node(self, lab: str) -> int:
         """Global node of a system label (``"B_14"``)."""
-        return int(self.mtc.topology.system_node[self.system.node_index(lab)])
+        return int(self.topology.system_node[self.system.node_index(lab)])
 
     # ------------------------------------------------------------------ operators
     def start_state(self) -> State:
@@ -249,7 +244,7 @@ class SBCModel:
         (mean over each bar's Gauss points; compression negative). A bar carrying H_1j
         (1-N(D)) reports the larger compression of its two segments A-H and H-B, as
         :func:`tmfem.equilibrium.design.bar_axial_loads` does."""
-        k = self.mtc.topology.tendon_elements
+        k = self.topology.tendon_elements
         N = truss_internal(state.x, self.tendons, tangent=False, dofmap=self.dofmap).N
         segments = 2 if self.system.deployable else 1
         Nb = self.beam.section_forces(state)["N"].reshape(
@@ -272,7 +267,7 @@ class SBCModel:
         x[:, :num.n_mtc_nodes] = x_mtc
         x[:, num.bar_chain] = self.along_bars(x)
         R = np.broadcast_to(np.eye(3), (self.dofmap.n_nodes, 3, 3)).copy()
-        mesh = self.mtc.topology.mesh
+        mesh = self.topology.mesh
         nodes = np.arange(mesh.p.shape[1])
         R[nodes] = smallest_rotation(self.shell.frames[nodes, :, 2].T,
                                      nodal_normals(x[:, nodes], mesh.t))
@@ -281,9 +276,10 @@ class SBCModel:
         R[ch] = turn[:, None]
         return State(x=x, R=R, frames=self.shell.frames)
 
-    def solve_static(self, *, start: State | None = None, predictor: str | None = None,
-                     tol: float = 1e-9, max_iter: int = 200, monitor=(), progress=None) -> SBCStaticResult:
-        """Equilibrium reached from the undeformed membrane (6.2) or from ``start``.
+    def equilibrium(self, u=None, *, start: State | None = None, predictor: str | None = None,
+                    tol: float = 1e-9, max_iter: int = 200, monitor=(), progress=None) -> Equilibrium:
+        """Equilibrium reached from the undeformed membrane (6.2) or from ``start``, for the
+        tendon rest lengths u (default the current ones, ``u0`` unless changed).
 
         ``predictor="mtc"`` (the default without ``start``): the MTC model of the same mesh and rest lengths is
         solved first from the same undeformed start (with its mesh sequencing above 20 x 20;
@@ -295,6 +291,8 @@ class SBCModel:
         step (:func:`trust_region_newton`). ``monitor``: node labels recorded every iteration
         (predictor iterations first); ``progress(iteration, rnorm, mu, rho)``.
         """
+        if u is not None:
+            self.set_tendon_lengths(u)
         if predictor not in (None, "mtc", "none"):
             raise InputError(f"predictor: expected 'mtc' or 'none', found {predictor!r}")
         if start is not None and predictor == "mtc":
@@ -306,8 +304,8 @@ class SBCModel:
         if start is not None:
             s0 = start
         elif predictor == "mtc":
-            pre = self.mtc.solve_static(tol=tol, max_iter=max_iter, monitor=monitor, progress=progress,
-                                        sequence=sequence_of(self.mtc.topology.mesh.n, None))
+            pre = self.predictor().equilibrium(tol=tol, max_iter=max_iter, monitor=monitor, progress=progress,
+                                       sequence=sequence_of(self.topology.mesh.n, None))
             s0 = self.state_from_mtc(pre.x)
         else:
             s0 = self.start_state()
@@ -333,26 +331,30 @@ class SBCModel:
             residual, energy, s0, free=unknowns, scale=np.maximum(Md, 1e-9 * Md.max()),
             force_scale=self._force_scale, tol=tol, max_iter=max_iter, backend=self.backend,
             callback=record, newton_first=start is not None or pre is not None, update=advance,
-            describe=lambda s: self.mtc.state_note(self.mtc.reduce(s.x[:, :self.numbering.n_mtc_nodes])),
+            describe=lambda s: self.state_note(s.x),
             what="SBC static solve")
         mon = {k: np.array(v) for k, v in hist.items()}
         rh = res.residual_history
         if pre is not None:
             mon = {k: np.concatenate([pre.monitor[k], v[1:]]) for k, v in mon.items()}
             rh = pre.residual_history + rh[1:]
-        return SBCStaticResult(state=res.u, iterations=res.iterations, residual_history=rh,
-                               monitor=mon, mu_history=res.mu_history,
-                               time=time.perf_counter() - t0,
-                               predictor_iterations=0 if pre is None else pre.iterations,
-                               tangent=res.tangent)
+        return Equilibrium(state=res.u, u=self.rest_lengths.copy(),
+                           outputs=self.named_outputs(res.u), iterations=res.iterations,
+                           residual_history=rh, monitor=mon, mu_history=res.mu_history,
+                           time=time.perf_counter() - t0,
+                           predictor_iterations=0 if pre is None else pre.iterations,
+                           level_iterations=[] if pre is None else [pre.iterations, res.iterations],
+                           tangent=res.tangent)
 
     # ------------------------------------------------------------------ modes
-    def modes(self, state: State, *, k: int = 12, sigma: float = -1.0, tangent=None):
-        """Lowest ``k`` modes about the prestressed ``state`` (eq. 5.32): symmetric part of
-        the reduced tangent, mass at the current directors. ``tangent``: the reduced tangent
-        at ``state`` when already assembled (``SBCStaticResult.tangent``). Shapes are reduced
-        vectors (:meth:`full_shapes`). With distributed assembly the symmetric part is
-        assembled from the element matrices (``tangent`` is not needed)."""
+    def modes(self, *, k: int = 12, at=None, sigma: float = -1.0):
+        """Lowest ``k`` modes about the prestressed equilibrium ``at`` (eq. 5.32): symmetric
+        part of the reduced tangent, mass at the current directors. ``at``: an
+        :class:`~tmfem.models.base.Equilibrium` of this model (its tangent is reused), a
+        ``State``, or None (:meth:`equilibrium`). Shapes are reduced vectors
+        (:meth:`full_shapes`). With distributed assembly the symmetric part is assembled from
+        the element matrices (the equilibrium's tangent is not needed)."""
+        state, tangent = self._at(at)
         dist = self.distributed
         if dist is None:
             K = self.residual(state)[1] if tangent is None else tangent

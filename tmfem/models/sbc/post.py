@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.models.mtc.post import (bar_loads, check_lines, design_checks, printed_rows,
-                                   q_from_positions)
+from tmfem.models.fe.outputs import q_from_positions
+from tmfem.models.fe.summary import bar_loads, check_lines, design_checks, printed_rows
 from tmfem.system.coordinates import q_index
 from tmfem.system.topology import label
 
@@ -64,7 +64,7 @@ def membrane_peaks(model, state) -> dict:
 
 
 def static_summary(model, result) -> dict:
-    """Summary of an SBC equilibrium ``result`` (:class:`SBCStaticResult`) of ``model``:
+    """Summary of an SBC equilibrium ``result`` (:class:`~tmfem.models.base.Equilibrium`) of ``model``:
     iterations (MTC predictor and SBC), residual history, landing against the design (largest
     node distance, theta, psi of the bar chords, the corner offsets Delta), tendon forces and stresses, bar axial forces and loads
     (per stage for M >= 2) and the largest bar bending moment |M| [N m] at the Gauss points,
@@ -72,19 +72,19 @@ def static_summary(model, result) -> dict:
     (:func:`tmfem.models.mtc.post.design_checks`), the printed Table 6.3/6.5 values and, for
     1-N(D) systems, the bars' bending deflection at H_1j."""
     sysm, st = model.system, result.state
-    mt = model.mtc.topology
+    mt = model.topology
     X = sysm.nodes()
     x = st.x[:, mt.system_node]
     f = model.member_forces(st)
     sec = model.beam.section_forces(st)
     c = st.x[:, mt.mesh.corners]
-    stress = f["tendon"] / model.mtc.tendon_area
+    stress = f["tendon"] / model.tendon_area
     slack = f["tendon_element"].reshape(len(sysm.tendons), -1).min(axis=1) <= 0
     peaks = membrane_peaks(model, st)
     out = {"system": sysm.name, "model": "sbc", "dofs": model.ndof, "mesh_n": mt.mesh.n,
            "tendon_elements": mt.tendon_elements, "bar_elements": model.numbering.bar_elements,
            "attachment": mt.attachment, "membrane_law": model.shell.law.name,
-           "rest_lengths_source": model.mtc.rest_lengths_source,
+           "rest_lengths_source": model.rest_lengths_source,
            "rest_lengths": {t.name: float(r) for t, r in zip(sysm.tendons, model.rest_lengths)},
            "iterations": result.iterations, "static_time_s": result.time,
            "residual_history": [float(v) for v in result.residual_history],
@@ -97,7 +97,7 @@ def static_summary(model, result) -> dict:
            **{f"membrane_{k}": v for k, v in peaks.items()},
            "checks": design_checks(sysm, sigma_p1=peaks["max_sigma_p1"],
                                    von_mises=peaks["max_von_mises"], tendon_stress=stress,
-                                   tendon_yield=model.mtc.tendon_yield, tendon_slack=slack,
+                                   tendon_yield=model.tendon_yield, tendon_slack=slack,
                                    bar_force=f["bar"]),
            "printed": dict(sysm.printed),
            "monitor": {k: v.tolist() for k, v in result.monitor.items()}}
@@ -116,7 +116,7 @@ def static_summary(model, result) -> dict:
 
 def bar_angles(system, x: np.ndarray) -> dict:
     """theta_ij, psi_ij [deg] of the bar chords A_ij -> B_ij at labelled positions x (3.2,
-    :func:`tmfem.models.mtc.post.q_from_positions`) and at the design."""
+    :func:`tmfem.models.fe.outputs.q_from_positions`) and at the design."""
     q = q_from_positions(system, x)
     _, ti, pi_ = q_index(system.M, system.N)
     deg = lambda v: np.degrees(v).ravel().tolist()          # noqa: E731

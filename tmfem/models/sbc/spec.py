@@ -1,9 +1,10 @@
-"""The SBC model in the model registry: its command-line options and how they build it."""
+"""The SBC model in the model registry: its options and how they build it."""
 from __future__ import annotations
 
-from tmfem.models.base import ModelSpec, Option, register
-from tmfem.models.mtc.spec import apply_rest_lengths
+from tmfem.models.fe.options import FE_OPTIONS, rayleigh_kwargs
+from tmfem.models.fe.rest_lengths import apply_rest_lengths
 from tmfem.models.sbc.model import SBCModel
+from tmfem.models.spec import ModelSpec, Option
 
 
 def build(system, options: dict, backend) -> SBCModel:
@@ -15,15 +16,16 @@ def build(system, options: dict, backend) -> SBCModel:
                     membrane_law=options["membrane_law"])
 
 
-SPEC = register(ModelSpec(
+SPEC = ModelSpec(
     name="sbc", help="shell-beam-cable finite-element model (4.3): MITC4 shell membrane, 4-node "
                      "beam bars, tension-only truss tendons",
-    commands=("static", "modal", "vibrate"), build=build,
-    shared=("mesh", "tendon_elements", "attachment", "patch", "membrane_law", "rayleigh"),
-    own=(
-        Option("--bar-elements", 1, None, dict(type=int, help="4-node beam elements per bar (6.2: 1); per bar segment A-H, H-B of a 1-N(D) system")),
-        Option("--rest-lengths", None, None, dict(help=(
+    build=build, plant_kwargs=rayleigh_kwargs, capabilities=("finite-element",), dofs_per_node=6,
+    post="tmfem.post.sbc",
+    options=FE_OPTIONS + (
+        Option("bar_elements", int, 1, doc="4-node beam elements per bar (6.2: 1); per bar "
+                                           "segment A-H, H-B of a 1-N(D) system"),
+        Option("rest_lengths", str, None, doc=(
             "tendon rest lengths: 'system', 'design' (eq. 3.8 on this model's mesh), 'design@n' "
             "(eq. 3.8 on the n x n mesh, e.g. design@10), 'mtc' (the MTC model's consistent ones) "
-            "or values per group/tendon, e.g. 'S1=1.5025'"))),
-    )))
+            "or values per group/tendon, e.g. 'S1=1.5025'")),
+    ))

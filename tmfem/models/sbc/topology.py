@@ -1,6 +1,6 @@
 """Node numbering of the shell-beam-cable model (dissertation 4.3, 6.2).
 
-The SBC model numbers its nodes as the MTC model does (:mod:`tmfem.models.mtc.topology`) and
+The SBC model numbers its nodes as the MTC model does (:mod:`tmfem.models.fe.topology`) and
 appends the interior nodes of the bars:
 
 * ``0 .. nm-1``           membrane nodes, 5 dofs each (MITC4 shell: 3 translations, 2

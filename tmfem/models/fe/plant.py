@@ -18,10 +18,10 @@ so through three hooks (:meth:`FEPlant.configuration`, :meth:`FEPlant.positions`
 :attr:`FEPlant.T`); the rest is shared here:
 
 * **outputs** y (eqs. 3.1-3.2, 5.36-5.38): the bar coordinates q recovered from the bar end
-  positions (:func:`tmfem.models.mtc.post.q_from_positions`) and the membrane transverse
+  positions (:func:`tmfem.models.fe.outputs.q_from_positions`) and the membrane transverse
   deflections w_k at the monitored material points (``system.monitor_points``), measured along
   z_f of the floating frame of the current corners (eq. 3.3,
-  :func:`tmfem.models.mtc.topology.to_floating`), both from positions in the MTC numbering
+  :func:`tmfem.models.fe.outputs.to_floating`), both from positions in the MTC numbering
   (which the SBC model extends);
 * **initial state** (:func:`initial_state`): the equilibrium plus the perturbation of the
   control-oriented model, with the labelled nodes moved rigidly with their bars and the other
@@ -36,10 +36,8 @@ import scipy.sparse as sp
 
 from tmfem.equilibrium.general import node_jacobian
 from tmfem.errors import InputError
-from tmfem.fem.membrane import point_matrix
 from tmfem.models.base import split_perturbation
-from tmfem.models.mtc.post import q_from_positions
-from tmfem.models.mtc.topology import to_floating
+from tmfem.models.fe.outputs import MeasuredOutputs, q_from_positions
 
 
 #: where the stiffness-proportional damping beta K takes its tangent (module docstring)
@@ -66,9 +64,9 @@ class FEPlant(ABC):
     """Shared part of the finite-element plants (module docstring); a
     :class:`tmfem.models.base.Plant`.
 
-    Subclasses set ``model`` (with ``residual``, ``backend``, ``rest_lengths``,
-    ``set_tendon_lengths``), ``mtc`` (the MTC model whose numbering, topology and membrane the
-    positions use: the model itself for MTC), ``dofmap`` and ``constraints`` (the model's
+    Subclasses set ``model`` (an FE model, :mod:`tmfem.models.fe.model`: ``residual``,
+    ``backend``, ``rest_lengths``, ``set_tendon_lengths`` and the placement ``topology`` the
+    positions are numbered on), ``dofmap`` and ``constraints`` (the model's
     :class:`tmfem.fem.constraints.ConstraintMap`) and ``free``, then call :meth:`_setup`; they
     implement :meth:`state0`, :meth:`configuration`, :meth:`positions`,
     :meth:`strain_energy`, :meth:`state_of`, :meth:`member_forces` and
@@ -77,7 +75,6 @@ class FEPlant(ABC):
 
     name = None
     model = None
-    mtc = None
     dofmap = None
     constraints = None
     free = None
@@ -95,13 +92,11 @@ class FEPlant(ABC):
         self.alpha, self.beta = float(alpha), float(beta)
         self.C = self.damping_matrix(self.K0) if (alpha or beta) else None
         system = self.model.system
-        pts = system.monitor_points.T if output_points is None else np.reshape(output_points, (-1, 2))
-        self.output_points = [tuple(map(float, p)) for p in pts]
-        self._P = point_matrix(self.mtc.membrane.skmesh, np.asarray(self.output_points).T) \
-            if self.output_points else None
+        self.measured = MeasuredOutputs(system, self.model.topology, output_points)
+        self.output_points = self.measured.points
         self.u0 = np.asarray(self.model.rest_lengths, dtype=float).copy()
         self.input_names = [f"r_{t.name}" for t in system.tendons]
-        self.output_names = list(system.q_names) + [f"w_{i + 1}" for i in range(len(self.output_points))]
+        self.output_names = self.measured.names
         self.x0, self.v0 = initial_state(self, perturb)
 
     # hooks -------------------------------------------------------------------------------
@@ -199,13 +194,7 @@ class FEPlant(ABC):
 
     def outputs_of(self, xf: np.ndarray) -> np.ndarray:
         """:meth:`outputs` of positions xf (3, n) in the MTC numbering."""
-        topo = self.mtc.topology
-        q = q_from_positions(self.model.system, xf[:, topo.system_node])
-        if self._P is None:
-            return q
-        xm = xf[:, :topo.n_mesh]
-        w = to_floating((self._P @ xm.T).T, xm[:, topo.mesh.corners])[2]
-        return np.concatenate([q, w])
+        return self.measured.of(xf)
 
     def kinetic_energy(self, v) -> float:
         """v^T M v / 2 [J] of the free-dof velocities v."""
@@ -236,12 +225,12 @@ def initial_state(dyn: FEPlant, perturb: dict | None):
         return u0, np.zeros_like(u0)
     dq, dqd = split_perturbation(perturb, system.q_names)
     x_eq = dyn.positions(u0)
-    q_e = q_from_positions(system, x_eq[:, dyn.mtc.topology.system_node])
+    q_e = q_from_positions(system, x_eq[:, dyn.model.topology.system_node])
     X_e = system.nodes(q_e)
     dX_pos = system.nodes(q_e + dq) - X_e if np.any(dq) else np.zeros_like(X_e)
     J = node_jacobian(system, q_e) @ dqd                       # dX/dq q' (eqs. 3.1-3.2)
     T = sp.csr_matrix(dyn.constraints.T)
-    rows = dyn.translation_rows(dyn.mtc.topology.system_node)  # (n_labels, 3)
+    rows = dyn.translation_rows(dyn.model.topology.system_node)  # (n_labels, 3)
     n_red = T.shape[1]
     pres = np.zeros(n_red, dtype=bool)
     vp = np.zeros(n_red)

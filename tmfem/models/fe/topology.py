@@ -160,12 +160,6 @@ def build_topology(system, *, mesh_n: int, tendon_elements: int, attachment: str
 
 
 # ---------------------------------------------------------------------------- frames
-def to_floating(x: np.ndarray, corners: np.ndarray) -> np.ndarray:
-    """Coordinates (3, n) of points ``x`` in the floating frame of ``corners`` (eq. 3.3)."""
-    o, R = floating_frame(corners)
-    return R.T @ (x - o[:, None])
-
-
 def membrane_placement(system, mesh: MembraneMesh, corners_3d: np.ndarray, *,
                        stretch_to_corners: bool) -> np.ndarray:
     """Positions (3, nm) of the membrane mesh nodes placed in the plane of ``corners_3d``.
