@@ -20,7 +20,7 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "lowest_modes": "tmfem.solvers.eigen",
     "LoadPath": "tmfem.solvers.newton",
     "NewtonResult": "tmfem.solvers.newton",
-    "arc_length": "tmfem.solvers.newton",
+    "arc_length": "tmfem.solvers.continuation",
     "free_index": "tmfem.solvers.newton",
     "load_stepping": "tmfem.solvers.newton",
     "ParkResult": "tmfem.solvers.park",

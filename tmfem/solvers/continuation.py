@@ -47,7 +47,8 @@ import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.backends import get_backend
-from tmfem.solvers.newton import advance, copy_iterate, factorize, free_index, submatrix
+from tmfem.solvers.newton import (LoadPath, advance, convergence_failure, copy_iterate, factorize,
+                                  free_index, submatrix)
 
 log = logging.getLogger(__name__)
 
@@ -301,3 +302,55 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
     if reason in ("divergence", "budget"):
         log.warning("path following stopped (%s): %s", reason, message)
     return ContinuationResult(u=us, steps=steps, reason=reason, message=message, increment=prev, dl=step_abs)
+
+
+def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: int = 100,
+               lam_max: float | None = None, stop: Callable | None = None, tol: float = 1e-9,
+               max_iter: int = 25, target_iter: int = 5, dl_min: float | None = None,
+               dl_max: float | None = None, backend=None, update: Callable | None = None) -> LoadPath:
+    """Crisfield's cylindrical arc-length method: f_int(u) = lam f_ext with ||Delta u|| = dl.
+
+    Parameters
+    ----------
+    internal : callable
+        ``internal(u) -> (f_int, K)`` internal force and tangent.
+    f_ext : array (n,)
+        Reference external load; the load factor lam scales it (may become negative: the
+        method follows the path through limit points and snap-backs).
+    u0 : array (n,)
+        Equilibrium start at lam = 0 (fixed dofs keep their values).
+    dl : float
+        Arc length (2-norm of the displacement increment on the free dofs).
+    n_steps, lam_max, stop :
+        Stop after ``n_steps`` steps, when lam exceeds ``lam_max``, or when ``stop(u, lam)`` is True.
+    tol : float
+        Converged when ||f_int - lam f_ext|| <= tol ||f_ext|| (free dofs).
+    target_iter, dl_min, dl_max :
+        The arc length adapts as dl *= sqrt(target_iter / iterations) within [dl_min, dl_max];
+        a failed step is retried with half the arc length.
+
+    The predictor follows the previous increment's direction (sign of Delta u_prev . du_t), so
+    the path goes through limit points; of the two roots of the constraint in each corrector
+    iteration the one closer to the previous increment direction is taken. This is
+    :func:`tmfem.solvers.continuation.follow` for a fixed load f_ext (no pivot counts, plain
+    solves), raising when it stops short.
+
+    Returns
+    -------
+    LoadPath with ``lam`` (m,) and ``u`` (m, n), the starting state included.
+    """
+    f_ext = np.asarray(f_ext, dtype=float)
+    if float(np.linalg.norm(f_ext[free_index(free, f_ext.size)])) == 0.0:
+        raise InputError("arc length: expected a non-zero reference load on the free dofs, found 0")
+
+    def system(u, lam):
+        fint, K = internal(u)
+        return np.asarray(fint) - lam * f_ext, K, f_ext
+    res = follow(system, u0, free=free, dl=dl, max_steps=n_steps, lam_max=lam_max, tol=tol, max_iter=max_iter,
+                 target_iter=target_iter, dl_min=dl_min, dl_max=dl_max, growth=np.inf, stability=False,
+                 stop=stop, update=update, backend=backend, equilibrate=False)
+    if res.reason == "divergence":
+        raise convergence_failure(f"arc length: {res.message}", step=len(res.steps), history=res.steps[-1].residuals,
+                    load_factor=res.steps[-1].lam, u=res.u[-1])
+    its = [st.iterations for st in res.steps[1:]]
+    return LoadPath(lam=res.lam, u=np.array(res.u) if update is None else res.u, iterations=its)

@@ -109,7 +109,9 @@ def copy_iterate(u, update):
     return np.array(u, dtype=float, copy=True) if update is None else u
 
 
-def _fail(message, *, step=None, history=(), load_factor=None, u=None):
+def convergence_failure(message, *, step=None, history=(), load_factor=None, u=None) -> ConvergenceError:
+    """A :class:`ConvergenceError` carrying the failed step, its residual history, the load
+    factor reached and the last iterate (for callers that report or continue from them)."""
     err = ConvergenceError(message)
     err.step = step
     err.residual_history = list(history)
@@ -187,7 +189,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
     where = (f" (load step {step}, load factor {load_factor:g})" if load_factor is not None
              else (f" (step {step})" if step is not None else ""))
     if not np.isfinite(rn):
-        raise _fail(f"newton{where}: expected a finite residual at the start, found {rn}",
+        raise convergence_failure(f"newton{where}: expected a finite residual at the start, found {rn}",
                     step=step, history=history, load_factor=load_factor, u=u)
     ref = rn if scale is None else float(scale)
     target = max(tol * ref, atol)
@@ -200,7 +202,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
         try:
             solve = factorize(submatrix(K, idx), be, equilibrate=equilibrate)
         except ConvergenceError as exc:
-            raise _fail(f"newton{where}: iteration {it}: {exc}; residual history "
+            raise convergence_failure(f"newton{where}: iteration {it}: {exc}; residual history "
                         f"{[f'{h:.3e}' for h in history]}", step=step, history=history,
                         load_factor=load_factor, u=u) from None
         du = -solve(r[idx])
@@ -217,7 +219,7 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
                 break
             alpha *= 0.5
         if best is None:
-            raise _fail(f"newton{where}: iteration {it}: expected a finite residual after the update, "
+            raise convergence_failure(f"newton{where}: iteration {it}: expected a finite residual after the update, "
                         f"found {rnt}; residual history {[f'{h:.3e}' for h in history]}",
                         step=step, history=history, load_factor=load_factor, u=u)
         progress = best[0] <= 0.99 * rn
@@ -232,13 +234,13 @@ def newton(residual: Callable, u0, *, free=None, tol: float = 1e-9, atol: float 
             return NewtonResult(u=u, iterations=it, residual_history=history, converged=True,
                                 r=r, K=K, floor_limited=True)
         if stalled >= max_stall:
-            raise _fail(f"newton{where}: stalled: no reduction of ||r|| in {stalled} iterations at "
+            raise convergence_failure(f"newton{where}: stalled: no reduction of ||r|| in {stalled} iterations at "
                         f"{rn:.3e} (target {target:.3e}); residual history "
                         f"{[f'{h:.3e}' for h in history[-8:]]}", step=step, history=history,
                         load_factor=load_factor, u=u)
     if rn <= target:
         return NewtonResult(u=u, iterations=max_iter, residual_history=history, converged=True, r=r, K=K)
-    raise _fail(f"newton{where}: expected ||r|| <= {target:.3e} within {max_iter} iterations, found "
+    raise convergence_failure(f"newton{where}: expected ||r|| <= {target:.3e} within {max_iter} iterations, found "
                 f"{rn:.3e}; residual history {[f'{h:.3e}' for h in history[-8:]]}",
                 step=step, history=history, load_factor=load_factor, u=u)
 
@@ -298,7 +300,7 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
             rejected += 1
             dlam *= 0.5
             if dlam < dlam_min:
-                raise _fail(f"load stepping: expected to reach load factor 1, stuck at {lam:g} (increment "
+                raise convergence_failure(f"load stepping: expected to reach load factor 1, stuck at {lam:g} (increment "
                             f"{2 * dlam:.2e} < {dlam_min:g} failed): {exc}", step=step,
                             history=getattr(exc, "residual_history", []), load_factor=target, u=u) from None
             continue
@@ -317,55 +319,3 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
     return LoadPath(lam=np.array(lams), u=np.array(us) if store else u[None], iterations=its,
                     last=last, rejected=rejected)
 
-
-def arc_length(internal: Callable, f_ext, u0, *, free=None, dl: float, n_steps: int = 100,
-               lam_max: float | None = None, stop: Callable | None = None, tol: float = 1e-9,
-               max_iter: int = 25, target_iter: int = 5, dl_min: float | None = None,
-               dl_max: float | None = None, backend=None, update: Callable | None = None) -> LoadPath:
-    """Crisfield's cylindrical arc-length method: f_int(u) = lam f_ext with ||Delta u|| = dl.
-
-    Parameters
-    ----------
-    internal : callable
-        ``internal(u) -> (f_int, K)`` internal force and tangent.
-    f_ext : array (n,)
-        Reference external load; the load factor lam scales it (may become negative: the
-        method follows the path through limit points and snap-backs).
-    u0 : array (n,)
-        Equilibrium start at lam = 0 (fixed dofs keep their values).
-    dl : float
-        Arc length (2-norm of the displacement increment on the free dofs).
-    n_steps, lam_max, stop :
-        Stop after ``n_steps`` steps, when lam exceeds ``lam_max``, or when ``stop(u, lam)`` is True.
-    tol : float
-        Converged when ||f_int - lam f_ext|| <= tol ||f_ext|| (free dofs).
-    target_iter, dl_min, dl_max :
-        The arc length adapts as dl *= sqrt(target_iter / iterations) within [dl_min, dl_max];
-        a failed step is retried with half the arc length.
-
-    The predictor follows the previous increment's direction (sign of Delta u_prev . du_t), so
-    the path goes through limit points; of the two roots of the constraint in each corrector
-    iteration the one closer to the previous increment direction is taken. This is
-    :func:`tmfem.solvers.continuation.follow` for a fixed load f_ext (no pivot counts, plain
-    solves), raising when it stops short.
-
-    Returns
-    -------
-    LoadPath with ``lam`` (m,) and ``u`` (m, n), the starting state included.
-    """
-    from tmfem.solvers.continuation import follow
-    f_ext = np.asarray(f_ext, dtype=float)
-    if float(np.linalg.norm(f_ext[free_index(free, f_ext.size)])) == 0.0:
-        raise InputError("arc length: expected a non-zero reference load on the free dofs, found 0")
-
-    def system(u, lam):
-        fint, K = internal(u)
-        return np.asarray(fint) - lam * f_ext, K, f_ext
-    res = follow(system, u0, free=free, dl=dl, max_steps=n_steps, lam_max=lam_max, tol=tol, max_iter=max_iter,
-                 target_iter=target_iter, dl_min=dl_min, dl_max=dl_max, growth=np.inf, stability=False,
-                 stop=stop, update=update, backend=backend, equilibrate=False)
-    if res.reason == "divergence":
-        raise _fail(f"arc length: {res.message}", step=len(res.steps), history=res.steps[-1].residuals,
-                    load_factor=res.steps[-1].lam, u=res.u[-1])
-    its = [st.iterations for st in res.steps[1:]]
-    return LoadPath(lam=res.lam, u=np.array(res.u) if update is None else res.u, iterations=its)

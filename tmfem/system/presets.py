@@ -11,7 +11,8 @@ import tomllib
 from importlib import resources
 
 from tmfem.errors import InputError
-from tmfem.system.spec import deep_merge, system_from_dict
+from tmfem.system.problem import deep_merge
+from tmfem.system.spec import system_from_dict
 from tmfem.system.system import System
 
 

@@ -21,6 +21,7 @@ that does not declare a table gets the documented defaults, which depend on the 
 """
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass, field
 
@@ -208,9 +209,7 @@ def _gains(v, where: str) -> tuple:
     if not (isinstance(v, list) and len(v) == 4):
         raise InputError(f"{where}: expected 'gains' as {{omega_0, omega_e, tau, d_c}} "
                          f"(Table 7.1), found {v!r}")
-    from tmfem.control.deployment.adaptive import Gains
     g = tuple(_positive({k: x}, k, where, zero=k == "omega_e") for k, x in zip(GAIN_KEYS, v))
-    Gains(*g)
     return g
 
 
@@ -280,13 +279,23 @@ def _report(t: dict, where: str) -> ReportSettings:
 TABLES = ("control", "deployment", "lpv", "report", "packaged")
 
 
+def deep_merge(base: dict, override: dict) -> dict:
+    """Return ``base`` with ``override`` merged in, tables recursively."""
+    out = copy.deepcopy(base)
+    for k, v in override.items():
+        if isinstance(v, dict) and isinstance(out.get(k), dict):
+            out[k] = deep_merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
 def problem_from_dict(d: dict, where: str, build) -> Problem:
     """The :class:`Problem` of the parsed file ``d``; ``build(dict, where)`` builds the
     packaged System from the file with ``[packaged]`` merged in."""
     raw = {k: d[k] for k in TABLES if k in d}
     packaged = None
     if "packaged" in d:
-        from tmfem.system.spec import deep_merge
         p = d["packaged"]
         if not isinstance(p, dict):
             raise InputError(f"{where}: expected [packaged] to be a table of overrides, found {p!r}")

@@ -30,7 +30,6 @@ the rest of the file when the dissertation's printed values are requested; see
 """
 from __future__ import annotations
 
-import copy
 import math
 import re
 import tomllib
@@ -62,17 +61,6 @@ _TABLE_KEYS = {
     "monitor": {"nodes", "points"},
     "models.com": {"membrane_modes"},
 }
-
-
-def deep_merge(base: dict, override: dict) -> dict:
-    """Return ``base`` with ``override`` merged in, tables recursively."""
-    out = copy.deepcopy(base)
-    for k, v in override.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = deep_merge(out[k], v)
-        else:
-            out[k] = copy.deepcopy(v)
-    return out
 
 
 def _check_keys(t: dict, kind: str, where: str) -> None:
