@@ -122,7 +122,7 @@ def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None 
                             bases=deployment_bases(final) if path == "table-7-7-bases" else None,
                             delta_path=path == "delta", allocation=allocation,
                             evaluation=evaluation, tendon_law=tendon_law,
-                            n_centres=p.rbf_centres, w_bar=p.w_bar, gamma=p.gamma, r_min=p.r_min)
+                            n_centers=p.rbf_centres, w_bar=p.w_bar, gamma=p.gamma, r_min=p.r_min)
 
 
 def check_choices(system, *, controller: str = "adaptive-hinf", uncertainty=None,
