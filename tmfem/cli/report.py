@@ -88,7 +88,8 @@ def format_text(r: dict) -> str:
              tabulate(srows, headers=["MTC statics", "tendon stress [MPa]", "bar load [N]",
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
-             f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+             f"index: {r['out']}/index.md ({len(r['files'])} files)",
+             f"web page: {r['out']}/report.html"]
     d = r.get("deployment")
     if d:
         lines.insert(-1, f"deployment {d['preset']} ({d['controller']}, uncertainty "

@@ -150,7 +150,9 @@ def membrane_frames(model, result, idx) -> tuple[np.ndarray, np.ndarray, np.ndar
     xs, ds, ns = [], [], []
     for k in idx:
         x, d = model.membrane_positions(result.z[k])
-        xs.append(x); ds.append(d); ns.append(_rotation(P0 + d, x)[:, 2])
+        xs.append(x)
+        ds.append(d)
+        ns.append(_rotation(P0 + d, x)[:, 2])
     return np.array(xs), np.array(ds), np.array(ns)
 
 
@@ -226,7 +228,9 @@ def animate_deployment(gif, model, result, *, frames: int = 40) -> Path:
         surf = ax.plot_trisurf(XM[i, 0], XM[i, 1], XM[i, 2], triangles=tri, linewidth=0,
                                antialiased=False, shade=False)
         surf.set_facecolor(cmap(norm(wmm[i][tri].mean(axis=1))))
-        ax.set_xlim(lo[0], hi[0]); ax.set_ylim(lo[1], hi[1]); ax.set_zlim(lo[2], hi[2])
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+        ax.set_zlim(lo[2], hi[2])
         ax.set_box_aspect(box, zoom=0.8)
         ax.locator_params(axis="z", nbins=3)
         for axis, lab in ((ax.xaxis, "x [m]"), (ax.yaxis, "y [m]"), (ax.zaxis, "z [m]")):
