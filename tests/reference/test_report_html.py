@@ -150,3 +150,19 @@ def test_screenshots_of_the_page_and_its_views(report, browser, tmp_path):  # no
         # drawn, not blank: a colour-mapped membrane and the text give many distinct colours
         assert len(np.unique(im.reshape(-1, 3), axis=0)) > 200, name
         _keep(png, name)
+
+
+def test_a_directory_without_models_gives_a_page_without_views(tmp_path):
+    # an index with one table and one plot and nothing for ParaView: the page holds the table
+    # and the embedded plot and no 3-D view; a directory without index.md is refused
+    from matplotlib.figure import Figure
+
+    from tmfem.errors import InputError
+    from tmfem.post.html_report import write_html_report
+    Figure(figsize=(2, 2)).savefig(tmp_path / "p.png")
+    (tmp_path / "index.md").write_text("# Report: x\n\n## 1. Part\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n![p](p.png)\n")
+    html = write_html_report(tmp_path).read_text()
+    assert html.count("<table") == 1 and '<div class="viewer"' not in html
+    assert re.search(r'<img alt="p" src="data:image/png;base64,', html)
+    with pytest.raises(InputError, match="expected index.md"):
+        write_html_report(tmp_path / "nothing")
