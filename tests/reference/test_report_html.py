@@ -4,14 +4,18 @@ scripts/install_browser.sh; the browser tests skip where it is absent).
 
 The page is the reduced report of tests/reference/test_report.py. In the browser: the page
 loads without script errors (its own error handler and Chromium's console log), every image
-decodes, every table and 3-D view is there and drew its elements; screenshots of the page and
-of its 3-D views are kept under the test's tmp dir and, when ``TMFEM_ARTEFACTS`` names a
-directory, copied there."""
+decodes, every table and 3-D view is there and drew its elements, and (through the DevTools
+protocol) every control, rotation, zoom, pick and playback of every view changes it;
+screenshots of the page and of its 3-D views are kept under the test's tmp dir and, when
+``TMFEM_ARTEFACTS`` names a directory, copied there."""
 import base64
+import json
 import os
 import re
 import shutil
 import subprocess
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,7 +25,7 @@ from tests.reference.test_report import report  # noqa: F401  (the reduced repor
 BROWSERS = ("chromium", "chromium-browser", "google-chrome")
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update", "--disable-sync",
-         "--hide-scrollbars", "--virtual-time-budget=4000"]
+         "--hide-scrollbars"]
 
 
 def _browser():
@@ -30,10 +34,80 @@ def _browser():
 
 def _run(browser, tmp_path, url, *args):
     profile = tmp_path / f"profile-{len(list(tmp_path.glob('profile-*')))}"
-    r = subprocess.run([browser, *FLAGS, f"--user-data-dir={profile}", "--enable-logging=stderr",
+    r = subprocess.run([browser, *FLAGS, "--virtual-time-budget=4000", f"--user-data-dir={profile}",
+                        "--enable-logging=stderr",
                         "--v=0", *args, url], capture_output=True, text=True, timeout=120)
     assert r.returncode == 0, r.stderr[-2000:]
     return r
+
+
+class DevTools:
+    """A page of headless Chromium driven through the DevTools protocol on a pipe
+    (``--remote-debugging-pipe``: JSON messages ending in NUL on the child's fds 3 and 4), so
+    that the test needs no client library. Collects uncaught exceptions and console errors."""
+
+    def __init__(self, browser, profile):
+        r_cmd, self._w = os.pipe()
+        self._r, w_evt = os.pipe()
+
+        def fds():                                   # the child reads fd 3, writes fd 4
+            a, b = os.dup(r_cmd), os.dup(w_evt)
+            os.dup2(a, 3)
+            os.dup2(b, 4)
+            os.set_inheritable(3, True)
+            os.set_inheritable(4, True)
+        self.proc = subprocess.Popen([browser, *FLAGS, f"--user-data-dir={profile}", "--remote-debugging-pipe",
+                                      "--window-size=1100,800"], preexec_fn=fds,
+                                     close_fds=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        os.close(r_cmd)
+        os.close(w_evt)
+        self._buf, self._id, self.errors = b"", 0, []
+        target = self.call("Target.createTarget", url="about:blank")["targetId"]
+        self.session = self.call("Target.attachToTarget", targetId=target, flatten=True)["sessionId"]
+        for domain in ("Runtime", "Log", "Page"):
+            self.call(f"{domain}.enable", session=True)
+
+    def call(self, method, session=False, **params):
+        self._id += 1
+        msg = {"id": self._id, "method": method, "params": params}
+        if session:
+            msg["sessionId"] = self.session
+        os.write(self._w, json.dumps(msg).encode() + b"\0")
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            while b"\0" in self._buf:
+                raw, self._buf = self._buf.split(b"\0", 1)
+                m = json.loads(raw)
+                if m.get("method") == "Runtime.exceptionThrown":
+                    self.errors.append(m["params"]["exceptionDetails"].get("exception", {}).get("description", "?"))
+                elif m.get("method") == "Log.entryAdded" and m["params"]["entry"]["level"] == "error":
+                    self.errors.append(m["params"]["entry"]["text"])
+                elif m.get("id") == self._id:
+                    assert "error" not in m, m["error"]
+                    return m["result"]
+            self._buf += os.read(self._r, 1 << 20)
+        raise TimeoutError(method)
+
+    def evaluate(self, js):
+        r = self.call("Runtime.evaluate", session=True, expression=js, awaitPromise=True, returnByValue=True)
+        assert "exceptionDetails" not in r, r["exceptionDetails"]
+        return r["result"].get("value")
+
+    def open(self, url):
+        self.call("Page.navigate", session=True, url=url)
+        for _ in range(200):
+            if self.evaluate("!!document.documentElement && document.documentElement.hasAttribute('data-images')"):
+                return
+            time.sleep(0.05)
+        raise TimeoutError(url)
+
+    def close(self):
+        self.proc.kill()
+        self.proc.wait()
+
+
+#: the script that works every control of the page's 3-D views (returns check -> bool)
+INTERACT = (Path(__file__).parent / "report_interact.js").read_text()
 
 
 def _keep(png, name):
@@ -166,3 +240,21 @@ def test_a_directory_without_models_gives_a_page_without_views(tmp_path):
     assert re.search(r'<img alt="p" src="data:image/png;base64,', html)
     with pytest.raises(InputError, match="expected index.md"):
         write_html_report(tmp_path / "nothing")
+
+
+def test_every_control_of_every_view_works(report, browser, tmp_path):  # noqa: F811
+    # through the DevTools protocol: the selectors (data set, membrane field, mode), the
+    # sliders (amplitude, time, deflection scale), rotation, zoom, picking and playback each
+    # change the view; no exception and no console error on the way
+    page = DevTools(browser, tmp_path / "profile")
+    try:
+        page.open((report / "report.html").as_uri())
+        checks = page.evaluate(INTERACT)
+    finally:
+        page.close()
+    _, _, views = _counts(report)
+    assert sum(k.endswith(": rotate") for k in checks) == views
+    assert any("select mode" in k for k in checks) and any("slider t" in k for k in checks)
+    assert any(k.endswith(": playback") for k in checks)
+    assert all(checks.values()), {k: v for k, v in checks.items() if not v}
+    assert page.errors == []
