@@ -2,7 +2,7 @@
 directory and opened in headless Chromium (Debian's ``chromium``, installed by
 scripts/install_browser.sh; the browser tests skip where it is absent).
 
-The page is the reduced report of tests/reference/conftest.py. In the browser: the page
+The page is the reduced report of tests/reference/test_report.py. In the browser: the page
 loads without script errors (its own error handler and Chromium's console log), every image
 decodes, every table and 3-D view is there and drew its elements, and (through the DevTools
 protocol) every control, rotation, zoom, pick and playback of every view changes it;
@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from tests.reference.test_report import report  # noqa: F401  (the reduced report directory)
 
 BROWSERS = ("chromium", "chromium-browser", "google-chrome")
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -135,7 +137,7 @@ def _counts(directory):
     return md_tables + len(csvs) + 1, images, views       # + 1: the summary of report.json
 
 
-def test_page_is_one_file_with_every_image_table_and_view(report):
+def test_page_is_one_file_with_every_image_table_and_view(report):  # noqa: F811
     html = (report / "report.html").read_text()
     tables, images, views = _counts(report)
     # images embedded: no image refers to a file
@@ -149,7 +151,7 @@ def test_page_is_one_file_with_every_image_table_and_view(report):
     assert "http://" not in html and "https://" not in html        # nothing from the network
 
 
-def test_scenes_carry_the_files_geometry_and_fields(report):
+def test_scenes_carry_the_files_geometry_and_fields(report):  # noqa: F811
     # an independent read of the ParaView files (meshio) against the arrays in the page
     import meshio
     from tmfem.post.html_report import configuration_scene, modes_scene, pvd_frames, series_scene
@@ -190,7 +192,7 @@ def browser():
     return b
 
 
-def test_page_loads_in_chromium_without_script_errors(report, browser, tmp_path):
+def test_page_loads_in_chromium_without_script_errors(report, browser, tmp_path):  # noqa: F811
     url = (report / "report.html").as_uri()
     r = _run(browser, tmp_path, url, "--dump-dom")
     dom = r.stdout
@@ -209,7 +211,7 @@ def test_page_loads_in_chromium_without_script_errors(report, browser, tmp_path)
     assert dom.count('type="range"') >= views - 1 and dom.count("<select") >= 2
 
 
-def test_screenshots_of_the_page_and_its_views(report, browser, tmp_path):
+def test_screenshots_of_the_page_and_its_views(report, browser, tmp_path):  # noqa: F811
     from PIL import Image
     url = (report / "report.html").as_uri()
     _, _, views = _counts(report)
@@ -240,7 +242,7 @@ def test_a_directory_without_models_gives_a_page_without_views(tmp_path):
         write_html_report(tmp_path / "nothing")
 
 
-def test_every_control_of_every_view_works(report, browser, tmp_path):
+def test_every_control_of_every_view_works(report, browser, tmp_path):  # noqa: F811
     # through the DevTools protocol: the selectors (data set, membrane field, mode), the
     # sliders (amplitude, time, deflection scale), rotation, zoom, picking and playback each
     # change the view; no exception and no console error on the way
