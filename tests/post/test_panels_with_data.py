@@ -1,13 +1,11 @@
-"""Plots draw a panel only where there is something to show (tmfem.post.plots.plot_free_vibration,
-the report's frequency plot): a figure of n panels is 2.4 n + 0.8 in (free vibration) high at
-120 dpi, the frequency plot 7.2 in with its difference panel and 4.6 in without."""
+"""The free-vibration plot (tmfem.post.plots.plot_free_vibration) draws a panel only where there
+is something to show: a figure of n panels is 2.4 n + 0.8 in high at 120 dpi."""
 from types import SimpleNamespace
 
 import matplotlib.image as plt_image
 import numpy as np
 
 from tmfem.post.plots import plot_free_vibration
-from tmfem.reference.report import _frequency_plot
 
 T = np.linspace(0.0, 2.0, 101)
 
@@ -31,10 +29,3 @@ def test_free_vibration_panels_follow_the_monitored_points(tmp_path):
     for k, (nodes, n_w, panels) in enumerate(cases):
         png = plot_free_vibration(_result(nodes, n_w), tmp_path / f"v{k}.png", title="t")
         assert _height(png) == round((2.4 * panels + 0.8) * 120), (k, panels)
-
-
-def test_frequency_plot_drops_the_difference_panel_without_printed_values(tmp_path):
-    f = {"MTC designed": np.linspace(0.1, 3.0, 6), "COM designed": np.linspace(0.12, 3.1, 6)}
-    printed = {"source": "dissertation Table 6.6", "MTC": list(np.linspace(0.1, 3.0, 6)), "SBC": [], "COM": []}
-    assert _height(_frequency_plot(tmp_path / "a.png", f, printed, 6, "x")) == round(7.2 * 120)
-    assert _height(_frequency_plot(tmp_path / "b.png", f, None, 6, "x")) == round(4.6 * 120)

@@ -63,7 +63,7 @@ def run(args) -> dict:
                               dt=args.dt, render=not args.no_render, deploy=not args.no_deploy,
                               progress=lambda done: bar.step(next(nxt, "done")),
                               run_progress=lambda label: bar.callback(label))
-    print(f"tmfem report: done: {out / 'index.md'}", file=sys.stderr)
+    print(f"tmfem report: done: {out / 'index.md'}, web page {out / 'report.html'}", file=sys.stderr)
     return result
 
 
@@ -88,8 +88,7 @@ def format_text(r: dict) -> str:
              tabulate(srows, headers=["MTC statics", "tendon stress [MPa]", "bar load [N]",
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
-             f"index: {r['out']}/index.md ({len(r['files'])} files)",
-             f"web page: {r['out']}/report.html"]
+             f"index: {r['out']}/index.md ({len(r['files'])} files)"]
     d = r.get("deployment")
     if d:
         lines.insert(-1, f"deployment {d['preset']} ({d['controller']}, uncertainty "

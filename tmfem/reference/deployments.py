@@ -131,6 +131,24 @@ def write_csv(path, r) -> str:
     return str(path)
 
 
+def write_deployment_series(directory, model, r, *, name: str) -> Path:
+    """The ParaView series of run ``r``, a frame every :data:`VTK_EVERY` samples: bars,
+    tendons with their forces and rest lengths, and the deflected membrane of the model's
+    field (:func:`tmfem.post.deploy_plots.membrane_frames`) with its deflection in O_f."""
+    from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
+    from tmfem.io.series import SeriesWriter
+    from tmfem.post.deploy_plots import membrane_frames
+    idx = np.arange(0, r.t.size, VTK_EVERY)
+    xm, defl, _ = membrane_frames(model, r, idx)
+    series = SeriesWriter(directory, name=name)
+    for j, k in enumerate(idx):
+        series.append_configuration(
+            float(r.t[k]), model.system, q=r.z[k, :model.nq], tendon_forces=r.tendon_force[k],
+            rest_lengths=r.u[k], membrane=MembraneField(mesh=model.membrane.mesh, x=xm[j],
+                                                        point_data={DISPLACEMENT_FIELD: defl[j]}))
+    return series.pvd
+
+
 def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gif=None,
                   vtk=None) -> dict:
     """Write the files of deployment run ``r`` of set-up ``s``: CSV, plot (Figures 7.2-7.4, or
@@ -147,26 +165,8 @@ def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gi
         from tmfem.post.deploy_plots import animate_deployment
         out["gif"] = str(animate_deployment(gif, s.model, r))
     if vtk:
-        out["pvd"] = str(write_series(Path(vtk), s.model, r, name=preset))
+        out["pvd"] = str(write_deployment_series(Path(vtk), s.model, r, name=preset))
     return out
-
-
-def write_series(directory, model, r, *, name: str) -> Path:
-    """The ParaView series of run ``r``, a frame every :data:`VTK_EVERY` samples: bars,
-    tendons with their forces and rest lengths, and the deflected membrane of the model's
-    field (:func:`tmfem.post.deploy_plots.membrane_frames`) with its deflection in O_f."""
-    from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
-    from tmfem.io.series import SeriesWriter
-    from tmfem.post.deploy_plots import membrane_frames
-    idx = np.arange(0, r.t.size, VTK_EVERY)
-    xm, defl, _ = membrane_frames(model, r, idx)
-    series = SeriesWriter(directory, name=name)
-    for j, k in enumerate(idx):
-        series.append_configuration(
-            float(r.t[k]), model.system, q=r.z[k, :model.nq], tendon_forces=r.tendon_force[k],
-            rest_lengths=r.u[k], membrane=MembraneField(mesh=model.membrane.mesh, x=xm[j],
-                                                        point_data={DISPLACEMENT_FIELD: defl[j]}))
-    return series.pvd
 
 
 #: 8.4: eq. 5.100 (xi_r = 1, omega_r; theta_0, theta_e, psi_0 from the preset's printed
