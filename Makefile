@@ -1,6 +1,6 @@
 # Two commands do all the set-up on a fresh Debian machine with Python >= 3.11:
 #   make demo   -- install, then the complete analysis of the 1-4 system with its deployment
-#                  (tmfem report; out/1-4/index.md links every file)
+#                  (tmfem report; out/1-4/report.html shows it, index.md links every file)
 #   make test   -- install, then run the fast test suite (every feature, a few minutes)
 # and beside them:
 #   make test-full     -- every test, the studies at full scale (about 40 min)
@@ -26,10 +26,12 @@ $(STAMP): pyproject.toml $(VENV)/.syslibs
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	@bash scripts/install_petsc.sh $(VENV)
+	@bash scripts/install_browser.sh
 	@touch $@
 
 demo: $(STAMP)
 	$(BIN)/tmfem report --preset 1-4 --out $(OUT)/1-4
+	@echo "tmfem: the report as one web page: $(abspath $(OUT))/1-4/report.html"
 
 # two workers: the suite is CPU-bound and the machines have two cores
 PYTEST := $(BIN)/python -m pytest -q -n 2

@@ -35,3 +35,24 @@ def test_largest_deflection_is_marked_as_the_switch_transient_when_it_follows_th
         text = " ".join(t.get_text() for t in ax.texts)
         assert "largest |w|: 1 mm (w_1)" in text
         assert ("after the switch" in text) is says
+
+
+def test_membrane_frames_follow_the_model_field_and_its_floating_frame():
+    # the deflected membrane of a state z with membrane modal coordinates eta: its w at the
+    # model's output points equals the model's own output map W_out (eq. 5.1, another code
+    # path), and the fitted normal is the z axis of O_f of the model's rotation (eq. 3.3)
+    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.post.deploy_plots import membrane_frames
+    from tmfem.system.geometry import rotation_ef
+    from tmfem.system.presets import load_preset
+    model = ControlOrientedModel(load_preset("1-4"), membrane_modes=3, mesh_n=4)
+    z = np.array(model.z0, dtype=float)
+    z[:model.nq] += 1e-3 * np.arange(model.nq) / model.nq
+    z[model.nq:] = [2e-3, -1e-3, 5e-4][:model.K]
+    x, d, n = membrane_frames(model, SimpleNamespace(z=z[None, :]), [0])
+    assert model.output_points                   # 1-4: the monitored points of eq. 5.36
+    probe = model.membrane.probe(np.array(model.output_points).T)
+    assert np.allclose(probe @ d[0, 2], model.membrane_w(z), atol=1e-12)
+    zeta = model.zeta(z[:model.nq])
+    assert np.allclose(n[0], rotation_ef(zeta[model.layout.n_delta:])[:, 2], atol=1e-9)
+    assert x.shape == d.shape == (1, 3, model.membrane.mesh.p.shape[1])

@@ -71,7 +71,7 @@ def run(args) -> dict:
                               dt=args.dt, render=not args.no_render, deploy=not args.no_deploy,
                               progress=lambda done: bar.step(next(nxt, "done")),
                               run_progress=lambda label: bar.callback(label))
-    print(f"tmfem report: done: {out / 'index.md'}", file=sys.stderr)
+    print(f"tmfem report: done: {out / 'index.md'}, web page {out / 'report.html'}", file=sys.stderr)
     return result
 
 

@@ -129,28 +129,94 @@ def plot_lpv_deployment(png, result, *, title: str = "") -> Path:
                            coordinates=["theta_11", "psi_11", "theta_21", "psi_21", "x_21", "y_21", "z_21"])
 
 
-def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
-    """GIF of the bars (thick), tendons (thin) and the membrane polygon (flat, its corners)
-    over the run (Figures 7.5, 7.9, 7.14), with matplotlib's pillow writer; equal x/y scales,
-    the z axis at least 30 % of the plan size."""
+def membrane_frames(model, result, idx) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The deflected membrane of the run at samples ``idx`` from the recorded state z through
+    the control-oriented model's field (eqs. 5.1, 5.3,
+    :meth:`~tmfem.models.com.model.ControlOrientedModel.membrane_positions`): static corner
+    shapes and the K relative modes at the modal coordinates eta of z. On a finite-element
+    plant z is its measured state, so this is the FE membrane projected on the model's basis.
+
+    Returns
+    -------
+    x : ndarray (n, 3, n_nodes)
+        Node positions of the membrane's FE mesh in the inertial frame.
+    d : ndarray (n, 3, n_nodes)
+        Deflections u, v, w in O_f.
+    normal : ndarray (n, 3)
+        The z axis of O_f in the inertial frame (the rotation that carries the O_f positions
+        onto x, a least-squares fit that is exact for this rigid placement).
+    """
+    P0 = model.membrane.shapes[0]
+    xs, ds, ns = [], [], []
+    for k in idx:
+        x, d = model.membrane_positions(result.z[k])
+        xs.append(x)
+        ds.append(d)
+        ns.append(_rotation(P0 + d, x)[:, 2])
+    return np.array(xs), np.array(ds), np.array(ns)
+
+
+def deflection_scale(system, w_max: float) -> float:
+    """Drawing factor of the transverse membrane deflection: the largest |w| drawn as 4 % of
+    the plan size of the membrane (at least 1, a power of ten times 1, 2 or 5)."""
+    c = system.membrane_corners_inertial(system.q)
+    plan = float(np.max(np.ptp(c[:2], axis=1)))
+    if not w_max > 0:
+        return 1.0
+    f = max(1.0, 0.04 * plan / w_max)
+    e = 10.0 ** np.floor(np.log10(f))
+    return float(max(m * e for m in (1, 2, 5) if m * e <= f))
+
+
+def animate_deployment(gif, model, result, *, frames: int = 40) -> Path:
+    """GIF of the bars (thick), tendons (thin) and the deflected membrane over the run
+    (Figures 7.5, 7.9, 7.14), with matplotlib's pillow writer.
+
+    The membrane is the control-oriented model's field (:func:`membrane_frames`, eqs. 5.1,
+    5.3) on its FE mesh, coloured by the transverse deflection w in O_f [mm] (one colour bar
+    over the run), its deflection drawn enlarged by the factor of :func:`deflection_scale`
+    (stated in the legend). Equal x/y scales, the z axis at least 30 % of the plan size.
+
+    Parameters
+    ----------
+    gif : str or Path
+    model : ControlOrientedModel
+        The controller's model of the run (its system, membrane basis and coordinates z).
+    result : DeploymentResult
+    frames : int
+    """
+    from matplotlib import colormaps
     from matplotlib.animation import FuncAnimation, PillowWriter
+    from matplotlib.colors import Normalize
+    from matplotlib.lines import Line2D
     r = result
+    system = model.system
     nq = len(r.names["q"])
     idx = np.linspace(0, r.t.size - 1, frames).astype(int)
     Xs = [system.nodes(r.z[k, :nq]) for k in idx]
-    Cs = [system.membrane_corners_inertial(r.z[k, :nq]) for k in idx]
-    allX = np.concatenate(Xs, axis=1)
+    XM, D, normals = membrane_frames(model, r, idx)
+    w = D[:, 2, :]
+    scale = deflection_scale(system, float(np.max(np.abs(w))))
+    # the drawn membrane: its transverse deflection enlarged along the z axis of O_f
+    XM = XM + (scale - 1.0) * w[:, None, :] * normals[:, :, None]
+    tri = _triangles(model.membrane.mesh.t)
+    allX = np.concatenate(Xs + list(XM), axis=1)
     lo, hi = allX.min(axis=1), allX.max(axis=1)
     box = hi - lo
     box[2] = max(box[2], 0.3 * box[:2].max())      # a flat system keeps a readable z axis
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
-    fig = new_figure(figsize=(6.0, 5.5))
+    wmm = 1e3 * w
+    lim = float(np.max(np.abs(wmm))) or 1.0
+    norm, cmap = Normalize(-lim, lim), colormaps["coolwarm"]
+    fig = new_figure(figsize=(6.4, 5.6))
     ax = fig.add_subplot(projection="3d")
+    from matplotlib.cm import ScalarMappable
+    fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.6, pad=0.12,
+                 label="membrane deflection w in O_f [mm]")
     bars, tends = system.bar_connectivity, system.tendon_connectivity
     legend = [Line2D([], [], color="saddlebrown", lw=3, label="bar"),
               Line2D([], [], color="tab:blue", lw=0.8, label="tendon"),
-              Patch(color="gold", alpha=0.4, label="membrane (corner polygon)")]
+              Line2D([], [], color="0.5", lw=0, marker="s", ms=8,
+                     label=f"membrane, deflection x {scale:g}")]
 
     def draw(i):
         ax.cla()
@@ -159,15 +225,35 @@ def animate_deployment(gif, system, result, *, frames: int = 40) -> Path:
             ax.plot(*X[:, [a, b]], color="saddlebrown", lw=3)
         for a, b in tends.T:
             ax.plot(*X[:, [a, b]], color="tab:blue", lw=0.8)
-        C = Cs[i]
-        ax.plot_trisurf(C[0], C[1], C[2], color="gold", alpha=0.4)
-        ax.set_xlim(lo[0], hi[0]); ax.set_ylim(lo[1], hi[1]); ax.set_zlim(lo[2], hi[2])
-        ax.set_box_aspect(box, zoom=0.85)
+        surf = ax.plot_trisurf(XM[i, 0], XM[i, 1], XM[i, 2], triangles=tri, linewidth=0,
+                               antialiased=False, shade=False)
+        surf.set_facecolor(cmap(norm(wmm[i][tri].mean(axis=1))))
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+        ax.set_zlim(lo[2], hi[2])
+        ax.set_box_aspect(box, zoom=0.8)
         ax.locator_params(axis="z", nbins=3)
-        ax.set_xlabel("x [m]"); ax.set_ylabel("y [m]"); ax.set_zlabel("z [m]")
+        for axis, lab in ((ax.xaxis, "x [m]"), (ax.yaxis, "y [m]"), (ax.zaxis, "z [m]")):
+            axis.set_label_text(lab)
+            axis.labelpad = 10
+        ax.tick_params(labelsize=7, pad=2)
         ax.legend(handles=legend, loc="upper left", fontsize=7, frameon=False)
         ax.set_title(f"{system.name} deployment, t = {r.t[idx[i]]:.2f} s\ncontroller: "
                      f"{r.controller[min(idx[i], len(r.controller) - 1)]}", fontsize=10)
     anim = FuncAnimation(fig, draw, frames=len(idx))
     anim.save(str(gif), writer=PillowWriter(fps=8))
     return Path(gif)
+
+
+def _triangles(quads) -> np.ndarray:
+    """Two triangles per quadrilateral (4, n_el) of the membrane mesh: (2 n_el, 3)."""
+    q = np.asarray(quads).T
+    return np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]])
+
+
+def _rotation(a, b) -> np.ndarray:
+    """The rotation R (3, 3) with b - mean(b) ~ R (a - mean(a)) in least squares (Kabsch)."""
+    H = (a - a.mean(axis=1, keepdims=True)) @ (b - b.mean(axis=1, keepdims=True)).T
+    U, _, Vt = np.linalg.svd(H)
+    d = np.sign(np.linalg.det(Vt.T @ U.T)) or 1.0
+    return Vt.T @ np.diag([1.0, 1.0, d]) @ U.T

@@ -207,19 +207,46 @@ def plot_xy(png, curves: dict, *, xlabel: str, ylabel: str, title: str | None = 
 
 def plot_free_vibration(result, path, *, title: str = "") -> str:
     """Monitored node coordinates and membrane deflections vs time (Figs. 6.21-6.28) of a
-    free-vibration result (``nodes``: label -> (nt, 3), ``w`` (nt, k), ``t``)."""
-    nn = len(result.nodes)
-    fig = new_figure(figsize=(8, 2.4 * (nn + 1)))
-    axes = fig.subplots(nn + 1, 1, sharex=True)
-    axes = np.atleast_1d(axes)
-    for ax, (name, X) in zip(axes, result.nodes.items()):
-        for c, lab in enumerate("xyz"):
-            ax.plot(result.t, 1e3 * (X[:, c] - X[0, c]), label=f"{lab} - {lab}(0)")
-        ax.set_ylabel(f"{name} [mm]"); ax.legend(loc="upper right", fontsize=7)
-    ax = axes[-1]
-    for k in range(result.w.shape[1]):
-        ax.plot(result.t, 1e3 * result.w[:, k], label=f"w_{k + 1}")
-    ax.set_ylabel("w [mm]"); ax.set_xlabel("t [s]"); ax.legend(loc="upper right", fontsize=7)
-    if title:
-        axes[0].set_title(title)
+    free-vibration result (``nodes``: label -> (nt, 3), ``w`` (nt, k), ``t``).
+
+    A panel per monitored node and one for the membrane deflections w, each only where the
+    system has them; a system with neither gets the bar coordinates instead (angles
+    theta, psi in mrad, positions in mm, from t = 0), and the title says so."""
+    panels = [("node", name, X) for name, X in result.nodes.items()]
+    if result.w.shape[1]:
+        panels.append(("w", None, result.w))
+    note = ""
+    if not panels:
+        q = getattr(result, "q", None)
+        q = result.z if q is None else q
+        names = list(result.columns[1:1 + q.shape[1]])
+        for fam, test, f, unit in (("angles", lambda n: n.startswith(("theta", "psi")), 1e3, "mrad"),
+                                   ("positions", lambda n: n.split("_")[0] in ("x", "y", "z"), 1e3, "mm")):
+            cols = [k for k, n in enumerate(names) if test(n)]
+            if cols:
+                panels.append(("q", (fam, unit, [names[k] for k in cols]), f * (q[:, cols] - q[0, cols])))
+        note = "\n(no monitored nodes or membrane points in the system: its bar coordinates)"
+    if not panels:
+        raise InputError("free vibration plot: expected monitored nodes, membrane points or bar "
+                         "coordinates in the result, found none")
+    fig = new_figure(figsize=(8, 2.4 * len(panels) + 0.8))
+    axes = np.atleast_1d(fig.subplots(len(panels), 1, sharex=True))
+    for ax, (kind, name, X) in zip(axes, panels):
+        if kind == "node":
+            for c, lab in enumerate("xyz"):
+                ax.plot(result.t, 1e3 * (X[:, c] - X[0, c]), label=f"{lab} - {lab}(0)")
+            ax.set_ylabel(f"{name} [mm]")
+        elif kind == "w":
+            for k in range(X.shape[1]):
+                ax.plot(result.t, 1e3 * X[:, k], label=f"w_{k + 1}")
+            ax.set_ylabel("w [mm]")
+        else:
+            fam, unit, labels = name
+            for k, lab in enumerate(labels):
+                ax.plot(result.t, X[:, k], label=f"{lab} - {lab}(0)")
+            ax.set_ylabel(f"{fam} [{unit}]")
+        ax.legend(loc="upper right", fontsize=7, ncol=2)
+    axes[-1].set_xlabel("t [s]")
+    if title or note:
+        axes[0].set_title(title + note)
     return str(save_figure(fig, path))

@@ -179,6 +179,24 @@ def write_csv(path, r) -> str:
     return str(path)
 
 
+def write_deployment_series(directory, model, r, *, name: str) -> Path:
+    """The ParaView series of run ``r``, a frame every :data:`VTK_EVERY` samples: bars,
+    tendons with their forces and rest lengths, and the deflected membrane of the model's
+    field (:func:`tmfem.post.deploy_plots.membrane_frames`) with its deflection in O_f."""
+    from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
+    from tmfem.io.series import SeriesWriter
+    from tmfem.post.deploy_plots import membrane_frames
+    idx = np.arange(0, r.t.size, VTK_EVERY)
+    xm, defl, _ = membrane_frames(model, r, idx)
+    series = SeriesWriter(directory, name=name)
+    for j, k in enumerate(idx):
+        series.append_configuration(
+            float(r.t[k]), model.system, q=r.z[k, :model.nq], tendon_forces=r.tendon_force[k],
+            rest_lengths=r.u[k], membrane=MembraneField(mesh=model.membrane.mesh, x=xm[j],
+                                                        point_data={DISPLACEMENT_FIELD: defl[j]}))
+    return series.pvd
+
+
 def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gif=None,
                   vtk=None, lpv: bool | None = None) -> dict:
     """Write the files of deployment run ``r`` of set-up ``s``: CSV, plot (Figures 7.2-7.4, or
@@ -196,15 +214,9 @@ def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gi
         out["plot"] = str(draw(plot, r, title=title))
     if gif:
         from tmfem.post.deploy_plots import animate_deployment
-        out["gif"] = str(animate_deployment(gif, s.model.system, r))
+        out["gif"] = str(animate_deployment(gif, s.model, r))
     if vtk:
-        from tmfem.io.codes import configuration_cells
-        from tmfem.io.series import write_series
-        sysm = s.model.system
-        cells = configuration_cells(sysm)
-        idx = range(0, r.t.size, VTK_EVERY)
-        out["pvd"] = str(write_series(Path(vtk), ((float(r.t[k]), sysm.nodes(r.z[k, :s.model.nq]),
-                                                   cells) for k in idx), name=preset))
+        out["pvd"] = str(write_deployment_series(Path(vtk), s.model, r, name=preset))
     return out
 
 

@@ -315,6 +315,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     add("report.json", out / "report.json")
     _index(out, system, summary, files, tables["rows"], notes, freqs, printed, statics)
     add("index.md", out / "index.md")
+    from tmfem.post.html_report import write_html_report
+    add("report.html", write_html_report(out))
     step(STEPS[9])
     summary["files"] = files
     summary["notes"] = notes
