@@ -9,7 +9,10 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 FILES = sorted([*ROOT.glob("docs/**/*.md"), ROOT / "README.md", *ROOT.glob("examples/*.py"),
                 *ROOT.glob("demos/*.py"), *ROOT.glob("benchmarks/*.py"), *ROOT.glob("docs/hooks/*.py")])
-PROCESS = re.compile(r"\bissues? \d+|\bissue's\b|\bsessions?\b|\bbranch(es)?\b|\bhelpers?\b|"
+#: process words; "branch" and "helper" count only in their process uses (a git branch, a
+#: worker), not as the branch of an equilibrium path or a helper function
+PROCESS = re.compile(r"\bissues? \d+|\(issue\b|\bissue's\b|\bsessions?\b|\b(on|git) branch(es)?\b|"
+                     r"\bbranch(es)? (main|[a-z]+\d+)\b|\bhelpers? [A-Z]\d?\b|\bhelper-\d|\bthe helpers?\b|"
                      r"\bthe lead\b|\(lead\b|\bstop \d+\b|\b20\d\d-\d\d-\d\d\b|\bthis machine state\b",
                      re.IGNORECASE)
 HASH = re.compile(r"(?<![\w.+-])[0-9a-f]{7,40}(?![\w.])")
@@ -24,7 +27,9 @@ def process_words(text: str) -> list[str]:
 
 def test_the_scan_finds_process_words():
     assert process_words("fixed in issue 13 on branch sbc14d, commit 862f9a6 (2026-12-03)") == \
-        ["issue 13", "branch", "2026-12-03", "862f9a6"]
+        ["issue 13", "on branch", "2026-12-03", "862f9a6"]
+    assert process_words("written by helper B2") == ["helper B2"]
+    assert process_words("the far branch of the path; option helpers") == []
     assert process_words("E = 1.539595e-3, 165000000 Pa, mode 12") == []
 
 

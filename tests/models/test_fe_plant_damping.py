@@ -1,4 +1,4 @@
-"""Stiffness-proportional plant damping on the current tangent (issue 15, docs/guides/fe-plant.md
+"""Stiffness-proportional plant damping on the current tangent (docs/guides/fe-plant.md
 "Plant damping along the path"): C_n = alpha M + beta K_T(x_n) at every sample
 (``damping_tangent="current"``) against C = alpha M + beta K_0 (``"initial"``)."""
 import numpy as np

@@ -29,7 +29,7 @@ def sbc_1_4():
 
 
 def test_frequencies_vs_table_6_6_sbc(sbc_1_4):
-    # Table 6.6, SBC column; the targets: modes 1-4 within 0.5 %, 5-12 within 1.5 %
+    # Table 6.6, SBC column; targets: modes 1-4 within 0.5 %, 5-12 within 1.5 %
     _, _, modes = sbc_1_4
     ref = np.array(FREQUENCIES["1-4"]["SBC"])
     f = modes.freq_hz

@@ -1,4 +1,4 @@
-"""The shell-beam-cable model as the plant of the deployment controllers (issue 15): the
+"""The shell-beam-cable model as the plant of the deployment controllers: the
 COM-state estimate on a plant with beam bars and shell rotations, the start in the SBC's own
 packaged equilibrium, Park's predictor for dofs without inertia, the measured input response
 that breaks the 1-4(D) loop, the deploy CLI's --plant sbc and the two-plant comparison."""

@@ -1,4 +1,4 @@
-"""The SBC model's studies (issue 10): free vibration through the common plant (6.5), the three
+"""The SBC model's studies: free vibration through the common plant (6.5), the three
 models beside Tables 6.5-6.7, the SBC statics beside Tables 6.3/6.5, ParaView/PNG output, and
 the mesh convergence of 6.3.
 
@@ -85,7 +85,7 @@ def test_cli_vibrate_sbc(tmp_path, capsys):
 
 
 def test_compare_1_4_beside_table_6_6(tmp_path, capsys):
-    # the issue's targets for the SBC column: modes 1-4 within 0.5 %, 5-12 within 1.5 %;
+    # the targets for the SBC column: modes 1-4 within 0.5 %, 5-12 within 1.5 %;
     # 6.4.1: every model within 3 % of the SBC model
     rc = main(["compare", "--preset", "1-4", "--modes", "12", "--csv", str(tmp_path / "f.csv"),
                "--json"])
@@ -214,7 +214,7 @@ def test_convergence_row_from_mtc_start_is_the_sbc_equilibrium():
 
 @pytest.mark.slow
 def test_sbc_convergence_answer():
-    # 6.3 / issue 10: the shell's bending stiffness does not make the 1-4 membrane modes 5-12
+    # 6.3: the shell's bending stiffness does not make the 1-4 membrane modes 5-12
     # converge under the point attachment: every halving of h still moves them by percents
     # (measured: 2.6-6.3 % at n = 20 -> 30, 1.9-8.1 % at 12 -> 16), as in the MTC model, while
     # the global modes 1-4 move by at most 0.57 %; the corner peak stress grows like 1/h
