@@ -43,7 +43,7 @@ def main():
 
     # The same gain on the nonlinear model: its plant outputs the full state y = [z, z'],
     # the controller acts on y - y_e and adds u_e (zero-order hold at dt).
-    z_e = com.equilibrium(com.u0)
+    z_e = com.equilibrium(com.u0).state
     plant = StatePlant(com, z0=z_e)
     i = list(com.z_names).index("theta_11")
     plant.v0 = np.zeros(com.nz)

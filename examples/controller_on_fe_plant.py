@@ -37,7 +37,7 @@ def main(argv=None):
 
     # The design model and its equilibrium, and the LQR gain on its linearisation.
     com = ControlOrientedModel(system, membrane_modes=2)
-    z_e = com.equilibrium(com.u0)
+    z_e = com.equilibrium(com.u0).state
     lin = linearize(com, z_e=z_e, u_e=com.u0)
     K, _, _ = ct.lqr(lin.A, lin.B, 100 * np.eye(lin.A.shape[0]), np.eye(lin.B.shape[1]) / 0.01**2)
     y_e = np.concatenate([lin.z_e, np.zeros(com.nz)])        # the plants output y = [z, z']
