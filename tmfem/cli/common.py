@@ -13,6 +13,9 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError, ResourceLimit
+from tmfem.resources import (BASE_BYTES, BYTES_PER_DOF, MAX_MEMBRANE_MODES,  # noqa: F401
+                             MEMORY_FRACTION, check_membrane_modes, check_mesh_budget,
+                             check_system_budget, machine_memory)
 from tmfem.system import System, load_preset, load_system
 
 log = logging.getLogger(__name__)
@@ -34,7 +37,9 @@ def system_from_args(args: argparse.Namespace) -> System:
         return load_preset(args.preset, as_printed=args.as_printed)
     if args.as_printed:
         raise InputError("--as-printed applies to presets only")
-    return load_system(args.spec)
+    system = load_system(args.spec)
+    check_system_budget(system, source=str(args.spec))
+    return system
 
 
 def add_model_args(parser, command: str, *, default: str) -> None:
@@ -254,47 +259,7 @@ def output_dir(path, *, option: str) -> Path:
         raise InputError(f"{option}: {exc}") from None
 
 
-def machine_memory() -> float:
-    """Physical memory of this machine in bytes (24 GiB on the project's machines)."""
-    try:
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):     # pragma: no cover - non-POSIX
-        return 24.0 * 2**30
-
-
-# Measured on the 1-4 MTC model (modal, 12 modes): peak RSS grows by ~8-11 kB per free
-# DOF from n = 20 (5 067 DOFs, 0.17 GB) to n = 80 (78 000 DOFs, 0.81 GB); 16 kB leaves
-# room for the fill of larger factorisations. Base: the interpreter with numpy/scipy/VTK.
-BYTES_PER_DOF = 16e3
-BASE_BYTES = 0.3e9
-MEMORY_FRACTION = 0.6         # of the physical memory: the machine is shared
-
-
-def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3,
-                      extra_dofs: int = 0, extra_text: str = "") -> int:
-    """Refuse a membrane mesh whose FE model would not fit this machine.
-
-    The N n x n quadrilateral patches have about N (n + 1)^2 nodes, hence
-    ``dofs_per_node`` N (n + 1)^2 unknowns, plus ``extra_dofs`` (members, named by
-    ``extra_text``); the estimated peak memory is ``BASE_BYTES + BYTES_PER_DOF * dofs`` and
-    must stay under ``MEMORY_FRACTION`` of the physical memory. Returns the DOF estimate.
-
-    Raises
-    ------
-    ResourceLimit
-        with the estimate and the limit.
-    """
-    dofs = dofs_per_node * N * (n + 1) ** 2 + int(extra_dofs)
-    need = BASE_BYTES + BYTES_PER_DOF * dofs
-    limit = MEMORY_FRACTION * machine_memory()
-    if need > limit:
-        given = option if " " in option else f"{option} {n}"    # "--mesh n ..." or the flag
-        raise ResourceLimit(f"{given}: the membrane mesh {N} x {n} x {n}"
-                            + (f" with {extra_text}" if extra_text else "") + " gives about "
-                            f"{dofs:,} DOFs and needs about {need / 2**30:.1f} GiB; the limit "
-                            f"is {limit / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this "
-                            f"machine's {machine_memory() / 2**30:.0f} GiB)")
-    return dofs
+# the estimates live in the library (tmfem.resources); the CLI checks them before any work
 
 
 MAX_STEPS = 200_000
@@ -340,21 +305,6 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
         raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
                          "DOFs")
     return dofs
-
-
-#: Largest K of the control-oriented model: its equations are built symbolically (CasADi)
-#: at a cost that grows faster than K^2 (1-4, measured under load: K = 10: 8 s, 20: 9 s,
-#: 40: 24 s; K = 1000 would run for hours).
-MAX_MEMBRANE_MODES = 40
-
-
-def check_membrane_modes(K: int) -> None:
-    """``--membrane-modes K`` of the control-oriented model: 0 <= K <= MAX_MEMBRANE_MODES."""
-    if not 0 <= K <= MAX_MEMBRANE_MODES:
-        cls = ResourceLimit if K > MAX_MEMBRANE_MODES else InputError
-        raise cls(f"--membrane-modes {K}: expected 0 <= K <= {MAX_MEMBRANE_MODES} (the model's "
-                  f"equations are built symbolically; K = 40 takes ~25 s, the cost grows faster "
-                  f"than K^2)")
 
 
 def check_com_modes(system: System, *, modes: int, membrane_modes=None) -> int:
