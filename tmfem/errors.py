@@ -40,6 +40,11 @@ class SlackMembrane(InfeasibleDesign):
     """A membrane that is not stretched (corner displacement Delta <= 0, eq. 3.36)."""
 
 
+class CollapsedStructure(InfeasibleDesign):
+    """A static equilibrium that is no tensegrity: bars fallen flat or through their lower
+    ends, non-finite results (:func:`tmfem.system.collapse.check_standing`)."""
+
+
 class ConvergenceError(TmfemError):
     """An iterative solve (Newton, arc length, constraint projection) that did not converge."""
 

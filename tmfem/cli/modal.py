@@ -7,7 +7,7 @@ import numpy as np
 
 from tmfem.cli.common import (add_model_args, add_system_args, check_com_modes, model_from_args,
                               model_options_from_args)
-from tmfem.cli.static import default_monitor
+from tmfem.cli.static import check_fe_static, check_stable, default_monitor
 from tmfem.errors import InputError
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import sequence_of
@@ -34,7 +34,9 @@ def configure(parser) -> None:
 def mtc_modes(model, *, k: int, start: str = "undeformed", sequence: int | None = None):
     """Static equilibrium of ``model`` and its ``k`` lowest modes (eq. 5.32)."""
     res = model.solve_static(start=start, monitor=default_monitor(model.system), sequence=sequence)
+    check_fe_static(model, res)
     modes = model.modes(res.x, k=k, tangent=res.tangent)
+    check_stable(model, modes)
     return res, modes
 
 
@@ -107,7 +109,9 @@ def sbc_modal(args, model, tables) -> dict:
     from tmfem.models.sbc.post import modal_summary
     print(f"tmfem modal: {model.system.name} SBC, {model.ndof} free dofs", file=sys.stderr)
     res = model.solve_static(monitor=default_monitor(model.system))
+    check_fe_static(model, res)
     modes = model.modes(res.state, k=args.modes, tangent=res.tangent)
+    check_stable(model, modes)
     out = modal_summary(model, res, modes)
     if args.vtk or args.png:
         from tmfem.post.sbc import mode_data, sbc_cells

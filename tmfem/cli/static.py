@@ -8,6 +8,7 @@ import numpy as np
 from tmfem.cli.common import add_model_args, add_system_args, model_from_args
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import sequence_of
+from tmfem.system.collapse import check_standing
 
 NAME = "static"
 HELP = "static equilibrium of the membrane-truss-cable model (dissertation 6.2)"
@@ -56,7 +57,35 @@ def solve(args, model, options):
     res = model.solve_static(start=options["start"], monitor=monitor,
                              progress=static_progress(args.progress),
                              sequence=sequence_of(options["mesh"], options["sequence"]))
-    return res, static_summary(model, res.x, result=res)
+    summary = static_summary(model, res.x, result=res)
+    check_fe_static(model, res, values=summary)
+    return res, summary
+
+
+def check_fe_static(model, res, *, values=None) -> None:
+    """Refuse a static equilibrium of an FE model (MTC or SBC) that collapsed or has
+    non-finite results, before anything is written (:func:`check_standing`)."""
+    if hasattr(model, "mtc"):                     # SBC: the MTC topology's labelled nodes
+        X, kind = res.state.x[:, model.mtc.topology.system_node], "SBC"
+    else:
+        X, kind = res.x[:, model.topology.system_node], "MTC"
+    check_standing(model.system, X, values=values, rest_lengths=model.rest_lengths,
+                   what=f"static equilibrium of {model.system.name} ({kind})")
+
+
+def check_stable(model, modes) -> None:
+    """Refuse an equilibrium that lost its stability: a mode of negative stiffness (omega^2
+    < 0 in K_T phi = omega^2 M phi, eq. 5.32, beyond 1e-6 of the largest |omega^2|)."""
+    from tmfem.errors import CollapsedStructure
+    w2 = np.asarray(modes.omega2, dtype=float)
+    neg = np.flatnonzero(~(w2 >= -1e-6 * np.max(np.abs(w2), initial=0.0)))
+    if neg.size:
+        kind = "SBC" if hasattr(model, "mtc") else "MTC"
+        raise CollapsedStructure(
+            f"static equilibrium of {model.system.name} ({kind}) is unstable: {neg.size} of "
+            f"{w2.size} modes have negative stiffness (mode {neg[0] + 1}: omega^2 = "
+            f"{w2[neg[0]]:.4g} 1/s^2; check: the tangent stiffness K_T positive definite, "
+            "eq. 5.32); expected a stable tensegrity, check the rest lengths and the prestress")
 
 
 def write_outputs(args, model, x, summary) -> None:
@@ -101,6 +130,7 @@ def sbc_static(args, model) -> dict:
     monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
     res = model.solve_static(monitor=monitor, progress=static_progress(args.progress))
     out = sbc_summary(model, res)
+    check_fe_static(model, res, values=out)
     if args.vtk:
         from tmfem.post.sbc import write_sbc_state
         out["vtk"] = write_sbc_state(args.vtk, model, res.state)

@@ -9,6 +9,7 @@ import numpy as np
 from tmfem.cli.common import (add_model_args, add_system_args, check_time_steps, finite_float,
                               model_from_args, parse_perturbation, positive_int, progress_bar)
 from tmfem.errors import InputError
+from tmfem.cli.static import check_fe_static
 from tmfem.models.mtc.spec import sequence_of
 
 NAME = "vibrate"
@@ -97,6 +98,7 @@ def run_fe(args, model, options) -> dict:
     else:
         st = model.solve_static()
         run, eq = sbc_free_vibration, st.state
+    check_fe_static(model, st)
     with progress_bar(args.t_end, args.dt, f"vibrate {system.name} {name}") as bar:
         res = run(model, eq, t_end=args.t_end, dt=args.dt, perturb=pert, csv_path=args.csv,
                   scheme=args.scheme, alpha=rayleigh[0], beta=rayleigh[1], progress=bar,
