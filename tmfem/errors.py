@@ -8,10 +8,12 @@ line and exits with :attr:`TmfemError.exit_code` (the contract is in docs/cli.md
 0     success (with ``--allow-infeasible``: also when checks failed; they are listed)
 1     the analysis says no: infeasible design, slack tendon or membrane, a failed
       design check, no convergence
-2     bad input: malformed system file, option out of range, unwritable output path
+2     bad input: malformed system file, option out of range, unwritable output path, an
+      output directory in use by another run
 3     the job would not fit this machine (estimated memory/time over the limit)
 4     an optional backend or dependency is not installed
-130   interrupted (Ctrl-C)
+130   interrupted (Ctrl-C, SIGINT)
+143   terminated (SIGTERM)
 ====  ==========================================================================
 """
 
@@ -63,6 +65,11 @@ class SingularInputMatrix(TmfemError):
     5.46) is not square or not invertible at a configuration (its condition number exceeds
     the limit)."""
     exit_code = 4
+
+
+class OutputBusy(InputError):
+    """An output directory in use by another tmfem run (:mod:`tmfem.io.lock`); the message
+    names that run."""
 
 
 class ResourceLimit(InputError):

@@ -1,7 +1,6 @@
 """Validation of every field of a system file (tmfem.system.validate): each refusal names the
 table and the field, says what was expected and what was found. The files start from the
 1-4 and 2-3 presets (valid files), with one field made hostile."""
-import copy
 import os
 import re
 import threading

@@ -187,13 +187,26 @@ def parse_perturbation(items, names) -> dict:
     return out
 
 
+#: ``--quiet`` of the running command (set by :func:`tmfem.cli.main`)
+QUIET = {"on": False}
+
+
+def progress_options() -> dict:
+    """tqdm options of the CLI's bars: drawn on stderr only when it is a terminal, never
+    with ``--quiet`` or ``TQDM_DISABLE`` set (not empty, 0 or false); plain ASCII with
+    ``NO_COLOR`` set (docs/cli.md, "Progress and messages")."""
+    off = (QUIET["on"] or not sys.stderr.isatty()
+           or os.environ.get("TQDM_DISABLE", "").strip().lower() not in ("", "0", "false"))
+    return {"file": sys.stderr, "disable": off, "ascii": bool(os.environ.get("NO_COLOR"))}
+
+
 @contextmanager
 def progress_bar(t_end: float, dt: float, label: str):
     """A tqdm progress bar over the steps of a time run, as a ``progress(step, n_steps)``
-    callback (on stderr; closed on exit, also on an error)."""
+    callback (:func:`progress_options`; closed on exit, also on an error)."""
     from tqdm import tqdm
     bar = tqdm(total=int(round(t_end / dt)), desc=label, unit="step", leave=False,
-               mininterval=0.5)
+               mininterval=0.5, **progress_options())
 
     def update(k, n):
         bar.update(k - bar.n)
@@ -365,7 +378,7 @@ def warn_long_rest_lengths(system: System, rest=None) -> list[str]:
 
 # ---------------------------------------------------------------------------- progress
 class Progress:
-    """The CLI's progress bar (tqdm on stderr; silent when stderr is not a terminal).
+    """The CLI's progress bar (tqdm on stderr, :func:`progress_options`).
 
     ``step(label)`` advances one stage of a multi-stage job and names the next one;
     ``callback(desc)`` returns a ``progress(done, total)`` function for library loops
@@ -376,8 +389,8 @@ class Progress:
         from tqdm import tqdm
 
         self._tqdm = tqdm
-        self.bar = tqdm(total=total, desc=desc, unit="step", file=sys.stderr, disable=None,
-                        leave=True, dynamic_ncols=True)
+        self.bar = tqdm(total=total, desc=desc, unit="step", leave=True, dynamic_ncols=True,
+                        **progress_options())
 
     def step(self, label: str) -> None:
         self.bar.set_postfix_str(label, refresh=False)
@@ -392,8 +405,8 @@ class Progress:
 
         def progress(done: int, total: int) -> None:
             if "bar" not in inner:
-                inner["bar"] = self._tqdm(total=total, desc=desc, file=sys.stderr, disable=None,
-                                          leave=False, position=1, dynamic_ncols=True)
+                inner["bar"] = self._tqdm(total=total, desc=desc, leave=False, position=1,
+                                          dynamic_ncols=True, **progress_options())
             inner["bar"].n = done
             inner["bar"].refresh()
             if done >= total:

@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.io.atomic import atomic_open
+from tmfem.io.run import partial_name
 
 #: 7.4: omega_r (eq. 5.68), Table 7.1 (omega_0, omega_e, tau, d_c), uncertainty, points (5.73-5.75)
 DEPLOYMENTS = {
@@ -116,9 +118,14 @@ def _tendon_signals(r) -> list:
 
 
 def write_csv(path, r) -> str:
-    """The deployment CSV (:func:`csv_columns`), ``\\n`` line endings."""
+    """The deployment CSV (:func:`csv_columns`), ``\\n`` line endings, written atomically;
+    a run that stopped early (``r.failure``) is written as ``NAME.csv.partial``
+    (:func:`tmfem.io.run.partial_name`) and an earlier ``NAME.csv`` is removed."""
     nq = len(r.names["q"])
-    with open(path, "w", newline="") as fh:
+    if r.failure:
+        Path(path).unlink(missing_ok=True)
+        path = partial_name(path)
+    with atomic_open(path, "w", newline="") as fh:
         wr = csv.writer(fh, lineterminator="\n")
         wr.writerow(csv_columns(r))
         for k in range(r.t.size):
