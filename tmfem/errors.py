@@ -18,6 +18,14 @@ line and exits with :attr:`TmfemError.exit_code` (the contract is in docs/cli.md
 """
 
 
+def shorten(items, limit: int = 4) -> str:
+    """``a, b, c, d, ... (9 in all)``: the first ``limit`` items of a list, then an ellipsis
+    and the count -- never a list cut off silently (messages and the CLI's text)."""
+    items = [str(x) for x in items]
+    head = ", ".join(items[:limit])
+    return head if len(items) <= limit else f"{head}, ... ({len(items)} in all)"
+
+
 class TmfemError(Exception):
     """Base class of all tmfem errors."""
 

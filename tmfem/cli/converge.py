@@ -6,7 +6,7 @@ import csv
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
                               check_attachment_options, check_model_budget, check_outputs,
                               system_from_args)
-from tmfem.errors import InputError
+from tmfem.errors import InputError, shorten
 from tmfem.io.units import unit_of
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import apply_rest_lengths
@@ -126,8 +126,7 @@ def format_text(r: dict) -> str:
     lines = [f"{r['system']} {r.get('model', 'mtc').upper()} convergence, {r['attachment']} attachment, "
              f"{r.get('membrane_law', 'svk')} membrane",
              f"rest lengths: {r['rest_lengths_rule']} ({r['rest_lengths_note']})"
-             + (": " + ", ".join(f"{k}={v:.5f} m" for k, v in list(fixed.items())[:4])
-                + (" ..." if len(fixed) > 4 else "") if fixed else ""), head]
+             + (": " + shorten(f"{k}={v:.5f} m" for k, v in fixed.items()) if fixed else ""), head]
     for w in rows:
         lines.append(f"{w['mesh_n']:3d} {w['tendon_elements']:2d} {w['elements']:6d} {w['dofs']:7d} "
                      f"{w['Delta_mm']:9.4f} {w['sigma_p1_max_MPa']:8.3f} {w['von_mises_max_MPa']:8.3f} "

@@ -8,7 +8,7 @@ import numpy as np
 from tmfem.cli.common import (add_model_args, add_system_args, check_com_modes, model_from_args,
                               model_options_from_args)
 from tmfem.cli.static import check_fe_static, check_stable, default_monitor
-from tmfem.errors import InputError
+from tmfem.errors import InputError, shorten
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import sequence_of
 
@@ -145,7 +145,7 @@ def format_text(r: dict) -> str:
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
              f"membrane, {r['dofs']} free dofs",
              f"rest lengths {r['rest_lengths_source']}: {r['rest_lengths_note']}",
-             "prestress: " + ", ".join(f"{k}={v:.5f} m" for k, v in list(r["rest_lengths"].items())[:4])
+             "prestress: " + shorten(f"{k}={v:.5f} m" for k, v in r["rest_lengths"].items())
              + f"; max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, bar load "
                f"{r['bar_load_max']:.3f} N, Delta {r['Delta_mean'] * 1e3:.4f} mm"]
     d = r.get("dissertation")

@@ -6,6 +6,7 @@ import sys
 import numpy as np
 
 from tmfem.cli.common import add_model_args, add_system_args, model_from_args
+from tmfem.errors import shorten
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import sequence_of
 from tmfem.system.collapse import check_standing
@@ -164,8 +165,7 @@ def format_text(r: dict) -> str:
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
              f"membrane, {r['dofs']} free dofs",
              f"rest lengths {r['rest_lengths_source']} ({describe_rule(r['rest_lengths_source'])}): "
-             + ", ".join(f"{k}={v:.5f} m" for k, v in list(r["rest_lengths"].items())[:8])
-             + (" ..." if len(r["rest_lengths"]) > 8 else ""),
+             + shorten((f"{k}={v:.5f} m" for k, v in r["rest_lengths"].items()), 8),
              f"converged in {r.get('iterations')} iterations ({r.get('static_time_s', 0):.2f} s); "
              f"residual {r['residual_history'][0]:.3e} -> {r['residual_history'][-1]:.3e} N",
              f"max distance of a node from the design: {r['max_deviation_from_design'] * 1e3:.3f} mm",
@@ -184,8 +184,8 @@ def format_text(r: dict) -> str:
     lines.append(f"{'':32s} {'MTC':>12s} {'dissertation':>12s}")
     lines += [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
               for a, b, c in rows]
-    lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.3f}" for k, v in
-                                                   list(r["tendon_force"].items())[:12]))
+    lines.append("tendon forces [N]: " + shorten((f"{k}={v:.3f}" for k, v in
+                                                  r["tendon_force"].items()), 12))
     if r["tendon_slack"]:
         lines.append(f"SLACK tendons: {r['tendon_slack']}")
     lines += check_lines(r["checks"])

@@ -11,7 +11,7 @@ import logging
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.errors import InputError, shorten
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.reference.tables import FREQUENCIES, HIGHEST_COM_FREQUENCY
@@ -123,8 +123,7 @@ def format_summary(r: dict) -> str:
              f"from the {r.get('rest_lengths_source', 'design')}"]
     forces = r.get("design_tendon_forces") or r.get("equilibrium_tendon_forces") or {}
     if forces:
-        lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.4g}" for k, v in list(forces.items())[:6])
-                     + (" ..." if len(forces) > 6 else ""))
+        lines.append("tendon forces [N]: " + shorten((f"{k}={v:.4g}" for k, v in forces.items()), 6))
     if "printed_stress_prestress_scale" in r:
         lines.append(f"prestress implied by the printed tendon stress: x{r['printed_stress_prestress_scale']:.4f}"
                      " (--prestress-scale in the Python API, docs/com.md)")

@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from tmfem.errors import CollapsedStructure
+from tmfem.errors import CollapsedStructure, shorten
 from tmfem.system.topology import label
 
 #: A bar has collapsed when the rise of its upper end above its lower end is at most this
@@ -29,13 +29,6 @@ def flat_bars(system, X) -> list[int]:
     lengths = np.asarray(system.l, dtype=float).ravel()
     limit = np.minimum(FLAT_RISE * lengths, 0.1 * rise_d)
     return np.flatnonzero((rise_d > 0) & ~(rise > limit)).tolist()
-
-
-def _listed(items, limit: int = 4) -> str:
-    """``a, b, c, d, ... (9 in all)``: a list shortened with an ellipsis and its count."""
-    items = list(items)
-    head = ", ".join(map(str, items[:limit]))
-    return head if len(items) <= limit else f"{head}, ... ({len(items)} in all)"
 
 
 def nonfinite_keys(values: dict) -> list[str]:
@@ -94,7 +87,7 @@ def check_standing(system, X, *, what: str, values: dict | None = None,
         k0 = flat[0]
         rise = float(X[2, n + k0] - X[2, k0])
         rise_d = float(Xd[2, n + k0] - Xd[2, k0])
-        parts.append(f"bars {_listed(names)} lie flat (check: the rise of a bar's upper end "
+        parts.append(f"bars {shorten(names)} lie flat (check: the rise of a bar's upper end "
                      f"above its lower end > {FLAT_RISE:.0%} of its length; {names[0]}: "
                      f"{rise:.4g} m, design {rise_d:.4g} m)")
     if rest_lengths is not None:
@@ -105,9 +98,9 @@ def check_standing(system, X, *, what: str, values: dict | None = None,
         top = [f"{system.tendons[k].name} at {stretch[k]:.3g} x its rest length"
                for k in order if stretch[k] > 1.5]
         if top:
-            parts.append(f"tendons stretched {_listed(top, 3)}")
+            parts.append(f"tendons stretched {shorten(top, 3)}")
     if bad or not np.all(np.isfinite(X)):
-        parts.append(f"non-finite results ({_listed(bad or ['node positions'])}; e.g. a "
+        parts.append(f"non-finite results ({shorten(bad or ['node positions'])}; e.g. a "
                      "membrane strained beyond the range of its law)")
     kind = "collapsed" if flat else "has no valid state"
     raise CollapsedStructure(f"{what} {kind}: " + "; ".join(parts) + " (expected a standing "

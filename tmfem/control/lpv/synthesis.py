@@ -210,8 +210,10 @@ class LPVStateFeedback:
         InputError
             Not a file written by :meth:`save`.
         """
+        from tmfem.io.npz import read_npz
+        d = read_npz(path, expected="an .npz LPV controller written by `tmfem control lpv "
+                                    "--save`")
         try:
-            d = np.load(path, allow_pickle=False)
             keys = ("gamma", "P", "Q", "centre", "half_width", "varying", "rate_bounds",
                     "parameter_names", "state_names")
             f = {k: d[k] for k in keys}
