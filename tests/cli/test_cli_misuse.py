@@ -125,6 +125,11 @@ def string_rest(tmp_path):
     (["static", "--preset", "1-4", "--wrinkle-plot", "FILE/w.png"], BAD_INPUT, "not a directory"),
     (["report", "--preset", "2-3", "--out", "OUT", "--no-deploy"], BAD_INPUT, "does not apply"),
     (["report", "--preset", "1-4", "--out", "OUT", "--modes", "20"], BAD_INPUT, "coordinates"),
+    # a pseudo-filesystem that refuses writes (os.access says yes to root): a real write
+    (["vibrate", "--preset", "1-4", "--csv", "/proc/h.csv"], BAD_INPUT, "not writable"),
+    (["static", "--preset", "1-4", "--vtk", "/sys/s.vtu"], BAD_INPUT, "not writable"),
+    (["study", "--preset", "1-4", "--out", "/proc/study"], BAD_INPUT, "cannot create"),
+    (["equilibrium", "/dev/zero"], BAD_INPUT, "at most 1,048,576 bytes"),
 ])
 def test_misuse_one_line_and_exit_code(argv, code, needle, tmp_path, capsys):
     f = tmp_path / "a_file"
