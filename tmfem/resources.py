@@ -95,8 +95,9 @@ def check_system_budget(system, *, source: str = "the system") -> float:
     Every command starts from the design, so this bounds the stages, bars per stage and
     tendons of a system file. Returns the estimate in bytes."""
     M, N, nt = system.M, system.N, len(system.tendons)
+    stages = f"{M} stage{'s' if M != 1 else ''}"
     return require_memory(design_bytes(M=M, N=N, n_tendons=nt, deployable=system.deployable),
-                          given=f"{source}: {M} stages x {N} bars, {nt} tendons",
+                          given=f"{source}: {stages} x {N} bars, {nt} tendons",
                           what="the equilibrium design (dense node Jacobian and the SVD of "
                                "the equilibrium matrix, eqs. 3.1-3.16)")
 

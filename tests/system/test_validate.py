@@ -211,3 +211,9 @@ def test_every_preset_is_within_the_bounds():
     for name in list_presets():
         for as_printed in (False, True):
             load_preset(name, as_printed=as_printed)
+
+
+@pytest.mark.parametrize("value", [1e-300, 1e300])
+def test_rest_lengths_from_an_option_share_the_bounds(value):
+    with pytest.raises(InputError, match=r"within 0.001..1000 m .* found 1e[+-]300 m \(tendon 1 of 4\)"):
+        load_preset("1-4").with_rest_lengths({"S1": value})

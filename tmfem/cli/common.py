@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.errors import InputError, ResourceLimit
+from tmfem.errors import InputError, ResourceLimit, shorten
 from tmfem.resources import (BASE_BYTES, BYTES_PER_DOF, MAX_MEMBRANE_MODES,  # noqa: F401
                              MEMORY_FRACTION, check_membrane_modes, check_mesh_budget,
                              check_system_budget, machine_memory)
@@ -368,7 +368,8 @@ def warn_long_rest_lengths(system: System, rest=None) -> list[str]:
             "design configuration; it is slack there" for k in np.flatnonzero(r >= L)]
     if msgs and len(msgs) == len(names):
         raise InputError(f"every tendon is slack at the design configuration: rest lengths "
-                         f"{np.round(r, 5).tolist()} m >= lengths {np.round(L, 5).tolist()} m; "
+                         f"{shorten(np.round(r, 5).tolist())} m >= lengths "
+                         f"{shorten(np.round(L, 5).tolist())} m; "
                          "nothing prestresses the system (expected rest lengths shorter than "
                          "the tendons)")
     for m in msgs:
