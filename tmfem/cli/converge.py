@@ -2,11 +2,14 @@
 from __future__ import annotations
 
 import csv
+import os
+from pathlib import Path
 
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
                               check_attachment_options, check_model_budget, check_outputs,
                               system_from_args)
 from tmfem.errors import InputError, shorten
+from tmfem.io.run import partial_name
 from tmfem.io.units import unit_of
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import apply_rest_lengths
@@ -76,9 +79,11 @@ def run(args) -> dict:
     rest, rule = resolve_rest_lengths(system, rest_lengths=rest)
     rows = []
     writer = fh = None
+    complete = False
     try:
-        if args.csv:
-            fh = open(args.csv, "w", newline="")
+        if args.csv:                   # NAME.csv.partial until the last run (docs/cli.md)
+            Path(args.csv).unlink(missing_ok=True)
+            fh = open(partial_name(args.csv), "w", newline="")
         for row in convergence_rows(system, meshes=meshes, tendon_elements=tendons,
                                     attachment=args.attachment, rest_lengths=rest,
                                     modes=args.modes, patch=args.patch, backend=args.backend,
@@ -91,9 +96,12 @@ def run(args) -> dict:
                     writer.writerow({k: _header(k) for k in keys})
                 writer.writerow(row)
                 fh.flush()
+        complete = True
     finally:
         if fh is not None:
             fh.close()
+            if complete:
+                os.replace(partial_name(args.csv), args.csv)
     out = {"system": system.name, "model": args.model, "attachment": args.attachment,
            "membrane_law": args.membrane_law, "rest_lengths_rule": rule,
            "rest_lengths_note": describe_rule(rule, per_mesh_study=True),
