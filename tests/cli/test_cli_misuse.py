@@ -130,6 +130,9 @@ def string_rest(tmp_path):
     (["static", "--preset", "1-4", "--vtk", "/sys/s.vtu"], BAD_INPUT, "not writable"),
     (["study", "--preset", "1-4", "--out", "/proc/study"], BAD_INPUT, "cannot create"),
     (["equilibrium", "/dev/zero"], BAD_INPUT, "at most 1,048,576 bytes"),
+    # the eigen solver's basis beside the model (tmfem.cli.common.check_model_budget)
+    (["modal", "--preset", "1-4", "--mesh", "150", "--modes", "50000"], TOO_LARGE,
+     "basis of 2 x 50000 vectors needs about"),
 ])
 def test_misuse_one_line_and_exit_code(argv, code, needle, tmp_path, capsys):
     f = tmp_path / "a_file"

@@ -15,7 +15,7 @@ import numpy as np
 from tmfem.errors import InputError, ResourceLimit, shorten
 from tmfem.resources import (BASE_BYTES, BYTES_PER_DOF, MAX_MEMBRANE_MODES,  # noqa: F401
                              MEMORY_FRACTION, check_membrane_modes, check_mesh_budget,
-                             check_system_budget, machine_memory)
+                             check_system_budget, machine_memory, require_memory)
 from tmfem.system import System, load_preset, load_system
 
 log = logging.getLogger(__name__)
@@ -87,7 +87,7 @@ def model_options_from_args(args, command: str):
                          f"--backend {args.backend or 'scipy'}")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
-        check_model_budget(system, mesh=options["mesh"],
+        check_model_budget(system, mesh=options["mesh"], modes=getattr(args, "modes", None),
                            tendon_elements=options.get("tendon_elements") or 1,
                            bar_elements=options.get("bar_elements"),
                            dofs_per_node=6 if args.model == "sbc" else 3)
@@ -304,7 +304,8 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
     it is built: the membrane mesh (:func:`check_mesh_budget`, ``dofs_per_node`` 3 for the
     membrane elements, 6 for shells) plus 3 (k - 1) DOFs per tendon of k truss elements and,
     with ``bar_elements`` b (beam bars, 6 DOFs per node), 6 (3 b - 1) per bar; ``modes`` must
-    stay below the DOF estimate. Returns the DOF estimate."""
+    stay below the DOF estimate, and the eigen solver's basis (2 ``modes`` vectors of the
+    DOFs, 8 bytes an entry) must fit beside the model. Returns the DOF estimate."""
     extra = 3 * len(system.tendons) * (tendon_elements - 1)
     what = [f"{len(system.tendons)} tendons x {tendon_elements} elements"]
     if bar_elements is not None:
@@ -317,6 +318,10 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
     if modes is not None and modes >= dofs:
         raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
                          "DOFs")
+    if modes is not None:                 # the eigen solver's basis: 2 x modes vectors
+        require_memory(BASE_BYTES + BYTES_PER_DOF * dofs + 16.0 * dofs * modes,
+                       given=f"--modes {modes} {given}",
+                       what=f"the model's about {dofs:,} DOFs with a basis of 2 x {modes} vectors")
     return dofs
 
 
