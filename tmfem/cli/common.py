@@ -87,10 +87,12 @@ def model_options_from_args(args, command: str):
                          f"--backend {args.backend or 'scipy'}")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
-        check_model_budget(system, mesh=options["mesh"], modes=getattr(args, "modes", None),
-                           tendon_elements=options.get("tendon_elements") or 1,
-                           bar_elements=options.get("bar_elements"),
-                           dofs_per_node=6 if args.model == "sbc" else 3)
+        dofs = check_model_budget(system, mesh=options["mesh"],
+                                  tendon_elements=options.get("tendon_elements") or 1,
+                                  bar_elements=options.get("bar_elements"),
+                                  dofs_per_node=6 if args.model == "sbc" else 3)
+        if isinstance(getattr(args, "modes", None), int):     # modal: the exact DOFs later
+            check_modes_budget(dofs, modes=args.modes, given=f"--mesh {options['mesh']}")
     if "attachment" in options:
         check_attachment_options(system, attachment=options["attachment"], patch=options["patch"])
     if options.get("membrane_modes") is not None:
@@ -318,11 +320,17 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
     if modes is not None and modes >= dofs:
         raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
                          "DOFs")
-    if modes is not None:                 # the eigen solver's basis: 2 x modes vectors
-        require_memory(BASE_BYTES + BYTES_PER_DOF * dofs + 16.0 * dofs * modes,
-                       given=f"--modes {modes} {given}",
-                       what=f"the model's about {dofs:,} DOFs with a basis of 2 x {modes} vectors")
+    if modes is not None:
+        check_modes_budget(dofs, modes=modes, given=given)
     return dofs
+
+
+def check_modes_budget(dofs: int, *, modes: int, given: str = "") -> None:
+    """Refuse ``--modes`` whose eigen-solver basis (2 ``modes`` vectors of ``dofs`` entries,
+    8 bytes each) does not fit beside the model (``BYTES_PER_DOF`` per DOF)."""
+    require_memory(BASE_BYTES + BYTES_PER_DOF * dofs + 16.0 * dofs * modes,
+                   given=f"--modes {modes} {given}".strip(),
+                   what=f"the model's about {dofs:,} DOFs with a basis of 2 x {modes} vectors")
 
 
 def check_com_modes(system: System, *, modes: int, membrane_modes=None) -> int:
