@@ -217,3 +217,12 @@ def test_every_preset_is_within_the_bounds():
 def test_rest_lengths_from_an_option_share_the_bounds(value):
     with pytest.raises(InputError, match=r"within 0.001..1000 m .* found 1e[+-]300 m \(tendon 1 of 4\)"):
         load_preset("1-4").with_rest_lengths({"S1": value})
+
+
+def test_section_and_rest_length_keys_no_tendon_takes(tmp_path):
+    d = preset("1-4")
+    d["tendons"]["V2"] = dict(d["tendons"]["S"])          # 1-4 has S_1j tendons only
+    refused(tmp_path, d, "[tendons.V2]", "'V2'", "['S1']")
+    d = preset("1-4")
+    d["rest_lengths"] = {"S1": 1.5, "S9": 1.0}
+    refused(tmp_path, d, "[rest_lengths]", "'S9'")

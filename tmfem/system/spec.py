@@ -46,8 +46,8 @@ from tmfem.system.geometry import SymmetricConfig, membrane_corners_regular
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
 from tmfem.system.system import System
 from tmfem.system.topology import Tendon
-from tmfem.system.validate import (check_bounds, check_stage_lists, check_tendon_list,
-                                   read_bounded, system_name)
+from tmfem.system.validate import (check_bounds, check_keys_used, check_stage_lists,
+                                   check_tendon_list, read_bounded, system_name)
 
 _TOP_KEYS = {"name", "description", "N", "deployable", "k_H", "notes", "symmetric", "general",
              "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed",
@@ -295,9 +295,11 @@ def system_from_dict(d: dict, where: str = "system") -> System:
                               z=_floats(s, "z", w, M, np.zeros(M)), r=_floats(s, "r", w, M),
                               l=_floats(s, "l", w, M))
         r_mb = _num(mtab, "r_mb", f"{where} [membrane]")
-        return System.symmetric_system(N=N, config=cfg, r_mb=r_mb, membrane=membrane, bar=bar,
-                                       tendon_sections=sections, deployable=deployable, k_H=k_H,
-                                       rest_lengths=rest, **common)
+        sys = System.symmetric_system(N=N, config=cfg, r_mb=r_mb, membrane=membrane, bar=bar,
+                                      tendon_sections=sections, deployable=deployable, k_H=k_H,
+                                      rest_lengths=rest, **common)
+        check_keys_used(sys, d, where)
+        return sys
     g = _table(d, "general", where)
     w = f"{where} [general]"
     base = _floats(g, "base", w).reshape(-1, 3).T if np.size(g.get("base", [])) else None
@@ -318,6 +320,7 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     sys = System(M=M, N=N, deployable=deployable, base=base, l=l, q=q, membrane=membrane,
                  membrane_corners=corners, bar=bar, tendon_sections=sections, k_H=k_H,
                  tendons=tendons, r_mb=r_mb, **common)
+    check_keys_used(sys, d, where)
     return sys.with_rest_lengths(rest) if rest else sys
 
 

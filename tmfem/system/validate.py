@@ -15,7 +15,7 @@ import stat
 import time
 from pathlib import Path
 
-from tmfem.errors import InputError
+from tmfem.errors import InputError, shorten
 from tmfem.system.topology import FAMILIES_D, FAMILIES_MN
 
 #: Largest system file read [bytes]; the presets are below 8 kB, a 2000-stage file ~150 kB.
@@ -196,3 +196,24 @@ def check_stage_lists(d: dict, N, where: str) -> None:
         if n and nl not in (0, 1, M * N):
             raise InputError(f"{where} [general]: expected 'l' to have 1 or M N = {M * N} entries "
                              f"(M = {M} stages from 'q'), found {nl}")
+
+
+def check_keys_used(system, d: dict, where: str) -> None:
+    """Keys of ``[tendons.KEY]`` and ``[rest_lengths]`` that no tendon of the built
+    ``system`` takes (a misspelt group would be ignored silently): refused, with the keys
+    the system has. ``"*"`` (every tendon) is always taken."""
+    groups = sorted({t.group for t in system.tendons})
+    families = sorted({t.family for t in system.tendons})
+    sections = d.get("tendons") if isinstance(d.get("tendons"), dict) else {}
+    for key in sections:
+        if key != "*" and key not in groups and key not in families:
+            raise InputError(f"{where} [tendons.{key}]: expected a tendon group {groups}, a "
+                             f"family {families} or \"*\", found {key!r}, which no tendon of "
+                             "this system has")
+    rest = d.get("rest_lengths") if isinstance(d.get("rest_lengths"), dict) else {}
+    names = {t.name for t in system.tendons}
+    for key in rest:
+        if key not in names and key not in groups:
+            raise InputError(f"{where} [rest_lengths]: expected tendon names or groups "
+                             f"({shorten(groups)}), found {key!r}, which no tendon of this "
+                             "system has")
