@@ -82,3 +82,13 @@ def test_write_series_ends_complete(tmp_path):
     from tmfem.io.series import write_series
     pvd = write_series(tmp_path, [(0.0, np.zeros((3, 3)), [("triangle", np.array([[0], [1], [2]]))])])
     assert INCOMPLETE not in pvd.read_text()
+
+
+def test_nonfinite_row_is_refused(tmp_path):
+    from tmfem.errors import ConvergenceError
+    out = run_outputs(tmp_path)
+    out.row(0.0, np.array([0.1]))
+    with pytest.raises(ConvergenceError, match=r"t = 0.01 s: non-finite values of theta_11"):
+        out.row(0.01, np.array([np.nan]))
+    out.close(complete=False)
+    assert partial_name(tmp_path / "h.csv").read_text().count("\n") == 2     # header, t = 0

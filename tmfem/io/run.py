@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError, shorten
 from tmfem.io.series import SeriesWriter
 
 
@@ -78,6 +78,7 @@ class RunOutputs:
         self.writer = csv.writer(self.fh, lineterminator="\n") if self.fh else None
         if self.writer:
             self.writer.writerow([column_header(c) for c in columns])
+        self.columns = list(columns)
         self.vtk_every = vtk_every
         self.count = 0
         self.min_force = [np.inf, 0.0, ""]        # smallest tendon force, its time and tendon
@@ -93,7 +94,20 @@ class RunOutputs:
             self.min_force[:] = [float(force[k]), float(t), names[k]]
 
     def row(self, t: float, values: np.ndarray) -> None:
-        """Write the CSV row of time t (when a CSV is asked) and count the step."""
+        """Write the CSV row of time t (when a CSV is asked) and count the step.
+
+        Raises
+        ------
+        ConvergenceError
+            when a value is NaN or infinite (the run diverged): no such row is written, the
+            files keep their partial mark.
+        """
+        values = np.asarray(values, dtype=float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size or not np.isfinite(t):
+            names = [self.columns[1 + k] for k in bad] if bad.size else ["t"]
+            raise ConvergenceError(f"t = {t:.6g} s: non-finite values of {shorten(names)} (the "
+                                   "run diverged; nothing non-finite is written)")
         self.count += 1
         if self.writer:
             self.writer.writerow([f"{t:.6g}"] + [f"{v:.10g}" for v in values])
