@@ -85,3 +85,11 @@ def test_no_progress_bar_when_disabled(env):
 def test_no_color_draws_plain_ascii():
     text = on_terminal(NO_COLOR="1")
     assert "/300" in text and not any(ord(c) > 127 for c in text)
+
+
+def test_edge_membrane_points_snapped_silently(capsys):
+    # eq. 5.73's point (2, 1) lies on the edge of the 1-4(D) membrane (side 1.9997 m): moved
+    # inside by the documented rule, without a message on every run
+    rc, out, err = run(["control", "pbh", "--preset", "1-4D"], capsys)
+    assert rc == 0 and "controllable True" in out
+    assert "outside the mesh" not in err
