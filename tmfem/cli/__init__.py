@@ -194,13 +194,20 @@ OUTPUTS = ("out", "vtk", "png", "stress_plot", "wrinkle_plot", "csv", "plot", "s
 
 
 def output_directories(args) -> list:
-    """The directories a command will write to (:data:`OUTPUTS`), each once."""
+    """The directories a command will write to (:data:`OUTPUTS`), each once; two options
+    that name the same path (``--csv a.csv --compare-csv a.csv``) are refused."""
     from pathlib import Path
-    dirs = []
+    dirs, seen = [], {}
     for dest in OUTPUTS:
         value = getattr(args, dest, None)
         if isinstance(value, (str, os.PathLike)) and str(value):
             p = Path(value)
+            key = os.path.abspath(p)
+            if key in seen:
+                raise InputError(f"--{dest.replace('_', '-')} {str(value)!r}: expected its own "
+                                 f"output path, found the one of --{seen[key].replace('_', '-')} "
+                                 "(one would overwrite the other)")
+            seen[key] = dest
             dirs.append(p.parent if p.suffix else p)
     return list(dict.fromkeys(dirs))
 
