@@ -132,6 +132,8 @@ def string_rest(tmp_path):
     (["equilibrium", "/dev/zero"], BAD_INPUT, "at most 1,048,576 bytes"),
     (["static", "--preset", "1-4", "--png", "OUT/a.png", "--stress-plot", "OUT/a.png"], BAD_INPUT,
      "expected its own output path, found the one of --png"),
+    (["compare", "--preset", "1-4", "--mesh", "2000"], TOO_LARGE, "GiB"),
+    (["compare", "--preset", "1-4", "--vibrate", "--mesh", "2000"], TOO_LARGE, "GiB"),
     # the eigen solver's basis beside the model (tmfem.cli.common.check_model_budget)
     (["modal", "--preset", "1-4", "--mesh", "150", "--modes", "50000"], TOO_LARGE,
      "basis of 2 x 50000 vectors needs about"),

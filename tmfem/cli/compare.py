@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import sys
 
-from tmfem.cli.common import (Progress, check_time_steps, finite_float, output_file,
-                              parse_perturbation, positive_int)
+from tmfem.cli.common import (Progress, check_model_budget, check_time_steps, finite_float,
+                              output_file, parse_perturbation, positive_int)
 from tmfem.errors import InputError
+from tmfem.system import load_preset
 from tmfem.solvers.backends import backend_names
 
 NAME = "compare"
@@ -51,6 +52,9 @@ def run(args) -> dict:
         flags = ", ".join("--" + d.replace("_", "-") for d in wrong)
         raise InputError(f"compare{' --vibrate' if args.vibrate else ''}: option does not apply: "
                          f"{flags} ({'without' if args.vibrate is False else 'with'} --vibrate)")
+    # the SBC model is the larger of the two FE models (shells: 6 DOFs a node)
+    check_model_budget(load_preset(args.preset), mesh=args.mesh,
+                       tendon_elements=args.tendon_elements, modes=args.modes, dofs_per_node=6)
     output_file(args.csv, option="--csv", suffixes=(".csv",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
     return run_vibration(args) if args.vibrate else run_frequencies(args)
