@@ -134,6 +134,8 @@ def string_rest(tmp_path):
      "expected its own output path, found the one of --png"),
     (["compare", "--preset", "1-4", "--mesh", "2000"], TOO_LARGE, "GiB"),
     (["compare", "--preset", "1-4", "--vibrate", "--mesh", "2000"], TOO_LARGE, "GiB"),
+    (["vibrate", "--preset", "1-4", "--t-end", "1000", "--vtk", "OUT/s", "--vtk-every", "1"],
+     TOO_LARGE, "100,001 ParaView frames; the limit is 10,000"),
     # the eigen solver's basis beside the model (tmfem.cli.common.check_model_budget)
     (["modal", "--preset", "1-4", "--mesh", "150", "--modes", "50000"], TOO_LARGE,
      "basis of 2 x 50000 vectors needs about"),

@@ -299,6 +299,21 @@ def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> i
     return steps
 
 
+#: Most ParaView frames of one series (a frame is a .vtu of the whole configuration: 1-4's
+#: COM frames take ~50 kB, so 10 000 frames ~0.5 GB of disk)
+MAX_FRAMES = 10_000
+
+
+def check_frames(*, steps: int, every: int, option: str = "--vtk-every") -> int:
+    """ParaView frames of a time run of ``steps`` steps, one every ``every``: at most
+    :data:`MAX_FRAMES`. Returns the number of frames."""
+    frames = steps // every + 1
+    if frames > MAX_FRAMES:
+        raise ResourceLimit(f"{option} {every}: {steps:,} steps give {frames:,} ParaView frames; "
+                            f"the limit is {MAX_FRAMES:,} (raise {option} or lower --t-end)")
+    return frames
+
+
 def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
                        bar_elements: int | None = None, modes: int | None = None,
                        dofs_per_node: int = 3) -> int:

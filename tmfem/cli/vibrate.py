@@ -6,8 +6,9 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_model_args, add_system_args, check_time_steps, finite_float,
-                              model_from_args, parse_perturbation, positive_int, progress_bar)
+from tmfem.cli.common import (add_model_args, add_system_args, check_frames, check_time_steps,
+                              finite_float, model_from_args, parse_perturbation, positive_int,
+                              progress_bar)
 from tmfem.errors import InputError
 from tmfem.cli.static import check_fe_static
 from tmfem.models.mtc.spec import sequence_of
@@ -36,11 +37,13 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
-    check_time_steps(t_end=args.t_end, dt=args.dt)
+    steps = check_time_steps(t_end=args.t_end, dt=args.dt)
     if args.vtk_every is not None and args.vtk is None:
         raise InputError("--vtk-every: option does not apply without --vtk DIR (it spaces the "
                          "ParaView frames)")
     args.vtk_every = args.vtk_every or 10
+    if args.vtk is not None:
+        check_frames(steps=steps, every=args.vtk_every)
     model, options = model_from_args(args, NAME)
     if args.model in ("mtc", "sbc"):
         return run_fe(args, model, options)
