@@ -15,6 +15,7 @@ these.
 """
 from __future__ import annotations
 
+import _thread
 import argparse
 import importlib
 import json
@@ -25,6 +26,7 @@ import pkgutil
 import signal
 import sys
 import threading
+import time
 import warnings
 
 import numpy as np
@@ -108,17 +110,20 @@ class _MessageFormatter(logging.Formatter):
         return f"tmfem: {text}"
 
 
+_HANDLER = logging.StreamHandler(sys.stderr)
+_HANDLER.setFormatter(_MessageFormatter())
+
+
 def _setup_logging(*, quiet: bool = False) -> None:
     """Library progress (``logging`` INFO of the ``tmfem`` loggers, not with ``--quiet``)
     and warnings on stderr, one line each, prefixed ``tmfem:``. Python warnings (the
     library's and numpy's) go through the same channel: once per message, without the
     source path and line (:func:`_show_warning`)."""
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(_MessageFormatter())
     log = logging.getLogger("tmfem")
-    if not log.handlers:
-        log.addHandler(handler)
+    if _HANDLER not in log.handlers:
+        log.addHandler(_HANDLER)
         log.propagate = False
+    _HANDLER.stream = sys.stderr          # this run's stderr (the old one may be closed)
     log.setLevel(logging.WARNING if quiet else logging.INFO)
     _SHOWN.clear()
     warnings.showwarning = _show_warning
@@ -139,6 +144,8 @@ def _show_warning(message, category, filename, lineno, file=None, line=None) -> 
 
 #: Exit codes of the signals the CLI ends on: 128 + the signal number, as a shell reports.
 SIGNAL_EXITS = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminated")}
+#: Seconds the main thread has to take SIGTERM before its own thread ends the process.
+SIGTERM_GRACE_S = 5.0
 
 
 def _install_interrupt_handler(command: str, cleanup=None):
@@ -152,8 +159,11 @@ def _install_interrupt_handler(command: str, cleanup=None):
 
     SIGTERM is blocked and taken by a thread of its own (``sigwait``): compiled libraries
     reset its disposition to the default (measured: the COM's free vibration does, after its
-    first steps), which would end the process without a word. Returns a function that puts
-    the previous handling back (None off the main thread)."""
+    first steps), which would end the process without a word. The thread hands it to the
+    main thread (``_thread.interrupt_main``), so that nothing is written while the handler
+    cleans up; when the main thread stays in a compiled call for :data:`SIGTERM_GRACE_S`,
+    the thread ends the process itself. Returns a function that puts the previous handling
+    back (None off the main thread)."""
     if threading.current_thread() is not threading.main_thread():
         return None
 
@@ -166,14 +176,17 @@ def _install_interrupt_handler(command: str, cleanup=None):
         print(f"\ntmfem {command}: {what}", file=sys.stderr, flush=True)
         os._exit(code)
 
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: end(signum))
+    previous = {sig: signal.signal(sig, lambda signum, frame: end(signum)) for sig in SIGNAL_EXITS}
     signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
     state = {"stopping": False}
 
     def wait():
         signal.sigwait({signal.SIGTERM})
-        if not state["stopping"]:
-            end(signal.SIGTERM)
+        if state["stopping"]:
+            return
+        _thread.interrupt_main(signal.SIGTERM)     # the handler runs on the main thread
+        time.sleep(SIGTERM_GRACE_S)
+        end(signal.SIGTERM)
     waiter = threading.Thread(target=wait, name="tmfem-sigterm", daemon=True)
     waiter.start()
 
@@ -182,7 +195,8 @@ def _install_interrupt_handler(command: str, cleanup=None):
         signal.pthread_kill(waiter.ident, signal.SIGTERM)
         waiter.join()
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
-        signal.signal(signal.SIGINT, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     return restore
 
 
@@ -217,6 +231,7 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     mod = args._module
+    show_warning = warnings.showwarning          # put back when main returns
     _setup_logging(quiet=args.quiet)
     from tmfem.cli.common import QUIET
     QUIET["on"] = args.quiet
@@ -251,6 +266,7 @@ def main(argv=None) -> int:
         cleanup()
         if restore is not None:
             restore()
+        warnings.showwarning = show_warning
     return _checks_exit(args, result)
 
 
