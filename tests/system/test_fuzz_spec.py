@@ -6,8 +6,6 @@ message for the CLI); never another exception. Mutations start from the shipped 
 (a real, valid file), so most examples get deep into the validation.
 """
 import copy
-import math
-import tomllib
 
 import pytest
 import tomli_w
