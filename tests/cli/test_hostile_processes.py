@@ -83,7 +83,7 @@ def test_second_run_refused_and_signal_leaves_partial_files(tmp_path, sig, code,
 
 def test_two_study_runs_into_one_directory(tmp_path):
     out = tmp_path / "study"
-    first = tmfem("study", "--preset", "2-3", "--out", out, "--map-grid", "30")
+    first = tmfem("study", "--preset", "2-3", "--out", out, "--map-grid", "60")
     try:
         wait_for(lambda: (out / LOCK_NAME).exists())
         second = tmfem("study", "--preset", "1-4", "--out", out, "--map-grid", "0")
@@ -93,3 +93,9 @@ def test_two_study_runs_into_one_directory(tmp_path):
         first.send_signal(signal.SIGTERM)
         first.communicate(timeout=60)
     assert first.returncode in (0, 143)
+    # a directory whose run did not end says so (its files may mix two runs)
+    assert (out / "INCOMPLETE").exists() == (first.returncode == 143)
+    done = tmfem("study", "--preset", "1-4", "--out", out, "--mesh", "4", "--map-grid", "0")
+    _, err = done.communicate(timeout=300)
+    assert done.returncode == 0, err
+    assert not (out / "INCOMPLETE").exists() and not (out / LOCK_NAME).exists()

@@ -207,6 +207,25 @@ OUTPUTS = ("out", "vtk", "png", "stress_plot", "wrinkle_plot", "csv", "plot", "s
            "compare_csv", "compare_plot")
 
 
+#: File in an output directory (``--out``) while its run has not ended: a run that fails or
+#: is interrupted leaves it, since the directory may then hold files of an earlier run.
+INCOMPLETE_MARK = "INCOMPLETE"
+
+
+def _mark_incomplete(args):
+    """Write :data:`INCOMPLETE_MARK` into the output directory ``--out`` (when there is
+    one); returns its path, or None."""
+    from pathlib import Path
+    out = getattr(args, "out", None)
+    if not isinstance(out, (str, os.PathLike)) or Path(out).suffix or not Path(out).is_dir():
+        return None
+    mark = Path(out) / INCOMPLETE_MARK
+    mark.write_text(f"tmfem {args.command} (pid {os.getpid()}) has not finished writing this "
+                    "directory; a run that stops leaves this file, and the directory may then "
+                    "hold files of an earlier run\n")
+    return mark
+
+
 def output_directories(args) -> list:
     """The directories a command will write to (:data:`OUTPUTS`), each once; two options
     that name the same path (``--csv a.csv --compare-csv a.csv``) are refused."""
@@ -248,8 +267,11 @@ def main(argv=None) -> int:
     try:
         for d in output_directories(args):
             lock.acquire(d, label=f"tmfem {args.command}")
+        mark = _mark_incomplete(args)
         result = mod.run(args)
         print(render(args, mod, result))
+        if mark is not None:
+            mark.unlink(missing_ok=True)
     except TmfemError as exc:
         print(f"tmfem {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
