@@ -8,12 +8,22 @@ line and exits with :attr:`TmfemError.exit_code` (the contract is in docs/guides
 0     success (with ``--allow-infeasible``: also when checks failed; they are listed)
 1     the analysis says no: infeasible design, slack tendon or membrane, a failed
       design check, no convergence
-2     bad input: malformed system file, option out of range, unwritable output path
+2     bad input: malformed system file, option out of range, unwritable output path, an
+      output directory in use by another run
 3     the job would not fit this machine (estimated memory/time over the limit)
 4     an optional backend or dependency is not installed
-130   interrupted (Ctrl-C)
+130   interrupted (Ctrl-C, SIGINT)
+143   terminated (SIGTERM)
 ====  ==========================================================================
 """
+
+
+def shorten(items, limit: int = 4) -> str:
+    """``a, b, c, d, ... (9 in all)``: the first ``limit`` items of a list, then an ellipsis
+    and the count -- never a list cut off silently (messages and the CLI's text)."""
+    items = [str(x) for x in items]
+    head = ", ".join(items[:limit])
+    return head if len(items) <= limit else f"{head}, ... ({len(items)} in all)"
 
 
 class TmfemError(Exception):
@@ -40,6 +50,11 @@ class SlackMembrane(InfeasibleDesign):
     """A membrane that is not stretched (corner displacement Delta <= 0, eq. 3.36)."""
 
 
+class CollapsedStructure(InfeasibleDesign):
+    """A static equilibrium that is no tensegrity: bars fallen flat or through their lower
+    ends, non-finite results (:func:`tmfem.system.collapse.check_standing`)."""
+
+
 class ConvergenceError(TmfemError):
     """An iterative solve (Newton, arc length, constraint projection) that did not converge."""
 
@@ -58,6 +73,11 @@ class SingularInputMatrix(TmfemError):
     5.46) is not square or not invertible at a configuration (its condition number exceeds
     the limit)."""
     exit_code = 4
+
+
+class OutputBusy(InputError):
+    """An output directory in use by another tmfem run (:mod:`tmfem.io.lock`); the message
+    names that run."""
 
 
 class ResourceLimit(InputError):

@@ -125,6 +125,20 @@ def string_rest(tmp_path):
     (["static", "--preset", "1-4", "--wrinkle-plot", "FILE/w.png"], BAD_INPUT, "not a directory"),
     (["report", "--preset", "2-3", "--out", "OUT", "--no-deploy"], BAD_INPUT, "does not apply"),
     (["report", "--preset", "1-4", "--out", "OUT", "--modes", "20"], BAD_INPUT, "coordinates"),
+    # a pseudo-filesystem that refuses writes (os.access says yes to root): a real write
+    (["vibrate", "--preset", "1-4", "--csv", "/proc/h.csv"], BAD_INPUT, "not writable"),
+    (["static", "--preset", "1-4", "--vtk", "/sys/s.vtu"], BAD_INPUT, "not writable"),
+    (["study", "--preset", "1-4", "--out", "/proc/study"], BAD_INPUT, "cannot create"),
+    (["equilibrium", "/dev/zero"], BAD_INPUT, "at most 1,048,576 bytes"),
+    (["static", "--preset", "1-4", "--png", "OUT/a.png", "--stress-plot", "OUT/a.png"], BAD_INPUT,
+     "expected its own output path, found the one of --png"),
+    (["compare", "--preset", "1-4", "--mesh", "2000"], TOO_LARGE, "GiB"),
+    (["compare", "--preset", "1-4", "--vibrate", "--mesh", "2000"], TOO_LARGE, "GiB"),
+    (["vibrate", "--preset", "1-4", "--t-end", "1000", "--vtk", "OUT/s", "--vtk-every", "1"],
+     TOO_LARGE, "100,001 ParaView frames; the limit is 10,000"),
+    # the eigen solver's basis beside the model (tmfem.cli.common.check_model_budget)
+    (["modal", "--preset", "1-4", "--mesh", "150", "--modes", "50000"], TOO_LARGE,
+     "basis of 2 x 50000 vectors needs about"),
 ])
 def test_misuse_one_line_and_exit_code(argv, code, needle, tmp_path, capsys):
     f = tmp_path / "a_file"

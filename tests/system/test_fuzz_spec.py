@@ -6,8 +6,6 @@ message for the CLI); never another exception. Mutations start from the shipped 
 (a real, valid file), so most examples get deep into the validation.
 """
 import copy
-import math
-import tomllib
 
 import pytest
 import tomli_w
@@ -18,7 +16,11 @@ from tmfem.errors import TmfemError
 from tmfem.system import load_system
 from tmfem.system.presets import list_presets, preset_dict
 
+from tests.system.test_validate import general_2_3
+from tmfem.system.validate import MAX_FILE_BYTES
+
 PRESETS = {name: preset_dict(name) for name in list_presets()}
+PRESETS["general-2-3"] = general_2_3()         # [general] with a [[tendon]] list
 
 # values a user might put where another type is expected
 _odd = st.one_of(
@@ -28,7 +30,14 @@ _odd = st.one_of(
     st.text(max_size=8), st.sampled_from(["1.5", "abc", "", "nan", "S_11"]),
     st.lists(st.floats(allow_nan=True, allow_infinity=True), max_size=4),
     st.lists(st.text(max_size=3), max_size=3),
-    st.dictionaries(st.text(max_size=4), st.integers(), max_size=2))
+    st.dictionaries(st.text(max_size=4), st.integers(), max_size=2),
+    # the fields of tmfem.system.validate: names, families, tendon entries, list lengths
+    st.sampled_from(["a/b", "../x", "1-4", "S_11", "SL", "X", "q" * 70, "x y"]),
+    st.lists(st.floats(-10, 10), max_size=40),
+    st.lists(st.fixed_dictionaries({"name": st.sampled_from(["S_11", "S_12", "T"]),
+                                    "family": st.sampled_from(["S", "V", "X", "SU"]),
+                                    "ends": st.just(["A_11", "B_13"])}), max_size=3),
+    st.integers(min_value=0, max_value=10**6))
 
 
 def _paths(d, prefix=()):
@@ -109,6 +118,23 @@ def test_arbitrary_bytes_load_or_raise_tmfem_error(tmp_path, data):
     p = tmp_path / "fuzz.toml"
     p.write_bytes(data)
     _check(p)
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(extra=st.integers(-64, 64))
+def test_files_around_the_size_limit(tmp_path, extra):
+    """A valid file padded to MAX_FILE_BYTES + extra bytes: loaded up to the limit, refused
+    with the limit beyond it."""
+    text = tomli_w.dumps(PRESETS["1-4"]).encode()
+    size = MAX_FILE_BYTES + extra
+    p = tmp_path / "padded.toml"
+    p.write_bytes(text + b"#" * (size - len(text) - 1) + b"\n")
+    assert p.stat().st_size == size
+    if size > MAX_FILE_BYTES:
+        with pytest.raises(TmfemError, match="at most 1,048,576 bytes"):
+            load_system(p)
+    else:
+        assert load_system(p).name == "1-4"
 
 
 def test_non_utf8_file_is_an_input_error(tmp_path):

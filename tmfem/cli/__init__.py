@@ -9,11 +9,13 @@ Exit codes (docs/guides/cli.md): a :class:`tmfem.errors.TmfemError` becomes one 
 and its ``exit_code`` (1 the analysis says no, 2 bad input, 3 too large for this machine,
 4 missing backend); a result whose ``ok`` is false or whose ``checks`` failed is printed
 and exits 1 unless the command was given ``--allow-infeasible``; an output path that
-cannot be written is exit 2; Ctrl-C prints one line and exits 130. Never a traceback for
-any of these.
+cannot be written, or an output directory in use by another run (:mod:`tmfem.io.lock`), is
+exit 2; Ctrl-C prints one line and exits 130, SIGTERM 143. Never a traceback for any of
+these.
 """
 from __future__ import annotations
 
+import _thread
 import argparse
 import importlib
 import json
@@ -24,6 +26,8 @@ import pkgutil
 import signal
 import sys
 import threading
+import time
+import warnings
 
 import numpy as np
 
@@ -62,6 +66,9 @@ def build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(name, help=mod.HELP, description=mod.HELP,
                            formatter_class=_HelpWithDefaults)
         p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
+        p.add_argument("--quiet", action="store_true",
+                       help="no progress bars and no library progress lines (logging INFO) "
+                            "on stderr; warnings and errors still")
         mod.configure(p)
         p.set_defaults(_module=mod)
     return parser
@@ -93,36 +100,149 @@ def failed_checks(result) -> list[str]:
     return names
 
 
-def _setup_logging() -> None:
-    """Library progress (``logging`` INFO of the ``tmfem`` loggers), warnings and log
-    records on stderr, one line each, prefixed ``tmfem:``."""
-    handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter("tmfem: %(message)s"))
-    for name in ("tmfem", "py.warnings"):
-        log = logging.getLogger(name)
-        if not log.handlers:
-            log.addHandler(handler)
-            log.propagate = False
-        log.setLevel(logging.INFO)
-    logging.captureWarnings(True)
+class _MessageFormatter(logging.Formatter):
+    """``tmfem: <message>``, and ``tmfem: WARNING: <message>`` from WARNING up."""
+
+    def format(self, record):
+        text = record.getMessage()
+        if record.levelno >= logging.WARNING:
+            text = f"{record.levelname}: {text}"
+        return f"tmfem: {text}"
 
 
-def _install_interrupt_handler(command: str):
-    """Ctrl-C: one line and exit code 130, at once. A KeyboardInterrupt raised inside
-    compiled callbacks (CasADi functions of the control-oriented model) is swallowed there
-    and resurfaces as an unrelated error, so the handler ends the process itself; what was
-    written so far stays valid (CSV rows are flushed as they come, the .pvd collection is
-    rewritten atomically after each frame). Returns the previous handler (main thread only)."""
+_HANDLER = logging.StreamHandler(sys.stderr)
+_HANDLER.setFormatter(_MessageFormatter())
+
+
+def _setup_logging(*, quiet: bool = False) -> None:
+    """Library progress (``logging`` INFO of the ``tmfem`` loggers, not with ``--quiet``)
+    and warnings on stderr, one line each, prefixed ``tmfem:``. Python warnings (the
+    library's and numpy's) go through the same channel: once per message, without the
+    source path and line (:func:`_show_warning`)."""
+    log = logging.getLogger("tmfem")
+    if _HANDLER not in log.handlers:
+        log.addHandler(_HANDLER)
+        log.propagate = False
+    _HANDLER.stream = sys.stderr          # this run's stderr (the old one may be closed)
+    log.setLevel(logging.WARNING if quiet else logging.INFO)
+    _SHOWN.clear()
+    warnings.showwarning = _show_warning
+
+
+_SHOWN: set = set()
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """``warnings.showwarning`` of the CLI: the warning as one ``tmfem: WARNING:`` line of
+    the ``tmfem`` logger, each text once per run, without the source location."""
+    text = _one_line(message)
+    if (text, category) in _SHOWN:
+        return
+    _SHOWN.add((text, category))
+    logging.getLogger("tmfem").warning("%s (%s)", text, category.__name__)
+
+
+#: Exit codes of the signals the CLI ends on: 128 + the signal number, as a shell reports.
+SIGNAL_EXITS = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "terminated")}
+#: Seconds the main thread has to take SIGTERM before its own thread ends the process.
+SIGTERM_GRACE_S = 5.0
+
+
+def _install_interrupt_handler(command: str, cleanup=None):
+    """Ctrl-C (SIGINT) and SIGTERM: one line (``interrupted`` / ``terminated``) and exit
+    code 130 / 143, at once. A KeyboardInterrupt raised inside compiled callbacks (CasADi
+    functions of the control-oriented model) is swallowed there and resurfaces as an
+    unrelated error, so the handler ends the process itself, after ``cleanup()`` (removes
+    temporary files and the output locks). What was written so far stays valid and marked:
+    time series keep their ``.partial`` name and the ``.pvd`` its ``incomplete`` comment
+    (docs/guides/cli.md, "Partial files").
+
+    SIGTERM is blocked and taken by a thread of its own (``sigwait``): compiled libraries
+    reset its disposition to the default (measured: the COM's free vibration does, after its
+    first steps), which would end the process without a word. The thread hands it to the
+    main thread (``_thread.interrupt_main``), so that nothing is written while the handler
+    cleans up; when the main thread stays in a compiled call for :data:`SIGTERM_GRACE_S`,
+    the thread ends the process itself. Returns a function that puts the previous handling
+    back (None off the main thread)."""
     if threading.current_thread() is not threading.main_thread():
         return None
 
-    def handler(signum, frame):
+    def end(signum):
+        code, what = SIGNAL_EXITS[signum]
         sys.stdout.flush()
+        if cleanup is not None:
+            cleanup()
         # on a line of its own: a progress bar may be half drawn
-        print(f"\ntmfem {command}: interrupted", file=sys.stderr, flush=True)
-        os._exit(130)
+        print(f"\ntmfem {command}: {what}", file=sys.stderr, flush=True)
+        os._exit(code)
 
-    return signal.signal(signal.SIGINT, handler)
+    previous = {sig: signal.signal(sig, lambda signum, frame: end(signum)) for sig in SIGNAL_EXITS}
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+    state = {"stopping": False}
+
+    def wait():
+        signal.sigwait({signal.SIGTERM})
+        if state["stopping"]:
+            return
+        _thread.interrupt_main(signal.SIGTERM)     # the handler runs on the main thread
+        time.sleep(SIGTERM_GRACE_S)
+        end(signal.SIGTERM)
+    waiter = threading.Thread(target=wait, name="tmfem-sigterm", daemon=True)
+    waiter.start()
+
+    def restore():
+        state["stopping"] = True
+        signal.pthread_kill(waiter.ident, signal.SIGTERM)
+        waiter.join()
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    return restore
+
+
+#: Options that name an output: a file (``static --vtk s.vtu``, ``mesh OUT.msh``), whose
+#: directory is locked, or a directory without a suffix (``study --out``, ``vibrate --vtk``),
+#: locked itself.
+OUTPUTS = ("out", "vtk", "png", "stress_plot", "wrinkle_plot", "csv", "plot", "save", "gif",
+           "compare_csv", "compare_plot")
+
+
+#: File in an output directory (``--out``) while its run has not ended: a run that fails or
+#: is interrupted leaves it, since the directory may then hold files of an earlier run.
+INCOMPLETE_MARK = "INCOMPLETE"
+
+
+def _mark_incomplete(args):
+    """Write :data:`INCOMPLETE_MARK` into the output directory ``--out`` (when there is
+    one); returns its path, or None."""
+    from pathlib import Path
+    out = getattr(args, "out", None)
+    if not isinstance(out, (str, os.PathLike)) or Path(out).suffix or not Path(out).is_dir():
+        return None
+    mark = Path(out) / INCOMPLETE_MARK
+    mark.write_text(f"tmfem {args.command} (pid {os.getpid()}) has not finished writing this "
+                    "directory; a run that stops leaves this file, and the directory may then "
+                    "hold files of an earlier run\n")
+    return mark
+
+
+def output_directories(args) -> list:
+    """The directories a command will write to (:data:`OUTPUTS`), each once; two options
+    that name the same path (``--csv a.csv --compare-csv a.csv``) are refused."""
+    from pathlib import Path
+    dirs, seen = [], {}
+    for dest in OUTPUTS:
+        value = getattr(args, dest, None)
+        if isinstance(value, (str, os.PathLike)) and str(value):
+            p = Path(value)
+            key = os.path.abspath(p)
+            if key in seen:
+                raise InputError(f"--{dest.replace('_', '-')} {str(value)!r}: expected its own "
+                                 f"output path, found the one of --{seen[key].replace('_', '-')} "
+                                 "(one would overwrite the other)")
+            seen[key] = dest
+            dirs.append(p.parent if p.suffix else p)
+    return list(dict.fromkeys(dirs))
 
 
 def main(argv=None) -> int:
@@ -130,13 +250,28 @@ def main(argv=None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     mod = args._module
-    _setup_logging()
+    show_warning = warnings.showwarning          # put back when main returns
+    _setup_logging(quiet=args.quiet)
+    from tmfem.cli.common import QUIET
+    QUIET["on"] = args.quiet
     if _mpi_size() > 1:
         return _main_mpi(args, mod)
-    previous = _install_interrupt_handler(args.command)
+    from tmfem.io.atomic import remove_pending
+    from tmfem.io.lock import OutputLock
+    lock = OutputLock()
+
+    def cleanup():
+        remove_pending()
+        lock.release()
+    restore = _install_interrupt_handler(args.command, cleanup)
     try:
+        for d in output_directories(args):
+            lock.acquire(d, label=f"tmfem {args.command}")
+        mark = _mark_incomplete(args)
         result = mod.run(args)
         print(render(args, mod, result))
+        if mark is not None:
+            mark.unlink(missing_ok=True)
     except TmfemError as exc:
         print(f"tmfem {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
@@ -150,12 +285,15 @@ def main(argv=None) -> int:
         print(f"tmfem {args.command}: error: {_OUT_OF_MEMORY}", file=sys.stderr)
         return 3
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGINT, previous)
+        cleanup()
+        if restore is not None:
+            restore()
+        warnings.showwarning = show_warning
     return _checks_exit(args, result)
 
 
-_OUT_OF_MEMORY = "out of memory; use a coarser mesh or fewer modes/steps"
+_OUT_OF_MEMORY = ("out of memory; the estimates of docs/guides/cli.md (Limits) did not foresee this "
+                  "job: reduce the input that scales it (mesh, modes, steps, stages)")
 
 
 def render(args, mod, result) -> str:

@@ -37,7 +37,8 @@ def run(args) -> dict:
         check_path(args.csv, suffixes=(".csv",))
     out = {"benchmark": args.name, "units": dict(mod.COLUMNS), **mod.run(reduced=args.reduced)}
     if args.csv:
-        with open(args.csv, "w", newline="") as fh:
+        from tmfem.io.atomic import atomic_open
+        with atomic_open(args.csv, "w", newline="") as fh:
             w = csv.DictWriter(fh, fieldnames=list(mod.COLUMNS), extrasaction="ignore",
                                lineterminator="\n")
             w.writerow({k: f"{k} [{u}]" if u else k for k, u in mod.COLUMNS.items()})

@@ -12,7 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from tmfem.errors import InputError, ResourceLimit
+from tmfem.errors import InputError, ResourceLimit, shorten
+from tmfem.resources import (BASE_BYTES, BYTES_PER_DOF, MAX_MEMBRANE_MODES,  # noqa: F401
+                             MEMORY_FRACTION, check_membrane_modes, check_mesh_budget,
+                             check_system_budget, machine_memory, require_memory)
 from tmfem.system import System, load_preset, load_system
 
 log = logging.getLogger(__name__)
@@ -34,7 +37,9 @@ def system_from_args(args: argparse.Namespace) -> System:
         return load_preset(args.preset, as_printed=args.as_printed)
     if args.as_printed:
         raise InputError("--as-printed applies to presets only")
-    return load_system(args.spec)
+    system = load_system(args.spec)
+    check_system_budget(system, source=str(args.spec))
+    return system
 
 
 def add_model_args(parser, command: str, *, default: str, capability: str | None = None,
@@ -95,10 +100,12 @@ def model_options_from_args(args, command: str):
                          f"--backend {args.backend or 'scipy'}")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
-        check_model_budget(system, mesh=options["mesh"],
-                           tendon_elements=options.get("tendon_elements") or 1,
-                           bar_elements=options.get("bar_elements"),
-                           dofs_per_node=spec.dofs_per_node)
+        dofs = check_model_budget(system, mesh=options["mesh"],
+                                  tendon_elements=options.get("tendon_elements") or 1,
+                                  bar_elements=options.get("bar_elements"),
+                                  dofs_per_node=spec.dofs_per_node)
+        if isinstance(getattr(args, "modes", None), int):     # modal: the exact DOFs later
+            check_modes_budget(dofs, modes=args.modes, given=f"--mesh {options['mesh']}")
     if "attachment" in options:
         check_attachment_options(system, attachment=options["attachment"], patch=options["patch"])
     if options.get("membrane_modes") is not None:
@@ -215,13 +222,26 @@ def parse_perturbation(items, names) -> dict:
     return out
 
 
+#: ``--quiet`` of the running command (set by :func:`tmfem.cli.main`)
+QUIET = {"on": False}
+
+
+def progress_options() -> dict:
+    """tqdm options of the CLI's bars: drawn on stderr only when it is a terminal, never
+    with ``--quiet`` or ``TQDM_DISABLE`` set (not empty, 0 or false); plain ASCII with
+    ``NO_COLOR`` set (docs/guides/cli.md, "Progress and messages")."""
+    off = (QUIET["on"] or not sys.stderr.isatty()
+           or os.environ.get("TQDM_DISABLE", "").strip().lower() not in ("", "0", "false"))
+    return {"file": sys.stderr, "disable": off, "ascii": bool(os.environ.get("NO_COLOR"))}
+
+
 @contextmanager
 def progress_bar(t_end: float, dt: float, label: str):
     """A tqdm progress bar over the steps of a time run, as a ``progress(step, n_steps)``
-    callback (on stderr; closed on exit, also on an error)."""
+    callback (:func:`progress_options`; closed on exit, also on an error)."""
     from tqdm import tqdm
     bar = tqdm(total=int(round(t_end / dt)), desc=label, unit="step", leave=False,
-               mininterval=0.5)
+               mininterval=0.5, **progress_options())
 
     def update(k, n):
         bar.update(k - bar.n)
@@ -287,47 +307,7 @@ def output_dir(path, *, option: str) -> Path:
         raise InputError(f"{option}: {exc}") from None
 
 
-def machine_memory() -> float:
-    """Physical memory of this machine in bytes (24 GiB on the project's machines)."""
-    try:
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):     # pragma: no cover - non-POSIX
-        return 24.0 * 2**30
-
-
-# Measured on the 1-4 MTC model (modal, 12 modes): peak RSS grows by ~8-11 kB per free
-# DOF from n = 20 (5 067 DOFs, 0.17 GB) to n = 80 (78 000 DOFs, 0.81 GB); 16 kB leaves
-# room for the fill of larger factorisations. Base: the interpreter with numpy/scipy/VTK.
-BYTES_PER_DOF = 16e3
-BASE_BYTES = 0.3e9
-MEMORY_FRACTION = 0.6         # of the physical memory: the machine is shared
-
-
-def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3,
-                      extra_dofs: int = 0, extra_text: str = "") -> int:
-    """Refuse a membrane mesh whose FE model would not fit this machine.
-
-    The N n x n quadrilateral patches have about N (n + 1)^2 nodes, hence
-    ``dofs_per_node`` N (n + 1)^2 unknowns, plus ``extra_dofs`` (members, named by
-    ``extra_text``); the estimated peak memory is ``BASE_BYTES + BYTES_PER_DOF * dofs`` and
-    must stay under ``MEMORY_FRACTION`` of the physical memory. Returns the DOF estimate.
-
-    Raises
-    ------
-    ResourceLimit
-        with the estimate and the limit.
-    """
-    dofs = dofs_per_node * N * (n + 1) ** 2 + int(extra_dofs)
-    need = BASE_BYTES + BYTES_PER_DOF * dofs
-    limit = MEMORY_FRACTION * machine_memory()
-    if need > limit:
-        given = option if " " in option else f"{option} {n}"    # "--mesh n ..." or the flag
-        raise ResourceLimit(f"{given}: the membrane mesh {N} x {n} x {n}"
-                            + (f" with {extra_text}" if extra_text else "") + " gives about "
-                            f"{dofs:,} DOFs and needs about {need / 2**30:.1f} GiB; the limit "
-                            f"is {limit / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this "
-                            f"machine's {machine_memory() / 2**30:.0f} GiB)")
-    return dofs
+# the estimates live in the library (tmfem.resources); the CLI checks them before any work
 
 
 MAX_STEPS = 200_000
@@ -352,6 +332,21 @@ def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> i
     return steps
 
 
+#: Most ParaView frames of one series (a frame is a .vtu of the whole configuration: 1-4's
+#: COM frames take ~50 kB, so 10 000 frames ~0.5 GB of disk)
+MAX_FRAMES = 10_000
+
+
+def check_frames(*, steps: int, every: int, option: str = "--vtk-every") -> int:
+    """ParaView frames of a time run of ``steps`` steps, one every ``every``: at most
+    :data:`MAX_FRAMES`. Returns the number of frames."""
+    frames = steps // every + 1
+    if frames > MAX_FRAMES:
+        raise ResourceLimit(f"{option} {every}: {steps:,} steps give {frames:,} ParaView frames; "
+                            f"the limit is {MAX_FRAMES:,} (raise {option} or lower --t-end)")
+    return frames
+
+
 def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
                        bar_elements: int | None = None, modes: int | None = None,
                        dofs_per_node: int = 3) -> int:
@@ -359,7 +354,8 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
     it is built: the membrane mesh (:func:`check_mesh_budget`, ``dofs_per_node`` 3 for the
     membrane elements, 6 for shells) plus 3 (k - 1) DOFs per tendon of k truss elements and,
     with ``bar_elements`` b (beam bars, 6 DOFs per node), 6 (3 b - 1) per bar; ``modes`` must
-    stay below the DOF estimate. Returns the DOF estimate."""
+    stay below the DOF estimate, and the eigen solver's basis (2 ``modes`` vectors of the
+    DOFs, 8 bytes an entry) must fit beside the model. Returns the DOF estimate."""
     extra = 3 * len(system.tendons) * (tendon_elements - 1)
     what = [f"{len(system.tendons)} tendons x {tendon_elements} elements"]
     if bar_elements is not None:
@@ -372,22 +368,17 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
     if modes is not None and modes >= dofs:
         raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
                          "DOFs")
+    if modes is not None:
+        check_modes_budget(dofs, modes=modes, given=given)
     return dofs
 
 
-#: Largest K of the control-oriented model: its equations are built symbolically (CasADi)
-#: at a cost that grows faster than K^2 (1-4, measured under load: K = 10: 8 s, 20: 9 s,
-#: 40: 24 s; K = 1000 would run for hours).
-MAX_MEMBRANE_MODES = 40
-
-
-def check_membrane_modes(K: int) -> None:
-    """``--membrane-modes K`` of the control-oriented model: 0 <= K <= MAX_MEMBRANE_MODES."""
-    if not 0 <= K <= MAX_MEMBRANE_MODES:
-        cls = ResourceLimit if K > MAX_MEMBRANE_MODES else InputError
-        raise cls(f"--membrane-modes {K}: expected 0 <= K <= {MAX_MEMBRANE_MODES} (the model's "
-                  f"equations are built symbolically; K = 40 takes ~25 s, the cost grows faster "
-                  f"than K^2)")
+def check_modes_budget(dofs: int, *, modes: int, given: str = "") -> None:
+    """Refuse ``--modes`` whose eigen-solver basis (2 ``modes`` vectors of ``dofs`` entries,
+    8 bytes each) does not fit beside the model (``BYTES_PER_DOF`` per DOF)."""
+    require_memory(BASE_BYTES + BYTES_PER_DOF * dofs + 16.0 * dofs * modes,
+                   given=f"--modes {modes} {given}".strip(),
+                   what=f"the model's about {dofs:,} DOFs with a basis of 2 x {modes} vectors")
 
 
 def check_com_modes(system: System, *, modes: int, membrane_modes=None) -> int:
@@ -438,7 +429,8 @@ def warn_long_rest_lengths(system: System, rest=None) -> list[str]:
             "design configuration; it is slack there" for k in np.flatnonzero(r >= L)]
     if msgs and len(msgs) == len(names):
         raise InputError(f"every tendon is slack at the design configuration: rest lengths "
-                         f"{np.round(r, 5).tolist()} m >= lengths {np.round(L, 5).tolist()} m; "
+                         f"{shorten(np.round(r, 5).tolist())} m >= lengths "
+                         f"{shorten(np.round(L, 5).tolist())} m; "
                          "nothing prestresses the system (expected rest lengths shorter than "
                          "the tendons)")
     for m in msgs:
@@ -448,7 +440,7 @@ def warn_long_rest_lengths(system: System, rest=None) -> list[str]:
 
 # ---------------------------------------------------------------------------- progress
 class Progress:
-    """The CLI's progress bar (tqdm on stderr; silent when stderr is not a terminal).
+    """The CLI's progress bar (tqdm on stderr, :func:`progress_options`).
 
     ``step(label)`` advances one stage of a multi-stage job and names the next one;
     ``callback(desc)`` returns a ``progress(done, total)`` function for library loops
@@ -459,8 +451,8 @@ class Progress:
         from tqdm import tqdm
 
         self._tqdm = tqdm
-        self.bar = tqdm(total=total, desc=desc, unit="step", file=sys.stderr, disable=None,
-                        leave=True, dynamic_ncols=True)
+        self.bar = tqdm(total=total, desc=desc, unit="step", leave=True, dynamic_ncols=True,
+                        **progress_options())
 
     def step(self, label: str) -> None:
         self.bar.set_postfix_str(label, refresh=False)
@@ -475,8 +467,8 @@ class Progress:
 
         def progress(done: int, total: int) -> None:
             if "bar" not in inner:
-                inner["bar"] = self._tqdm(total=total, desc=desc, file=sys.stderr, disable=None,
-                                          leave=False, position=1, dynamic_ncols=True)
+                inner["bar"] = self._tqdm(total=total, desc=desc, leave=False, position=1,
+                                          dynamic_ncols=True, **progress_options())
             inner["bar"].n = done
             inner["bar"].refresh()
             if done >= total:

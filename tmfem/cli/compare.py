@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import sys
 
-from tmfem.cli.common import (Progress, add_system_args, check_time_steps, finite_float,
-                              output_file, parse_perturbation, positive_int, system_from_args)
+from tmfem.cli.common import (Progress, add_system_args, check_model_budget, check_time_steps,
+                              finite_float, output_file, parse_perturbation, positive_int,
+                              system_from_args)
 from tmfem.errors import InputError
 from tmfem.solvers.backends import backend_names
 
@@ -57,6 +58,9 @@ def run(args) -> dict:
         flags = ", ".join("--" + d.replace("_", "-") for d in wrong)
         raise InputError(f"compare{' --vibrate' if args.vibrate else ''}: option does not apply: "
                          f"{flags} ({'without' if args.vibrate is False else 'with'} --vibrate)")
+    # the SBC model is the larger of the two FE models (shells: 6 DOFs a node)
+    check_model_budget(args.system, mesh=args.mesh,
+                       tendon_elements=args.tendon_elements, modes=args.modes, dofs_per_node=6)
     output_file(args.csv, option="--csv", suffixes=(".csv",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
     if args.plot and not args.vibrate and "frequencies_hz" not in args.system.printed:

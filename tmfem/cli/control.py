@@ -141,9 +141,9 @@ def format_text(r: dict) -> str:
                 f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} (alpha_1 = {r['alpha']:g}): ok")
     p = r["pbh"]
     lines = [f"system {r['system']}: {r['n_states']} states, {r['n_inputs']} inputs",
-             f"open-loop f_max = {r['open_loop_f_max_hz']:.4f} Hz"
-             + ("" if r['open_loop_f_max_printed_hz'] is None else
-                f" (printed {r['open_loop_f_max_printed_hz']})"),
+             f"open-loop f_max = {r['open_loop_f_max_hz']:.4f} Hz" + (
+                 "" if r["open_loop_f_max_printed_hz"] is None
+                 else f" (printed {r['open_loop_f_max_printed_hz']})"),
              f"PBH (tol {p['tol']:g}): controllable {p['controllable']} (least margin "
              f"{p['least_controllable']['margin']:.3g} at {p['least_controllable']['frequency_hz']:.3f} Hz), "
              f"observable {p['observable']} (least margin {p['least_observable']['margin']:.3g})"]
@@ -151,8 +151,9 @@ def format_text(r: dict) -> str:
         s = r["solver"]
         lines += [f"gamma = {r['gamma']:.6g} (||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}), "
                   f"alpha_1 = {r['alpha']:g}, max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g}",
-                  f"{r['method']}, controller order {r['controller_order']}, cond(I - RS) = "
-                  f"{r['cond_I_minus_RS'] if r['cond_I_minus_RS'] is None else format(r['cond_I_minus_RS'], '.3g')}",
+                  f"{r['method']}, controller order {r['controller_order']}"
+                  + ("" if r["cond_I_minus_RS"] is None else
+                     f", cond(I - RS) = {r['cond_I_minus_RS']:.3g}"),
                   f"solver {s['solver']}: {s['status']}, {s['solve_time_s']:.1f} s, "
                   f"{s['n_variables']} variables, LMI sizes {s['lmi_sizes']}"]
         if "saved" in r:

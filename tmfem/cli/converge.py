@@ -2,11 +2,14 @@
 from __future__ import annotations
 
 import csv
+import os
+from pathlib import Path
 
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
                               check_attachment_options, check_model_budget, check_outputs,
                               system_from_args)
-from tmfem.errors import InputError
+from tmfem.errors import InputError, shorten
+from tmfem.io.run import partial_name
 from tmfem.io.units import unit_of
 from tmfem.models.fe.rest_lengths import describe_rule
 from tmfem.models.fe.rest_lengths import apply_rest_lengths
@@ -78,9 +81,11 @@ def run(args) -> dict:
     rest, rule = resolve_rest_lengths(system, rest_lengths=rest)
     rows = []
     writer = fh = None
+    complete = False
     try:
-        if args.csv:
-            fh = open(args.csv, "w", newline="")
+        if args.csv:                   # NAME.csv.partial until the last run (docs/guides/cli.md)
+            Path(args.csv).unlink(missing_ok=True)
+            fh = open(partial_name(args.csv), "w", newline="")
         for row in convergence_rows(system, meshes=meshes, tendon_elements=tendons,
                                     attachment=args.attachment, rest_lengths=rest,
                                     modes=args.modes, patch=args.patch, backend=args.backend,
@@ -93,9 +98,12 @@ def run(args) -> dict:
                     writer.writerow({k: _header(k) for k in keys})
                 writer.writerow(row)
                 fh.flush()
+        complete = True
     finally:
         if fh is not None:
             fh.close()
+            if complete:
+                os.replace(partial_name(args.csv), args.csv)
     out = {"system": system.name, "model": args.model, "attachment": args.attachment,
            "membrane_law": args.membrane_law, "rest_lengths_rule": rule,
            "rest_lengths_note": describe_rule(rule, per_mesh_study=True),
@@ -128,8 +136,7 @@ def format_text(r: dict) -> str:
     lines = [f"{r['system']} {r.get('model', 'mtc').upper()} convergence, {r['attachment']} attachment, "
              f"{r.get('membrane_law', 'svk')} membrane",
              f"rest lengths: {r['rest_lengths_rule']} ({r['rest_lengths_note']})"
-             + (": " + ", ".join(f"{k}={v:.5f} m" for k, v in list(fixed.items())[:4])
-                + (" ..." if len(fixed) > 4 else "") if fixed else ""), head]
+             + (": " + shorten(f"{k}={v:.5f} m" for k, v in fixed.items()) if fixed else ""), head]
     for w in rows:
         lines.append(f"{w['mesh_n']:3d} {w['tendon_elements']:2d} {w['elements']:6d} {w['dofs']:7d} "
                      f"{w['Delta_mm']:9.4f} {w['sigma_p1_max_MPa']:8.3f} {w['von_mises_max_MPa']:8.3f} "

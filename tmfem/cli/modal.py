@@ -8,6 +8,7 @@ from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, 
 from tmfem.errors import InputError
 from tmfem.models.registry import get_spec
 from tmfem.reference.printed_modes import with_printed
+from tmfem.system.collapse import check_equilibrium, check_stable
 
 NAME = "modal"
 HELP = "natural frequencies and mode shapes (finite-element or control-oriented model)"
@@ -43,7 +44,9 @@ def run(args) -> dict:
           "freedom", file=sys.stderr)
     res = model.equilibrium(monitor=default_monitor(model.system),
                             **spec.equilibrium_kwargs(options))
+    check_equilibrium(model, res)
     modes = model.modes(k=args.modes, at=res)
+    check_stable(model, modes)
     out = with_printed(report.modal_summary(model, res, modes), system=model.system, modes=args.modes)
     if files:
         out.update(report.write_mode_files(model, res, modes, **files))

@@ -6,6 +6,7 @@ import sys
 from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
                               requested_files)
 from tmfem.models.registry import get_spec
+from tmfem.system.collapse import check_equilibrium
 
 NAME = "static"
 HELP = "static equilibrium of a finite-element model (dissertation 6.2)"
@@ -53,6 +54,7 @@ def run(args) -> dict:
     res = model.equilibrium(monitor=monitor, progress=static_progress(args.progress),
                             **spec.equilibrium_kwargs(options))
     out = report.static_summary(model, res)
+    check_equilibrium(model, res, values=out)          # before anything is written
     if files:
         out.update(report.write_static_files(model, res, **files))
     return out

@@ -30,6 +30,7 @@ from tmfem.cli.common import (Progress, add_attachment_args, add_membrane_law_ar
                               check_attachment_options, check_mesh_budget, output_dir, positive_int,
                               system_from_args)
 from tmfem.errors import InputError
+from tmfem.io.atomic import write_text
 from tmfem.io.units import with_units
 from tmfem.reference.report import explanations
 from tmfem.reference.study import (plot_configuration, plot_membrane_stress, text_table,
@@ -85,7 +86,7 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
     tables = write_tables(out, d, system, notes=notes)
     for f in ("equilibrium.csv", "tendons.csv", "equilibrium.md"):
         files[f] = str(out / f)
-    (out / "design.json").write_text(json.dumps(with_units(result), default=json_default))
+    write_text(out / "design.json", json.dumps(with_units(result), default=json_default))
     files["design.json"] = str(out / "design.json")
     bar.step("plots")
     files["configuration.png"] = str(plot_configuration(out / "configuration.png", d, system))
@@ -114,7 +115,7 @@ def _study(args, system, out: Path, bar: Progress) -> dict:
         th = np.radians(np.linspace(30, 85, k))
         ps = np.radians(np.linspace(-60, 60, k))
         emap = equilibrium_map(system, theta=th, psi=ps, progress=bar.callback("map rows"))
-        (out / "equilibrium_map.json").write_text(json.dumps(with_units(emap.to_dict())))
+        write_text(out / "equilibrium_map.json", json.dumps(with_units(emap.to_dict())))
         files["equilibrium_map.json"] = str(out / "equilibrium_map.json")
         design = (c.theta[0], c.psi[0] - c.sigma[0])
         # a finer map +-10 deg around the design resolves a thin feasible region

@@ -6,10 +6,12 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import (add_model_args, add_system_args, check_time_steps, finite_float,
-                              model_from_args, parse_perturbation, positive_int, progress_bar)
+from tmfem.cli.common import (add_model_args, add_system_args, check_frames, check_time_steps,
+                              finite_float, model_from_args, parse_perturbation, positive_int,
+                              progress_bar)
 from tmfem.errors import InputError
 from tmfem.simulation.vibration import model_free_vibration
+from tmfem.system.collapse import check_equilibrium
 
 NAME = "vibrate"
 HELP = "free vibration after an initial perturbation (COM, MTC or SBC model, Park's method)"
@@ -38,17 +40,20 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
-    check_time_steps(t_end=args.t_end, dt=args.dt)
+    steps = check_time_steps(t_end=args.t_end, dt=args.dt)
     if args.vtk_every is not None and args.vtk is None:
         raise InputError("--vtk-every: option does not apply without --vtk DIR (it spaces the "
                          "ParaView frames)")
     args.vtk_every = args.vtk_every or 10
+    if args.vtk is not None:
+        check_frames(steps=steps, every=args.vtk_every)
     model, options, spec = model_from_args(args, NAME)
     system, name = model.system, spec.name.upper()
     pert = parse_perturbation(default_perturbation(args, system), model.perturbation_names)
     size = ", ".join(f"{k} {v}" for k, v in model.describe().items())
     print(f"tmfem vibrate: {system.name} {name}, {size}, static equilibrium", file=sys.stderr)
     eq = model.equilibrium(**spec.equilibrium_kwargs(options))
+    check_equilibrium(model, eq)
     dynamics = spec.plant_kwargs(options)
     with progress_bar(args.t_end, args.dt, f"vibrate {system.name} {name}") as bar:
         res = model_free_vibration(model, at=eq, perturb=pert, dynamics=dynamics,

@@ -20,7 +20,6 @@ import re
 import numpy as np
 
 from tmfem.errors import InputError
-from tmfem.models.members import FAMILY_CODES
 from tmfem.system.topology import label
 
 KIND_CODES = {"bar": 0, "tendon": 1, "membrane": 2}

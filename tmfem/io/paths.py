@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 from tmfem.errors import InputError
@@ -25,9 +26,20 @@ def check_path(path, *, suffixes=SUFFIXES) -> Path:
     except OSError as exc:
         raise InputError(f"output file {str(path)!r}: cannot create directory "
                          f"{str(parent)!r} ({exc.strerror})") from None
-    if not os.access(parent, os.W_OK):
-        raise InputError(f"output file {str(path)!r}: directory {str(parent)!r} is not writable")
+    _probe(parent, f"output file {str(path)!r}: directory {str(parent)!r}")
     return path
+
+
+def _probe(directory: Path, what: str) -> None:
+    """Create and remove a file in ``directory``: the permission bits do not tell (root
+    passes them; a read-only mount or a pseudo-filesystem such as /proc refuses the write)."""
+    if not os.access(directory, os.W_OK):
+        raise InputError(f"{what} is not writable")
+    try:
+        with tempfile.NamedTemporaryFile(dir=directory, prefix=".tmfem-probe-"):
+            pass
+    except OSError as exc:
+        raise InputError(f"{what} is not writable ({exc.strerror})") from None
 
 
 def check_dir(path) -> Path:
@@ -40,6 +52,5 @@ def check_dir(path) -> Path:
     except OSError as exc:
         raise InputError(f"output directory {str(path)!r}: cannot create it "
                          f"({exc.strerror})") from None
-    if not os.access(path, os.W_OK):
-        raise InputError(f"output directory {str(path)!r} is not writable")
+    _probe(path, f"output directory {str(path)!r}")
     return path

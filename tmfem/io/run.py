@@ -1,16 +1,21 @@
 """Outputs of a time run written as it goes: CSV history, ParaView series, smallest tendon force.
 
 Every row is flushed and every ParaView frame committed when it is computed, so a run that
-stops early (an error, Ctrl-C) leaves everything computed so far on disk.
+stops early (an error, Ctrl-C, SIGTERM) leaves everything computed so far on disk -- marked
+as incomplete: the CSV is written as ``NAME.csv.partial`` and renamed to ``NAME.csv`` when
+the run ends (:meth:`RunOutputs.close` with ``complete=True``), and the ``.pvd`` collection
+carries an ``incomplete`` comment until then (docs/guides/cli.md, "Partial files").
 """
 from __future__ import annotations
 
 import csv
+import os
 import re
+from pathlib import Path
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError, shorten
 from tmfem.io.series import SeriesWriter
 
 
@@ -36,6 +41,12 @@ def column_header(name: str) -> str:
     return name
 
 
+def partial_name(path) -> Path:
+    """The name of a time series while its run is under way: ``NAME.csv.partial``."""
+    path = Path(path)
+    return path.with_name(path.name + ".partial")
+
+
 class RunOutputs:
     """Per-step outputs of a simulation run, shared by every model's runs (6.5, 7.4).
 
@@ -58,10 +69,16 @@ class RunOutputs:
             if not (isinstance(vtk_every, int) and vtk_every >= 1):
                 raise InputError(f"vtk_every: expected an integer >= 1, found {vtk_every!r}")
             self.series = SeriesWriter(vtk_dir, name=name.replace("(", "").replace(")", ""))
-        self.fh = open(csv_path, "w", newline="") if csv_path else None
+        self.csv_path = Path(csv_path) if csv_path else None
+        self.fh = None
+        if self.csv_path is not None:
+            if self.csv_path.exists():             # no earlier run's file beside this one's
+                self.csv_path.unlink()
+            self.fh = open(partial_name(self.csv_path), "w", newline="")
         self.writer = csv.writer(self.fh, lineterminator="\n") if self.fh else None
         if self.writer:
             self.writer.writerow([column_header(c) for c in columns])
+        self.columns = list(columns)
         self.vtk_every = vtk_every
         self.count = 0
         self.min_force = [np.inf, 0.0, ""]        # smallest tendon force, its time and tendon
@@ -77,15 +94,35 @@ class RunOutputs:
             self.min_force[:] = [float(force[k]), float(t), names[k]]
 
     def row(self, t: float, values: np.ndarray) -> None:
-        """Write the CSV row of time t (when a CSV is asked) and count the step."""
+        """Write the CSV row of time t (when a CSV is asked) and count the step.
+
+        Raises
+        ------
+        ConvergenceError
+            when a value is NaN or infinite (the run diverged): no such row is written, the
+            files keep their partial mark.
+        """
+        values = np.asarray(values, dtype=float)
+        bad = np.flatnonzero(~np.isfinite(values))
+        if bad.size or not np.isfinite(t):
+            names = [self.columns[1 + k] for k in bad] if bad.size else ["t"]
+            raise ConvergenceError(f"t = {t:.6g} s: non-finite values of {shorten(names)} (the "
+                                   "run diverged; nothing non-finite is written)")
         self.count += 1
         if self.writer:
             self.writer.writerow([f"{t:.6g}"] + [f"{v:.10g}" for v in values])
             self.fh.flush()
 
-    def close(self) -> None:
+    def close(self, *, complete: bool) -> None:
+        """Close the files; ``complete``: the run reached its end, so the CSV gets its final
+        name and the ``.pvd`` loses its ``incomplete`` mark (else both stay marked)."""
         if self.fh:
             self.fh.close()
+            self.fh = None
+            if complete:
+                os.replace(partial_name(self.csv_path), self.csv_path)
+        if complete and self.series is not None:
+            self.series.finish()
 
     def stats(self, sim) -> dict:
         """Step and Newton counts of the simulation ``sim``, the smallest tendon force, the .pvd."""

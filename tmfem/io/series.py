@@ -1,7 +1,6 @@
 """Time series for ParaView: one ``.vtu`` per frame and the ``.pvd`` collection."""
 from __future__ import annotations
 
-import os
 import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -9,15 +8,22 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.io.atomic import write_text
 from tmfem.io.meshes import block_data, normalize_cells, to_meshio
 from tmfem.io.writer import write_configuration, write_mesh
+
+
+#: Comment of a ``.pvd`` collection whose run has not ended (or stopped early).
+INCOMPLETE = "incomplete: the run has not reached its end"
 
 
 class SeriesWriter:
     """A time series of ``.vtu`` files and the ``.pvd`` collection that lists them.
 
     Every :meth:`append` writes one frame file and rewrites the ``.pvd`` (atomically), so
-    a run that stops early leaves a valid collection of the frames written so far.
+    a run that stops early leaves a valid collection of the frames written so far; until
+    :meth:`finish` the collection carries the comment :data:`INCOMPLETE` (a run that
+    stopped early keeps it).
     """
 
     def __init__(self, directory, *, name: str = "frame"):
@@ -31,20 +37,27 @@ class SeriesWriter:
         self.name = name
         self.pvd = directory / f"{name}.pvd"
         self.entries: list[tuple[float, str]] = []
+        self.complete = False
 
     def _next(self) -> Path:
         return self.directory / f"{self.name}_{len(self.entries):05d}.vtu"
 
     def _commit(self, time: float, path: Path) -> Path:
         self.entries.append((float(time), path.name))
+        self._write_pvd()
+        return path
+
+    def _write_pvd(self) -> None:
         rows = "".join(f'    <DataSet timestep="{t!r}" group="" part="0" file="{f}"/>\n'
                        for t, f in self.entries)
-        text = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
-                f"  <Collection>\n{rows}  </Collection>\n</VTKFile>\n")
-        tmp = self.pvd.with_suffix(".pvd.tmp")
-        tmp.write_text(text)
-        os.replace(tmp, self.pvd)
-        return path
+        mark = "" if self.complete else f"<!-- {INCOMPLETE} -->\n"
+        write_text(self.pvd, '<?xml version="1.0"?>\n' + mark + '<VTKFile type="Collection" '
+                   f'version="0.1">\n  <Collection>\n{rows}  </Collection>\n</VTKFile>\n')
+
+    def finish(self) -> None:
+        """The run reached its end: the collection loses its :data:`INCOMPLETE` mark."""
+        self.complete = True
+        self._write_pvd()
 
     def _check_time(self, time) -> float:
         time = float(time)
@@ -88,6 +101,7 @@ def write_series(directory, frames, *, name: str = "frame") -> Path:
         else:
             raise InputError(f"series frame: expected (time, points, cells[, point_data]), "
                              f"found a tuple of {len(fr)}")
+    w.finish()
     return w.pvd
 
 

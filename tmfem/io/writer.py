@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import BackendUnavailable, InputError
+from tmfem.io.atomic import atomic_path
 from tmfem.io.fields import MembraneField
 from tmfem.io.meshes import configuration_mesh, modes_mesh
 from tmfem.io.paths import check_path
@@ -46,8 +47,18 @@ def _polygons_as_triangles(mesh):
 def write_mesh(path, mesh) -> Path:
     """Write a meshio.Mesh. Its ``field_data`` (e.g. the frequencies of a modes file) goes to
     ``.vtu`` only, written by VTK's own XML writer (meshio reads VTU field data but does not
-    write it); everything else by meshio."""
+    write it); everything else by meshio. Written atomically (:mod:`tmfem.io.atomic`),
+    except ``.xdmf``, whose ``.h5`` companion file is named after it."""
     path = Path(path)
+    if path.suffix.lower() == ".xdmf":
+        _write_mesh(path, mesh)
+        return path
+    with atomic_path(path) as tmp:
+        _write_mesh(tmp, mesh)
+    return path
+
+
+def _write_mesh(path: Path, mesh) -> None:
     suffix = path.suffix.lower()
     if mesh.field_data:
         if suffix != ".vtu":
@@ -59,14 +70,13 @@ def write_mesh(path, mesh) -> Path:
         for k, v in mesh.field_data.items():
             grid.field_data[k] = np.atleast_1d(np.asarray(v, dtype=float))
         grid.save(str(path), binary=True)
-        return path
+        return
     import meshio
 
     if suffix == ".xdmf":
         require_h5py()
         mesh = _polygons_as_triangles(mesh)
     meshio.write(path, mesh)
-    return path
 
 
 def write_configuration(path, system, *, q=None, tendon_forces=None, rest_lengths=None,

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from tmfem.errors import shorten
+
 from tmfem.models.com.model import default_membrane_modes
 
 #: files ``tmfem modal`` can write for this model (none: it has no mesh of its own)
@@ -76,8 +78,7 @@ def format_modal(r: dict) -> str:
              f"from the {r.get('rest_lengths_source', 'design')}"]
     forces = r.get("design_tendon_forces") or r.get("equilibrium_tendon_forces") or {}
     if forces:
-        lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.4g}" for k, v in list(forces.items())[:6])
-                     + (" ..." if len(forces) > 6 else ""))
+        lines.append("tendon forces [N]: " + shorten((f"{k}={v:.4g}" for k, v in forces.items()), 6))
     if "printed_stress_prestress_scale" in r:
         lines.append(f"prestress implied by the printed tendon stress: x{r['printed_stress_prestress_scale']:.4f}"
                      " (--prestress-scale in the Python API, docs/guides/com.md)")

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from tmfem.errors import shorten
+
 from tmfem.io.fields import DISPLACEMENT_FIELD, MembraneField
 
 from tmfem.io.paths import check_path
@@ -230,7 +232,7 @@ def format_modal(r: dict) -> str:
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
              f"membrane, {r['dofs']} free dofs",
              f"rest lengths {r['rest_lengths_source']}: {r['rest_lengths_note']}",
-             "prestress: " + ", ".join(f"{k}={v:.5f} m" for k, v in list(r["rest_lengths"].items())[:4])
+             "prestress: " + shorten(f"{k}={v:.5f} m" for k, v in r["rest_lengths"].items())
              + f"; max tendon stress {r['tendon_stress_max'] / 1e6:.2f} MPa, bar load "
                f"{r['bar_load_max']:.3f} N, Delta {r['Delta_mean'] * 1e3:.4f} mm"]
     d = r.get("dissertation")

@@ -23,8 +23,10 @@ def new_figure(*, figsize=(7.0, 4.5)):
 
 
 def save_figure(fig, png) -> Path:
-    """Write ``fig`` to ``png`` (120 dpi) and return the path."""
-    fig.savefig(png, dpi=120)
+    """Write ``fig`` to ``png`` (120 dpi, atomically) and return the path."""
+    from tmfem.io.atomic import atomic_path
+    with atomic_path(png) as tmp:
+        fig.savefig(tmp, dpi=120)
     return Path(png)
 
 

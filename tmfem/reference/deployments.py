@@ -18,6 +18,8 @@ import numpy as np
 
 from tmfem.control.linear.generalized_plant import measured_points
 from tmfem.errors import InputError
+from tmfem.io.atomic import atomic_open
+from tmfem.io.run import partial_name
 
 CONTROLLERS = {"adaptive-hinf": "lmi", "adaptive-hinf-riccati": "hinf", "adaptive-lqr": "lqr",
                "adaptive": "none"}
@@ -164,9 +166,14 @@ def _tendon_signals(r) -> list:
 
 
 def write_csv(path, r) -> str:
-    """The deployment CSV (:func:`csv_columns`), ``\\n`` line endings."""
+    """The deployment CSV (:func:`csv_columns`), ``\\n`` line endings, written atomically;
+    a run that stopped early (``r.failure``) is written as ``NAME.csv.partial``
+    (:func:`tmfem.io.run.partial_name`) and an earlier ``NAME.csv`` is removed."""
     nq = len(r.names["q"])
-    with open(path, "w", newline="") as fh:
+    if r.failure:
+        Path(path).unlink(missing_ok=True)
+        path = partial_name(path)
+    with atomic_open(path, "w", newline="") as fh:
         wr = csv.writer(fh, lineterminator="\n")
         wr.writerow(csv_columns(r))
         for k in range(r.t.size):

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.io.atomic import atomic_open
 from tmfem.reference.tables import printed_frequencies
 
 log = logging.getLogger(__name__)
@@ -192,7 +193,7 @@ def write_compare_csv(path, r: dict) -> Path:
     cols = (["mode"] + [f"{m}_ours_hz" for m in MODELS] + [f"{m}_printed_hz" for m in MODELS]
             + [f"{m}_vs_printed" for m in MODELS] + ["MTC_vs_SBC", "COM_vs_SBC",
                                                     "MTC_vs_SBC_printed", "COM_vs_SBC_printed"])
-    with open(path, "w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for i in range(len(r["ours"]["SBC"])):

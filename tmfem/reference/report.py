@@ -28,6 +28,8 @@ from pathlib import Path
 import numpy as np
 from tabulate import tabulate
 
+from tmfem.io.atomic import atomic_open, write_text
+
 log = logging.getLogger(__name__)
 
 def explanations(system, part: str) -> list[str]:
@@ -68,7 +70,7 @@ STEPS = ("equilibrium design", "MTC statics (designed)", "MTC statics (implied)"
 
 
 def _csv(path: Path, header: list, rows: list) -> Path:
-    with open(path, "w", newline="") as f:
+    with atomic_open(path, "w", newline="") as f:
         w = csv.writer(f, lineterminator="\n")
         w.writerow(header)
         w.writerows(rows)
@@ -311,7 +313,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                "printed_frequencies_hz": printed, "vibration": vibration,
                "deployment": deployment}
     summary = finite_or_none(summary)
-    (out / "report.json").write_text(json.dumps(with_units(summary), indent=1, allow_nan=False))
+    write_text(out / "report.json", json.dumps(with_units(summary), indent=1, allow_nan=False))
     add("report.json", out / "report.json")
     _index(out, system, summary, files, tables["rows"], notes, freqs, printed, statics)
     add("index.md", out / "index.md")
@@ -677,4 +679,4 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
           img(f"vibration_{lo}.png", f"{fe} free vibration"), ""]
     L += _deployment_section(summary.get("deployment"), link, img)
     L += ["## All files", ""] + [f"- [{k}]({p})" for k, p in sorted(files.items())]
-    (out / "index.md").write_text("\n".join(L) + "\n")
+    write_text(out / "index.md", "\n".join(L) + "\n")

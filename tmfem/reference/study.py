@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 from tabulate import tabulate
 
+from tmfem.io.atomic import atomic_open, write_text
 from tmfem.post.plots import new_figure, save_figure
 
 
@@ -101,7 +102,7 @@ def write_tables(out: Path, d, system, *, notes=()) -> dict:
     (units in the headers) and ``equilibrium.md`` (the table, ``notes`` explaining it, the
     checks) into ``out``; CSV line endings are ``\n``."""
     rows = table_rows(d, system)
-    with open(out / "equilibrium.csv", "w", newline="") as f:
+    with atomic_open(out / "equilibrium.csv", "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=["quantity", "unit", "ours", "printed", "rel_diff", "source"],
                            lineterminator="\n")
         w.writeheader()
@@ -109,7 +110,7 @@ def write_tables(out: Path, d, system, *, notes=()) -> dict:
             w.writerow({k: (fmt(v, 8) if isinstance(v, float) else v) for k, v in row.items()})
             f.flush()
     given = d.given_rest_lengths
-    with open(out / "tendons.csv", "w", newline="") as f:
+    with atomic_open(out / "tendons.csv", "w", newline="") as f:
         w = csv.writer(f, lineterminator="\n")
         head = ["tendon", "group", "length_m", "force_N", "force_density_N_per_m", "rest_length_m",
                 "stress_MPa"]
@@ -145,7 +146,7 @@ def write_tables(out: Path, d, system, *, notes=()) -> dict:
                       f"{given['forces'][k]:.4g}{' (slack)' if given['slack'][k] else ''} |")
     if system.notes:
         md += ["", "## Notes on the system", ""] + [f"- {n}" for n in system.notes]
-    (out / "equilibrium.md").write_text("\n".join(md) + "\n")
+    write_text(out / "equilibrium.md", "\n".join(md) + "\n")
     return {"rows": rows}
 
 

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
+from tmfem.io.atomic import atomic_open
 from tmfem.models.mtc.dynamics import fit_frequency
 from tmfem.reference.model_compare import MODELS, com_model, compared_system, fe_models
 
@@ -193,7 +194,7 @@ def write_vibration_csv(path, t, signals) -> Path:
     (:func:`tmfem.io.run.column_header`: ``t [s]``, ``SBC_theta_12 [rad]``, ``MTC_w_1 [m]``, ...)."""
     from tmfem.io.run import column_header
     cols = [(m, s) for m in MODELS for s in signals[m]]
-    with open(path, "w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow([column_header("t")] + [f"{m}_{column_header(s)}" for m, s in cols])
         data = np.column_stack([t] + [signals[m][s] for m, s in cols])

@@ -11,6 +11,7 @@ ends (``system.monitor_nodes``; Figs. 6.21-6.22, 6.25-6.27) are written row by r
 from __future__ import annotations
 
 import logging
+import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -117,7 +118,7 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
                        scheme=scheme, jacobian=jacobian, record=record, progress=progress,
                        outputs=False)
     finally:
-        out.close()
+        out.close(complete=sys.exc_info()[0] is None)     # else the files stay partial
     Xa = np.array(XS)
     stats = out.stats(sim)
     if stats["min_tendon_force"] <= 0:
@@ -273,7 +274,7 @@ def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_pat
         sim = simulate(dyn, t_end=t_end, dt=dt, scheme=scheme, jacobian=jacobian, tol=tol,
                        record=record, progress=progress, line_search=line_search)
     finally:
-        out.close()
+        out.close(complete=sys.exc_info()[0] is None)     # else the files stay partial
     Xa = np.array(XS)
     stats = out.stats(sim)
     stats.update({"ndof": int(dyn.free.sum()), "max_tendon_deflection": worst[0],

@@ -39,12 +39,15 @@ import numpy as np
 import tomli_w
 
 from tmfem.errors import InputError
+from tmfem.resources import check_membrane_modes
 from tmfem.system.coordinates import q_stages
 from tmfem.system.geometry import SymmetricConfig, membrane_corners_regular
 from tmfem.system.materials import BarSection, MembraneMaterial, TendonSection
 from tmfem.system.problem import problem_from_dict
 from tmfem.system.system import System
 from tmfem.system.topology import Tendon
+from tmfem.system.validate import (check_bounds, check_keys_used, check_stage_lists,
+                                   check_tendon_list, read_bounded, system_name)
 
 _TOP_KEYS = {"name", "description", "N", "deployable", "k_H", "notes", "symmetric", "general",
              "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed",
@@ -216,6 +219,8 @@ def _model_defaults(d: dict, where: str) -> dict:
         if K is not None and not (isinstance(K, int) and not isinstance(K, bool) and K >= 0):
             raise InputError(f"{where} [models.{name}]: expected membrane_modes as an integer >= 0, "
                              f"found {K!r}")
+        if K is not None:
+            check_membrane_modes(K, given=f"{where} [models.{name}] membrane_modes")
         out[name] = dict(opts)
     return out
 
@@ -232,6 +237,10 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     if not isinstance(deployable, bool):
         raise InputError(f"{where}: expected 'deployable' to be true or false, found {deployable!r}")
     k_H = _optional_num(d, "k_H", where)
+    name = system_name(d, where)
+    check_stage_lists(d, N, where)
+    check_tendon_list(d.get("tendon"), where, symmetric="symmetric" in d)
+    check_bounds(d, where)
     for key, kind in (("tendons", dict), ("printed", dict), ("notes", list), ("tendon", list)):
         if key in d and not isinstance(d[key], kind):
             raise InputError(f"{where}: expected '{key}' to be a "
@@ -242,7 +251,7 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     membrane, bar, sections = _materials(d, where)
     mtab = d["membrane"]
     rest = _rest_lengths(d, where)
-    common = dict(name=_string(d, "name", where, where),
+    common = dict(name=name,
                   description=_string(d, "description", where),
                   notes=tuple(notes), printed=_printed(d, where),
                   **_monitor(d, where), model_defaults=_model_defaults(d, where),
@@ -276,9 +285,11 @@ def system_from_dict(d: dict, where: str = "system") -> System:
                               z=_floats(s, "z", w, M, np.zeros(M)), r=_floats(s, "r", w, M),
                               l=_floats(s, "l", w, M))
         r_mb = _num(mtab, "r_mb", f"{where} [membrane]")
-        return System.symmetric_system(N=N, config=cfg, r_mb=r_mb, membrane=membrane, bar=bar,
-                                       tendon_sections=sections, deployable=deployable, k_H=k_H,
-                                       rest_lengths=rest, **common)
+        sys = System.symmetric_system(N=N, config=cfg, r_mb=r_mb, membrane=membrane, bar=bar,
+                                      tendon_sections=sections, deployable=deployable, k_H=k_H,
+                                      rest_lengths=rest, **common)
+        check_keys_used(sys, d, where)
+        return sys
     g = _table(d, "general", where)
     w = f"{where} [general]"
     base = _floats(g, "base", w).reshape(-1, 3).T if np.size(g.get("base", [])) else None
@@ -299,6 +310,7 @@ def system_from_dict(d: dict, where: str = "system") -> System:
     sys = System(M=M, N=N, deployable=deployable, base=base, l=l, q=q, membrane=membrane,
                  membrane_corners=corners, bar=bar, tendon_sections=sections, k_H=k_H,
                  tendons=tendons, r_mb=r_mb, **common)
+    check_keys_used(sys, d, where)
     return sys.with_rest_lengths(rest) if rest else sys
 
 
@@ -306,9 +318,7 @@ def load_system(path) -> System:
     """Read a system file (TOML); errors name the file and what is wrong."""
     path = Path(path)
     try:
-        text = path.read_bytes().decode("utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read system file {path}: {exc.strerror}") from None
+        text = read_bounded(path).decode("utf-8")
     except UnicodeDecodeError as exc:
         raise InputError(f"{path}: expected UTF-8 text (TOML), found byte 0x{exc.object[exc.start]:02x} "
                          f"at offset {exc.start} that is not UTF-8") from None

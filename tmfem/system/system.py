@@ -23,10 +23,17 @@ from tmfem.system.topology import Tendon, label, node_labels, tendon_topology
 
 def rest_length_array(values, n_tendons: int) -> np.ndarray:
     """Rest lengths r (eqs. 3.8-3.9) as a float array, checked: ``n_tendons`` finite
-    positive values, else InputError."""
+    positive values within the plausibility bounds of a system file
+    (:data:`tmfem.system.validate.BOUNDS`), else InputError."""
+    from tmfem.system.validate import BOUNDS
     r = np.asarray(values, dtype=float)
     if r.shape != (n_tendons,) or np.any(~np.isfinite(r)) or np.any(r <= 0):
         raise InputError(f"expected {n_tendons} positive rest lengths, found {r}")
+    lo, hi, unit, _ = BOUNDS[("rest_lengths", "*")]
+    if np.any((r < lo) | (r > hi)):
+        k = int(np.flatnonzero((r < lo) | (r > hi))[0])
+        raise InputError(f"expected rest lengths within {lo:g}..{hi:g} {unit} (docs/guides/equilibrium.md, "
+                         f"limits), found {r[k]:.4g} {unit} (tendon {k + 1} of {n_tendons})")
     return r
 
 

@@ -8,7 +8,6 @@ shell's strain code, the same criterion applied to the mid-surface Green-Lagrang
 the bilinear surface through the written node positions (E = (g_a.g_b - G_a.G_b) / 2 at the
 element centre; the MITC4 in-plane strain at r_3 = 0 is exactly this, eq. 4.14).
 """
-import json
 
 import meshio
 import numpy as np

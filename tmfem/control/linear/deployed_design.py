@@ -179,14 +179,8 @@ def save_design(design: HinfDesign, path) -> None:
 def load_design(path) -> tuple:
     """Read an ``.npz`` of :func:`save_design`: (GeneralizedPlant, controller StateSpace, data)."""
     import control
-    try:
-        f = np.load(path, allow_pickle=False)
-    except (OSError, ValueError, EOFError) as exc:     # EOFError: an empty or text file
-        raise InputError(f"design file {path}: expected an .npz written by `tmfem control hinf "
-                         f"--save`, found: {exc or type(exc).__name__}") from None
-    if not hasattr(f, "files"):                          # a single .npy array
-        raise InputError(f"design file {path}: expected an .npz written by `tmfem control hinf "
-                         f"--save`, found one array of shape {np.shape(f)}")
+    from tmfem.io.npz import read_npz
+    f = read_npz(path, expected="an .npz design file written by `tmfem control hinf --save`")
     need = ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22", "Ak", "Bk", "Ck", "Dk")
     missing = [k for k in need if k not in f]
     if missing:

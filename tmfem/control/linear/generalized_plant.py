@@ -76,7 +76,9 @@ def point_coordinates(basis, *, K: int, points) -> list:
 def _on_membrane(basis, point, *, max_shift: float = 0.01):
     """The point, or (if it lies just outside the discretised polygon, as the edge points
     of eq. 5.73 do with r_mb = 1.414 m: side 1.9997 m) the nearest point on the segment to
-    the membrane centroid that lies inside, moved by at most ``max_shift`` x r_mb."""
+    the membrane centroid that lies inside, moved by at most ``max_shift`` x r_mb. The move
+    is the documented rule for points on the edge (docs/guides/control.md), logged at DEBUG level
+    only: the presets' edge points take it on every run."""
     x, y = map(float, point)
     pm = basis.scalar_basis.mesh.p
     c = pm.mean(axis=1)
@@ -89,7 +91,7 @@ def _on_membrane(basis, point, *, max_shift: float = 0.01):
         except InputError:
             continue
         if s > 0:
-            log.info("membrane point (%g, %g) lies outside the mesh: using (%.4f, %.4f)", x, y, *cand)
+            log.debug("membrane point (%g, %g) lies outside the mesh: using (%.4f, %.4f)", x, y, *cand)
         return (float(cand[0]), float(cand[1]))
     raise InputError(f"membrane point ({x}, {y}) m: expected a point on the membrane (within "
                      f"{max_shift * r:.3g} m of it), found it outside")

@@ -40,7 +40,7 @@ from __future__ import annotations
 import logging
 import numpy as np
 
-from tmfem.control.linear.verification import (HinfDesign, check_loop, closed_loop, controller_ss,
+from tmfem.control.linear.verification import (HinfDesign, check_loop, controller_ss,
                                               verify)
 from tmfem.control.linear.hinf_central import verified_gamma
 from tmfem.control.linear.hinf_riccati import strict_point
@@ -177,7 +177,6 @@ def _controller_from_RS(P: GeneralizedPlant, alpha: float, R, S, gamma: float):
 
     Returns the controller matrices for the *shifted* plant and cond(I - R S).
     """
-    import scipy.linalg as sla
     n, nw, nu, np_, ny = (P.sizes[k] for k in ("n", "nw", "nu", "np", "ny"))
     # uniform state scaling x = c x_c balances R and S (R -> R / c^2, S -> c^2 S): same
     # controller, better-conditioned X

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from tmfem.io.npz import read_npz
 from tmfem.errors import InputError
 
 
@@ -82,8 +83,9 @@ class LPVStateFeedback:
         InputError
             Not a file written by :meth:`save`.
         """
+        d = read_npz(path, expected="an .npz LPV controller written by `tmfem control lpv "
+                                    "--save`")
         try:
-            d = np.load(path, allow_pickle=False)
             keys = ("gamma", "P", "Q", "centre", "half_width", "varying", "rate_bounds",
                     "parameter_names", "state_names")
             f = {k: d[k] for k in keys}

@@ -1,0 +1,112 @@
+"""Cost estimates of the inputs that scale the work, checked before anything is built.
+
+Every input whose size drives memory or run time -- the stages and bars of a system and its
+tendons (the equilibrium design's dense matrices), the membrane mesh and the members' elements
+(the finite-element models' DOFs), the control-oriented model's membrane modes -- has an
+estimate here. A job over the limit raises :class:`tmfem.errors.ResourceLimit` (exit 3) whose
+message names the input, the estimate and the limit (docs/guides/cli.md, "Limits"). The limit is
+:data:`MEMORY_FRACTION` of the machine's physical memory: the machines are shared.
+"""
+from __future__ import annotations
+
+import os
+
+from tmfem.errors import InputError, ResourceLimit
+
+MEMORY_FRACTION = 0.6         # of the physical memory: the machine is shared
+
+# Measured on the 1-4 MTC model (modal, 12 modes): peak RSS grows by ~8-11 kB per free
+# DOF from n = 20 (5 067 DOFs, 0.17 GB) to n = 80 (78 000 DOFs, 0.81 GB); 16 kB leaves
+# room for the fill of larger factorisations. Base: the interpreter with numpy/scipy/VTK.
+BYTES_PER_DOF = 16e3
+BASE_BYTES = 0.3e9
+
+#: Largest K of the control-oriented model: its equations are built symbolically (CasADi)
+#: at a cost that grows faster than K^2 (1-4, measured under load: K = 10: 8 s, 20: 9 s,
+#: 40: 24 s; K = 1000 would run for hours).
+MAX_MEMBRANE_MODES = 40
+
+
+def machine_memory() -> float:
+    """Physical memory of this machine in bytes (24 GiB on the project's machines)."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):     # pragma: no cover - non-POSIX
+        return 24.0 * 2**30
+
+
+def memory_limit() -> float:
+    """Bytes a job may use: :data:`MEMORY_FRACTION` of :func:`machine_memory`."""
+    return MEMORY_FRACTION * machine_memory()
+
+
+def require_memory(need: float, *, given: str, what: str) -> float:
+    """Refuse ``need`` bytes over :func:`memory_limit`: ``given`` names the input (an option
+    or a file's field), ``what`` says what it builds. Returns ``need``."""
+    limit = memory_limit()
+    if need > limit:
+        raise ResourceLimit(f"{given}: {what} needs about {need / 2**30:.1f} GiB; the limit is "
+                            f"{limit / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this machine's "
+                            f"{machine_memory() / 2**30:.0f} GiB)")
+    return need
+
+
+def mesh_dofs(*, N: int, n: int, dofs_per_node: int = 3, extra_dofs: int = 0) -> int:
+    """DOFs of N n x n quadrilateral membrane patches (about N (n + 1)^2 nodes) with
+    ``dofs_per_node`` unknowns each, plus ``extra_dofs`` (members)."""
+    return dofs_per_node * N * (n + 1) ** 2 + int(extra_dofs)
+
+
+def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3,
+                      extra_dofs: int = 0, extra_text: str = "") -> int:
+    """Refuse a membrane mesh whose FE model would not fit this machine.
+
+    The DOFs are :func:`mesh_dofs`; the estimated peak memory is ``BASE_BYTES +
+    BYTES_PER_DOF * dofs`` and must stay under :func:`memory_limit`. Returns the DOF estimate.
+
+    Raises
+    ------
+    ResourceLimit
+        with the estimate and the limit.
+    """
+    dofs = mesh_dofs(N=N, n=n, dofs_per_node=dofs_per_node, extra_dofs=extra_dofs)
+    given = option if " " in option else f"{option} {n}"    # "--mesh n ..." or the flag
+    require_memory(BASE_BYTES + BYTES_PER_DOF * dofs, given=given,
+                   what=f"the membrane mesh {N} x {n} x {n}"
+                   + (f" with {extra_text}" if extra_text else "") + f" gives about {dofs:,} "
+                   "DOFs and")
+    return dofs
+
+
+def design_bytes(*, M: int, N: int, n_tendons: int, deployable: bool = False) -> float:
+    """Peak memory [bytes] of the equilibrium design of an M-N system (ch. 3): the dense node
+    Jacobian dX/dq (3 n_nodes x n_q, built from two arrays of the bar ends of the same size,
+    eqs. 3.1-3.2) and the full SVD of the n_q x n_t equilibrium matrix A_T (eq. 3.16:
+    U n_q^2, V n_t^2 and the scaled copy), 8 bytes each, plus :data:`BASE_BYTES`."""
+    n_q = 2 * N + 5 * N * (M - 1)
+    n_nodes = 2 * M * N + (N if deployable else 0)
+    entries = 3 * (3 * n_nodes * n_q) + n_q**2 + n_tendons**2 + 2 * n_q * n_tendons
+    return BASE_BYTES + 8.0 * entries
+
+
+def check_system_budget(system, *, source: str = "the system") -> float:
+    """Refuse a system whose equilibrium design (:func:`design_bytes`) would not fit this
+    machine, before anything is built; ``source`` names where it comes from (the file).
+    Every command starts from the design, so this bounds the stages, bars per stage and
+    tendons of a system file. Returns the estimate in bytes."""
+    M, N, nt = system.M, system.N, len(system.tendons)
+    stages = f"{M} stage{'s' if M != 1 else ''}"
+    return require_memory(design_bytes(M=M, N=N, n_tendons=nt, deployable=system.deployable),
+                          given=f"{source}: {stages} x {N} bars, {nt} tendons",
+                          what="the equilibrium design (dense node Jacobian and the SVD of "
+                               "the equilibrium matrix, eqs. 3.1-3.16)")
+
+
+def check_membrane_modes(K: int, *, given: str = "--membrane-modes") -> None:
+    """Membrane modes K of the control-oriented model: 0 <= K <= :data:`MAX_MEMBRANE_MODES`
+    (``given`` names the input: the option or the file's ``[models.com] membrane_modes``)."""
+    if not 0 <= K <= MAX_MEMBRANE_MODES:
+        cls = ResourceLimit if K > MAX_MEMBRANE_MODES else InputError
+        raise cls(f"{given} {K}: expected 0 <= K <= {MAX_MEMBRANE_MODES} (the model's "
+                  f"equations are built symbolically; K = 40 takes ~25 s, the cost grows faster "
+                  f"than K^2)")
