@@ -20,6 +20,7 @@ import re
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.models.members import FAMILY_CODES  # noqa: F401  (re-exported: the family codes of the files)
 from tmfem.system.topology import label
 
 KIND_CODES = {"bar": 0, "tendon": 1, "membrane": 2}

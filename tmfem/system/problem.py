@@ -305,7 +305,7 @@ def problem_from_dict(d: dict, where: str, build) -> Problem:
             merged["rest_lengths"] = p["rest_lengths"]
         elif "rest_lengths" in rest:
             merged.pop("rest_lengths")                 # the deployed ones do not hold there
-        merged["name"] = f"{d.get('name', where)} (packaged)"
+        merged["name"] = f"{d.get('name', where)}-packaged"
         packaged = build(merged, f"{where} [packaged]")
     return Problem(control=_control(d["control"], where) if "control" in d else HinfWeights(),
                    deployment=_deployment(d["deployment"], where) if "deployment" in d else None,

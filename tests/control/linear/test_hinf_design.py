@@ -19,7 +19,8 @@ import control
 import numpy as np
 import pytest
 
-from tmfem.control.linear.hinf_lmi import (GeneralizedPlant, closed_loop, hinf_gamma, hinf_lmi,
+from tmfem.control.linear.verification import closed_loop
+from tmfem.control.linear.hinf_lmi import (GeneralizedPlant, hinf_gamma, hinf_lmi,
                                 hinf_state_feedback)
 from tmfem.control.linear.pbh import pbh
 from tmfem.errors import InfeasibleController, InputError
