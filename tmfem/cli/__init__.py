@@ -197,7 +197,10 @@ def _main_mpi(args, mod) -> int:
     import contextlib
     import io
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
-    if getattr(args, "backend", None) != "petsc":
+    backend = getattr(args, "backend", None)
+    if backend is None and hasattr(args, "_model_option_dests"):
+        backend = "auto"                   # the finite-element commands' default
+    if backend not in ("petsc", "auto"):
         if rank == 0:
             print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
                   f"--backend petsc, found --backend {getattr(args, 'backend', None) or 'scipy'} "

@@ -6,7 +6,7 @@ import sys
 import numpy as np
 
 from tmfem.cli.common import (add_model_args, add_system_args, check_com_modes, model_from_args,
-                              model_options_from_args)
+                              model_options_from_args, with_backend)
 from tmfem.cli.static import default_monitor
 from tmfem.errors import InputError
 from tmfem.models.mtc.design import describe_rule
@@ -20,11 +20,6 @@ def configure(parser) -> None:
     add_system_args(parser)
     add_model_args(parser, NAME, default="mtc")
     parser.add_argument("--modes", type=int, default=12, help="number of modes (default 12)")
-    parser.add_argument("--eig-solver", choices=("auto", "block", "slepc", "redundant"), default=None,
-                        help="the PETSc backend's eigen solver (--backend petsc only; default auto: "
-                             "block Krylov-Schur, on the distributed factors under mpiexec; redundant: every "
-                             "rank factorises the whole K - sigma M, for cores shared with other "
-                             "jobs; docs/guides/backends.md). The JSON's eig_solver says which one ran")
     parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu "
                                       "[finite-element models]")
     parser.add_argument("--png", help="render the first six mode shapes to this PNG "
@@ -59,7 +54,7 @@ def run(args) -> dict:
         raise InputError(f"--modes {args.modes}: expected fewer modes than the model's "
                          f"{model.ndof} free DOFs")
     if args.model == "sbc":
-        return with_eig_solver(sbc_modal(args, model, FREQUENCIES), model)
+        return with_backend(sbc_modal(args, model, FREQUENCIES), model)
     system_name = model.system.name
     print(f"tmfem modal: {system_name} MTC, {model.ndof} free dofs", file=sys.stderr)
     res, modes = mtc_modes(model, k=args.modes, start=options["start"],
@@ -91,14 +86,7 @@ def run(args) -> dict:
             out["png"] = str(render_modes(args.png, points=res.x, cells=cells, shapes=shapes,
                                           freq_hz=modes.freq_hz, k=min(6, args.modes),
                                           title=f"{system_name} MTC modes"))
-    return with_eig_solver(out, model)
-
-
-def with_eig_solver(out: dict, model) -> dict:
-    """``out`` with the key ``eig_solver``, the PETSc backend's eigen solver that ran (its
-    ``last_eig_solver``; small problems take SLEPc whatever was asked), under ``--backend petsc``."""
-    ran = getattr(model.backend, "last_eig_solver", None)
-    return out if ran is None else {**out, "eig_solver": ran}
+    return with_backend(out, model)
 
 
 def sbc_modal(args, model, tables) -> dict:

@@ -5,7 +5,7 @@ import sys
 
 import numpy as np
 
-from tmfem.cli.common import add_model_args, add_system_args, model_from_args
+from tmfem.cli.common import add_model_args, add_system_args, model_from_args, with_backend
 from tmfem.models.mtc.design import describe_rule
 from tmfem.models.mtc.spec import sequence_of
 
@@ -120,10 +120,10 @@ def sbc_static(args, model) -> dict:
 def run(args) -> dict:
     model, options = model_from_args(args, NAME)
     if args.model == "sbc":
-        return sbc_static(args, model)
+        return with_backend(sbc_static(args, model), model)
     res, summary = solve(args, model, options)
     write_outputs(args, model, res.x, summary)
-    return summary
+    return with_backend(summary, model)
 
 
 def format_text(r: dict) -> str:

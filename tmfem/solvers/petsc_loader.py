@@ -1,7 +1,7 @@
 """petsc4py and slepc4py, imported and initialised on first use.
 
-The PETSc backend's modules (:mod:`tmfem.solvers.petsc`, :mod:`tmfem.solvers.distributed`,
-:mod:`tmfem.solvers.petsc_redundant`) import this module at module level and call
+The PETSc backend's modules (:mod:`tmfem.solvers.petsc`, :mod:`tmfem.solvers.distributed`)
+import this module at module level and call
 :func:`petsc_modules` where they need PETSc, so that importing them costs nothing on a
 machine without PETSc and ``import tmfem`` never loads it (docs/architecture.md,
 "Imports").

@@ -112,7 +112,7 @@ class MTCModel:
         gives a pinned rigid bar its exact rotary inertia m l^2 / 3).
     backend : str or Backend
         Linear-algebra backend of every factorisation and eigen solve (``"scipy"`` default;
-        :func:`tmfem.solvers.get_backend`).
+        ``"auto"`` chooses by the free dofs; :func:`tmfem.solvers.get_backend`).
     membrane_law : {"svk", "tension-field"}
         Membrane law (:mod:`tmfem.fem.tension_field`): St.Venant-Kirchhoff (eq. 4.9, default)
         or the tension-field (wrinkling) law. The prestress is the static equilibrium of this
@@ -138,7 +138,6 @@ class MTCModel:
         self.tendon_law = tendon_law
         self.system = system
         self.membrane_law = check_law_name(membrane_law)
-        self.backend = get_backend(backend)
         self.mesh_n, self.patch = mesh_n, patch
         self.topology: MTCTopology = build_topology(system, mesh_n=mesh_n,
                                                     tendon_elements=tendon_elements,
@@ -160,6 +159,7 @@ class MTCModel:
         self.lumped_tendon_mass = lumped_tendon_mass
         self.bar_element = TrussElement(self.bars, topo.dofmap)
         self.free = topo.constraints.free
+        self.backend = get_backend(backend, n_dofs=self.ndof)
         self._M = None
         self._dist = None
         self.rest_lengths_source = None
