@@ -5,7 +5,7 @@ rank 0 prints one JSON document.
 
 usage: python tests/mpi/fe_distributed.py PRESET MESH_N [--model mtc|sbc]
                                           [--start design|undeformed] [--fail-rank R] [--nan-rank R]
-                                          [--options "-snes_type newtonls ..."]
+                                          [--options="-snes_type newtonls ..."]
 --model: the MTC model (membrane, bars, tendons; default) or the SBC model (MITC4 shells,
 beams, cables; static from the undeformed membrane through the MTC predictor);
 --start: the MTC model's start; --fail-rank R: the membrane/shell kernel of rank R raises

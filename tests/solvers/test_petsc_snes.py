@@ -4,6 +4,7 @@ Sources: the scipy backend's trust-region statics of the same model (an independ
 solver on the same residual), PETSc's own output (-snes_monitor, -snes_view) and converged
 reasons, the crossover constant of tmfem.solvers.backends.
 """
+import json
 import os
 import subprocess
 import sys
@@ -13,7 +14,7 @@ import numpy as np
 import pytest
 
 from tmfem.errors import ConvergenceError, InputError
-from tests.solvers.test_petsc_backend import needs_petsc
+from tests.solvers.test_petsc_backend import _mpirun, needs_mpi, needs_petsc
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -94,3 +95,23 @@ def test_auto_model_below_the_crossover_is_scipy():
     from tmfem.system import load_preset
     m = MTCModel(load_preset("2-3"), mesh_n=4, backend="auto")
     assert m.ndof < 5000 and m.backend.name == "scipy"
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_snes_under_ranks_honours_options_and_reports_its_reason_once(scipy_2_3, ranks):
+    # source: the scipy trust region's equilibrium (displacements to 1e-9); under mpiexec the
+    # SNES monitor prints from rank 0 and a SNES failure on every rank is one error
+    m, st = scipy_2_3
+    p = _mpirun(ranks, "2-3", "4", "--options=-snes_monitor")
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.strip().splitlines()
+    assert "SNES Function norm" in p.stdout
+    run = json.loads(lines[-1])
+    assert run["ranks"] == ranks
+    x0 = m.reduce(m.initial_positions("undeformed"))
+    xs = m.reduce(st.x)
+    assert np.linalg.norm(np.array(run["x"]) - xs) <= 1e-9 * np.linalg.norm(xs - x0)
+    p = _mpirun(ranks, "2-3", "4", "--options=-snes_max_funcs 1")
+    assert p.returncode != 0
+    assert p.stderr.count("SNES DIVERGED_FUNCTION_COUNT") == 1

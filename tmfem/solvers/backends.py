@@ -253,7 +253,7 @@ def get_backend(name: str | Backend | None = None, *, n_dofs: int | None = None,
             raise InputError(f"backend 'auto': option does not apply: {', '.join(sorted(options))} "
                              "(options of the PETSc backend: expected backend 'petsc')")
         name = choose_backend(n_dofs=n_dofs)
-        log.info("backend auto: %s for %d free dofs (crossover %d)", name, n_dofs,
+        log.debug("backend auto: %s for %d free dofs (crossover %d)", name, n_dofs,
                  AUTO_CROSSOVER_DOFS)
     cls = _BACKENDS.get(name)
     if cls is None:
