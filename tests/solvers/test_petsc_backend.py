@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_missing_petsc4py_raises_backend_unavailable_naming_the_command(monkeypatch):
-    # source: the install contract of issue 11 (a missing backend names the command)
+    # source: the install contract (a missing backend names the install command)
     monkeypatch.setitem(sys.modules, "petsc4py", None)
     from tmfem.solvers.backends import get_backend
     with pytest.raises(BackendUnavailable, match="make install"):

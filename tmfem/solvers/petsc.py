@@ -475,8 +475,8 @@ class PetscBackend:
     def solve_equilibrium(self, residual, energy, u0, **kwargs):
         """The equilibrium r(u) = 0 of the energy W from u0 by PETSc's SNES with
         pseudo-transient continuation (:func:`tmfem.solvers.petsc_snes.snes_equilibrium`:
-        the arguments and result of :func:`tmfem.solvers.trust_region.trust_region_newton`
-        with every dof free and a distributed tangent)."""
+        the arguments of :func:`tmfem.solvers.trust_region.trust_region_newton` with every
+        dof free and a distributed tangent, the fields of its result as a dict)."""
         from tmfem.solvers.petsc_snes import snes_equilibrium
         return snes_equilibrium(self, residual, energy, u0, **kwargs)
 

@@ -156,10 +156,9 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                      max_iter: int = 200, newton_first: bool = False, callback=None,
                      describe=None, what: str = "static solve", update=None):
     """The equilibrium r(u) = 0 of the energy W by SNES solves (module docstring); the
-    arguments and the result (:class:`tmfem.solvers.trust_region.TrustRegionResult`) are
-    those of :func:`tmfem.solvers.trust_region.trust_region_newton` with every dof free.
-    ``max_iter`` bounds the SNES iterations over all solves."""
-    from tmfem.solvers.trust_region import TrustRegionResult
+    arguments are those of :func:`tmfem.solvers.trust_region.trust_region_newton` with every
+    dof free, the result the fields of its result: ``dict(u, iterations, residual_history,
+    mu_history, tangent)``. ``max_iter`` bounds the SNES iterations over all solves."""
     PETSc = backend.PETSc
     u = np.array(u0, dtype=float, copy=True) if update is None else u0
     r, K = residual(u)
@@ -279,5 +278,4 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         note = f" ({describe(u)})" if describe is not None else ""
         raise ConvergenceError(f"{what}: SNES stopped after {total} iterations (max_iter {max_iter}) "
                                f"at |r| = {rn:.3e} N, expected <= {tol:g} x force scale{note}")
-    return TrustRegionResult(u=u, iterations=total, residual_history=res_hist, mu_history=mu_hist,
-                             tangent=K)
+    return dict(u=u, iterations=total, residual_history=res_hist, mu_history=mu_hist, tangent=K)

@@ -87,9 +87,10 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     if getattr(be, "solve_equilibrium", None) is not None and free.all():
         # a backend with a nonlinear solver of its own (PETSc's SNES) on a distributed
         # assembly, where every unknown is free
-        return be.solve_equilibrium(residual, energy, u0, scale=scale, force_scale=force_scale,
-                                    tol=tol, max_iter=max_iter, newton_first=newton_first,
-                                    callback=callback, describe=describe, what=what, update=update)
+        return TrustRegionResult(**be.solve_equilibrium(
+            residual, energy, u0, scale=scale, force_scale=force_scale, tol=tol,
+            max_iter=max_iter, newton_first=newton_first, callback=callback, describe=describe,
+            what=what, update=update))
     idx = free_index(free, free.size)
     u = np.array(u0, dtype=float, copy=True) if update is None else u0
     Dm = sp.diags(np.asarray(scale, dtype=float))
