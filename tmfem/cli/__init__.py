@@ -186,8 +186,9 @@ def _checks_exit(args, result, *, printing: bool = True) -> int:
 
 
 def _mpi_size() -> int:
-    """Number of ranks when started by mpiexec (Open MPI's or MPICH's variable), else 1."""
-    return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
+    """Number of ranks when started by mpiexec, else 1."""
+    from tmfem.solvers.petsc_loader import launched_ranks
+    return launched_ranks()
 
 
 def _main_mpi(args, mod) -> int:

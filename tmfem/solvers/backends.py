@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import hashlib
 import logging
-import os
 from typing import Callable, Protocol
 
 import numpy as np
@@ -28,9 +27,9 @@ import scipy.linalg as la
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from tmfem.errors import BackendUnavailable, ConvergenceError, InputError
+from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.petsc import PetscBackend
-from tmfem.solvers.petsc_loader import petsc_modules
+from tmfem.solvers.petsc_loader import launched_ranks, petsc_available
 from tmfem.solvers.singular import SingularMatrix
 
 log = logging.getLogger(__name__)
@@ -198,21 +197,6 @@ _BACKENDS = {"scipy": ScipyBackend, "petsc": PetscBackend}
 #: membrane with 12 modes was faster with scipy up to about 5k free dofs (4 x 20 x 20) and
 #: faster with PETSc from there on (``benchmarks/bench_backend_crossover.py`` measures it).
 AUTO_CROSSOVER_DOFS = 5000
-
-
-def launched_ranks() -> int:
-    """Number of MPI ranks of this process's job as the launcher announces it (Open MPI's or
-    MPICH's environment), 1 outside ``mpiexec``; does not initialise MPI."""
-    return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
-
-
-def petsc_available() -> bool:
-    """Whether petsc4py and slepc4py load (:func:`tmfem.solvers.petsc_loader.petsc_modules`)."""
-    try:
-        petsc_modules()
-    except BackendUnavailable:
-        return False
-    return True
 
 
 def choose_backend(*, n_dofs: int, ranks: int | None = None) -> str:

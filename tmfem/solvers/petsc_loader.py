@@ -8,6 +8,8 @@ machine without PETSc and ``import tmfem`` never loads it (docs/architecture.md,
 """
 from __future__ import annotations
 
+import os
+
 from tmfem.errors import BackendUnavailable
 
 PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/guides/backends.md)"
@@ -27,3 +29,18 @@ def petsc_modules():
         raise BackendUnavailable(f"backend 'petsc': expected petsc4py and slepc4py importable, found "
                                  f"{exc}; install with: {PETSC_INSTALL}") from None
     return PETSc, SLEPc
+
+
+def petsc_available() -> bool:
+    """Whether petsc4py and slepc4py load (:func:`petsc_modules`)."""
+    try:
+        petsc_modules()
+    except BackendUnavailable:
+        return False
+    return True
+
+
+def launched_ranks() -> int:
+    """Number of MPI ranks of this process's job as the launcher announces it (Open MPI's or
+    MPICH's environment), 1 outside ``mpiexec``; does not initialise MPI."""
+    return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
