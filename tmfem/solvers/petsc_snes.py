@@ -11,13 +11,11 @@ by one SNES solve from u_k (backward Euler on the gradient flow D du/dt = -r wit
 time step 1 / mu). Its solution minimises W(u) + mu/2 |u - u_k|_D^2, so an accepted step
 lowers the energy: the iteration slides down the energy to a minimum, the same equilibrium
 as the trust region of :mod:`tmfem.solvers.trust_region` (whose step is one Newton iteration
-of this problem). A step is accepted when it lowers W; then mu falls eightfold, a failed or
-rejected step multiplies it by 4. Below ``1e-6`` of the stiffness-to-mass scale mu becomes 0
-and the last SNES solve is Newton's method on r(u) = 0 itself, stopping at
-||r|| <= 1e-3 tol x force scale (SNES ``atol``; quadratic convergence makes that at most one
-iteration more than ``tol`` asks, and the equilibrium the same to round-off whichever path
-led to it); a final solve that does not converge sends the
-iteration back to the continuation.
+of this problem). A step is accepted when it lowers W; then, if its SNES solve converged,
+mu falls eightfold; a failed or rejected step multiplies mu by 4. Below :data:`MU_NEWTON` of
+the stiffness-to-mass scale mu becomes 0 and the last SNES solve is Newton's method on
+r(u) = 0 itself, stopping at ||r|| <= tol x force scale (SNES ``atol``: the test of the trust
+region).
 
 Every SNES solve reads the options database (``-snes_*``, ``-ksp_*``, ``-pc_*`` of
 ``PETSC_OPTIONS`` and of the backend's ``options=``), so ``-snes_monitor`` prints every
@@ -56,8 +54,6 @@ log = logging.getLogger(__name__)
 MU_NEWTON = 1e-8
 #: SNES iterations of the final Newton solve before the continuation takes over again
 NEWTON_MAX_IT = 20
-#: SNES ``atol`` of the final solve in units of tol x force scale
-FINAL_ATOL = 1.0
 #: SNES iterations of a continuation step (an inexact proximal step: accepted when it lowers
 #: the energy)
 STEP_MAX_IT = 3
@@ -225,11 +221,7 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
 
     try:
         while True:
-            # the final Newton solve asks FINAL_ATOL of the tolerance: quadratic convergence
-            # makes that at most one more iteration, and the equilibrium is then the same
-            # to round-off whichever path led to it (not only to tol)
-            fs = force_scale(u)
-            un, rr, KK, its, reason = solve(mu, tol * fs * (FINAL_ATOL if mu == 0.0 else 1.0))
+            un, rr, KK, its, reason = solve(mu, tol * force_scale(u))
             total += its
             ok = un is not None and np.all(np.isfinite(rr))
             if ok and mu == 0.0:
