@@ -2,8 +2,8 @@
 
 Source of every expected number: an independent formulation -- the scipy backend (SuperLU,
 ARPACK/LAPACK) on the same matrices, the residual of the linear system itself, and the
-serial run for the 2-rank run. The model-level statics use the solver layer's Newton on
-the MTC residual from the design (``MTCModel.solve_static`` has no ``backend=`` yet).
+serial run for the 2-rank run. The PETSc backend's model statics are SNES solves
+(tmfem.solvers.petsc_snes; their options and reasons: tests/solvers/test_petsc_snes.py).
 """
 import json
 import os
