@@ -4,13 +4,12 @@
 
 Configurations (each run in a fresh process, so that peak memory is per run):
   scipy    the embedded backend (SuperLU symmetric mode with nested dissection, ARPACK)
-  petsc    PETSc/SLEPc on 1 rank (MUMPS Cholesky; eigen: the block Krylov-Schur
-           shift-invert, PetscBackend eig_solver='auto'); the model assembles through
-           tmfem.fem.distributed (one rank: all elements)
+  petsc    PETSc/SLEPc on 1 rank (MUMPS Cholesky; eigen: SLEPc Krylov-Schur
+           shift-invert); the model assembles through tmfem.fem.distributed (one rank:
+           all elements)
   petsc2   the same under ``mpiexec -n 2``: each rank evaluates and assembles half of the
-           membrane elements into one parallel matrix; MUMPS on both ranks; eigen: the
-           block Krylov-Schur on the parallel factors ('auto'; --eig-solver
-           slepc|redundant chooses the others)
+           membrane elements into one parallel matrix; MUMPS on both ranks; eigen: SLEPc
+           on the parallel factors
 Columns: free DOFs, iterations of the static solve on the finest mesh, time per iteration
 (static time over all iterations, mesh sequencing from n = 10 included), static time, eigen
 time, time inside the backend's factorisations (incl. MUMPS/SuperLU analysis; their number)
@@ -20,8 +19,6 @@ ranks), first frequency. A second table splits rank 0's static time by phase
 (:class:`PhaseTimer`: element kernels and assembly, pattern set-up, interpolation, model
 builds, factorisations, solves, the rest: trust-region algebra, MPI waits).
 OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
---eig-solver: the PETSc backend's eigen solver (default 'auto'; the one that ran is printed
-per row).
 --mpi-yield: petsc2's waiting ranks yield the core (Open MPI ``--mca mpi_yield_when_idle 1``;
 helps on a loaded machine: busy-waiting takes the core from the working rank and other jobs).
 Targets (2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
@@ -119,7 +116,7 @@ def system_1_4(rest_length: float):
     return load_preset("1-4", as_printed=True).with_rest_lengths({"S1": rest_length})
 
 
-def run_one(mesh: int, config: str, rest_length: float, sequence: int, eig_solver: str = "auto") -> dict:
+def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     """One configuration on one mesh (in this process); rank 0's dict, max memory over ranks."""
     from tmfem.models.mtc.model import MTCModel
     from tmfem.solvers.backends import get_backend
@@ -132,7 +129,7 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int, eig_solve
         inner = get_backend("scipy")
     else:
         from tmfem.solvers.petsc import PetscBackend
-        inner = PetscBackend(eig_solver=eig_solver)
+        inner = PetscBackend()
     be = TimedBackend(inner)
     system = system_1_4(rest_length)
     t0 = time.perf_counter()
@@ -156,8 +153,7 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int, eig_solve
                 static_factor_s=f_static, static_cpu_factor_s=c_static, static_solve_s=s_static,
                 static_cpu_solve_s=cs_static, cpu_s=c3 - c1, cpu_static_s=c2 - c1,
                 cpu_eigen_s=c3 - c2, cpu_phases=cpu_phases, wall_phases=wall_phases, rss_mb=rss,
-                f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0],
-                eig_solver=getattr(inner, "last_eig_solver", None) or "arpack")
+                f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0])
 
 
 def launch(mesh: int, config: str, args) -> dict:
@@ -165,7 +161,7 @@ def launch(mesh: int, config: str, args) -> dict:
            if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
     env["OPENBLAS_NUM_THREADS"] = "1"
     cmd = [sys.executable, HERE, "--run", str(mesh), config, "--rest-length", str(args.rest_length),
-           "--sequence", str(args.sequence), "--eig-solver", args.eig_solver]
+           "--sequence", str(args.sequence)]
     if config == "petsc2":
         cmd = ([shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"]
                + (["--mca", "mpi_yield_when_idle", "1"] if args.mpi_yield else []) + cmd)
@@ -182,8 +178,6 @@ def main(argv=None) -> int:
     ap.add_argument("--rest-length", type=float, default=1.5025,
                     help="rest length of the S tendons [m] (the value Tables 6.3/6.6 imply)")
     ap.add_argument("--sequence", type=int, default=10, help="coarsest mesh of the mesh sequencing")
-    ap.add_argument("--eig-solver", default="auto", choices=("auto", "redundant", "block", "slepc"),
-                    help="the PETSc backend's eigen solver (PetscBackend eig_solver)")
     ap.add_argument("--mpi-yield", action="store_true",
                     help="petsc2: Open MPI's waiting ranks yield the core (--mca mpi_yield_when_idle 1) "
                          "instead of busy-waiting")
@@ -197,21 +191,18 @@ def main(argv=None) -> int:
             print(json.dumps(run_one(int(args.run[0]), "scipy", args.rest_length, args.sequence)))
             return 0
         return mpi_main(lambda: json.dumps(run_one(int(args.run[0]), args.run[1], args.rest_length,
-                                                   args.sequence, args.eig_solver)),
+                                                   args.sequence)),
                         report=rank_report())
     rows = []
     if not args.json:
         print(f"# 1-4 MTC, static from the undeformed membrane + 12 modes; {os.cpu_count()} cpus, "
               f"load average {os.getloadavg()[0]:.2f} (wall times grow with it; CPU s is rank 0's)")
-        from tmfem.solvers.petsc import EIG_BLOCK
-        print("# eigen (column 'eig'): scipy ARPACK shift-invert; petsc the block Krylov-Schur on "
-              f"MUMPS solves of {EIG_BLOCK} right-hand sides ('block'), on every rank's own factors with the "
-              "columns split ('redundant') or SLEPc Krylov-Schur ('slepc'); PetscBackend "
-              f"eig_solver={args.eig_solver!r}; petsc2 MPI waiting: "
+        print("# eigen: scipy ARPACK shift-invert; petsc SLEPc Krylov-Schur shift-invert on MUMPS; "
+              "petsc2 MPI waiting: "
               + ("yield (--mca mpi_yield_when_idle 1)" if args.mpi_yield else "busy (Open MPI default)"))
         print(f"{'config':>7s} {'mesh':>11s} {'dofs':>8s} {'its':>4s} {'s/it':>7s} {'static s':>9s} "
               f"{'eigen s':>8s} {'factor s':>9s} {'n':>3s} {'solve s':>8s} {'CPU s':>7s} "
-              f"{'RSS MB/rank':>11s} {'f1 [Hz]':>9s} load eig")
+              f"{'RSS MB/rank':>11s} {'f1 [Hz]':>9s} load")
     for mesh in [int(v) for v in args.meshes.split(",")]:
         for config in args.configs.split(","):
             row = launch(mesh, config, args)
@@ -225,7 +216,7 @@ def main(argv=None) -> int:
                   f"{row['s_per_it']:7.3f} {row['static_s']:9.2f} {row['eigen_s']:8.2f} "
                   f"{row['factor_s']:9.2f} {row['n_factor']:3d} {row['solve_s']:8.2f} "
                   f"{row['cpu_s']:7.2f} {row['rss_mb']:11.0f} {row['f1_hz']:9.6f} "
-                  f"{row['load']:.1f} {row['eig_solver']}", flush=True)
+                  f"{row['load']:.1f}", flush=True)
     if args.json:
         print(json.dumps(rows))
         return 0

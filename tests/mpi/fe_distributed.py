@@ -5,15 +5,13 @@ rank 0 prints one JSON document.
 
 usage: python tests/mpi/fe_distributed.py PRESET MESH_N [--model mtc|sbc]
                                           [--start design|undeformed] [--fail-rank R] [--nan-rank R]
-                                          [--eig-solver auto|redundant|block|slepc]
-                                          [--eig-memory-mb MB]
+                                          [--options="-snes_type newtonls ..."]
 --model: the MTC model (membrane, bars, tendons; default) or the SBC model (MITC4 shells,
 beams, cables; static from the undeformed membrane through the MTC predictor);
 --start: the MTC model's start; --fail-rank R: the membrane/shell kernel of rank R raises
 (a failure on one rank: the other ranks wait in a collective call, mpi_main aborts the
 job); --nan-rank R: rank R's element matrices are not finite (caught collectively by the
-assembler: one clean error); --eig-solver, --eig-memory-mb: the PETSc backend's eigen
-solver and its memory budget per rank for the redundant factors. The MTC document has
+assembler: one clean error); --options: PETSc options of the backend. The MTC document has
 ``m_orth``: max |Phi^T M Phi - I| of the modes with the scipy mass of the model.
 """
 import argparse
@@ -34,13 +32,12 @@ def main():
     ap.add_argument("--start", default="undeformed")
     ap.add_argument("--fail-rank", type=int, default=None)
     ap.add_argument("--nan-rank", type=int, default=None)
-    ap.add_argument("--eig-solver", choices=("auto", "redundant", "block", "slepc"), default="auto")
-    ap.add_argument("--eig-memory-mb", type=int, default=None)
+    ap.add_argument("--options", default=None)
     args = ap.parse_args()
     from tmfem.solvers.petsc import PetscBackend
     from tmfem.system import load_preset
     comm = comm_world()
-    backend = PetscBackend(eig_solver=args.eig_solver, eig_memory_mb=args.eig_memory_mb)
+    backend = PetscBackend(options=args.options)
     if args.model == "mtc":
         from tmfem.models.mtc.model import MTCModel
         model = MTCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend=backend)
@@ -71,7 +68,7 @@ def main():
         md = model.modes(k=12, at=st)
         out.update(x=st.state.x.tolist(), R=st.state.R.tolist(), iterations=st.iterations,
                    predictor_iterations=st.predictor_iterations)
-    return json.dumps(dict(out, omega2=md.omega2.tolist(), eig_solver=backend.last_eig_solver))
+    return json.dumps(dict(out, omega2=md.omega2.tolist()))
 
 
 if __name__ == "__main__":

@@ -2,8 +2,8 @@
 
 Source of every expected number: an independent formulation -- the scipy backend (SuperLU,
 ARPACK/LAPACK) on the same matrices, the residual of the linear system itself, and the
-serial run for the 2-rank run. The model-level statics use the solver layer's Newton on
-the MTC residual from the design (``MTCModel.equilibrium`` has no ``backend=`` yet).
+serial run for the 2-rank run. The PETSc backend's model statics are SNES solves
+(tmfem.solvers.petsc_snes; their options and reasons: tests/solvers/test_petsc_snes.py).
 """
 import json
 from dataclasses import replace
@@ -163,7 +163,6 @@ def test_static_equilibrium_and_frequencies_agree(models, petsc_runs, preset):
     x0 = m.initial_positions("undeformed")
     u_scipy, u_petsc = st.x - x0, sts.x - x0
     assert np.linalg.norm(u_petsc - u_scipy) <= 1e-9 * np.linalg.norm(u_scipy)
-    assert sts.iterations == st.iterations
     md = m.modes(k=12, at=st.x)
     assert np.allclose(mds.freq_hz, md.freq_hz, rtol=1e-8, atol=0)
 
@@ -225,7 +224,7 @@ def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
     p1 = subprocess.run(tmfem + argv, capture_output=True, text=True, cwd=ROOT)
     d2, d1 = json.loads(p2.stdout), json.loads(p1.stdout)     # exactly one document
     assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
-    p = _mpirun(2, *argv, program=tmfem)
+    p = _mpirun(2, *argv, "--backend", "scipy", program=tmfem)
     assert p.returncode == 2 and p.stderr.count("expected --backend petsc") == 1
 
 
@@ -247,17 +246,18 @@ def test_one_and_two_ranks_agree(models, equilibria):
     for n in (1, 2):
         x = np.array(runs[n]["x"])
         assert np.linalg.norm(x - xs) <= 1e-9 * np.linalg.norm(xs - x0)
-        assert runs[n]["iterations"] == equilibria["1-4"].iterations
     assert np.allclose(runs[2]["omega2"], runs[1]["omega2"], rtol=2e-8, atol=0)
     ref = m.modes(k=12, at=equilibria["1-4"].x)
     assert np.allclose(runs[2]["omega2"], ref.omega2, rtol=2e-8, atol=0)
 
 
 @needs_mpi
-def test_model_on_petsc_under_two_ranks_agrees(models):
-    # the static continuation from the undeformed membrane and the modes under 2 ranks
-    # (distributed assembly, MUMPS and SLEPc) agree with the scipy model
-    p = _mpirun(2, "1-4", "6")
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_model_on_petsc_under_ranks_agrees(models, ranks):
+    # source: the scipy model (its trust-region continuation and ARPACK); the SNES
+    # continuation from the undeformed membrane and the SLEPc modes under 2 and 3 ranks
+    # (distributed assembly, MUMPS) reach the same equilibrium and frequencies
+    p = _mpirun(ranks, "1-4", "6")
     assert p.returncode == 0, p.stderr
     run = json.loads(p.stdout.strip())
     m = models["1-4"]
@@ -265,7 +265,6 @@ def test_model_on_petsc_under_two_ranks_agrees(models):
     x0 = m.reduce(m.initial_positions("undeformed"))
     xs = m.reduce(st.x)
     assert np.linalg.norm(np.array(run["x"]) - xs) <= 1e-9 * np.linalg.norm(xs - x0)
-    assert run["iterations"] == st.iterations
     assert np.allclose(run["omega2"], m.modes(k=12, at=st.x).omega2, rtol=2e-8, atol=0)
 
 
@@ -448,11 +447,6 @@ def test_sbc_one_and_two_ranks_agree_with_scipy(sbc_scipy):
     runs[2] = json.loads(lines[0])
     for n, run in runs.items():
         assert run["ranks"] == n and run["distributed"]
-        assert run["predictor_iterations"] == st.predictor_iterations
-        # the SBC stage starts on the round-off floor of its 1e-9 test (|r| ~ 1e-7 N against
-        # 9e-8 N: the thin shells' stiff rotations), so round-off decides between 1 and 2
-        # steps; the equilibrium is the same (below)
-        assert abs(run["iterations"] - st.iterations) <= 1
         x = np.array(run["x"])
         assert np.linalg.norm(x - st.state.x) <= 1e-9 * np.linalg.norm(u)
         assert np.abs(np.array(run["R"]) - st.state.R).max() <= 1e-9
@@ -478,8 +472,8 @@ def test_sbc_failure_on_one_rank_one_error_nonzero_exit():
 
 @needs_mpi
 def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
-    # source: the same command on 1 process with scipy (frequencies to their round-off floor,
-    # static iterations within one); the VTK file written once, by rank 0. The floor: entries
+    # source: the same command on 1 process with scipy (frequencies to their round-off
+    # floor); the VTK file written once, by rank 0. The floor: entries
     # of K known to eps relative move f_1 by up to 3.6e-8 here (the first-order estimate of the
     # test above, on the same 1-4 SBC at mesh 6); a CI run measured 1.08e-8 in f_1, above the
     # 1e-8 this test first asked
@@ -492,97 +486,46 @@ def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
     p1 = subprocess.run([sys.executable, "-m", "tmfem", *argv], capture_output=True, text=True,
                         cwd=tmp_path)
     d1 = json.loads(p1.stdout)
-    assert abs(d2["iterations"] - d1["iterations"]) <= 1          # round-off floor (above)
     assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=4e-8, atol=0)
-
-
-@needs_petsc
-def test_petsc_block_and_slepc_agree_on_the_mtc_modes():
-    # source: SLEPc's Krylov-Schur on the same model; the 1-4 MTC model at its equilibrium
-    # (531 free dofs: the block solver's path; tmfem.solvers.block_krylov)
-    from tmfem.models.mtc.model import MTCModel
-    from tmfem.solvers.petsc import EIG_BLOCK_MIN_N, PetscBackend
-    from tmfem.system import load_preset
-    m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
-    assert m.distributed.N >= EIG_BLOCK_MIN_N
-    st = m.equilibrium(start="design")
-    block = m.modes(k=12, at=st.x)
-    m.backend = PetscBackend(eig_solver="slepc")
-    slepc = m.modes(k=12, at=st.x)
-    assert np.allclose(block.freq_hz, slepc.freq_hz, rtol=1e-10, atol=0)
-
-
-@needs_petsc
-def test_slepc_options_choose_slepc_and_are_refused_by_the_block_solver(monkeypatch):
-    from tmfem.solvers.petsc import PetscBackend
-    assert PetscBackend().eig_solver == "block"
-    assert PetscBackend(options="-eps_ncv 40").eig_solver == "slepc"
-    # the same from the environment (PETSc reads PETSC_OPTIONS at its initialisation, this
-    # choice at every backend's construction)
-    monkeypatch.setenv("PETSC_OPTIONS", "-ksp_view -eps_tol 1e-10")
-    assert PetscBackend().eig_solver == "slepc"
-    with pytest.raises(InputError, match=r"-eps_tol \(options= or PETSC_OPTIONS\) are SLEPc's"):
-        PetscBackend(eig_solver="block")
-    monkeypatch.setenv("PETSC_OPTIONS", "-ksp_view")
-    assert PetscBackend().eig_solver == "block"
-    with pytest.raises(InputError, match="expected eig_solver='slepc'"):
-        PetscBackend(options="-eps_ncv 40", eig_solver="block")
-    with pytest.raises(InputError, match="expected eig_solver 'auto', 'redundant', 'block' or 'slepc'"):
-        PetscBackend(eig_solver="arpack")
-    with pytest.raises(InputError, match="expected eig_solver='slepc'"):
-        PetscBackend(options="-eps_ncv 40", eig_solver="redundant")
-    assert PetscBackend(eig_solver="redundant").eig_solver == "block"     # one rank: the same
-    with pytest.raises(InputError, match="eig_memory_mb applies to the redundant eigen solve"):
-        PetscBackend(eig_solver="slepc", eig_memory_mb=100)
-    with pytest.raises(InputError, match="eig_memory_mb applies to the redundant eigen solve"):
-        PetscBackend(eig_memory_mb=100)                   # "auto" never takes it
-    with pytest.raises(InputError, match="expected eig_memory_mb >= 1"):
-        PetscBackend(eig_solver="redundant", eig_memory_mb=0)
-
-
-@needs_mpi
-def test_block_solver_under_two_ranks_agrees_with_scipy(models, equilibria):
-    # source: the scipy model's 12 modes at its own equilibrium from the design; the block
-    # solver on the distributed factors (the default, here asked for: rows of the basis
-    # distributed, inner products summed over the ranks)
-    from tmfem.solvers.petsc import EIG_BLOCK_MIN_N
-    p = _mpirun(2, "1-4", "6", "--start", "design", "--eig-solver", "block")
-    assert p.returncode == 0, p.stderr
-    run = json.loads(p.stdout.strip())
-    m = models["1-4"]
-    assert m.free.sum() >= EIG_BLOCK_MIN_N                       # the block solver's size
-    ref = m.modes(k=12, at=equilibria["1-4"].x)
-    assert np.allclose(run["omega2"], ref.omega2, rtol=2e-8, atol=0)
 
 
 @needs_mpi
 @pytest.mark.parametrize("ranks", [2, 3])
-def test_redundant_block_eigen_agrees_with_scipy(models, equilibria, ranks):
+def test_slepc_eigen_under_ranks_agrees_with_scipy(models, equilibria, ranks):
     # source: the scipy model's 12 modes at its own equilibrium from the design (ARPACK on
-    # the scipy matrices) and the model's scipy mass for the M-orthonormality; every rank
-    # factorises the whole K - sigma M sequentially and solves its share of the columns of
-    # each block (tmfem.solvers.petsc_redundant), on request; "auto" takes the block solver
-    # on the distributed factors under P > 1 ranks too, and "slepc" SLEPc: they agree as well
-    ref = models["1-4"].modes(k=12, at=equilibria["1-4"].x)
-    for solver, ran in (("redundant", "redundant"), ("auto", "block"), ("slepc", "slepc")):
-        p = _mpirun(ranks, "1-4", "6", "--start", "design", "--eig-solver", solver)
-        assert p.returncode == 0, p.stderr
-        run = json.loads(p.stdout.strip())
-        assert run["eig_solver"] == ran
-        freq = np.sqrt(run["omega2"]) / (2 * np.pi)
-        assert np.allclose(freq, ref.freq_hz, rtol=1e-8, atol=0)
-        assert run["m_orth"] <= 1e-10
+    # the scipy matrices) and the model's scipy mass for the M-orthonormality; SLEPc's
+    # Krylov-Schur on the distributed MUMPS factors of K - sigma M
+    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    p = _mpirun(ranks, "1-4", "6", "--start", "design")
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip())
+    freq = np.sqrt(run["omega2"]) / (2 * np.pi)
+    assert np.allclose(freq, ref.freq_hz, rtol=1e-8, atol=0)
+    assert run["m_orth"] <= 1e-10
 
 
-@needs_mpi
-def test_redundant_eigen_refused_when_over_its_memory(models):
-    # source: MUMPS' own estimate of the sequential factors (INFOG(16), 6 MB at 4x12x12
-    # against the budget of 1 MB: ICNTL(23)); one error from the two ranks, exit code 3
-    args = ("1-4", "12", "--start", "design", "--eig-memory-mb", "1")
-    p = _mpirun(2, *args, "--eig-solver", "redundant")
-    assert p.returncode == 3, p.stderr                       # ResourceLimit
-    assert p.stderr.count("expected every rank's factors of K - sigma M within 1 MB") == 1
-    assert "found MUMPS' estimate" in p.stderr
+@needs_petsc
+def test_eps_and_st_options_are_honoured(capfd):
+    # source: SLEPc's own view of its objects (-eps_view): -eps_ncv, -eps_tol and -st_pc_type
+    # from options= reach the EPS of the eigen solve and its ST (LU in place of the default
+    # Cholesky); the frequencies stay those of the default run to 1e-9
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
+    st = m.solve_static(start="design")
+    base = m.modes(st.x, k=6)
+    capfd.readouterr()
+    m.backend = PetscBackend(options="-eps_ncv 33 -eps_tol 1e-11 -st_pc_type lu -eps_view")
+    modes = m.modes(st.x, k=6)
+    view = capfd.readouterr().out
+    assert "krylovschur" in view.replace("-", "").lower()
+    assert "(ncv): 33" in view
+    assert "tolerance: 1e-11" in view
+    assert "type: sinvert" in view
+    st_view = view[view.index("ST Object"):]
+    assert "PC Object: (st_)" in st_view and "type: lu" in st_view and "type: cholesky" not in st_view
+    assert np.allclose(modes.freq_hz, base.freq_hz, rtol=1e-9, atol=0)
 
 
 @needs_mpi
@@ -600,8 +543,7 @@ def test_block_pair_pattern_is_scipys_pattern_and_matrix(ranks):
 
 
 @needs_petsc
-@pytest.mark.parametrize("eig_solver", ["block", "slepc"])
-def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria, eig_solver):
+def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria):
     # source: the scipy model's 12 modes at its equilibrium from the design; PETSc's log of
     # MUMPS' symbolic (MatCholFctrSym) and numeric factorisations: K - sigma M has the
     # tangent's pattern (the mass lies within it), so the eigen solve factorises it
@@ -616,8 +558,8 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
     ref = models["1-4"].modes(k=12, at=equilibria["1-4"].x)
     for options, analyses in ((None, 0), ("-st_mat_mumps_icntl_14 40", 1)):
         m = MTCModel(load_preset("1-4"), mesh_n=6,
-                     backend=PetscBackend(eig_solver=eig_solver, options=options))
-        st = m.equilibrium(start="design")
+                     backend=PetscBackend(options=options))
+        st = m.solve_static(start="design")
         s0, n0 = sym.getPerfInfo()["count"], num.getPerfInfo()["count"]
         modes = m.modes(k=12, at=st.x)
         assert sym.getPerfInfo()["count"] - s0 == analyses
@@ -670,43 +612,37 @@ def _modal_cli(*argv):
     return p
 
 
-def test_cli_eig_solver_refused_without_the_petsc_backend():
-    # --eig-solver chooses the PETSc backend's eigen solver: with scipy (the default) and
-    # with the control-oriented model (no backend) it is refused before any work
-    for extra in ([], ["--backend", "scipy"], ["--model", "com"]):
-        p = _modal_cli("--preset", "2-3", "--mesh", "4", "--modes", "4", "--eig-solver", "slepc",
-                       *extra)
-        assert p.returncode == 2, p.stderr
-        assert "--eig-solver slepc: option does not apply" in p.stderr
-        assert "expected --backend petsc, found --backend scipy" in p.stderr
+def test_cli_eig_solver_is_not_an_option():
+    # the PETSc backend has one eigen solver (SLEPc): the option is gone, argparse refuses it
+    p = _modal_cli("--preset", "2-3", "--mesh", "4", "--modes", "4", "--eig-solver", "slepc")
+    assert p.returncode == 2
+    assert "unrecognized arguments: --eig-solver" in p.stderr
 
 
 @needs_petsc
-def test_cli_eig_solver_chooses_the_solver_and_agrees_with_scipy():
+def test_cli_petsc_modes_agree_with_scipy_and_name_the_backend():
     # source: the same command with scipy (ARPACK shift-invert on the scipy matrices):
-    # frequencies to 1e-8; the JSON names the solver that ran (4x12x12: 2 000 free dofs,
-    # above the block solver's minimum size)
+    # frequencies to 1e-8; the JSON and a stderr line name the backend that ran
     argv = ["--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
-    ref = json.loads(_modal_cli(*argv).stdout)
-    assert "eig_solver" not in ref
-    for solver, ran in (("slepc", "slepc"), ("block", "block"), ("auto", "block")):
-        p = _modal_cli(*argv, "--backend", "petsc", "--eig-solver", solver)
-        assert p.returncode == 0, p.stderr
-        d = json.loads(p.stdout)
-        assert d["eig_solver"] == ran
-        assert np.allclose(d["freq_hz"], ref["freq_hz"], rtol=1e-8, atol=0)
+    ref = _modal_cli(*argv, "--backend", "scipy")
+    assert json.loads(ref.stdout)["backend"] == "scipy"
+    assert "backend scipy (" in ref.stderr
+    p = _modal_cli(*argv, "--backend", "petsc")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["backend"] == "petsc" and "backend petsc (" in p.stderr
+    assert np.allclose(d["freq_hz"], json.loads(ref.stdout)["freq_hz"], rtol=1e-8, atol=0)
 
 
 @needs_mpi
-def test_cli_eig_solver_redundant_under_two_ranks():
-    # source: the 1-process scipy command (frequencies to 1e-8); under 2 ranks "redundant" runs
-    # (every rank factorises the whole K - sigma M) where "auto" would take the distributed
-    # factors
+def test_cli_modal_under_two_ranks_takes_petsc_by_default():
+    # source: the 1-process scipy command (frequencies to 1e-8); under 2 ranks the default
+    # backend "auto" takes PETSc (SLEPc on the distributed factors) whatever the size
     argv = ["modal", "--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
-    ref = json.loads(_modal_cli(*argv[1:]).stdout)
+    ref = json.loads(_modal_cli(*argv[1:], "--backend", "scipy").stdout)
     tmfem = [sys.executable, "-m", "tmfem"]
-    p = _mpirun(2, *argv, "--backend", "petsc", "--eig-solver", "redundant", program=tmfem)
+    p = _mpirun(2, *argv, program=tmfem)
     assert p.returncode == 0, p.stderr
     d = json.loads(p.stdout)
-    assert d["eig_solver"] == "redundant"
+    assert d["backend"] == "petsc"
     assert np.allclose(d["freq_hz"], ref["freq_hz"], rtol=1e-8, atol=0)

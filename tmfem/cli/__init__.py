@@ -324,8 +324,9 @@ def _checks_exit(args, result, *, printing: bool = True) -> int:
 
 
 def _mpi_size() -> int:
-    """Number of ranks when started by mpiexec (Open MPI's or MPICH's variable), else 1."""
-    return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
+    """Number of ranks when started by mpiexec, else 1."""
+    from tmfem.solvers.petsc_loader import launched_ranks
+    return launched_ranks()
 
 
 def _main_mpi(args, mod) -> int:
@@ -335,7 +336,10 @@ def _main_mpi(args, mod) -> int:
     import contextlib
     import io
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
-    if getattr(args, "backend", None) != "petsc":
+    backend = getattr(args, "backend", None)
+    if backend is None and hasattr(args, "_model_option_dests"):
+        backend = "auto"                   # the finite-element commands' default
+    if backend not in ("petsc", "auto"):
         if rank == 0:
             print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
                   f"--backend petsc, found --backend {getattr(args, 'backend', None) or 'scipy'} "

@@ -55,8 +55,9 @@ def add_model_args(parser, command: str, *, default: str, capability: str | None
                         help="; ".join(f"{n}: {s.help}" for n, s in specs.items())
                         + f" (default {default})")
     parser.add_argument("--backend", choices=backend_names(), default=None,
-                        help="linear-algebra backend of the finite-element models (default scipy; "
-                             "petsc: docs/guides/backends.md)")
+                        help="linear-algebra backend of the finite-element models (default auto: "
+                             "petsc from 5000 free dofs when installed, else scipy; "
+                             "docs/guides/backends.md)")
     options, owners = {}, {}
     for name in specs:
         for o in model_options(name, stages):
@@ -93,11 +94,6 @@ def model_options_from_args(args, command: str):
         raise InputError(f"{command} --model {args.model}: option does not apply: --backend "
                          f"(the {args.model} model solves small dense systems; --backend is for "
                          "the finite-element models)")
-    eig_solver = getattr(args, "eig_solver", None)
-    if eig_solver is not None and args.backend != "petsc":
-        raise InputError(f"{command} --eig-solver {eig_solver}: option does not apply: it chooses "
-                         "the PETSc backend's eigen solver: expected --backend petsc, found "
-                         f"--backend {args.backend or 'scipy'}")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
         dofs = check_model_budget(system, mesh=options["mesh"],
@@ -153,14 +149,15 @@ def check_outputs(args, command: str) -> None:
             output_file(path, option="--" + dest.replace("_", "-"), suffixes=suffixes)
 
 
-def backend_from_args(args):
-    """The backend of ``--backend`` (default scipy), with the PETSc eigen solver of
-    ``--eig-solver`` where the command has that option (refused without ``--backend petsc``)."""
-    from tmfem.solvers.backends import get_backend
-    eig_solver = getattr(args, "eig_solver", None)
-    if eig_solver is None:
-        return args.backend or "scipy"
-    return get_backend("petsc", eig_solver=eig_solver)
+def backend_from_args(args) -> str:
+    """The backend name of ``--backend`` (default ``auto``: the model chooses by its free dofs,
+    :func:`tmfem.solvers.backends.choose_backend`)."""
+    return args.backend or "auto"
+
+
+def with_backend(out: dict, model) -> dict:
+    """``out`` with the key ``backend``: the backend the model solved with."""
+    return {**out, "backend": model.backend.name}
 
 
 def model_from_args(args, command: str):
@@ -168,6 +165,9 @@ def model_from_args(args, command: str):
     options (:func:`model_options_from_args`), and its registry entry."""
     system, options, spec = model_options_from_args(args, command)
     model = spec.build(system, options, backend_from_args(args))
+    if spec.uses_backend:
+        print(f"tmfem {command}: backend {model.backend.name} ({model.ndof} free dofs)",
+              file=sys.stderr)
     rest = model.u0
     if np.ndim(rest) == 1 and len(rest) == len(system.tendons):
         warn_long_rest_lengths(system, rest)     # all slack: an error before the solve

@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
-                              requested_files)
+                              requested_files, with_backend)
 from tmfem.errors import InputError
 from tmfem.models.registry import get_spec
 from tmfem.reference.printed_modes import with_printed
@@ -19,11 +19,6 @@ def configure(parser) -> None:
     add_system_args(parser)
     add_model_args(parser, NAME, default="mtc", stages=STAGES)
     parser.add_argument("--modes", type=int, default=12, help="number of modes (default 12)")
-    parser.add_argument("--eig-solver", choices=("auto", "block", "slepc", "redundant"), default=None,
-                        help="the PETSc backend's eigen solver (--backend petsc only; default auto: "
-                             "block Krylov-Schur, on the distributed factors under mpiexec; redundant: every "
-                             "rank factorises the whole K - sigma M, for cores shared with other "
-                             "jobs; docs/guides/backends.md). The JSON's eig_solver says which one ran")
     parser.add_argument("--vtk", help="write the mode shapes (point data mode_k) to this .vtu "
                                       "[finite-element models]")
     parser.add_argument("--png", help="render the first six mode shapes to this PNG "
@@ -50,8 +45,7 @@ def run(args) -> dict:
     out = with_printed(report.modal_summary(model, res, modes), system=model.system, modes=args.modes)
     if files:
         out.update(report.write_mode_files(model, res, modes, **files))
-    ran = getattr(getattr(model, "backend", None), "last_eig_solver", None)
-    return out if ran is None else {**out, "eig_solver": ran}
+    return with_backend(out, model) if spec.uses_backend else out
 
 
 def format_text(r: dict) -> str:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
-                              requested_files)
+                              requested_files, with_backend)
 from tmfem.models.registry import get_spec
 from tmfem.system.collapse import check_equilibrium
 
@@ -57,7 +57,7 @@ def run(args) -> dict:
     check_equilibrium(model, res, values=out)          # before anything is written
     if files:
         out.update(report.write_static_files(model, res, **files))
-    return out
+    return with_backend(out, model) if spec.uses_backend else out
 
 
 def format_text(r: dict) -> str:

@@ -11,12 +11,15 @@ provides
 
 ``get_backend("scipy")`` is always available (SuperLU + ARPACK shift-invert).
 ``get_backend("petsc")`` is the PETSc/SLEPc backend (:mod:`tmfem.solvers.petsc`: KSP with
-MUMPS, SLEPc shift-invert, MPI); without petsc4py/slepc4py it raises
+MUMPS, SNES, SLEPc shift-invert, MPI); without petsc4py/slepc4py it raises
 :class:`tmfem.errors.BackendUnavailable` naming the install command.
+``get_backend("auto", n_dofs=N)`` chooses one of them for a model of N free dofs
+(:func:`choose_backend`).
 """
 from __future__ import annotations
 
 import hashlib
+import logging
 from typing import Callable, Protocol
 
 import numpy as np
@@ -26,7 +29,10 @@ import scipy.sparse.linalg as spla
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.petsc import PetscBackend
+from tmfem.solvers.petsc_loader import launched_ranks, petsc_available
 from tmfem.solvers.singular import SingularMatrix
+
+log = logging.getLogger(__name__)
 
 
 class Backend(Protocol):
@@ -185,15 +191,37 @@ def nested_dissection(A) -> np.ndarray:
 
 _BACKENDS = {"scipy": ScipyBackend, "petsc": PetscBackend}
 
+#: free dofs from which ``"auto"`` takes the PETSc backend. Below it the PETSc backend's fixed
+#: start-up cost (0.4-0.5 s more than scipy in building the model, at every size) outweighs
+#: its faster factorisations and eigen solves: a 1-4 MTC static solve from the undeformed
+#: membrane with 12 modes was faster with scipy up to about 5k free dofs (4 x 20 x 20) and
+#: faster with PETSc from there on (``benchmarks/bench_backend_crossover.py`` measures it).
+AUTO_CROSSOVER_DOFS = 5000
+
+
+def choose_backend(*, n_dofs: int, ranks: int | None = None) -> str:
+    """The backend ``"auto"`` takes for a model of ``n_dofs`` free dofs: ``"petsc"`` under
+    ``mpiexec`` with more than one rank (``ranks``, default :func:`launched_ranks`; the
+    scipy backend would solve the whole problem on every rank) and, when PETSc is installed,
+    from :data:`AUTO_CROSSOVER_DOFS` dofs on; ``"scipy"`` otherwise."""
+    ranks = launched_ranks() if ranks is None else int(ranks)
+    if ranks > 1:
+        return "petsc"
+    if int(n_dofs) < AUTO_CROSSOVER_DOFS:
+        return "scipy"
+    return "petsc" if petsc_available() else "scipy"
+
 
 def backend_names() -> list[str]:
     """Names accepted by :func:`get_backend`."""
-    return sorted(_BACKENDS)
+    return sorted(_BACKENDS) + ["auto"]
 
 
-def get_backend(name: str | Backend | None = None, **options) -> Backend:
-    """Return a backend by name ('scipy' default, 'petsc') built with ``options`` (the PETSc
-    backend's keyword arguments; the scipy backend takes none), or pass an object through."""
+def get_backend(name: str | Backend | None = None, *, n_dofs: int | None = None,
+                **options) -> Backend:
+    """Return a backend by name ('scipy' default, 'petsc', or 'auto': :func:`choose_backend`
+    for ``n_dofs`` free dofs) built with ``options`` (the PETSc backend's keyword arguments;
+    the scipy backend and 'auto' take none), or pass an object through."""
     if name is None:
         name = "scipy"
     if not isinstance(name, str):
@@ -201,9 +229,19 @@ def get_backend(name: str | Backend | None = None, **options) -> Backend:
             raise InputError(f"backend: options {sorted(options)} apply to a backend built by "
                              f"name, found a backend object {type(name).__name__}")
         return name
+    if name == "auto":
+        if n_dofs is None:
+            raise InputError("backend 'auto': expected the model's number of free dofs (n_dofs=) "
+                             "to choose between scipy and petsc, found none")
+        if options:
+            raise InputError(f"backend 'auto': option does not apply: {', '.join(sorted(options))} "
+                             "(options of the PETSc backend: expected backend 'petsc')")
+        name = choose_backend(n_dofs=n_dofs)
+        log.debug("backend auto: %s for %d free dofs (crossover %d)", name, n_dofs,
+                 AUTO_CROSSOVER_DOFS)
     cls = _BACKENDS.get(name)
     if cls is None:
-        raise InputError(f"backend: expected one of {sorted(_BACKENDS)}, found {name!r}")
+        raise InputError(f"backend: expected one of {backend_names()}, found {name!r}")
     if options and name == "scipy":
         raise InputError(f"backend 'scipy': option does not apply: {', '.join(sorted(options))} "
                          "(options of the PETSc backend: expected backend 'petsc')")

@@ -9,16 +9,12 @@ Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py
     ||b - A x|| <= rtol ||b|| (PETSc's default preconditioned norm stops 10-100x short of
     the requested accuracy).
 ``eigsh(K, M, k, sigma) -> (w, V)``
-    The generalised Hermitian problem K v = w M v (eq. 5.32) by shift-and-invert about
-    ``sigma`` (the factorisation of K - sigma M by the same MUMPS Cholesky): the block
-    Krylov-Schur of :mod:`tmfem.solvers.block_krylov` (MUMPS solves of 4 right-hand sides
-    at once, on the parallel factors under ``mpiexec -n P > 1``), or on request SLEPc EPS
-    Krylov-Schur or the block method on every rank's own sequential factors with each
-    block's columns split over the ranks (:mod:`tmfem.solvers.petsc_redundant`;
-    ``eig_solver``);
-    the k eigenvalues nearest to sigma, vectors M-orthonormal (the
-    B-inner product, then a Rayleigh-Ritz step in their span, so that repeated eigenvalues
-    come out as full M-orthonormal pairs).
+    The generalised Hermitian problem K v = w M v (eq. 5.32) by SLEPc's EPS: Krylov-Schur
+    with shift-and-invert about ``sigma`` (ST ``sinvert``, the factorisation of K - sigma M
+    by MUMPS Cholesky), on one rank and on the distributed factors under ``mpiexec -n P``;
+    the k eigenvalues nearest to sigma, then a Rayleigh-Ritz step in the span of their
+    vectors, so that the vectors are M-orthonormal (the B-inner product) and repeated
+    eigenvalues come out as full M-orthonormal pairs.
 
 Matrices are scipy sparse matrices (the same on every rank) or a
 :class:`tmfem.solvers.distributed.DistributedMatrix` assembled rank by rank. Vectors in
@@ -36,7 +32,6 @@ from __future__ import annotations
 
 import hashlib
 import logging
-import os
 import shlex
 import weakref
 from contextlib import contextmanager
@@ -46,29 +41,13 @@ import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
 
-from tmfem.errors import ConvergenceError, InputError, ResourceLimit
-from tmfem.solvers.block_krylov import block_krylov_schur, start_block
+from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather
 from tmfem.solvers.petsc_loader import petsc_modules
-from tmfem.solvers.petsc_redundant import (RedundantDoesNotFit, default_budget_mb,
-                                           redundant_shift_invert)
 from tmfem.solvers.singular import SingularMatrix
 
 log = logging.getLogger(__name__)
 
-
-#: right-hand sides per MUMPS solve of the block eigensolver, on 1 rank and on the parallel
-#: factors of P > 1 ranks (4: 80-84 columns for 12 modes against 120-136 with 8, 53 single
-#: solves in SLEPc; at 309k DOF on 1 rank 9.7-12.7 s against 12.8-14.8 s with 8, on 2 ranks
-#: 8.1-10.7 s against SLEPc's 9.5-12.7 s; equal within the drift at 20k-78k DOF;
-#: docs/validation/benchmarks.md, "Eigen solvers")
-EIG_BLOCK = 4
-#: right-hand sides per block of the redundant eigensolver, split by columns over the ranks
-#: (8: 4 per rank on 2 ranks, 2.6-3.1 s of CPU at 78k DOF against 3.2-3.7 s with 8 per
-#: rank and 3.7-4.7 s with SLEPc; docs/guides/backends.md, petsc6)
-EIG_BLOCK_REDUNDANT = 8
-#: smallest problem for the block eigensolver (smaller ones: SLEPc)
-EIG_BLOCK_MIN_N = 400
 
 #: PETSc's KSP converged reasons by value (for messages)
 _KSP_REASONS = {-2: "DIVERGED_NULL", -3: "DIVERGED_ITS", -4: "DIVERGED_DTOL",
@@ -100,17 +79,6 @@ def parse_options(options) -> dict:
     return out
 
 
-def environment_slepc_options() -> list[str]:
-    """Names (without '-') of the SLEPc eigen solver's options (``-eps_*``) in the
-    ``PETSC_OPTIONS`` environment variable."""
-    text = os.environ.get("PETSC_OPTIONS", "")
-    try:
-        tokens = shlex.split(text)
-    except ValueError:                 # unbalanced quotes: PETSc splits on blanks
-        tokens = text.split()
-    return [t.lstrip("-") for t in tokens if t.startswith("-eps_")]
-
-
 def _is_number(tok: str) -> bool:
     try:
         float(tok)
@@ -137,6 +105,8 @@ class _Factorisation:
     serial: int                      #: creation count, the same on every rank (``_reap``)
     #: mass pattern -> whether it lies within this pattern (:meth:`PetscBackend._analysed`)
     mass_within: weakref.WeakKeyDictionary = field(default_factory=weakref.WeakKeyDictionary)
+    #: the PETSc object that owns ``ksp`` (a SNES, whose hooks the KSP calls), or None
+    owner: object = None
 
 
 class PetscBackend:
@@ -157,27 +127,6 @@ class PetscBackend:
     eig_tol : float
         Relative residual tolerance of the eigenpairs (||Op x - theta x|| <= eig_tol |theta|
         of the shift-invert operator, both eigen solvers).
-    eig_solver : {"auto", "redundant", "block", "slepc"}
-        ``"block"``: :func:`tmfem.solvers.block_krylov.block_krylov_schur`, a block
-        Krylov-Schur on MUMPS solves of :data:`EIG_BLOCK` right-hand sides at once (on the
-        parallel factors under ``mpiexec -n P > 1``); ``"redundant"``: the same block
-        method under ``mpiexec -n P > 1`` on every rank's own sequential factors of the
-        whole K - sigma M (:mod:`tmfem.solvers.petsc_redundant`), each block of
-        :data:`EIG_BLOCK_REDUNDANT` right-hand sides split by columns between the ranks
-        (on one rank it is ``"block"``); refused (:class:`~tmfem.errors.ResourceLimit`) when MUMPS
-        estimates more than ``eig_memory_mb`` per rank; ``"slepc"``: SLEPc's Krylov-Schur
-        (one parallel solve per vector), which reads the ``eps_`` options (refused with
-        the block solvers); ``"auto"`` (default): ``"block"``, or SLEPc when ``eps_``
-        options are given (with 4 right-hand sides per block the block method needs 1.6x
-        SLEPc's columns and is as fast as SLEPc on 2 ranks at 20k-78k DOF, 14 % faster at
-        309k DOF; ``"redundant"`` is as fast as SLEPc at 78k DOF and 27 % slower at 309k
-        DOF on 2 idle cores, faster only on oversubscribed ones: docs/guides/backends.md).
-        Problems of fewer than :data:`EIG_BLOCK_MIN_N` unknowns always go to SLEPc.
-    eig_memory_mb : int, optional
-        Memory per rank for the redundant factorisation (MUMPS ICNTL(23), checked by MUMPS
-        against its estimate before it allocates the factors); default
-        :data:`tmfem.solvers.petsc_redundant.MEMORY_SHARE` of the node's available memory
-        shared by its ranks. Only with ``eig_solver`` "redundant".
     """
 
     name = "petsc"
@@ -187,7 +136,7 @@ class PetscBackend:
     distributed_assembly = True
 
     def __init__(self, *, solver: str = "direct", rtol: float | None = None, options=None,
-                 eig_tol: float = 1e-12, eig_solver: str = "auto", eig_memory_mb: int | None = None):
+                 eig_tol: float = 1e-12):
         self.PETSc, self.SLEPc = petsc_modules()
         if solver not in ("direct", "iterative"):
             raise InputError(f"backend 'petsc': expected solver 'direct' or 'iterative', found {solver!r}")
@@ -200,31 +149,6 @@ class PetscBackend:
             raise InputError(f"backend 'petsc': expected 0 < rtol < 1, found {self.rtol}")
         self.options = parse_options(options)
         self.eig_tol = float(eig_tol)
-        if eig_solver not in ("auto", "redundant", "block", "slepc"):
-            raise InputError(f"backend 'petsc': expected eig_solver 'auto', 'redundant', 'block' or "
-                             f"'slepc', found {eig_solver!r}")
-        # SLEPc's own options, from options= or from PETSC_OPTIONS, choose SLEPc under "auto"
-        eps = sorted(set(k for k in self.options if k.startswith("eps_"))
-                     | set(environment_slepc_options()))
-        if eps and eig_solver in ("block", "redundant"):
-            raise InputError(f"backend 'petsc': the options {', '.join('-' + k for k in eps)} "
-                             f"(options= or PETSC_OPTIONS) are SLEPc's: expected "
-                             f"eig_solver='slepc' with them, found {eig_solver!r}")
-        if eig_memory_mb is not None:
-            if eig_solver != "redundant":
-                raise InputError(f"backend 'petsc': eig_memory_mb applies to the redundant eigen "
-                                 f"solve (eig_solver 'redundant'), found {eig_solver!r}")
-            if int(eig_memory_mb) < 1:
-                raise InputError(f"backend 'petsc': expected eig_memory_mb >= 1, found {eig_memory_mb}")
-        self.eig_memory_mb = None if eig_memory_mb is None else int(eig_memory_mb)
-        parallel = self.PETSc.COMM_WORLD.size > 1
-        if eig_solver == "auto":
-            eig_solver = "slepc" if eps else "block"
-        elif eig_solver == "redundant" and not parallel:
-            eig_solver = "block"
-        self.eig_solver = eig_solver
-        #: the eigen solver of the latest ``eigsh`` ("block", "redundant" or "slepc")
-        self.last_eig_solver = None
         self.comm = self.PETSc.COMM_WORLD
         self._cache = {}          # sparsity pattern -> _Factorisation
         self._dead = []           # retired cache entries, destroyed by _reap
@@ -300,6 +224,20 @@ class PetscBackend:
             M.setDiagonal(d, addv=self.PETSc.InsertMode.ADD_VALUES)
         return M, key
 
+    def adopt(self, A, mat, ksp, symmetric: bool, owner=None) -> None:
+        """Make ``mat`` and ``ksp`` (a KSP of this backend's configuration that has
+        factorised a matrix of the DistributedMatrix A's pattern: the one of the statics'
+        SNES ``owner``, kept alive with it) the cache entry of that pattern, so that later
+        solves and the eigen solve reuse MUMPS' analysis (:meth:`_analyzed`). Collective."""
+        key = ("dist", id(A.pattern))
+        old = self._cache.pop(key, None)
+        if old is None:
+            weakref.finalize(A.pattern, self._drop, key).atexit = False
+        else:
+            self._dead.append(old)
+        self._serial += 1
+        self._cache[key] = _Factorisation(mat, ksp, 0, symmetric, self._serial, owner=owner)
+
     def _drop(self, key) -> None:
         """Retire the cached Mat and KSP (MUMPS factors) of ``key`` (its pattern is gone).
 
@@ -332,6 +270,8 @@ class PetscBackend:
         entry.generation = -1
         entry.ksp.destroy()
         entry.mat.destroy()
+        if entry.owner is not None:
+            entry.owner.destroy()
 
     def _symmetric(self, A, M) -> bool:
         """Whether A (scipy, the same on every rank) or its PETSc Mat M equals its transpose
@@ -531,13 +471,19 @@ class PetscBackend:
         """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
         return gather(vec)
 
+    # ------------------------------------------------------------------ nonlinear statics
+    def solve_equilibrium(self, residual, energy, u0, **kwargs):
+        """The equilibrium r(u) = 0 of the energy W from u0 by PETSc's SNES with
+        pseudo-transient continuation (:func:`tmfem.solvers.petsc_snes.snes_equilibrium`:
+        the arguments of :func:`tmfem.solvers.trust_region.trust_region_newton` with every
+        dof free and a distributed tangent, the fields of its result as a dict)."""
+        from tmfem.solvers.petsc_snes import snes_equilibrium
+        return snes_equilibrium(self, residual, energy, u0, **kwargs)
+
     # ------------------------------------------------------------------ eigenproblems
     def eigsh(self, K, M, k, sigma):
         """The k eigenpairs of K v = w M v nearest to ``sigma`` (eq. 5.32), ascending, by
-        shift-and-invert (module docstring): the block Krylov-Schur of
-        :mod:`tmfem.solvers.block_krylov` for symmetric K, M of at least
-        :data:`EIG_BLOCK_MIN_N` unknowns (``eig_solver`` "block" or "auto"), else SLEPc's
-        Krylov-Schur; V (n, k) M-orthonormal."""
+        SLEPc's Krylov-Schur shift-and-invert (module docstring); V (n, k) M-orthonormal."""
         self._reap()
         Kp, _ = self._mat(K, cache=False)
         Mp, _ = self._mat(M, cache=False)
@@ -547,31 +493,14 @@ class PetscBackend:
             raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
         sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
         reuse = self._analyzed(K, M) if sym else None
-        w = None
-        self.last_eig_solver = "slepc"
-        if self.eig_solver in ("block", "redundant") and sym and n >= EIG_BLOCK_MIN_N:
-            try:
-                w, V = self._block_eigsh(Kp, Mp, k, float(sigma), reuse,
-                                         redundant=self.eig_solver == "redundant")
-                self.last_eig_solver = self.eig_solver
-            except RedundantDoesNotFit as exc:
-                raise ResourceLimit(f"eigen (petsc, eig_solver='redundant'): expected every "
-                                    f"rank's factors of K - sigma M within {exc.budget_mb} MB "
-                                    f"(eig_memory_mb), found MUMPS' estimate {exc.estimate_mb} "
-                                    "MB per rank; use a larger eig_memory_mb, or eig_solver "
-                                    "'slepc' or 'block' (the distributed factors)") from None
-        if w is None:
-            w, V = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym, reuse)
+        w, V = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym, reuse)
         order = np.argsort(np.abs(w - sigma), kind="stable")[:k]
         w, V = w[order], V[:, order]
-        # Rayleigh-Ritz in span(V) (scipy operators on the full arrays): exactly M-orthonormal,
-        # also inside clusters of equal eigenvalues
-        Ks = sp.csr_matrix(K) if sp.issparse(K) else None
-        if Ks is not None:
-            Ms = sp.csr_matrix(M)
-            Kr, Mr = V.T @ (Ks @ V), V.T @ (Ms @ V)
-            w, Y = la.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
-            V = V @ Y
+        # Rayleigh-Ritz in span(V) (the matrices applied to the full arrays): exactly
+        # M-orthonormal, also inside clusters of equal eigenvalues
+        Kr, Mr = V.T @ (K @ V), V.T @ (M @ V)
+        w, Y = la.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
+        V = V @ Y
         o = np.argsort(w)
         return w[o], V[:, o]
 
@@ -615,119 +544,6 @@ class PetscBackend:
             return mine
         return all(self.comm.tompi4py().allgather(mine))
 
-    def _shifted_in(self, entry, Kp, Mp, sigma: float):
-        """K - sigma M in the cached Mat of ``entry`` (its pattern: see :meth:`_analysed`),
-        numerically factorised by the entry's KSP (the analysis reused); the KSP. Earlier
-        solves of the entry are stale from here on."""
-        PETSc = self.PETSc
-        A, ksp = entry.mat, entry.ksp
-        entry.generation += 1
-        Kp.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        ksp.setOperators(A)
-        try:
-            ksp.setUp()
-        except PETSc.Error as exc:
-            raise _shift_invert_failure(sigma, exc) from None
-        return ksp
-
-    def _st_ksp(self, A, comm) -> object:
-        """The eigen solve's own KSP (prefix ``st_``, as SLEPc's) of the symmetric A: MUMPS
-        Cholesky, then the ``st_`` options."""
-        ksp = self.PETSc.KSP().create(comm=comm)
-        ksp.setOptionsPrefix("st_")
-        ksp.setOperators(A)
-        ksp.setType("preonly")
-        ksp.getPC().setType("cholesky")
-        ksp.getPC().setFactorSolverType("mumps")
-        with self._database({key: v for key, v in self.options.items() if key.startswith("st_")}):
-            ksp.setFromOptions()
-        return ksp
-
-    def _block_eigsh(self, Kp, Mp, k: int, sigma: float, reuse=None, redundant: bool = False):
-        """(w, V) of K v = w M v, the k eigenvalues nearest to sigma and their M-orthonormal
-        vectors (full arrays on every rank), by :func:`block_krylov_schur` on the MUMPS
-        Cholesky factors of K - sigma M (the ``st_`` options apply to its KSP, as to
-        SLEPc's), vectors distributed by rows. The factors: the parallel ones (in the
-        static solve's analysed Mat with ``reuse``, else in a KSP of its own) with
-        EIG_BLOCK right-hand sides per solve, or with ``redundant`` every rank's own
-        sequential ones (:mod:`tmfem.solvers.petsc_redundant`) with EIG_BLOCK_REDUNDANT
-        right-hand sides per solve, split by columns over the ranks; :class:`RedundantDoesNotFit` when they
-        exceed the memory budget (nothing left allocated)."""
-        PETSc = self.PETSc
-        n = Kp.getSize()[0]
-        comm = self.comm.tompi4py()
-        lo, hi = Kp.getOwnershipRange()
-        b = EIG_BLOCK_REDUNDANT if redundant else EIG_BLOCK
-        dense, own = {}, []
-
-        def mat(key, m):
-            """A dense PETSc Mat (n, m) of rows distributed as A's, one per key and m."""
-            if (key, m) not in dense:
-                dense[(key, m)] = PETSc.Mat().createDense(((hi - lo, n), (None, m)), comm=self.comm)
-                dense[(key, m)].setUp()
-            return dense[(key, m)]
-
-        def block(X, key):
-            """This rank's rows X (n_local, m) in the dense Mat of ``key``."""
-            Bm = mat(key, X.shape[1])
-            Bm.getDenseArray()[:] = X
-            Bm.assemble()
-            return Bm
-
-        try:
-            if reuse is not None and not redundant:
-                F = self._shifted_in(reuse, Kp, Mp, sigma).getPC().getFactorMatrix()
-            else:
-                A = Kp.duplicate(copy=True)
-                own.append(A)
-                A.axpy(-sigma, Mp, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-                A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-                try:
-                    if redundant:
-                        budget = self.eig_memory_mb or default_budget_mb(comm)
-                        op = redundant_shift_invert(PETSc, A, budget,
-                                                    lambda S: self._st_ksp(S, PETSc.COMM_SELF))
-                        own.append(op)
-                        own.remove(A)
-                        A.destroy()             # only the sequential copies are needed
-                    else:
-                        own.append(self._st_ksp(A, self.comm))
-                        own[-1].setUp()
-                        F = own[-1].getPC().getFactorMatrix()
-                except PETSc.Error as exc:
-                    raise _shift_invert_failure(sigma, exc) from None
-
-            if redundant:
-                solve = op.solve
-            else:
-                def solve(X):
-                    out = mat("x", X.shape[1])
-                    F.matSolve(block(X, "b"), out)
-                    return np.array(out.getDenseArray())
-
-            def mass(X):
-                key = ("m", X.shape[1])
-                dense[key] = Mp.matMult(block(X, "v"), result=dense.get(key))
-                return np.array(dense[key].getDenseArray())
-
-            def dot(X, Y):
-                local = X.T @ Y
-                return local if comm.size == 1 else comm.allreduce(local)
-
-            max_basis = max(4 * k, k + 4 * b)
-            theta, X, restarts = block_krylov_schur(solve, mass, dot, start_block(lo, hi, b), k=k,
-                                                    max_basis=max_basis, tol=self.eig_tol)
-        finally:
-            for Bm in dense.values():
-                Bm.destroy()
-            for obj in reversed(own):
-                obj.destroy()
-        log.debug("eigen (petsc, %s): %d modes, %d restarts", "redundant" if redundant else "block",
-                  k, restarts)
-        V = X if comm.size == 1 else np.concatenate(comm.allgather(X), axis=0)
-        return sigma + 1.0 / theta, V
-
     def _slepc_eigsh(self, Kp, Mp, k: int, sigma: float, sym: bool, reuse=None):
         """(w, V) of K v = w M v, the converged eigenvalues nearest to sigma (at least k) and
         their vectors (full arrays on every rank), by SLEPc (module docstring). With
@@ -761,17 +577,19 @@ class PetscBackend:
             ksp.setType("preonly")
             ksp.getPC().setType("cholesky" if sym else "lu")
             ksp.getPC().setFactorSolverType("mumps")
+            # the options stay in the database through the solve, which reads the viewers
+            # (-eps_view, -eps_error_relative ::ascii_info_detail) at its end
             with self._database({key: v for key, v in self.options.items()
                                  if key.startswith(("eps_", "st_"))}):
                 E.setFromOptions()
-            if reuse is not None:
-                st.setMatMode(SLEPc.ST.MatMode.INPLACE)
-                st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-                st.setKSP(reuse.ksp)
-            try:
-                E.solve()
-            except PETSc.Error as exc:
-                raise _shift_invert_failure(sigma, exc) from None
+                if reuse is not None:
+                    st.setMatMode(SLEPc.ST.MatMode.INPLACE)
+                    st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+                    st.setKSP(reuse.ksp)
+                try:
+                    E.solve()
+                except PETSc.Error as exc:
+                    raise _shift_invert_failure(sigma, exc) from None
             nconv = E.getConverged()
             if nconv < k:
                 raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "

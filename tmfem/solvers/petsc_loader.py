@@ -1,12 +1,14 @@
 """petsc4py and slepc4py, imported and initialised on first use.
 
-The PETSc backend's modules (:mod:`tmfem.solvers.petsc`, :mod:`tmfem.solvers.distributed`,
-:mod:`tmfem.solvers.petsc_redundant`) import this module at module level and call
+The PETSc backend's modules (:mod:`tmfem.solvers.petsc`, :mod:`tmfem.solvers.distributed`)
+import this module at module level and call
 :func:`petsc_modules` where they need PETSc, so that importing them costs nothing on a
 machine without PETSc and ``import tmfem`` never loads it (docs/architecture.md,
 "Imports").
 """
 from __future__ import annotations
+
+import os
 
 from tmfem.errors import BackendUnavailable
 
@@ -27,3 +29,18 @@ def petsc_modules():
         raise BackendUnavailable(f"backend 'petsc': expected petsc4py and slepc4py importable, found "
                                  f"{exc}; install with: {PETSC_INSTALL}") from None
     return PETSc, SLEPc
+
+
+def petsc_available() -> bool:
+    """Whether petsc4py and slepc4py load (:func:`petsc_modules`)."""
+    try:
+        petsc_modules()
+    except BackendUnavailable:
+        return False
+    return True
+
+
+def launched_ranks() -> int:
+    """Number of MPI ranks of this process's job as the launcher announces it (Open MPI's or
+    MPICH's environment), 1 outside ``mpiexec``; does not initialise MPI."""
+    return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)

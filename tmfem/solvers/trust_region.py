@@ -14,6 +14,10 @@ Newton step, or on the round-off floor: a step whose energy change is round-off 
 no longer halves |r| while |r| <= 1e3 tol x force scale (stiff beams and shells put that
 floor near tol). The solver knows nothing of tensegrities: it sees a
 residual with its tangent, an energy, a dof scale and a convergence scale.
+
+A backend with a nonlinear solver of its own (``backend.solve_equilibrium``: the PETSc
+backend's SNES, :mod:`tmfem.solvers.petsc_snes`) solves the problem instead when every
+unknown is free (the distributed assembly's numbering).
 """
 from __future__ import annotations
 
@@ -80,6 +84,13 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     """
     be = get_backend(backend)
     free = np.asarray(free, dtype=bool)
+    if getattr(be, "solve_equilibrium", None) is not None and free.all():
+        # a backend with a nonlinear solver of its own (PETSc's SNES) on a distributed
+        # assembly, where every unknown is free
+        return TrustRegionResult(**be.solve_equilibrium(
+            residual, energy, u0, scale=scale, force_scale=force_scale, tol=tol,
+            max_iter=max_iter, newton_first=newton_first, callback=callback, describe=describe,
+            what=what, update=update))
     idx = free_index(free, free.size)
     u = np.array(u0, dtype=float, copy=True) if update is None else u0
     Dm = sp.diags(np.asarray(scale, dtype=float))

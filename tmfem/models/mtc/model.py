@@ -76,7 +76,7 @@ class MTCModel(FEModel, Tendons, Placement):
         gives a pinned rigid bar its exact rotary inertia m l^2 / 3).
     backend : str or Backend
         Linear-algebra backend of every factorisation and eigen solve (``"scipy"`` default;
-        :func:`tmfem.solvers.get_backend`).
+        ``"auto"`` chooses by the free dofs; :func:`tmfem.solvers.get_backend`).
     membrane_law : {"svk", "tension-field"}
         Membrane law (:mod:`tmfem.fem.tension_field`): St.Venant-Kirchhoff (eq. 4.9, default)
         or the tension-field (wrinkling) law. The prestress is the static equilibrium of this
@@ -102,7 +102,6 @@ class MTCModel(FEModel, Tendons, Placement):
                  rigid_bar_points: bool = False, tendon_law: str = "cable"):
         self.system = system
         self.membrane_law = check_law_name(membrane_law)
-        self.backend = get_backend(backend)
         self.mesh_n, self.patch = mesh_n, patch
         self.topology: MTCTopology = build_topology(system, mesh_n=mesh_n,
                                                     tendon_elements=tendon_elements,
@@ -120,6 +119,7 @@ class MTCModel(FEModel, Tendons, Placement):
         self.bar_element = TrussElement(self.bars, topo.dofmap)
         self.free = topo.constraints.free
         self.dofmap = topo.dofmap
+        self.backend = get_backend(backend, n_dofs=self.ndof)
         self._M = None
         self._dist = None
         self._init_tendons(rest_lengths, tendon_law)

@@ -96,7 +96,6 @@ class SBCModel(FEModel, Tendons, Placement):
                  backend="scipy", membrane_law: str = "svk"):
         self.system = system
         self.membrane_law = check_law_name(membrane_law)
-        self.backend = get_backend(backend)
         self.mesh_n, self.patch, self.lumped_tendon_mass = mesh_n, patch, False
         mt = self.topology = build_topology(system, mesh_n=mesh_n, tendon_elements=tendon_elements,
                                             attachment=attachment, patch=patch,
@@ -129,6 +128,7 @@ class SBCModel(FEModel, Tendons, Placement):
             dm, dependent=[(mt.top_nodes[j], nodes, w) for j, (nodes, w) in enumerate(mt.weights)],
             fixed_nodes=mt.fixed_nodes, dependent_dofs=spins)
         self.free = self.constraints.free
+        self.backend = get_backend(backend, n_dofs=self.ndof)        # "auto" by the free dofs
         # start: the MTC start (bar tops on the corners), bar interiors on the chords
         x0 = X.copy()
         x0[:, :num.n_mtc_nodes] = x_start

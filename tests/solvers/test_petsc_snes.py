@@ -1,0 +1,135 @@
+"""SNES statics of the PETSc backend (tmfem.solvers.petsc_snes) and the automatic backend choice.
+
+Sources: the scipy backend's trust-region statics of the same model (an independent nonlinear
+solver on the same residual), PETSc's own output (-snes_monitor, -snes_view) and converged
+reasons, the crossover constant of tmfem.solvers.backends.
+"""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tmfem.errors import ConvergenceError, InputError
+from tests.solvers.test_petsc_backend import _mpirun, needs_mpi, needs_petsc
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+@pytest.fixture(scope="module")
+def scipy_2_3():
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("2-3"), mesh_n=4)
+    return m, m.solve_static()
+
+
+def _petsc_model(options=None):
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    return MTCModel(load_preset("2-3"), mesh_n=4, backend=PetscBackend(options=options))
+
+
+@needs_petsc
+def test_snes_options_are_honoured_and_reach_the_same_equilibrium(scipy_2_3, capfd):
+    # source: the scipy trust region's equilibrium (displacements to 1e-9); PETSc's monitor
+    # and view show that the static solve is a SNES solve with the options given
+    m, st = scipy_2_3
+    capfd.readouterr()
+    res = _petsc_model("-snes_monitor -snes_view -ksp_type preonly").solve_static()
+    out = capfd.readouterr().out
+    assert "SNES Function norm" in out and "type: newtonls" in out
+    x0 = m.initial_positions("undeformed")
+    assert np.linalg.norm(res.x - st.x) <= 1e-9 * np.linalg.norm(st.x - x0)
+
+
+@needs_petsc
+def test_snes_converged_reason_names_the_convergence_error():
+    # every SNES solve stops after one function evaluation (-snes_max_funcs 1): the
+    # continuation runs out and the error names PETSc's reason
+    with pytest.raises(ConvergenceError, match="SNES DIVERGED_FUNCTION_COUNT"):
+        _petsc_model("-snes_max_funcs 1").solve_static()
+
+
+@needs_petsc
+def test_cli_snes_monitor_is_visible():
+    # PETSC_OPTIONS reaches the SNES of the CLI's static solve; its monitor prints on stdout
+    env = dict(os.environ, PETSC_OPTIONS="-snes_monitor")
+    p = subprocess.run([sys.executable, "-m", "tmfem", "static", "--preset", "2-3", "--mesh", "4",
+                        "--backend", "petsc"], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert p.returncode == 0, p.stderr
+    assert "SNES Function norm" in p.stdout
+    assert "backend petsc (" in p.stderr
+
+
+def test_auto_backend_chooses_by_the_crossover(monkeypatch):
+    # source: AUTO_CROSSOVER_DOFS (5000, the measured crossover of the module's constant)
+    from tmfem.solvers import backends as b
+    assert b.AUTO_CROSSOVER_DOFS == 5000
+    assert b.choose_backend(n_dofs=4999, ranks=1) == "scipy"
+    assert b.choose_backend(n_dofs=100, ranks=2) == "petsc"          # under mpiexec
+    monkeypatch.setattr(b, "petsc_available", lambda: True)
+    assert b.choose_backend(n_dofs=5000, ranks=1) == "petsc"
+    monkeypatch.setattr(b, "petsc_available", lambda: False)
+    assert b.choose_backend(n_dofs=10**6, ranks=1) == "scipy"       # PETSc not installed
+    assert b.get_backend("auto", n_dofs=10**6).name == "scipy"
+    with pytest.raises(InputError, match="expected the model's number of free dofs"):
+        b.get_backend("auto")
+    with pytest.raises(InputError, match="backend 'auto': option does not apply: solver"):
+        b.get_backend("auto", n_dofs=10, solver="iterative")
+    assert "auto" in b.backend_names()
+
+
+def test_petsc_available_is_false_without_petsc4py(monkeypatch):
+    monkeypatch.setitem(sys.modules, "petsc4py", None)
+    from tmfem.solvers.backends import petsc_available
+    assert petsc_available() is False
+
+
+def test_auto_model_below_the_crossover_is_scipy():
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("2-3"), mesh_n=4, backend="auto")
+    assert m.ndof < 5000 and m.backend.name == "scipy"
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [2, 3])
+def test_snes_under_ranks_honours_options_and_reports_its_reason_once(scipy_2_3, ranks):
+    # source: the scipy trust region's equilibrium (displacements to 1e-9); under mpiexec the
+    # SNES monitor prints from rank 0 and a SNES failure on every rank is one error
+    m, st = scipy_2_3
+    p = _mpirun(ranks, "2-3", "4", "--options=-snes_monitor")
+    assert p.returncode == 0, p.stderr
+    lines = p.stdout.strip().splitlines()
+    assert "SNES Function norm" in p.stdout
+    run = json.loads(lines[-1])
+    assert run["ranks"] == ranks
+    x0 = m.reduce(m.initial_positions("undeformed"))
+    xs = m.reduce(st.x)
+    assert np.linalg.norm(np.array(run["x"]) - xs) <= 1e-9 * np.linalg.norm(xs - x0)
+    p = _mpirun(ranks, "2-3", "4", "--options=-snes_max_funcs 1")
+    assert p.returncode != 0
+    assert p.stderr.count("SNES DIVERGED_FUNCTION_COUNT") == 1
+
+
+@needs_mpi
+def test_sbc_snes_under_three_ranks_agrees_with_scipy():
+    # source: the scipy SBC model's static solve from the undeformed membrane (MTC predictor,
+    # then the SBC trust region); the SNES continuation on 3 ranks, the shells assembled rank
+    # by rank: positions and rotations to 1e-9
+    from tmfem.models.sbc.model import SBCModel
+    from tmfem.system import load_preset
+    m = SBCModel(load_preset("1-4"), mesh_n=4)
+    st = m.solve_static()
+    p = _mpirun(3, "1-4", "4", "--model", "sbc")
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip().splitlines()[-1])
+    assert run["ranks"] == 3
+    u = st.state.x - m.start_state().x
+    assert np.linalg.norm(np.array(run["x"]) - st.state.x) <= 1e-9 * np.linalg.norm(u)
+    assert np.abs(np.array(run["R"]) - st.state.R).max() <= 1e-9

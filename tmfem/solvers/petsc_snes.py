@@ -1,0 +1,273 @@
+"""Equilibrium by PETSc's SNES: the static solves of the PETSc backend.
+
+The finite-element statics start from a singular state (the flat, unstretched membrane has no
+transverse stiffness), so a plain Newton iteration cannot start there. The continuation is
+*pseudo-transient continuation* in its implicit form, the proximal-point method on the energy
+W: each continuation step solves the nonlinear system
+
+    G(u) = r(u) + mu D (u - u_k) = 0,        J_G = K_T(u) + mu D,        D = diag(M),
+
+by one SNES solve from u_k (backward Euler on the gradient flow D du/dt = -r with the pseudo
+time step 1 / mu). Its solution minimises W(u) + mu/2 |u - u_k|_D^2, so an accepted step
+lowers the energy: the iteration slides down the energy to a minimum, the same equilibrium
+as the trust region of :mod:`tmfem.solvers.trust_region` (whose step is one Newton iteration
+of this problem). A step is accepted when it lowers W; then, if its SNES solve converged,
+mu falls eightfold; a failed or rejected step multiplies mu by 4. Below :data:`MU_NEWTON` of
+the stiffness-to-mass scale mu becomes 0 and the last SNES solve is Newton's method on
+r(u) = 0 itself, stopping at ||r|| <= tol x force scale (SNES ``atol``: the test of the trust
+region).
+
+Every SNES solve reads the options database (``-snes_*``, ``-ksp_*``, ``-pc_*`` of
+``PETSC_OPTIONS`` and of the backend's ``options=``), so ``-snes_monitor`` prints every
+iteration, ``-snes_linesearch_type``, ``-snes_type`` or ``-snes_rtol`` change the solver; the
+defaults are Newton (``newtonls``) on MUMPS (Cholesky, LU where the tangent is
+unsymmetric), ``atol`` as above, ``rtol = stol = 0`` for the final solve and ``rtol = 1e-2``
+with at most 3 iterations for a continuation step (an inexact proximal step only needs to
+lower the energy), and full steps (line search ``basic``: the continuation, whose energy
+test accepts or rejects a step, is the globalisation; PETSc's backtracking on ||r|| took
+20-50 tiny steps near the MTC equilibria, where full Newton steps converge quadratically).
+A final solve that does not converge within 20 iterations sends the iteration back to the
+continuation; when that runs out (mu beyond 1e12 of its scale, or ``max_iter`` SNES
+iterations), :class:`~tmfem.errors.ConvergenceError` names the last SNES converged reason.
+The final solve also stops on the round-off floor (a step that no longer halves ||r|| while
+||r|| <= 1e3 tol x force scale, as in the trust region: stiff shells put it near tol).
+
+The unknowns are the free dofs of a distributed assembly (``residual(u) -> (r, K)`` with K a
+:class:`tmfem.solvers.distributed.DistributedMatrix`); states that do not add (finite
+rotations) advance by ``update(u, du)``: SNES iterates on the increment from a base state,
+which is moved to the current iterate at every Newton iteration (``SNESSetUpdate``), so that
+the tangent K_T(u) is the Jacobian of the increment.
+"""
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+from tmfem.errors import ConvergenceError, InputError
+from tmfem.solvers.distributed import DistributedMatrix, gather
+
+log = logging.getLogger(__name__)
+
+#: mu (in units of the stiffness-to-mass scale) below which the continuation ends with a
+#: plain Newton solve of r(u) = 0
+MU_NEWTON = 1e-8
+#: SNES iterations of the final Newton solve before the continuation takes over again
+NEWTON_MAX_IT = 20
+#: SNES iterations of a continuation step (an inexact proximal step: accepted when it lowers
+#: the energy)
+STEP_MAX_IT = 3
+#: relative tolerance of a continuation step's SNES solve
+STEP_RTOL = 1e-2
+
+
+#: the "converged reason" of a final solve stopped on the round-off floor
+FLOOR = 1000
+
+
+class _Floor(Exception):
+    """Raised by the monitor of the final solve on the round-off floor (stops SNES)."""
+
+
+def reason_name(PETSc, reason: int) -> str:
+    """The name of a SNES converged reason (``CONVERGED_FNORM_ABS``, ``DIVERGED_LINE_SEARCH``)."""
+    names = {v: k for k, v in vars(PETSc.SNES.ConvergedReason).items()
+             if isinstance(v, int) and not k.startswith("_")}
+    return names.get(int(reason), str(reason))
+
+
+class _Problem:
+    """The residual and Jacobian callbacks of one SNES: G(x) = r(u(x)) + mu D (offset + x)
+    with u(x) the base state advanced by the increment x (module docstring)."""
+
+    def __init__(self, backend, residual, u0, *, scale, update, first):
+        self.backend, self.residual, self.update = backend, residual, update
+        self.D = np.asarray(scale, dtype=float)
+        self.base, self.offset, self.mu = u0, np.zeros(self.D.size), 0.0
+        self.cache = {"x": np.zeros(self.D.size), "u": u0, "r": first[0], "K": first[1]}
+        self.J = None
+        self.symmetric = None
+
+    def state(self, x: np.ndarray):
+        """The state of the increment x from the base."""
+        if self.update is None:
+            return self.base + x
+        return self.update(self.base, x)
+
+    def evaluate(self, x: np.ndarray):
+        """(u, r, K) at the increment x (the last evaluation reused)."""
+        c = self.cache
+        if not np.array_equal(c["x"], x):
+            u = self.state(x)
+            r, K = self.residual(u)
+            c.update(x=x.copy(), u=u, r=np.asarray(r, dtype=float), K=K)
+        return c["u"], c["r"], c["K"]
+
+    def start(self, u, mu: float) -> None:
+        """A new solve from the state u (it is the cache's state) with the shift mu."""
+        self.base, self.offset, self.mu = u, np.zeros(self.D.size), float(mu)
+        self.cache["x"] = np.zeros(self.D.size)
+
+    def function(self, snes, X, F) -> None:
+        x = gather(X)
+        _, r, _ = self.evaluate(x)
+        lo, hi = F.getOwnershipRange()
+        g = r[lo:hi]
+        if self.mu > 0:
+            g = g + self.mu * self.D[lo:hi] * (self.offset[lo:hi] + x[lo:hi])
+        F.setArray(g)
+
+    def jacobian(self, snes, X, J, P) -> None:
+        PETSc = self.backend.PETSc
+        _, _, K = self.evaluate(gather(X))
+        K.mat.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        if self.mu > 0:
+            d, _ = P.createVecs()
+            lo, hi = P.getOwnershipRange()
+            d.setArray(self.mu * self.D[lo:hi])
+            P.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+        sym = self.backend._symmetric(K, K.mat)
+        P.setOption(PETSc.Mat.Option.SYMMETRIC, sym)
+        pc = snes.getKSP().getPC()
+        if not sym and pc.getType() == "cholesky":     # the default, for a symmetric tangent
+            pc.setType("lu")
+            pc.setFactorSolverType("mumps")
+            log.debug("SNES: unsymmetric tangent, MUMPS LU")
+        P.assemble()
+
+    def rebase(self, snes, its: int) -> None:
+        """SNESSetUpdate: move the base to the current iterate and the increment to 0."""
+        X = snes.getSolution()
+        x = gather(X)
+        if not np.any(x):
+            return
+        u, _, _ = self.evaluate(x)
+        self.base = u
+        self.offset = self.offset + x
+        self.cache["x"] = np.zeros(x.size)
+        X.set(0.0)
+
+
+def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: float = 1e-9,
+                     max_iter: int = 200, newton_first: bool = False, callback=None,
+                     describe=None, what: str = "static solve", update=None):
+    """The equilibrium r(u) = 0 of the energy W by SNES solves (module docstring); the
+    arguments are those of :func:`tmfem.solvers.trust_region.trust_region_newton` with every
+    dof free, the result the fields of its result: ``dict(u, iterations, residual_history,
+    mu_history, tangent)``. ``max_iter`` bounds the SNES iterations over all solves."""
+    PETSc = backend.PETSc
+    u = np.array(u0, dtype=float, copy=True) if update is None else u0
+    r, K = residual(u)
+    if not isinstance(K, DistributedMatrix):
+        raise InputError(f"{what} (SNES): expected the tangent of a distributed assembly "
+                         f"(DistributedMatrix), found {type(K).__name__}")
+    prob = _Problem(backend, residual, u, scale=scale, update=update, first=(r, K))
+    rn = float(np.linalg.norm(r))
+    W = energy(u)
+    Kd = np.abs(K.diagonal())
+    Md = prob.D
+    mu_scale = float(np.median(Kd[Kd > 0]) / np.median(Md)) if np.any(Kd > 0) else 1.0
+    mu = 0.0 if newton_first else 1e-3 * mu_scale
+    mu_last = MU_NEWTON * mu_scale      # the shift to come back to after a failed Newton solve
+    res_hist, mu_hist = [rn], []
+    total = 0
+
+    snes = PETSc.SNES().create(comm=backend.comm)
+    P = K.mat.duplicate(copy=True)
+    F, X = P.createVecs()[1], P.createVecs()[0]
+    snes.setFunction(prob.function, F)
+    snes.setJacobian(prob.jacobian, P, P)
+    snes.setUpdate(prob.rebase)
+    snes.setType("newtonls")
+    backend._configure(snes.getKSP(), backend._symmetric(K, K.mat))
+
+    def monitor(s, its, fnorm):
+        if its == 0:
+            return
+        x = gather(s.getSolution())
+        uu, rr, _ = prob.evaluate(x)
+        rnorm = float(np.linalg.norm(rr))
+        res_hist.append(rnorm)
+        mu_hist.append(prob.mu)
+        if callback is not None:
+            callback(total + its, uu, rnorm, prob.mu, 1.0)
+        log.debug("%s SNES it %3d |r| = %.3e N mu = %.3g", what, total + its, rnorm, prob.mu)
+        if prob.mu == 0.0 and rnorm > 0.5 * res_hist[-2] and rnorm <= 1e3 * tol * force_scale(uu):
+            raise _Floor    # the round-off floor: a Newton step no longer halves |r|
+    snes.setMonitor(monitor)
+
+    def solve(mu_step: float, atol: float):
+        """One SNES solve from u with the shift mu_step: (state, r, K, its, reason)."""
+        prob.start(u, mu_step)
+        # full Newton steps unless -snes_linesearch_type is given (module docstring)
+        search = {} if PETSc.Options().hasName("snes_linesearch_type") else \
+            {"snes_linesearch_type": "basic"}
+        with backend._database({**search, **backend.options}):
+            snes.setTolerances(atol=atol, rtol=STEP_RTOL if mu_step > 0 else 0.0, stol=0.0,
+                               max_it=max(1, min(STEP_MAX_IT if mu_step > 0 else NEWTON_MAX_IT,
+                                                 max_iter - total)))
+            snes.setFromOptions()
+            X.set(0.0)
+            try:
+                snes.solve(None, X)
+            except _Floor:
+                return (*prob.evaluate(gather(X)), snes.getIterationNumber(), FLOOR)
+            except PETSc.Error as exc:
+                log.debug("%s: SNES error %s", what, exc.ierr)
+                return None, None, None, snes.getIterationNumber(), -100
+        x = gather(X)
+        un, rr, KK = prob.evaluate(x)
+        return un, rr, KK, snes.getIterationNumber(), snes.getConvergedReason()
+
+    try:
+        while True:
+            un, rr, KK, its, reason = solve(mu, tol * force_scale(u))
+            total += its
+            ok = un is not None and np.all(np.isfinite(rr))
+            if ok and mu == 0.0:
+                rnn = float(np.linalg.norm(rr))
+                # converged: by the residual (tmfem's test, or -snes_atol/-snes_rtol given),
+                # or on the round-off floor
+                if reason == FLOOR or (reason > 0 and reason_name(PETSc, reason).startswith(
+                        "CONVERGED_FNORM")):
+                    u, r, K = un, rr, KK
+                    break
+                if reason > 0 and rnn < float(np.linalg.norm(r)):
+                    u, r, K = un, rr, KK      # stopped on a step test: Newton again from there
+                    W = energy(u)
+                    if total < max_iter:
+                        continue
+            elif ok:
+                Wn = energy(un)
+                if np.isfinite(Wn) and Wn < W:
+                    u, r, K, W = un, rr, KK, Wn
+                    mu_last = mu
+                    if reason > 0:       # the step's system solved: a longer pseudo time step
+                        mu = mu / 8.0 if mu / 8.0 >= MU_NEWTON * mu_scale else 0.0
+                    if total >= max_iter:
+                        break
+                    continue
+            # the step failed: regularise harder from the last accepted state
+            mu = 4.0 * (mu if mu > 0 else mu_last)
+            prob.start(u, mu)
+            prob.cache.update(x=np.zeros(Md.size), u=u, r=r, K=K)
+            if mu > 1e12 * mu_scale or total >= max_iter:
+                note = f" ({describe(u)})" if describe is not None else ""
+                raise ConvergenceError(
+                    f"{what}: SNES {reason_name(PETSc, reason)} (expected an equilibrium with "
+                    f"|r| <= {tol:g} x force scale, found |r| = {float(np.linalg.norm(r)):.3e} N "
+                    f"after {total} SNES iterations, mu = {mu:.3g}){note}")
+    finally:
+        # the SNES, its KSP (MUMPS' analysis of the tangent's pattern) and matrix stay with
+        # the backend for the eigen solve about this equilibrium
+        ksp = snes.getKSP()
+        snes.cancelMonitor()
+        backend.adopt(K, P, ksp, symmetric=ksp.getPC().getType() == "cholesky", owner=snes)
+        F.destroy()
+        X.destroy()
+    rn = float(np.linalg.norm(r))
+    if not rn <= 1e3 * tol * force_scale(u):
+        note = f" ({describe(u)})" if describe is not None else ""
+        raise ConvergenceError(f"{what}: SNES stopped after {total} iterations (max_iter {max_iter}) "
+                               f"at |r| = {rn:.3e} N, expected <= {tol:g} x force scale{note}")
+    return dict(u=u, iterations=total, residual_history=res_hist, mu_history=mu_hist, tangent=K)
