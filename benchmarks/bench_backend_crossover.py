@@ -30,9 +30,9 @@ def run_one(mesh: int, backend: str) -> dict:
     from tmfem.system import load_preset
     m = MTCModel(load_preset("1-4"), mesh_n=mesh, backend=backend)
     t1 = time.perf_counter()
-    st = m.solve_static()
+    st = m.equilibrium()
     t2 = time.perf_counter()
-    m.modes(st.x, k=12, tangent=st.tangent)
+    m.modes(k=12, at=st)
     t3 = time.perf_counter()
     return dict(dofs=m.ndof, build_s=t1 - t0, static_s=t2 - t1, eigen_s=t3 - t2, total_s=t3 - t0)
 

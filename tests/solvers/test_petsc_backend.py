@@ -495,7 +495,7 @@ def test_slepc_eigen_under_ranks_agrees_with_scipy(models, equilibria, ranks):
     # source: the scipy model's 12 modes at its own equilibrium from the design (ARPACK on
     # the scipy matrices) and the model's scipy mass for the M-orthonormality; SLEPc's
     # Krylov-Schur on the distributed MUMPS factors of K - sigma M
-    ref = models["1-4"].modes(equilibria["1-4"].x, k=12)
+    ref = models["1-4"].modes(k=12, at=equilibria["1-4"])
     p = _mpirun(ranks, "1-4", "6", "--start", "design")
     assert p.returncode == 0, p.stderr
     run = json.loads(p.stdout.strip())
@@ -513,11 +513,11 @@ def test_eps_and_st_options_are_honoured(capfd):
     from tmfem.solvers.petsc import PetscBackend
     from tmfem.system import load_preset
     m = MTCModel(load_preset("1-4"), mesh_n=6, backend=PetscBackend())
-    st = m.solve_static(start="design")
-    base = m.modes(st.x, k=6)
+    st = m.equilibrium(start="design")
+    base = m.modes(k=6, at=st)
     capfd.readouterr()
     m.backend = PetscBackend(options="-eps_ncv 33 -eps_tol 1e-11 -st_pc_type lu -eps_view")
-    modes = m.modes(st.x, k=6)
+    modes = m.modes(k=6, at=st)
     view = capfd.readouterr().out
     assert "krylovschur" in view.replace("-", "").lower()
     assert "(ncv): 33" in view
@@ -559,7 +559,7 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
     for options, analyses in ((None, 0), ("-st_mat_mumps_icntl_14 40", 1)):
         m = MTCModel(load_preset("1-4"), mesh_n=6,
                      backend=PetscBackend(options=options))
-        st = m.solve_static(start="design")
+        st = m.equilibrium(start="design")
         s0, n0 = sym.getPerfInfo()["count"], num.getPerfInfo()["count"]
         modes = m.modes(k=12, at=st.x)
         assert sym.getPerfInfo()["count"] - s0 == analyses

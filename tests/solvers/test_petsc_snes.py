@@ -24,7 +24,7 @@ def scipy_2_3():
     from tmfem.models.mtc.model import MTCModel
     from tmfem.system import load_preset
     m = MTCModel(load_preset("2-3"), mesh_n=4)
-    return m, m.solve_static()
+    return m, m.equilibrium()
 
 
 def _petsc_model(options=None):
@@ -40,7 +40,7 @@ def test_snes_options_are_honoured_and_reach_the_same_equilibrium(scipy_2_3, cap
     # and view show that the static solve is a SNES solve with the options given
     m, st = scipy_2_3
     capfd.readouterr()
-    res = _petsc_model("-snes_monitor -snes_view -ksp_type preonly").solve_static()
+    res = _petsc_model("-snes_monitor -snes_view -ksp_type preonly").equilibrium()
     out = capfd.readouterr().out
     assert "SNES Function norm" in out and "type: newtonls" in out
     x0 = m.initial_positions("undeformed")
@@ -52,7 +52,7 @@ def test_snes_converged_reason_names_the_convergence_error():
     # every SNES solve stops after one function evaluation (-snes_max_funcs 1): the
     # continuation runs out and the error names PETSc's reason
     with pytest.raises(ConvergenceError, match="SNES DIVERGED_FUNCTION_COUNT"):
-        _petsc_model("-snes_max_funcs 1").solve_static()
+        _petsc_model("-snes_max_funcs 1").equilibrium()
 
 
 @needs_petsc
@@ -125,7 +125,7 @@ def test_sbc_snes_under_three_ranks_agrees_with_scipy():
     from tmfem.models.sbc.model import SBCModel
     from tmfem.system import load_preset
     m = SBCModel(load_preset("1-4"), mesh_n=4)
-    st = m.solve_static()
+    st = m.equilibrium()
     p = _mpirun(3, "1-4", "4", "--model", "sbc")
     assert p.returncode == 0, p.stderr
     run = json.loads(p.stdout.strip().splitlines()[-1])

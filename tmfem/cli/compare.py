@@ -27,7 +27,7 @@ def configure(parser) -> None:
                              "6.5: 10, the '20 x 20' square of 6.5.1 is 4 x 10 x 10)")
     parser.add_argument("--tendon-elements", type=positive_int, default=3,
                         help="truss elements per tendon of the FE models (6.4: 3)")
-    parser.add_argument("--backend", choices=backend_names(), default="scipy",
+    parser.add_argument("--backend", choices=backend_names(), default="auto",
                         help="linear-algebra backend of the FE models")
     parser.add_argument("--modes", type=positive_int, default=None,
                         help="frequencies per model (default 12, as Tables 6.6/6.7)")

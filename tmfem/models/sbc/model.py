@@ -122,13 +122,13 @@ class SBCModel(FEModel, Tendons, Placement):
         self.beam = BeamElement(BeamSet(conn=num.beam_conn, section=BeamSection.circle(d=bar.d),
                                         E=bar.E, nu=BAR_NU, rho=bar.rho), dm, X=X)
         self._M = self._dist = None
-        self._init_tendons(rest_lengths, "cable")
         spins = [spin_constraint(self.beam, nodes=chain) for chain in num.bar_chain]
         self.constraints = ConstraintMap.build(
             dm, dependent=[(mt.top_nodes[j], nodes, w) for j, (nodes, w) in enumerate(mt.weights)],
             fixed_nodes=mt.fixed_nodes, dependent_dofs=spins)
         self.free = self.constraints.free
         self.backend = get_backend(backend, n_dofs=self.ndof)        # "auto" by the free dofs
+        self._init_tendons(rest_lengths, "cable")
         # start: the MTC start (bar tops on the corners), bar interiors on the chords
         x0 = X.copy()
         x0[:, :num.n_mtc_nodes] = x_start
