@@ -17,7 +17,7 @@ from tmfem.system.presets import preset_dict
 from tmfem.system.spec import system_to_dict
 from tmfem.system.validate import BOUNDS, MAX_FILE_BYTES, read_bounded
 
-DOCS = Path(__file__).resolve().parents[2] / "docs" / "equilibrium.md"
+DOCS = Path(__file__).resolve().parents[2] / "docs" / "guides" / "equilibrium.md"
 
 
 def preset(name):

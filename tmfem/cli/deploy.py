@@ -281,7 +281,7 @@ def check_plant(args) -> int | None:
         raise InputError(f"--plant-tendons belongs to an MTC plant: the SBC model has the cable "
                          f"law only (EA fixed, k = EA / r); expected no --plant-tendons with "
                          f"--plant sbc, found --plant-tendons {args.plant_tendons}")
-    system = args.system
+    system = args.system if getattr(args, "system", None) is not None else deployed_system(args)
     if system.deployable and "mtc" in fe:
         raise InputError(f"--plant mtc: {args.preset} is a 1-N(D) system (tendons attached at "
                          "H_1j along the bars), which the MTC model cannot represent; expected a "

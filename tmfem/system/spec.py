@@ -292,7 +292,8 @@ def system_from_dict(d: dict, where: str = "system") -> System:
         return sys
     g = _table(d, "general", where)
     w = f"{where} [general]"
-    base = _floats(g, "base", w).reshape(-1, 3).T if np.size(g.get("base", [])) else None
+    base = _floats(g, "base", w) if g.get("base") not in (None, []) else None
+    base = base.reshape(-1, 3).T if base is not None and base.size % 3 == 0 else None
     if base is None or base.shape != (3, N):
         raise InputError(f"{w}: expected 'base' as {N} rows [x, y, z], found {g.get('base')!r}")
     q = _floats(g, "q", w)
