@@ -336,9 +336,9 @@ def _main_mpi(args, mod) -> int:
     import contextlib
     import io
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
-    backend = getattr(args, "backend", None)
-    if backend is None and hasattr(args, "_model_option_dests"):
-        backend = "auto"                   # the finite-element commands' default
+    backend = getattr(args, "backend", "scipy")   # a command without --backend solves with scipy
+    if backend is None:
+        backend = "auto"                   # the default of the commands that take --backend
     if backend not in ("petsc", "auto"):
         if rank == 0:
             print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "

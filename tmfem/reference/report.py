@@ -247,7 +247,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                                               title=f"{name} MTC modes, designed prestress"))
     step(STEPS[3])
     for label, (sbc, st) in sbc_runs.items():
-        freqs[f"SBC {label}"] = sbc.modes(st.state, k=modes, tangent=st.tangent).freq_hz
+        freqs[f"SBC {label}"] = sbc.modes(k=modes, at=st).freq_hz
     if not system.deployable:
         from tmfem.models.sbc.model import SBCModel
         for label, (rest, sys_k) in cases.items():
