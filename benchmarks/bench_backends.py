@@ -120,11 +120,11 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     """One configuration on one mesh (in this process); rank 0's dict, max memory over ranks."""
     from tmfem.models.mtc.model import MTCModel
     from tmfem.solvers.backends import get_backend
-    rank, size, comm = 0, 1, None
+    size, comm = 1, None
     if config != "scipy":
         from tmfem.solvers.distributed import comm_world
         comm = comm_world()
-        rank, size = comm.rank, comm.size
+        size = comm.size
     if config == "scipy":
         inner = get_backend("scipy")
     else:

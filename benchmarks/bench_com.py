@@ -1,6 +1,7 @@
 """Speed of the control-oriented model: one evaluation of M_hat, F_hat, B_hat,
 one linearisation, and a 20 s free vibration (dt = 0.01 s, Park) of the 2-3 and 1-4
-systems (presets; 2-3 is the design of Tables 6.5/6.7). Target: the 20 s run of the 2-3 system in < 2 s (ten times faster than real
+systems (presets; 2-3 is the design of Tables 6.5/6.7). Target: the 20 s run of the 2-3 system in < 2 s (ten times
+faster than real
 time). Prints wall and CPU times and where the time of the run goes.
 
     .venv/bin/python benchmarks/bench_com.py [--systems 2-3 1-4] [--t-end 20]

@@ -1,4 +1,5 @@
-"""Cost of the plant damping on the current tangent (docs/guides/fe-plant.md, "Plant damping"): the per-sample tangent ``FEPlant.sample`` (C_n = beta K_T(x_n)) on the 1-4(D) SBC
+"""Cost of the plant damping on the current tangent (docs/guides/fe-plant.md, "Plant damping"):
+the per-sample tangent ``FEPlant.sample`` (C_n = beta K_T(x_n)) on the 1-4(D) SBC
 deployment plant (N x n x n shell, rigid fit, beta = 1e-3 s), and the CPU per step of a
 closed loop (the adaptive PFL of 7.4 at the reference, no switch, dt = 0.01 s) with
 ``damping_tangent="initial"`` and ``"current"``. Process (CPU) times.

@@ -44,7 +44,8 @@ def main():
         if a.solver == "EIGOPT":
             from tmfem.control.lpv.bisect import bisect_gamma
             lb = pointwise_state_feedback_bound(gp).lower_bound
-            print(f"pointwise bound {lb:.4f}: {time.perf_counter() - t:.1f} s wall, {time.process_time() - c:.1f} s CPU")
+            print(f"pointwise bound {lb:.4f}: {time.perf_counter() - t:.1f} s wall, "
+                  f"{time.process_time() - c:.1f} s CPU")
             gc = {"auto": None, "on": True, "off": False}[a.grid_continuation]
             r, br = bisect_gamma(gp, lower=lb, upper=a.gamma_upper or 2 * lb, rtol=a.rtol, time_budget=a.budget,
                                  max_iter=150, sample_time=a.sample_time, grid_continuation=gc)

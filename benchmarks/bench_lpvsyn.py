@@ -30,7 +30,8 @@ def random_plant(n: int, seed: int = 0, output_feedback: bool = True):
     A1, A2 = (0.5 * M / np.linalg.norm(M, 2) for M in rng.standard_normal((2, n, n)))
     B1, B2 = rng.standard_normal((n, 2)), rng.standard_normal((n, 2))
     C1 = np.vstack([np.eye(2, n), np.zeros((2, n))])
-    D1 = np.zeros((4, 6 if output_feedback else 4)); D1[2:, -2:] = 0.1 * np.eye(2)
+    D1 = np.zeros((4, 6 if output_feedback else 4))
+    D1[2:, -2:] = 0.1 * np.eye(2)
     C2 = rng.standard_normal((2, n))
 
     def P(rho):
@@ -38,7 +39,8 @@ def random_plant(n: int, seed: int = 0, output_feedback: bool = True):
         A = A0 + np.cos(t) * A1 + np.sin(t) * A2
         if not output_feedback:
             return A, np.hstack([B1, B2]), C1, D1
-        D2 = np.zeros((2, 6)); D2[:, 2:4] = 0.1 * np.eye(2)
+        D2 = np.zeros((2, 6))
+        D2[:, 2:4] = 0.1 * np.eye(2)
         return A, np.hstack([B1, np.zeros((n, 2)), B2]), np.vstack([C1, C2]), np.vstack([D1, D2])
     return P
 

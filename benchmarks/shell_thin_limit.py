@@ -56,7 +56,8 @@ def tight_newton(s, stage1, equilibrate):
 def plate(h, n=16, a=2.0, E=1e9, nu=0.3):
     xs = np.linspace(0, a, n + 1)
     s = Structure.shell(MeshQuad.init_tensor(xs, xs), section=ShellSection(E=E, nu=nu, thickness=h))
-    s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0) | np.isclose(x, a) | np.isclose(y, 0) | np.isclose(y, a)), "uz")
+    edge = s.nodes_where(lambda x, y, z: np.isclose(x, 0) | np.isclose(x, a) | np.isclose(y, 0) | np.isclose(y, a))
+    s.fix(edge, "uz")
     s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0) & np.isclose(y, 0)), ["ux", "uy"])
     s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, a) & np.isclose(y, 0)), "uy")
     s.pressure(1.0, follower=False)

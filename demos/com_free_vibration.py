@@ -28,7 +28,8 @@ def main():
     ap.add_argument("--t-end", type=float, default=20.0)
     ap.add_argument("--prestress-scale", type=float, default=1.0)
     a = ap.parse_args()
-    out = Path(a.out); out.mkdir(parents=True, exist_ok=True)
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
     for name, pert in CASES.items():
         try:
             system = load_preset(name)

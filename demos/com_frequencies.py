@@ -32,10 +32,13 @@ def plot_study(rows, path, *, title: str, reference=None) -> str:
         if reference:
             for f in reference:
                 ax.axhline(f, color="C3", lw=0.6, alpha=0.6)
-        ax.set_xlabel("membrane modes K"); ax.set_title(f"prestress x{sc:.4f}")
+        ax.set_xlabel("membrane modes K")
+        ax.set_title(f"prestress x{sc:.4f}")
     axes[0][0].set_ylabel("frequency [Hz] (first 12)")
     fig.suptitle(title + (" (red: printed COM column)" if reference else ""))
-    fig.tight_layout(); fig.savefig(path, dpi=110); plt.close(fig)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
     return str(path)
 
 

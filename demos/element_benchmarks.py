@@ -77,7 +77,9 @@ def membrane(out: Path, plt, fine: bool):
         wr = csv.writer(fh)
         wr.writerow(["mesh", "y_m", "x_m", "w_m"])
         for k, y in enumerate((0.4, 1.0, 1.6)):
-            print(f"\nw [mm] along y = {y} m (Figure {4.10 + 0.01 * k:.2f}); columns: mesh {', '.join(f'{2*n}x{2*n}' for n in ns)}, linearised (20x20)")
+            meshes = ", ".join(f"{2 * n}x{2 * n}" for n in ns)
+            print(f"\nw [mm] along y = {y} m (Figure {4.10 + 0.01 * k:.2f}); columns: mesh {meshes}, "
+                  "linearised (20x20)")
             print("  x [m] " + "".join(f"{2*n}x{2*n}".rjust(10) for n in ns) + "   linear".rjust(10))
             for x in xs:
                 vals = [np.interp(x, *res[n].lines[y]) * 1e3 for n in ns]

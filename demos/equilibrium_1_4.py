@@ -3,7 +3,6 @@
 Run: .venv/bin/python demos/equilibrium_1_4.py
 The printed r_1^S = 1.529 m contradicts the printed tendon stress (see docs/validation/errata.md).
 """
-import numpy as np
 
 from tmfem.equilibrium.design import design_equilibrium
 from tmfem.equilibrium.symmetric import r1_1N
@@ -31,8 +30,10 @@ def main():
             float(EA * (L - P2["rest_S1"]) / P2["rest_S1"] / A) / 1e6, "MPa"),
         row("bar load", P3["bar_load"], float(d.bar_loads.max()), "N"),
         row("bar critical load (eq. 5.31, E = 200 GPa)", P3["bar_critical_load"], float(d.bar_critical.max()), "N"),
-        row("max sigma_p1 (eq. 5.29, mesh-dependent)", P3["membrane_max_sigma_p1"] / 1e6, d.membrane_max_principal / 1e6, "MPa"),
-        row("max sigma_v (eq. 5.30, mesh-dependent)", P3["membrane_max_von_mises"] / 1e6, d.membrane_max_von_mises / 1e6, "MPa"),
+        row("max sigma_p1 (eq. 5.29, mesh-dependent)", P3["membrane_max_sigma_p1"] / 1e6,
+            d.membrane_max_principal / 1e6, "MPa"),
+        row("max sigma_v (eq. 5.30, mesh-dependent)", P3["membrane_max_von_mises"] / 1e6,
+            d.membrane_max_von_mises / 1e6, "MPa"),
     ]
     print(format_comparison(rows, "1-4 system: Tables 6.2 / 6.3 vs tmfem (membrane mesh 4 x 10 x 10)"))
 

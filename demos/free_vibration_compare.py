@@ -95,7 +95,7 @@ def main():
         print(f"  MTC ({m.ndof} DOFs, {system.N}x{a.mesh}x{a.mesh} membrane elements): static "
               f"{t_static:.2f} s, integration {rm.wall_time:.2f} s, {rm.stats['newton_iterations']} "
               f"Newton iterations, {rm.stats['jacobian_evaluations']} factorisations")
-        print(f"  MTC modes [Hz]: " + ", ".join(f"{f:.4f}" for f in f_modes))
+        print("  MTC modes [Hz]: " + ", ".join(f"{f:.4f}" for f in f_modes))
         print(f"  {qname}: peak-to-peak COM {np.ptp(yc):.4e} rad, MTC {np.ptp(ym):.4e} rad; "
               f"fitted frequency COM {fit_frequency(rc.t, yc, f_min=0.05, f_max=2.0):.4f} Hz, "
               f"MTC {fit_frequency(rm.t, ym, f_min=0.05, f_max=2.0):.4f} Hz")

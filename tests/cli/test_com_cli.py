@@ -27,7 +27,8 @@ def test_vibrate_cli_csv_and_plot(tmp_path, capsys):
     assert "theta_12_dot [rad/s]" in rows[0] and "B_12_z [m]" in rows[0]
     assert head[:2] == ["t", "theta_11"] and "w_1" in head and "B_12_z" in head
     # the initial rate is the perturbation; the bar starts to turn (theta_12 grows)
-    i = head.index("theta_12_dot"); j = head.index("theta_12")
+    i = head.index("theta_12_dot")
+    j = head.index("theta_12")
     assert float(rows[1][i]) == pytest.approx(0.01)
     assert float(rows[3][j]) > float(rows[1][j])
     assert png.stat().st_size > 1000

@@ -77,7 +77,6 @@ def test_output_feedback_on_one_point_of_the_2_3_plant(capsys, tmp_path):
     assert saved["L"].shape == (1, 1, 50, 25) and float(saved["W_n"]) == 1e-3
 
 
-from tests.control.lpv.test_lpv_deployment import design21  # noqa: E402,F401  (the 2 x 1 design at gamma = 20, sampled at 0.01 s)
 
 
 @pytest.mark.slow

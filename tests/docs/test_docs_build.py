@@ -73,9 +73,12 @@ def test_cli_reference_has_every_subcommand(site):
 
 @pytest.mark.parametrize("logger, message, docstring", [
     ("mkdocs.plugins.griffe", "griffe: tmfem/x.py:1: Parameter 'A' does not appear in the function signature", True),
-    ("mkdocs.plugins.mkdocs_autorefs", f"api.md: from {os.sep}r{os.sep}tmfem{os.sep}x.py:1: Could not find cross-reference target 'N_R 0'", True),
-    ("mkdocs.structure.pages", "Doc file 'guides/a.md' contains a link 'b.md', but the target 'guides/b.md' is not found among documentation files.", False),
-    ("mkdocs.structure.pages", "Doc file 'guides/a.md' contains a link 'b.md#x', but the doc 'guides/b.md' does not contain an anchor '#x'.", False),
+    ("mkdocs.plugins.mkdocs_autorefs",
+     f"api.md: from {os.sep}r{os.sep}tmfem{os.sep}x.py:1: Could not find cross-reference target 'N_R 0'", True),
+    ("mkdocs.structure.pages", "Doc file 'guides/a.md' contains a link 'b.md', but the target 'guides/b.md' "
+                               "is not found among documentation files.", False),
+    ("mkdocs.structure.pages", "Doc file 'guides/a.md' contains a link 'b.md#x', but the doc 'guides/b.md' "
+                               "does not contain an anchor '#x'.", False),
     ("mkdocs.plugins.mkdocs_autorefs", "guides/a.md: Could not find cross-reference target 'tmfem.nothing'", False),
 ])
 def test_only_docstring_formatting_is_demoted(logger, message, docstring):

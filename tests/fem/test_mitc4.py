@@ -189,7 +189,8 @@ def _ss_plate_ratio(thickness, shear="mitc"):
     xs = np.linspace(0, a, n + 1)
     s = Structure.shell(MeshQuad.init_tensor(xs, xs), section=ShellSection(E=E, nu=nu, thickness=thickness),
                         shear=shear)
-    s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0) | np.isclose(x, a) | np.isclose(y, 0) | np.isclose(y, a)), "uz")
+    edge = s.nodes_where(lambda x, y, z: np.isclose(x, 0) | np.isclose(x, a) | np.isclose(y, 0) | np.isclose(y, a))
+    s.fix(edge, "uz")
     s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0) & np.isclose(y, 0)), ["ux", "uy"])
     s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, a) & np.isclose(y, 0)), "uy")
     s.pressure(q, follower=False)

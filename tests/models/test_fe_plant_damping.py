@@ -137,8 +137,8 @@ def test_initial_tangent_reproduces_the_constant_damping(sbc):
                           perturb={"theta_11_dot": 0.05})
         plant = _WithoutHook(dyn) if name == "hookless" else dyn
         seen = []
-        rec = (lambda t, x, v, a, u, y, dyn=dyn, seen=seen:
-               seen.append(abs(dyn.C - dyn.damping_matrix(dyn._tangent(x))).max()))
+        def rec(t, x, v, a, u, y, dyn=dyn, seen=seen):
+            seen.append(abs(dyn.C - dyn.damping_matrix(dyn._tangent(x))).max())
         runs[name] = (simulate(plant, t_end=0.2, dt=0.01, outputs=False,
                                record=rec if name == "current" else None), dyn, seen)
     ref = runs["hookless"][0]

@@ -8,7 +8,9 @@ from tmfem.solvers.park import LinearSecondOrder, park_integrate
 
 
 def _oscillator(omega, zeta=0.0):
-    M = np.eye(1); C = np.array([[2 * zeta * omega]]); K = np.array([[omega**2]])
+    M = np.eye(1)
+    C = np.array([[2 * zeta * omega]])
+    K = np.array([[omega**2]])
     return LinearSecondOrder(M, C, K)
 
 
@@ -39,7 +41,9 @@ def test_damped_oscillator_closed_form():
 def test_stiff_mode_is_damped_not_amplified():
     # a soft and a very stiff uncoupled oscillator, omega_stiff dt = 1e4: Park must stay
     # bounded and damp the stiff mode (L-stability), while the soft mode stays accurate.
-    M = np.eye(2); C = np.zeros((2, 2)); K = np.diag([1.0, 1e12])
+    M = np.eye(2)
+    C = np.zeros((2, 2))
+    K = np.diag([1.0, 1e12])
     res = park_integrate(LinearSecondOrder(M, C, K), x0=[1.0, 1.0], v0=[0.0, 0.0],
                          dt=0.01, n_steps=500)
     assert np.all(np.abs(res.x[:, 1]) <= 1.0 + 1e-12)
@@ -49,7 +53,8 @@ def test_stiff_mode_is_damped_not_amplified():
 
 def test_trapezoidal_conserves_energy_linear():
     # trapezoidal rule conserves the quadratic energy of a linear undamped system exactly
-    K = np.array([[2.0, -1.0], [-1.0, 2.0]]); M = np.diag([1.0, 2.0])
+    K = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    M = np.diag([1.0, 2.0])
     res = park_integrate(LinearSecondOrder(M, np.zeros((2, 2)), K), x0=[1.0, 0.0],
                          v0=[0.0, 0.3], dt=0.1, n_steps=400, scheme="trapezoidal")
     E = 0.5 * np.einsum("ti,ij,tj->t", res.v, M, res.v) + 0.5 * np.einsum("ti,ij,tj->t", res.x, K, res.x)
@@ -85,7 +90,8 @@ def test_sparse_jacobians_and_callback():
     K = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n), format="csr") * 100.0
     sysd = LinearSecondOrder(np.eye(n), np.zeros((n, n)), K.toarray())
     syss = LinearSecondOrder(sp.identity(n, format="csr"), sp.csr_matrix((n, n)), K)
-    x0 = np.sin(np.linspace(0, np.pi, n)); v0 = np.zeros(n)
+    x0 = np.sin(np.linspace(0, np.pi, n))
+    v0 = np.zeros(n)
     rows = []
     rd = park_integrate(sysd, x0=x0, v0=v0, dt=0.01, n_steps=50)
     rs = park_integrate(syss, x0=x0, v0=v0, dt=0.01, n_steps=50, store=False,

@@ -125,12 +125,14 @@ def run(args) -> dict:
 
 def format_text(r: dict) -> str:
     deg = [f"{np.degrees(a):.2f} deg" for a in r["lpv_gamma_lower_bound_at"]]
-    lines = [f"LPV state feedback, {r['preset']}, grid {r['grid'][0]}x{r['grid'][1]}, rates +-{r['rate_bound_deg']:g} deg/s",
+    lines = [f"LPV state feedback, {r['preset']}, grid {r['grid'][0]}x{r['grid'][1]}, "
+             f"rates +-{r['rate_bound_deg']:g} deg/s",
              f"pointwise state-feedback lower bound of gamma: {r['lpv_gamma_lower_bound']:.4g} at "
              f"(theta_13, psi_13) = ({', '.join(deg)}) (printed ||G_pw|| < {r['printed_gamma_bound']})"]
     if "gamma" in r:
         lines += [f"{'K(rho): ' if r.get('output_feedback') else ''}gamma = "
-                  f"{r.get('state_feedback_gamma', r['gamma']):.5g} ({r['solver']}, {r['status']}, {r['solve_time_s']:.1f} s, sizes {r['sizes']})",
+                  f"{r.get('state_feedback_gamma', r['gamma']):.5g} ({r['solver']}, {r['status']}, "
+                  f"{r['solve_time_s']:.1f} s, sizes {r['sizes']})",
                   f"verification on {r['verification_grid']}: max LMI eigenvalue {r['verification_max_eig']:.3e}, "
                   f"max closed-loop Re {r['closed_loop_max_real']:.3e}"]
     if r.get("output_feedback"):

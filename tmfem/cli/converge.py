@@ -44,7 +44,8 @@ def configure(parser) -> None:
                         help="finite-element model (" + "; ".join(
                             f"{n}: {spec.help}" for n, spec in specs.items()) + ")")
     parser.add_argument("--backend", choices=backend_names(), default="auto",
-                        help="linear-algebra backend (auto: PETSc from 5000 free dofs where installed; docs/guides/backends.md)")
+                        help="linear-algebra backend (auto: PETSc from 5000 free dofs where installed; "
+                             "docs/guides/backends.md)")
     parser.add_argument("--mesh", default="10",
                         help="comma-separated membrane subdivisions n (N quads of n x n each)")
     parser.add_argument("--tendon-elements", default="3",

@@ -35,7 +35,8 @@ def configure(parser) -> None:
                              "1.01 gamma_opt, tmfem control hinf --method central), "
                              "adaptive-hinf-riccati (python-control hinfsyn), adaptive-lqr (LQR "
                              "state feedback) or adaptive (no switch); LPV presets (8.4): lpv (default; "
-                             "the scheduled state feedback of 8.3) or lpv-output (its observer-based output feedback on the "
+                             "the scheduled state feedback of 8.3) or lpv-output (its observer-based output "
+                             "feedback on the "
                              "measured q and membrane points, docs/guides/lpv.md)")
     parser.add_argument("--uncertainty", choices=list(UNCERTAINTIES),
                         help="controller model error (default: the 7.4 choice of the preset)")

@@ -24,7 +24,8 @@ MAX_VERIFY_POINTS = 500
 
 def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
     """The synthesis options shared by `tmfem control lpv` and `tmfem deploy --controller lpv`."""
-    parser.add_argument("--grid", default=None, help=prefix + "theta x psi points of the printed grid (8.3; default 6x3)")
+    parser.add_argument("--grid", default=None,
+                        help=prefix + "theta x psi points of the printed grid (8.3; default 6x3)")
     parser.add_argument("--refine", type=int, default=None,
                         help=prefix + "verification grid refinement factor (>= 4, default 4)")
     parser.add_argument("--gamma", type=float, default=None,
@@ -64,7 +65,8 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
     (system, grid axes, refine, EIGOPT bisection or fixed level)."""
     refine = 4 if args.refine is None else args.refine
     if refine < 4:
-        raise InputError(f"--refine: expected >= 4 (the verification standard: 4 points between grid points), found {refine}")
+        raise InputError(f"--refine: expected >= 4 (the verification standard: 4 points between grid "
+                         f"points), found {refine}")
     if solver not in ("CLARABEL", "SCS", "EIGOPT"):
         raise InputError(f"--solver {solver}: applies to `tmfem control hinf` only; lpv takes CLARABEL, SCS or EIGOPT")
     eig = {k: getattr(args, k, None) for k in ("gamma_rtol", "time_budget", "fixed_gamma", "start")}

@@ -344,8 +344,9 @@ class MITC4Shell:
         Ux = ua[:, :, None] + pts.r3[None, None, :, None, None] * ub[:, :, None]  # (ne,nq,nz,2,3)
         G = pts.Ga[:, :, None] + pts.r3[None, None, :, None, None] * pts.Gb[:, :, None]
         g = G + Ux
-        e11 = 2 * np.einsum("...i,...i->...", Ux[..., 0, :], G[..., 0, :]) + np.einsum("...i,...i->...", Ux[..., 0, :], Ux[..., 0, :])
-        e22 = 2 * np.einsum("...i,...i->...", Ux[..., 1, :], G[..., 1, :]) + np.einsum("...i,...i->...", Ux[..., 1, :], Ux[..., 1, :])
+        dot = "...i,...i->..."
+        e11 = 2 * np.einsum(dot, Ux[..., 0, :], G[..., 0, :]) + np.einsum(dot, Ux[..., 0, :], Ux[..., 0, :])
+        e22 = 2 * np.einsum(dot, Ux[..., 1, :], G[..., 1, :]) + np.einsum(dot, Ux[..., 1, :], Ux[..., 1, :])
         g12 = (np.einsum("...i,...i->...", Ux[..., 0, :], G[..., 1, :])
                + np.einsum("...i,...i->...", G[..., 0, :], Ux[..., 1, :])
                + np.einsum("...i,...i->...", Ux[..., 0, :], Ux[..., 1, :]))

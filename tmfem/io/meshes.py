@@ -54,7 +54,8 @@ def configuration_mesh(system, *, q=None, tendon_forces=None, rest_lengths=None,
 
     Returns
     -------
-    meshio.Mesh (one cell block each: bar lines, tendon lines, membrane). Cell data: ``kind``, ``member_id``, ``family``, ``stage``,
+    meshio.Mesh (one cell block each: bar lines, tendon lines, membrane). Cell data: ``kind``, ``member_id``,
+    ``family``, ``stage``,
     ``j``, ``length``, ``axial_force``, ``force_density``, ``axial_stress``, ``slack``,
     ``rest_length``, ``strain`` and the membrane's cell data; point data: node codes
     (see the module docstring), the membrane's and ``point_data``.

@@ -168,7 +168,8 @@ def twisted_annulus(*, a: float, b: float, material: MembraneMaterial, delta: fl
         Rstar = brentq(lambda R: 1.0 if np.isfinite(g(R, 0)) else -1.0, Rs[both[0] - 1], R1,
                        xtol=1e-15 * b)
         Rstar = Rstar + 1e-13 * b if not np.isfinite(g(Rstar, 0)) else Rstar
-        fold = lambda t: g(Rstar + (R1 - Rstar) * t * t, 0 if t > 0 else 1)
+        def fold(t, Rstar=Rstar, R1=R1):
+            return g(Rstar + (R1 - Rstar) * t * t, 0 if t > 0 else 1)
         t = brentq(fold, -1.0, 1.0, xtol=1e-12)
         found.append((Rstar + (R1 - Rstar) * t * t, 0 if t > 0 else 1))
     if len(found) != 1:

@@ -142,7 +142,9 @@ def simulate(plant, *, t_end: float, dt: float, controller=None, x0=None, v0=Non
         loop.u = u if actuate is None else np.asarray(actuate(x, u), dtype=float)
         if sample is not None:
             sample(x, loop.u)
-        T.append(t); U.append(u); C.append(ctrl.name)
+        T.append(t)
+        U.append(u)
+        C.append(ctrl.name)
         if outputs:
             Y.append(y)
         return bool(record(t, x, v, a, u, y)) if record is not None else False

@@ -110,7 +110,11 @@ def free_vibration(model, *, t_end: float, dt: float = 0.01, perturb: dict | Non
                 t, system, q=(model.P @ z)[: model.nq], tendon_forces=force, rest_lengths=rest,
                 membrane=MembraneField(mesh=model.membrane.mesh, x=xm,
                                        point_data={DISPLACEMENT_FIELD: defl}))
-        T.append(t); Z.append(z.copy()); ZD.append(zd.copy()); W.append(w); XS.append(pos)
+        T.append(t)
+        Z.append(z.copy())
+        ZD.append(zd.copy())
+        W.append(w)
+        XS.append(pos)
         out.row(t, np.concatenate([z, zd, w, pos.T.ravel()]))
 
     try:
@@ -266,7 +270,12 @@ def fe_free_vibration(dyn, *, name: str, t_end: float, dt: float = 0.01, csv_pat
                                             rest_lengths=dyn.model.rest_lengths,
                                             membrane=None if membrane is None else membrane(u),
                                             bar_forces=ms["bar_force"])
-        T.append(t); Q.append(q); W.append(w); XS.append(pos); TD.append(td); KE.append(ke)
+        T.append(t)
+        Q.append(q)
+        W.append(w)
+        XS.append(pos)
+        TD.append(td)
+        KE.append(ke)
         SE.append(se)
         out.row(t, np.concatenate([q, w, pos.T.ravel(), [td, ke, se]]))
 

@@ -156,7 +156,8 @@ def follow(system: Callable, u0, *, lam0: float = 0.0, free=None, method: str = 
         raise InputError(f"path following: expected a finite non-zero first step dl (> 0 for arc length), found {dl!r}")
     unknown = set(stop_at) - {"limit point", "bifurcation"}
     if unknown:
-        raise InputError(f"path following: expected stop_at events from 'limit point', 'bifurcation', found {sorted(unknown)}")
+        raise InputError(f"path following: expected stop_at events from 'limit point', 'bifurcation', "
+                         f"found {sorted(unknown)}")
     be = get_backend(backend)
     u = copy_iterate(u0, update)
     lam = float(lam0)

@@ -59,7 +59,8 @@ def jacobi_scaling(A) -> np.ndarray:
 
 def factorize(A, backend, *, equilibrate: bool = False):
     """``solve(b)`` of a tangent: a small dense one (ndarray) by LU in place (LAPACK), any other
-    (sparse, a backend's distributed matrix) by the backend; a singular matrix raises :class:`~tmfem.solvers.backends.SingularMatrix`.
+    (sparse, a backend's distributed matrix) by the backend; a singular matrix raises
+    :class:`~tmfem.solvers.backends.SingularMatrix`.
 
     ``equilibrate``: factorise D A D instead (:func:`jacobi_scaling`) and return
     x = D (D A D)^-1 D b, the same solution with the backward error of the pivots measured on
@@ -300,7 +301,8 @@ def load_stepping(residual_lam: Callable, u0, *, free=None, dlam0: float = 1.0,
             rejected += 1
             dlam *= 0.5
             if dlam < dlam_min:
-                raise convergence_failure(f"load stepping: expected to reach load factor 1, stuck at {lam:g} (increment "
+                raise convergence_failure(f"load stepping: expected to reach load factor 1, stuck at {lam:g} "
+                            f"(increment "
                             f"{2 * dlam:.2e} < {dlam_min:g} failed): {exc}", step=step,
                             history=getattr(exc, "residual_history", []), load_factor=target, u=u) from None
             continue

@@ -178,7 +178,9 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
     a = initial_acceleration(system, x, v, t0) if a0 is None else np.array(a0, dtype=float)
     n = x.size
     if store:
-        X = np.empty((n_steps + 1, n)); V = np.empty_like(X); A = np.empty_like(X)
+        X = np.empty((n_steps + 1, n))
+        V = np.empty_like(X)
+        A = np.empty_like(X)
         X[0], V[0], A[0] = x, v, a
     T = t0 + dt * np.arange(n_steps + 1)
     res = ParkResult(t=T, x=None, v=None, a=None)
@@ -269,9 +271,11 @@ def park_integrate(system, *, x0, v0, dt: float, n_steps: int, t0: float = 0.0,
                                    f"{dx_norm:.3e} (tolerance {tol:g} (1 + |x|))")
         x = xk
         v, a = kin(x)
-        hx.append(x.copy()); hv.append(v.copy())
+        hx.append(x.copy())
+        hv.append(v.copy())
         if len(hx) > 3:
-            hx.pop(0); hv.pop(0)
+            hx.pop(0)
+            hv.pop(0)
         if store:
             X[k], V[k], A[k] = x, v, a
         last = k

@@ -346,6 +346,9 @@ class System:
                 raise InputError(f"stage {i + 1} is not symmetric (eqs. 3.19-3.20): expected a "
                                  f"spread <= {limit:.3g} over the bars, found "
                                  + ", ".join(f"{k} {v:.3g}" for k, v in bad.items()))
-            th.append(theta[i, 0]); ps.append(psi0[-1]); sg.append(0.0 if i == 0 else sig[-1])
-            zz.append(0.0 if i == 0 else rel[2, 0]); rr.append(rad[0])
+            th.append(theta[i, 0])
+            ps.append(psi0[-1])
+            sg.append(0.0 if i == 0 else sig[-1])
+            zz.append(0.0 if i == 0 else rel[2, 0])
+            rr.append(rad[0])
         return SymmetricConfig(theta=th, psi=ps, sigma=sg, z=zz, r=rr, l=self.l[:, 0])

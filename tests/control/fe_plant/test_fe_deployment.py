@@ -1,4 +1,5 @@
-"""The 2-3 deployment of 7.4 (adaptive PFL, Table 7.7) on the MTC finite-element plant (docs/guides/fe-plant.md): where the PFL evaluates its model, its tendon model, and the closed
+"""The 2-3 deployment of 7.4 (adaptive PFL, Table 7.7) on the MTC finite-element plant
+(docs/guides/fe-plant.md): where the PFL evaluates its model, its tendon model, and the closed
 loop on the FE plant against the same controller on the control-oriented model."""
 import os
 

@@ -10,7 +10,6 @@ import dataclasses
 import numpy as np
 import pytest
 
-from tests.control.lpv.test_lpv_deployment import design21  # noqa: F401  (the 2 x 1 design at gamma = 20, dt = 0.01 s)
 from tmfem.control.fe_plant.sampled_loop import (LinearizedFEPlant, dominant_eigenvalues, lpv_start_loop,
                                            park_loop)
 from tmfem.errors import InputError

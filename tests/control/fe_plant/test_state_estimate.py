@@ -56,7 +56,8 @@ def test_lqr_designed_on_the_com_damps_the_mtc_plant(models):
     iq = list(s.q_names).index("theta_11")
     fe_plant = FEStatePlant(MTCDynamics(fe, x_eq, perturb={"theta_11_dot": 0.02}), com)
     com_plant = StatePlant(com, z0=z_e)
-    com_plant.v0 = np.zeros(com.nz); com_plant.v0[iq] = 0.02
+    com_plant.v0 = np.zeros(com.nz)
+    com_plant.v0[iq] = 0.02
     runs = {}
     for name, plant in (("com", com_plant), ("mtc", fe_plant)):
         sim = simulate(plant, t_end=3.0, dt=0.01, controller=ctrl, jacobian="iteration")

@@ -133,7 +133,8 @@ def nonlinear_oscillator(rho):
 def nonlinear():
     pl = nonlinear_oscillator([0.0, 2.0])
     d = make_design(pl)
-    return pl, d, rate_bounded_certificate(d, pl, W_e=W_E, W_u=W_U, rtol=1e-2), nonlinear_oscillator(np.linspace(0, 2, 5))
+    cert = rate_bounded_certificate(d, pl, W_e=W_E, W_u=W_U, rtol=1e-2)
+    return pl, d, cert, nonlinear_oscillator(np.linspace(0, 2, 5))
 
 
 def largest_brl(X, gamma, d, plant):

@@ -36,7 +36,8 @@ def test_scheduled_controller_tracks_a_step_with_integral_action():
     c = LPVController(design, pl, state_index=[0, 1], q_index=[0], rho_index=[2], reference=lambda t: [q_d])
     # the true plant frozen at rho = 1.3 (between grid points), exact zero-order-hold steps
     rho, dt = 1.3, 0.01
-    A = np.array([[0, 1], [-(1 + rho), -0.1]]); B = np.array([[0.0], [1.0]])
+    A = np.array([[0, 1], [-(1 + rho), -0.1]])
+    B = np.array([[0.0], [1.0]])
     E = sla.expm(np.block([[A, B], [np.zeros((1, 3))]]) * dt)
     Ad, Bd = E[:2, :2], E[:2, 2:]
     x = np.array([X0, 0.0])
@@ -78,11 +79,13 @@ def test_state_feedback_riccati_test_matches_the_lmi():
     # with C2 = I, D21 = 0 the dual LMI is ||D11|| < gamma) and the Riccati test: one optimum
     rng = np.random.default_rng(2)
     n, nw, nu = 4, 3, 2
-    A = rng.standard_normal((n, n)); A -= (np.max(np.linalg.eigvals(A).real) - 0.3) * np.eye(n)
+    A = rng.standard_normal((n, n))
+    A -= (np.max(np.linalg.eigvals(A).real) - 0.3) * np.eye(n)
     from tmfem.control.linear.hinf_lmi import GeneralizedPlant
     C1 = np.vstack([rng.standard_normal((2, n)), np.zeros((nu, n))])
     D12 = np.vstack([np.zeros((2, nu)), np.eye(nu)])
-    D11 = np.zeros((4, nw)); D11[0, 0] = 3.0
+    D11 = np.zeros((4, nw))
+    D11[0, 0] = 3.0
     P = GeneralizedPlant(A=A, B1=rng.standard_normal((n, nw)), B2=rng.standard_normal((n, nu)), C1=C1,
                          C2=np.eye(n), D11=D11, D12=D12, D21=np.zeros((n, nw)), D22=np.zeros((n, nu)),
                          state_names=[f"x{i}" for i in range(n)], w_names=[f"w{i}" for i in range(nw)],

@@ -46,23 +46,6 @@ def test_measured_wrapper_refuses_a_non_controller():
         Measured(object(), lambda y: y)
 
 
-@pytest.fixture(scope="module")
-def design21(tmp_path_factory):
-    """A 2 x 1 grid design at gamma = 20 with the sampled-loop LMI at dt = 0.01 s, saved."""
-    from tmfem.control.lpv.plant import com_lpv_plant
-    from tmfem.control.lpv.generalized_plant import interconnection_8_1
-    from tmfem.control.lpv.synthesis import synthesize_state_feedback
-    from tmfem.reference.tables import deployment_bases
-    from tmfem.system import load_preset
-    s = load_preset("2-3-lpv")
-    pl = com_lpv_plant(s, theta=np.radians([63.0, 77.32]), psi=np.radians([8.36]), bases=deployment_bases(s))
-    d = synthesize_state_feedback(interconnection_8_1(pl, tracked=s.q_names), solver="EIGOPT", gamma=20.0,
-                                  sample_time=0.01)
-    path = tmp_path_factory.mktemp("lpv") / "d21.npz"
-    d.save(path)
-    return pl, d, path
-
-
 @pytest.mark.slow
 def test_measurement_starts_at_the_design_equilibrium(design21):
     # at the start (theta = 77.32, psi = 8.36 deg, at rest) the measured LPV state is the

@@ -11,7 +11,8 @@ from tmfem.errors import InfeasibleController, InputError
 
 def scalar_gp(a, rate=0.0):
     """x' = a(rho) x + w + u, p = [x; u] on a grid rho = 0, 1, ..."""
-    a = np.asarray(a, dtype=float); s = (a.size,)
+    a = np.asarray(a, dtype=float)
+    s = (a.size,)
     return GeneralizedLPV.from_matrices(
         axes=[np.arange(a.size, dtype=float)], parameter_names=["r"], rate_bounds=[[-rate, rate]],
         A=a.reshape(s + (1, 1)), B1=np.ones(s + (1, 1)), B2=np.ones(s + (1, 1)),

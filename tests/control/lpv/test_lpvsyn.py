@@ -91,7 +91,10 @@ def oscillator_gp():
     """x'' + (0.2 + 0.1 rho2) x' + (1 + rho1) x = u + w, p = [x; 0.3 u] on a 3 x 2 grid."""
     r1, r2 = np.array([0.0, 1.0, 2.0]), np.array([0.0, 1.0])
     R1, R2 = np.meshgrid(r1, r2, indexing="ij")
-    A = np.zeros((3, 2, 2, 2)); A[..., 0, 1] = 1.0; A[..., 1, 0] = -(1 + R1); A[..., 1, 1] = -(0.2 + 0.1 * R2)
+    A = np.zeros((3, 2, 2, 2))
+    A[..., 0, 1] = 1.0
+    A[..., 1, 0] = -(1 + R1)
+    A[..., 1, 1] = -(0.2 + 0.1 * R2)
     col = np.broadcast_to([[0.0], [1.0]], (3, 2, 2, 1))
     return GeneralizedLPV.from_matrices(
         axes=[r1, r2], parameter_names=["k", "c"], rate_bounds=[[-0.5, 0.5], [-1.0, 1.0]], A=A, B1=col, B2=col,
@@ -261,9 +264,14 @@ def wu_1996(rho):
     c, s = np.cos(rho[0]), np.sin(rho[0])
     A = np.array([[0.75, 2, c, s, 0, 0], [0, 0.5, -s, c, 0, 0], [0, 0, -10, 0, 0, 0], [0, 0, 0, -10, 0, 0],
                   [0, 0, 0, 0, -0.2, 0], [0, 0, 0, 0, 0, -0.2]])
-    B = np.zeros((6, 4)); B[4, 0] = B[5, 1] = 4.0; B[2, 2] = B[3, 3] = 10.0
-    C1 = np.zeros((4, 6)); C1[0, 0] = C1[1, 1] = 1.0; C1[0, 4] = C1[1, 5] = -5.0
-    D = np.zeros((6, 4)); D[2, 2] = D[3, 3] = 1 / 280
+    B = np.zeros((6, 4))
+    B[4, 0] = B[5, 1] = 4.0
+    B[2, 2] = B[3, 3] = 10.0
+    C1 = np.zeros((4, 6))
+    C1[0, 0] = C1[1, 1] = 1.0
+    C1[0, 4] = C1[1, 5] = -5.0
+    D = np.zeros((6, 4))
+    D[2, 2] = D[3, 3] = 1 / 280
     return A, B, np.vstack([C1, C1[:2]]), D
 
 

@@ -88,7 +88,8 @@ def test_membrane_basis_properties(m14, sys14):
     # static shapes: unit displacement of their own corner component, zero elsewhere
     for k, (i, c) in enumerate(mb.layout.corner_components):
         P = mb.shapes[1 + k][:, corners]
-        target = np.zeros((3, sys14.N)); target[c, i] = 1.0
+        target = np.zeros((3, sys14.N))
+        target[c, i] = 1.0
         assert np.allclose(P, target, atol=1e-12)
     # relative modes vanish at the corners (corner-held, no double counting) and are
     # mass-normalised (eq. 5.79): int rho phi_i . phi_j = delta_ij
@@ -232,10 +233,12 @@ def test_linear_state_space_names(m14, sys14):
 def test_energy_conserved_without_damping(sys14, m14):
     m = m14
     z0 = m.equilibrium().state
-    zd0 = np.zeros(m.nz); zd0[2] = 0.01          # theta_12_dot = 0.01 rad/s (6.5.1)
+    zd0 = np.zeros(m.nz)
+    zd0[2] = 0.01          # theta_12_dot = 0.01 rad/s (6.5.1)
     E = []
-    res = park_integrate(m, x0=z0, v0=zd0, dt=0.005, n_steps=300, scheme="trapezoidal",
-                         jacobian="reuse", callback=lambda t, x, v, a: E.append(m.kinetic_energy(x, v) + m.potential_energy(x)))
+    park_integrate(m, x0=z0, v0=zd0, dt=0.005, n_steps=300, scheme="trapezoidal",
+                         jacobian="reuse",
+                         callback=lambda t, x, v, a: E.append(m.kinetic_energy(x, v) + m.potential_energy(x)))
     E = np.array(E)
     T0 = m.kinetic_energy(z0, zd0)
     assert np.max(np.abs(E - E[0])) < 1e-4 * T0
@@ -243,7 +246,8 @@ def test_energy_conserved_without_damping(sys14, m14):
     md = ControlOrientedModel(sys14, membrane_modes=3, damping=0.5)
     Ed = []
     park_integrate(md, x0=z0, v0=zd0, dt=0.005, n_steps=300, scheme="trapezoidal",
-                   jacobian="reuse", callback=lambda t, x, v, a: Ed.append(md.kinetic_energy(x, v) + md.potential_energy(x)))
+                   jacobian="reuse",
+                   callback=lambda t, x, v, a: Ed.append(md.kinetic_energy(x, v) + md.potential_energy(x)))
     assert Ed[-1] < Ed[0] - 1e-3 * T0
 
 
@@ -343,7 +347,8 @@ def test_free_vibration_matches_linear_response(m14):
     from tmfem.simulation.vibration import free_vibration
     res = free_vibration(m14, t_end=3.0, dt=0.005, perturb={"theta_12_dot": 0.01}, jacobian="reuse")
     lin = linearize(m14)
-    x0 = np.zeros(2 * m14.nz); x0[m14.nz + 2] = 0.01
+    x0 = np.zeros(2 * m14.nz)
+    x0[m14.nz + 2] = 0.01
     Phi = expm(lin.A * 0.005)
     X = [x0]
     for _ in range(len(res.t) - 1):
@@ -362,7 +367,8 @@ def test_rest_length_step_matches_linear_input_response(m14):
     response against the exact zero-order-hold response of the linearisation (A, B of 5.33)."""
     from scipy.linalg import expm
     from tmfem.simulation.vibration import free_vibration
-    du = np.zeros(m14.n_t); du[1] = -1e-3
+    du = np.zeros(m14.n_t)
+    du[1] = -1e-3
     dt = 0.005
     res = free_vibration(m14, t_end=2.0, dt=dt, u=m14.u0 + du, jacobian="reuse")
     lin = linearize(m14)
@@ -385,7 +391,8 @@ def test_driven_run_frames_carry_the_driven_rest_lengths_and_forces(m14, tmp_pat
     import meshio
     from tmfem.io.series import read_pvd
     from tmfem.simulation.vibration import free_vibration
-    du = np.zeros(m14.n_t); du[1] = -1e-3
+    du = np.zeros(m14.n_t)
+    du[1] = -1e-3
     res = free_vibration(m14, t_end=0.02, dt=0.01, u=m14.u0 + du, vtk_dir=tmp_path, vtk_every=1)
     frames = read_pvd(res.stats["pvd"])
     assert len(frames) == 3

@@ -28,7 +28,8 @@ def m23(s23):
 def test_bar_kinetic_energy_literal_eq_5_10_5_11(s23):
     """Our vector form against eqs. 5.10-5.11 written out term by term."""
     nq = len(s23.q_names)
-    q = ca.SX.sym("q", nq); qd = ca.SX.sym("qd", nq)
+    q = ca.SX.sym("q", nq)
+    qd = ca.SX.sym("qd", nq)
     f = ca.Function("T", [q, qd], [bar_kinetic_energy_sx(s23, q, qd)])
     rng = np.random.default_rng(2)
     qv = s23.q + 0.05 * rng.standard_normal(nq)
@@ -37,13 +38,15 @@ def test_bar_kinetic_energy_literal_eq_5_10_5_11(s23):
     T = 0.0
     for j in range(N):                                   # stage 1 (T_2 absent)
         th, thd, psd = qv[2 * j], qdv[2 * j], qdv[2 * j + 1]
-        l = s23.l[0, j]; m = s23.bar.mass(l)
+        l = s23.l[0, j]
+        m = s23.bar.mass(l)
         T += m / 6 * l**2 * (thd**2 + psd**2 * np.sin(th) ** 2)
     for j in range(N):                                   # stage 2
         k = 2 * N + 5 * j
         x, y, z, th, ps = qv[k:k + 5]
         xd, yd, zd, thd, psd = qdv[k:k + 5]
-        l = s23.l[1, j]; m = s23.bar.mass(l)
+        l = s23.l[1, j]
+        m = s23.bar.mass(l)
         T1 = l**2 * (thd**2 + psd**2 * np.sin(th) ** 2)
         T2 = (xd**2 + yd**2 + zd**2
               + l * xd * (thd * np.cos(th) * np.cos(ps) - psd * np.sin(th) * np.sin(ps))
@@ -58,7 +61,8 @@ def test_layout_and_partitioning_2_3(s23, m23):
     assert m23.nz == 21 + 2
     ms = ControlOrientedModel(s23, membrane_modes=2, formulation="substituted")
     rng = np.random.default_rng(4)
-    z = m23.z0 + 0.01 * rng.standard_normal(m23.nz); zd = 0.1 * rng.standard_normal(m23.nz)
+    z = m23.z0 + 0.01 * rng.standard_normal(m23.nz)
+    zd = 0.1 * rng.standard_normal(m23.nz)
     for a, b, c in zip(m23.matrices(z, zd), ms.matrices(z, zd), matrices_newton(m23, z, zd)):
         assert np.allclose(a, b, rtol=1e-10, atol=1e-10 * np.abs(a).max())
         assert np.allclose(a, c, rtol=1e-10, atol=1e-10 * np.abs(a).max())
@@ -77,7 +81,8 @@ def test_stable_and_energy_conserved(s23, m23):
     f = linearize(m23).frequencies_hz()
     assert np.all(f > 0)                          # a stable equilibrium: no imaginary frequency
     z0 = m23.equilibrium().state
-    zd0 = np.zeros(m23.nz); zd0[0] = 0.01         # theta_11_dot = 0.01 rad/s (6.5.2)
+    zd0 = np.zeros(m23.nz)
+    zd0[0] = 0.01         # theta_11_dot = 0.01 rad/s (6.5.2)
     E = []
     park_integrate(m23, x0=z0, v0=zd0, dt=0.005, n_steps=200, scheme="trapezoidal",
                    jacobian="reuse",

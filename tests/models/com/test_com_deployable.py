@@ -27,7 +27,8 @@ def test_design_and_stability(m4d):
 
 def test_paths_agree(m4d):
     rng = np.random.default_rng(5)
-    z = m4d.z0 + 0.01 * rng.standard_normal(m4d.nz); zd = 0.1 * rng.standard_normal(m4d.nz)
+    z = m4d.z0 + 0.01 * rng.standard_normal(m4d.nz)
+    zd = 0.1 * rng.standard_normal(m4d.nz)
     for a, b in zip(m4d.matrices(z, zd), matrices_newton(m4d, z, zd)):
         assert np.allclose(a, b, rtol=1e-10, atol=1e-10 * np.abs(a).max())
     d = dae_terms(m4d, z, zd)

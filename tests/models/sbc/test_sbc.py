@@ -192,7 +192,7 @@ def test_1nd_bars_bend_as_pinned_beams_under_the_tendon_load_at_h():
     st = m.equilibrium().state
     x = st.x[:, m.topology.system_node]
     N, l, k = s.N, s.l[0, 0], s.k_H
-    A, B, H = x[:, :N], x[:, N:2 * N], x[:, 2 * N:]
+    A, B = x[:, :N], x[:, N:2 * N]
     c = s.tendon_connectivity
     d = x[:, c[0]] - x[:, c[1]]
     pull = m.member_forces(st)["tendon"] * d / np.linalg.norm(d, axis=0)   # on end 2, toward end 1

@@ -233,8 +233,11 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
 
     def record(t, x, v, a, u, y):
         y = plant.outputs(x, v, u) if y is None else y
-        T.append(t); C.append(lim.name)
-        X.append(y[:nz].copy()); V.append(y[nz:].copy()); U.append(u.copy())
+        T.append(t)
+        C.append(lim.name)
+        X.append(y[:nz].copy())
+        V.append(y[nz:].copy())
+        U.append(u.copy())
         if recover is not None:
             S.append(x.copy())
         return False

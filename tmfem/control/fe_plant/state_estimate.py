@@ -15,7 +15,8 @@ FE state as sensors would give it:
   bending, docs/guides/fe-plant.md);
 * eta by projecting the FE membrane onto the COM's membrane basis (eq. 5.1): the FE membrane
   nodes (the SBC shell's mid-surface nodes) are taken into the floating frame of the current
-  corners (eq. 3.3), interpolated at the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta from the
+  corners (eq. 3.3), interpolated at the nodes of the COM basis, the prestressing part sum_k Psi_k Delta_k(q) (Delta
+  from the
   corner constraints, eqs. 3.5, 5.14) is subtracted and the rest is projected on the
   relative modes in the mass inner product (:meth:`MembraneBasis.modal_coordinates`) -- a
   full-field measurement of the membrane (photogrammetry), the best case of the "projection
@@ -298,15 +299,19 @@ class FEStatePlant:
             w.append(dyn.outputs(x)[nq:])
             u = self.actuate(x, uc)
             if force:
-                Td.append(self.tension_demand(x, uc)); R.append(u)
+                Td.append(self.tension_demand(x, uc))
+                R.append(u)
                 L.append(fe_tendon_lengths(dyn, x))
             dyn.model.set_tendon_lengths(u)
             m = dyn.member_forces(x)
-            T.append(m["tendon_force"]); Te.append(m["element_force"]); bar.append(m["bar_force"])
+            T.append(m["tendon_force"])
+            Te.append(m["element_force"])
+            bar.append(m["bar_force"])
             slack_t.append(m["tendon_slack"])
             if k % stress_every == 0:
                 st = dyn.membrane_stress(x)
-                vm.append(st["max_von_mises"]); p1.append(st["max_sigma_p1"])
+                vm.append(st["max_von_mises"])
+                p1.append(st["max_sigma_p1"])
         dyn.model.set_tendon_lengths(dyn.u0)
         T, Te, bar = np.array(T), np.array(Te), np.array(bar)
         slack = np.sum(Te <= 0.0, axis=1)

@@ -195,7 +195,8 @@ def _controller_from_RS(P: GeneralizedPlant, alpha: float, R, S, gamma: float):
     X = np.block([[S, N], [N.T, (X22 + X22.T) / 2]])
     X = (X + X.T) / 2
     # closed loop: A_cl = A0 + Bt Th Ct, etc. (controller order n)
-    A0 = np.zeros((2 * n, 2 * n)); A0[:n, :n] = Aa
+    A0 = np.zeros((2 * n, 2 * n))
+    A0[:n, :n] = Aa
     B0 = np.vstack([P.B1, np.zeros((n, nw))])
     C0 = np.hstack([P.C1, np.zeros((np_, n))])
     Bt = np.block([[np.zeros((n, n)), P.B2], [np.eye(n), np.zeros((n, nu))]])

@@ -129,7 +129,8 @@ class Basis:
         h = (1e-6 if central else 1e-4) * np.maximum(1.0, np.abs(pts)) if step is None else step
         out = []
         for k in range(pts.shape[1]):
-            e = np.zeros(pts.shape); e[:, k] = h[:, k]
+            e = np.zeros(pts.shape)
+            e[:, k] = h[:, k]
             f0, fp, fm = self.values(pts), self.values(pts + e), self.values(pts - e)
             out.append((fp - fm) / (2 * h[:, k:k + 1]) if central else
                        ((fp - f0) / h[:, k:k + 1], (f0 - fm) / h[:, k:k + 1]))

@@ -275,7 +275,8 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
     ``gamma``: the level of the re-check and the re-solves (default the certificate's; a level
     above it relaxes the w and p blocks, not the Lyapunov block A X + X A^T - dX/dt, which any
     level needs negative). Returns a new certificate (gamma that level): X(rho) the last one
-    found (the input's when no round found one), ``refinement`` the rounds (points added, largest fine-grid eigenvalue before each round,
+    found (the input's when no round found one), ``refinement`` the rounds (points added, largest fine-grid eigenvalue
+    before each round,
     evaluations, times) and ``passed``.
 
     Raises

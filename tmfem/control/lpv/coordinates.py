@@ -40,7 +40,8 @@ class Coordinates:
     def of(cls, gp: GeneralizedLPV, *, scale: bool = True) -> "Coordinates":
         shp = gp.grid_shape
         n, nw, nu, npp = (gp.sizes[k] for k in ("n_x", "n_w", "n_u", "n_p"))
-        lo = np.array([a[0] for a in gp.axes]); hi = np.array([a[-1] for a in gp.axes])
+        lo = np.array([a[0] for a in gp.axes])
+        hi = np.array([a[-1] for a in gp.axes])
         varying = [k for k in range(len(shp)) if shp[k] > 1]
         verts = gp.rate_vertices()
         nvar = (1 + len(varying)) * (n * (n + 1) // 2 + nu * n) + 1
@@ -118,7 +119,8 @@ def accepted_design(gp, Pv, Qv, g, T, verts, center, half, varying, *, solver, s
     for idx in np.ndindex(*gp.grid_shape):
         rho = np.array([a[i] for a, i in zip(gp.axes, idx)])
         c = np.concatenate([[1.0], ((rho - center) / half)[varying]])
-        P = sum(ck * Pk for ck, Pk in zip(c, Pv)); Q = sum(ck * Qk for ck, Qk in zip(c, Qv))
+        P = sum(ck * Pk for ck, Pk in zip(c, Pv))
+        Q = sum(ck * Qk for ck, Qk in zip(c, Qv))
         minP = min(minP, np.linalg.eigvalsh((P * Ti[:, None] * Ti[None, :])).min())
         for v in verts:
             dP = sum((v[k] / half[k]) * Pv[1 + j] for j, k in enumerate(varying)) if varying \

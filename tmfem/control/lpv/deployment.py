@@ -141,7 +141,8 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
     initial = with_configuration(system, configuration_5_97(system, theta_0, psi_0, **bases(theta_0, psi_0)))
     if model_at not in ("final", "initial"):
         raise InputError(f"LPV deployment: model_at expected 'final' or 'initial', found {model_at!r}")
-    model = ControlOrientedModel(final if model_at == "final" else initial, membrane_modes=membrane_modes, output_points=output_points)
+    model = ControlOrientedModel(final if model_at == "final" else initial, membrane_modes=membrane_modes,
+                                 output_points=output_points)
     _, T_veta, _ = point_coordinates(model.membrane, plant.membrane_points)
     ref = DeploymentReference(initial=initial.symmetric, final=final.symmetric, N=final.N,
                               q_names=list(final.q_names), omega_r=omega_r, bases=bases)
@@ -175,8 +176,9 @@ def state_feedback_controller(dep: LPVDeployment, design):
                          + ("" if len(design.state_names) != len(want) else " with other names"))
     for a, b in zip(design.axes, pl.axes):
         if a.shape != b.shape or not np.allclose(a, b, rtol=0, atol=1e-9):
-            raise InputError(f"LPV controller: expected the design grid {[np.degrees(x).round(2).tolist() for x in pl.axes]} deg, "
-                             f"found {[np.degrees(x).round(2).tolist() for x in design.axes]} deg")
+            want = [np.degrees(x).round(2).tolist() for x in pl.axes]
+            got = [np.degrees(x).round(2).tolist() for x in design.axes]
+            raise InputError(f"LPV controller: expected the design grid {want} deg, found {got} deg")
     n = pl.nx
     return LPVController(design, pl, state_index=np.arange(n), q_index=np.arange(nq),
                          rho_index=[n, n + 1], reference=lambda t: dep.reference(t)[0],

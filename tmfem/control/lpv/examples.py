@@ -37,15 +37,20 @@ def rotating_spring(*, k0: float = 1.0, k1: float = 0.6, c: float = 0.1, r: floa
         t = float(np.asarray(rho, dtype=float).reshape(-1)[0])
         K = k0 * np.eye(2) + k1 * np.array([[np.cos(t), np.sin(t)], [np.sin(t), -np.cos(t)]])
         A = np.block([[np.zeros((2, 2)), np.eye(2)], [-K, -c * np.eye(2)]])
-        B1 = np.zeros((4, nw)); B1[:2, :2] = np.eye(2)
-        B2 = np.zeros((4, 2)); B2[2, 0], B2[3, 1] = 1.0, b2
-        C1 = np.zeros((4, 4)); C1[0, 0] = C1[1, 1] = 1.0
-        D1 = np.zeros((4, nw + 2)); D1[2:, nw:] = r * np.eye(2)
+        B1 = np.zeros((4, nw))
+        B1[:2, :2] = np.eye(2)
+        B2 = np.zeros((4, 2))
+        B2[2, 0], B2[3, 1] = 1.0, b2
+        C1 = np.zeros((4, 4))
+        C1[0, 0] = C1[1, 1] = 1.0
+        D1 = np.zeros((4, nw + 2))
+        D1[2:, nw:] = r * np.eye(2)
         B = np.hstack([B1, B2])
         if not output_feedback:
             return A, B, C1, D1
         C2 = np.hstack([np.eye(2), np.zeros((2, 2))])
-        D2 = np.zeros((2, nw + 2)); D2[:, 2:4] = noise * np.eye(2)
+        D2 = np.zeros((2, nw + 2))
+        D2[:, 2:4] = noise * np.eye(2)
         return A, B, np.vstack([C1, C2]), np.vstack([D1, D2])
 
     return P

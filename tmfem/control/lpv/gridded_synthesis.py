@@ -51,7 +51,8 @@ with Y = P, C^ = Q.
 replaced by an equivalent one orthonormal on the design grid; gamma minimised (Clarabel via
 cvxpy); then the **back-off**: the LMIs re-solved at gamma_b = (1 + backoff) gamma_min
 maximising a margin t with the matrices bounded by ``budget`` times their largest norm at
-gamma_min: every LMI <= -t I (room for the parameter values between grid points) and (state feedback: P >= t I, P <= b_P I, |Q| <= b_Q, so cond P <= b_P / t and
+gamma_min: every LMI <= -t I (room for the parameter values between grid points) and (state feedback: P >= t I, P <= b_P
+I, |Q| <= b_Q, so cond P <= b_P / t and
 |K| <= b_Q / t; output feedback: [[Y - t I, I], [I, X]] >= 0, X <= b_X I, Y <= b_Y I, so
 Y - X^-1 >= t I keeps I - X Y away from singular). The returned controller and certificate are those at gamma_b.
 
@@ -336,7 +337,8 @@ def _resolve_basis(basis, n_par: int, axes, what: str) -> Basis:
     if basis == "constant":
         return Basis.constant()
     if basis == "affine":
-        lo = np.array([a[0] for a in axes]); hi = np.array([a[-1] for a in axes])
+        lo = np.array([a[0] for a in axes])
+        hi = np.array([a[-1] for a in axes])
         return Basis.affine(n_par, centre=(lo + hi) / 2, half_width=np.where(hi > lo, (hi - lo) / 2, 1.0),
                             parameters=[k for k in range(n_par) if hi[k] > lo[k]])
     raise InputError(f"{what}: expected a Basis, 'constant' or 'affine' (1 and each parameter with more "
@@ -542,7 +544,8 @@ class _Problem:
         if k in ("P", "X", "Y"):
             out = []
             for a, b in zip(*np.triu_indices(r)):
-                E = np.zeros((r, c)); E[a, b] = E[b, a] = 1.0
+                E = np.zeros((r, c))
+                E[a, b] = E[b, a] = 1.0
                 out.append(E)
             return out
         return [np.eye(1, r * c, j).reshape(r, c) for j in range(r * c)]

@@ -25,7 +25,8 @@ of the state-feedback design.
 
 What is guaranteed. K(rho) carries the rate-bounded certificate of eqs. 5.95-5.96 on the
 design grid (for *state* feedback). The output-feedback loop's own rate-bounded certificate is
-:mod:`tmfem.control.lpv.certificate`; without it, at a design grid point the frozen closed loop has the eigenvalues of A + B2 K and of A - L C_m
+:mod:`tmfem.control.lpv.certificate`; without it, at a design grid point the frozen closed loop has the eigenvalues of A
++ B2 K and of A - L C_m
 (separation principle); between grid points and for the closed-loop H-infinity norm from
 w = [q_d, n_d, n] to p = [e_r, e_u], :func:`verify_output_feedback` checks frozen plants of a
 finer grid (frozen-parameter stability and norm only; nothing about varying rho), and the

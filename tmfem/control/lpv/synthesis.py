@@ -167,8 +167,10 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
                                    shape=(N * N, nvar)))
         Gfix = sp.csr_matrix(sum(f.tocsr() for f in fixed))
         M0 = np.zeros((N, N))
-        M0[:n, n:n + nw] = B1; M0[n:n + nw, :n] = B1.T
-        M0[n + nw:, n:n + nw] = D11; M0[n:n + nw, n + nw:] = D11.T
+        M0[:n, n:n + nw] = B1
+        M0[n:n + nw, :n] = B1.T
+        M0[n + nw:, n:n + nw] = D11
+        M0[n:n + nw, n + nw:] = D11.T
         for v in verts:
             G = Gfix
             for j, k in enumerate(varying):
@@ -181,7 +183,8 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
     scale_data = 1.0
     tries = [solver] + (["SCS"] if solver == "CLARABEL" else [])
     last = None
-    qobj = np.zeros(nvar); qobj[-1] = 1.0
+    qobj = np.zeros(nvar)
+    qobj[-1] = 1.0
     for s in tries:
         rows_tri, sc = _triangle(N, s)
         rows_p, scp = _triangle(n, s)
@@ -193,8 +196,10 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
             As.append(-(sp.diags(scp) @ Pm[rows_p]))
             bs.append(-scp * (margin * np.eye(n)).ravel(order="F")[rows_p])
         # gamma >= 0
-        As.append(sp.csr_matrix(([-1.0], ([0], [nvar - 1])), shape=(1, nvar))); bs.append(np.zeros(1))
-        Acon = sp.vstack(As, format="csc"); bcon = np.concatenate(bs)
+        As.append(sp.csr_matrix(([-1.0], ([0], [nvar - 1])), shape=(1, nvar)))
+        bs.append(np.zeros(1))
+        Acon = sp.vstack(As, format="csc")
+        bcon = np.concatenate(bs)
         t1 = time.perf_counter()
         x, status = _solve_conic(s, qobj, Acon, bcon, cones=(len(lmi_parts), N, len(psd_parts), n),
                                  max_iter=max_iter)
@@ -219,7 +224,9 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
 
 def _unsym(p: np.ndarray, n: int) -> np.ndarray:
     a, b = np.triu_indices(n)
-    P = np.zeros((n, n)); P[a, b] = p; P[b, a] = p
+    P = np.zeros((n, n))
+    P[a, b] = p
+    P[b, a] = p
     return P
 
 

@@ -629,7 +629,8 @@ class Structure:
         displacement scaled by 1e-6 (the Green-Lagrange terms quadratic in it vanish to
         1e-6 relative) and scaled back; a nonlinear state as it is."""
         if st.linear and st.increment is not None:
-            return self.reference_state().advanced(self._LINEAR_PROBE * st.increment, self.dofmap), 1 / self._LINEAR_PROBE
+            probe = self.reference_state().advanced(self._LINEAR_PROBE * st.increment, self.dofmap)
+            return probe, 1 / self._LINEAR_PROBE
         return st.state, 1.0
 
     def _reaction(self, r_red: np.ndarray) -> np.ndarray:

@@ -113,8 +113,10 @@ def zeta_closed_form_sx(system, layout: ZetaLayout, q):
     N = system.N
     _, _, B = bars_sx(system, q)
     BM = B[(system.M - 1) * N:]
-    ex = BM[0] - BM[N - 1]; ex = ex / ca.norm_2(ex)
-    nz = ca.cross(ex, BM[N - 2] - BM[N - 1]); ez = nz / ca.norm_2(nz)
+    ex = BM[0] - BM[N - 1]
+    ex = ex / ca.norm_2(ex)
+    nz = ca.cross(ex, BM[N - 2] - BM[N - 1])
+    ez = nz / ca.norm_2(nz)
     ey = ca.cross(ez, ex)
     R = ca.horzcat(ex, ey, ez)
     c = system.membrane_corners
@@ -122,7 +124,9 @@ def zeta_closed_form_sx(system, layout: ZetaLayout, q):
     for (i, comp) in layout.corner_components:
         rel = ca.dot(R[:, comp], BM[i] - BM[N - 1])
         out.append(rel - (float(c[comp, i]) if comp < 2 else 0.0))
-    g1 = ca.atan2(R[1, 0], R[0, 0]); g2 = -ca.asin(R[2, 0]); g3 = ca.atan2(R[2, 1], R[2, 2])
+    g1 = ca.atan2(R[1, 0], R[0, 0])
+    g2 = -ca.asin(R[2, 0])
+    g3 = ca.atan2(R[2, 1], R[2, 2])
     return ca.vertcat(*out, g1, g2, g3)
 
 

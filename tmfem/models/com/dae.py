@@ -25,7 +25,8 @@ def _constrained_state(model, z, zd, zeta):
     zq = -lu[:, :nq]
     zetad = zq @ qd
     gamma = np.asarray(con(q, zeta, qd, zetad)[3]).ravel()
-    x = np.concatenate([z, zeta]); xd = np.concatenate([zd, zetad])
+    x = np.concatenate([z, zeta])
+    xd = np.concatenate([zd, zetad])
     M, F, B = (np.asarray(a) for a in model.graphs.dae(x, xd))
     return {"Phi_zeta": Pz, "Phi_q": Pq, "zeta_q": zq, "Phi_zeta_inv": lu[:, nq:],
             "gamma": gamma, "x": x, "xd": xd, "M": M, "F": F.ravel(), "B": B}
@@ -54,7 +55,8 @@ def dae_terms(model, z, zd, zeta=None) -> dict:
         raise InputError(f"dae_terms: expected formulation='partitioned', found "
                          f"{model.formulation!r}")
     nq, K = model.nq, model.K
-    z = np.asarray(z, dtype=float); zd = np.asarray(zd, dtype=float)
+    z = np.asarray(z, dtype=float)
+    zd = np.asarray(zd, dtype=float)
     zeta = model.zeta(z[:nq]) if zeta is None else np.asarray(zeta, dtype=float)
     s = _constrained_state(model, z, zd, zeta)
     nx = s["x"].size
@@ -84,8 +86,10 @@ def _partitioned_numeric(model, z, zd, zeta):
     Mh[:nq, :] += (Mzc @ zq).T
     Mh[:nq, :nq] += zq.T @ Mcc @ zq
     FG = F + M[:, nz:] @ g
-    Fh = FG[:nz].copy(); Fh[:nq] += zq.T @ FG[nz:]
-    Bh = B[:nz].copy(); Bh[:nq] += zq.T @ B[nz:]
+    Fh = FG[:nz].copy()
+    Fh[:nq] += zq.T @ FG[nz:]
+    Bh = B[:nz].copy()
+    Bh[:nq] += zq.T @ B[nz:]
     return Mh, Fh, Bh
 
 

@@ -53,7 +53,8 @@ def design_rest_lengths(system, static, q0, zeta0) -> StaticDesign:
         The design configuration and its dependent coordinates.
     """
     JL, gm, L = (np.asarray(a) for a in static(q0, zeta0))
-    L = L.ravel(); gm = gm.ravel()
+    L = L.ravel()
+    gm = gm.ravel()
     T, *_ = np.linalg.lstsq(JL.T, -gm, rcond=None)
     res = np.linalg.norm(JL.T @ T + gm) / max(np.linalg.norm(gm), 1e-300)
     if res > 1e-3:

@@ -121,10 +121,14 @@ def build_graphs(system, membrane, layout, *, k, damping: float, prestress_scale
     formulation : {"partitioned", "substituted"}
     """
     nq, K, nzeta, n_t = len(system.q_names), membrane.K, layout.n, len(k)
-    q = ca.SX.sym("q", nq); qd = ca.SX.sym("qd", nq)
-    eta = ca.SX.sym("eta", K); etad = ca.SX.sym("etad", K)
-    zz = ca.SX.sym("zeta", nzeta); zzd = ca.SX.sym("zetad", nzeta)
-    z = ca.vertcat(q, eta); zd = ca.vertcat(qd, etad)
+    q = ca.SX.sym("q", nq)
+    qd = ca.SX.sym("qd", nq)
+    eta = ca.SX.sym("eta", K)
+    etad = ca.SX.sym("etad", K)
+    zz = ca.SX.sym("zeta", nzeta)
+    zzd = ca.SX.sym("zetad", nzeta)
+    z = ca.vertcat(q, eta)
+    zd = ca.vertcat(qd, etad)
     L, U_td = tendon_energy_sx(system, k, q)
     kL = ca.DM(k) * L
 
@@ -138,7 +142,8 @@ def build_graphs(system, membrane, layout, *, k, damping: float, prestress_scale
 
     dae = con = None
     if formulation == "partitioned":
-        x = ca.vertcat(q, eta, zz); xd = ca.vertcat(qd, etad, zzd)
+        x = ca.vertcat(q, eta, zz)
+        xd = ca.vertcat(qd, etad, zzd)
         M, F, B = lagrange_terms_sx(kinetic(zz, x, xd), potential(zz), kL, x, xd, etad,
                                     nq=nq, damping=damping)               # eq. 5.19
         # coordinate partitioning, eqs. 5.22-5.26
@@ -146,7 +151,8 @@ def build_graphs(system, membrane, layout, *, k, damping: float, prestress_scale
         Pz, Pq = ca.jacobian(phi, zz), ca.jacobian(phi, q)
         # g = d/dq(zeta_q q') q' (eq. 5.25) from differentiating Phi twice along the
         # motion with the velocities held: Phi_q q'' + Phi_zeta zeta'' + (Phi_x x')_x x' = 0
-        xc = ca.vertcat(q, zz); xcd = ca.vertcat(qd, zzd)
+        xc = ca.vertcat(q, zz)
+        xcd = ca.vertcat(qd, zzd)
         acc = ca.jtimes(ca.jtimes(phi, xc, xcd), xc, xcd)
         dae = ca.Function("com_dae", [x, xd], [M, F, B])
         con = ca.Function("com_con", [q, zz, qd, zzd], [phi, Pz, Pq, acc])
@@ -184,13 +190,16 @@ def build_graphs(system, membrane, layout, *, k, damping: float, prestress_scale
                        [ca.vertcat(*[ca.vec(ca.densify(o)) for o in outs])], {"cse": True})
     fast_mg = None if MG is None else ca.Function(
         "com_fast_mg", [ca.vertcat(z, zd)], [ca.substitute(MG, zz, zcf)], {"cse": True})
-    zdd_f = ca.SX.sym("zdd", nq + K); u_f = ca.SX.sym("u", n_t)
+    zdd_f = ca.SX.sym("zdd", nq + K)
+    u_f = ca.SX.sym("u", n_t)
     fast_r = ca.Function(
         "com_fast_r", [ca.vertcat(z, zd, zdd_f, u_f)],
         [ca.mtimes(outs[0], zdd_f) + outs[1] + ca.mtimes(outs[2], u_f)], {"cse": True})
     # residual and Newton matrix for implicit integration (Park, 5.34)
-    zdd = ca.SX.sym("zdd", nq + K); u = ca.SX.sym("u", n_t)
-    cv = ca.SX.sym("cv"); cacc = ca.SX.sym("ca")
+    zdd = ca.SX.sym("zdd", nq + K)
+    u = ca.SX.sym("u", n_t)
+    cv = ca.SX.sym("cv")
+    cacc = ca.SX.sym("ca")
     r = ca.mtimes(Mh, zdd) + Fh + ca.mtimes(Bh, u)
     Kr = ca.jacobian(r, z)
     if dzeta_dz is not None:
@@ -209,7 +218,8 @@ def static_graph(system, membrane, layout, *, prestress_scale: float, delta0) ->
     """(q, zeta) -> (d|d|/dq, dU_m/dq, |d|): the tendon length Jacobian, the membrane
     generalised force dU_m/dq = zeta_q^T dU_m/dzeta (zeta_q of eq. 5.23) and the tendon
     lengths, the terms of the static equilibrium of eq. 3.16 with the COM's membrane energy."""
-    q = ca.SX.sym("q", len(system.q_names)); zz = ca.SX.sym("zeta", layout.n)
+    q = ca.SX.sym("q", len(system.q_names))
+    zz = ca.SX.sym("zeta", layout.n)
     eta = ca.SX.sym("eta", membrane.K)
     L = tendon_lengths_sx(system, q)
     Um = membrane_potential_sx(membrane, layout, zz, eta, prestress_scale=prestress_scale,

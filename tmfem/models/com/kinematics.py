@@ -41,7 +41,9 @@ def bars_sx(system, q):
                 a = ca.vertcat(*[q[int(k)] for k in xyz[:, i, j]])
             th, ps = q[int(ith[i, j])], q[int(ips[i, j])]
             d = bar_direction_sx(th, ps)
-            A.append(a); e.append(d); B.append(a + float(system.l[i, j]) * d)
+            A.append(a)
+            e.append(d)
+            B.append(a + float(system.l[i, j]) * d)
     return A, e, B
 
 

@@ -204,13 +204,15 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
     for (i, c) in layout.corner_components:
         P = np.zeros((3, nn))
         if c < 2:
-            d = np.zeros((2, N)); d[c, i] = 1.0
+            d = np.zeros((2, N))
+            d[c, i] = 1.0
             x = inplane_shape(d)
             P[:2] = x[nd]
         else:
             if lu_w is None:
                 lu_w = ps.backend.factorize(KG[free_w][:, free_w].tocsc())
-            w = np.zeros(nn); w[corners[i]] = 1.0
+            w = np.zeros(nn)
+            w[corners[i]] = 1.0
             w[free_w] = -lu_w(KG[free_w][:, corners] @ w[corners])
             P[2] = w
         shapes.append(P)
@@ -220,14 +222,16 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
     uv = np.stack([P[:2].T.ravel() for P in Psi], axis=1) if len(Psi) else np.zeros((2 * nn, 0))
     # map (node, comp) interleaving to the skfem in-plane dof numbering
     perm = nd.T.ravel()
-    U = np.zeros((Kuv.shape[0], len(Psi))); U[perm] = uv
+    U = np.zeros((Kuv.shape[0], len(Psi)))
+    U[perm] = uv
     W = np.stack([P[2] for P in Psi], axis=1) if len(Psi) else np.zeros((nn, 0))
     S = U.T @ (Kuv @ U) + W.T @ (KG @ W)
     S = 0.5 * (S + S.T)
     # ---------------------------------------------------------------- fixed-corner modes
     modes, omega2, kind = [], [], []
     if n_modes > 0:
-        Kw = KG[free_w][:, free_w]; Mw = Ms[free_w][:, free_w]
+        Kw = KG[free_w][:, free_w]
+        Mw = Ms[free_w][:, free_w]
         kw = min(n_modes, len(free_w) - 2)
         lw, vw = _lowest_modes(Kw, Mw, kw, ps.backend)
         if lw[0] <= 0:
@@ -245,13 +249,16 @@ def build_membrane_basis(system, *, delta0, n_modes: int, mesh_n: int = 10,
             if kd == "w":
                 P[2, free_w] = vw[:, k]
             else:
-                x = np.zeros(Kuv.shape[0]); x[Iuv] = vp[:, k]
+                x = np.zeros(Kuv.shape[0])
+                x[Iuv] = vp[:, k]
                 P[:2] = x[nd]
             # sign convention: largest |entry| positive
             flat = P.ravel()
             if flat[np.argmax(np.abs(flat))] < 0:
                 P = -P
-            modes.append(P); omega2.append(lam); kind.append(kd)
+            modes.append(P)
+            omega2.append(lam)
+            kind.append(kd)
     shapes = np.concatenate([shapes, np.array(modes).reshape(-1, 3, nn)], axis=0)
     # ---------------------------------------------------------------- mass invariants
     nP = shapes.shape[0]

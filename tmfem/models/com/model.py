@@ -230,7 +230,8 @@ class ControlOrientedModel:
         out, k = [], 0
         for shp in self.graphs.fast_shapes:
             n = shp[0] * shp[1]
-            out.append(flat[k:k + n].reshape(shp, order="F")); k += n
+            out.append(flat[k:k + n].reshape(shp, order="F"))
+            k += n
         Mh, Fh, Bh = out
         if self.membrane_points is None:
             return Mh, Fh.ravel(), Bh

@@ -32,7 +32,9 @@ def shell_stresses(model, state) -> dict:
             s = sh.stresses(state, xi=tuple(xi))
             s11, s22, s12 = s["sigma"][..., 0], s["sigma"][..., 1], s["sigma"][..., 2]
             c, r = 0.5 * (s11 + s22), np.hypot(0.5 * (s11 - s22), s12)
-            p1.append((c + r).T); p2.append((c - r).T); vm.append(s["von_mises"].T)
+            p1.append((c + r).T)
+            p2.append((c - r).T)
+            vm.append(s["von_mises"].T)
         out[key] = {"sigma_p1": np.stack(p1, -1), "sigma_p2": np.stack(p2, -1),
                     "von_mises": np.stack(vm, -1)}
     out["centre"] = {k: v[..., 0] for k, v in out["centre"].items()}
@@ -66,7 +68,8 @@ def membrane_peaks(model, state) -> dict:
 def static_summary(model, result) -> dict:
     """Summary of an SBC equilibrium ``result`` (:class:`~tmfem.models.base.Equilibrium`) of ``model``:
     iterations (MTC predictor and SBC), residual history, landing against the design (largest
-    node distance, theta, psi of the bar chords, the corner offsets Delta), tendon forces and stresses, bar axial forces and loads
+    node distance, theta, psi of the bar chords, the corner offsets Delta), tendon forces and stresses, bar axial forces
+    and loads
     (per stage for M >= 2) and the largest bar bending moment |M| [N m] at the Gauss points,
     the membrane stress peaks (:func:`membrane_peaks`), the design checks
     (:func:`tmfem.models.mtc.post.design_checks`), the printed Table 6.3/6.5 values and, for

@@ -6,7 +6,8 @@ import numpy as np
 
 NAME = "shell-hinged-roof"
 HELP = ("hinged cylindrical roof (R = 2540, half length 254, half angle 0.1 rad, h = 12.7, E = 3102.75, "
-        "nu = 0.3) under a central point load up to P_max = 3000, quarter model 16 x 16 MITC4, arc length through both limit points, against Sze, Liu & Lo, Finite Elem. Anal. Des. 40 "
+        "nu = 0.3) under a central point load up to P_max = 3000, quarter model 16 x 16 MITC4, arc length "
+        "through both limit points, against Sze, Liu & Lo, Finite Elem. Anal. Des. 40 "
         "(2004) 1551, test 3.8")
 COLUMNS = {"W_C": "1", "P_ratio": "1", "P_ratio_ref": "1"}
 
