@@ -57,9 +57,9 @@ def test_results_as_meshio_mesh(tmp_path):
     assert (tmp_path / "hemisphere.vtu").stat().st_size > 0
 
 
-def test_pinned_truss_on_a_shell_corner_and_mixed_dof_counts():
-    """A bar (3-dof nodes) pinned to the corner of a stiff clamped plate: the bar force of a
-    tip load P at the bar's free end is P (truss closed form, N = EA E l / L at equilibrium)."""
+def plate_with_pinned_bar():
+    """A 2 x 2 clamped plate (5-dof nodes) with a truss bar (3-dof nodes) pinned to its corner
+    (1, 1, 0), the bar's other end (node 10) on a roller in x, y and loaded by 5 N in z."""
     xs = np.linspace(0, 1, 3)
     m = MeshQuad.init_tensor(xs, xs)
     p = np.hstack([np.vstack([m.p, np.zeros(9)]), [[1.0, 1.0], [1.0, 1.0], [0.0, 1.0]]])
@@ -72,8 +72,16 @@ def test_pinned_truss_on_a_shell_corner_and_mixed_dof_counts():
     s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0) & (z == 0)))
     s.fix([10], ["ux", "uy"])
     s.point_load([10], force=(0, 0, 5.0))
+    return s
+
+
+def test_pinned_truss_on_a_shell_corner_and_mixed_dof_counts():
+    """A bar (3-dof nodes) pinned to the corner of a stiff clamped plate: the bar force of a
+    tip load P at the bar's free end is P (truss closed form, N = EA E l / L at equilibrium)."""
+    s = plate_with_pinned_bar()
     st = s.solve(steps=2)[-1]
     d = st.x[:, 10] - st.x[:, 9]
+    corner = int(s.nodes_where(lambda x, y, z: np.isclose(x, 1) & np.isclose(y, 1) & np.isclose(z, 0))[0])
     assert np.allclose(st.x[:, 9], st.x[:, corner])
     l = np.linalg.norm(d)
     assert 1e3 * (l**2 - 1) / 2 * l == pytest.approx(5.0, rel=1e-6)

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from skfem import MeshQuad
 
+from tests.fem.test_structure import plate_with_pinned_bar
 from tmfem.fem.beam import BeamElement, BeamSection, BeamSet, line_mesh
 from tmfem.fem.mitc4 import ShellSection
 from tmfem.fem.structure import Structure
-from tmfem.fem.truss import TrussElement, TrussSet
 
 
 def _free_body(s, st, scale, *, tol):
@@ -77,18 +77,7 @@ def test_cantilever_beam_clamp_reactions_closed_form():
 def test_mixed_shell_and_truss_free_body_and_meshio_fields(tmp_path):
     """A bar (3-dof nodes) pinned to the corner of a clamped plate, its other end on a
     roller and loaded: reactions at the plate's clamp and at the roller balance the load."""
-    xs = np.linspace(0, 1, 3)
-    m = MeshQuad.init_tensor(xs, xs)
-    p = np.hstack([np.vstack([m.p, np.zeros(9)]), [[1.0, 1.0], [1.0, 1.0], [0.0, 1.0]]])
-    s = Structure(points=p, dofs=[5] * 9 + [3, 3])
-    s.add_shell(m.t, section=ShellSection(E=1e9, nu=0.3, thickness=0.1))
-    corner = int(s.nodes_where(lambda x, y, z: np.isclose(x, 1) & np.isclose(y, 1) & np.isclose(z, 0))[0])
-    s.add(TrussElement(TrussSet(conn=np.array([[9], [10]]), L=np.array([1.0]), EA=1e3, rhoA=0.0,
-                                tension_only=np.array([False])), s.dofmap))
-    s.pin(9, to=corner)
-    s.fix(s.nodes_where(lambda x, y, z: np.isclose(x, 0) & (z == 0)))
-    s.fix([10], ["ux", "uy"])
-    s.point_load([10], force=(0, 0, 5.0))
+    s = plate_with_pinned_bar()
     s.point_load([4], force=(1.0, 2.0, -3.0))
     st = s.solve(steps=2, tol=1e-9)[-1]
     R = _free_body(s, st, 5.0, tol=1e-8)
