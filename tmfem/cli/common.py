@@ -166,8 +166,7 @@ def model_from_args(args, command: str):
     system, options, spec = model_options_from_args(args, command)
     model = spec.build(system, options, backend_from_args(args))
     if spec.uses_backend:
-        print(f"tmfem {command}: backend {model.backend.name} ({model.ndof} free dofs)",
-              file=sys.stderr)
+        say(command, f"backend {model.backend.name} ({model.ndof} free dofs)")
     rest = model.u0
     if np.ndim(rest) == 1 and len(rest) == len(system.tendons):
         warn_long_rest_lengths(system, rest)     # all slack: an error before the solve
@@ -224,6 +223,13 @@ def parse_perturbation(items, names) -> dict:
 
 #: ``--quiet`` of the running command (set by :func:`tmfem.cli.main`)
 QUIET = {"on": False}
+
+
+def say(command: str, text: str) -> None:
+    """A command's progress line ``tmfem <command>: <text>`` on stderr, the CLI's message
+    channel; silent with ``--quiet`` (errors, warnings and failed checks still print)."""
+    if not QUIET["on"]:
+        print(f"tmfem {command}: {text}", file=sys.stderr, flush=True)
 
 
 def progress_options() -> dict:
@@ -337,13 +343,16 @@ def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> i
 MAX_FRAMES = 10_000
 
 
-def check_frames(*, steps: int, every: int, option: str = "--vtk-every") -> int:
-    """ParaView frames of a time run of ``steps`` steps, one every ``every``: at most
-    :data:`MAX_FRAMES`. Returns the number of frames."""
+def check_frames(*, steps: int, every: int, option: str | None = "--vtk-every") -> int:
+    """ParaView frames of a time run of ``steps`` steps, one every ``every`` (set by
+    ``option``, or fixed when it is None: ``deploy --vtk``): at most :data:`MAX_FRAMES`.
+    Returns the number of frames."""
     frames = steps // every + 1
     if frames > MAX_FRAMES:
-        raise ResourceLimit(f"{option} {every}: {steps:,} steps give {frames:,} ParaView frames; "
-                            f"the limit is {MAX_FRAMES:,} (raise {option} or lower --t-end)")
+        given, fix = ((f"{option} {every}", f"raise {option} or lower --t-end") if option else
+                      (f"--vtk (a frame every {every} steps)", "raise --dt or lower --t-end"))
+        raise ResourceLimit(f"{given}: {steps:,} steps give {frames:,} ParaView frames; "
+                            f"the limit is {MAX_FRAMES:,} ({fix})")
     return frames
 
 

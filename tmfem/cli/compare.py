@@ -3,11 +3,10 @@ the printed ones when the file has them: Tables 6.6/6.7 for 1-4 and 2-3, 6.4), o
 ``--vibrate`` free vibration from the same perturbation (6.5)."""
 from __future__ import annotations
 
-import sys
 
 from tmfem.cli.common import (Progress, add_system_args, check_model_budget, check_time_steps,
                               finite_float, output_file, parse_perturbation, positive_int,
-                              system_from_args)
+                              say, system_from_args)
 from tmfem.errors import InputError
 from tmfem.solvers.backends import backend_names
 
@@ -94,8 +93,7 @@ def run_vibration(args) -> dict:
     check_time_steps(t_end=t_end, dt=dt)
     system = fe_system(args.system)
     pert = parse_perturbation(args.perturb, perturbation_names(system)) if args.perturb else None
-    print(f"tmfem compare --vibrate: {args.preset}, {t_end:g} s at dt = {dt:g} s, FE mesh "
-          f"{args.mesh}", file=sys.stderr)
+    say("compare --vibrate", f"{args.preset}, {t_end:g} s at dt = {dt:g} s, FE mesh {args.mesh}")
     with Progress(total=3, desc=f"vibrate {args.preset}") as bar:
         def progress(model):
             bar.step(model)

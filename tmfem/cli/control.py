@@ -8,10 +8,9 @@ gridded LPV state feedback of ch. 8 (:mod:`tmfem.cli.control_lpv`).
 """
 from __future__ import annotations
 
-import sys
 
 from tmfem.cli import control_lpv
-from tmfem.cli.common import add_system_args, output_file, system_from_args
+from tmfem.cli.common import add_system_args, output_file, say, system_from_args
 from tmfem.errors import InputError, ResourceLimit
 
 NAME = "control"
@@ -111,7 +110,7 @@ def run(args) -> dict:
     output_file(args.plot, option="--plot", suffixes=(".png",))
     system = system_from_args(args)
     check_control_modes(system, args.membrane_modes)
-    print(f"tmfem control {args.action}: {system.name}: building the plant", file=sys.stderr)
+    say(f"control {args.action}", f"{system.name}: building the plant")
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
                         solver=args.solver, synthesize=args.action == "hinf",
                         pbh_tol=args.pbh_tol,

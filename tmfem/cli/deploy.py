@@ -13,11 +13,11 @@ from dataclasses import astuple
 
 from tmfem import reference
 from tmfem.cli import deploy_lpv
-from tmfem.cli.common import (check_mesh_budget, check_time_steps, output_dir, output_file,
-                              positive_float, progress_bar)
+from tmfem.cli.common import (check_frames, check_mesh_budget, check_time_steps, output_dir,
+                              output_file, positive_float, progress_bar)
 from tmfem.errors import InputError
 from tmfem.reference.deployments import (CONTROLLERS, LPV_CONTROLLERS, UNCERTAINTIES, check_choices,
-                                         own_path, setup, write_outputs)
+                                         VTK_EVERY, own_path, setup, write_outputs)
 
 NAME = "deploy"
 HELP = "deploy a system from its packaged to its deployed configuration (adaptive PFL, switch to a linear controller)"
@@ -154,7 +154,9 @@ def pfl_gains(text: str) -> tuple:
 
 def run(args) -> dict:
     # refused before the controller design: time grid, output paths
-    check_time_steps(t_end=args.t_end, dt=args.dt)
+    steps = check_time_steps(t_end=args.t_end, dt=args.dt)
+    if args.vtk is not None:
+        check_frames(steps=steps, every=VTK_EVERY, option=None)
     output_file(args.csv, option="--csv", suffixes=(".csv",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
     output_file(args.gif, option="--gif", suffixes=(".gif",))

@@ -12,7 +12,6 @@ and :data:`BUILDERS` (a new ``--controller`` name adds an entry to each and to
 """
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
@@ -20,7 +19,7 @@ import numpy as np
 
 from tmfem import reference, simulation
 from tmfem.cli import lpv_options
-from tmfem.cli.common import progress_bar
+from tmfem.cli.common import progress_bar, say
 from tmfem.control import lpv
 from tmfem.errors import InfeasibleController, InputError
 from tmfem.reference.tables import deployment_bases
@@ -89,7 +88,7 @@ def design(args, preset: str):
         d = lpv.LPVStateFeedback.load(args.lpv_controller)
         s = args.system
         n = int(np.prod([a.size for a in d.axes]))
-        print(f"tmfem deploy: {preset}: rebuilding the design plant at its {n} grid points", file=sys.stderr)
+        say("deploy", f"{preset}: rebuilding the design plant at its {n} grid points")
         try:
             plant = lpv.saved_design_plant(d, s, bases=deployment_bases(s), progress=lpv_options.progress)
         except InputError as exc:
@@ -98,7 +97,7 @@ def design(args, preset: str):
         return plant, d, {"lpv_controller": args.lpv_controller, "gamma": d.gamma,
                           **{f"design_grid_{k}": x for k, x in v.to_dict().items()}}
     cfg = lpv_options.check_synthesis(args, solver=args.solver or "EIGOPT", preset=preset)
-    plant, gp, bound, out = lpv_options.design_plant(cfg, rate_deg=10.0)
+    plant, gp, bound, out = lpv_options.design_plant(cfg, rate_deg=10.0, command="deploy")
     sample = args.dt if cfg["solver"] == "EIGOPT" else None
     ctrl, syn = lpv_options.synthesize(cfg, gp, bound, sample_time=sample)
     v = lpv_options.verify_finer(cfg, plant, ctrl, sample_time=args.dt)

@@ -5,12 +5,11 @@ through the lazy attributes of its packages (``lpv.design_plant``), so that the 
 starts without loading the models."""
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import numpy as np
 
-from tmfem.cli.common import progress_bar
+from tmfem.cli.common import progress_bar, say
 from tmfem.control import lpv
 from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
 from tmfem.errors import InputError, ResourceLimit
@@ -20,6 +19,11 @@ from tmfem.system import load_preset
 #: Largest verification grid: every point is one COM linearisation (~2 s for 2-3 on this
 #: machine under load), so 500 points is about a quarter of an hour.
 MAX_VERIFY_POINTS = 500
+#: Largest ``--max-iter``: SCS's own cap (each SCS iteration projects onto the PSD cone of
+#: every grid point's LMI; a solve that does not converge runs to the cap); CLARABEL (an
+#: interior-point Newton step an iteration) and EIGOPT (an L-BFGS step, the LMI eigenvalues at
+#: every imposed point) stop by 200 and 150 iterations unless told otherwise.
+MAX_ITER = 100_000
 
 
 def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
@@ -104,6 +108,7 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
         raise ResourceLimit(f"--grid {args.grid or '6x3'} --refine {refine}: the verification grid "
                             f"has {fine_n[0]} x {fine_n[1]} = {fine_n[0] * fine_n[1]:,} points, one COM "
                             f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
+    check_iteration_limits(args, fine_points=fine_n[0] * fine_n[1], design_points=th.size * ps.size)
     return {"system": s, "preset": preset, "theta": th, "psi": ps, "refine": refine, "solver": solver,
             "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget, "start": start}
 
@@ -113,12 +118,31 @@ def progress(total, label):
     return progress_bar(total, 1, label)
 
 
-def design_plant(cfg: dict, *, rate_deg: float):
+def check_iteration_limits(args, *, fine_points: int, design_points: int) -> None:
+    """Upper bounds of ``control lpv --max-iter`` (:data:`MAX_ITER`, exit 3) and
+    ``--certificate-rounds`` (exit 2): a cutting-plane round that goes on imposes at least one
+    verification-grid point that is not imposed yet and re-solves the certificate's LMI by
+    EIGOPT on all imposed points, so more rounds than the verification grid has points beyond
+    the design grid cannot add anything (:func:`tmfem.control.lpv.certificate.refine_certificate`)."""
+    max_iter = getattr(args, "max_iter", None)
+    if max_iter is not None and max_iter > MAX_ITER:
+        raise ResourceLimit(f"--max-iter {max_iter:,}: each iteration is one pass of the solver over the "
+                            f"LMIs of every grid point, and a solve that does not converge runs to the "
+                            f"cap; the limit is {MAX_ITER:,} (SCS's own cap)")
+    rounds, extra = getattr(args, "certificate_rounds", None), fine_points - design_points
+    if rounds is not None and rounds > extra:
+        raise InputError(f"--certificate-rounds: expected at most {extra} (each round re-solves the "
+                         f"certificate by EIGOPT with at least one more of the verification grid's "
+                         f"{fine_points} points imposed, {design_points} are the design grid's), "
+                         f"found {rounds}")
+
+
+def design_plant(cfg: dict, *, rate_deg: float, command: str = "control lpv"):
     """The gridded plant of ``cfg`` (:func:`check_synthesis`), its interconnection (Fig. 8.1)
     and the pointwise lower bound of gamma (:func:`tmfem.control.lpv.workflow.design_plant`);
-    returns (plant, gp, bound, JSON dict)."""
+    returns (plant, gp, bound, JSON dict); its progress line names ``command``."""
     s, th, ps = cfg["system"], cfg["theta"], cfg["psi"]
-    print(f"tmfem: {cfg['preset']}: linearising at {th.size * ps.size} grid points", file=sys.stderr)
+    say(command, f"{cfg['preset']}: linearising at {th.size * ps.size} grid points")
     p = lpv.design_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bound=np.radians(rate_deg),
                               progress=progress)
     out = {"preset": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,

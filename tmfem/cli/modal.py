@@ -1,10 +1,9 @@
 """``tmfem modal``: natural frequencies and mode shapes about the prestressed state (6.4, eq. 5.32)."""
 from __future__ import annotations
 
-import sys
 
 from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
-                              requested_files, with_backend)
+                              requested_files, say, with_backend)
 from tmfem.errors import InputError
 from tmfem.models.registry import get_spec
 from tmfem.reference.printed_modes import with_printed
@@ -35,8 +34,7 @@ def run(args) -> dict:
         raise InputError(f"--modes {args.modes}: expected at most {model.max_modes} modes (the "
                          f"{spec.name} model of {model.system.name} has {model.ndof} free DOFs, the "
                          "coordinates of its equation of motion)")
-    print(f"tmfem modal: {model.system.name} {spec.name.upper()}, {model.ndof} degrees of "
-          "freedom", file=sys.stderr)
+    say(NAME, f"{model.system.name} {spec.name.upper()}, {model.ndof} degrees of freedom")
     res = model.equilibrium(monitor=default_monitor(model.system),
                             **spec.equilibrium_kwargs(options))
     check_equilibrium(model, res)

@@ -9,12 +9,11 @@ animation and ParaView file linked from ``index.md``
 """
 from __future__ import annotations
 
-import sys
 import textwrap
 
 from tmfem.cli.common import (Progress, add_system_args, check_com_modes, check_model_budget,
                               check_time_steps, output_dir, positive_float, positive_int,
-                              system_from_args)
+                              say, system_from_args)
 from tmfem.errors import InputError
 
 NAME = "report"
@@ -51,8 +50,8 @@ def run(args) -> dict:
     if args.modes is None:
         args.modes = min(12, com_coordinates(system))
         if args.modes < 12:
-            print(f"tmfem report: {args.modes} modes: the control-oriented model of {system.name} "
-                  f"has {args.modes} coordinates", file=sys.stderr)
+            say("report", f"{args.modes} modes: the control-oriented model of {system.name} "
+                f"has {args.modes} coordinates")
     check_model_budget(system, mesh=args.mesh, tendon_elements=3, modes=args.modes)
     check_com_modes(system, modes=args.modes)
     check_time_steps(t_end=args.t_end, dt=args.dt)
@@ -71,7 +70,7 @@ def run(args) -> dict:
                               dt=args.dt, render=not args.no_render, deploy=not args.no_deploy,
                               progress=lambda done: bar.step(next(nxt, "done")),
                               run_progress=lambda label: bar.callback(label))
-    print(f"tmfem report: done: {out / 'index.md'}, web page {out / 'report.html'}", file=sys.stderr)
+    say("report", f"done: {out / 'index.md'}, web page {out / 'report.html'}")
     return result
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
-                              requested_files, with_backend)
+                              requested_files, say, with_backend)
 from tmfem.models.registry import get_spec
 from tmfem.system.collapse import check_equilibrium
 
@@ -49,8 +49,7 @@ def run(args) -> dict:
     report = spec.report()
     files = requested_files(args, NAME, report.STATIC_FILES, FILES)
     monitor = args.monitor.split(",") if args.monitor else default_monitor(model.system)
-    print(f"tmfem static: {model.system.name} {spec.name.upper()}, {model.ndof} free dofs",
-          file=sys.stderr)
+    say(NAME, f"{model.system.name} {spec.name.upper()}, {model.ndof} free dofs")
     res = model.equilibrium(monitor=monitor, progress=static_progress(args.progress),
                             **spec.equilibrium_kwargs(options))
     out = report.static_summary(model, res)

@@ -19,7 +19,6 @@ Progress goes to stderr.
 from __future__ import annotations
 
 import json
-import sys
 import textwrap
 from pathlib import Path
 
@@ -28,7 +27,7 @@ import numpy as np
 from tmfem.cli import json_default
 from tmfem.cli.common import (Progress, add_attachment_args, add_membrane_law_arg, add_system_args,
                               check_attachment_options, check_mesh_budget, output_dir, positive_int,
-                              system_from_args)
+                              say, system_from_args)
 from tmfem.errors import InputError
 from tmfem.io.atomic import write_text
 from tmfem.io.units import with_units
@@ -69,7 +68,7 @@ def run(args) -> dict:
     out = output_dir(args.out, option="--out")
     with Progress(total=6, desc=f"study {system.name}") as bar:
         result = _study(args, system, out, bar)
-    print(f"tmfem study: done: {out}", file=sys.stderr)     # also when the bar is off (no tty)
+    say("study", f"done: {out}")     # also when the bar is off (no tty)
     return result
 
 

@@ -2,13 +2,12 @@
 (membrane-truss-cable, shell-beam-cable; 6.5, Park's method)."""
 from __future__ import annotations
 
-import sys
 
 import numpy as np
 
 from tmfem.cli.common import (add_model_args, add_system_args, check_frames, check_time_steps,
                               finite_float, model_from_args, parse_perturbation, positive_int,
-                              progress_bar)
+                              progress_bar, say)
 from tmfem.errors import InputError
 from tmfem.simulation.vibration import model_free_vibration
 from tmfem.system.collapse import check_equilibrium
@@ -51,7 +50,7 @@ def run(args) -> dict:
     system, name = model.system, spec.name.upper()
     pert = parse_perturbation(default_perturbation(args, system), model.perturbation_names)
     size = ", ".join(f"{k} {v}" for k, v in model.describe().items())
-    print(f"tmfem vibrate: {system.name} {name}, {size}, static equilibrium", file=sys.stderr)
+    say(NAME, f"{system.name} {name}, {size}, static equilibrium")
     eq = model.equilibrium(**spec.equilibrium_kwargs(options))
     check_equilibrium(model, eq)
     dynamics = spec.plant_kwargs(options)
