@@ -4,6 +4,8 @@ as the library's progress is; errors still print (docs/guides/cli.md, "Progress 
 messages")."""
 import json
 
+import pytest
+
 from tests.cli.test_cli_misuse import TOO_LARGE, last_line, run
 
 
@@ -28,3 +30,16 @@ def test_quiet_still_prints_the_error(capsys):
     assert rc == TOO_LARGE
     assert len(err.strip().splitlines()) == 1
     assert last_line(err).startswith("tmfem static: error: ")
+
+
+@pytest.mark.parametrize("argv, line", [
+    (["modal", "--preset", "1-4"], "tmfem modal: 1-4 MTC, "),
+    (["control", "hinf", "--preset", "1-4D"], "tmfem control hinf: 1-4D: building the plant"),
+    (["vibrate", "--preset", "1-4", "--model", "com", "--t-end", "0.1"],
+     "tmfem vibrate: 1-4 COM, "),
+])
+def test_quiet_hides_each_commands_own_line(argv, line, capsys):
+    rc, _, err = run(argv, capsys)
+    assert rc == 0 and any(l.startswith(line) for l in err.splitlines()), err
+    rc, _, err = run(argv + ["--quiet"], capsys)
+    assert rc == 0 and err == ""
