@@ -100,7 +100,7 @@ def string_rest(tmp_path):
     (["control", "lpv", "--grid", "abc"], BAD_INPUT, "AxB"),
     (["control", "lpv", "--rate-bound-deg", "nan"], BAD_INPUT, "--rate-bound-deg"),
     (["control", "lpv", "--save", "FILE/p.npz"], BAD_INPUT, "not a directory"),
-    (["control", "lpv", "--preset", "1-4"], BAD_INPUT, "printed LPV grid"),
+    (["control", "lpv", "--preset", "1-4"], BAD_INPUT, "expected an [lpv] table"),
     (["benchmark", "nope"], BAD_INPUT, "expected one of"),
     (["benchmark", "truss-arch", "--plot", "OUT/b.txt"], BAD_INPUT, "suffix"),
     (["benchmark", "--list", "--csv", "OUT/b.csv"], BAD_INPUT, "--list"),

@@ -12,7 +12,7 @@ from tmfem.cli import main
     (["control", "lpv", "--grid", "7x3"], "at most 6x3"),
     (["control", "lpv", "--grid", "six"], "expected AxB"),
     (["control", "lpv", "--refine", "2"], "expected >= 4"),
-    (["control", "lpv", "--preset", "2-3", "--grid", "1x1"], "printed LPV grid"),
+    (["control", "lpv", "--preset", "2-3", "--grid", "1x1"], "expected an [lpv] table"),
     (["control", "lpv", "--alpha", "0.4"], "do not apply"),
     (["control", "lpv", "--solver", "ARE"], "applies to `tmfem control hinf` only"),
     (["control", "pbh", "--preset", "1-4D", "--grid", "2x2"], "apply to `tmfem control lpv` only"),

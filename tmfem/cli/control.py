@@ -3,7 +3,7 @@
 ``tmfem control hinf --preset 1-4D [--alpha 0.5] [--save k.npz] [--plot out.png] [--json]``:
 H-infinity output feedback by LMIs with alpha-stability; ``tmfem control pbh --preset ...``:
 the PBH tests alone; ``tmfem control recheck k.npz``: re-verify a saved design;
-``tmfem control lpv --preset 2-3-lpv [--grid 6x3] [--rate-bound-deg 10] [--save lpv.npz]``: the
+``tmfem control lpv FILE|--preset 2-3-lpv [--grid 6x3] [--rate-bound-deg 10] [--save lpv.npz]``: the
 gridded LPV state feedback of ch. 8 (:mod:`tmfem.cli.control_lpv`).
 """
 from __future__ import annotations

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.cli import lpv_options
-from tmfem.cli.common import output_file
+from tmfem.cli.common import output_file, system_from_args
 from tmfem.control import lpv
 from tmfem.control.lpv.defaults import CERTIFICATE_ROUNDS
 from tmfem.errors import InputError
@@ -19,7 +19,8 @@ LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma
 def configure(parser) -> None:
     lpv_options.configure_synthesis(parser)
     parser.add_argument("--rate-bound-deg", type=float, default=None,
-                        help="lpv: |d rho/dt| bound [deg/s] (8.3: 10, the default)")
+                        help="lpv: |d rho/dt| bound [deg/s] (default the [lpv] table's rate_bound_deg; "
+                             "8.3: 10)")
     parser.add_argument("--max-iter", type=int, default=None, help="lpv: SDP solver iteration limit")
     parser.add_argument("--sample-time", type=float, default=None,
                         help="lpv: EIGOPT: also require the frozen loops sampled at this zero-order-hold "
@@ -72,8 +73,8 @@ def check_estimator_refine(R, *, refine: int, output_feedback: bool) -> int:
 
 
 def run(args) -> dict:
-    rate = 10.0 if args.rate_bound_deg is None else args.rate_bound_deg
-    if not (np.isfinite(rate) and rate >= 0):
+    rate = args.rate_bound_deg
+    if rate is not None and not (np.isfinite(rate) and rate >= 0):
         raise InputError(f"--rate-bound-deg: expected >= 0, found {rate}")
     if args.max_iter is not None and args.max_iter < 1:
         raise InputError(f"--max-iter: expected an integer >= 1, found {args.max_iter}")
@@ -96,9 +97,9 @@ def run(args) -> dict:
     noise = 1e-3 if args.noise is None else args.noise
     if not (np.isfinite(noise) and noise > 0):
         raise InputError(f"--noise: expected a weight > 0, found {noise}")
-    if args.spec is not None:
-        raise InputError(f"lpv: expected --preset (a preset with a printed LPV grid), found the file {args.spec!r}")
-    cfg = lpv_options.check_synthesis(args, solver=args.solver or "SCS", preset=args.preset or "2-3-lpv")
+    if args.spec is None and args.preset is None:
+        args.preset = "2-3-lpv"
+    cfg = lpv_options.check_synthesis(args, solver=args.solver or "SCS", system=system_from_args(args))
     R = check_estimator_refine(args.estimator_refine, refine=cfg["refine"], output_feedback=bool(args.output_feedback))
     plant, gp, bound, out = lpv_options.design_plant(cfg, rate_deg=rate)
     out = {"action": "lpv", **out}
@@ -125,10 +126,11 @@ def run(args) -> dict:
 
 def format_text(r: dict) -> str:
     deg = [f"{np.degrees(a):.2f} deg" for a in r["lpv_gamma_lower_bound_at"]]
+    printed = f" (printed ||G_pw|| < {r['printed_gamma_bound']})" if "printed_gamma_bound" in r else ""
     lines = [f"LPV state feedback, {r['preset']}, grid {r['grid'][0]}x{r['grid'][1]}, "
              f"rates +-{r['rate_bound_deg']:g} deg/s",
              f"pointwise state-feedback lower bound of gamma: {r['lpv_gamma_lower_bound']:.4g} at "
-             f"(theta_13, psi_13) = ({', '.join(deg)}) (printed ||G_pw|| < {r['printed_gamma_bound']})"]
+             f"(theta_13, psi_13) = ({', '.join(deg)}){printed}"]
     if "gamma" in r:
         lines += [f"{'K(rho): ' if r.get('output_feedback') else ''}gamma = "
                   f"{r.get('state_feedback_gamma', r['gamma']):.5g} ({r['solver']}, {r['status']}, "

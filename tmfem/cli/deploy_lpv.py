@@ -96,8 +96,8 @@ def design(args, preset: str):
         v = lpv.verify_design(d, plant, tracked=s.q_names, sample_time=args.dt)
         return plant, d, {"lpv_controller": args.lpv_controller, "gamma": d.gamma,
                           **{f"design_grid_{k}": x for k, x in v.to_dict().items()}}
-    cfg = lpv_options.check_synthesis(args, solver=args.solver or "EIGOPT", preset=preset)
-    plant, gp, bound, out = lpv_options.design_plant(cfg, rate_deg=10.0, command="deploy")
+    cfg = lpv_options.check_synthesis(args, solver=args.solver or "EIGOPT", system=args.system)
+    plant, gp, bound, out = lpv_options.design_plant(cfg, command="deploy")
     sample = args.dt if cfg["solver"] == "EIGOPT" else None
     ctrl, syn = lpv_options.synthesize(cfg, gp, bound, sample_time=sample)
     v = lpv_options.verify_finer(cfg, plant, ctrl, sample_time=args.dt)

@@ -14,7 +14,6 @@ from tmfem.control import lpv
 from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
 from tmfem.errors import InputError, ResourceLimit
 from tmfem.reference.tables import deployment_bases
-from tmfem.system import load_preset
 
 #: Largest verification grid: every point is one COM linearisation (~2 s for 2-3 on this
 #: machine under load), so 500 points is about a quarter of an hour.
@@ -29,7 +28,8 @@ MAX_ITER = 100_000
 def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
     """The synthesis options shared by `tmfem control lpv` and `tmfem deploy --controller lpv`."""
     parser.add_argument("--grid", default=None,
-                        help=prefix + "theta x psi points of the printed grid (8.3; default 6x3)")
+                        help=prefix + "theta x psi points of the system file's [lpv] grid (evenly spread, both "
+                             "ends; default all of it: 6x3 for 2-3-lpv, 8.3)")
     parser.add_argument("--refine", type=int, default=None,
                         help=prefix + "verification grid refinement factor (>= 4, default 4)")
     parser.add_argument("--gamma", type=float, default=None,
@@ -48,25 +48,34 @@ def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
                              "at its middle value and starts from that design)")
 
 
-def printed_grid(spec: str, printed: dict):
-    """The --grid AxB points of the printed LPV grid (evenly spread, both ends; one point: the middle)."""
+def lpv_grid(spec: str | None, system):
+    """The --grid AxB points (default: all) of the grid of ``system``'s ``[lpv]`` table
+    (``theta_grid_deg``, ``psi_grid_deg``), evenly spread, both ends; one point: the middle one."""
+    p = system.problem.lpv
+    if p is None or p.theta_grid_deg is None or p.psi_grid_deg is None:
+        raise InputError(f"{system.name}: expected an [lpv] table with the design grid theta_grid_deg and "
+                         f"psi_grid_deg [deg] (and rate_bound_deg [deg/s], default 10; "
+                         f"docs/guides/system-file.md), found " + ("no [lpv] table" if p is None else "no grid"))
+    th, ps = np.radians(p.theta_grid_deg), np.radians(p.psi_grid_deg)
+    if spec is None:
+        return th, ps
     try:
         nt, nps = (int(v) for v in spec.lower().split("x"))
     except ValueError:
         raise InputError(f"--grid: expected AxB (e.g. 6x3), found {spec!r}") from None
-    th, ps = np.radians(printed["theta_grid_deg"]), np.radians(printed["psi_grid_deg"])
     if not (1 <= nt <= th.size and 1 <= nps <= ps.size):
-        raise InputError(f"--grid: expected at most {th.size}x{ps.size} points of the printed grid, found {spec}")
+        raise InputError(f"--grid: expected at most {th.size}x{ps.size} points of the [lpv] grid, found {spec}")
     # k evenly spread points including both ends; one point: the middle one (psi_0 = 8.36 deg of
-    # eq. 5.100 on the printed psi axis, so a reduced grid still holds the 8.4 reference)
+    # eq. 5.100 on the 2-3-lpv psi axis, so a reduced grid still holds the 8.4 reference)
     pick = lambda a, k: a[np.round(np.linspace(0, a.size - 1, k)).astype(int)] if k > 1 \
         else a[[a.size // 2]]                                                    # noqa: E731
     return pick(th, nt), pick(ps, nps)
 
 
-def check_synthesis(args, *, solver: str, preset: str) -> dict:
-    """The synthesis options, checked before any work; returns the resolved settings
-    (system, grid axes, refine, EIGOPT bisection or fixed level)."""
+def check_synthesis(args, *, solver: str, system) -> dict:
+    """The synthesis options and ``system``'s ``[lpv]`` grid (:func:`lpv_grid`), checked before
+    any work; returns the resolved settings (system, grid axes, refine, EIGOPT bisection or
+    fixed level)."""
     refine = 4 if args.refine is None else args.refine
     if refine < 4:
         raise InputError(f"--refine: expected >= 4 (the verification standard: 4 points between grid "
@@ -98,18 +107,14 @@ def check_synthesis(args, *, solver: str, preset: str) -> dict:
         raise InputError(f"--time-budget: expected seconds > 0, found {budget}")
     if args.gamma is not None and not (np.isfinite(args.gamma) and args.gamma > 0):
         raise InputError(f"--gamma: expected > 0, found {args.gamma}")
-    s = load_preset(preset)
-    printed = dict(s.printed or {})
-    if "theta_grid_deg" not in printed or "psi_grid_deg" not in printed:
-        raise InputError(f"preset {preset!r}: expected a printed LPV grid (theta_grid_deg, psi_grid_deg), found none")
-    th, ps = printed_grid(args.grid or "6x3", printed)
+    th, ps = lpv_grid(args.grid, system)
     fine_n = [(a.size - 1) * refine + 1 for a in (th, ps)]
     if fine_n[0] * fine_n[1] > MAX_VERIFY_POINTS:
-        raise ResourceLimit(f"--grid {args.grid or '6x3'} --refine {refine}: the verification grid "
+        raise ResourceLimit(f"--grid {args.grid or f'{th.size}x{ps.size}'} --refine {refine}: the verification grid "
                             f"has {fine_n[0]} x {fine_n[1]} = {fine_n[0] * fine_n[1]:,} points, one COM "
                             f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
     check_iteration_limits(args, fine_points=fine_n[0] * fine_n[1], design_points=th.size * ps.size)
-    return {"system": s, "preset": preset, "theta": th, "psi": ps, "refine": refine, "solver": solver,
+    return {"system": system, "preset": system.name, "theta": th, "psi": ps, "refine": refine, "solver": solver,
             "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget, "start": start}
 
 
@@ -137,16 +142,22 @@ def check_iteration_limits(args, *, fine_points: int, design_points: int) -> Non
                          f"found {rounds}")
 
 
-def design_plant(cfg: dict, *, rate_deg: float, command: str = "control lpv"):
+def design_plant(cfg: dict, *, rate_deg: float | None = None, command: str = "control lpv"):
     """The gridded plant of ``cfg`` (:func:`check_synthesis`), its interconnection (Fig. 8.1)
-    and the pointwise lower bound of gamma (:func:`tmfem.control.lpv.workflow.design_plant`);
-    returns (plant, gp, bound, JSON dict); its progress line names ``command``."""
+    and the pointwise lower bound of gamma (:func:`tmfem.control.lpv.workflow.design_plant`)
+    with the rate bound ``rate_deg`` [deg/s] (default the ``[lpv]`` table's ``rate_bound_deg``);
+    returns (plant, gp, bound, JSON dict), with the ``[printed] lpv_gamma_bound`` when the
+    file carries one; its progress line names ``command``."""
     s, th, ps = cfg["system"], cfg["theta"], cfg["psi"]
+    rate_deg = s.problem.lpv.rate_bound_deg if rate_deg is None else rate_deg
     say(command, f"{cfg['preset']}: linearising at {th.size * ps.size} grid points")
     p = lpv.design_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bound=np.radians(rate_deg),
                               progress=progress)
     out = {"preset": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,
-           **p.bound.to_dict(), "printed_gamma_bound": 4.18}
+           **p.bound.to_dict()}
+    printed = (s.printed or {}).get("lpv_gamma_bound")
+    if printed is not None:
+        out["printed_gamma_bound"] = printed
     return p.plant, p.generalized, p.bound, out
 
 

@@ -233,10 +233,9 @@ LPV_CONTROLLERS = ("lpv", "lpv-output")
 
 def lpv_setup(system, plant, *, model_at: str = "final"):
     """The deployment of 8.4 of ``system`` (a System with an ``[lpv]`` table and the
-    scheduling values theta0_deg, theta_e_deg, psi0_deg of eq. 5.100 in ``[printed]``, or a
-    preset name) for the design plant ``plant`` (its grid built with
-    :func:`tmfem.reference.tables.deployment_bases`, as ``tmfem control lpv``):
-    :func:`tmfem.control.lpv.deployment.lpv_deployment` with the file's ``[lpv]`` parameters
+    scheduling values theta0_deg, theta_e_deg, psi0_deg of eq. 5.100, or a preset name) for
+    the design plant ``plant`` (its grid built with :func:`tmfem.reference.tables.deployment_bases`,
+    as ``tmfem control lpv``): :func:`tmfem.control.lpv.deployment.lpv_deployment` with the file's ``[lpv]`` parameters
     (another System, e.g. with stiffer bars, for a perturbation study of an FE plant)."""
     from tmfem.control.lpv.deployment import lpv_deployment
     from tmfem.models.com.model import default_membrane_modes
@@ -248,14 +247,13 @@ def lpv_setup(system, plant, *, model_at: str = "final"):
     if p is None:
         raise InputError(f"LPV deployment of {system.name}: expected an [lpv] table in the system "
                          "file (omega_r, membrane_modes, points, path; docs/guides/system-file.md)")
-    pr = system.printed
-    missing = [k for k in ("theta0_deg", "theta_e_deg", "psi0_deg") if k not in pr]
+    missing = [k for k in ("theta0_deg", "theta_e_deg", "psi0_deg") if getattr(p, k) is None]
     if missing:
         raise InputError(f"LPV deployment of {system.name}: expected {missing} (eq. 5.100) in the "
-                         "system file's [printed] table")
+                         "system file's [lpv] table")
     pts = p.points if p.points is not None else measured_points(system)
-    return lpv_deployment(system, plant, theta_0=np.radians(pr["theta0_deg"]),
-                          theta_e=np.radians(pr["theta_e_deg"]), psi_0=np.radians(pr["psi0_deg"]),
+    return lpv_deployment(system, plant, theta_0=np.radians(p.theta0_deg),
+                          theta_e=np.radians(p.theta_e_deg), psi_0=np.radians(p.psi0_deg),
                           omega_r=p.omega_r,
                           bases=deployment_bases(system), output_points=inside_points(system, pts),
                           membrane_modes=p.membrane_modes or default_membrane_modes(system),

@@ -12,7 +12,8 @@ may carry:
 * ``[deployment]``: the deployment of 7.4: omega_r, xi_r of eq. 5.68, the PFL gains of
   Table 7.1 (eq. 5.69), the RBF and adaptation parameters, the controller's model error, the
   path and the rest-length limit;
-* ``[lpv]``: the LPV deployment of 8.4 (omega_r of eq. 5.100, K, points, path);
+* ``[lpv]``: the LPV design of 8.3 and deployment of 8.4 (the grid of (theta, psi), the
+  rate bound, the scheduling values and omega_r of eq. 5.100, K, points, path);
 * ``[report]``: what ``tmfem report`` adds for this system: the free-vibration perturbation,
   a second prestress case with its source, explanatory notes, and the deployment it runs.
 
@@ -34,7 +35,8 @@ KEYS = {
     "control": {"alpha", "u_m", "W_e", "W_d", "points"},
     "deployment": {"omega_r", "xi_r", "gains", "uncertainty", "path", "rbf_centres", "w_bar",
                    "gamma", "r_min"},
-    "lpv": {"omega_r", "membrane_modes", "points", "path"},
+    "lpv": {"omega_r", "membrane_modes", "points", "path", "theta_grid_deg", "psi_grid_deg", "theta0_deg",
+            "theta_e_deg", "psi0_deg", "rate_bound_deg"},
     "report": {"perturbation", "implied_rest_lengths", "implied_source", "notes_design",
                "notes_models", "deployment", "com_prestress"},
     "report.deployment": {"system", "uncertainty", "t_end", "controller"},
@@ -143,12 +145,37 @@ class DeploymentParameters:
 
 @dataclass(frozen=True)
 class LPVParameters:
-    """``[lpv]``: the LPV deployment of 8.4 (eq. 5.100)."""
+    """``[lpv]``: the LPV design of 8.3 and the deployment of 8.4 (eqs. 5.95-5.100).
+
+    theta_grid_deg, psi_grid_deg : tuple of float or None
+        The design grid of the scheduling parameters rho = (theta, psi) of eq. 5.97 (the
+        scheduled stage's bar attitude) [deg], strictly increasing; None: not declared
+        (``tmfem control lpv`` refuses the file).
+    rate_bound_deg : float
+        |d rho_k / dt| <= rate_bound_deg for both parameters [deg/s] (8.3: 10).
+    theta0_deg, theta_e_deg, psi0_deg : float or None
+        The scheduling values of eq. 5.100: theta from theta_0 (packaged) to theta_e
+        (deployed) at psi_0 [deg]; None: not declared (the deployment refuses the file).
+    omega_r : float
+        Reference of eq. 5.100 [rad/s].
+    membrane_modes : int or None
+        K of the COM; None: ``[models.com]``.
+    points : tuple of (x_f, y_f) or None
+        Monitored membrane points of eq. 5.101 [m]; None: as ``[control]``.
+    path : str
+        The stage bases along the grid (:data:`PATHS`).
+    """
 
     omega_r: float = 0.3
     membrane_modes: int | None = None
     points: tuple | None = None
     path: str = "linear"
+    theta_grid_deg: tuple | None = None
+    psi_grid_deg: tuple | None = None
+    rate_bound_deg: float = 10.0
+    theta0_deg: float | None = None
+    theta_e_deg: float | None = None
+    psi0_deg: float | None = None
 
 
 @dataclass(frozen=True)
@@ -232,15 +259,41 @@ def _deployment(t: dict, where: str) -> DeploymentParameters:
         gamma=_positive(t, "gamma", w, d.gamma), r_min=_positive(t, "r_min", w, d.r_min))
 
 
+def _angle(t: dict, key: str, where: str):
+    if key not in t:
+        return None
+    v = t[key]
+    if not (isinstance(v, (int, float)) and not isinstance(v, bool) and -180.0 <= v <= 180.0):
+        raise InputError(f"{where}: expected '{key}' to be an angle in degrees in [-180, 180], found {v!r}")
+    return float(v)
+
+
+def _axis(t: dict, key: str, where: str):
+    if key not in t:
+        return None
+    v = t[key]
+    ok = isinstance(v, list) and v and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) and -180.0 <= x <= 180.0 for x in v)
+    if not ok or any(b <= a for a, b in zip(v, v[1:])):
+        raise InputError(f"{where}: expected '{key}' as a strictly increasing list of angles in "
+                         f"degrees, found {v!r}")
+    return tuple(float(x) for x in v)
+
+
 def _lpv(t: dict, where: str) -> LPVParameters:
     w = f"{where} [lpv]"
     _keys(t, "lpv", where)
     K = t.get("membrane_modes")
     if K is not None and not (isinstance(K, int) and not isinstance(K, bool) and K >= 1):
         raise InputError(f"{w}: expected 'membrane_modes' to be an integer >= 1, found {K!r}")
-    return LPVParameters(omega_r=_positive(t, "omega_r", w, LPVParameters.omega_r),
+    d = LPVParameters()
+    return LPVParameters(omega_r=_positive(t, "omega_r", w, d.omega_r),
                          membrane_modes=K, points=_points(t, "points", w),
-                         path=_choice(t, "path", w, PATHS, "linear"))
+                         path=_choice(t, "path", w, PATHS, "linear"),
+                         theta_grid_deg=_axis(t, "theta_grid_deg", w), psi_grid_deg=_axis(t, "psi_grid_deg", w),
+                         rate_bound_deg=_positive(t, "rate_bound_deg", w, d.rate_bound_deg, zero=True),
+                         theta0_deg=_angle(t, "theta0_deg", w), theta_e_deg=_angle(t, "theta_e_deg", w),
+                         psi0_deg=_angle(t, "psi0_deg", w))
 
 
 def _report(t: dict, where: str) -> ReportSettings:

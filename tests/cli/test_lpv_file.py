@@ -1,0 +1,86 @@
+"""`tmfem control lpv FILE`: the grid, the rate bound and the scheduling values come from the
+file's `[lpv]` table; a file without one is refused."""
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tmfem.cli import main
+from tmfem.errors import InputError
+from tmfem.system import load_system
+from tmfem.system.presets import _preset_files
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "systems"
+
+
+def preset_text_renamed(name: str, *, printed: bool) -> str:
+    """The 2-3-lpv preset file under another name, with or without its `[printed]` table."""
+    text = _preset_files()["2-3-lpv"].read_text()
+    text = re.sub(r'^name = ".*"$', f'name = "{name}"', text, count=1, flags=re.M)
+    return text if printed else text[:text.index("[printed]")]
+
+
+def bound_only(argv, capsys) -> dict:
+    assert main(["control", "lpv", *argv, "--bound-only", "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_a_renamed_copy_of_the_preset_gives_the_preset_numbers(tmp_path, capsys):
+    # the same [lpv] grid and rate bound read from a user file: the same frozen plants and
+    # pointwise optima (Riccati) as the preset; without [printed] no printed bound is shown
+    f = tmp_path / "my-two-stage.toml"
+    f.write_text(preset_text_renamed("my-two-stage", printed=False))
+    ours = bound_only([str(f), "--grid", "2x1"], capsys)
+    ref = bound_only(["--preset", "2-3-lpv", "--grid", "2x1"], capsys)
+    assert ours["preset"] == "my-two-stage" and ours["grid"] == ref["grid"] == [2, 1]
+    assert ours["rate_bound_deg"] == ref["rate_bound_deg"] == 10.0
+    np.testing.assert_allclose(ours["pointwise_gamma"], ref["pointwise_gamma"], rtol=1e-10)
+    np.testing.assert_allclose(ours["lpv_gamma_lower_bound_at"], ref["lpv_gamma_lower_bound_at"], rtol=1e-12)
+    # --grid 2x1 takes both ends of theta and the middle psi of the 6 x 3 grid of 8.3
+    assert np.degrees(ref["lpv_gamma_lower_bound_at"]) == pytest.approx([63.0, 8.36])
+    assert "printed_gamma_bound" not in ours and ref["printed_gamma_bound"] == 4.18
+
+
+def test_the_grid_and_the_rate_bound_are_the_files(tmp_path, capsys):
+    text = preset_text_renamed("one-point", printed=False)
+    text = re.sub(r"^theta_grid_deg = .*$", "theta_grid_deg = [70.0]", text, flags=re.M)
+    text = re.sub(r"^psi_grid_deg = .*$", "psi_grid_deg = [8.0]", text, flags=re.M)
+    text = re.sub(r"^rate_bound_deg = .*$", "rate_bound_deg = 5.0", text, flags=re.M)
+    f = tmp_path / "one-point.toml"
+    f.write_text(text)
+    out = bound_only([str(f)], capsys)
+    assert out["grid"] == [1, 1] and out["rate_bound_deg"] == 5.0
+    assert np.degrees(out["lpv_gamma_lower_bound_at"]) == pytest.approx([70.0, 8.0])
+    # the pointwise optimum is tight: the norm a static gain at 1.01 x it achieves lies between
+    g, nrm = out["lpv_gamma_lower_bound"], out["lpv_gamma_lower_bound_achieved_norm"]
+    assert g * (1 - 1e-4) <= nrm <= 1.01 * g * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("make, msg", [
+    (lambda: (DATA / "square-2-4.toml").read_text(), "expected an [lpv] table with the design grid"),
+    (lambda: re.sub(r"^theta_grid_deg = .*$", "", preset_text_renamed("x", printed=False), flags=re.M),
+     "found no grid"),
+])
+def test_a_file_without_an_lpv_grid_is_refused(make, msg, tmp_path, capsys):
+    f = tmp_path / "s.toml"
+    f.write_text(make())
+    assert main(["control", "lpv", str(f), "--bound-only"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert msg in err and "theta_grid_deg" in err and len(err.splitlines()) == 1
+
+
+@pytest.mark.parametrize("line, msg", [
+    ("psi_grid_deg = [9.21, 7.5]", "strictly increasing"),
+    ("psi_grid_deg = []", "strictly increasing"),
+    ("rate_bound_deg = -1.0", "'rate_bound_deg' to be a finite number >= 0"),
+    ("theta0_deg = 400.0", "'theta0_deg' to be an angle"),
+])
+def test_bad_lpv_fields_are_refused(line, msg, tmp_path):
+    key = line.split(" = ")[0]
+    text = re.sub(rf"^{key} = .*$", line, preset_text_renamed("x", printed=False), flags=re.M)
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    with pytest.raises(InputError, match=re.escape(msg)):
+        load_system(f)
