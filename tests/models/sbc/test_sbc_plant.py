@@ -4,6 +4,7 @@ packaged equilibrium, Park's predictor for dofs without inertia, the measured in
 that breaks the 1-4(D) loop, the deploy CLI's --plant sbc and the two-plant comparison."""
 import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -207,8 +208,9 @@ def test_1_4d_sbc_deployment_fails_and_keeps_its_record(tmp_path, capsys):
     """The 1-4(D) deployment (7.4, adaptive + H-infinity) on the SBC plant measured through
     the bar chords diverges within 0.2 s (docs/guides/fe-plant.md: 0.11 s on 4 x 4 x 4 and 4 x 10 x
     10; 0.41 s with the default rigid fit): the CLI exits 1 naming
-    the failed check, with the record up to the failure in the CSV and the comparison with
-    the COM run (4 x 10 x 10; reduced: 4 x 4 x 4)."""
+    the failed check, with the record up to the failure in the CSV (marked incomplete:
+    ``sbc.csv.partial``, docs/guides/output.md) and the comparison with the COM run
+    (4 x 10 x 10; reduced: 4 x 4 x 4)."""
     from tmfem.cli import main
     csv = tmp_path / "sbc.csv"
     rc = main(["deploy", "--preset", "1-4D", "--plant", "sbc", "--plant-bars", "chord", "--plant-mesh",
@@ -219,7 +221,8 @@ def test_1_4d_sbc_deployment_fails_and_keeps_its_record(tmp_path, capsys):
     assert rc == 1 and "closed loop on the sbc plant diverged" in cap.err
     assert out["failure"] and out["t_end_s"] < 0.2
     assert out["compare"]["failure"] is None and out["compare"]["t_end_s"] == pytest.approx(0.3)
-    rows = csv.read_text().strip().splitlines()
+    assert not csv.exists() and out["csv"] == str(csv) + ".partial"
+    rows = Path(out["csv"]).read_text().strip().splitlines()
     assert len(rows) - 1 == round(out["t_end_s"] / 0.01) + 1
 
 
