@@ -7,22 +7,16 @@ The layer imports nothing of tmfem but :mod:`tmfem.errors`. PETSc is loaded only
 :func:`tmfem.solvers.newton.newton` (a function of the same name as its module is imported
 from the module).
 """
-from tmfem._lazy import lazy_exports
+# the solver layer imports nothing of tmfem but tmfem.errors, so its names are imported here
+# directly (its modules need NumPy and SciPy only; PETSc stays behind petsc_loader)
+from tmfem.solvers.backends import Backend, ScipyBackend, backend_names, get_backend
+from tmfem.solvers.continuation import arc_length
+from tmfem.solvers.eigen import Modes, lowest_modes
+from tmfem.solvers.newton import LoadPath, NewtonResult, free_index, load_stepping
+from tmfem.solvers.park import ParkResult, park_integrate
+from tmfem.solvers.petsc import PetscBackend
+from tmfem.solvers.singular import SingularMatrix
 
-__getattr__, __dir__, __all__ = lazy_exports(__name__, {
-    "Backend": "tmfem.solvers.backends",
-    "ScipyBackend": "tmfem.solvers.backends",
-    "backend_names": "tmfem.solvers.backends",
-    "get_backend": "tmfem.solvers.backends",
-    "PetscBackend": "tmfem.solvers.petsc",
-    "SingularMatrix": "tmfem.solvers.singular",
-    "Modes": "tmfem.solvers.eigen",
-    "lowest_modes": "tmfem.solvers.eigen",
-    "LoadPath": "tmfem.solvers.newton",
-    "NewtonResult": "tmfem.solvers.newton",
-    "arc_length": "tmfem.solvers.continuation",
-    "free_index": "tmfem.solvers.newton",
-    "load_stepping": "tmfem.solvers.newton",
-    "ParkResult": "tmfem.solvers.park",
-    "park_integrate": "tmfem.solvers.park"
-})
+__all__ = ["Backend", "ScipyBackend", "backend_names", "get_backend", "PetscBackend", "SingularMatrix",
+           "Modes", "lowest_modes", "LoadPath", "NewtonResult", "arc_length", "free_index",
+           "load_stepping", "ParkResult", "park_integrate"]
