@@ -1,0 +1,147 @@
+"""Memory per rank: 1-4 MTC static + 12 modes with the PETSc backend on 1 and 2 ranks.
+
+    .venv/bin/python benchmarks/bench_memory_ranks.py [--meshes 80,160] [--ranks 1,2]
+
+Each rank count runs in a fresh job (``mpiexec --allow-run-as-root --oversubscribe -n P``,
+OPENBLAS_NUM_THREADS=1), so that the peak resident memory is that of the run. Printed per run:
+free DOFs, wall time per phase (build: the model and its mesh; static: the equilibrium from
+the undeformed membrane with mesh sequencing; modes: 12 modes about it), and for every rank
+its resident memory (VmRSS of /proc/self/status) after start-up (Python, numpy, PETSc, MPI
+loaded) and after each phase, and its peak (``ru_maxrss``). Last: the ratio of the largest
+2-rank (P-rank) peak to the 1-rank peak on the same mesh; a model whose memory divides over
+ranks gives about 1/P plus the start-up's share (target for 2 ranks: at most 0.6).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.abspath(__file__)
+sys.path.insert(0, os.path.dirname(HERE))
+
+PHASES = ("start", "build", "static", "modes")
+
+
+def vm_rss_mb() -> float:
+    """Current resident memory of this process [MB] (VmRSS of /proc/self/status)."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def peak_rss_mb() -> float:
+    """Peak resident memory of this process so far [MB] (ru_maxrss, KiB on Linux)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def run_one(mesh: int, rest_length: float, sequence: int) -> dict:
+    """One run in this process (every rank); rank 0 returns the rows of all ranks."""
+    from bench_backends import system_1_4
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.distributed import comm_world
+    from tmfem.solvers.petsc import PetscBackend
+    comm = comm_world()
+    rss, peak, wall = {"start": vm_rss_mb()}, {"start": peak_rss_mb()}, {}
+    system = system_1_4(rest_length)
+
+    def phase(name, t0):
+        wall[name] = time.perf_counter() - t0
+        rss[name], peak[name] = vm_rss_mb(), peak_rss_mb()
+
+    t = time.perf_counter()
+    m = MTCModel(system, mesh_n=mesh, tendon_elements=3, backend=PetscBackend())
+    phase("build", t)
+    t = time.perf_counter()
+    res = m.equilibrium(sequence=sequence or None)
+    phase("static", t)
+    t = time.perf_counter()
+    modes = m.modes(k=12, at=res)
+    phase("modes", t)
+    mine = dict(rank=comm.rank, rss_mb=rss, peak_mb=peak, wall_s=wall)
+    ranks = comm.gather(mine, root=0)
+    return dict(mesh=f"4x{mesh}x{mesh}", n=mesh, ranks=comm.size, dofs=m.ndof,
+                f1_hz=float(modes.freq_hz[0]), per_rank=ranks)
+
+
+def launch(mesh: int, ranks: int, args) -> dict:
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
+    env["OPENBLAS_NUM_THREADS"] = "1"
+    cmd = [shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", str(ranks),
+           sys.executable, HERE, "--run", str(mesh), "--rest-length", str(args.rest_length),
+           "--sequence", str(args.sequence)]
+    p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    if p.returncode != 0:
+        return dict(mesh=f"4x{mesh}x{mesh}", ranks=ranks,
+                    error=(p.stderr.strip().splitlines() or ["exit %d" % p.returncode])[-1])
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--meshes", default="80,160", help="n of the 4xnxn membrane meshes")
+    ap.add_argument("--ranks", default="1,2", help="rank counts (the first one is the reference)")
+    ap.add_argument("--rest-length", type=float, default=1.5025,
+                    help="rest length of the S tendons [m] (the value Tables 6.3/6.6 imply)")
+    ap.add_argument("--sequence", type=int, default=10, help="coarsest mesh of the mesh sequencing")
+    ap.add_argument("--run", type=int, metavar="MESH", help=argparse.SUPPRESS)
+    ap.add_argument("--json", action="store_true", help="one JSON document of all runs")
+    args = ap.parse_args(argv)
+    if args.run:
+        from tmfem.cli import rank_report
+        from tmfem.solvers.distributed import mpi_main
+        return mpi_main(lambda: json.dumps(run_one(args.run, args.rest_length, args.sequence)),
+                        report=rank_report())
+    rank_counts = [int(v) for v in args.ranks.split(",")]
+    runs = []
+    if not args.json:
+        print(f"# 1-4 MTC static + 12 modes, --backend petsc; {os.cpu_count()} cpus, "
+              f"load average {os.getloadavg()[0]:.2f}")
+        print("# memory: VmRSS [MB] after start-up / build / static / modes, and peak (ru_maxrss);"
+              " time: wall s per phase (rank 0)")
+        print(f"{'mesh':>11s} {'dofs':>8s} {'P':>2s} {'rank':>4s} "
+              + " ".join(f"{p:>7s}" for p in PHASES) + f" {'peak':>7s} "
+              + " ".join(f"{p + ' s':>8s}" for p in PHASES[1:]))
+    for mesh in [int(v) for v in args.meshes.split(",")]:
+        ref = None
+        for ranks in rank_counts:
+            run = launch(mesh, ranks, args)
+            runs.append(run)
+            if "error" in run:
+                if not args.json:
+                    print(f"4x{mesh}x{mesh}".rjust(11) + f" P={ranks} error: {run['error']}",
+                          flush=True)
+                continue
+            peak = max(r["peak_mb"]["modes"] for r in run["per_rank"])
+            run["peak_mb"] = peak
+            if ref is None:
+                ref = peak
+            run["ratio"] = peak / ref
+            if args.json:
+                continue
+            for r in run["per_rank"]:
+                w = run["per_rank"][0]["wall_s"]
+                print(f"{run['mesh']:>11s} {run['dofs']:8d} {ranks:2d} {r['rank']:4d} "
+                      + " ".join(f"{r['rss_mb'][p]:7.0f}" for p in PHASES)
+                      + f" {r['peak_mb']['modes']:7.0f} "
+                      + " ".join(f"{w[p]:8.2f}" for p in PHASES[1:]), flush=True)
+        if not args.json:
+            ratios = ", ".join(f"P={r['ranks']}: {r['ratio']:.2f}" for r in runs
+                               if r.get("mesh") == f"4x{mesh}x{mesh}" and "ratio" in r)
+            print(f"# 4x{mesh}x{mesh}: peak per rank / {rank_counts[0]}-rank peak: {ratios}",
+                  flush=True)
+    if args.json:
+        print(json.dumps(runs))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
