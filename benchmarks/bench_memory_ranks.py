@@ -127,8 +127,8 @@ def main(argv=None) -> int:
             run["ratio"] = peak / ref
             if args.json:
                 continue
+            w = run["per_rank"][0]["wall_s"]
             for r in run["per_rank"]:
-                w = run["per_rank"][0]["wall_s"]
                 print(f"{run['mesh']:>11s} {run['dofs']:8d} {ranks:2d} {r['rank']:4d} "
                       + " ".join(f"{r['rss_mb'][p]:7.0f}" for p in PHASES)
                       + f" {r['peak_mb']['modes']:7.0f} "
