@@ -1,7 +1,9 @@
 """Exact design sensitivities of the MTC model at its static equilibrium.
 
 Variables p: tendon rest lengths, per group (``"S1"``, ``"V2"``: every tendon of the group
-moves together, r = r_0 + G p) or per tendon. Responses at the equilibrium R(u, p) = 0:
+moves together, r = r_0 + G p) or per tendon, and optionally the membrane thickness h, on
+which the membrane's internal force, tangent and mass depend linearly (dR/dh = f_mb / h,
+dK/dh = K_mb / h, dM/dh = M_mb / h at fixed positions). Responses at the equilibrium R(u, p) = 0:
 
 * the lowest eigenvalues lambda = omega^2 of (K_T - lambda M) phi = 0 (eq. 5.32),
 * the largest tendon force and the largest tendon stress,
@@ -19,7 +21,7 @@ dK = dK_T/du du/dp + dK_T/dp: with du/dp at hand this is one directional derivat
 variable, whereas the adjoint of an eigenvalue would need the gradient of phi^T K_T(u) phi
 with respect to u (third derivatives of the strain energy of every element). That
 directional derivative is a central difference of the assembled tangent along (du/dp, dp)
-with a step h of 1e-4 of the scale of the state: truncation O(h^2) about 1e-8 relative, while
+with a step that moves the state by 1e-4 of its scale: truncation O(h^2) about 1e-8 relative, while
 the rounding of the stiff tendon and bar entries, eps |K| / h, stays below the smallest
 eigenvalues' derivatives (a step of 1e-6 already loses five digits of the lowest ones to it).
 The mass, linear in the rest lengths, is differenced exactly. For a simple M-normalised mode,
@@ -40,6 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.errors import InputError
+from tmfem.fem.element import State
 from tmfem.fem.truss import truss_axial_force_derivatives, truss_mass, truss_rest_length_derivatives
 
 #: relative gap below which neighbouring eigenvalues form a cluster
@@ -104,9 +107,9 @@ def _clusters(lam: np.ndarray) -> list:
     return np.split(np.arange(lam.size), breaks)
 
 
-def rest_length_sensitivities(model, *, equilibrium=None, variables: str = "groups", k: int = 4,
+def design_sensitivities(model, *, equilibrium=None, variables: str = "groups", k: int = 4,
                               node: str | None = None, axis: int = 2,
-                              step: float = 1e-4) -> Sensitivities:
+                              thickness: bool = False, step: float = 1e-4) -> Sensitivities:
     """Responses of an MTC model at its static equilibrium and their exact derivatives with
     respect to the tendon rest lengths (module docstring: direct method, eigenvalue and
     cluster derivatives).
@@ -123,6 +126,8 @@ def rest_length_sensitivities(model, *, equilibrium=None, variables: str = "grou
         Number of lowest eigenvalues.
     node : str, optional
         Label of a system node (``"H_11"``, ``"A_12"``) whose coordinate ``axis`` is a response.
+    thickness : bool
+        Add the membrane thickness h as the last variable (``"h_membrane"``).
     step : float
         Relative step of the directional central difference of the tangent.
     """
@@ -145,10 +150,20 @@ def rest_length_sensitivities(model, *, equilibrium=None, variables: str = "grou
                         shape=(tendons.ne, G.shape[0]))
     dL = e2t @ G                                                       # dL_e / dp  (ne, n_var)
     dR = T.T @ (truss_rest_length_derivatives(x, tendons, dofmap=model.dofmap) @ dL)
+    M_mb = K_mb = None
+    if thickness:
+        h_mb = model.membrane.material.h
+        f_mb, K_mb = model.membrane_element.internal(State(x=x))
+        M_mb = T.T @ model.membrane_element.mass() @ T / h_mb
+        K_mb = T.T @ K_mb @ T / h_mb
+        names = names + ["h_membrane"]
+        G = np.column_stack([G, np.zeros(G.shape[0])])
+        dL = np.column_stack([dL, np.zeros(dL.shape[0])])
+        dR = np.column_stack([dR, T.T @ f_mb / h_mb])
     K = eq.tangent if eq.tangent is not None else model.residual(xr)[1]
     solve = model.backend.factorize(sp.csr_matrix(K)[free][:, free])
     du = np.zeros((xr.size, G.shape[1]))
-    du[free] = -np.atleast_2d(solve(np.asarray(dR[free]).reshape(int(free.sum()), -1))).reshape(-1, G.shape[1])
+    du[free] = solve(-dR[free]).reshape(-1, G.shape[1])
     dx = np.stack([model.full(du[:, j]) for j in range(du.shape[1])], axis=-1)   # (3, nn, n_var)
 
     # eigenvalues: two extra modes so that a cluster at the k-th is complete
@@ -158,18 +173,23 @@ def rest_length_sensitivities(model, *, equilibrium=None, variables: str = "grou
     clusters = [c for c in _clusters(lam) if c[0] < k]
     r0 = model.rest_lengths.copy()
     L0 = tendons.L.copy()
-    h = step * max(float(np.abs(xr).max()), float(r0.max()))
+    scale = step * max(float(np.abs(xr).max()), float(r0.max()))
     dlam = np.zeros((k, G.shape[1]))
     for j in range(G.shape[1]):
+        # the step moves the state by `scale` at most, whatever the variable's units
+        h = scale / max(1.0, float(np.abs(du[:, j]).max()), float(np.abs(G[:, j]).max()))
         Kpm = []
         for sgn in (1.0, -1.0):
             model.set_tendon_lengths(r0 + sgn * h * G[:, j])
             Kpm.append(model.residual(xr + sgn * h * du[:, j])[1])
         model.set_tendon_lengths(r0)
         dK = (Kpm[0] - Kpm[1]) / (2 * h)
-        dM = T.T @ truss_mass(dataclasses.replace(tendons, L=L0 + dL[:, j]), model.dofmap,
-                              lumped=model.lumped_tendon_mass) @ T \
-            - T.T @ truss_mass(tendons, model.dofmap, lumped=model.lumped_tendon_mass) @ T
+        if thickness and j == G.shape[1] - 1:
+            dK, dM = dK + K_mb, M_mb
+        else:
+                dM = T.T @ truss_mass(dataclasses.replace(tendons, L=L0 + dL[:, j]), model.dofmap,
+                                  lumped=model.lumped_tendon_mass) @ T \
+                - T.T @ truss_mass(tendons, model.dofmap, lumped=model.lumped_tendon_mass) @ T
         for c in clusters:
             P = Phi[:, c]
             A = P.T @ (dK @ P) - lam[c].mean() * (P.T @ (dM @ P))
