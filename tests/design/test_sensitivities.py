@@ -4,9 +4,11 @@ equilibrium re-solved to a residual of 1e-12 of the member forces from the nomin
 import dataclasses
 
 import numpy as np
+import pytest
 
 from tmfem.design import design_sensitivities
 from tmfem.design.sensitivities import variable_map
+from tmfem.errors import InputError
 from tmfem.models.mtc.model import MTCModel
 from tmfem.system import load_preset
 
@@ -89,3 +91,13 @@ def test_membrane_thickness_gradients_of_1_4_match_finite_differences():
         central.append((vals[0] - vals[1]) / (2 * dh))
     fd = (4 * central[0] - central[1]) / 3
     assert np.all(rel_err(exact, fd) < 1e-5), rel_err(exact, fd)
+
+
+def test_options_that_do_not_apply_are_refused():
+    m = MTCModel(load_preset("1-4"), mesh_n=2)
+    for kwargs, text in (({"variables": "bars"}, "variables"), ({"k": 0}, "k:"), ({"axis": 3}, "axis"),
+                         ({"node": "Q_99"}, "Q_99")):
+        with pytest.raises(InputError, match=text):
+            design_sensitivities(m, **kwargs)
+    with pytest.raises(InputError, match="tendon_law"):
+        design_sensitivities(MTCModel(load_preset("1-4"), mesh_n=2, tendon_law="fixed-rate"))

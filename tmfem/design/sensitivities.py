@@ -135,9 +135,13 @@ def design_sensitivities(model, *, equilibrium=None, variables: str = "groups", 
         raise InputError(f"k: expected a positive integer, found {k!r}")
     if axis not in (0, 1, 2):
         raise InputError(f"axis: expected 0, 1 or 2, found {axis!r}")
+    if model.tendon_law != "cable":
+        raise InputError(f"sensitivities: expected a model with tendon_law='cable' (EA fixed as the "
+                         f"rest length changes), found {model.tendon_law!r}")
     if model.distributed is not None:
         raise InputError("sensitivities: expected a model on a serial backend (scipy), found a "
                          "distributed one")
+    node_at = None if node is None else model.topology.system_node[model.system.node_index(node)]
     eq = model.equilibrium() if equilibrium is None else equilibrium
     names, G = variable_map(model, variables)
     topo, free = model.topology, model.free
@@ -207,9 +211,8 @@ def design_sensitivities(model, *, equilibrium=None, variables: str = "groups", 
     area = model.tendon_area[topo.tendon_of_element]
     i_f, i_s = int(np.argmax(N)), int(np.argmax(N / area))
     position = d_position = None
-    if node is not None:
-        n = topo.system_node[model.system.node_index(node)]
-        position, d_position = float(x[axis, n]), dx[axis, n].copy()
+    if node_at is not None:
+        position, d_position = float(x[axis, node_at]), dx[axis, node_at].copy()
     return Sensitivities(names=names, omega2=lam, d_omega2=dlam, freq_hz=freq, d_freq_hz=dfreq,
                          clusters=clusters, max_tendon_force=float(N[i_f]), d_max_tendon_force=dN[i_f],
                          max_tendon_stress=float(N[i_s] / area[i_s]),
