@@ -183,15 +183,17 @@ def design_sensitivities(model, *, equilibrium=None, variables: str = "groups", 
         # the step moves the state by `scale` at most, whatever the variable's units
         h = scale / max(1.0, float(np.abs(du[:, j]).max()), float(np.abs(G[:, j]).max()))
         Kpm = []
-        for sgn in (1.0, -1.0):
-            model.set_tendon_lengths(r0 + sgn * h * G[:, j])
-            Kpm.append(model.residual(xr + sgn * h * du[:, j])[1])
-        model.set_tendon_lengths(r0)
+        try:
+            for sgn in (1.0, -1.0):
+                model.set_tendon_lengths(r0 + sgn * h * G[:, j])
+                Kpm.append(model.residual(xr + sgn * h * du[:, j])[1])
+        finally:
+            model.set_tendon_lengths(r0)
         dK = (Kpm[0] - Kpm[1]) / (2 * h)
         if thickness and j == G.shape[1] - 1:
             dK, dM = dK + K_mb, M_mb
         else:
-                dM = T.T @ truss_mass(dataclasses.replace(tendons, L=L0 + dL[:, j]), model.dofmap,
+            dM = T.T @ truss_mass(dataclasses.replace(tendons, L=L0 + dL[:, j]), model.dofmap,
                                   lumped=model.lumped_tendon_mass) @ T \
                 - T.T @ truss_mass(tendons, model.dofmap, lumped=model.lumped_tendon_mass) @ T
         for c in clusters:
