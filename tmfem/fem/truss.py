@@ -228,3 +228,39 @@ def green_rest_length(length, tension, EA):
 def linear_rest_length(length, tension, EA):
     """Rest length of the linear spring of eqs. 3.8-3.9: T = EA (|d| - r) / r."""
     return np.asarray(EA) * np.asarray(length) / (np.asarray(tension) + np.asarray(EA))
+
+
+def truss_rest_length_derivatives(x: np.ndarray, trusses: TrussSet, *,
+                                  dofmap: DofMap | None = None) -> sp.csr_matrix:
+    """Partial derivatives df/dL_e (ndof, ne) of the internal force with respect to each
+    element's rest length L_e at fixed positions x (3, nn).
+
+    From f_2 = -f_1 = s d with s = EA E / L = EA (l^2 / (2 L^3) - 1 / (2 L)):
+
+        ds/dL = EA (1 / (2 L^2) - 3 l^2 / (2 L^4)),     df_2/dL = -df_1/dL = (ds/dL) d;
+
+    zero for slack tension-only members (their force is identically zero nearby).
+    """
+    x = np.asarray(x, dtype=float)
+    dofmap = dofmap or DofMap.translations(x.shape[1])
+    d = x[:, trusses.conn[1]] - x[:, trusses.conn[0]]
+    l2 = np.einsum("ie,ie->e", d, d)
+    L = trusses.L
+    slack = trusses.tension_only & (l2 <= L**2)
+    ds = np.where(slack, 0.0, trusses.EA * (0.5 / L**2 - 1.5 * l2 / L**4))
+    vals = np.concatenate([-(ds * d), ds * d], axis=0).T               # (ne, 6)
+    rows = dofmap.element_dofs(trusses.conn)                           # (ne, 6)
+    cols = np.broadcast_to(np.arange(trusses.ne)[:, None], rows.shape)
+    return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=(dofmap.ndof, trusses.ne))
+
+
+def truss_axial_force_derivatives(x: np.ndarray, trusses: TrussSet):
+    """True axial force N = EA E l / L = EA (l^3 / L^3 - l / L) / 2 of each element and its
+    partial derivatives: dN/dl = EA (3 l^2 / L^3 - 1 / L) / 2, dN/dL = EA (-3 l^3 / L^4
+    + l / L^2) / 2 (zero for slack tension-only members), and the unit chords e = d / l
+    (3, ne), so that dN = dN/dl e . (dx_2 - dx_1) + dN/dL dL."""
+    d = x[:, trusses.conn[1]] - x[:, trusses.conn[0]]
+    l = np.sqrt(np.einsum("ie,ie->e", d, d))
+    L, EA = trusses.L, np.where(trusses.tension_only & (l <= trusses.L), 0.0, trusses.EA)
+    N = 0.5 * EA * (l**3 / L**3 - l / L)
+    return N, 0.5 * EA * (3 * l**2 / L**3 - 1 / L), 0.5 * EA * (-3 * l**3 / L**4 + l / L**2), d / l
