@@ -36,5 +36,5 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "deployed_hinf": "tmfem.control.linear.deployed_design",
     "synthesize_state_feedback": "tmfem.control.lpv.synthesis",
     "design_output_feedback": "tmfem.control.lpv.output_feedback"
-}, subpackages=("control", "equilibrium", "errors", "fem", "io", "mesh", "models", "post", "reference",
+}, subpackages=("control", "design", "equilibrium", "errors", "fem", "io", "mesh", "models", "post", "reference",
                 "simulation", "solvers", "system"))
