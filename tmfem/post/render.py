@@ -316,7 +316,7 @@ def render_modes(png_path, *, points, cells, shapes, freq_hz, k: int = 6,
     caption = "mode shapes drawn with their largest displacement at 15 % of the model size" \
         if scale is None else f"mode shapes drawn at scale {float(scale):.3g}"
     fig.suptitle(f"{title}\n{caption}" if title else caption, fontsize=12)
-    fig.savefig(png_path, dpi=dpi)
+    fig.savefig(png_path, dpi=dpi, bbox_inches="tight", pad_inches=0.15)   # nothing cropped at the edges
     plt.close(fig)
     if not png_path.is_file() or png_path.stat().st_size == 0:
         raise RuntimeError(f"matplotlib wrote no image to {png_path}")
