@@ -84,3 +84,19 @@ def test_bad_lpv_fields_are_refused(line, msg, tmp_path):
     f.write_text(text)
     with pytest.raises(InputError, match=re.escape(msg)):
         load_system(f)
+
+
+def test_the_lpv_deployment_of_a_renamed_copy_is_the_presets(design21, tmp_path, capsys):
+    # the 8.4 deployment reads its grid, path and eq. 5.100 values from [lpv]: a user file that
+    # is the preset under another name deploys with the same saved controller to the same run
+    pl, d, path = design21
+    f = tmp_path / "my-two-stage.toml"
+    f.write_text(preset_text_renamed("my-two-stage", printed=False))
+    runs = []
+    for spec in ([str(f)], ["--preset", "2-3-lpv"]):
+        assert main(["deploy", *spec, "--lpv-controller", str(path), "--t-end", "0.2", "--json"]) == 0
+        runs.append(json.loads(capsys.readouterr().out))
+    ours, ref = runs
+    assert ours["preset"] == "my-two-stage" and ours["controller"] == ref["controller"] == "lpv"
+    for key in ("t_end_s", "max_membrane_deflection_m", "max_tendon_stress_Pa", "peak_bar_compression_N"):
+        assert ours[key] == pytest.approx(ref[key], rel=1e-10), key

@@ -171,10 +171,6 @@ def run(args) -> dict:
                          f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
                          f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
     if lpv:
-        if args.spec is not None:
-            raise InputError(f"tmfem deploy {args.spec}: the LPV deployment (8.4) runs on the preset "
-                             "2-3-lpv only (--preset 2-3-lpv); a system file deploys with its "
-                             "[packaged] and [deployment] tables (7.4)")
         deploy_lpv.check(args)
         return deploy_lpv.run(args, mesh_n=check_plant(args))
     lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise", "estimator_interpolation",
