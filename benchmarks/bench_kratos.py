@@ -1,7 +1,7 @@
 """tmfem beside Kratos Multiphysics: the same 1-4 MTC problem, static + 12 modes, one thread each.
 
     .venv/bin/python benchmarks/bench_kratos.py [--meshes 10,20,40,80] [--rounds 1]
-                                                [--kratos-python PATH]
+        [--kratos-python PATH] [--programs scipy,petsc,kratos] [--sequence N]
 
 The problem: ``MTCModel(load_preset("1-4"), mesh_n=n)``, the static equilibrium from the
 undeformed membrane (flat, unstressed; the tendon rest lengths pull the system into shape),
@@ -33,7 +33,12 @@ two programs are compared: a ratio of times is printed only where they agree wit
 
 Each run is a fresh process (tmfem with the scipy and with the PETSc backend, then Kratos,
 alternating ``--rounds`` times; the best of each is kept), OMP_NUM_THREADS=1 and
-OPENBLAS_NUM_THREADS=1. Times exclude the imports; "build" is the model set-up (tmfem: mesh and
+OPENBLAS_NUM_THREADS=1. tmfem solves as the CLI does (no mesh sequencing unless ``--sequence``);
+a ``*`` marks the backend that ``--backend auto`` (the CLI's default) chooses at that size. The
+table prints wall and CPU seconds (a loaded machine stretches the wall times; the load average
+is printed per row), the Newton iterations (Kratos: per prestress step), the largest relative
+difference of the ``--modes`` frequencies from tmfem's scipy run and the largest difference
+of the equilibrium node positions [m]. Times exclude the imports; "build" is the model set-up (tmfem: mesh and
 model; Kratos: the ModelPart from the exported arrays). Kratos runs in ``--kratos-python``
 (default: this interpreter if it imports KratosMultiphysics); without Kratos only tmfem's
 figures are printed.
@@ -192,19 +197,22 @@ def kratos_run(path: str, *, k: int, prestress: float, steps: int, tol: float) -
 
 
 # ---------------------------------------------------------------------------- tmfem side
-def tmfem_run(mesh: int, backend: str, *, k: int, export: str | None = None) -> dict:
-    """Build, solve and take the modes of the 1-4 MTC model in this process."""
+def tmfem_run(mesh: int, backend: str, *, k: int, sequence: int | None = None,
+              export: str | None = None) -> dict:
+    """Build, solve and take the modes of the 1-4 MTC model in this process (``sequence``: the
+    mesh sequencing of :meth:`MTCModel.equilibrium`, default none, as the CLI)."""
     from tmfem.models.mtc.model import MTCModel
     from tmfem.system import load_preset
     t0, c0 = time.perf_counter(), time.process_time()
     m = MTCModel(load_preset("1-4"), mesh_n=mesh, backend=backend)
     t1, c1 = time.perf_counter(), time.process_time()
-    st = m.equilibrium()
+    st = m.equilibrium(sequence=sequence)
     t2, c2 = time.perf_counter(), time.process_time()
     modes = m.modes(k=k, at=st)
     t3, c3 = time.perf_counter(), time.process_time()
     out = dict(dofs=m.ndof, backend=m.backend.name, build_s=t1 - t0, static_s=t2 - t1, eigen_s=t3 - t2,
-               cpu_s=c3 - c0, cpu_static_s=c2 - c1, cpu_eigen_s=c3 - c2, iterations=[st.iterations],
+               cpu_s=c3 - c0, cpu_static_s=c2 - c1, cpu_eigen_s=c3 - c2,
+               iterations=st.level_iterations or [st.iterations],
                freq_hz=np.asarray(modes.freq_hz).tolist(), load=os.getloadavg()[0])
     if export:
         np.savez(export, **export_model(m))
@@ -250,7 +258,11 @@ def main(argv=None) -> int:
     ap.add_argument("--meshes", default="10,20,40,80", help="membrane meshes 4 x n x n")
     ap.add_argument("--rounds", type=int, default=1, help="alternating runs per program (best kept)")
     ap.add_argument("--kratos-python", help="interpreter with Kratos 10.4.4 installed")
+    ap.add_argument("--programs", default="scipy,petsc,kratos",
+                    help="what runs: tmfem's backends scipy and petsc, kratos (scipy always: the reference)")
     ap.add_argument("--modes", type=int, default=12)
+    ap.add_argument("--sequence", type=int, help="tmfem's mesh sequencing from this coarsest mesh "
+                    "(MTCModel.equilibrium(sequence=); default none, as the CLI)")
     ap.add_argument("--membrane-prestress", type=float, default=1e4,
                     help="initial isotropic membrane prestress of the Kratos run [Pa], stepped to zero")
     ap.add_argument("--prestress-steps", type=int, default=1)
@@ -263,22 +275,25 @@ def main(argv=None) -> int:
     ap.add_argument("--kratos-run", metavar="NPZ", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.tmfem_run:
-        print(json.dumps(tmfem_run(int(args.tmfem_run[0]), args.tmfem_run[1], k=args.modes, export=args.export)))
+        print(json.dumps(tmfem_run(int(args.tmfem_run[0]), args.tmfem_run[1], k=args.modes,
+                                   sequence=args.sequence, export=args.export)))
         return 0
     if args.kratos_run:
         print(json.dumps(kratos_run(args.kratos_run, k=args.modes, prestress=args.membrane_prestress,
                                     steps=args.prestress_steps, tol=args.kratos_tol)))
         return 0
 
-    kpy = kratos_python(args.kratos_python)
-    if kpy is None:
+    programs = set(args.programs.split(",")) | {"scipy"}
+    kpy = kratos_python(args.kratos_python) if "kratos" in programs else None
+    if kpy is None and "kratos" in programs:
         print(f"# Kratos is not installed for {args.kratos_python or sys.executable}: tmfem's figures only. "
               f"Install it into a virtual environment of its own (python3 -m venv ~/kratos-venv && "
               f"~/kratos-venv/bin/pip install numpy {KRATOS_PACKAGES}) and pass "
               f"--kratos-python ~/kratos-venv/bin/python")
     from tmfem.solvers.backends import choose_backend
     print(f"# 1-4 MTC, static from the undeformed membrane + {args.modes} modes; one thread each; best of "
-          f"{args.rounds} alternating runs; {os.cpu_count()} cpus, load average {os.getloadavg()[0]:.2f}")
+          f"{args.rounds} alternating runs; {os.cpu_count()} cpus, load average {os.getloadavg()[0]:.2f}; "
+          f"tmfem mesh sequencing: {f'from n = {args.sequence}' if args.sequence else 'none'}")
     print(f"{'mesh':>9s} {'dofs':>6s} {'program':>13s} {'build s':>8s} {'static s':>9s} {'eigen s':>8s} "
           f"{'total s':>8s} {'CPU s':>7s} {'CPU st':>7s} {'CPU eig':>7s} {'its':>9s} {'f1 [Hz]':>9s} "
           f"{'max df/f':>9s} {'max dx':>8s} load")
@@ -288,7 +303,11 @@ def main(argv=None) -> int:
             runs = {"scipy": [], "petsc": [], "kratos": []}
             for r in range(args.rounds):
                 for backend in ("scipy", "petsc"):
+                    if backend not in programs:
+                        continue
                     extra = ["--export", npz] if (r == 0 and backend == "scipy") else []
+                    if args.sequence:
+                        extra += ["--sequence", str(args.sequence)]
                     runs[backend].append(_launch(sys.executable, ["--tmfem-run", str(mesh), backend,
                                                                   "--modes", str(args.modes), *extra]))
                 if kpy is not None and os.path.exists(npz):
