@@ -160,6 +160,8 @@ def kratos_run(path: str, *, k: int, prestress: float, steps: int, tol: float) -
     # converged when |r| <= tol |r_0| of the step, or |r| / n_dofs <= tol (1 N + sum |N|) / n_dofs
     # (Kratos' absolute residual is per dof; tmfem's test: |r| <= tol (1 N + sum of |member forces|))
     ndof = 3 * X.shape[1] - 3 * len(d["fixed"])
+    if ndof != int(d["ndof"]):
+        return dict(error=f"the Kratos model has {ndof} free dofs, tmfem's {int(d['ndof'])}")
     scale = 1.0 + np.sum(np.abs(kratos_truss_force(L0, L0, tp)))
     strategy = KM.ResidualBasedNewtonRaphsonStrategy(
         mp, KM.ResidualBasedIncrementalUpdateStaticScheme(), KM.ResidualCriteria(tol, tol * scale / ndof),
@@ -192,7 +194,7 @@ def kratos_run(path: str, *, k: int, prestress: float, steps: int, tol: float) -
     u = np.array([mp.GetNode(i + 1).GetSolutionStepValue(KM.DISPLACEMENT) for i in range(X.shape[1])]).T
     return dict(dofs=ndof, build_s=t1 - t0, static_s=t2 - t1, eigen_s=t3 - t2, cpu_s=c3 - c0,
                 cpu_static_s=c2 - c1, cpu_eigen_s=c3 - c2,
-                iterations=its, freq_hz=(np.sqrt(np.abs(lam)) / (2 * np.pi)).tolist(),
+                iterations=its, freq_hz=(np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)).tolist(),
                 x=(X + u).tolist(), load=os.getloadavg()[0])
 
 
@@ -284,6 +286,8 @@ def main(argv=None) -> int:
         return 0
 
     programs = set(args.programs.split(",")) | {"scipy"}
+    if not programs <= {"scipy", "petsc", "kratos"}:
+        ap.error(f"--programs: expected names among scipy, petsc, kratos, found {args.programs!r}")
     kpy = kratos_python(args.kratos_python) if "kratos" in programs else None
     if kpy is None and "kratos" in programs:
         print(f"# Kratos is not installed for {args.kratos_python or sys.executable}: tmfem's figures only. "
