@@ -23,7 +23,8 @@ where l < L.
 The start from the undeformed membrane: a flat unstressed membrane has no transverse stiffness,
 so Newton's method fails on it (tmfem regularises it with a mass-scaled trust region). Kratos
 users prestress the membrane (``PRESTRESS_VECTOR``): the Kratos run solves with an isotropic
-membrane prestress ``--membrane-prestress`` that is then stepped down to zero over
+membrane prestress ``--membrane-prestress`` (default 10 kPa, about the mean membrane stress of
+the equilibrium) that is then stepped down to zero over
 ``--prestress-steps`` Newton solves (``ResidualBasedNewtonRaphsonStrategy``, the fastest direct
 solver of the installed Kratos, residual criterion), so that the equilibrium reached is that
 of the unprestressed model, tmfem's. Modes: ``EigensolverStrategy`` with LinearSolversApplication's
@@ -38,8 +39,8 @@ a ``*`` marks the backend that ``--backend auto`` (the CLI's default) chooses at
 table prints wall and CPU seconds (a loaded machine stretches the wall times; the load average
 is printed per row), the Newton iterations (Kratos: per prestress step), the largest relative
 difference of the ``--modes`` frequencies from tmfem's scipy run and the largest difference
-of the equilibrium node positions [m]. Times exclude the imports; "build" is the model set-up (tmfem: mesh and
-model; Kratos: the ModelPart from the exported arrays). Kratos runs in ``--kratos-python``
+of the equilibrium node positions [m]. Times exclude the imports; "build" is the model set-up
+(tmfem: mesh and model; Kratos: the ModelPart from the exported arrays). Kratos runs in ``--kratos-python``
 (default: this interpreter if it imports KratosMultiphysics); without Kratos only tmfem's
 figures are printed.
 """
