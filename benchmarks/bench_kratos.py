@@ -23,10 +23,10 @@ where l < L.
 The start from the undeformed membrane: a flat unstressed membrane has no transverse stiffness,
 so Newton's method fails on it (tmfem regularises it with a mass-scaled trust region). Kratos
 users prestress the membrane (``PRESTRESS_VECTOR``): the Kratos run solves with an isotropic
-membrane prestress ``--membrane-prestress`` (default 10 kPa, of the order of the median membrane
-stress of the equilibrium) that is then stepped down to zero over ``--prestress-steps`` Newton
-solves (``ResidualBasedNewtonRaphsonStrategy``, the fastest direct
-solver of the installed Kratos, residual criterion), so that the equilibrium reached is that
+membrane prestress ``--membrane-prestress`` (default 10 kPa, between the median minor and major
+principal membrane stresses of the equilibrium, about 5 and 50 kPa) that is then stepped down
+to zero over ``--prestress-steps`` Newton solves (``ResidualBasedNewtonRaphsonStrategy``, the
+fastest direct solver of the installed Kratos, residual criterion), so that the equilibrium reached is that
 of the unprestressed model, tmfem's. Modes: ``EigensolverStrategy`` with LinearSolversApplication's
 ``spectra_sym_g_eigs_shift`` (shift-invert at -1 rad^2/s^2, as tmfem). The frequencies of the
 two programs are compared: a ratio of times is printed only where they agree within
