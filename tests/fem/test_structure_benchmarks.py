@@ -29,3 +29,22 @@ def test_hinged_roof_snap_through_by_arc_length():
     assert np.max(np.abs(P - ref)) < 0.04 * 0.7421
     assert r["limit_load_ratio"] == pytest.approx(0.7421, rel=0.01)
     assert r["events"] == ["limit point", "limit point"]
+
+
+def test_hinged_roof_under_load_control_stops_at_the_limit_point():
+    # 8 x 8 quarter, 10 load steps of 0.1 P_max: the step past the limit load jumps to the far
+    # branch; the run stops below the reference limit load 0.7421 P_max (Sze 3.8)
+    s, c = shell_hinged_roof.model(n=8)
+    path = s.solve(steps=10)
+    assert path.reason == "limit point" and "solve_arc_length" in path.message
+    assert 0.7 <= path.lam[-1] < 0.7421
+    W = np.array([-(st.x[2, c] - s.X[2, c]) for st in path])
+    ref = np.interp(W, shell_hinged_roof.REFERENCE[:11, 1], shell_hinged_roof.REFERENCE[:11, 0])
+    assert np.max(np.abs(path.lam - ref)) < 0.02 * 0.7421
+    # the jumped state (on_snap="mark") lies on the far branch of the reference curve
+    marked = s.solve(steps=10, on_snap="mark")
+    (k, event), = marked.events
+    W_far = -(marked[k].x[2, c] - s.X[2, c])
+    far = shell_hinged_roof.REFERENCE[27:]
+    assert event == "snap-through" and W_far > 24.0
+    assert marked.lam[k] == pytest.approx(np.interp(W_far, far[:, 1], far[:, 0]), abs=0.04 * 0.7421)
