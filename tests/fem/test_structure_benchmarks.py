@@ -72,3 +72,17 @@ def test_pinched_cylinder_follows_the_published_path():
     # U_B wobbles as the folds under the load cross element rows (more on the coarser mesh)
     assert np.max(np.abs(U - U_ref)) < (0.05 if REDUCED else 0.035) * np.abs(U_ref).max()
     assert r["max_curve_distance"] < (0.035 if REDUCED else 0.033)
+
+
+def test_pinched_cylinder_error_measures_on_known_paths():
+    # a path whose load drops once: load control reaches 0.5 first on the way up, at d = 1
+    lam = np.array([0.0, 0.4, 0.6, 0.5, 0.8])
+    d = np.array([0.0, 0.8, 1.2, 2.0, 3.0])
+    got = shell_pinched_cylinder_nonlinear.at_first_crossing(lam, np.array([0.0, 0.5, 0.7, 0.9]), d)
+    np.testing.assert_allclose(got[:3], [0.0, 1.0, 2.0 + (0.7 - 0.5) / 0.3])
+    assert np.isnan(got[3])                                    # never reached
+    # distances to the polyline (0, 0) - (1, 1) - (1, 2) in (P, d / 2): closed forms
+    dist = shell_pinched_cylinder_nonlinear.curve_distance(np.array([0.0, 1.0, 1.0]), np.array([0.0, 2.0, 4.0]),
+                                                           np.array([1.0, 0.0, 2.0]), np.array([0.0, 2.0, 3.0]),
+                                                           d_scale=2.0)
+    np.testing.assert_allclose(dist, [np.sqrt(0.5), np.sqrt(0.5), 1.0])
