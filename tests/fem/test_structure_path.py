@@ -152,5 +152,6 @@ def test_load_control_refuses_bad_snap_controls():
     s, _ = arch()
     with pytest.raises(InputError, match="on_snap"):
         s.solve(on_snap="ignore")
-    with pytest.raises(InputError, match="snap_ratio"):
-        s.solve(snap_ratio=0.5)
+    for bad in (0.5, "large", float("nan")):
+        with pytest.raises(InputError, match="snap_ratio"):
+            s.solve(snap_ratio=bad)

@@ -711,8 +711,8 @@ class Structure:
         previous load factor must return to the previous state; when it converges elsewhere,
         two equilibria at that load bound a limit point (:meth:`_snapped`). ``on_snap="stop"``
         ends the run there with the reason "limit point" (the jumped state is not part of the
-        path; continue with :meth:`solve_arc_length` from it); ``"mark"`` keeps the jumped
-        state with the event "snap-through" and goes on.
+        path; ``solve_arc_length(start=path)`` continues through the limit point); ``"mark"``
+        keeps the jumped state with the event "snap-through" and goes on.
 
         Returns a :class:`Path` of every converged state (the start included) that says why
         it stopped: "completed", "limit point" (a snap-through detected, or a step failed
@@ -723,7 +723,7 @@ class Structure:
             raise InputError(f"solve: expected steps >= 1, found {steps!r}")
         if on_snap not in ("stop", "mark"):
             raise InputError(f"solve: expected on_snap 'stop' or 'mark', found {on_snap!r}")
-        if not (np.isfinite(snap_ratio) and snap_ratio > 1):
+        if not (isinstance(snap_ratio, (int, float, np.number)) and np.isfinite(snap_ratio) and snap_ratio > 1):
             raise InputError(f"solve: expected snap_ratio > 1, found {snap_ratio!r}")
         controls = dict(steps=steps, lam_end=lam_end, tol=tol, max_iter=max_iter, line_search=line_search,
                         min_step=min_step, equilibrate=equilibrate, stability=stability, snap_ratio=snap_ratio,
