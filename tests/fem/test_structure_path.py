@@ -112,3 +112,46 @@ def test_displacement_control_through_the_limit_point():
     assert short.reason == "budget"
     whole = s.resume(short, max_steps=100)
     assert _w(s, whole[-1]) == pytest.approx(2.2 * B, abs=1e-12) and whole.reason == "completed"
+
+
+def test_load_control_that_jumps_a_snap_through_stops_at_the_limit_point():
+    # five load steps of 0.24 P_max to 1.2 P_max: the fifth converges on the inverted branch
+    s, _ = arch()
+    P_max = arch_load_green(B * (1 - 1 / np.sqrt(3)), a=A, b=B, EA=EA)
+    path = s.solve(steps=5, lam_end=1.2 * P_max)
+    assert path.reason == "limit point" and "solve_arc_length" in path.message
+    assert path.lam[-1] == pytest.approx(0.96 * P_max)            # the last step below P_max
+    w = np.array([_w(s, st) for st in path])
+    assert np.all(w < B * (1 - 1 / np.sqrt(3)))                    # all on the first stable branch
+    np.testing.assert_allclose(path.lam, arch_load_green(w, a=A, b=B, EA=EA), atol=1e-7)
+    # kept with on_snap="mark": the jumped state is on the far stable branch (w > b (1 + 1/sqrt 3))
+    marked = s.solve(steps=5, lam_end=1.2 * P_max, on_snap="mark")
+    assert marked.reason == "completed" and marked.events == [(5, "snap-through")]
+    w_far = _w(s, marked[5])
+    assert w_far > B * (1 + 1 / np.sqrt(3))
+    assert marked.lam[5] == pytest.approx(arch_load_green(w_far, a=A, b=B, EA=EA), abs=1e-7)
+    # a smooth load-controlled path below the limit point raises no event
+    below = s.solve(steps=5, lam_end=0.9 * P_max)
+    assert below.reason == "completed" and below.events == []
+
+
+def test_load_control_that_jumps_a_snap_through_resumes_by_arc_length():
+    s, _ = arch()
+    P_max = arch_load_green(B * (1 - 1 / np.sqrt(3)), a=A, b=B, EA=EA)
+    path = s.solve(steps=5, lam_end=1.2 * P_max)
+    on = s.solve_arc_length(start=path, dl=0.02, max_steps=400, stop=lambda st, lam: st.x[2, 2] < -1.2 * B)
+    assert on.reason == "stopped"
+    w = np.array([_w(s, st) for st in on])
+    assert np.all(np.diff(w) > 0) and on.lam[w < B].max() == pytest.approx(P_max, rel=5e-3)
+    assert w[-1] > B * (1 + 1 / np.sqrt(3))                       # past the limit points
+    np.testing.assert_allclose(on.lam, arch_load_green(w, a=A, b=B, EA=EA), atol=1e-7)
+
+
+def test_load_control_refuses_bad_snap_controls():
+    from tmfem.errors import InputError
+    s, _ = arch()
+    with pytest.raises(InputError, match="on_snap"):
+        s.solve(on_snap="ignore")
+    for bad in (0.5, "large", float("nan")):
+        with pytest.raises(InputError, match="snap_ratio"):
+            s.solve(snap_ratio=bad)

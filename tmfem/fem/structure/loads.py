@@ -20,7 +20,9 @@ as consistent nodal forces f_k = int h_k q ds:
   f_b = q L (d_a/6 + d_b/3) with L the current edge length; its load stiffness (exact,
   non-symmetric): df_a/dx_b = -df_a/dx_a = q (d_a/3 + d_b/6) e^T (e the unit chord) and, with
   the rotation increments about the current V_1, V_2 (d' = -V_2 dalpha + V_1 dbeta),
-  df_a/dalpha_a = -q L V_2,a / 3, df_a/dbeta_a = q L V_1,a / 3, df_a/dalpha_b = -q L V_2,b / 6, ...
+  df_a/dalpha_a = -q L V_2,a / 3, df_a/dbeta_a = q L V_1,a / 3, df_a/dalpha_b = -q L V_2,b / 6, ...;
+- follower (beam elements): q [N/m] (3,) per unit current length, given in the reference
+  configuration and turned with the sections (:class:`BeamFollowerLoad`).
 """
 from __future__ import annotations
 
@@ -31,7 +33,9 @@ import scipy.sparse as sp
 
 from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler
+from tmfem.fem.beam import shape_functions
 from tmfem.fem.dofmap import DofMap
+from tmfem.fem.element import skew
 
 
 @dataclass
@@ -215,3 +219,61 @@ class LineLoad:
         if tangent and K is None:
             K = sp.csr_matrix((self.dofmap.ndof,) * 2)
         return -f, (-K if tangent else None)
+
+
+class BeamFollowerLoad:
+    """Follower line load on 4-node beam elements (module docstring): q [N/m] (3,) per unit
+    current length of the axis, given in global axes in the reference configuration and
+    turned with the sections: at a point r of an element the load is
+    q(r) = sum_k h_k(r) R_k q (R_k the rotation of node k), so a load normal to the axis stays
+    normal to it. Consistent nodal forces (4-point Gauss along the axis)
+
+        f_a = int h_a |x'| q(r) dr,
+
+    and the exact load stiffness (translations x_b, spatial rotation increments theta_k of the
+    nodes, d(R_k q) = theta_k x R_k q):
+
+        df_a/dx_b = int h_a h_b' q(r) e^T dr,   df_a/dtheta_k = -int h_a h_k |x'| dr skew(R_k q),
+
+    with e = x' / |x'| the unit tangent of the current axis.
+
+    Parameters
+    ----------
+    lines : (4, ne) beam element nodes; dofmap : DofMap (six dofs at every node of ``lines``);
+    q : (3,) [N/m].
+    """
+
+    def __init__(self, *, lines, dofmap: DofMap, q):
+        self.lines = np.asarray(lines, dtype=np.int64)
+        if self.lines.ndim != 2 or self.lines.shape[0] != 4 or self.lines.shape[1] == 0:
+            raise InputError(f"beam follower load: expected beam elements of shape (4, ne >= 1), "
+                             f"found {self.lines.shape}")
+        dofmap.check_element_nodes(self.lines, 6, element="beam follower load", dofs="six dofs")
+        q = np.asarray(q, dtype=float)
+        if q.shape != (3,) or not np.all(np.isfinite(q)):
+            raise InputError(f"beam follower load: expected a finite q of 3 components [N/m], found {q!r}")
+        self.q = q
+        self.dofmap = dofmap
+        r, self.w = _gauss(4)
+        self.h, self.dh = shape_functions(r)                                # (4, ng)
+        self._asm = Assembler(dofmap.element_dofs(self.lines, rotations=True), dofmap.ndof)
+
+    def load(self, state, *, tangent: bool = True):
+        """Nodal force (ndof,) and its load stiffness (csr)."""
+        h, dh, w = self.h, self.dh, self.w
+        xp = np.einsum("kg,ike->egi", dh, state.x[:, self.lines])          # (ne, ng, 3)
+        L = np.linalg.norm(xp, axis=-1)                                     # (ne, ng)
+        Rq = np.einsum("keij,j->eki", state.R[self.lines], self.q)          # (ne, 4, 3)
+        d = np.einsum("kg,eki->egi", h, Rq)                                 # (ne, ng, 3)
+        ne = L.shape[0]
+        fe = np.zeros((ne, 4, 6))
+        fe[..., :3] = np.einsum("g,ag,eg,egi->eai", w, h, L, d)
+        f = self._asm.vector(fe.reshape(ne, 24))
+        if not tangent:
+            return f, None
+        Ke = np.zeros((ne, 4, 6, 4, 6))
+        e = xp / L[..., None]
+        Ke[:, :, :3, :, :3] = np.einsum("g,ag,bg,egi,egj->eaibj", w, h, dh, d, e)
+        c = np.einsum("g,ag,kg,eg->eak", w, h, h, L)                        # (ne, 4, 4)
+        Ke[:, :, :3, :, 3:] = -np.einsum("eak,ekij->eaikj", c, skew(Rq))
+        return f, self._asm.matrix(Ke.reshape(ne, 24, 24))

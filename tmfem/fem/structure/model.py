@@ -35,7 +35,7 @@ from tmfem.fem.dofmap import DofMap
 from tmfem.fem.element import State, assemble, smallest_rotation
 from tmfem.fem.mitc4 import MITC4Shell, ShellPressure, ShellSection
 from tmfem.fem.structure.from_mesh import structure_from_mesh
-from tmfem.fem.structure.loads import LineLoad, LoadCases
+from tmfem.fem.structure.loads import BeamFollowerLoad, LineLoad, LoadCases
 from tmfem.fem.structure.path import Path
 from tmfem.fem.structure.reactions import Reactions, nodal_vectors
 from tmfem.fem.structure.results import beam_nodal_section_forces, shell_nodal_results
@@ -454,9 +454,14 @@ class Structure:
         ne) array of edges, a (4, ne) beam connectivity or a beam element set), as consistent
         nodal forces (:mod:`tmfem.fem.structure.loads`): dead, q [N/m] (3,) or q(x, y, z) ->
         (3, m) per unit reference length; or ``follower``, q [N/m] per unit current length
-        along the current shell director."""
-        ld = LineLoad(X=self.X, lines=self._lines(where), dofmap=self.dofmap, q=q, follower=follower,
-                      frames=self.frames)
+        along the current shell director; on beam elements, q [N/m] (3,) per unit current length of
+        the axis, given in global axes in the reference configuration and turned with the
+        sections (a load normal to the axis stays normal to it; :class:`BeamFollowerLoad`)."""
+        lines = self._lines(where)
+        if follower and lines.shape[0] == 4:
+            ld = BeamFollowerLoad(lines=lines, dofmap=self.dofmap, q=q)
+        else:
+            ld = LineLoad(X=self.X, lines=lines, dofmap=self.dofmap, q=q, follower=follower, frames=self.frames)
         c = self.loads.case(case)
         if follower:
             c.loads.append(ld)
@@ -685,7 +690,8 @@ class Structure:
 
     def solve(self, *, steps: int = 10, lam_end: float = 1.0, tol: float = 1e-8, max_iter: int = 30,
               line_search: bool = False, min_step: float = 1e-4, start=None, callback=None,
-              equilibrate: bool = True, stability: bool = False) -> Path:
+              equilibrate: bool = True, stability: bool = False, snap_ratio: float = 2.5,
+              on_snap: str = "stop") -> Path:
         """Load control: from ``start`` (a state or a :class:`Path`, default the reference
         state at lam = 0) to ``lam_end`` in ``steps`` equal increments of the load factor,
         which scales the live loads and the prescribed displacements together; Newton at
@@ -698,30 +704,47 @@ class Structure:
         solves (docs/guides/shells.md, thin shells). ``stability``: count the negative pivots of the
         tangent at every converged step (a bifurcation indicator; an extra factorization).
 
+        Snap-through: a load step that passes a limit point may still converge, on a distant
+        branch (the jump of a snap-through, not a path). A step whose displacement per load
+        increment, ||Dx|| / |Dlam| (nodal positions), exceeds ``snap_ratio`` times that of the
+        previous step (the first step: always) is checked: Newton from its state at the
+        previous load factor must return to the previous state; when it converges elsewhere,
+        two equilibria at that load bound a limit point (:meth:`_snapped`). ``on_snap="stop"``
+        ends the run there with the reason "limit point" (the jumped state is not part of the
+        path; ``solve_arc_length(start=path)`` continues through the limit point); ``"mark"``
+        keeps the jumped state with the event "snap-through" and goes on.
+
         Returns a :class:`Path` of every converged state (the start included) that says why
-        it stopped: "completed", or, when a step fails below ``min_step``, "limit point" (the
-        tangent at the failed iterate has more negative pivots than at the last converged
-        state: continue with :meth:`solve_arc_length`) or "divergence".
+        it stopped: "completed", "limit point" (a snap-through detected, or a step failed
+        below ``min_step`` with more negative pivots at the failed iterate than at the last
+        converged state) or "divergence".
         """
         if not (isinstance(steps, (int, np.integer)) and steps >= 1):
             raise InputError(f"solve: expected steps >= 1, found {steps!r}")
+        if on_snap not in ("stop", "mark"):
+            raise InputError(f"solve: expected on_snap 'stop' or 'mark', found {on_snap!r}")
+        if not (isinstance(snap_ratio, (int, float, np.number)) and np.isfinite(snap_ratio) and snap_ratio > 1):
+            raise InputError(f"solve: expected snap_ratio > 1, found {snap_ratio!r}")
         controls = dict(steps=steps, lam_end=lam_end, tol=tol, max_iter=max_iter, line_search=line_search,
-                        min_step=min_step, equilibrate=equilibrate, stability=stability)
+                        min_step=min_step, equilibrate=equilibrate, stability=stability, snap_ratio=snap_ratio,
+                        on_snap=on_snap)
         scale = self._scale()
         cur = self._start(start)
         out = [cur]
         dlam = (lam_end - cur.lam) / steps
         lam = cur.lam
+        flex = None                                       # ||Dx|| / |Dlam| of the last step
         reason, message = "completed", f"load factor {lam_end:g} reached"
+
+        def equilibrium(s, at):
+            return newton(lambda u: self.residual(u, at), s, free=self.constraints.free, tol=tol, scale=scale,
+                          max_iter=max_iter, line_search=line_search, load_factor=at, update=self.advance,
+                          equilibrate=equilibrate, backend=self.backend)
         while (lam_end - lam) * np.sign(dlam) > 1e-12 * abs(lam_end):
             d = dlam if abs(dlam) <= abs(lam_end - lam) else lam_end - lam
             target = lam + d
-            s_try = self._with_prescribed(cur.state, d)
             try:
-                res = newton(lambda s: self.residual(s, target), s_try, free=self.constraints.free,
-                             tol=tol, scale=scale, max_iter=max_iter, line_search=line_search,
-                             load_factor=target, update=self.advance, equilibrate=equilibrate,
-                             backend=self.backend)
+                res = equilibrium(self._with_prescribed(cur.state, d), target)
             except ConvergenceError as exc:
                 dlam = 0.5 * d
                 log.info("structure: step to lam = %g failed (%s); halving", target, exc)
@@ -739,10 +762,21 @@ class Structure:
                     log.warning("structure: load control stopped (%s): %s", reason, message)
                     break
                 continue
+            step = float(np.linalg.norm(res.u.x - cur.state.x)) / abs(d)
+            snapped = (flex is None or step > snap_ratio * flex) and self._snapped(res.u, cur, -d, equilibrium)
+            flex = step
+            if snapped and on_snap == "stop":
+                reason = "limit point"
+                message = (f"snap-through between load factors {lam:g} and {target:g}: the step converged on a "
+                           f"distant branch ({step * abs(d):.3g} of nodal displacement; Newton from there at "
+                           f"{lam:g} stays on it); continue with solve_arc_length(start=path)")
+                log.warning("structure: load control stopped (%s): %s", reason, message)
+                break
             lam = target
             piv = self._stability(res.u, lam) if stability else None
-            event = ("bifurcation" if piv is not None and cur.negative_pivots is not None
-                     and piv != cur.negative_pivots else None)
+            event = "snap-through" if snapped else (
+                "bifurcation" if piv is not None and cur.negative_pivots is not None
+                and piv != cur.negative_pivots else None)
             cur = StructureState(state=res.u, lam=lam, iterations=res.iterations,
                                  residual_history=res.residual_history, reaction=self._reaction(res.r),
                                  negative_pivots=piv, event=event)
@@ -750,6 +784,18 @@ class Structure:
             if callback is not None:
                 callback(cur)
         return Path(out, method="load", controls=controls, reason=reason, message=message)
+
+    def _snapped(self, new: State, prev: StructureState, back: float, equilibrium) -> bool:
+        """True when Newton from the converged state ``new`` at the previous load factor
+        (prescribed displacements moved back by ``back``) converges to an equilibrium other
+        than ``prev`` (farther from it than half the step): the load step jumped across a limit
+        point. A failed check (no convergence) counts as no evidence."""
+        try:
+            res = equilibrium(self._with_prescribed(new, back), prev.lam)
+        except ConvergenceError:
+            return False
+        dist = float(np.linalg.norm(res.u.x - prev.state.x))
+        return dist > 0.5 * float(np.linalg.norm(new.x - prev.state.x))
 
     def _start(self, start) -> StructureState:
         if start is None:

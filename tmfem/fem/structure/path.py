@@ -58,7 +58,8 @@ class Path(list):
 
     @property
     def events(self) -> list:
-        """(index, event) of the steps that passed a limit point or a bifurcation indicator."""
+        """(index, event) of the steps that passed a limit point or a bifurcation indicator, or
+        (load control, ``on_snap="mark"``) jumped a snap-through."""
         return [(i, s.event) for i, s in enumerate(self) if s.event]
 
     def __repr__(self) -> str:
