@@ -98,7 +98,8 @@ class OptimizationResult:
     start_responses, optimum_responses : objective and constraint responses at both designs;
     active : the active constraints and bounds with their multipliers; kkt_residual : the
     stationarity residual relative to |grad f|; history : rows (iteration, objective,
-    max_violation, step); system : the optimal System (rest lengths included);
+    max_violation, step); system : the optimal System (rest lengths included); state : the
+    MTC positions (3, n_nodes) at the optimum (a warm start for further solves);
     success, message, evaluations, time_s.
     """
 
@@ -119,6 +120,7 @@ class OptimizationResult:
     time_s: float
     objective: str = ""
     constraints: list = field(default_factory=list)
+    state: np.ndarray | None = None
 
 
 class _Evaluator:
@@ -234,7 +236,13 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
         return sign * v[0] / f_scale, g
 
     def constraint_rows(z):
-        """Scaled g(z) <= 0 rows and their Jacobian; equality rows flagged."""
+        """Scaled g(z) <= 0 rows and their Jacobian, equality rows flagged; rows identical at
+        the start (members equal by symmetry) are one row, the largest of them."""
+        g, J, eqf = all_rows(z)
+        pick = np.array([grp[int(np.argmax(g[grp]))] for grp in groups])
+        return g[pick], J[pick], eqf[pick]
+
+    def all_rows(z):
         s, _ = ev(p_of(z))
         rows, jac, eq = [], [], []
         if vector_obj:
@@ -261,6 +269,7 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
     z0 = (p0 - lo) / span
     if vector_obj:
         z0 = np.append(z0, f_vals0.min() / f_scale if sense == "max" else f_vals0.max() / f_scale)
+    groups = _identical_rows(*all_rows(z0))
     bounds = [(0.0, 1.0)] * n + ([(None, None)] if vector_obj else [])
     scipy_cons = []
     _, _, eq0 = constraint_rows(z0)
@@ -298,7 +307,8 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
     _, gobj = objective_fn(z)
     g, J, eqf = constraint_rows(z)
     act = np.flatnonzero(eqf | (g > -ACTIVE_TOL))
-    labels = _row_labels(cons, s, obj, vector_obj)
+    every = _row_labels(cons, s, obj, vector_obj)
+    labels = [every[grp[0]] + (f" (with {len(grp) - 1} equal)" if len(grp) > 1 else "") for grp in groups]
     A = [J[i] for i in act]
     act_labels = [labels[i] for i in act]
     for j in range(n):
@@ -327,7 +337,21 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
         start_responses=_responses(s0, wanted), optimum_responses=_responses(s, wanted),
         active=active, kkt_residual=kkt, history=hist, system=sysp, success=bool(res.success),
         message=str(res.message), evaluations=ev.count, time_s=time.perf_counter() - t0,
-        objective=f"{sense}:{obj}", constraints=[c.label() for c in cons])
+        objective=f"{sense}:{obj}", constraints=[c.label() for c in cons], state=ev.x)
+
+
+def _identical_rows(g, J, eqf) -> list:
+    """Index groups of constraint rows equal in value and gradient (to 1e-9 of their size):
+    SLSQP's subproblem is degenerate with repeated rows."""
+    key = np.column_stack([g, J, eqf])
+    tol = 1e-9 * max(float(np.abs(key).max(initial=0.0)), 1e-30)
+    groups, used = [], np.zeros(len(g), dtype=bool)
+    for i in range(len(g)):
+        if not used[i]:
+            same = np.flatnonzero(~used & np.all(np.abs(key - key[i]) <= tol, axis=1))
+            used[same] = True
+            groups.append(same)
+    return groups
 
 
 def _objective_value(ev, p, obj, sense, vector_obj) -> float:
@@ -382,5 +406,5 @@ class _HistoryWriter:
 
 def result_dict(result: OptimizationResult) -> dict:
     """The JSON-able fields of a result (without the System)."""
-    d = {f.name: getattr(result, f.name) for f in dataclasses.fields(result) if f.name != "system"}
+    d = {f.name: getattr(result, f.name) for f in dataclasses.fields(result) if f.name not in ("system", "state")}
     return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in d.items()}
