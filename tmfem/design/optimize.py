@@ -174,9 +174,16 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
         ``"tendon_stress<=6.32e7"``, ``"freq>=0.1"``, ``"mass<=start"``.
     variables : dict {name: (lower, upper)}, optional
         Design variables and bounds; default the system file's ``[design] variables``.
-    mesh_n, k, aperture : the MTC mesh, the number of eigenvalues, the wrinkling aperture
-        (:func:`design_sensitivities`).
-    max_iter, tol : SLSQP's iteration limit and tolerance (on the scaled objective).
+    mesh_n : int
+        Membrane elements per side of the MTC model.
+    k : int
+        Number of lowest eigenvalues (the bound formulation's m).
+    aperture : float, optional
+        The wrinkling indicator's aperture (:func:`design_sensitivities`).
+    max_iter : int
+        SLSQP's iteration limit.
+    tol : float
+        SLSQP's tolerance on the scaled objective.
     history : path, optional
         CSV of the iterations (iteration, objective, max_violation, step), written as
         ``NAME.csv.partial`` while the run goes and renamed when it ends.
