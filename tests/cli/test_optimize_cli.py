@@ -46,9 +46,19 @@ def test_optimum_written_back_is_taken_by_static_and_modal(tmp_path, capsys):
     assert mo["freq_hz"][0] == pytest.approx(r["optimum_responses"]["freq"][0], rel=1e-6)
 
 
+def test_sbc_optimum_is_taken_by_static_on_the_sbc_model(tmp_path, capsys):
+    path = design_file(tmp_path, {"variables": {"S1": [1.40, 1.52]}})
+    rc, r = run(["optimize", str(path), "--model", "sbc", "--mesh", "4", "--objective", "max:freq",
+                 "--constraint", f"tendon_stress<={LIMIT}", "--out", str(tmp_path / "sbc")], capsys)
+    assert rc == 0 and r["ok"] and r["optimum_responses"]["freq"][0] > 1.25 * r["start_responses"]["freq"][0]
+    rc, st = run(["static", str(tmp_path / "sbc" / "optimal.toml"), "--model", "sbc", "--mesh", "4"], capsys)
+    assert rc == 0 and st["tendon_stress_max"] == pytest.approx(LIMIT, rel=1e-5)
+
+
 def test_options_that_do_not_apply_are_refused(tmp_path, capsys):
     path = design_file(tmp_path, {"variables": {"S1": [1.40, 1.52]}})
-    for argv, text in ((["--model", "sbc", "--objective", "max:freq"], "MTC model only"),
+    for argv, text in ((["--model", "sbc", "--objective", "max:freq", "--variable", "d_bar=0.01:0.04"],
+                        "expected rest-length variables"),
                        ([], "expected --objective"),
                        (["--objective", "max:freq", "--variable", "r_mb=1:2"], "ch. 3 design geometry"),
                        (["--objective", "max:freq", "--variable", "S1=1.4"], "NAME=LOWER:UPPER")):

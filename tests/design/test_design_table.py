@@ -1,11 +1,8 @@
-"""The ``[design]`` table of a system file: read, written back, refused when malformed; and
-the models and backends the sensitivities do not cover, refused."""
+"""The ``[design]`` table of a system file: read, written back, refused when malformed."""
 import pytest
 import tomli_w
 
-from tmfem.design import design_sensitivities
 from tmfem.errors import InputError
-from tmfem.models.sbc.model import SBCModel
 from tmfem.system import dump_system, load_preset, load_system
 from tmfem.system.spec import system_to_dict
 
@@ -44,9 +41,3 @@ def test_design_table_is_read_and_written_back(tmp_path):
 def test_malformed_design_tables_are_refused(tmp_path, design, text):
     with pytest.raises(InputError, match=text):
         load_system(write(tmp_path, design))
-
-
-def test_the_sbc_model_is_refused():
-    m = SBCModel(load_preset("1-4D"), mesh_n=2)
-    with pytest.raises(InputError, match="expected an MTC model"):
-        design_sensitivities(m)

@@ -1,4 +1,4 @@
-"""Optimal design of a tensegrity-membrane system on the MTC model with exact gradients.
+"""Optimal design of a tensegrity-membrane system on the MTC (or SBC) model with exact gradients.
 
 Problem: minimise or maximise one response f(p) of :data:`tmfem.design.sensitivities.RESPONSES`
 over the design variables p (:mod:`tmfem.design.variables`) within their bounds, subject to
@@ -124,14 +124,19 @@ class OptimizationResult:
 
 
 class _Evaluator:
-    """Equilibrium and sensitivities at a design p, cached for the last p."""
+    """Equilibrium and sensitivities at a design p, cached for the last p; each equilibrium
+    starts from the last one."""
 
-    def __init__(self, system, names, mesh_n, k, aperture, model_options):
+    def __init__(self, system, names, model, mesh_n, k, aperture, model_options):
         from tmfem.models.mtc.model import MTCModel
-        self.MTCModel = MTCModel
+        from tmfem.models.sbc.model import SBCModel
+        if model not in ("mtc", "sbc"):
+            raise InputError(f"optimize: expected model 'mtc' or 'sbc', found {model!r}")
+        self.Model = MTCModel if model == "mtc" else SBCModel
+        self.start = "x0" if model == "mtc" else "start"
         self.system, self.mesh_n, self.k, self.aperture = system, mesh_n, k, aperture
         self.model_options = model_options
-        m = MTCModel(system, mesh_n=mesh_n, **model_options)
+        m = self.Model(system, mesh_n=mesh_n, **model_options)
         self.r0 = m.rest_lengths.copy()
         self.vars = parse_variables(system, names)
         self.p0 = variable_values(system, self.r0, self.vars)
@@ -144,8 +149,8 @@ class _Evaluator:
         if self.last is not None and np.array_equal(self.last[0], p):
             return self.last[1]
         sysp, r = apply_design(self.system, self.r0, self.vars, p)
-        m = self.MTCModel(sysp, mesh_n=self.mesh_n, rest_lengths=r, **self.model_options)
-        eq = m.equilibrium(x0=self.x) if self.x is not None else m.equilibrium()
+        m = self.Model(sysp, mesh_n=self.mesh_n, rest_lengths=r, **self.model_options)
+        eq = m.equilibrium(**({} if self.x is None else {self.start: self.x}))
         self.x = eq.state
         s = design_sensitivities(m, equilibrium=eq, variables=[v.name for v in self.vars], k=self.k,
                                  aperture=self.aperture)
@@ -160,7 +165,8 @@ def _entries(s, name: str):
     return np.atleast_1d(v).astype(float), np.reshape(g, (-1, len(s.names)))
 
 
-def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: int = 10, k: int = 4,
+def optimize(system, *, objective: str, constraints=(), variables=None, model: str = "mtc",
+             mesh_n: int = 10, k: int = 4,
              aperture: float | None = None, max_iter: int = 60, tol: float = 1e-6, history=None,
              model_options=None) -> OptimizationResult:
     """Optimal design of ``system`` (module docstring).
@@ -174,6 +180,8 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
         ``"tendon_stress<=6.32e7"``, ``"freq>=0.1"``, ``"mass<=start"``.
     variables : dict {name: (lower, upper)}, optional
         Design variables and bounds; default the system file's ``[design] variables``.
+    model : {"mtc", "sbc"}
+        The finite-element model (the SBC model: rest-length variables only).
     mesh_n : int
         Membrane elements per side of the MTC model.
     k : int
@@ -188,7 +196,7 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
         CSV of the iterations (iteration, objective, max_violation, step), written as
         ``NAME.csv.partial`` while the run goes and renamed when it ends.
     model_options : dict, optional
-        Further :class:`MTCModel` options (``tendon_elements``, ``attachment``, ...).
+        Further options of the model (``tendon_elements``, ``attachment``, ...).
     """
     t0 = time.perf_counter()
     sense, obj = parse_objective(objective)
@@ -206,7 +214,7 @@ def optimize(system, *, objective: str, constraints=(), variables=None, mesh_n: 
     hi = np.array([float(variables[n][1]) for n in names])
     if not np.all(np.isfinite(lo) & np.isfinite(hi) & (hi > lo)):
         raise InputError(f"optimize: expected finite bounds lower < upper, found {dict(zip(names, zip(lo, hi)))}")
-    ev = _Evaluator(system, names, mesh_n, k, aperture, dict(model_options or {}))
+    ev = _Evaluator(system, names, model, mesh_n, k, aperture, dict(model_options or {}))
     p0 = ev.p0
     if np.any(p0 < lo - 1e-12) or np.any(p0 > hi + 1e-12):
         bad = [n for n, a, b, v in zip(names, lo, hi, p0) if not a - 1e-12 <= v <= b + 1e-12]

@@ -1,7 +1,8 @@
 """State responses of the MTC model and their derivatives along a change of the positions.
 
 Each function takes the positions x (3, n_nodes) and directions dx (3, n_nodes, n_var) (the
-derivatives of x with respect to the variables from the direct sensitivity equation) and
+derivatives of x with respect to the variables from the direct sensitivity equation), or the
+reduced increments du and the model's kinematics (:mod:`tmfem.design.kinematics`), and
 returns the value and its derivative (n_var,) at fixed design; the design's own (partial)
 dependence is added by :func:`tmfem.design.sensitivities.design_sensitivities`.
 
@@ -10,8 +11,9 @@ dependence is added by :func:`tmfem.design.sensitivities.design_sensitivities`.
   the minimum is -KS(-g), a lower bound. It replaces the maximum over the membrane's Gauss
   points, which is not differentiable where the largest point changes.
 * :func:`membrane_aggregates`: the von Mises stress (eq. 5.30) and the minor in-plane
-  principal stress (eq. 5.29; below zero the membrane wrinkles) of the Cauchy stress in the
-  floating frame at every Gauss point, aggregated by KS. Their derivative along dx is a
+  principal stress (eq. 5.29; below zero the membrane wrinkles) at every Gauss point (MTC:
+  of the Cauchy stress in the floating frame; SBC: of the shells' mid surface), aggregated
+  by KS. Their derivative along dx is a
   Richardson-extrapolated central difference (4 D(h) - D(2h)) / 3 of the explicit stress
   function of the positions (no re-solve), error O(h^4), with a step h that moves a node by
   1e-4 of the model's size: the membrane strains are small (1e-6 to 1e-4) and formed from
@@ -60,35 +62,28 @@ def aperture_mask(model, points: np.ndarray, aperture: float | None) -> np.ndarr
     return np.linalg.norm(points - c[:, None, None], axis=0) <= aperture * inradius
 
 
-def membrane_aggregates(model, x: np.ndarray, dx: np.ndarray, *, width: float,
-                        aperture: float | None) -> dict:
+def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: float | None) -> dict:
     """KS aggregates of the von Mises and (with -KS(-g)) the minor principal stress over
     the membrane's Gauss points (the minor one inside the ``aperture``), and their
-    derivatives along dx (module docstring). Returns ``{name: (value, derivative)}``."""
-    nm = model.topology.n_mesh
-    mem = model.membrane
-
-    def fields(xm):
-        st = mem.stresses(xm)
-        return st.von_mises, minor_principal(st.cauchy), st.points
-
-    vm, mp, points = fields(x[:, :nm])
+    derivatives along the reduced increments du (n_red, n_var) (module docstring); ``kin``
+    moves the model's state (:mod:`tmfem.design.kinematics`). Returns ``{name: (value,
+    derivative)}``."""
+    vm, mp, points = kin.membrane(kin.point(np.zeros(du.shape[0])))
     inside = aperture_mask(model, points, aperture)
     vm_ks, w_vm = ks_max(vm, width)
     mp_ks, w_mp = ks_max(-mp[inside], width)
-    n_var = dx.shape[-1]
+    n_var = du.shape[-1]
     d_vm, d_mp = np.zeros(n_var), np.zeros(n_var)
-    size = float(np.ptp(x, axis=1).max())
+    size = float(np.ptp(kin.x, axis=1).max())
     for j in range(n_var):
-        dxj = dx[:, :nm, j]
-        top = float(np.abs(dxj).max())
+        top = float(np.abs(kin.positions(du[:, j])).max())
         if top == 0.0:
             continue
         h = 1e-4 * size / top
         diffs = []
         for step in (h, 2 * h):
-            vp, mpp, _ = fields(x[:, :nm] + step * dxj)
-            vmn, mpn, _ = fields(x[:, :nm] - step * dxj)
+            vp, mpp, _ = kin.membrane(kin.point(step * du[:, j]))
+            vmn, mpn, _ = kin.membrane(kin.point(-step * du[:, j]))
             diffs.append(np.array([w_vm @ (vp - vmn).ravel(), w_mp @ (mpp - mpn)[inside]]) / (2 * step))
         d_vm[j], d_mp[j] = (4 * diffs[0] - diffs[1]) / 3
     return {"membrane_von_mises": (vm_ks, d_vm), "membrane_min_principal": (-mp_ks, d_mp)}
@@ -97,8 +92,9 @@ def membrane_aggregates(model, x: np.ndarray, dx: np.ndarray, *, width: float,
 def surface_rms(model, x: np.ndarray, dx: np.ndarray):
     """RMS distance of the membrane nodes from their best-fit plane and its derivative along
     dx (module docstring)."""
+    from tmfem.fem.membrane import MembraneTL
     nm = model.topology.n_mesh
-    mem = model.membrane
+    mem = getattr(model, "membrane", None) or MembraneTL(mesh=model.topology.mesh, material=model.system.membrane)
     w = np.asarray(mem.mass().sum(axis=1)).ravel()[0::3]
     w = w / w.sum()
     xm = x[:, :nm]

@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from tmfem.design.kinematics import kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
 from tmfem.design.variables import Variable, area_derivative, parse_variables
 from tmfem.errors import InputError
@@ -196,11 +197,11 @@ def _subset(trusses: TrussSet, mask: np.ndarray) -> TrussSet:
                     rhoA=trusses.rhoA[mask], tension_only=trusses.tension_only[mask])
 
 
-def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndarray) -> _Partials:
-    """The :class:`_Partials` of variable v (g: its column of G, dL: of the element rest lengths)."""
-    T = model.topology.T
-    nt, nb = len(model.system.tendons), model.bars.ne
-    tendons, bars = model.tendons, model.bars
+def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndarray, T) -> _Partials:
+    """The :class:`_Partials` of variable v (g: its column of G, dL: of the element rest
+    lengths; T: the reduced-to-full map of the residual)."""
+    nt, nb = len(model.system.tendons), Ncr.size
+    tendons, bars = model.tendons, getattr(model, "bars", None)
     zt, zb = np.zeros(tendons.ne), np.zeros(nb)
     if v.kind == "rest_length":
         dR = T.T @ (truss_rest_length_derivatives(x, tendons, dofmap=model.dofmap) @ dL)
@@ -239,10 +240,11 @@ def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndar
 
 
 def total_mass(model) -> float:
-    """Total mass [kg]: bars and tendons rho A L (rest lengths), membrane rho h area."""
-    mat = model.membrane.material
-    return float(model.bars.rhoA @ model.bars.L + model.tendons.rhoA @ model.tendons.L
-                 + mat.rho * mat.h * model.membrane.area())
+    """Total mass [kg]: bars rho A l, tendons rho A r (rest lengths), membrane rho h area."""
+    sysm = model.system
+    mat = sysm.membrane
+    return float(sysm.bar.mass(float(sysm.l.sum())) + model.tendons.rhoA @ model.tendons.L
+                 + mat.rho * mat.h * model.membrane_area())
 
 
 def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int = 4,
@@ -281,9 +283,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
         raise InputError(f"k: expected a positive integer, found {k!r}")
     if axis not in (0, 1, 2):
         raise InputError(f"axis: expected 0, 1 or 2, found {axis!r}")
-    if getattr(model, "name", None) != "mtc":
-        raise InputError(f"sensitivities: expected an MTC model, found {getattr(model, 'name', model)!r} "
-                         f"(the SBC model's sensitivities are not implemented)")
+    if getattr(model, "name", None) not in ("mtc", "sbc"):
+        raise InputError(f"sensitivities: expected an MTC or SBC model, found {getattr(model, 'name', model)!r}")
     if model.tendon_law != "cable":
         raise InputError(f"sensitivities: expected a model with tendon_law='cable' (EA fixed as the "
                          f"rest length changes), found {model.tendon_law!r}")
@@ -292,33 +293,39 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
                          "distributed one")
     if aperture is not None and not (isinstance(aperture, (int, float)) and aperture > 0):
         raise InputError(f"aperture: expected a positive fraction of the inradius, found {aperture!r}")
-    width = 1e-6 * model.membrane.material.E if ks_width is None else ks_width
+    width = 1e-6 * model.system.membrane.E if ks_width is None else ks_width
     if not (isinstance(width, (int, float)) and width > 0):
         raise InputError(f"ks_width: expected a positive stress [Pa], found {ks_width!r}")
     node_at = None if node is None else model.topology.system_node[model.system.node_index(node)]
     vs = parse_variables(model.system, variables)
     if thickness and "h_membrane" not in [v.name for v in vs]:
         vs.append(Variable("h_membrane", "thickness"))
+    sbc = model.name == "sbc"
+    if sbc and any(v.kind != "rest_length" for v in vs):
+        raise InputError(f"sensitivities of the SBC model: expected rest-length variables, found "
+                         f"{[v.name for v in vs if v.kind != 'rest_length']} (its shells and beams bend: "
+                         f"not linear in the thickness and the diameters; use the MTC model)")
     eq = model.equilibrium() if equilibrium is None else equilibrium
+    kin = kinematics(model, eq)
     names = [v.name for v in vs]
     G = _rest_length_map(model, vs)
     n_var = len(vs)
     topo, free = model.topology, model.free
-    x = eq.state
-    xr = model.reduce(x)
+    x = kin.x
     tendons = model.tendons
     kt = topo.tendon_elements
     e2t = sp.csr_matrix((np.full(tendons.ne, 1.0 / kt), (np.arange(tendons.ne), topo.tendon_of_element)),
                         shape=(tendons.ne, G.shape[0]))
     dL = e2t @ G                                                       # dL_e / dp  (ne, n_var)
-    Ncr = np.array([model.system.bar.euler_critical_load(l) for l in model.bars.L])
-    parts = [_partials(model, v, G[:, j], x, dL[:, j], Ncr) for j, v in enumerate(vs)]
+    Ncr = np.array([model.system.bar.euler_critical_load(l) for l in model.system.l.ravel()])
+    parts = [_partials(model, v, G[:, j], x, dL[:, j], Ncr, kin.T) for j, v in enumerate(vs)]
     dR = np.column_stack([p.dR for p in parts])
-    K = eq.tangent if eq.tangent is not None else model.residual(xr)[1]
+    n_red = dR.shape[0]
+    K = eq.tangent if eq.tangent is not None else kin.tangent(kin.point(np.zeros(n_red)))
     solve = model.backend.factorize(sp.csr_matrix(K)[free][:, free])
-    du = np.zeros((xr.size, n_var))
+    du = np.zeros((n_red, n_var))
     du[free] = solve(-dR[free]).reshape(-1, n_var)
-    dx = np.stack([model.full(du[:, j]) for j in range(n_var)], axis=-1)   # (3, nn, n_var)
+    dx = np.stack([kin.positions(du[:, j]) for j in range(n_var)], axis=-1)   # (3, nn, n_var)
 
     # eigenvalues: two extra modes so that a cluster at the k-th is complete
     n_modes = min(k + 2, int(free.sum()))
@@ -326,22 +333,29 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     lam, Phi = modes.omega2, modes.shapes
     clusters = [c for c in _clusters(lam) if c[0] < k]
     r0 = model.rest_lengths.copy()
-    scale = step * max(float(np.abs(xr).max()), float(r0.max()))
+    scale = step * max(float(np.abs(x).max()), float(r0.max()))
     dlam = np.zeros((k, n_var))
+    dNb_state = np.zeros((Ncr.size, n_var))
     for j in range(n_var):
         # the step moves the state by `scale` at most, whatever the variable's units
         h = scale / max(1.0, float(np.abs(du[:, j]).max()), float(np.abs(G[:, j]).max()))
-        Kpm = []
+        Kpm, Mpm, Npm = [], [], []
         try:
             for sgn in (1.0, -1.0):
                 model.set_tendon_lengths(r0 + sgn * h * G[:, j])
-                Kpm.append(model.residual(xr + sgn * h * du[:, j])[1])
+                pt = kin.point(sgn * h * du[:, j])
+                Kpm.append(kin.tangent(pt))
+                if sbc:                  # the shells' and beams' mass follows the directors
+                    Mpm.append(kin.mass(pt))
+                    Npm.append(kin.bar_forces(pt))
         finally:
             model.set_tendon_lengths(r0)
         dK = (Kpm[0] - Kpm[1]) / (2 * h)
         if parts[j].dK is not None:
             dK = dK + parts[j].dK
-        dM = parts[j].dM
+        dM = (Mpm[0] - Mpm[1]) / (2 * h) if sbc else parts[j].dM
+        if sbc:
+            dNb_state[:, j] = (Npm[0] - Npm[1]) / (2 * h)
         for c in clusters:
             P = Phi[:, c]
             A = P.T @ (dK @ P) - lam[c].mean() * (P.T @ (dM @ P))
@@ -363,7 +377,10 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     area = model.tendon_area[topo.tendon_of_element]
     dA = np.column_stack([p.dA_t for p in parts])
     dstress = dN / area[:, None] - (N / area**2)[:, None] * dA[topo.tendon_of_element]
-    Nb, dNb = member_forces(model.bars, np.column_stack([p.dN_b for p in parts]))
+    if sbc:                              # the beams' axial forces, along (du/dp, dp)
+        Nb, dNb = kin.bar_forces(kin.point(np.zeros(n_red))), dNb_state
+    else:
+        Nb, dNb = member_forces(model.bars, np.column_stack([p.dN_b for p in parts]))
     dNcr = np.column_stack([p.dNcr for p in parts])
     i_f, i_s = int(np.argmax(N)), int(np.argmax(N / area))
     position = d_position = None
@@ -389,7 +406,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
                             ("corner_delta_max", "corner_delta", np.argmax)):
         i = int(pick(values[vec]))
         values[name], grads[name] = float(values[vec][i]), grads[vec][i].copy()
-    for name, (val, grad) in membrane_aggregates(model, x, dx, width=width, aperture=aperture).items():
+    for name, (val, grad) in membrane_aggregates(model, kin, du, width=width, aperture=aperture).items():
         values[name], grads[name] = val, grad
     values["surface_rms"], grads["surface_rms"] = surface_rms(model, x, dx)
     if position is not None:
