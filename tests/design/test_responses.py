@@ -129,3 +129,10 @@ def test_variables_that_change_the_geometry_or_do_not_exist_are_refused():
                             (["S1", "S_11"], "two variables"), ([], "at least one")):
         with pytest.raises(InputError, match=text):
             design_sensitivities(m, variables=variables)
+
+
+def test_a_distributed_backend_is_refused():
+    pytest.importorskip("petsc4py")
+    m = MTCModel(load_preset("1-4"), mesh_n=2, backend="petsc")
+    with pytest.raises(InputError, match="serial backend"):
+        design_sensitivities(m)
