@@ -1,6 +1,7 @@
 """``tmfem optimize`` on a system file with a [design] table: the optimum is written back as a
-system file that ``tmfem static`` and ``tmfem modal`` take, and their results agree with the
-optimiser's (tendon stress at its bound, the same first frequency)."""
+system file that ``tmfem equilibrium`` (every ch. 3 check passes), ``static`` and ``modal``
+take, and their results agree with the optimiser's (tendon stress at its bound, the same
+first frequency)."""
 import json
 
 import pytest
@@ -41,6 +42,8 @@ def test_optimum_written_back_is_taken_by_static_and_modal(tmp_path, capsys):
     rc, st = run(["static", opt, "--mesh", "4"], capsys)
     assert rc == 0 and all(c["ok"] for c in st["checks"])
     assert st["tendon_stress_max"] == pytest.approx(LIMIT, rel=1e-5)
+    rc, eq = run(["equilibrium", opt], capsys)                   # every check of ch. 3
+    assert rc == 0 and eq["ok"] and all(c["ok"] for c in eq["checks"])
     rc, mo = run(["modal", opt, "--mesh", "4", "--modes", "4"], capsys)
     assert rc == 0
     assert mo["freq_hz"][0] == pytest.approx(r["optimum_responses"]["freq"][0], rel=1e-6)
