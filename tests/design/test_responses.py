@@ -120,6 +120,10 @@ def test_every_response_is_read_by_name():
             s.value(bad)
     with pytest.raises(InputError, match="expected a node"):
         design_sensitivities(m, k=1).value("position")
+    for kwargs, text in (({"aperture": 1e-3}, "found none on this mesh"), ({"aperture": -1.0}, "aperture"),
+                         ({"ks_width": 0.0}, "ks_width")):
+        with pytest.raises(InputError, match=text):
+            design_sensitivities(m, k=1, **kwargs)
 
 
 def test_variables_that_change_the_geometry_or_do_not_exist_are_refused():

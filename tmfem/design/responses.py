@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from tmfem.errors import InputError
 from tmfem.system.topology import label
 
 
@@ -70,6 +71,9 @@ def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: f
     derivative)}``."""
     vm, mp, points = kin.membrane(kin.point(np.zeros(du.shape[0])))
     inside = aperture_mask(model, points, aperture)
+    if not inside.any():
+        raise InputError(f"aperture: expected Gauss points within {aperture} of the membrane's inradius, "
+                         f"found none on this mesh (enlarge the aperture or refine the mesh)")
     vm_ks, w_vm = ks_max(vm, width)
     mp_ks, w_mp = ks_max(-mp[inside], width)
     n_var = du.shape[-1]
