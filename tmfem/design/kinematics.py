@@ -20,7 +20,6 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.design.responses import minor_principal
-from tmfem.errors import InputError
 
 
 class MTCKinematics:
@@ -84,10 +83,5 @@ class SBCKinematics:
 
 
 def kinematics(model, eq):
-    """The adapter of ``model`` (MTC or SBC) at the equilibrium ``eq``."""
-    name = getattr(model, "name", None)
-    if name == "mtc":
-        return MTCKinematics(model, eq)
-    if name == "sbc":
-        return SBCKinematics(model, eq)
-    raise InputError(f"sensitivities: expected an MTC or SBC model, found {name or model!r}")
+    """The adapter of ``model`` (an MTC or SBC model, ``model.name``) at the equilibrium ``eq``."""
+    return (SBCKinematics if model.name == "sbc" else MTCKinematics)(model, eq)

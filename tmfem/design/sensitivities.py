@@ -1,4 +1,5 @@
-"""Exact design sensitivities of the MTC model at its static equilibrium.
+"""Exact design sensitivities of the MTC model (and, for the rest lengths, of the SBC model) at
+its static equilibrium.
 
 Variables p (:mod:`tmfem.design.variables`): tendon rest lengths, per group (``"S1"``,
 ``"V2"``: every tendon of the group moves together, r = r_0 + G p) or per tendon, the membrane
@@ -251,15 +252,16 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
                          node: str | None = None, axis: int = 2, thickness: bool = False,
                          aperture: float | None = None, ks_width: float | None = None,
                          step: float = 1e-4) -> Sensitivities:
-    """Responses of an MTC model at its static equilibrium and their exact derivatives with
-    respect to the design variables (module docstring: direct method, eigenvalue and
-    cluster derivatives).
+    """Responses of an MTC or SBC model at its static equilibrium and their exact derivatives
+    with respect to the design variables (module docstring: direct method, eigenvalue and
+    cluster derivatives; :mod:`tmfem.design.kinematics` for the SBC model's rotations).
 
     Parameters
     ----------
-    model : MTCModel
+    model : MTCModel or SBCModel
+        On a serial backend; the SBC model with rest-length variables only.
     equilibrium : Equilibrium, optional
-        A converged :meth:`MTCModel.equilibrium` at the model's current rest lengths (default:
+        A converged ``model.equilibrium()`` at the model's current rest lengths (default:
         solved here from the undeformed membrane).
     variables : {"groups", "tendons"} or sequence of str
         One variable per tendon group (r_t = r_t0 + p_group), per tendon, or the named
