@@ -45,6 +45,7 @@ def _variables(items) -> dict:
 def run(args) -> dict:
     from tmfem.design.optimize import optimize, result_dict
     from tmfem.design.plots import plot_history
+    from tmfem.design.sensitivities import RESPONSES
     from tmfem.system import dump_system
 
     out = output_dir(args.out, option="--out")
@@ -63,7 +64,9 @@ def run(args) -> dict:
     r = result_dict(res)
     if out is not None:
         dump_system(res.system.replace(name=f"{system.name}-optimal"), out / "optimal.toml")
-        plot_history(res.history, out / "history.png", objective=res.objective)
+        name = res.objective.split(":")[1]
+        unit = RESPONSES.get(name, RESPONSES.get(name.rpartition("_")[0], ("", "")))[1]
+        plot_history(res.history, out / "history.png", objective=f"{res.objective} [{unit}]")
         r["files"] = {k: str(out / f) for k, f in (("history", "history.csv"), ("plot", "history.png"),
                                                    ("system", "optimal.toml"))}
     r["ok"] = res.success
