@@ -10,7 +10,7 @@ from scipy.optimize import nnls
 from tmfem.design import design_sensitivities, optimize
 from tmfem.design.optimize import parse_constraint, parse_objective
 from tmfem.design.variables import apply_design, parse_variables
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError
 from tmfem.models.mtc.model import MTCModel
 from tmfem.system import load_preset, load_system
 
@@ -128,3 +128,21 @@ def test_objectives_and_constraints_that_do_not_parse_are_refused():
         optimize(system, objective="max:freq", variables={"S1": (1.0, 1.2)}, mesh_n=2)
     with pytest.raises(InputError, match="expected design variables"):
         optimize(system, objective="max:freq", mesh_n=2)
+
+
+def test_a_failed_warm_start_falls_back_to_the_undeformed_membrane(monkeypatch):
+    # every warm-started solve fails: the run restarts each design from the undeformed
+    # membrane and reaches the same optimum as example 1's group form (the stress bound)
+    solve = MTCModel.equilibrium
+
+    def failing(self, *args, **kwargs):
+        if kwargs.get("x0") is not None:
+            raise ConvergenceError("no equilibrium from this start")
+        return solve(self, *args, **kwargs)
+
+    monkeypatch.setattr(MTCModel, "equilibrium", failing)
+    system = load_preset("1-4")
+    res = optimize(system, objective="max:freq", constraints=["tendon_stress<=6.32e7"],
+                   variables={"S1": (1.40, 1.52)}, mesh_n=4)
+    assert res.success
+    assert res.optimum_responses["tendon_stress"] == pytest.approx([6.32e7] * 4, rel=1e-6)

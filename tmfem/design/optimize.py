@@ -33,7 +33,7 @@ from scipy.optimize import minimize, nnls
 
 from tmfem.design.sensitivities import RESPONSES, design_sensitivities
 from tmfem.design.variables import apply_design, parse_variables, variable_values
-from tmfem.errors import InputError
+from tmfem.errors import ConvergenceError, InputError
 from tmfem.io.run import partial_name
 
 log = logging.getLogger(__name__)
@@ -125,7 +125,7 @@ class OptimizationResult:
 
 class _Evaluator:
     """Equilibrium and sensitivities at a design p, cached for the last p; each equilibrium
-    starts from the last one."""
+    starts from the last one (from the undeformed membrane when that fails)."""
 
     def __init__(self, system, names, model, mesh_n, k, aperture, model_options):
         from tmfem.models.mtc.model import MTCModel
@@ -150,7 +150,13 @@ class _Evaluator:
             return self.last[1]
         sysp, r = apply_design(self.system, self.r0, self.vars, p)
         m = self.Model(sysp, mesh_n=self.mesh_n, rest_lengths=r, **self.model_options)
-        eq = m.equilibrium(**({} if self.x is None else {self.start: self.x}))
+        try:
+            eq = m.equilibrium(**({} if self.x is None else {self.start: self.x}))
+        except ConvergenceError:
+            if self.x is None:
+                raise
+            log.info("optimize: no equilibrium from the last design's state; from the undeformed membrane")
+            eq = m.equilibrium()
         self.x = eq.state
         s = design_sensitivities(m, equilibrium=eq, variables=[v.name for v in self.vars], k=self.k,
                                  aperture=self.aperture)
