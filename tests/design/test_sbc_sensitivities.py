@@ -2,14 +2,9 @@
 differences of its re-solved equilibrium: tendon-group rest lengths of 1-4 and of the
 deployable 1-4D (Richardson-extrapolated differences at 5e-4 and 1e-3 m, equilibrium to 1e-12
 of the member forces; a derivative is compared relative to its own size or, where smaller, to
-a tenth of |f| / |p| as in test_responses.py).
-
-The member forces, Euler ratios, mass, membrane stresses and corner displacements agree
-within 1e-5. The eigenvalue derivatives agree within 3e-5 on 1-4 but only within 1e-3 on
-1-4D: there the directional derivatives of the lowest pair split by 7e-4 while the re-solved
-pair stays double (its sum agrees within 1.4e-4); the tangent's directional derivative is
-converged in its step (1e-6 to 1e-3 give the same values) and the residual along (du/dp, dp)
-is O(h^2), so the difference is not the step's."""
+a tenth of |f| / |p| as in test_responses.py). The eigenvalue derivatives need the modes'
+refinement of :func:`tmfem.design.sensitivities._refined_modes`: with ARPACK's modes as they
+come (residual 3e-4) the lowest pair of 1-4D was 7e-4 off."""
 import numpy as np
 import pytest
 
@@ -53,11 +48,11 @@ def fd_check(preset):
     return err[:-4], err[-4:]
 
 
-@pytest.mark.parametrize("preset, eig_tol", [("1-4", 3e-5), ("1-4D", 1e-3)])
-def test_sbc_rest_length_gradients_match_finite_differences(preset, eig_tol):
+@pytest.mark.parametrize("preset", ["1-4", "1-4D"])
+def test_sbc_rest_length_gradients_match_finite_differences(preset):
     err_forces, err_eig = fd_check(preset)
     assert np.all(err_forces < 1e-5), err_forces.max(axis=0)
-    assert np.all(err_eig < eig_tol), err_eig
+    assert np.all(err_eig < 2e-5), err_eig          # worst 1.02e-5: omega_3^2 of 1-4D, along SL
 
 
 def test_sbc_sections_and_thickness_are_refused():

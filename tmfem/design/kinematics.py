@@ -11,9 +11,10 @@ sensitivities (:func:`tmfem.design.sensitivities.design_sensitivities`).
 
 Each adapter gives: ``T`` (the reduced-to-full map of the residual), ``x`` (node positions of
 the model's own numbering, (3, n)), ``point(du)`` (the residual's argument after the reduced
-increment du), ``tangent(point)``, ``mass(point)``, ``positions(du)`` (the translations (3, n)
-of a reduced increment), ``membrane(point)`` (von Mises and minor principal stresses and the
-reference points (2, ne, nqp) where they are evaluated) and ``bar_forces(point)``.
+increment du), ``tangent(point)``, ``mass(point)`` (the MTC model's does not depend on it),
+``positions(du)`` (the translations (3, n) of a reduced increment), ``membrane(point)`` (von
+Mises and minor principal stresses and the reference points (2, ne, nqp) where they are
+evaluated) and, for the SBC model, ``bar_forces(point)``.
 """
 from __future__ import annotations
 
@@ -37,6 +38,9 @@ class MTCKinematics:
 
     def tangent(self, point):
         return self.model.residual(point)[1]
+
+    def mass(self, point):
+        return self.model.mass()
 
     def positions(self, du) -> np.ndarray:
         return self.model.full(du)
