@@ -54,6 +54,7 @@ from tmfem.errors import InputError
 from tmfem.fem.element import State
 from tmfem.fem.truss import (TrussSet, truss_axial_force_derivatives, truss_internal, truss_mass,
                              truss_rest_length_derivatives)
+from tmfem.solvers.eigen import lowest_modes
 
 #: relative gap below which neighbouring eigenvalues form a cluster
 CLUSTER_TOL = 1e-6
@@ -295,7 +296,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     Parameters
     ----------
     model : MTCModel or SBCModel
-        On a serial backend; the SBC model with rest-length variables only.
+        The SBC model with rest-length variables only. On the PETSc backend (one rank) the
+        matrices are assembled serially and factorised and eigen-solved by PETSc.
     equilibrium : Equilibrium, optional
         A converged ``model.equilibrium()`` at the model's current rest lengths (default:
         solved here from the undeformed membrane).
@@ -326,9 +328,10 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     if model.tendon_law != "cable":
         raise InputError(f"sensitivities: expected a model with tendon_law='cable' (EA fixed as the "
                          f"rest length changes), found {model.tendon_law!r}")
-    if model.distributed is not None:
-        raise InputError("sensitivities: expected a model on a serial backend (scipy), found a "
-                         "distributed one")
+    distributed = model.distributed is not None
+    if distributed and getattr(getattr(model.backend, "comm", None), "size", 1) > 1:
+        raise InputError("sensitivities: expected one process (the PETSc backend on one rank), found "
+                         f"{model.backend.comm.size} ranks")
     if aperture is not None and not (isinstance(aperture, (int, float)) and aperture > 0):
         raise InputError(f"aperture: expected a positive fraction of the inradius, found {aperture!r}")
     width = 1e-6 * model.system.membrane.E if ks_width is None else ks_width
@@ -359,7 +362,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     parts = [_partials(model, v, G[:, j], x, dL[:, j], Ncr, kin.T) for j, v in enumerate(vs)]
     dR = np.column_stack([p.dR for p in parts])
     n_red = dR.shape[0]
-    K = eq.tangent if eq.tangent is not None else kin.tangent(kin.point(np.zeros(n_red)))
+    # the assembled tangent (a distributed backend's equilibrium holds its own matrix type)
+    K = eq.tangent if eq.tangent is not None and not distributed else kin.tangent(kin.point(np.zeros(n_red)))
     solve = model.backend.factorize(sp.csr_matrix(K)[free][:, free])
     du = np.zeros((n_red, n_var))
     du[free] = solve(-dR[free]).reshape(-1, n_var)
@@ -367,12 +371,14 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
 
     # eigenvalues: two extra modes so that a cluster at the k-th is complete
     n_modes = min(k + 2, int(free.sum()))
-    modes = model.modes(k=n_modes, at=eq)
+    K0 = sp.csr_matrix(K)
+    K0 = 0.5 * (K0 + K0.T)
+    M0 = kin.mass(kin.point(np.zeros(n_red)))
+    modes = lowest_modes(K0, M0, k=n_modes, free=free, sigma=-1.0, backend=model.backend) if distributed \
+        else model.modes(k=n_modes, at=eq)
     lam, Phi = modes.omega2, modes.shapes
     clusters = [c for c in _clusters(lam) if c[0] < k]
-    K0 = sp.csr_matrix(K)
-    lam, Phi = _refined_modes(0.5 * (K0 + K0.T), kin.mass(kin.point(np.zeros(n_red))), lam, Phi,
-                              clusters, free, model.backend)
+    lam, Phi = _refined_modes(K0, M0, lam, Phi, clusters, free, model.backend)
     r0 = model.rest_lengths.copy()
     scale = step * max(float(np.abs(x).max()), float(r0.max()))
     dlam = np.zeros((k, n_var))
