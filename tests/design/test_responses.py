@@ -3,7 +3,8 @@ re-solved equilibrium, for rest lengths, the membrane thickness and the bar and 
 diameters (mesh_n=4, equilibrium to a residual of 1e-12 of the member forces).
 
 The differences are Richardson-extrapolated central differences (4 D(h) - D(2h)) / 3, error
-O(h^4), with h = 5e-4 m on rest lengths and 1 % of a thickness or diameter: the membrane
+O(h^4), with h = 5e-4 m on rest lengths, 1 % of a thickness or diameter and 0.1 % of the
+membrane radius: the membrane
 strains are 1e-6 to 1e-4, so its stresses carry the equilibrium's round-off at smaller steps.
 A derivative is compared relative to its own size, or to a tenth of the response's logarithmic
 scale |f| / |p| where it is smaller than that: the bar forces depend on the bar diameter by
@@ -43,7 +44,7 @@ def fd_check(system, variables, names, rest_lengths=None):
     f0, exact = stacked(design_sensitivities(m, equilibrium=eq, variables=variables, **OPTIONS), names)
     fd = np.zeros_like(exact)
     for j, v in enumerate(vs):
-        h = 5e-4 if v.kind == "rest_length" else 0.01 * p0[j]
+        h = {"rest_length": 5e-4, "membrane_radius": 1e-3 * p0[j]}.get(v.kind, 0.01 * p0[j])
         central = []
         for step in (h, 2 * h):
             vals = []
@@ -69,14 +70,14 @@ def test_responses_of_1_4_for_every_kind_of_variable_match_finite_differences():
     # the 1-4 membrane stays flat (its corners coplanar by symmetry): surface_rms is checked
     # on an asymmetric design below
     names = [n for n in SCALARS if n != "surface_rms"] + VECTORS
-    exact, fd, f0, p0 = fd_check(load_preset("1-4"), ["S1", "h_membrane", "d_bar", "d_S"], names)
+    exact, fd, f0, p0 = fd_check(load_preset("1-4"), ["S1", "h_membrane", "d_bar", "d_S", "r_mb"], names)
     err = rel_err(exact, fd, f0, p0)
     assert np.all(err < 1e-5), err.max(axis=0)
 
 
 def test_responses_of_two_stage_2_3_match_finite_differences():
     names = [n for n in SCALARS if n != "surface_rms"] + VECTORS      # flat by symmetry too
-    exact, fd, f0, p0 = fd_check(load_preset("2-3"), ["S1", "V2", "d_V", "d_bar"], names)
+    exact, fd, f0, p0 = fd_check(load_preset("2-3"), ["S1", "V2", "d_V", "d_bar", "r_mb"], names)
     err = rel_err(exact, fd, f0, p0)
     assert np.all(err < 1e-5), err.max(axis=0)
 
@@ -97,14 +98,14 @@ def test_mass_is_the_sum_of_the_members_and_the_membrane():
     # sin(2 pi / N) / 2 of the regular polygon)
     system = load_preset("1-4")
     m = MTCModel(system, mesh_n=4)
-    s = design_sensitivities(m, variables=["S1", "h_membrane", "d_bar", "d_S"])
+    s = design_sensitivities(m, variables=["S1", "h_membrane", "d_bar", "d_S", "r_mb"])
     bar, sec, mem = system.bar, system.tendon_sections["S"], system.membrane
     area = system.r_mb**2 * system.N * np.sin(2 * np.pi / system.N) / 2
     tendon = sec.rho * sec.area * m.rest_lengths.sum()
     expected = bar.mass(1.0) * system.l.sum() + tendon + mem.rho * mem.h * area
     assert s.value("mass") == pytest.approx(expected, rel=1e-4)
     grad = [sec.rho * sec.area * 4, mem.rho * area, bar.rho * np.pi * bar.d / 2 * system.l.sum(),
-            2 * tendon / sec.d]
+            2 * tendon / sec.d, 2 * mem.rho * mem.h * area / system.r_mb]
     assert s.gradient("mass") == pytest.approx(grad, rel=1e-4)
 
 
@@ -129,7 +130,7 @@ def test_every_response_is_read_by_name():
 
 def test_variables_that_change_the_geometry_or_do_not_exist_are_refused():
     m = MTCModel(load_preset("1-4"), mesh_n=2)
-    for variables, text in ((["r_mb"], "ch. 3 design geometry"), (["theta_11"], "ch. 3 design geometry"),
+    for variables, text in ((["psi_11"], "ch. 3 design geometry"), (["theta_11"], "ch. 3 design geometry"),
                             (["d_Q"], "expected a tendon group"), (["S1", "S1"], "distinct"),
                             (["S1", "S_11"], "two variables"), ([], "at least one")):
         with pytest.raises(InputError, match=text):
@@ -140,7 +141,7 @@ def test_variables_that_change_the_geometry_or_do_not_exist_are_refused():
                                                (SBCModel, "groups")])
 def test_petsc_backend_gives_the_gradients_of_scipy(Model, variables):
     # the same responses and gradients with PETSc's factorisation and SLEPc's modes on the
-    # PETSc backend's equilibrium (measured: gradients within 1e-9 of each column's largest)
+    # PETSc backend's equilibrium (measured: within 2e-8 of each column's largest)
     pytest.importorskip("petsc4py")
     out = []
     for backend in ("scipy", "petsc"):
@@ -149,4 +150,4 @@ def test_petsc_backend_gives_the_gradients_of_scipy(Model, variables):
         out.append(stacked(s, SCALARS[:-1] + VECTORS))
     (f_s, g_s), (f_p, g_p) = out
     assert f_p == pytest.approx(f_s, rel=1e-7, abs=1e-9)
-    assert np.all(np.abs(g_p - g_s) <= 1e-8 * np.abs(g_s).max(axis=0)), np.abs(g_p - g_s).max(axis=0)
+    assert np.all(np.abs(g_p - g_s) <= 1e-7 * np.abs(g_s).max(axis=0)), np.abs(g_p - g_s).max(axis=0)

@@ -63,12 +63,16 @@ def aperture_mask(model, points: np.ndarray, aperture: float | None) -> np.ndarr
     return np.linalg.norm(points - c[:, None, None], axis=0) <= aperture * inradius
 
 
-def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: float | None) -> dict:
+def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: float | None,
+                        moved=None) -> dict:
     """KS aggregates of the von Mises and (with -KS(-g)) the minor principal stress over
     the membrane's Gauss points (the minor one inside the ``aperture``), and their
     derivatives along the reduced increments du (n_red, n_var) (module docstring); ``kin``
-    moves the model's state (:mod:`tmfem.design.kinematics`). Returns ``{name: (value,
-    derivative)}``."""
+    moves the model's state (:mod:`tmfem.design.kinematics`). ``moved``: {j: fields(step)},
+    the stresses at the state and design moved by +-step along variable j, for a variable
+    on which the stresses depend at fixed positions (the membrane radius). Returns
+    ``{name: (value, derivative)}``."""
+    moved = moved or {}
     vm, mp, points = kin.membrane(kin.point(np.zeros(du.shape[0])))
     inside = aperture_mask(model, points, aperture)
     if not inside.any():
@@ -81,13 +85,16 @@ def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: f
     size = float(np.ptp(kin.x, axis=1).max())
     for j in range(n_var):
         top = float(np.abs(kin.positions(du[:, j])).max())
-        if top == 0.0:
+        if top == 0.0 and j not in moved:
             continue
-        h = 1e-4 * size / top
+        h = 1e-4 * size / max(top, 1.0)
         diffs = []
         for step in (h, 2 * h):
-            vp, mpp, _ = kin.membrane(kin.point(step * du[:, j]))
-            vmn, mpn, _ = kin.membrane(kin.point(-step * du[:, j]))
+            if j in moved:
+                (vp, mpp, _), (vmn, mpn, _) = moved[j](step)
+            else:
+                vp, mpp, _ = kin.membrane(kin.point(step * du[:, j]))
+                vmn, mpn, _ = kin.membrane(kin.point(-step * du[:, j]))
             diffs.append(np.array([w_vm @ (vp - vmn).ravel(), w_mp @ (mpp - mpn)[inside]]) / (2 * step))
         d_vm[j], d_mp[j] = (4 * diffs[0] - diffs[1]) / 3
     return {"membrane_von_mises": (vm_ks, d_vm), "membrane_min_principal": (-mp_ks, d_mp)}

@@ -3,10 +3,12 @@ its static equilibrium.
 
 Variables p (:mod:`tmfem.design.variables`): tendon rest lengths, per group (``"S1"``,
 ``"V2"``: every tendon of the group moves together, r = r_0 + G p) or per tendon, the membrane
-thickness h, the bar diameter and the tendon diameters per family. The internal force,
-tangent and mass of the membrane are linear in h, those of the bars and of a tendon family
-linear in their area A at fixed positions: dR/dA = f / A, dK/dA = K / A, dM/dA = M / A, and
-dA/dd = pi d / 2. Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
+thickness h, the bar diameter, the tendon diameters per family and the membrane radius. The
+internal force, tangent and mass of the membrane are linear in h, those of the bars and of a
+tendon family linear in their area A at fixed positions: dR/dA = f / A, dK/dA = K / A,
+dM/dA = M / A, and dA/dd = pi d / 2; the membrane radius scales the membrane's reference mesh,
+whose partial derivatives are central differences of the assembled quantities at fixed
+positions (:func:`with_radius`). Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
 eigenvalues lambda = omega^2 of (K_T - lambda M) phi = 0 (eq. 5.32), the total mass, the tendon
 forces and stresses (the slack margin is the smallest force), the bars' compression against
 the Euler load (eq. 5.31), the membrane stresses (eqs. 5.29-5.30, KS aggregates), the corner
@@ -47,9 +49,9 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from tmfem.design.kinematics import kinematics
+from tmfem.design.kinematics import MTCKinematics, kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
-from tmfem.design.variables import Variable, area_derivative, parse_variables
+from tmfem.design.variables import Variable, area_derivative, parse_variables, with_membrane_radius
 from tmfem.errors import InputError
 from tmfem.fem.element import State
 from tmfem.fem.truss import (TrussSet, truss_axial_force_derivatives, truss_internal, truss_mass,
@@ -249,6 +251,18 @@ def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndar
         _, _, dN_dL, _ = truss_axial_force_derivatives(x, tendons)
         return _Partials(dR, None, dM, dN_dL * dL, zb, np.zeros(nt), np.zeros(nb),
                          float(model.tendon_rhoA @ g))
+    if v.kind == "membrane_radius":
+        # the membrane's reference mesh scales with r_mb: central differences of the assembled
+        # residual and mass at fixed positions (the bars' and tendons' parts cancel exactly);
+        # the residual's Richardson-extrapolated, error O(d^4): the membrane stresses respond to
+        # du/dp by E / (element size), so a relative error of 1e-8 in dR showed in them
+        r, d = model.system.r_mb, 1e-4 * model.system.r_mb
+        xr = model.reduce(x)
+        pm = {k: with_radius(model, r + k * d) for k in (2, 1, -1, -2)}
+        R = {k: m.residual(xr, tangent=False)[0] for k, m in pm.items()}
+        dR = (8 * (R[1] - R[-1]) - (R[2] - R[-2])) / (12 * d)
+        return _Partials(dR, None, (pm[1].mass() - pm[-1].mass()) / (2 * d), zt, zb, np.zeros(nt),
+                         np.zeros(nb), (total_mass(pm[1]) - total_mass(pm[-1])) / (2 * d))
     if v.kind == "thickness":
         h = model.membrane.material.h
         f, K = model.membrane_element.internal(State(x=x))
@@ -275,6 +289,18 @@ def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndar
     dA[list(v.tendons)] = area_derivative(d)
     return _Partials(T.T @ r.f * s, T.T @ r.K @ T * s, T.T @ M @ T * s, dN, zb, dA, np.zeros(nb),
                      float(sub.rhoA @ sub.L) * s)
+
+
+def with_radius(model, r_mb: float):
+    """The MTC model of ``model``'s system with the membrane radius r_mb (same mesh density,
+    options and rest lengths): its membrane mesh is the same mesh scaled."""
+    from tmfem.models.mtc.model import MTCModel
+    topo = model.topology
+    return MTCModel(model.system.replace(**with_membrane_radius(model.system, r_mb)), mesh_n=topo.mesh.n,
+                    tendon_elements=topo.tendon_elements, attachment=topo.attachment, patch=model.patch,
+                    rest_lengths=model.rest_lengths.copy(), lumped_tendon_mass=model.lumped_tendon_mass,
+                    membrane_law=model.membrane_law, rigid_bar_points=model.system.deployable,
+                    tendon_law=model.tendon_law)
 
 
 def total_mass(model) -> float:
@@ -391,6 +417,9 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
             for sgn in (1.0, -1.0):
                 model.set_tendon_lengths(r0 + sgn * h * G[:, j])
                 pt = kin.point(sgn * h * du[:, j])
+                if vs[j].kind == "membrane_radius":    # the state and the reference mesh together
+                    Kpm.append(with_radius(model, model.system.r_mb + sgn * h).residual(pt)[1])
+                    continue
                 Kpm.append(kin.tangent(pt))
                 if sbc:                  # the shells' and beams' mass follows the directors
                     Mpm.append(kin.mass(pt))
@@ -440,6 +469,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     buck = -Nb / Ncr
     d_buck = -dNb / Ncr[:, None] + (Nb / Ncr**2)[:, None] * dNcr
     delta, d_delta = corner_deltas(model, x, dx)
+    d_delta[:, [v.kind == "membrane_radius" for v in vs]] -= 1.0          # Delta = |c_j - c| - r_mb
     values = {"mass": total_mass(model), "omega2": lam, "freq": freq,
               "tendon_force": t_force, "tendon_stress": t_stress,
               "bar_force": Nb, "bar_buckling": buck, "corner_delta": delta}
@@ -453,7 +483,15 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
                             ("corner_delta_max", "corner_delta", np.argmax)):
         i = int(pick(values[vec]))
         values[name], grads[name] = float(values[vec][i]), grads[vec][i].copy()
-    for name, (val, grad) in membrane_aggregates(model, kin, du, width=width, aperture=aperture).items():
+    def radius_fields(j):
+        def fields(step):
+            return [MTCKinematics(with_radius(model, model.system.r_mb + sgn * step), eq).membrane(
+                kin.point(sgn * step * du[:, j])) for sgn in (1.0, -1.0)]
+        return fields
+
+    moved = {j: radius_fields(j) for j, v in enumerate(vs) if v.kind == "membrane_radius"}
+    for name, (val, grad) in membrane_aggregates(model, kin, du, width=width, aperture=aperture,
+                                                 moved=moved).items():
         values[name], grads[name] = val, grad
     values["surface_rms"], grads["surface_rms"] = surface_rms(model, x, dx)
     if position is not None:

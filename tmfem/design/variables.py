@@ -7,10 +7,12 @@ Names (:func:`parse_variables`):
 * a tendon name (``"S_11"``): that tendon's rest length [m];
 * ``"h_membrane"``: the membrane thickness h [m];
 * ``"d_bar"``: the diameter of the (solid circular) bars [m];
-* ``"d_<family>"`` (``"d_S"``, ``"d_V"``): the diameter of every tendon of that family [m].
+* ``"d_<family>"`` (``"d_S"``, ``"d_V"``): the diameter of every tendon of that family [m];
+* ``"r_mb"``: the circumradius of a regular membrane [m] (its corners scale about their
+  centroid; the bars and the rest lengths stay).
 
-The membrane radius r_mb and the configuration angles (theta, psi) move the design
-configuration itself (the ch. 3 equilibrium design); they are refused (:data:`GEOMETRY`).
+The configuration angles (theta, psi) and the other coordinates of the design configuration
+move the bars themselves (the ch. 3 equilibrium design); they are refused (:data:`GEOMETRY`).
 """
 from __future__ import annotations
 
@@ -23,9 +25,9 @@ import numpy as np
 from tmfem.errors import InputError
 
 #: kinds of variable
-KINDS = ("rest_length", "thickness", "bar_diameter", "tendon_diameter")
+KINDS = ("rest_length", "thickness", "bar_diameter", "tendon_diameter", "membrane_radius")
 #: names of variables that change the design configuration (refused)
-GEOMETRY = ("r_mb", "theta", "psi", "sigma", "z", "r", "l")
+GEOMETRY = ("theta", "psi", "sigma", "z", "r", "l")
 
 
 @dataclass(frozen=True)
@@ -82,18 +84,23 @@ def parse_variables(system, variables) -> list:
             out.append(Variable(n, "thickness"))
         elif n == "d_bar":
             out.append(Variable(n, "bar_diameter"))
+        elif n == "r_mb":
+            if system.r_mb is None:
+                raise InputError("design variable 'r_mb': expected a regular membrane (r_mb in the "
+                                 "system file), found one given by its corners")
+            out.append(Variable(n, "membrane_radius"))
         elif n.startswith("d_") and n[2:] in families:
             fam = n[2:]
             out.append(Variable(n, "tendon_diameter", tuple(i for i, t in enumerate(tendons)
                                                             if t.family == fam), fam))
         elif n.split("_")[0] in GEOMETRY:
-            raise InputError(f"design variable {n!r}: the membrane radius and the configuration "
-                             f"(theta, psi, ...) change the ch. 3 design geometry, which the "
-                             f"sensitivities do not differentiate; expected rest lengths, "
-                             f"'h_membrane', 'd_bar' or 'd_<family>'")
+            raise InputError(f"design variable {n!r}: the configuration (theta, psi, ...) changes "
+                             f"the ch. 3 design geometry of the bars, which the sensitivities do "
+                             f"not differentiate; expected rest lengths, 'h_membrane', 'd_bar', "
+                             f"'d_<family>' or 'r_mb'")
         else:
             raise InputError(f"design variable {n!r}: expected a tendon group {groups}, a tendon "
-                             f"name, 'h_membrane', 'd_bar' or one of "
+                             f"name, 'h_membrane', 'd_bar', 'r_mb' or one of "
                              f"{['d_' + f for f in families]}")
     rest = [i for v in out if v.kind == "rest_length" for i in v.tendons]
     if len(set(rest)) != len(rest):
@@ -111,6 +118,8 @@ def variable_values(system, rest_lengths: np.ndarray, variables: list) -> np.nda
             vals.append(system.membrane.h)
         elif v.kind == "bar_diameter":
             vals.append(system.bar.d)
+        elif v.kind == "membrane_radius":
+            vals.append(system.r_mb)
         else:
             vals.append(system.tendon_section(system.tendons[v.tendons[0]]).d)
     return np.array(vals)
@@ -146,6 +155,8 @@ def apply_design(system, rest_lengths: np.ndarray, variables: list, p) -> tuple:
             changes["membrane"] = dataclasses.replace(system.membrane, h=float(x))
         elif v.kind == "bar_diameter":
             changes["bar"] = dataclasses.replace(system.bar, d=float(x))
+        elif v.kind == "membrane_radius":
+            changes.update(with_membrane_radius(system, float(x)))
         else:
             secs = _family_section(system.replace(tendon_sections=secs), v.family, x)
     if any(v.kind == "tendon_diameter" for v in variables):
@@ -153,6 +164,16 @@ def apply_design(system, rest_lengths: np.ndarray, variables: list, p) -> tuple:
     if np.any(r <= 0):
         raise InputError(f"design: expected positive rest lengths, found {r}")
     return system.replace(**changes, rest_lengths=r), r
+
+
+def with_membrane_radius(system, r_mb: float) -> dict:
+    """The fields ``r_mb`` and ``membrane_corners`` of ``system`` with the regular membrane's
+    circumradius r_mb: the corners scaled about their centroid."""
+    if not r_mb > 0:
+        raise InputError(f"design: expected r_mb > 0, found {r_mb!r}")
+    c = system.membrane_corners
+    centre = c.mean(axis=1, keepdims=True)
+    return {"r_mb": r_mb, "membrane_corners": centre + (r_mb / system.r_mb) * (c - centre)}
 
 
 def area_derivative(d: float) -> float:
