@@ -146,3 +146,18 @@ def test_a_failed_warm_start_falls_back_to_the_undeformed_membrane(monkeypatch):
                    variables={"S1": (1.40, 1.52)}, mesh_n=4)
     assert res.success
     assert res.optimum_responses["tendon_stress"] == pytest.approx([6.32e7] * 4, rel=1e-6)
+
+
+def test_membrane_radius_optimum_written_back_reads_as_the_same_design(tmp_path):
+    # the first frequency of 1-4 by S1 and r_mb within the tendon stress limit; the optimal
+    # system written as a file and read back gives the optimiser's first frequency
+    from tmfem.system import dump_system
+    system = load_preset("1-4")
+    res = optimize(system, objective="max:freq", constraints=["tendon_stress<=6.32e7"],
+                   variables={"S1": (1.40, 1.52), "r_mb": (1.36, 1.46)}, mesh_n=4)
+    assert res.success and res.optimum[1] != res.start[1]
+    dump_system(res.system, tmp_path / "opt.toml")
+    back = load_system(tmp_path / "opt.toml")
+    assert back.r_mb == pytest.approx(res.optimum[1], rel=1e-12)
+    m = MTCModel(back, mesh_n=4)
+    assert m.modes(k=1, at=m.equilibrium()).freq_hz[0] == pytest.approx(res.optimum_responses["freq"][0], rel=1e-6)

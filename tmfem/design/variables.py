@@ -8,8 +8,8 @@ Names (:func:`parse_variables`):
 * ``"h_membrane"``: the membrane thickness h [m];
 * ``"d_bar"``: the diameter of the (solid circular) bars [m];
 * ``"d_<family>"`` (``"d_S"``, ``"d_V"``): the diameter of every tendon of that family [m];
-* ``"r_mb"``: the circumradius of a regular membrane [m] (its corners scale about their
-  centroid; the bars and the rest lengths stay).
+* ``"r_mb"``: the circumradius of a regular membrane [m] (its corners and reference mesh
+  scale; the bars and the rest lengths stay).
 
 The configuration angles (theta, psi) and the other coordinates of the design configuration
 move the bars themselves (the ch. 3 equilibrium design); they are refused (:data:`GEOMETRY`).
@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.system.geometry import membrane_corners_regular
 
 #: kinds of variable
 KINDS = ("rest_length", "thickness", "bar_diameter", "tendon_diameter", "membrane_radius")
@@ -85,7 +86,8 @@ def parse_variables(system, variables) -> list:
         elif n == "d_bar":
             out.append(Variable(n, "bar_diameter"))
         elif n == "r_mb":
-            if system.r_mb is None:
+            if system.r_mb is None or not np.allclose(system.membrane_corners,
+                                                      membrane_corners_regular(system.N, system.r_mb)):
                 raise InputError("design variable 'r_mb': expected a regular membrane (r_mb in the "
                                  "system file), found one given by its corners")
             out.append(Variable(n, "membrane_radius"))
@@ -168,12 +170,11 @@ def apply_design(system, rest_lengths: np.ndarray, variables: list, p) -> tuple:
 
 def with_membrane_radius(system, r_mb: float) -> dict:
     """The fields ``r_mb`` and ``membrane_corners`` of ``system`` with the regular membrane's
-    circumradius r_mb: the corners scaled about their centroid."""
+    circumradius r_mb: the corners of :func:`tmfem.system.geometry.membrane_corners_regular`,
+    as a system file with this r_mb reads (linear in r_mb: the reference mesh scales)."""
     if not r_mb > 0:
         raise InputError(f"design: expected r_mb > 0, found {r_mb!r}")
-    c = system.membrane_corners
-    centre = c.mean(axis=1, keepdims=True)
-    return {"r_mb": r_mb, "membrane_corners": centre + (r_mb / system.r_mb) * (c - centre)}
+    return {"r_mb": r_mb, "membrane_corners": membrane_corners_regular(system.N, r_mb)}
 
 
 def area_derivative(d: float) -> float:
