@@ -34,6 +34,7 @@ def test_optimum_written_back_is_taken_by_static_and_modal(tmp_path, capsys):
     rc, r = run(["optimize", str(path), "--mesh", "4", "--out", str(tmp_path / "out")], capsys)
     assert rc == 0 and r["ok"]
     assert r["optimum_responses"]["tendon_stress"] == pytest.approx([LIMIT] * 4, rel=1e-5)
+    assert r["units"]["optimum"] == "m" and r["units"]["optimum_responses"] == {"freq": "Hz", "tendon_stress": "Pa"}
     for name in ("history.csv", "history.png", "optimal.toml"):
         assert (tmp_path / "out" / name).stat().st_size > 0
     lines = (tmp_path / "out" / "history.csv").read_text().splitlines()

@@ -70,6 +70,13 @@ def run(args) -> dict:
         r["files"] = {k: str(out / f) for k, f in (("history", "history.csv"), ("plot", "history.png"),
                                                    ("system", "optimal.toml"))}
     r["ok"] = res.success
+    resp_units = {k: RESPONSES.get(k, RESPONSES.get(k.rpartition("_")[0], ("", "-")))[1]
+                  for k in res.start_responses}
+    r["units"] = {"lower": "m", "upper": "m", "start": "m", "optimum": "m", "kkt_residual": "-",
+                  "time_s": "s", "start_responses": resp_units, "optimum_responses": resp_units,
+                  "active": "multipliers of the scaled problem (objective / |start value|, "
+                            "constraints / |bound|, variables / their range): -",
+                  "history": "[iteration, objective in its response's unit, scaled violation -, step m]"}
     return r
 
 
