@@ -2,7 +2,8 @@
 independent check of its optimum: the KKT conditions evaluated with central finite
 differences of the re-solved equilibrium (step 1e-4 of each variable) instead of the exact
 gradients the optimiser used; the multipliers are the non-negative least-squares solution of
-grad f = -sum mu_i grad g_i over the active constraints and bounds."""
+grad f = -sum mu_i grad g_i over the active constraints and bounds. Example (1), a vertex
+(four active constraints in four variables), also by a brute-force grid over two variables."""
 import numpy as np
 import pytest
 from scipy.optimize import nnls
@@ -77,6 +78,20 @@ def test_example_1_maximises_the_first_frequency_of_1_4_within_the_tendon_stress
     G = fd_gradients(res, names, mesh_n=4, aperture=0.5)
     resid, mu = kkt_residual(-G[0], G[1:], bound_rows(res))       # maximise: minimise -f_1
     assert resid < 1e-4 and np.all(mu[:4] > 0), (resid, mu)
+    # brute force: a 5 x 5 grid of S_11, S_13 (+-2 mm) at the optimal S_12, S_14 has no
+    # feasible design with a higher first frequency
+    vs = parse_variables(res.system, res.names)
+    best = res.optimum_responses["freq"][0]
+    feasible = 0
+    for a in np.linspace(-2e-3, 2e-3, 5):
+        for b in np.linspace(-2e-3, 2e-3, 5):
+            sj, rj = apply_design(res.system, res.system.rest_lengths, vs, res.optimum + [a, 0, b, 0])
+            m = MTCModel(sj, mesh_n=4, rest_lengths=rj)
+            s = design_sensitivities(m, equilibrium=m.equilibrium(x0=res.state), variables=res.names, aperture=0.5)
+            if np.all(s.value("tendon_stress") <= limit * (1 + 1e-9)):
+                feasible += 1
+                assert s.value("freq_1") <= best * (1 + 1e-9), (a, b)
+    assert feasible >= 9                  # the quadrant of longer tendons, at least
 
 
 def test_example_2_minimises_the_mass_of_a_1_3_system_with_buckling_and_slack_limits():
