@@ -15,7 +15,9 @@ may carry:
 * ``[lpv]``: the LPV design of 8.3 and deployment of 8.4 (the grid of (theta, psi), the
   rate bound, the scheduling values and omega_r of eq. 5.100, K, points, path);
 * ``[report]``: what ``tmfem report`` adds for this system: the free-vibration perturbation,
-  a second prestress case with its source, explanatory notes, and the deployment it runs.
+  a second prestress case with its source, explanatory notes, and the deployment it runs;
+* ``[design]``: the design variables of ``tmfem optimize`` with their bounds, and optionally
+  its objective, constraints and wrinkling aperture (:mod:`tmfem.design.optimize`).
 
 Everything is read from the :class:`System` the library is given (``system.problem``); a file
 that does not declare a table gets the documented defaults, which depend on the system only.
@@ -40,6 +42,7 @@ KEYS = {
     "report": {"perturbation", "implied_rest_lengths", "implied_source", "notes_design",
                "notes_models", "deployment", "com_prestress"},
     "report.deployment": {"system", "uncertainty", "t_end", "controller"},
+    "design": {"variables", "objective", "constraints", "aperture"},
 }
 GAIN_KEYS = ("omega_0", "omega_e", "tau", "d_c")
 UNCERTAINTIES = ("initial", "no-MG", "exact")
@@ -204,6 +207,22 @@ class ReportSettings:
 
 
 @dataclass(frozen=True)
+class DesignTable:
+    """``[design]``: the optimisation of :func:`tmfem.design.optimize`.
+
+    variables : {name: (lower, upper)} (names of :mod:`tmfem.design.variables`; checked
+        against the system when the optimisation starts).
+    objective : str or None (``"max:freq"``); constraints : tuple of str
+        (``"tendon_stress<=6.32e7"``); aperture : the wrinkling aperture or None.
+    """
+
+    variables: dict
+    objective: str | None = None
+    constraints: tuple = ()
+    aperture: float | None = None
+
+
+@dataclass(frozen=True)
 class Problem:
     """The tables of a system file beyond the structure (module docstring); ``raw`` keeps them
     as read, for writing the file back."""
@@ -214,6 +233,7 @@ class Problem:
     report: ReportSettings = field(default_factory=ReportSettings)
     packaged: object = None
     raw: dict = field(default_factory=dict)
+    design: DesignTable | None = None
 
 
 def _control(t: dict, where: str) -> HinfWeights:
@@ -328,8 +348,26 @@ def _report(t: dict, where: str) -> ReportSettings:
                           com_prestress=_choice(t, "com_prestress", w, COM_PRESTRESS, "designed"))
 
 
+def _design(t: dict, where: str) -> DesignTable:
+    w = f"{where} [design]"
+    _keys(t, "design", where)
+    v = t.get("variables")
+    ok = isinstance(v, dict) and v and all(
+        isinstance(b, list) and len(b) == 2 and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                    and math.isfinite(x) for x in b) and b[0] < b[1]
+        for b in v.values())
+    if not ok:
+        raise InputError(f"{w}: expected 'variables' as a table name = [lower, upper] with lower < "
+                         f"upper, found {v!r}")
+    obj = t.get("objective")
+    if obj is not None and not isinstance(obj, str):
+        raise InputError(f"{w}: expected 'objective' as 'min:RESPONSE' or 'max:RESPONSE', found {obj!r}")
+    return DesignTable(variables={k: (float(a), float(b)) for k, (a, b) in v.items()}, objective=obj,
+                       constraints=_strings(t, "constraints", w), aperture=_positive(t, "aperture", w))
+
+
 #: top-level tables read here
-TABLES = ("control", "deployment", "lpv", "report", "packaged")
+TABLES = ("control", "deployment", "lpv", "report", "packaged", "design")
 
 
 def deep_merge(base: dict, override: dict) -> dict:
@@ -364,7 +402,8 @@ def problem_from_dict(d: dict, where: str, build) -> Problem:
                    deployment=_deployment(d["deployment"], where) if "deployment" in d else None,
                    lpv=_lpv(d["lpv"], where) if "lpv" in d else None,
                    report=_report(d["report"], where) if "report" in d else ReportSettings(),
-                   packaged=packaged, raw=raw)
+                   packaged=packaged, raw=raw,
+                   design=_design(d["design"], where) if "design" in d else None)
 
 
 def default_u_m(system) -> float:

@@ -51,7 +51,7 @@ from tmfem.system.validate import (check_bounds, check_keys_used, check_stage_li
 
 _TOP_KEYS = {"name", "description", "N", "deployable", "k_H", "notes", "symmetric", "general",
              "membrane", "bar", "tendons", "tendon", "rest_lengths", "printed", "as_printed",
-             "monitor", "models", "control", "deployment", "lpv", "report", "packaged"}
+             "monitor", "models", "control", "deployment", "lpv", "report", "packaged", "design"}
 # Keys accepted inside each sub-table ([printed] and [rest_lengths] are free-form;
 # [as_printed] is merged in before validation, see tmfem.system.presets.preset_dict).
 _TABLE_KEYS = {
