@@ -29,7 +29,8 @@ Routes (``method``):
 * ``"auto"`` (default): ``"riccati"`` for a regular plant, else ``"lmi"``. Where the Riccati
   bisection met numerical failures (levels it could not decide) and the plant has at most
   :data:`AUTO_LMI_MAX_STATES` states, the LMI optimum is computed too and the LMI
-  controller is used when it is verified lower.
+  controller is used when it is verified lower (not tried when the LMI optimum lies below
+  the Riccati route's certified lower bound: that SDP solution is inaccurate).
 
 ``alpha`` is alpha_1 of eq. 5.67 (closed-loop poles with Re < -alpha_1) by the shift A +
 alpha_1 I of 7.3, in every route.
@@ -191,7 +192,11 @@ def _route(G0, method, alpha, gamma_tol, solver):
             log.info("auto: the LMI cross-check failed (%s); keeping the Riccati design", exc)
             g_lmi = np.inf
         times["lmi gamma"] = time.perf_counter() - t0
-        if g_lmi * (1 + gamma_tol) < d.gamma / (1 + gamma_tol):
+        if d.gamma_lower is not None and g_lmi < d.gamma_lower * (1 - gamma_tol):
+            # below a certificate of infeasibility: the SDP solution is inaccurate
+            log.info("auto: LMI optimum %.6g below the certified lower bound %.6g; keeping the "
+                     "Riccati design", g_lmi, d.gamma_lower)
+        elif g_lmi * (1 + gamma_tol) < d.gamma / (1 + gamma_tol):
             try:
                 d2 = run("lmi")
             except InfeasibleController as exc:
