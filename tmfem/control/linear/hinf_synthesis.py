@@ -23,7 +23,8 @@ Routes (``method``):
   column rank, D21 full row rank, no imaginary-axis zeros of P12, P21);
 * ``"lmi"``: the eliminated LMIs (eq. 5.65) with an interior-point SDP solver (Clarabel) and
   the controller recovered by eq. 5.67 (:func:`tmfem.control.linear.hinf_lmi.hinf_lmi`); any
-  plant, O(n^6) time;
+  plant, O(n^6) time; refused when its controller is verified far below the SDP optimum
+  (an inaccurate SDP solution, :func:`_lmi_backoff`);
 * ``"slicot"``: python-control's ``hinfsyn`` (SB10AD), guarded and verified
   (:func:`tmfem.control.linear.hinf_slicot.hinf_slicot`);
 * ``"auto"`` (default): ``"riccati"`` for a regular plant, else ``"lmi"``. Where the Riccati
