@@ -4,7 +4,8 @@ norm and time per plant and route.
     PYTHONPATH=. OPENBLAS_NUM_THREADS=1 python benchmarks/bench_hinf.py [--skip-slicot] [--no-2-3]
 
 The family is tests/control/linear/family.py (random plants of several kinds and sizes,
-closed-form and published examples). "verified" is python-control's norm(CL, "inf") of the
+closed-form and published examples, near-integrating and ill-conditioned mixed-sensitivity
+plants, COMPleib plants). "verified" is python-control's norm(CL, "inf") of the
 returned closed loop; "lower" the certified lower bound of the Riccati route. The last line
 is the H-infinity design of the 50-state 2-3 plant by the default route (``tmfem control
 hinf --preset 2-3-deploy``), whose target is under 30 s.
@@ -29,23 +30,30 @@ def main() -> None:
     ap.add_argument("--no-2-3", action="store_true", help="leave out the 2-3 design")
     args = ap.parse_args()
     routes = [r for r in ROUTES if not (args.skip_slicot and r == "slicot")]
-    print(f"{'plant':26s} {'n':>3s} {'route':8s} {'gamma':>12s} {'verified':>12s} {'lower':>12s} "
+    print(f"{'plant':34s} {'n':>3s} {'route':8s} {'gamma':>12s} {'verified':>12s} {'lower':>12s} "
           f"{'time s':>7s}  chosen / refusal")
+    slowest = {}
     for name, (P, ny, nu, ref) in family().items():
         for r in routes:
             t0 = time.perf_counter()
             try:
                 res = hinfsyn(P, ny, nu, method=r)
             except TmfemError as exc:
-                print(f"{name:26s} {P.nstates:3d} {r:8s} {'-':>12s} {'-':>12s} {'-':>12s} "
-                      f"{time.perf_counter() - t0:7.2f}  refused: {str(exc)[:90]}")
-                continue
+                res = exc
             dt = time.perf_counter() - t0
+            if P.nstates <= 20:
+                slowest[r] = max(slowest.get(r, (0.0, "")), (dt, name))
+            if isinstance(res, TmfemError):
+                print(f"{name:34s} {P.nstates:3d} {r:8s} {'-':>12s} {'-':>12s} {'-':>12s} "
+                      f"{dt:7.2f}  refused: {str(res)[:90]}")
+                continue
             low = res.info["gamma_lower"]
-            print(f"{name:26s} {P.nstates:3d} {r:8s} {res.gamma:12.6g} "
+            print(f"{name:34s} {P.nstates:3d} {r:8s} {res.gamma:12.6g} "
                   f"{float(control.norm(res.CL, p='inf')):12.6g} "
                   f"{'-' if low is None else format(low, '12.6g'):>12s} {dt:7.2f}  "
                   f"{res.info['method']}" + (f" (published/closed form {ref:g})" if ref else ""))
+    print("\nslowest call on the plants of up to 20 states (target 10 s): " +
+          ", ".join(f"{r} {t:.2f} s ({nm})" for r, (t, nm) in slowest.items()))
     if not args.no_2_3:
         from tmfem.control.linear.deployed_design import deployed_hinf
         from tmfem.system import load_preset

@@ -1,7 +1,8 @@
 """The regression family of H-infinity plants (shared by the tests and benchmarks/bench_hinf.py).
 
-Random plants of several sizes and kinds, textbook plants with a closed-form optimum and a
-published mixed-sensitivity design. Each entry: name -> (python-control StateSpace with
+Random plants of several sizes and kinds, textbook plants with a closed-form optimum, a
+published mixed-sensitivity design and its near-integrating and ill-conditioned variants, and
+COMPleib plants (regular and singular). Each entry: name -> (python-control StateSpace with
 inputs [w, u] and outputs [p, y], nmeas, ncon, reference gamma or None). A reference is given
 where it is known independently of tmfem (closed form or publication); otherwise the
 reference is the LMI optimum computed by the test.
@@ -10,6 +11,8 @@ from __future__ import annotations
 
 import control
 import numpy as np
+
+from tests.data.compleib import compleib
 
 
 def random_plant(seed: int, n: int, *, nw: int = 3, nu: int = 2, np_: int = 4, ny: int = 2,
@@ -97,6 +100,34 @@ def skogestad_postlethwaite_2_17(design: int):
     return P, 1, 1, {1: 1.37, 2: 2.21}[design]
 
 
+def compleib_plant(name: str):
+    """A COMPleib example (tests/data/compleib.py: F. Leibfritz, COMPleib 1.1, 2005) as a
+    generalised plant; no reference gamma (the optimum is bracketed by the test)."""
+    A, B1, B2, C1, C2, D11, D12, D21 = compleib(name)
+    ny, nu = C2.shape[0], B2.shape[1]
+    P = control.ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]),
+                   np.block([[D11, D12], [D21, np.zeros((ny, nu))]]))
+    return P, ny, nu, None
+
+
+def near_integrating_mixed_sensitivity(A_w: float, W_u: float):
+    """The S/KS design of :func:`skogestad_postlethwaite_2_17` (design 1) with the weight's
+    pole moved to -w_B A_w and the input weight W_u: A_w = 1e-6 puts the pole at -1e-5 (a
+    near-integrating weight, the Riccati test meets Hamiltonian eigenvalues within 1e-5 of
+    the imaginary axis; the LMI solution of this plant is inaccurate), W_u = 0.01 makes the
+    plant ill-conditioned (Lyapunov matrices with entries of 1e8: a trace penalty of 1e-4 on
+    them gives a controller 18 times above the optimum). No reference gamma."""
+    s = control.tf("s")
+    G = 200 / ((10 * s + 1) * (0.05 * s + 1) ** 2)
+    Wp = (s / 1.5 + 10.0) / (s + 10.0 * A_w)
+    P = control.augw(control.ss(G), w1=control.ss(Wp), w2=control.ss(control.tf(W_u, 1)))
+    return P, 1, 1, None
+
+
+#: COMPleib members (regular: AC4; D21 = 0 or rank deficient: the others; REA3 has a double
+#: eigenvalue at 0, a Jordan block the PBH test must not mistake for an uncontrollable mode)
+COMPLEIB = ("AC1", "AC2", "AC3", "AC4", "HE1", "HE2", "HE3", "REA1", "REA2", "REA3", "DIS1", "DIS2")
+
 #: random members: name -> (seed, n, kind)
 RANDOM = {
     "regular-3": (1, 3, "regular"), "regular-6": (2, 6, "regular"),
@@ -117,4 +148,8 @@ def family() -> dict:
         out[f"first-order-a{a:+g}"] = first_order(a)
     for d in (1, 2):
         out[f"skogestad-2.17-design{d}"] = skogestad_postlethwaite_2_17(d)
+    out["mixed-sensitivity-pole-1e-5"] = near_integrating_mixed_sensitivity(1e-6, 1.0)
+    out["ill-conditioned-mixed-sensitivity"] = near_integrating_mixed_sensitivity(1e-6, 0.01)
+    for name in COMPLEIB:
+        out[f"compleib-{name}"] = compleib_plant(name)
     return out

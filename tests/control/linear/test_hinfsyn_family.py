@@ -16,9 +16,15 @@ Sources of the reference values:
 * python-control's ``hinfsyn`` on the same plant for the loop-shifting (D22 != 0) and
   alpha-shift checks.
 
-Stated tolerances (relative, on the verified level above the optimum): "auto" and "riccati"
+Stated tolerances (relative, on the verified norm above the optimum): "auto" and "riccati"
 3e-3 (gamma_tol = 1e-3 and a bisection to gamma_tol / 2), "lmi" 0.1 (its recovery backs off
-up to 10 % above the LMI optimum, LMI_BACKOFF), "slicot" 0.1 (SB10AD's own gamma iteration).
+up to 10 % above the LMI optimum, LMI_BACKOFF), "slicot" 0.1 (SB10AD's own gamma iteration);
+the reported level gamma is at most 10 % above the verified norm; an absolute 1e-7 (the SDP
+solver's resolution) where the optimum is near 0.
+
+COMPleib plants (tests/data/compleib.py, F. Leibfritz, COMPleib 1.1): published tables of
+their full-order optimum could not be consulted, so their reference is the bracket above
+(for the singular ones, the LMI optimum to the SDP solver's accuracy).
 """
 import time
 
@@ -29,14 +35,19 @@ import pytest
 from tests.control.linear.family import (family, first_order, first_order_state_feedback,
                                          random_plant, skogestad_postlethwaite_2_17)
 from tmfem.control import hinfsyn, hinfsyn_state
-from tmfem.control.linear.hinf_lmi import hinf_gamma
+from tmfem.control.linear.hinf_central import hinf_central
+from tmfem.control.linear.hinf_lmi import hinf_gamma, hinf_lmi
 from tmfem.control.linear.hinf_slicot import hinf_slicot
+from tmfem.control.linear.hinf_synthesis import LMI_BACKOFF
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.errors import InfeasibleController, InputError, ResourceLimit
 
 FAMILY = family()
 ROUTES = ("auto", "riccati", "lmi", "slicot")
 TOL = {"auto": 3e-3, "riccati": 3e-3, "lmi": 0.1, "slicot": 0.1}
+#: absolute tolerance: the resolution of the SDP solver (Clarabel's tolerances 1e-8 on data of
+#: unit size); COMPleib AC1 has the optimum 6e-7, known to about 2e-8
+ATOL = 1e-7
 # SB10AD stalls (> 30 s) on the near-integrating weights: its time bound is tested below
 SLOW_SLICOT = ("near-integrator",)
 
@@ -66,7 +77,9 @@ def _bracket(name, res):
     if lowers:
         lower = max(lowers)
     else:
-        lower = hinf_gamma(GeneralizedPlant.from_system(P, nmeas=ny, ncon=nu))[0] * (1 - 1e-4)
+        # singular plants: the LMI optimum (strict LMIs, an upper bound of the infimum up to
+        # the SDP solver's accuracy) or a verified norm below it
+        lower = min(hinf_gamma(GeneralizedPlant.from_system(P, nmeas=ny, ncon=nu))[0], upper) * (1 - 1e-4)
     return lower, upper
 
 
@@ -75,9 +88,11 @@ def test_every_route_is_verified_and_near_the_optimum(name, results):
     P, ny, nu, ref = FAMILY[name]
     res = results[name]
     assert not isinstance(res["auto"], Exception), f"auto refused {name}: {res['auto']}"
+    if P.nstates <= 20:                       # the speed target of the family (2 shared cores)
+        assert res["auto"].info["time_s"] < 10.0
     lower, upper = _bracket(name, res)
-    # the optimum is known to 0.3 % from independent evidence
-    assert lower <= upper * (1 + 1e-6) and upper <= lower * (1 + 3e-3)
+    # the optimum is known to 0.3 % (or ATOL) from independent evidence
+    assert lower <= upper * (1 + 1e-6) and upper <= lower * (1 + 3e-3) + ATOL
     for route, r in res.items():
         if isinstance(r, Exception):
             assert route != "auto"
@@ -86,12 +101,15 @@ def test_every_route_is_verified_and_near_the_optimum(name, results):
         poles = r.CL.poles()
         assert np.max(poles.real) < 0                          # python-control's own poles
         nrm = float(control.norm(r.CL, p="inf"))               # and its own norm (AB13DD)
-        # the verified norm is the larger of AB13DD and a frequency sweep
+        # the verified norm is the larger of AB13DD and a frequency sweep (which finds peaks
+        # AB13DD misses by up to 1.5e-4 on COMPleib HE1 and the ill-conditioned loops)
         assert nrm <= r.info["verified_norm"] * (1 + 1e-12)
-        assert nrm == pytest.approx(r.info["verified_norm"], rel=1e-5)
+        assert nrm == pytest.approx(r.info["verified_norm"], rel=3e-4)
         assert r.gamma >= nrm * (1 - 1e-9)                      # never below the verified norm
         assert nrm >= lower * (1 - 1e-6)                       # nobody beats the optimum
-        assert r.gamma <= lower * (1 + TOL[route]), (route, r.gamma, lower)
+        assert nrm <= lower * (1 + TOL[route]) + ATOL, (route, nrm, lower)
+        # the reported level: at most the LMI route's last back-off above the achieved norm
+        assert r.gamma <= nrm * (1 + LMI_BACKOFF[-1]) + ATOL, (route, r.gamma, nrm)
         assert list(r.K.input_labels) == list(P.output_labels[-ny:])     # named signals
         assert list(r.K.output_labels) == list(P.input_labels[-nu:])
         assert list(r.CL.input_labels) == list(P.input_labels[:-nu])
@@ -124,6 +142,52 @@ def test_singular_plants_go_to_the_lmi_side_with_a_reason(results):
         assert isinstance(res["slicot"], InputError) and "regular plant" in str(res["slicot"])
         assert res["auto"].info["method"] in ("lmi", "regularized riccati")
         assert "singular plant" in res["auto"].info["route_reason"]
+
+
+def test_compleib_singular_plants_go_to_the_lmi_side_and_regular_ac4_to_riccati(results):
+    # D21 = 0 (noise-free measurements) or rank-deficient D12, D21: no Riccati formula applies
+    for name in ("compleib-AC1", "compleib-HE1", "compleib-HE3", "compleib-DIS1", "compleib-REA3"):
+        res = results[name]
+        assert isinstance(res["riccati"], InputError) and "regular plant" in str(res["riccati"])
+        assert "singular plant" in res["auto"].info["route_reason"]
+    # AC1: P12 has an invariant zero at 0 besides; its optimum (6e-7) is reached through the
+    # regularised plant with state channels
+    assert results["compleib-AC1"]["auto"].info["method"] == "regularized riccati"
+    assert results["compleib-AC4"]["auto"].info["method"] == "riccati"
+
+
+def test_near_integrating_weight_inaccurate_sdp_is_refused_with_the_reason(results):
+    # weight pole at -1e-5: Clarabel's LMI optimum is 35 times the achievable level; the LMI
+    # route says so instead of reporting it, the default route is right (family test)
+    r = results["mixed-sensitivity-pole-1e-5"]["lmi"]
+    assert isinstance(r, InfeasibleController) and "SDP solution is inaccurate" in str(r)
+    auto = results["mixed-sensitivity-pole-1e-5"]["auto"]
+    assert auto.info["method"] == "riccati" and auto.info["gamma_lower"] is not None
+
+
+def test_a_trace_penalty_makes_the_lmi_controller_several_times_suboptimal(results):
+    # the ill-conditioned member: a trace penalty of 1e-4 on R, S (entries ~1e8) moves the
+    # recovered controller far from the optimum; the default route (no penalty) is within
+    # 0.3 % of the certified lower bound
+    P, ny, nu, _ = FAMILY["ill-conditioned-mixed-sensitivity"]
+    auto = results["ill-conditioned-mixed-sensitivity"]["auto"]
+    G = GeneralizedPlant.from_system(P, nmeas=ny, ncon=nu)
+    penalized = hinf_lmi(G, regularization=1e-4)
+    assert penalized.closed_loop_norm > 4.0 * auto.info["gamma_lower"]
+    assert auto.info["verified_norm"] <= auto.info["gamma_lower"] * (1 + 3e-3)
+
+
+@pytest.mark.parametrize("name", ["mixed-sensitivity-pole-1e-5", "ill-conditioned-mixed-sensitivity",
+                                  "skogestad-2.17-design1", "near-integrator-9"])
+def test_central_controller_is_labelled_with_its_verified_norm_near_the_optimum(name):
+    # hinf_central (the deployments' controller): its closed loop's norm by python-control
+    # is the norm it reports, within the bisection tolerance of the certified lower bound
+    P, ny, nu, _ = FAMILY[name]
+    d = hinf_central(GeneralizedPlant.from_system(P, nmeas=ny, ncon=nu), tol=1e-3, rtol=5e-4)
+    nrm = float(control.norm(d.closed_loop, p="inf"))
+    assert nrm == pytest.approx(d.closed_loop_norm, rel=3e-4)
+    assert d.gamma_lower <= nrm * (1 + 1e-9) and d.closed_loop_norm <= d.gamma
+    assert d.gamma <= d.gamma_lower * (1 + 3e-3)
 
 
 def test_sb10ad_is_bounded_in_time():

@@ -23,13 +23,15 @@ Routes (``method``):
   column rank, D21 full row rank, no imaginary-axis zeros of P12, P21);
 * ``"lmi"``: the eliminated LMIs (eq. 5.65) with an interior-point SDP solver (Clarabel) and
   the controller recovered by eq. 5.67 (:func:`tmfem.control.linear.hinf_lmi.hinf_lmi`); any
-  plant, O(n^6) time;
+  plant, O(n^6) time; refused when its controller is verified far below the SDP optimum
+  (an inaccurate SDP solution, :func:`_lmi_backoff`);
 * ``"slicot"``: python-control's ``hinfsyn`` (SB10AD), guarded and verified
   (:func:`tmfem.control.linear.hinf_slicot.hinf_slicot`);
 * ``"auto"`` (default): ``"riccati"`` for a regular plant, else ``"lmi"``. Where the Riccati
   bisection met numerical failures (levels it could not decide) and the plant has at most
   :data:`AUTO_LMI_MAX_STATES` states, the LMI optimum is computed too and the LMI
-  controller is used when it is verified lower.
+  controller is used when it is verified lower (not tried when the LMI optimum lies below
+  the Riccati route's certified lower bound: that SDP solution is inaccurate).
 
 ``alpha`` is alpha_1 of eq. 5.67 (closed-loop poles with Re < -alpha_1) by the shift A +
 alpha_1 I of 7.3, in every route.
@@ -129,7 +131,9 @@ LMI_BACKOFF = (1e-2, 3e-2, 1e-1)
 
 def _lmi_backoff(G0, *, alpha, solver, gamma_tol):
     """:func:`~tmfem.control.linear.hinf_lmi.hinf_lmi` at gamma_tol, then at the levels of
-    :data:`LMI_BACKOFF` above it, until the recovered controller is verified."""
+    :data:`LMI_BACKOFF` above it, until the recovered controller is verified; refused when
+    the verified norm lies more than the last back-off below the SDP optimum (an inaccurate
+    SDP solution: its level would be reported far above what the controller achieves)."""
     why = []
     for rel in (gamma_tol,) + tuple(r for r in LMI_BACKOFF if r > gamma_tol):
         try:
@@ -139,6 +143,14 @@ def _lmi_backoff(G0, *, alpha, solver, gamma_tol):
                 raise                 # the SDP itself failed: no level helps
             why.append(f"(1 + {rel:g}) gamma_LMI: {exc}")
             continue
+        if d.closed_loop_norm * (1 + LMI_BACKOFF[-1]) < d.gamma_lmi:
+            # the LMIs' optimum is the H-infinity optimum: a controller verified well below it
+            # proves the SDP solution inaccurate, and the level it reports meaningless
+            raise InfeasibleController(
+                f"LMI route: expected the SDP optimum gamma_LMI = {d.gamma_lmi:.6g} at most "
+                f"(1 + {LMI_BACKOFF[-1]:g}) x the verified norm of its own controller, found that "
+                f"norm {d.closed_loop_norm:.6g}: the SDP solution is inaccurate (ill-conditioned or "
+                "near-integrating data); use method='riccati' or 'auto'")
         d.info["lmi_backoff"] = rel
         return d
     raise InfeasibleController("LMI route: expected a verified controller at one of the levels "
@@ -181,7 +193,11 @@ def _route(G0, method, alpha, gamma_tol, solver):
             log.info("auto: the LMI cross-check failed (%s); keeping the Riccati design", exc)
             g_lmi = np.inf
         times["lmi gamma"] = time.perf_counter() - t0
-        if g_lmi * (1 + gamma_tol) < d.gamma / (1 + gamma_tol):
+        if d.gamma_lower is not None and g_lmi < d.gamma_lower * (1 - gamma_tol):
+            # below a certificate of infeasibility: the SDP solution is inaccurate
+            log.info("auto: LMI optimum %.6g below the certified lower bound %.6g; keeping the "
+                     "Riccati design", g_lmi, d.gamma_lower)
+        elif g_lmi * (1 + gamma_tol) < d.gamma / (1 + gamma_tol):
             try:
                 d2 = run("lmi")
             except InfeasibleController as exc:
@@ -195,16 +211,28 @@ def _route(G0, method, alpha, gamma_tol, solver):
     return d, "riccati", "regular plant", times
 
 
-def regularized(G0: GeneralizedPlant, rel: float) -> GeneralizedPlant:
+def regularized(G0: GeneralizedPlant, rel: float, *, states: bool = False) -> GeneralizedPlant:
     """The plant made regular: p gets the extra outputs eps_u u where D12 lacks column rank,
     y gets eps_y w' (new exogenous inputs w') where D21 lacks row rank, with eps_u = rel
-    max(||C1||, ||D12||) and eps_y = rel max(||B1||, ||D21||). The closed loop of the
-    original plant is a sub-block of the regularised one, so a controller's norm with the
-    original plant is at most its norm with the regularised plant (and the regularised
-    optimum decreases to the original one as rel -> 0)."""
+    max(||C1||, ||D12||) and eps_y = rel max(||B1||, ||D21||). With ``states``, also p gets
+    eps_x x and x' gets eps_x w'' (eps_x = rel max(||C1||, ||B1||)), which removes invariant
+    zeros of P12 and P21 on the imaginary axis (an integrator p does not see). The closed
+    loop of the original plant is a sub-block of the regularised one, so a controller's norm
+    with the original plant is at most its norm with the regularised plant (and the
+    regularised optimum decreases to the original one as rel -> 0)."""
     n, nw, nu, np_, ny = (G0.sizes[k] for k in ("n", "nw", "nu", "np", "ny"))
     A, B1, C1, C2, D11, D12, D21 = G0.A, G0.B1, G0.C1, G0.C2, G0.D11, G0.D12, G0.D21
     p_names, w_names = list(G0.p_names), list(G0.w_names)
+    if states:
+        e = rel * max(np.linalg.norm(C1, 2), np.linalg.norm(B1, 2), 1e-300)
+        C1 = np.vstack([C1, e * np.eye(n)])
+        D12 = np.vstack([D12, np.zeros((n, nu))])
+        D11 = np.vstack([D11, np.zeros((n, nw))])
+        p_names += [f"reg_{s}" for s in G0.state_names]
+        B1 = np.hstack([B1, e * np.eye(n)])
+        D21 = np.hstack([D21, np.zeros((ny, n))])
+        D11 = np.hstack([D11, np.zeros((D11.shape[0], n))])
+        w_names += [f"reg_w_{s}" for s in G0.state_names]
     if numerical_rank(D12) < nu:
         e = rel * max(np.linalg.norm(C1, 2), np.linalg.norm(D12, 2), 1e-300)
         C1 = np.vstack([C1, np.zeros((nu, n))])
@@ -236,7 +264,13 @@ def _regularized_riccati(G0, *, alpha, gamma_tol, target):
     for rel in REGULARIZATIONS:
         try:
             Gr = regularized(G0, rel)
-            check_regular(Gr, alpha=alpha)
+            try:
+                check_regular(Gr, alpha=alpha)
+            except InputError as exc:
+                if "invariant zero" not in str(exc):
+                    raise
+                Gr = regularized(G0, rel, states=True)
+                check_regular(Gr, alpha=alpha)
             d = hinf_central(Gr, alpha=alpha, tol=gamma_tol / 2, rtol=gamma_tol / 2)
             T = closed_loop(G0, d.controller)
             nrm, re = check_loop(T, gamma=d.gamma, alpha=alpha, rtol=1e-6,
@@ -269,10 +303,7 @@ def _singular_auto(G0, *, alpha, gamma_tol, solver, times, why):
         target = d.gamma_lmi
     except InfeasibleController as exc:
         errors.append(f"lmi: {exc}")
-        try:
-            target = hinf_gamma(G0, alpha=alpha, solver=solver)[0]
-        except InfeasibleController:
-            target = 0.0
+        target = 0.0              # no trusted optimum: every regularisation is tried
     times["lmi"] = time.perf_counter() - t0
     if not designs or designs[0][0].closed_loop_norm > target * (1 + gamma_tol):
         t0 = time.perf_counter()

@@ -123,7 +123,8 @@ def projection_solution(Psi, G, L, *, factor: float = 2.0):
     Q^T Psi Q on the range of G), not with Psi seen through an ill-conditioned G (a weight
     rho I makes rho G G^T swamp Psi in floating point when G is badly scaled). Returns
     (Theta, max eigenvalue of the LMI); (None, inf) when Psi is not negative definite on the
-    null space of G^T (the elimination condition fails in floating point).
+    null space of G^T (the elimination condition fails in floating point) or L Phi L^T is
+    singular in floating point.
     """
     import scipy.linalg as sla
     m = G.shape[1]
@@ -145,7 +146,10 @@ def projection_solution(Psi, G, L, *, factor: float = 2.0):
         return None, np.inf
     Lq = L @ Q                                                   # L in the QR coordinates
     PhiLt = sla.cho_solve(Lc, Lq.T)                              # Phi_q L_q^T
-    Th = -rho * sla.solve_triangular(G1, np.linalg.solve(Lq @ PhiLt, PhiLt[:m].T).T)
+    try:
+        Th = -rho * sla.solve_triangular(G1, np.linalg.solve(Lq @ PhiLt, PhiLt[:m].T).T)
+    except np.linalg.LinAlgError:                                # L Phi L^T singular in floating point
+        return None, np.inf
     GTL = G @ Th @ L
     lam = max_eig(Psi + GTL + GTL.T)
     return Th, lam

@@ -11,8 +11,10 @@ margins are scale-free (they do not change when B or C is multiplied by a consta
 equal the sine-like measure of how far the mode is from the input (output) directions; the
 smallest one names the least controllable (observable) mode. Repeated eigenvalues: the test
 is applied to an orthonormal basis of each eigenspace (eigenvalues within ``cluster_rtol``
-of each other are grouped), using the smallest singular value of V^H B over the eigenspace,
-so a degenerate pair cannot hide an uncontrollable combination.
+of each other are grouped; the basis is the numerical null space of A - lambda I, so a
+defective eigenvalue contributes only its true eigenvectors), using the smallest singular
+value of V^H B over the eigenspace, so a degenerate pair cannot hide an uncontrollable
+combination.
 """
 from __future__ import annotations
 
@@ -72,17 +74,33 @@ def _eigenspaces(lam: np.ndarray, cluster_rtol: float):
     return groups
 
 
+def _eigenspace_basis(S: np.ndarray, *, left: bool, tol: float, size: int) -> np.ndarray:
+    """Orthonormal basis of the (left) null space of S = A - lambda I for a cluster of
+    ``size`` eigenvalues: the singular vectors of S with singular value <= ``tol`` (at least
+    one, at most ``size``). A defective eigenvalue (a Jordan block) has fewer eigenvectors
+    than its multiplicity; its rounded eigenvectors are nearly parallel and their span would
+    contain directions that are not eigenvectors, so the basis is taken from S itself."""
+    U, sv, Vh = np.linalg.svd(S)
+    k = int(np.clip(np.count_nonzero(sv <= tol), 1, size))
+    return U[:, -k:] if left else Vh[-k:].conj().T
+
+
 def _margins(A: np.ndarray, M: np.ndarray, *, left: bool, cluster_rtol: float) -> tuple:
     import scipy.linalg as sla
     lam, VL, VR = sla.eig(A, left=True, right=True)
     V = VL if left else VR
     nM = np.linalg.norm(M, 2)
     out = np.empty(len(lam))
+    scale = max(1.0, float(np.linalg.norm(A, 2)))
     for g in _eigenspaces(lam, cluster_rtol):
-        Q, _ = np.linalg.qr(V[:, g])                      # orthonormal basis of the eigenspace
+        if len(g) == 1:
+            Q = V[:, g] / np.linalg.norm(V[:, g])
+        else:
+            Q = _eigenspace_basis(A - lam[g].mean() * np.eye(A.shape[0]), left=left,
+                                  tol=cluster_rtol * scale, size=len(g))
         prod = Q.conj().T @ M if left else M @ Q
         sv = np.linalg.svd(prod, compute_uv=False)
-        smin = sv[-1] if len(sv) >= len(g) else 0.0
+        smin = sv[-1] if len(sv) >= Q.shape[1] else 0.0
         out[g] = smin / nM if nM > 0 else 0.0
     return lam, out
 

@@ -46,4 +46,5 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "verify_design": "tmfem.control.lpv.workflow",
     "Basis": "tmfem.control.lpv.basis",
     "lpvsyn": "tmfem.control.lpv.gridded_synthesis",
+    "lpvsyn_cost": "tmfem.control.lpv.cost",
 })

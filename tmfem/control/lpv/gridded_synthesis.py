@@ -77,6 +77,7 @@ import scipy.sparse as sp
 from tmfem.control.linear.lmi import solve, sym
 from tmfem.control.linear.pbh import pbh
 from tmfem.control.lpv.basis import Basis
+from tmfem.control.lpv.cost import check_lpvsyn_cost, lpvsyn_cost
 from tmfem.control.lpv.gridded_plant import PlantFunction, grid_axes, plant_function
 from tmfem.control.lpv.generalized_plant import state_scaling
 from tmfem.errors import InfeasibleController, InputError
@@ -415,6 +416,9 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     InputError
         Inconsistent shapes, a grid without the plant's design points, a basis that is not
         finite or smooth or is linearly dependent on the grid, options out of range.
+    ResourceLimit
+        An SDP whose interior-point memory estimate (:mod:`tmfem.control.lpv.cost`) exceeds
+        this machine's limit, before anything is built.
     InfeasibleController
         Infeasible or failed SDP, with the solver status and the likely cause; a design whose
         verification failed (with ``require_verified``).
@@ -464,6 +468,11 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     else:
         bases = {"X": gbC if constant == "X" else gbL, "Y": gbC if constant == "Y" else gbL,
                  "A^": gbG, "B^": gbG, "C^": gbG, "D^": gbG}
+    cost = check_lpvsyn_cost(lpvsyn_cost(n=n, nw=m - ncon, np_=p - nmeas, nu=ncon, ny=nmeas, points=len(design),
+                                         vertices=len(_vertices(rb)), lyapunov_basis=len(lyap),
+                                         gain_basis=len(gain), constant=constant),
+                             what=f"lpvsyn: {n} states, {len(design)} grid points x {len(_vertices(rb))} rate "
+                                  f"vertices")
     centre = tuple((a.size - 1) // 2 for a in axes)
     T = state_scaling(plant.at([a[i] for a, i in zip(axes, centre)])[0]) if scale else np.ones(n)
     verts = _vertices(rb)
@@ -473,7 +482,7 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
                     nu=ncon, ny=nmeas)
     sizes = {"grid_points": len(design), "rate_vertices": len(verts), "lmis": len(design) * len(verts),
              "lmi_size": prob.lmi_size, "n_x": n, "basis": list(lyap.names), "gain_basis": list(gain.names),
-             "decision_variables": prob.n_variables}
+             "decision_variables": prob.n_variables, "memory_estimate_gib": cost.memory_bytes / 2**30}
     log.info("lpvsyn: %s feedback, %s", kind, sizes)
     try:
         g_min, rep1 = prob.minimize_gamma(solver, gamma_max=gamma_max, budget=budget)
