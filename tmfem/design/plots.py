@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from tmfem.post.plots import new_figure, save_figure
 
@@ -19,7 +20,14 @@ def plot_history(history, png, *, objective: str):
     axes[0].set_ylabel(objective)
     for ax, col, lab in ((axes[1], 2, "max violation (scaled)"), (axes[2], 3, "step |dp| (SI)")):
         v = h[:, col]
-        ax.semilogy(h[:, 0], np.where(v > 0, v, np.nan), "o-")
+        positive = v > 0
+        floor = min(0.1 * v[positive].min(), 1e-12) if positive.any() else 1e-12
+        ax.semilogy(h[:, 0], np.where(positive, v, floor), "o-", color="C0")
+        if not positive.all():                  # zeros drawn at a floor, marked, not dropped
+            ax.semilogy(h[~positive, 0], np.full((~positive).sum(), floor), "v", color="C3",
+                        label=f"exactly 0 (drawn at {floor:.1e})")
+            ax.legend(loc="best", fontsize="small")
         ax.set_ylabel(lab)
     axes[2].set_xlabel("iteration")
+    axes[2].xaxis.set_major_locator(MaxNLocator(integer=True))
     return save_figure(fig, png)
