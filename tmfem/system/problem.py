@@ -43,7 +43,7 @@ KEYS = {
 }
 GAIN_KEYS = ("omega_0", "omega_e", "tau", "d_c")
 UNCERTAINTIES = ("initial", "no-MG", "exact")
-PATHS = ("delta", "table-7-7-bases", "linear")
+PATHS = ("delta", "auto", "table-7-7-bases", "linear")
 COM_PRESTRESS = ("designed", "printed-tendon-stress")
 
 
@@ -125,8 +125,10 @@ class DeploymentParameters:
         implemented: the critically damped closed form).
     gains : (omega_0, omega_e, tau, d_c) of eq. 5.69 (Table 7.1) [rad/s, rad/s, s, -].
     uncertainty : the controller's model error ("initial": eq. 5.72, "no-MG", "exact").
-    path : "delta" (1-N(D): eq. 3.22 with Delta linear), "table-7-7-bases" (M = 2 with the
-        stage-2 base rule of Table 7.7) or "linear"; None: "delta" for 1-N(D), else "linear".
+    path : "delta" (1-N(D): eq. 3.22 with Delta linear), "auto" (M >= 2: the automatic path
+        through the symmetric equilibria, :mod:`tmfem.equilibrium.deployment_path`),
+        "table-7-7-bases" (M = 2 with the stage-2 base rule of Table 7.7) or "linear"; None:
+        "delta" for 1-N(D), "auto" for M >= 2, else "linear".
     rbf_centres, w_bar, gamma : RBF centres along the reference, the bound of the weights and
         the adaptation gain (eq. 5.58-5.60).
     r_min : smallest admissible rest length [m] (the rest-length limit of the PFL).
