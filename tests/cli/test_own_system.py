@@ -124,6 +124,31 @@ def test_deploy_of_a_user_1_5d_tracks_and_switches(tmp_path, capsys):
     assert_no_dissertation(out)
 
 
+def test_deploy_of_a_user_2_5_on_the_automatic_path(tmp_path, capsys):
+    """`deploy FILE` of a two-stage five-bar system (its own [packaged] and [deployment]; no
+    path declared: the automatic path of M >= 2 systems, which corrects the stage-2 base where
+    the straight line slackens P2), coarse step: the path checked at 101 points with a positive
+    margin, the switch to the H-infinity controller taken (eq. 5.70, R_c = 0.01, after the
+    reference of eq. 5.68 with omega_r = 0.5 rad/s has settled to 1 %: (1 + w t) exp(-w t) < 0.01
+    needs t > 13.3 s), the tracking error below R_c at the end, no slack tendon (tendon forces
+    > 0 in the CSV) and every rest length inside [r_min, |tendon|]."""
+    import csv
+    r, out = run(["deploy", str(SYSTEMS / "pentagon-2-5.toml"), "--t-end", "20", "--dt", "0.02",
+                  "--csv", str(tmp_path / "d.csv")], capsys)
+    assert r["path"] == "auto" and r["path_check"]["points_checked"] == 101
+    assert r["path_check"]["min_margin"] > 0 and r["path_check"]["optimizer_evaluations"] > 0
+    assert r["switch_time_s"] is not None and 13.3 < r["switch_time_s"] < 20
+    assert r["final_tracking_error"] < 0.01 and r["failure"] is None
+    assert r["min_rest_length_margin_m"] > 0
+    with open(tmp_path / "d.csv") as fh:
+        rows = list(csv.reader(fh))
+    head, data = rows[0], np.array([[float(v) for v in row[:-1]] for row in rows[1:]])
+    T = data[:, [k for k, h in enumerate(head) if h.startswith("T_")]]
+    u = data[:, [k for k, h in enumerate(head) if h.startswith("r_")]]
+    assert T.shape[1] == u.shape[1] == 35 and T.min() > 0 and u.min() >= 1e-3
+    assert_no_dissertation(out)
+
+
 def test_deploy_refuses_a_file_without_a_packaged_configuration(capsys):
     rc = main(["deploy", str(SYSTEMS / "pentagon-1-5.toml")])
     err = capsys.readouterr().err
