@@ -44,6 +44,8 @@ KEYS = {
 GAIN_KEYS = ("omega_0", "omega_e", "tau", "d_c")
 UNCERTAINTIES = ("initial", "no-MG", "exact")
 PATHS = ("delta", "auto", "table-7-7-bases", "linear")
+#: the stage-base rules of an LPV grid (``[lpv] path``)
+LPV_PATHS = ("table-7-7-bases",)
 COM_PRESTRESS = ("designed", "printed-tendon-stress")
 
 
@@ -165,13 +167,16 @@ class LPVParameters:
     points : tuple of (x_f, y_f) or None
         Monitored membrane points of eq. 5.101 [m]; None: as ``[control]``.
     path : str
-        The stage bases along the grid (:data:`PATHS`).
+        The stage bases over the grid (:data:`LPV_PATHS`): "table-7-7-bases", the rule of
+        :func:`tmfem.reference.tables.deployment_bases` for any two-stage system (sigma_2
+        fixed, z_2 = 0.7 l cos(theta), r_2 from eq. 3.22 for Delta = 1 mm), the only rule the
+        LPV grid implements.
     """
 
     omega_r: float = 0.3
     membrane_modes: int | None = None
     points: tuple | None = None
-    path: str = "linear"
+    path: str = "table-7-7-bases"
     theta_grid_deg: tuple | None = None
     psi_grid_deg: tuple | None = None
     rate_bound_deg: float = 10.0
@@ -291,7 +296,7 @@ def _lpv(t: dict, where: str) -> LPVParameters:
     d = LPVParameters()
     return LPVParameters(omega_r=_positive(t, "omega_r", w, d.omega_r),
                          membrane_modes=K, points=_points(t, "points", w),
-                         path=_choice(t, "path", w, PATHS, "linear"),
+                         path=_choice(t, "path", w, LPV_PATHS, LPV_PATHS[0]),
                          theta_grid_deg=_axis(t, "theta_grid_deg", w), psi_grid_deg=_axis(t, "psi_grid_deg", w),
                          rate_bound_deg=_positive(t, "rate_bound_deg", w, d.rate_bound_deg, zero=True),
                          theta0_deg=_angle(t, "theta0_deg", w), theta_e_deg=_angle(t, "theta_e_deg", w),
