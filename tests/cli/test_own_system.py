@@ -135,6 +135,8 @@ def test_deploy_of_a_user_2_5_on_the_automatic_path(tmp_path, capsys):
     import csv
     r, out = run(["deploy", str(SYSTEMS / "pentagon-2-5.toml"), "--t-end", "20", "--dt", "0.02",
                   "--csv", str(tmp_path / "d.csv")], capsys)
+    from tests.cli.test_cli_units import _unitless_numbers
+    assert _unitless_numbers({k: v for k, v in r.items() if k != "units"}) == []
     assert r["path"] == "auto" and r["path_check"]["points_checked"] == 101
     assert r["path_check"]["min_margin"] > 0 and r["path_check"]["optimizer_evaluations"] > 0
     assert r["switch_time_s"] is not None and 13.3 < r["switch_time_s"] < 20
