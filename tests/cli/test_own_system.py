@@ -7,6 +7,7 @@ declares and nothing else: no printed frequencies, no implied prestress, no expl
 7.4 design data appear for them.
 """
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -149,6 +150,25 @@ def test_deploy_of_a_user_2_5_on_the_automatic_path(tmp_path, capsys):
     u = data[:, [k for k, h in enumerate(head) if h.startswith("r_")]]
     assert T.shape[1] == u.shape[1] == 35 and T.min() > 0 and u.min() >= 1e-3
     assert_no_dissertation(out)
+
+
+def test_deploy_refuses_a_2_5_without_a_path_naming_the_obstacle(tmp_path, capsys):
+    """The 2-5 packaged at theta = 78 deg, psi = 28 deg with its stage-2 base at sigma_2 =
+    -60 deg (a feasible equilibrium, checked before the path): no path through the symmetric
+    equilibria is found, so `deploy` stops before any controller design with an error naming
+    the progress, the angles and the slack tendon group (InfeasibleDesign, exit 1)."""
+    text = (SYSTEMS / "pentagon-2-5.toml").read_text()
+    text = text.replace("psi_deg = [20.0, 20.0], sigma_deg = [0.0, 0.0], z = [0.0, 0.153], r = [0.9, 1.3286]",
+                        "psi_deg = [28.0, -32.0], sigma_deg = [0.0, -60.0], z = [0.0, 0.257], r = [0.9, 0.9573]")
+    f = tmp_path / "no-path.toml"
+    f.write_text(text)
+    assert main(["deploy", str(f), "--t-end", "1"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert [e for e in err if "error" in e] == err[-1:]        # before it: the search's log line
+    err = err[-1]
+    assert "no path through the symmetric equilibria" in err
+    assert re.search(r"fails at s = [0-9.]+ \(theta = \[[0-9., ]+\] deg, psi = \[[-0-9., ]+\] deg\): "
+                     r"no positive null vector of 3.3.2: force sign of .*P2", err), err
 
 
 def test_deploy_refuses_a_file_without_a_packaged_configuration(capsys):
