@@ -119,3 +119,30 @@ def test_rest_lengths_below_the_limit_are_named(tower):
     assert p.margin < 0 and f"rest length of {d.tendon_names[k][:-1]}" in p.reason
     assert f" {d.rest_lengths[k]:.4g} m below" in p.reason
     assert path_feasibility(f, f.symmetric, kappa=kappa, r_min=d.rest_lengths[k] - 1e-3).reason == ""
+
+
+def test_a_three_stage_path_ends_on_both_designs_through_equilibria():
+    # any M: a 3-3 of our own (tests/data/systems/tower-3-3.toml); the corrected parameters
+    # are r_2, z_2, z_3, sigma_2, sigma_3 (r_3 follows Delta by eq. 3.22); the straight line
+    # is feasible here, every checked point has a positive null vector by the LP of 3.2 over
+    # the two-dimensional null space of the 12 x 14 matrix, Delta linear in s; a correction of
+    # r_2 moves r_2 by its sine terms and leaves Delta on its line
+    from tmfem.reference.deployments import automatic_path_of, checked_configurations
+    f = checked_configurations(load_system(SYSTEMS / "tower-3-3.toml"))
+    rep = automatic_path_of(f, r_min=1e-3)
+    p = rep.path
+    assert p.names == ["r_2", "z_2", "z_3", "sigma_2", "sigma_3"] and rep.min_margin > 0
+    assert null_space(symmetric_matrix(f).A, 1e-9)[0].shape[1] == 2
+    a, b = f.problem.packaged.symmetric, f.symmetric
+    D0, De = a.membrane_delta(3, f.r_mb), b.membrane_delta(3, f.r_mb)
+    for s in (0.0, 0.25, 0.5, 0.75, 1.0):
+        cfg = p.config(s)
+        assert lp_margin(f, cfg) > 0
+        assert cfg.membrane_delta(3, f.r_mb) == pytest.approx(D0 + s * (De - D0), abs=1e-12)
+    assert np.allclose(p.config(1.0).r, b.r, atol=1e-9) and np.allclose(p.config(0.0).sigma, a.sigma)
+    coefficients = np.zeros((5, 3))
+    coefficients[0, 0] = 0.05                     # r_2 += 0.05 sin(pi s)
+    bent = SymmetricPath(system=f, initial=a, final=b, coefficients=coefficients)
+    c = bent.config(0.5)
+    assert c.r[1] == pytest.approx(p.config(0.5).r[1] + 0.05, abs=1e-12)
+    assert c.membrane_delta(3, f.r_mb) == pytest.approx(0.5 * (D0 + De), abs=1e-12)
