@@ -171,6 +171,15 @@ def test_deploy_refuses_a_2_5_without_a_path_naming_the_obstacle(tmp_path, capsy
                      r"no positive null vector of 3.3.2: force sign of .*P2", err), err
 
 
+def test_deploy_refuses_a_three_stage_system_before_any_design(capsys):
+    """The 3-3 has a path (tests/control/deployment/test_automatic_path.py) but 13 N = 39
+    tendons for 12 N = 36 bar coordinates (eqs. 3.1-3.2: 2N + 5N per upper stage): the square
+    B_q of eq. 5.46 does not exist, and the file is refused at once, saying so."""
+    assert main(["deploy", str(SYSTEMS / "tower-3-3.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "square B_q of eq. 5.46" in err and "39 tendons for 36 bar coordinates" in err
+
+
 def test_deploy_refuses_a_file_without_a_packaged_configuration(capsys):
     rc = main(["deploy", str(SYSTEMS / "pentagon-1-5.toml")])
     err = capsys.readouterr().err
