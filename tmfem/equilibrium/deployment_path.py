@@ -107,7 +107,8 @@ def path_feasibility(system, cfg: SymmetricConfig, *, kappa: float | None = None
     if not nv.margin > 0:
         neg = [f"{c} ({v:+.3g})" for c, v in zip(S.cols, nv.x) if v <= 0]
         return PathPoint(nv.margin, D, "no positive null vector of 3.3.2: force sign of "
-                         + ", ".join(neg) + " (tendon groups slack or the membrane pushing)")
+                         + ", ".join(neg) + " (a tendon group without tension needs a rest length "
+                         "at or above its tendon length, eq. 3.9; F_Delta <= 0: the membrane pushing)")
     if not D > 0:
         return PathPoint(min(nv.margin, D), D, f"membrane not stretched: Delta = {D:.4g} m <= 0 (eq. 3.22)")
     if kappa is None:
