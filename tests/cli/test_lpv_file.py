@@ -100,3 +100,26 @@ def test_the_lpv_deployment_of_a_renamed_copy_is_the_presets(design21, tmp_path,
     assert ours["preset"] == "my-two-stage" and ours["controller"] == ref["controller"] == "lpv"
     for key in ("t_end_s", "max_membrane_deflection_m", "max_tendon_stress_Pa", "peak_bar_compression_N"):
         assert ours[key] == pytest.approx(ref[key], rel=1e-10), key
+
+
+def test_a_user_two_stage_system_gets_its_own_lpv_bound(capsys):
+    # a 2-5 of our own (tests/data/systems/pentagon-2-5-lpv.toml), reduced to the two ends of
+    # its theta grid at the middle psi: the frozen plants at the file's points, no printed bound,
+    # and the pointwise optimum tight (the norm a static gain at 1.01 x it achieves lies between)
+    out = bound_only([str(DATA / "pentagon-2-5-lpv.toml"), "--grid", "2x1"], capsys)
+    assert out["preset"] == "pentatower-lpv" and out["grid"] == [2, 1] and "printed_gamma_bound" not in out
+    g = np.asarray(out["pointwise_gamma"]).ravel()
+    assert np.all(np.isfinite(g)) and np.all(g > 0)
+    assert out["lpv_gamma_lower_bound"] == pytest.approx(g.max(), rel=1e-12)
+    assert np.degrees(out["lpv_gamma_lower_bound_at"])[1] == pytest.approx(25.0)
+    assert np.degrees(out["lpv_gamma_lower_bound_at"])[0] in (pytest.approx(64.0), pytest.approx(70.0))
+    nrm = out["lpv_gamma_lower_bound_achieved_norm"]
+    assert g.max() * (1 - 1e-4) <= nrm <= 1.01 * g.max() * (1 + 1e-6)
+
+
+def test_an_lpv_path_other_than_the_grid_rule_is_refused(tmp_path):
+    text = (DATA / "pentagon-2-5-lpv.toml").read_text().replace('path = "table-7-7-bases"', 'path = "linear"')
+    f = tmp_path / "s.toml"
+    f.write_text(text)
+    with pytest.raises(InputError, match=re.escape("expected 'path' to be one of ['table-7-7-bases']")):
+        load_system(f)

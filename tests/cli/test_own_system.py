@@ -7,6 +7,7 @@ declares and nothing else: no printed frequencies, no implied prestress, no expl
 7.4 design data appear for them.
 """
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -122,6 +123,61 @@ def test_deploy_of_a_user_1_5d_tracks_and_switches(tmp_path, capsys):
     assert r["failure"] is None and r["min_rest_length_margin_m"] > 0
     assert r["pfl_gains"] == [4.0, 10.0, 20.0, 0.9]
     assert_no_dissertation(out)
+
+
+def test_deploy_of_a_user_2_5_on_the_automatic_path(tmp_path, capsys):
+    """`deploy FILE` of a two-stage five-bar system (its own [packaged] and [deployment]; no
+    path declared: the automatic path of M >= 2 systems, which corrects the stage-2 base where
+    the straight line slackens P2), coarse step: the path checked at 101 points with a positive
+    margin, the switch to the H-infinity controller taken (eq. 5.70, R_c = 0.01, after the
+    reference of eq. 5.68 with omega_r = 0.5 rad/s has settled to 1 %: (1 + w t) exp(-w t) < 0.01
+    needs t > 13.3 s), the tracking error below R_c at the end, no slack tendon (tendon forces
+    > 0 in the CSV) and every rest length inside [r_min, |tendon|]."""
+    import csv
+    r, out = run(["deploy", str(SYSTEMS / "pentagon-2-5.toml"), "--t-end", "20", "--dt", "0.02",
+                  "--csv", str(tmp_path / "d.csv")], capsys)
+    from tests.cli.test_cli_units import _unitless_numbers
+    assert _unitless_numbers({k: v for k, v in r.items() if k != "units"}) == []
+    assert r["path"] == "auto" and r["path_check"]["points_checked"] == 101
+    assert r["path_check"]["min_margin"] > 0 and r["path_check"]["optimizer_evaluations"] > 0
+    assert r["switch_time_s"] is not None and 13.3 < r["switch_time_s"] < 20
+    assert r["final_tracking_error"] < 0.01 and r["failure"] is None
+    assert r["min_rest_length_margin_m"] > 0
+    with open(tmp_path / "d.csv") as fh:
+        rows = list(csv.reader(fh))
+    head, data = rows[0], np.array([[float(v) for v in row[:-1]] for row in rows[1:]])
+    T = data[:, [k for k, h in enumerate(head) if h.startswith("T_")]]
+    u = data[:, [k for k, h in enumerate(head) if h.startswith("r_")]]
+    assert T.shape[1] == u.shape[1] == 35 and T.min() > 0 and u.min() >= 1e-3
+    assert_no_dissertation(out)
+
+
+def test_deploy_refuses_a_2_5_without_a_path_naming_the_obstacle(tmp_path, capsys):
+    """The 2-5 packaged at theta = 78 deg, psi = 28 deg with its stage-2 base at sigma_2 =
+    -60 deg (a feasible equilibrium, checked before the path): no path through the symmetric
+    equilibria is found, so `deploy` stops before any controller design with an error naming
+    the progress, the angles and the slack tendon group (InfeasibleDesign, exit 1)."""
+    text = (SYSTEMS / "pentagon-2-5.toml").read_text()
+    text = text.replace("psi_deg = [20.0, 20.0], sigma_deg = [0.0, 0.0], z = [0.0, 0.153], r = [0.9, 1.3286]",
+                        "psi_deg = [28.0, -32.0], sigma_deg = [0.0, -60.0], z = [0.0, 0.257], r = [0.9, 0.9573]")
+    f = tmp_path / "no-path.toml"
+    f.write_text(text)
+    assert main(["deploy", str(f), "--t-end", "1"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert [e for e in err if "error" in e] == err[-1:]        # before it: the search's log line
+    err = err[-1]
+    assert "no path through the symmetric equilibria" in err
+    assert re.search(r"fails at s = [0-9.]+ \(theta = \[[0-9., ]+\] deg, psi = \[[-0-9., ]+\] deg\): "
+                     r"no positive null vector of 3.3.2: force sign of .*P2", err), err
+
+
+def test_deploy_refuses_a_three_stage_system_before_any_design(capsys):
+    """The 3-3 has a path (tests/control/deployment/test_automatic_path.py) but 13 N = 39
+    tendons for 12 N = 36 bar coordinates (eqs. 3.1-3.2: 2N + 5N per upper stage): the square
+    B_q of eq. 5.46 does not exist, and the file is refused at once, saying so."""
+    assert main(["deploy", str(SYSTEMS / "tower-3-3.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "square B_q of eq. 5.46" in err and "39 tendons for 36 bar coordinates" in err
 
 
 def test_deploy_refuses_a_file_without_a_packaged_configuration(capsys):

@@ -79,3 +79,58 @@ def test_bases_of_a_two_stage_system_give_a_feasible_design(tmp_path, capsys):
     f = write(tmp_path, d)
     r, _ = run(["equilibrium", f, "--target-delta", "1"], capsys)
     assert r["ok"] and r["Delta"] == pytest.approx(1e-3, rel=1e-6)
+
+
+def test_packaged_configuration_of_a_user_1_6d_deploys_along_a_feasible_path(capsys):
+    """--packaged on a 1-6(D) of our own: the suggested psi is the file's [packaged] one, it lies
+    in a printed band, and the delta-rule path from it to the deployed configuration is an
+    equilibrium (eq. 3.41) at 101 progress values, checked here by the deployment's own
+    reference and checker; Delta within 10 % of the deployed one (eq. 3.22)."""
+    import numpy as np
+
+    from tmfem.control.deployment.reference_trajectory import DeploymentReference
+    from tmfem.control.deployment.run import equilibrium_checker
+    from tmfem.system import load_system
+    f = str(SYSTEMS / "hexagon-1-6D.toml")
+    r, _ = run(["equilibrium", f, "--packaged", "86"], capsys)
+    s = load_system(f)
+    assert r["psi_deg"] == pytest.approx(np.degrees(s.problem.packaged.symmetric.psi[0]))
+    assert any(a <= r["psi_deg"] <= b for a, b in r["psi_deg_bands"])
+    assert r["Delta"] == pytest.approx(r["Delta_deployed"], rel=0.1) and r["path_points_checked"] == 101
+    ref = DeploymentReference(initial=s.problem.packaged.symmetric, final=s.symmetric, N=6,
+                              q_names=list(s.q_names), omega_r=0.5, r_mb=s.r_mb)
+    assert ref.check_equilibria(checker=equilibrium_checker(s), n=101).size == 101
+
+
+def test_packaged_psi_of_a_1_3d_skips_a_start_whose_path_leaves_the_equilibria(capsys):
+    """The 1-3(D) at theta = 80 deg: the psi of smallest Delta (30 deg = 90 - 180/N, where
+    eq. 3.22 puts the bar ends closest to the axis) has no feasible delta-rule path to the
+    deployed configuration, so another psi of the band is suggested, whose path is feasible;
+    above theta_max = asin((r_mb + Delta_e + r_1) / l) the deployed Delta is out of reach and
+    the text says so."""
+    import dataclasses
+
+    import numpy as np
+
+    from tmfem.control.deployment.reference_trajectory import DeploymentReference
+    from tmfem.control.deployment.run import equilibrium_checker
+    from tmfem.errors import InfeasibleDesign
+    from tmfem.system import load_system
+    f = str(SYSTEMS / "triangle-1-3D.toml")
+    r, _ = run(["equilibrium", f, "--packaged", "80"], capsys)
+    s = load_system(f)
+    c = s.symmetric
+
+    def path_from(psi_deg):
+        start = dataclasses.replace(c, theta=np.radians([80.0]), psi=np.radians([psi_deg]))
+        ref = DeploymentReference(initial=start, final=c, N=3, q_names=list(s.q_names), omega_r=0.5,
+                                  r_mb=s.r_mb)
+        return ref.check_equilibria(checker=equilibrium_checker(s), n=101)
+
+    with pytest.raises(InfeasibleDesign):
+        path_from(30.0)
+    assert path_from(r["psi_deg"]).size == 101 and r["psi_deg"] != 30.0
+    Delta_e = r["Delta_deployed"]
+    assert r["theta_max_deg"] == pytest.approx(np.degrees(np.arcsin((s.r_mb + Delta_e + c.r[0]) / c.l[0])))
+    assert main(["equilibrium", f, "--packaged", "80"]) == 0
+    assert f"reachable only for theta <= {r['theta_max_deg']:.4g} deg" in capsys.readouterr().out

@@ -40,8 +40,10 @@ def configure(parser) -> None:
                              "measured q and membrane points, docs/guides/lpv.md)")
     parser.add_argument("--uncertainty", choices=list(UNCERTAINTIES),
                         help="controller model error (default: the 7.4 choice of the preset)")
-    parser.add_argument("--path", choices=["delta", "table-7-7-bases", "linear"],
-                        help="deployment path (default: delta for 1-N(D), table-7-7-bases for 2-3; "
+    parser.add_argument("--path", choices=["delta", "auto", "table-7-7-bases", "linear"],
+                        help="deployment path (default: the file's [deployment] path, else delta for "
+                             "1-N(D) and auto for M >= 2 (stage bases continued through the symmetric "
+                             "equilibria, docs/guides/deployment.md); table-7-7-bases for 2-3; "
                              "linear: every symmetric parameter linear in the progress)")
     parser.add_argument("--allocation", choices=["bounded", "clip"], default=None,
                         help="rest-length limits in the PFL: bounded (the admissible rest lengths "

@@ -118,8 +118,12 @@ def format_assist(r: dict) -> str:
     return (f"{r['system']}: at theta = {r['theta_deg']:g} deg the system is a feasible 1-N(D) "
             f"equilibrium for psi in {bands} deg (steps of {r['step_deg']:g} deg)"
             + f"; psi = {r['psi_deg']:g} deg gives Delta = {1e3 * r['Delta']:.4g} mm (deployed "
-            f"{1e3 * r['Delta_deployed']:.4g} mm):\n[packaged]\nsymmetric = {{ theta_deg = "
-            f"[{r['theta_deg']:g}], psi_deg = [{r['psi_deg']:g}] }}")
+            f"{1e3 * r['Delta_deployed']:.4g} mm; the deployment path from it checked at "
+            f"{r['path_points_checked']} points):\n[packaged]\nsymmetric = {{ theta_deg = "
+            f"[{r['theta_deg']:g}], psi_deg = [{r['psi_deg']:g}] }}"
+            + (f"\nthe deployed Delta is reachable only for theta <= {r['theta_max_deg']:.4g} deg "
+               f"(eq. 3.22: Delta >= l sin(theta) - r_1 - r_mb); a packaged theta above it "
+               f"stretches the membrane more" if r["theta_deg"] > r["theta_max_deg"] else ""))
 
 
 def _groups(r: dict) -> dict:

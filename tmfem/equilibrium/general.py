@@ -368,6 +368,12 @@ def positive_null_vector(A: np.ndarray, positive=None, *, rtol: float = 1e-9) ->
     if k == 0:
         return NullVector(x=np.zeros(n), margin=-np.inf, dim=0, sv=rel)
     Zp = Z[pos]
+    if k == 1:                  # one null vector: the normalisation fixes c, no LP to solve
+        s = Zp.sum()
+        if abs(s) <= rtol * np.abs(Zp).sum():
+            return NullVector(x=np.zeros(n), margin=-np.inf, dim=k, sv=rel)
+        x = Z[:, 0] / s
+        return NullVector(x=x, margin=float(min(x[pos].min(), 1.0)), dim=k, sv=rel)
     # variables (c_1..c_k, t); maximise t
     c = np.zeros(k + 1)
     c[-1] = -1.0

@@ -44,6 +44,8 @@ _EXACT = {
     "closed_loop_max_real": "1/s", "closed_loop_max_real_at": "rad", "sampled_max_radius": "-",
     "sampled_max_radius_at": "rad", "lpv_gamma_lower_bound_at": "rad", "omega_r": "rad/s", "xi_r": "-",
     "max_tracking_error": "rad (angles), m (positions)", "largest_scaled_eig": "- (scaled)",
+    # the automatic deployment path (docs/guides/deployment.md)
+    "min_margin": "-", "min_margin_progress": "-", "resolution": "- (progress s)", "hinf_gamma": "-",
 }
 _SUFFIX = [(r".*_deg$", "deg"), (r".*_hz$", "Hz"), (r".*_MPa$", "MPa"), (r".*_mm$", "mm"),
            (r".*_m$", "m"), (r".*_N$", "N"), (r".*_s$", "s"), (r".*_J$", "J"),

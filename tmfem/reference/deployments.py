@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.control.linear.generalized_plant import measured_points
-from tmfem.errors import InputError
+from tmfem.errors import InfeasibleDesign, InputError
 from tmfem.io.atomic import atomic_open
 from tmfem.io.run import partial_name
 
@@ -87,9 +87,25 @@ def checked_configurations(system):
 
 def own_path(system) -> str:
     """The deployment path of ``system``: its ``[deployment] path``, else ``"delta"`` for a
-    1-N(D) system and ``"linear"`` otherwise."""
+    1-N(D) system, ``"auto"`` for an M >= 2 system and ``"linear"`` otherwise."""
     p = system.problem.deployment.path
-    return p if p is not None else ("delta" if system.deployable else "linear")
+    if p is not None:
+        return p
+    return "delta" if system.deployable else ("auto" if system.M >= 2 else "linear")
+
+
+def automatic_path_of(final, *, r_min: float):
+    """The automatic path (:func:`tmfem.equilibrium.deployment_path.automatic_path`) of the
+    checked M >= 2 ``final`` (:func:`checked_configurations`) from its packaged configuration,
+    with the membrane stiffness of its equilibrium design and the rest-length limit ``r_min``
+    [m]."""
+    from tmfem.equilibrium.deployment_path import automatic_path, membrane_stiffness
+    from tmfem.equilibrium.design import design_equilibrium
+    kappa = membrane_stiffness(design_equilibrium(final.replace(rest_lengths=None), strict=False))
+    try:
+        return automatic_path(final, final.problem.packaged.symmetric, kappa=kappa, r_min=r_min)
+    except InfeasibleDesign as exc:
+        raise type(exc)(f"deploy {final.name}: {exc}") from None
 
 
 def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None = None,
@@ -102,7 +118,8 @@ def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None 
     ``path`` (default the file's): ``"delta"`` (1-N(D): psi_r from eq. 3.22 with the
     membrane stretch Delta linear in s), ``"table-7-7-bases"`` (2-3: the stage-2 base on the
     reconstructed Table 7.7 rule, :func:`tmfem.reference.tables.deployment_bases`) or
-    ``"linear"`` (every symmetric parameter linear in s). ``evaluation``: where the PFL
+    ``"auto"`` (M >= 2: the automatic path through the symmetric equilibria,
+    :func:`automatic_path_of`) or ``"linear"`` (every symmetric parameter linear in s). ``evaluation``: where the PFL
     evaluates its model terms (``"state"``, eq. 5.58, or ``"reference"``); ``tendon_law``: its
     tendon model (``"fixed-rate"``, eq. 5.19, or ``"cable"``, :mod:`tmfem.control.deployment.adaptive`)."""
     from tmfem.control.deployment.adaptive import Gains
@@ -115,6 +132,7 @@ def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None 
     path = path or own_path(final)
     w0, we, tau, dc = p.gains if gains is None else gains
     u_m = final.problem.control.u_m
+    auto = automatic_path_of(final, r_min=p.r_min) if path == "auto" else None
     return build_deployment(final=final, initial=final.problem.packaged, omega_r=p.omega_r,
                             gains=Gains(omega_0=w0, omega_e=we, tau=tau, d_c=dc),
                             uncertainty=uncertainty or p.uncertainty,
@@ -124,17 +142,27 @@ def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None 
                             bases=deployment_bases(final) if path == "table-7-7-bases" else None,
                             delta_path=path == "delta", allocation=allocation,
                             evaluation=evaluation, tendon_law=tendon_law,
-                            n_centers=p.rbf_centres, w_bar=p.w_bar, gamma=p.gamma, r_min=p.r_min)
+                            n_centers=p.rbf_centres, w_bar=p.w_bar, gamma=p.gamma, r_min=p.r_min,
+                            path=None if auto is None else auto.path.config,
+                            info=None if auto is None else {"path_check": auto.to_dict()})
 
 
 def check_choices(system, *, controller: str = "adaptive-hinf", uncertainty=None,
                   path=None) -> None:
-    """Refuse a system without a deployment, an unknown controller, uncertainty model or path
-    (before any work: ``tmfem deploy`` calls it first)."""
+    """Refuse a system without a deployment, one whose tendons do not match its bar
+    coordinates one to one (the square B_q of eq. 5.46), an unknown controller, uncertainty
+    model or path (before any work: ``tmfem deploy`` calls it first)."""
     system = deployable_system(system)
+    nt, nq = len(system.tendons), len(system.q_names)
+    if nt != nq:
+        raise InputError(f"deploy {system.name}: the adaptive PFL inverts the square B_q of eq. 5.46 "
+                         f"(one actuated tendon per bar coordinate, as in 1-N(D) and two-stage "
+                         f"systems); this {system.M}-{system.N} system has {nt} tendons for {nq} bar "
+                         f"coordinates")
     own = own_path(system)
-    if path is not None and path not in ("linear", own):
-        raise InputError(f"--path for {system.name}: expected 'linear' or {own!r}, found {path!r}")
+    allowed = ["linear", own] + (["auto"] if system.M >= 2 and own != "auto" else [])
+    if path is not None and path not in allowed:
+        raise InputError(f"--path for {system.name}: expected one of {allowed}, found {path!r}")
     if controller not in CONTROLLERS:
         raise InputError(f"--controller: expected one of {sorted(CONTROLLERS)}, found {controller!r}")
     if uncertainty is not None and uncertainty not in UNCERTAINTIES:

@@ -25,6 +25,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from tmfem.equilibrium.deployment_path import top_radius_for_delta
 from tmfem.errors import InputError
 from tmfem.fem.truss import linear_rest_length
 
@@ -220,20 +221,6 @@ def with_symmetric(system, **changes):
         raise InputError("with_symmetric: expected parameters among theta, psi, sigma, z, r, l, "
                          f"r_mb, k_H, found {sorted(changes)}")
     return with_configuration(system.replace(**extra) if extra else system, cfg)
-
-
-def top_radius_for_delta(*, l_M: float, theta_M: float, psi_rel: float, r_mb: float,
-                         Delta: float, N: int) -> float:
-    """Base radius r_M of the top stage that gives the corner displacement Delta (eq. 3.22
-    solved for r_M; the smaller root). ``psi_rel`` = psi_M - sigma_M [rad]."""
-    L = l_M * np.sin(theta_M)
-    b = 2 * L * np.sin(psi_rel + np.pi / N)
-    c = L**2 - (r_mb + Delta)**2
-    disc = b * b - 4 * c
-    if disc < 0:
-        raise InputError(f"eq. 3.22: no top radius gives r_mb + Delta = {r_mb + Delta:.6g} m "
-                         f"(bar reach l sin(theta) = {L:.6g} m)")
-    return float((b - np.sqrt(disc)) / 2)
 
 
 def deployment_bases(system, *, z_ratio: float = 0.7, Delta: float = 1e-3, sigma2=None):

@@ -46,7 +46,9 @@ KEYS = {
 }
 GAIN_KEYS = ("omega_0", "omega_e", "tau", "d_c")
 UNCERTAINTIES = ("initial", "no-MG", "exact")
-PATHS = ("delta", "table-7-7-bases", "linear")
+PATHS = ("delta", "auto", "table-7-7-bases", "linear")
+#: the stage-base rules of an LPV grid (``[lpv] path``)
+LPV_PATHS = ("table-7-7-bases",)
 COM_PRESTRESS = ("designed", "printed-tendon-stress")
 
 
@@ -128,8 +130,10 @@ class DeploymentParameters:
         implemented: the critically damped closed form).
     gains : (omega_0, omega_e, tau, d_c) of eq. 5.69 (Table 7.1) [rad/s, rad/s, s, -].
     uncertainty : the controller's model error ("initial": eq. 5.72, "no-MG", "exact").
-    path : "delta" (1-N(D): eq. 3.22 with Delta linear), "table-7-7-bases" (M = 2 with the
-        stage-2 base rule of Table 7.7) or "linear"; None: "delta" for 1-N(D), else "linear".
+    path : "delta" (1-N(D): eq. 3.22 with Delta linear), "auto" (M >= 2: the automatic path
+        through the symmetric equilibria, :mod:`tmfem.equilibrium.deployment_path`),
+        "table-7-7-bases" (M = 2 with the stage-2 base rule of Table 7.7) or "linear"; None:
+        "delta" for 1-N(D), "auto" for M >= 2, else "linear".
     rbf_centres, w_bar, gamma : RBF centres along the reference, the bound of the weights and
         the adaptation gain (eq. 5.58-5.60).
     r_min : smallest admissible rest length [m] (the rest-length limit of the PFL).
@@ -166,13 +170,16 @@ class LPVParameters:
     points : tuple of (x_f, y_f) or None
         Monitored membrane points of eq. 5.101 [m]; None: as ``[control]``.
     path : str
-        The stage bases along the grid (:data:`PATHS`).
+        The stage bases over the grid (:data:`LPV_PATHS`): "table-7-7-bases", the rule of
+        :func:`tmfem.reference.tables.deployment_bases` for any two-stage system (sigma_2
+        fixed, z_2 = 0.7 l cos(theta), r_2 from eq. 3.22 for Delta = 1 mm), the only rule the
+        LPV grid implements.
     """
 
     omega_r: float = 0.3
     membrane_modes: int | None = None
     points: tuple | None = None
-    path: str = "linear"
+    path: str = "table-7-7-bases"
     theta_grid_deg: tuple | None = None
     psi_grid_deg: tuple | None = None
     rate_bound_deg: float = 10.0
@@ -309,7 +316,7 @@ def _lpv(t: dict, where: str) -> LPVParameters:
     d = LPVParameters()
     return LPVParameters(omega_r=_positive(t, "omega_r", w, d.omega_r),
                          membrane_modes=K, points=_points(t, "points", w),
-                         path=_choice(t, "path", w, PATHS, "linear"),
+                         path=_choice(t, "path", w, LPV_PATHS, LPV_PATHS[0]),
                          theta_grid_deg=_axis(t, "theta_grid_deg", w), psi_grid_deg=_axis(t, "psi_grid_deg", w),
                          rate_bound_deg=_positive(t, "rate_bound_deg", w, d.rate_bound_deg, zero=True),
                          theta0_deg=_angle(t, "theta0_deg", w), theta_e_deg=_angle(t, "theta_e_deg", w),

@@ -322,7 +322,7 @@ def test_partition_with_several_force_columns(model14):
 
 def test_setup_refuses_a_path_of_the_other_system_kind():
     from tmfem.reference.deployments import setup
-    with pytest.raises(InputError, match="expected 'linear' or 'delta'"):
+    with pytest.raises(InputError, match=r"expected one of \['linear', 'delta'\]"):
         setup("1-4D", path="table-7-7-bases")
     with pytest.raises(InputError, match="allocation"):
         setup("1-4D", allocation="scale")

@@ -21,7 +21,10 @@ stretch the membrane mid-path, see docs/guides/deployment.md):
 * multi-stage (2-3, ``bases`` given): the stage bases (r_i, z_i, sigma_i, i >= 2) from a rule
   ``bases(theta, psi)`` of the eq. 5.97 family (the reconstructed Table 7.7 rule,
   :func:`tmfem.reference.tables.deployment_bases`: z_2 = 0.7 l cos(theta), r_2 such that
-  Delta = 1 mm).
+  Delta = 1 mm);
+* any symmetric M >= 2 system (``path`` given): the automatic path of
+  :mod:`tmfem.equilibrium.deployment_path` (stage bases as a smooth continuation of feasible
+  bases, Delta linear in s), a map s -> configuration.
 
 The path is checked against the equilibrium conditions (eq. 3.41 for 1-N(D): positive null
 vector of eq. 3.40 and Delta > 0; the positive null vector of the reduced symmetric
@@ -96,6 +99,10 @@ class DeploymentReference:
     r_mb : float, optional
         Membrane circumradius of a one-stage system: psi_r from eq. 3.22 with Delta linear
         in s (module docstring).
+    path : callable, optional
+        ``path(s) -> SymmetricConfig``: the whole configuration along the progress s (e.g.
+        :meth:`tmfem.equilibrium.deployment_path.SymmetricPath.config`). It must reproduce
+        both ends.
     """
 
     initial: SymmetricConfig
@@ -105,6 +112,7 @@ class DeploymentReference:
     omega_r: float
     bases: Callable | None = None
     r_mb: float | None = None
+    path: Callable | None = None
 
     def __post_init__(self):
         th0, the = self.initial.theta[0], self.final.theta[0]
@@ -118,7 +126,10 @@ class DeploymentReference:
                                  f"one-stage system without a bases rule, found M = "
                                  f"{self.initial.M}" + (" and a bases rule" if self.bases else ""))
             self._Delta = [c.membrane_delta(self.N, self.r_mb) for c in (self.initial, self.final)]
-        if self.bases is not None or self.r_mb is not None:
+        if sum(x is not None for x in (self.bases, self.r_mb, self.path)) > 1:
+            raise InputError("deployment path: expected one rule of bases, r_mb (Delta) and path, "
+                             "found several")
+        if self.bases is not None or self.r_mb is not None or self.path is not None:
             for s, end in ((0.0, self.initial), (1.0, self.final)):
                 c = self.config(s)
                 err = max(float(np.max(np.abs(getattr(c, k) - getattr(end, k))))
@@ -137,8 +148,10 @@ class DeploymentReference:
         return self.q_0 + d
 
     def config(self, s: float) -> SymmetricConfig:
-        """The symmetric configuration at progress s (linear in every parameter, or the
-        stage bases from ``bases``)."""
+        """The symmetric configuration at progress s (linear in every parameter, the
+        stage bases from ``bases``, psi from the Delta rule, or ``path(s)``)."""
+        if self.path is not None:
+            return self.path(s)
         a, b = self.initial, self.final
         lerp = lambda x, y: x + s * (y - x)                                     # noqa: E731
         theta, psi = lerp(a.theta, b.theta), lerp(a.psi, b.psi)

@@ -35,8 +35,8 @@ from tmfem.control.deployment.recovery import StressRecovery
 from tmfem.control.deployment.reference_trajectory import DeploymentReference
 from tmfem.control.deployment.switching import SwitchingController, relative_error
 from tmfem.control.linear.deployed_design import deployed_hinf
-from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
-from tmfem.equilibrium.symmetric import check_1ND, membrane_delta_system
+from tmfem.equilibrium.deployment_path import path_feasibility
+from tmfem.equilibrium.symmetric import check_1ND
 from tmfem.equilibrium.symmetric_map import with_configuration
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
 from tmfem.models.com.linearize import linearize
@@ -322,11 +322,12 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      check_path: bool = True, bases=None, allocation: str = "bounded",
                      hinf_method: str = "central", r_min: float = 1e-3,
                      delta_path: bool = False, evaluation: str = "state",
-                     tendon_law: str = "fixed-rate") -> DeploymentSetup:
+                     tendon_law: str = "fixed-rate", path=None, info=None) -> DeploymentSetup:
     """The model (built at the final configuration with its printed rest lengths), the
     reference from ``initial`` to ``final`` (:class:`DeploymentReference`, stage bases from
     ``bases`` when given, psi_r from eq. 3.22 with Delta linear in s when ``delta_path``,
-    one-stage systems), the adaptive PFL (eq. 5.58, limits treated by ``allocation``) and,
+    one-stage systems, the configurations ``path(s)`` when given: the automatic path of
+    :mod:`tmfem.equilibrium.deployment_path`), the adaptive PFL (eq. 5.58, limits treated by ``allocation``) and,
     unless ``linear="none"``, the switch (eq. 5.70) to a linear controller about the final
     equilibrium: ``"lmi"`` (the H-infinity output feedback of 7.3 with alpha-stability,
     :func:`lmi_hinf_controller`, synthesised by ``hinf_method``, its state at the switch by
@@ -334,7 +335,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     (:func:`lqr_state_feedback`) or ``"hinf"`` (:func:`hinf_output_feedback`, python-control
     Riccati on [q, w]). ``evaluation``: where the PFL evaluates its model terms, at the
     measured state (eq. 5.58) or at the reference; ``tendon_law``: the PFL's tendon model,
-    the rates of eq. 5.19 or k = EA / u (:mod:`tmfem.control.deployment.adaptive`)."""
+    the rates of eq. 5.19 or k = EA / u (:mod:`tmfem.control.deployment.adaptive`); ``info``: entries
+    added to the set-up's ``info`` (the JSON of a run)."""
     if allocation not in ALLOCATION:
         raise InputError(f"allocation: expected one of {ALLOCATION}, found {allocation!r}")
     if linear not in ("lmi", "lqr", "hinf", "none"):
@@ -345,7 +347,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                                  output_points=output_points)
     ref = DeploymentReference(initial=initial.symmetric, final=final.symmetric, N=final.N,
                               q_names=list(final.q_names), omega_r=omega_r, bases=bases,
-                              r_mb=final.r_mb if delta_path else None)
+                              r_mb=final.r_mb if delta_path else None, path=path)
     if check_path:
         ref.check_equilibria(checker=equilibrium_checker(final))
     t_settle = 8.0 / omega_r
@@ -355,7 +357,7 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      r_min=r_min, evaluation=evaluation, tendon_law=tendon_law)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
     z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)])).state
-    info = {"rbf_centres": n_centers, "rbf_sigma": sig, "w_bar": w_bar, "K": K}
+    info = {"rbf_centres": n_centers, "rbf_sigma": sig, "w_bar": w_bar, "K": K, **(info or {})}
     lin_ctrl = None
     ctrl = ad
     start = "bumpless"
@@ -386,12 +388,7 @@ def equilibrium_checker(system):
         return lambda cfg: check_1ND(with_configuration(system, cfg))
 
     def check(cfg):
-        s = with_configuration(system, cfg)
-        nv = positive_null_vector(symmetric_matrix(s).A)
-        if not nv.margin > 0:
-            raise SlackTendon("expected a positive null vector of the symmetric equilibrium "
-                              f"matrix (3.3.2), found margin {nv.margin:.3g}")
-        d = membrane_delta_system(s)
-        if not d > 0:
-            raise SlackMembrane(f"expected Delta > 0 (eq. 3.22), found {d:.4g} m")
+        p = path_feasibility(system, cfg)
+        if p.reason:
+            raise (SlackMembrane if p.Delta <= 0 and p.margin > 0 else SlackTendon)(p.reason)
     return check
