@@ -143,6 +143,10 @@ def test_deploy_of_a_user_2_5_on_the_automatic_path(tmp_path, capsys):
     assert r["switch_time_s"] is not None and 13.3 < r["switch_time_s"] < 20
     assert r["final_tracking_error"] < 0.01 and r["failure"] is None
     assert r["min_rest_length_margin_m"] > 0
+    # strength: the tendons' transient stays below the file's yield stress (450 MPa), the bars
+    # below their Euler load (eq. 5.31): no failed check
+    assert r["max_tendon_stress_Pa"] < 450e6 and r["peak_bar_compression_N"] < r["bar_critical_load_N"]
+    assert r["failed_checks"] == []
     with open(tmp_path / "d.csv") as fh:
         rows = list(csv.reader(fh))
     head, data = rows[0], np.array([[float(v) for v in row[:-1]] for row in rows[1:]])

@@ -221,7 +221,8 @@ def run(args) -> dict:
     out["total_wall_time_s"] = time.perf_counter() - t0
     # a diverged closed loop is a failed check: the result and the files of the record up
     # to the failure are written, the exit code is 1 (docs/guides/cli.md, docs/guides/fe-plant.md)
-    out["failed_checks"] = reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+    out["failed_checks"] = (reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+                            + out.get("strength_checks_failed", []))
     return out
 
 

@@ -182,5 +182,6 @@ def run(args, *, mesh_n) -> dict:
             about=f"gamma = {d.gamma:.4g}, {src}" + (f", noise {args.noise:g}" if args.noise else ""),
             reference="eq. 5.100")
     out["total_wall_time_s"] = time.perf_counter() - t0
-    out["failed_checks"] = reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+    out["failed_checks"] = (reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
+                            + out.get("strength_checks_failed", []))
     return out

@@ -289,6 +289,27 @@ def test_stress_recovery_superposition_against_direct_solves():
     assert rc.critical_load == pytest.approx(891.9, rel=1e-3)       # 7.4.1
 
 
+def test_stress_recovery_names_each_strength_limit_a_run_exceeds():
+    # the strength checks of a run against the file's limits: the tendon yield stress (94.8 MPa
+    # of the 1-4D's nylon, 7.4.1), the Euler load of the bars (eq. 5.31, 891.9 N) and the
+    # membrane yield stress (61 MPa, eq. 5.30); below every limit nothing is named
+    from tmfem.control.deployment.recovery import StressRecovery
+    sysm = load_preset("1-4D")
+    rc = StressRecovery(sysm, mesh_n=4)
+    t = np.array([0.0, 0.5, 1.0])
+    sig = np.full((3, len(sysm.tendons)), 50e6)
+    bar_t, bar, vm = t[[0, 2]], np.array([10.0, 20.0]), np.array([1e6, 2e6])
+    assert rc.failed_checks(t=t, tendon_stress=sig, bar_t=bar_t, bar_compression=bar, von_mises=vm) == []
+    sig[1, 3] = 100e6
+    failed = rc.failed_checks(t=t, tendon_stress=sig, bar_t=bar_t, bar_compression=np.array([10.0, 900.0]),
+                              von_mises=np.array([70e6, 1e6]))
+    assert len(failed) == 3
+    assert failed[0].startswith(f"tendon yield: {sysm.tendons[3].name} at 100 MPa (t = 0.5 s)")
+    assert "94.8 MPa" in failed[0]
+    assert failed[1].startswith("bar buckling: compression 900 N (t = 1 s) above the Euler load 891.")
+    assert failed[2].startswith("membrane yield: von Mises 70 MPa (t = 0 s) above the yield stress 61 MPa")
+
+
 def test_1ND_delta_path_keeps_the_stretch_linear():
     # 1-N(D): psi_r from eq. 3.22 with Delta linear in the progress s between its end values
     # (closed form of eq. 3.22 via SymmetricConfig.membrane_delta); ends on the presets,

@@ -49,7 +49,10 @@ class StressRecovery:
             F.append(sol.corner_forces)
         self._sigma = np.stack(sig, axis=-1)          # (3, n_el, n_qp, 2N)
         self._F = np.stack(F, axis=-1)                # (2, N, 2N)
-        self.area = np.array([system.tendon_section(t).area for t in system.tendons])
+        sections = [system.tendon_section(t) for t in system.tendons]
+        self.area = np.array([s.area for s in sections])
+        self.tendon_yield = np.array([np.nan if s.yield_stress is None else s.yield_stress
+                                      for s in sections])
         self.critical_load = float(np.min(np.vectorize(system.bar.euler_critical_load)(system.l)))
 
     def membrane(self, delta) -> tuple[np.ndarray, np.ndarray]:
@@ -67,6 +70,37 @@ class StressRecovery:
     def tendon_stress(self, k, lengths, rest_lengths) -> np.ndarray:
         """T / A (n, n_t) with T = k (|d| - r) (eq. 3.8)."""
         return k * (np.asarray(lengths) - np.asarray(rest_lengths)) / self.area
+
+    def failed_checks(self, *, t, tendon_stress, bar_t, bar_compression, von_mises) -> list[str]:
+        """The strength checks that a run fails, one line each: the largest stress of each
+        tendon against its yield stress (section 6.2; tendons without one are not checked),
+        the peak bar compression against the Euler load (eq. 5.31) and the largest membrane
+        von Mises stress against the membrane's yield stress (eq. 5.30).
+
+        Parameters
+        ----------
+        t, tendon_stress : (n,), (n, n_t)
+            Sample times [s] and tendon stresses [Pa] (:meth:`tendon_stress`).
+        bar_t, bar_compression, von_mises : (m,), (m,), (m,)
+            Times [s], peak bar compression [N] and membrane von Mises stress [Pa] of
+            :meth:`bars_and_membrane`.
+        """
+        failed = []
+        ratio = np.where(np.isfinite(self.tendon_yield), tendon_stress / self.tendon_yield, -np.inf)
+        if ratio.size and np.max(ratio) > 1:
+            i, k = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+            failed.append(f"tendon yield: {self.system.tendons[k].name} at {tendon_stress[i, k] / 1e6:.4g} MPa "
+                          f"(t = {t[i]:.4g} s) above its yield stress {self.tendon_yield[k] / 1e6:.4g} MPa")
+        if bar_compression.size and np.max(bar_compression) > self.critical_load:
+            i = int(np.argmax(bar_compression))
+            failed.append(f"bar buckling: compression {bar_compression[i]:.4g} N (t = {bar_t[i]:.4g} s) "
+                          f"above the Euler load {self.critical_load:.4g} N (eq. 5.31)")
+        sy = self.system.membrane.yield_stress
+        if sy is not None and von_mises.size and np.max(von_mises) > sy:
+            i = int(np.argmax(von_mises))
+            failed.append(f"membrane yield: von Mises {von_mises[i] / 1e6:.4g} MPa (t = {bar_t[i]:.4g} s) "
+                          f"above the yield stress {sy / 1e6:.4g} MPa (eq. 5.30)")
+        return failed
 
     def bars_and_membrane(self, q, tendon_forces) -> tuple[np.ndarray, np.ndarray]:
         """Peak bar compression (n,) [N] and maximum membrane von Mises stress (n,) [Pa] at
