@@ -176,7 +176,8 @@ def choose_membrane_modes(system, *, band_modes: int = BAND_MODES, tolerance: fl
     if bad:
         log.warning("%s: COM frequencies of modes %s differ from the %s model's by more than %g %% with "
                     "any K up to %d (largest %.1f %% at the chosen K = %d): the COM's own approximation "
-                    "(rigid bars, membrane modes about the designed prestress, ch. 5)", system.name, bad,
+                    "(rigid bars, linear tendon springs of eqs. 3.8-3.9, membrane modes about the "
+                    "designed prestress, ch. 5; docs/guides/com.md)", system.name, bad,
                     fe_name, 100 * tolerance, k_hi, 100 * float(np.max(np.abs(rel))), K)
     return choice
 
