@@ -80,3 +80,17 @@ def test_every_preset_declares_its_k(name):
     1-4(D)) whatever the automatic choice would give."""
     K = load_preset(name).model_defaults.get("com", {}).get("membrane_modes")
     assert K == {"1-4": 5, "1-4D": 3, "1-4D-initial": 3, "1-6D": 5, "1-6D-initial": 5}.get(name, 4)
+
+
+def test_an_unstable_mode_never_agrees_and_the_json_has_no_nan():
+    """A negative (unstable) frequency on either side counts as disagreeing; to_dict gives None
+    for its difference, so the commands' JSON stays valid (allow_nan=False)."""
+    import json
+    rel = mode_count._relative([-0.1, 0.5], [0.2, 0.5])
+    assert np.isinf(rel[0]) and rel[1] == 0
+    c = mode_count.MembraneModeChoice(K=3, source="automatic", reference="MTC", band_modes=2,
+                                      relative_difference=rel.tolist(), disagreeing_modes=[1],
+                                      max_difference_by_K={3: float(np.inf)})
+    d = c.to_dict()
+    json.dumps(d, allow_nan=False)
+    assert d["relative_difference"][0] is None and "modes [1]" in mode_count.MembraneModeChoice(**d).text

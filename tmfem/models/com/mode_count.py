@@ -98,12 +98,15 @@ class MembraneModeChoice:
         return s + ")"
 
     def to_dict(self) -> dict:
+        """JSON-able (a non-finite difference -- an unstable mode -- becomes None)."""
+        def finite(v):
+            return v if v is None or np.isfinite(v) else None
         return {"K": self.K, "source": self.source, "reference": self.reference,
                 "band_modes": self.band_modes, "tolerance": self.tolerance,
                 "reference_hz": self.reference_hz, "com_hz": self.com_hz,
-                "relative_difference": self.relative_difference,
+                "relative_difference": [finite(v) for v in self.relative_difference],
                 "disagreeing_modes": self.disagreeing_modes,
-                "max_difference_by_K": {str(k): v for k, v in self.max_difference_by_K.items()}}
+                "max_difference_by_K": {str(k): finite(v) for k, v in self.max_difference_by_K.items()}}
 
 
 _CHOICES: dict[str, MembraneModeChoice] = {}
