@@ -70,6 +70,10 @@ def point_coordinates(basis, *, K: int, points) -> list:
     Phi_nodes = basis.shapes[1 + nd:, 2, :].T                   # (n_nodes, K): w of each mode
     chosen = [basis.point_matrix(np.array([[x], [y]]), 2)[0, 1 + nd:] for x, y in pts]
     cand = interior_nodes(mesh.p, basis.mesh.p[:, basis.mesh.corners], clearance=EDGE_CLEARANCE)
+    if len(cand) < K - len(pts):
+        raise InputError(f"membrane points: expected {K - len(pts)} mesh nodes at least {EDGE_CLEARANCE:g} x the "
+                         f"inradius inside the membrane, found {len(cand)} (a finer mesh, or give the points "
+                         "in [control] points / coordinate_points)")
     while len(pts) < K:
         Q = np.linalg.qr(np.array(chosen).T)[0] if chosen else np.zeros((basis.K, 0))
         rows = Phi_nodes[cand]
