@@ -257,11 +257,12 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
             freqs[f"SBC {label}"] = sbc.modes(k=modes, at=st).freq_hz
     step(STEPS[4])
     K = default_membrane_modes(system)
-    com_design = modal_summary(system, modes=modes, membrane_modes=K)
+    com_design = modal_summary(system, modes=modes, membrane_modes=K, mesh_n=mesh_n)
     freqs["COM designed"] = np.array(com_design["freq_hz"])
     scale = com_design.get("printed_stress_prestress_scale")
     if scale is not None:
-        com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale)
+        com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale,
+                                   mesh_n=mesh_n)
         freqs[f"COM x{scale:.4f}"] = np.array(com_implied["freq_hz"])
     step(STEPS[5])
     disagreement = com_disagreement(freqs, fe, K)
