@@ -55,7 +55,7 @@ def modal_summary(model, result, modes) -> dict:
            "sizes": model.summary(), "freq_hz": f[:n].tolist(), "highest_hz": float(f[-1]),
            "rest_lengths_source": "design" if model.design is not None else "system",
            "rest_lengths": dict(zip(names, model.u0.tolist())),
-           "default_membrane_modes": default_membrane_modes(system),
+           "default_membrane_modes": _default_k(model),
            "membrane_mode_choice": model.membrane_mode_choice.to_dict()}
     if model.design is not None:
         out["design_tendon_forces"] = dict(zip(names, model.design.tendon_forces.tolist()))
@@ -71,6 +71,16 @@ def modal_summary(model, result, modes) -> dict:
     if s_bar is not None:
         out["printed_bar_load_prestress_scale"] = s_bar
     return out
+
+
+def _default_k(model) -> int | None:
+    """The system's default K: the model's own when it took the default; the file's when K was
+    given; None for a given K on a file without one (the automatic choice is not run for it)."""
+    c = model.membrane_mode_choice
+    if c.source != "given":
+        return c.K
+    K = model.system.model_defaults.get("com", {}).get("membrane_modes")
+    return None if K is None else default_membrane_modes(model.system)
 
 
 def format_modal(r: dict) -> str:
