@@ -44,6 +44,8 @@ CONVERGED = 0.01
 K_MIN = 3
 #: the most membrane modes the automatic choice considers (one COM of this size is built)
 K_SEARCH = 16
+#: membrane elements per side of each patch of the finite-element model compared with (6.2: 10)
+FE_MESH = 10
 
 
 @dataclass
@@ -137,9 +139,10 @@ def choose_membrane_modes(system, *, band_modes: int = BAND_MODES, tolerance: fl
     else the smallest K whose band is within :data:`CONVERGED` of the k_search model's, with a
     warning naming the modes that disagree."""
     from tmfem.models.com.model import ControlOrientedModel
-    from tmfem.resources import check_membrane_modes
+    from tmfem.resources import check_membrane_modes, check_mesh_budget
 
     check_membrane_modes(k_search, given="the automatic membrane-mode search")
+    check_mesh_budget(N=system.N, n=FE_MESH, option=f"the automatic membrane-mode search's FE mesh {FE_MESH}")
     rest = "design" if system.rest_lengths is None else "system"
     com = ControlOrientedModel(system, membrane_modes=k_search, rest_lengths=rest, output_points=[])
     lin = com.linearization()
@@ -211,7 +214,7 @@ def _fe_band(system, n: int, rest: str):
         from tmfem.models.mtc.model import MTCModel as FE
         name = "MTC"
     try:
-        model = FE(system, rest_lengths=rest)
+        model = FE(system, rest_lengths=rest, mesh_n=FE_MESH)
         return name, model.modes(k=n, at=model.equilibrium()).freq_hz
     except TmfemError as e:
         log.warning("%s: the %s model failed (%s); membrane modes chosen by the COM's own "
