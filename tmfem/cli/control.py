@@ -139,7 +139,10 @@ def format_text(r: dict) -> str:
         return (f"{r['file']}: gamma = {r['gamma']:.6g}, ||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}, "
                 f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} (alpha_1 = {r['alpha']:g}): ok")
     p = r["pbh"]
+    from tmfem.models.com.mode_count import MembraneModeChoice
     lines = [f"system {r['system']}: {r['n_states']} states, {r['n_inputs']} inputs",
+             "COM: " + MembraneModeChoice(**r["membrane_mode_choice"]).text + "; measured membrane points "
+             + ", ".join(f"({x:.3f}, {y:.3f})" for x, y in r["membrane_points"]) + " m",
              f"open-loop f_max = {r['open_loop_f_max_hz']:.4f} Hz" + (
                  "" if r["open_loop_f_max_printed_hz"] is None
                  else f" (printed {r['open_loop_f_max_printed_hz']})"),

@@ -16,6 +16,7 @@ from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_frames, check_mesh_budget, check_time_steps, output_dir,
                               output_file, positive_float, progress_bar)
 from tmfem.errors import InputError
+from tmfem.models.com.mode_count import MembraneModeChoice, membrane_mode_choice
 from tmfem.reference.deployments import (CONTROLLERS, LPV_CONTROLLERS, UNCERTAINTIES, check_choices,
                                          VTK_EVERY, own_path, setup, write_outputs)
 
@@ -206,6 +207,7 @@ def run(args) -> dict:
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
                              gif=args.gif, vtk=args.vtk, title=title))
     out["warnings"] = warnings
+    out["membrane_mode_choice"] = membrane_mode_choice(args.system).to_dict()
     if args.compare_plant:
         def rerun(kind):
             s2 = setup(args.system, controller=args.controller, uncertainty=args.uncertainty,
@@ -304,6 +306,8 @@ def format_text(r: dict) -> str:
     keys += [k for k in ("gamma", "max_tracking_error") if k in r]
     lines = [f"deployment {r['preset']} on the {r['plant']} plant ({r['controller']}, "
              f"uncertainty {r['uncertainty']})"]
+    if "membrane_mode_choice" in r:
+        lines.append("  COM: " + MembraneModeChoice(**r["membrane_mode_choice"]).text)
     lines += [f"  {k}: {r[k]:.6g}" if isinstance(r[k], float) else f"  {k}: {r[k]}" for k in keys]
     if "compare" in r:
         c = r["compare"]

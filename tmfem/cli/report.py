@@ -104,6 +104,9 @@ def format_text(r: dict) -> str:
                                       "membrane von Mises [MPa]"], disable_numparse=True), "",
              tabulate(rows, headers=head, disable_numparse=True), "",
              f"index: {r['out']}/index.md ({len(r['files'])} files)"]
+    if r.get("com_membrane_modes"):
+        from tmfem.models.com.mode_count import MembraneModeChoice
+        lines.insert(-1, "COM: " + MembraneModeChoice(**r["com_membrane_modes"]).text)
     if r.get("com_disagreement"):
         lines.insert(-1, f"warning: {r['com_disagreement']['message']}")
     for k, m in unstable.items():

@@ -7,6 +7,7 @@ import numpy as np
 from tmfem.errors import shorten
 
 from tmfem.models.com.model import default_membrane_modes
+from tmfem.models.com.mode_count import MembraneModeChoice
 
 #: files ``tmfem modal`` can write for this model (none: it has no mesh of its own)
 MODE_FILES = ()
@@ -54,7 +55,8 @@ def modal_summary(model, result, modes) -> dict:
            "sizes": model.summary(), "freq_hz": f[:n].tolist(), "highest_hz": float(f[-1]),
            "rest_lengths_source": "design" if model.design is not None else "system",
            "rest_lengths": dict(zip(names, model.u0.tolist())),
-           "default_membrane_modes": default_membrane_modes(system)}
+           "default_membrane_modes": _default_k(model),
+           "membrane_mode_choice": model.membrane_mode_choice.to_dict()}
     if model.design is not None:
         out["design_tendon_forces"] = dict(zip(names, model.design.tendon_forces.tolist()))
         out["design_rest_lengths"] = dict(zip(names, model.design.rest_lengths.tolist()))
@@ -71,11 +73,23 @@ def modal_summary(model, result, modes) -> dict:
     return out
 
 
+def _default_k(model) -> int | None:
+    """The system's default K: the model's own when it took the default; the file's when K was
+    given; None for a given K on a file without one (the automatic choice is not run for it)."""
+    c = model.membrane_mode_choice
+    if c.source != "given":
+        return c.K
+    K = model.system.model_defaults.get("com", {}).get("membrane_modes")
+    return None if K is None else default_membrane_modes(model.system)
+
+
 def format_modal(r: dict) -> str:
     """Text table of a :func:`modal_summary` result: ours beside the printed COM column."""
     lines = [f"COM of {r['system']}: {r['sizes']['n_z']} coordinates (nq = {r['sizes']['n_q']}, "
              f"K = {r['membrane_modes']}), prestress x{r['prestress_scale']:g}, rest lengths "
              f"from the {r.get('rest_lengths_source', 'design')}"]
+    if "membrane_mode_choice" in r:
+        lines.append(MembraneModeChoice(**r["membrane_mode_choice"]).text)
     forces = r.get("design_tendon_forces") or r.get("equilibrium_tendon_forces") or {}
     if forces:
         lines.append("tendon forces [N]: " + shorten((f"{k}={v:.4g}" for k, v in forces.items()), 6))

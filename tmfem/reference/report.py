@@ -144,6 +144,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     from tmfem.io.units import with_units
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+    from tmfem.models.com.mode_count import membrane_mode_choice
     from tmfem.models.mtc.model import MTCModel
     from tmfem.models.fe.outputs import q_from_positions
     from tmfem.models.mtc.post import member_state, static_summary
@@ -256,11 +257,12 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
             freqs[f"SBC {label}"] = sbc.modes(k=modes, at=st).freq_hz
     step(STEPS[4])
     K = default_membrane_modes(system)
-    com_design = modal_summary(system, modes=modes, membrane_modes=K)
+    com_design = modal_summary(system, modes=modes, membrane_modes=K, mesh_n=mesh_n)
     freqs["COM designed"] = np.array(com_design["freq_hz"])
     scale = com_design.get("printed_stress_prestress_scale")
     if scale is not None:
-        com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale)
+        com_implied = modal_summary(system, modes=modes, membrane_modes=K, prestress_scale=scale,
+                                   mesh_n=mesh_n)
         freqs[f"COM x{scale:.4f}"] = np.array(com_implied["freq_hz"])
     step(STEPS[5])
     disagreement = com_disagreement(freqs, fe, K)
@@ -310,6 +312,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
                "unstable_modes": unstable_modes(freqs), "com_disagreement": disagreement,
+               "com_membrane_modes": membrane_mode_choice(system).to_dict(),
                "printed_frequencies_hz": printed, "vibration": vibration,
                "deployment": deployment}
     summary = finite_or_none(summary)
@@ -363,7 +366,8 @@ def com_disagreement(freqs: dict, fe: str, K: int) -> dict | None:
            f"{100 * COM_TOLERANCE:g} % (largest {100 * np.max(np.abs(rel)):.1f} %): the COM has K = "
            f"{K} membrane modes ([models.com] membrane_modes in the system file): more modes bring "
            "its higher membrane modes closer; what remains is the COM's own approximation "
-           "(rigid bars, membrane modes about the designed prestress, ch. 5)")
+           "(rigid bars, linear tendon springs of eqs. 3.8-3.9, membrane modes about the designed "
+           "prestress, ch. 5)")
     return {"modes": bad, "relative_difference": rel.tolist(), "tolerance": COM_TOLERANCE,
             "message": msg}
 

@@ -34,7 +34,7 @@ from tmfem.errors import InputError
 
 #: keys of each table (anything else is refused)
 KEYS = {
-    "control": {"alpha", "u_m", "W_e", "W_d", "points"},
+    "control": {"alpha", "u_m", "W_e", "W_d", "points", "coordinate_points"},
     "deployment": {"omega_r", "xi_r", "gains", "uncertainty", "path", "rbf_centres", "w_bar",
                    "gamma", "r_min"},
     "lpv": {"omega_r", "membrane_modes", "points", "path", "theta_grid_deg", "psi_grid_deg", "theta0_deg",
@@ -113,6 +113,9 @@ class HinfWeights:
     points : tuple of (x_f, y_f) or None
         Measured membrane points of eq. 5.18 [m]; None: ``[monitor] points``, else chosen
         inside the membrane (:func:`tmfem.control.linear.generalized_plant.point_coordinates`).
+    coordinate_points : tuple of (x_f, y_f) or None
+        Points that complete the coordinates v of eq. 5.18 to K after the measured ones [m];
+        None: chosen greedily inside the membrane (the same function).
     """
 
     alpha: float | None = None
@@ -120,6 +123,7 @@ class HinfWeights:
     W_e: float = 0.5
     W_d: float = 0.001
     points: tuple | None = None
+    coordinate_points: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -249,7 +253,8 @@ def _control(t: dict, where: str) -> HinfWeights:
     d = HinfWeights()
     return HinfWeights(alpha=_positive(t, "alpha", w), u_m=_positive(t, "u_m", w),
                        W_e=_positive(t, "W_e", w, d.W_e), W_d=_positive(t, "W_d", w, d.W_d),
-                       points=_points(t, "points", w))
+                       points=_points(t, "points", w),
+                       coordinate_points=_points(t, "coordinate_points", w))
 
 
 def _gains(v, where: str) -> tuple:

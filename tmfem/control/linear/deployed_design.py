@@ -53,6 +53,8 @@ class DeployedDesign:
                "open_loop_f_max_printed_hz": self.plant.model.system.printed.get("f_max_hz"),
                "n_states": int(self.plant.ss.nstates), "n_inputs": int(self.plant.ss.ninputs),
                "membrane_points": [list(p) for p in self.plant.points],
+               "membrane_modes": self.plant.membrane_modes.K,
+               "membrane_mode_choice": self.plant.membrane_modes.to_dict(),
                "u_m": self.u_m, "pbh": self.pbh.as_dict()}
         notes = list(self.notes)
         if self.design is not None:

@@ -51,18 +51,29 @@ def interior_points(system, *, count: int = 3) -> list:
     return out
 
 
+#: the greedy choice of :func:`point_coordinates` keeps its points at least this fraction of the
+#: membrane's inradius away from its edges (and so from its corners)
+EDGE_CLEARANCE = 0.2
+
+
 def point_coordinates(basis, *, K: int, points) -> list:
     """K membrane points for the coordinates v of eq. 5.18: the given monitored points
     first, then mesh nodes chosen greedily (largest component of the node's row of mode
     deflections orthogonal to the rows already chosen: column-pivoted Gram-Schmidt), so
-    that T_v_eta of eq. 5.17 is as well conditioned as the greedy choice allows."""
+    that T_v_eta of eq. 5.17 is as well conditioned as the greedy choice allows. The greedy
+    choice takes nodes inside the membrane only, at least :data:`EDGE_CLEARANCE` x the
+    inradius from every edge (the free edges of the corner-held modes carry their largest
+    deflections, but a sensor on an edge is not where the membrane is)."""
     pts = [_on_membrane(basis, p) for p in points][:K]
     mesh = basis.scalar_basis.mesh
     nd = basis.n_delta
     Phi_nodes = basis.shapes[1 + nd:, 2, :].T                   # (n_nodes, K): w of each mode
     chosen = [basis.point_matrix(np.array([[x], [y]]), 2)[0, 1 + nd:] for x, y in pts]
-    corners = set(np.asarray(basis.mesh.corners).tolist())
-    cand = np.array([i for i in range(mesh.p.shape[1]) if i not in corners])
+    cand = interior_nodes(mesh.p, basis.mesh.p[:, basis.mesh.corners], clearance=EDGE_CLEARANCE)
+    if len(cand) < K - len(pts):
+        raise InputError(f"membrane points: expected {K - len(pts)} mesh nodes at least {EDGE_CLEARANCE:g} x the "
+                         f"inradius inside the membrane, found {len(cand)} (a finer mesh, or give the points "
+                         "in [control] points / coordinate_points)")
     while len(pts) < K:
         Q = np.linalg.qr(np.array(chosen).T)[0] if chosen else np.zeros((basis.K, 0))
         rows = Phi_nodes[cand]
@@ -71,6 +82,24 @@ def point_coordinates(basis, *, K: int, points) -> list:
         pts.append((float(mesh.p[0, cand[j]]), float(mesh.p[1, cand[j]])))
         chosen.append(rows[j])
     return pts
+
+
+def interior_nodes(nodes, corners, *, clearance: float) -> np.ndarray:
+    """Indices of the ``nodes`` (2, n) at least ``clearance`` x r_in from every edge of the
+    convex polygon ``corners`` (2, N), r_in its inradius (the smallest distance of the corners'
+    centroid to an edge). The distance of a node x to the edge (a, b) is that to the segment,
+    |x - a - t (b - a)| with t = clip((x - a).(b - a) / |b - a|^2, 0, 1)."""
+    P = np.asarray(corners, dtype=float)
+    X = np.asarray(nodes, dtype=float)
+
+    def edge_distance(x):                       # (2, n) -> (n,): distance to the nearest edge
+        a = P[:, :, None]
+        e = (np.roll(P, -1, axis=1) - P)[:, :, None]
+        t = np.clip(np.sum((x[:, None, :] - a) * e, axis=0) / np.sum(e * e, axis=0), 0.0, 1.0)
+        return np.min(np.linalg.norm(x[:, None, :] - a - t[None] * e, axis=0), axis=0)
+
+    r_in = float(edge_distance(P.mean(axis=1)[:, None])[0])
+    return np.flatnonzero(edge_distance(X) >= clearance * r_in)
 
 
 def _on_membrane(basis, point, *, max_shift: float = 0.01):
@@ -114,6 +143,8 @@ class DeployedPlant:
     frequencies_hz: np.ndarray
     model: object
     linearization: object
+    #: K and where it comes from (:class:`tmfem.models.com.mode_count.MembraneModeChoice`)
+    membrane_modes: object = None
 
     @property
     def f_max_hz(self) -> float:
@@ -140,10 +171,12 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
         The deployed (final) configuration, e.g. ``load_preset("1-4D")``.
     membrane_modes : int, optional
         K (7.4: 3 for 1-4(D), 5 for 1-6(D), 4 for 2-3); default the file's ``[models.com]
-        membrane_modes`` (:func:`tmfem.models.com.model.default_membrane_modes`).
+        membrane_modes``, else the automatic choice
+        (:func:`tmfem.models.com.mode_count.membrane_mode_choice`).
     points : list of (x_f, y_f), optional
         Membrane points of the coordinates v (eq. 5.18); default :func:`measured_points`
-        (eqs. 5.73-5.75 for the presets) completed to K by :func:`point_coordinates`.
+        (eqs. 5.73-5.75 for the presets); completed to K by the file's ``[control]
+        coordinate_points``, then by :func:`point_coordinates`.
     rest_lengths : {"system", "design"} or array, optional
         u_e; "system": the file's rest lengths (the printed ones of Tables 7.3, 7.5, 7.7 for
         the presets), "design": those of the equilibrium design (ch. 3); default the file's
@@ -152,15 +185,17 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
         Modal damping c_m of eq. 5.13 (7.4 states none: default 0).
     """
     from tmfem.models.com.linearize import linearize
-    from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.models.com.mode_count import membrane_modes_of
     import control
-    K = membrane_modes if membrane_modes is not None else default_membrane_modes(system)
+    choice = membrane_modes_of(system, membrane_modes)
+    K = choice.K
     if rest_lengths is None:
         rest_lengths = "system" if system.rest_lengths is not None else "design"
     modal = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, rest_lengths=rest_lengths,
                                  damping=damping, output_points=[])
-    pts = points if points is not None else measured_points(system)
-    pts = point_coordinates(modal.membrane, K=K, points=pts)
+    pts = list(points if points is not None else measured_points(system))
+    pts = point_coordinates(modal.membrane, K=K, points=pts + list(system.problem.control.coordinate_points or ()))
     model = ControlOrientedModel(system, membrane_modes=K, mesh_n=mesh_n, rest_lengths=modal.u0,
                                  damping=damping, output_points=[],
                                  membrane_points=[("w", x, y) for x, y in pts])
@@ -171,7 +206,7 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
                      outputs=list(lin.state_names), name="G")
     return DeployedPlant(ss=sys, q_e=lin.z_e[: model.nq].copy(), u_e=lin.u_e.copy(),
                          z_e=lin.z_e.copy(), points=pts, frequencies_hz=lin.frequencies_hz(),
-                         model=model, linearization=lin)
+                         model=model, linearization=lin, membrane_modes=choice)
 
 
 def generalized_plant(plant: DeployedPlant, *, u_m: float, W_e: float = W_E, W_d: float = W_D):

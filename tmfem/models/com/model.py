@@ -38,14 +38,16 @@ from tmfem.models.com.graphs import BufferedFunction, build_graphs, output_graph
 from tmfem.models.base import Equilibrium
 from tmfem.models.com import linearize as linearization
 from tmfem.models.com.membrane_modes import build_membrane_basis
+from tmfem.models.com.mode_count import membrane_mode_choice, membrane_modes_of
 from tmfem.models.com.plant import COMPlant
 from tmfem.solvers.newton import newton
 from tmfem.system.geometry import rotation_ef
 
 def default_membrane_modes(system) -> int:
     """K of the system's ``[models.com] membrane_modes`` (the presets carry the
-    dissertation's: 5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6D), else 4."""
-    return int(system.model_defaults.get("com", {}).get("membrane_modes", 4))
+    dissertation's: 5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6D), else the automatic
+    choice of :func:`tmfem.models.com.mode_count.membrane_mode_choice`."""
+    return membrane_mode_choice(system).K
 
 
 class ControlOrientedModel:
@@ -55,8 +57,9 @@ class ControlOrientedModel:
     ----------
     system : System
         Geometry, materials and the design configuration ``system.q``.
-    membrane_modes : int
-        Number K of relative membrane modes (5 for 1-4, 4 for 2-3 in 6.4).
+    membrane_modes : int, optional
+        Number K of relative membrane modes (5 for 1-4, 4 for 2-3 in 6.4); default
+        :func:`default_membrane_modes` (the file's, else chosen against the FE model).
     mesh_n : int
         Membrane mesh: N patches of mesh_n x mesh_n bilinear quads (6.2: 10).
     rest_lengths : {"design", "system"} or array
@@ -89,7 +92,7 @@ class ControlOrientedModel:
 
     name = "com"
 
-    def __init__(self, system, *, membrane_modes: int = 4, mesh_n: int = 10,
+    def __init__(self, system, *, membrane_modes: int | None = None, mesh_n: int = 10,
                  rest_lengths="design", damping: float = 0.0, prestress_scale: float = 1.0,
                  membrane_points=None, formulation: str = "partitioned", output_points=None,
                  membrane_law: str = "svk"):
@@ -102,6 +105,9 @@ class ControlOrientedModel:
         self.system = system
         self.mesh_n, self.membrane_law = mesh_n, membrane_law
         self.formulation = formulation
+        #: K and where it comes from (:class:`tmfem.models.com.mode_count.MembraneModeChoice`)
+        self.membrane_mode_choice = membrane_modes_of(system, membrane_modes)
+        membrane_modes = self.membrane_mode_choice.K
         self.layout = ZetaLayout.for_polygon(system.N)
         self.constraints = ConstraintSolver(system, self.layout)
         self.q0 = np.asarray(system.q, dtype=float)
@@ -186,7 +192,7 @@ class ControlOrientedModel:
 
     def describe(self) -> dict:
         """Size of the model, for reports."""
-        return {"membrane_modes": self.K}
+        return {"membrane_modes": self.K, "membrane_modes_from": self.membrane_mode_choice.source}
 
     @property
     def state_names(self) -> list[str]:

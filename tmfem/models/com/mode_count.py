@@ -1,0 +1,234 @@
+"""How many membrane modes K the control-oriented model keeps (eq. 5.1) when the system file
+does not say (``[models.com] membrane_modes``).
+
+The COM's frequencies converge towards the finite-element models' as K grows, until what
+remains is its own approximation (rigid bars, membrane modes about the designed prestress,
+ch. 5). The default K is the smallest one whose frequencies in the *band of interest* -- the
+:data:`BAND_MODES` lowest modes, those ``tmfem modal`` and ``tmfem report`` show by default --
+agree with the finite-element model's within :data:`TOLERANCE`:
+
+    max_i |f_i^COM(K) / f_i^FE - 1| <= TOLERANCE,   i = 1 .. BAND_MODES,
+
+with the MTC model as reference, or the SBC model for a 1-N(D) system (the MTC has no H_1j
+nodes). When no K up to :data:`K_SEARCH` agrees, K is the smallest whose band lies within
+:data:`CONVERGED` of the K = :data:`K_SEARCH` model's (more modes would not change the band)
+and a warning names the modes that still disagree.
+
+Cost: one finite-element modal analysis (mesh 10, 3 elements per tendon) and one COM with
+K = :data:`K_SEARCH`; the COM of K < K_SEARCH modes is the Galerkin truncation of that one
+(the first K of the same fixed-corner modes, eq. 5.1), so its linearised mass and stiffness
+(eq. 5.33) are the leading blocks of the K_SEARCH model's, exact about eta = 0. The choice is
+kept per system content, so the commands and functions that build several COMs of one system
+pay for it once.
+"""
+from __future__ import annotations
+
+import hashlib
+import logging
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tmfem.errors import TmfemError
+
+log = logging.getLogger(__name__)
+
+#: the band of interest: the lowest modes compared (the default ``--modes`` of modal and report)
+BAND_MODES = 12
+#: largest relative difference to the finite-element frequencies accepted in the band
+#: (6.4 finds < 3 % for 1-4 and < 1 % for 2-3 with the dissertation's K)
+TOLERANCE = 0.05
+#: relative change of the band below which more membrane modes no longer matter
+CONVERGED = 0.01
+#: smallest automatic K: the three measured membrane points of the deployed plants of 7.4
+K_MIN = 3
+#: the most membrane modes the automatic choice considers (one COM of this size is built)
+K_SEARCH = 16
+#: membrane elements per side of each patch of the finite-element model compared with (6.2: 10)
+FE_MESH = 10
+
+
+@dataclass
+class MembraneModeChoice:
+    """The membrane modes K of a system's control-oriented model and where K comes from.
+
+    Attributes
+    ----------
+    K : int
+    source : {"file", "automatic", "given"}
+        ``"file"``: the system file's ``[models.com] membrane_modes``; ``"automatic"``:
+        :func:`choose_membrane_modes`; ``"given"``: an option (``--membrane-modes``) or argument.
+    reference : str
+        The model the band was compared with (``"MTC"``, ``"SBC"``; ``"COM K=16"`` when the
+        finite-element model failed); "" for ``source="file"``.
+    band_modes, tolerance : int, float
+    reference_hz, com_hz : list of float
+        The band's frequencies of the reference and of the COM with the chosen K (truncation).
+    relative_difference : list of float
+        com_hz / reference_hz - 1 per mode of the band.
+    disagreeing_modes : list of int
+        Modes (1-based) of the band still more than ``tolerance`` off.
+    max_difference_by_K : dict
+        K -> largest |relative difference| in the band (None: fewer than band_modes modes).
+    """
+
+    K: int
+    source: str
+    reference: str = ""
+    band_modes: int = 0
+    tolerance: float = TOLERANCE
+    reference_hz: list = field(default_factory=list)
+    com_hz: list = field(default_factory=list)
+    relative_difference: list = field(default_factory=list)
+    disagreeing_modes: list = field(default_factory=list)
+    max_difference_by_K: dict = field(default_factory=dict)
+
+    @property
+    def text(self) -> str:
+        """One line for the commands' output."""
+        if self.source == "file":
+            return f"K = {self.K} membrane modes ([models.com] membrane_modes of the file)"
+        if self.source == "given":
+            return f"K = {self.K} membrane modes (given)"
+        s = (f"K = {self.K} membrane modes (chosen: the COM's {self.band_modes} lowest frequencies "
+             f"against the {self.reference} model's, tolerance {100 * self.tolerance:g} %")
+        if self.disagreeing_modes:
+            worst = max(abs(self.relative_difference[i - 1] if self.relative_difference[i - 1] is not None
+                            else np.inf) for i in self.disagreeing_modes)
+            return s + (f"; modes {self.disagreeing_modes} still differ, by up to {100 * worst:.1f} %, "
+                        "and more modes do not change them)")
+        return s + ")"
+
+    def to_dict(self) -> dict:
+        """JSON-able (a non-finite difference -- an unstable mode -- becomes None)."""
+        def finite(v):
+            return v if v is None or np.isfinite(v) else None
+        return {"K": self.K, "source": self.source, "reference": self.reference,
+                "band_modes": self.band_modes, "tolerance": self.tolerance,
+                "reference_hz": self.reference_hz, "com_hz": self.com_hz,
+                "relative_difference": [finite(v) for v in self.relative_difference],
+                "disagreeing_modes": self.disagreeing_modes,
+                "max_difference_by_K": {str(k): finite(v) for k, v in self.max_difference_by_K.items()}}
+
+
+_CHOICES: dict[str, MembraneModeChoice] = {}
+
+
+def membrane_modes_of(system, K: int | None = None) -> MembraneModeChoice:
+    """``K`` when given (``source="given"``), else :func:`membrane_mode_choice`."""
+    return membrane_mode_choice(system) if K is None else MembraneModeChoice(K=int(K), source="given")
+
+
+def membrane_mode_choice(system) -> MembraneModeChoice:
+    """K of the system's ``[models.com] membrane_modes`` (the presets carry the
+    dissertation's: 5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6D), else
+    :func:`choose_membrane_modes` (computed once per system content)."""
+    K = system.model_defaults.get("com", {}).get("membrane_modes")
+    if K is not None:
+        return MembraneModeChoice(K=int(K), source="file")
+    key = _fingerprint(system)
+    if key not in _CHOICES:
+        _CHOICES[key] = choose_membrane_modes(system)
+    return _CHOICES[key]
+
+
+def choose_membrane_modes(system, *, band_modes: int = BAND_MODES, tolerance: float = TOLERANCE,
+                          k_search: int = K_SEARCH) -> MembraneModeChoice:
+    """The smallest K in K_MIN..k_search whose COM frequencies in the band (the ``band_modes``
+    lowest) agree with the finite-element model's within ``tolerance`` (module docstring);
+    else the smallest K whose band is within :data:`CONVERGED` of the k_search model's, with a
+    warning naming the modes that disagree."""
+    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.resources import check_membrane_modes, check_mesh_budget
+
+    check_membrane_modes(k_search, given="the automatic membrane-mode search")
+    check_mesh_budget(N=system.N, n=FE_MESH, option=f"the automatic membrane-mode search's FE mesh {FE_MESH}")
+    rest = "design" if system.rest_lengths is None else "system"
+    com = ControlOrientedModel(system, membrane_modes=k_search, rest_lengths=rest, output_points=[])
+    lin = com.linearization()
+    nq, k_hi = com.nq, com.K
+    n = min(band_modes, nq + k_hi)
+    fe_name, ref = _fe_band(system, n, rest)
+    if ref is None:
+        ref = _truncated_hz(lin, nq + k_hi, n)
+        fe_name = f"COM K={k_hi}"
+    ref = np.asarray(ref, dtype=float)
+    n = min(n, len(ref))
+    ref = ref[:n]
+    hi = _truncated_hz(lin, nq + k_hi, n)
+    worst, bands = {}, {}
+    for K in range(min(K_MIN, k_hi), k_hi + 1):
+        if nq + K < n:
+            worst[K] = None
+            continue
+        f = _truncated_hz(lin, nq + K, n)
+        bands[K] = f
+        worst[K] = float(np.max(np.abs(_relative(f, ref))))
+    agree = [K for K, w in worst.items() if w is not None and w <= tolerance]
+    if agree:
+        K = agree[0]
+    else:
+        K = min(K for K, f in bands.items() if np.all(np.abs(f - hi) <= CONVERGED * np.abs(hi)))
+    rel = _relative(bands[K], ref)
+    bad = [int(i) + 1 for i in np.flatnonzero(np.abs(rel) > tolerance)]
+    choice = MembraneModeChoice(K=K, source="automatic", reference=fe_name, band_modes=n,
+                                tolerance=tolerance, reference_hz=ref.tolist(),
+                                com_hz=bands[K].tolist(), relative_difference=rel.tolist(),
+                                disagreeing_modes=bad, max_difference_by_K=worst)
+    log.info("%s: membrane modes by K (largest difference to %s in the %d lowest modes): %s",
+             system.name, fe_name, n, ", ".join(f"{k}: {'-' if w is None else f'{100 * w:.1f} %'}"
+                                                 for k, w in worst.items()))
+    log.debug("%s: %s", system.name, choice.text)
+    if bad:
+        log.warning("%s: COM frequencies of modes %s differ from the %s model's by more than %g %% with "
+                    "any K up to %d (largest %.1f %% at the chosen K = %d): the COM's own approximation "
+                    "(rigid bars, linear tendon springs of eqs. 3.8-3.9, membrane modes about the "
+                    "designed prestress, ch. 5; docs/guides/com.md)", system.name, bad,
+                    fe_name, 100 * tolerance, k_hi, 100 * float(np.max(np.abs(rel))), K)
+    return choice
+
+
+def _relative(f, ref) -> np.ndarray:
+    """f / ref - 1, with inf where either is not a positive frequency (an unstable mode never
+    agrees)."""
+    f, ref = np.asarray(f, dtype=float), np.asarray(ref, dtype=float)
+    ok = (f > 0) & (ref > 0)
+    return np.where(ok, f / np.where(ok, ref, 1.0) - 1.0, np.inf)
+
+
+def _truncated_hz(lin, m: int, n: int) -> np.ndarray:
+    """The ``n`` lowest frequencies [Hz] of the leading m x m blocks of the linearised mass and
+    stiffness (eq. 5.33): the COM with the first m - n_q membrane modes."""
+    import scipy.linalg as sla
+    lam = np.sort(sla.eigvals(lin.K[:m, :m], lin.M[:m, :m]).real)[:n]
+    return np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
+
+
+def _fe_band(system, n: int, rest: str):
+    """("MTC" or "SBC", the n lowest frequencies [Hz]) of the finite-element model the COM is
+    compared with (mesh 10, 3 elements per tendon), or (name, None) when it fails."""
+    if system.deployable:
+        from tmfem.models.sbc.model import SBCModel as FE
+        name = "SBC"
+    else:
+        from tmfem.models.mtc.model import MTCModel as FE
+        name = "MTC"
+    try:
+        model = FE(system, rest_lengths=rest, mesh_n=FE_MESH)
+        return name, model.modes(k=n, at=model.equilibrium()).freq_hz
+    except TmfemError as e:
+        log.warning("%s: the %s model failed (%s); membrane modes chosen by the COM's own "
+                    "convergence", system.name, name, e)
+        return name, None
+
+
+def _fingerprint(system) -> str:
+    """A key of everything the choice depends on: geometry, materials, tendons, rest lengths."""
+    h = hashlib.sha256()
+    for a in (system.base, system.l, system.q, system.membrane_corners,
+              system.rest_lengths if system.rest_lengths is not None else np.zeros(0)):
+        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+        h.update(b"|")
+    h.update(repr((system.M, system.N, system.deployable, system.k_H, system.membrane, system.bar,
+                   sorted(system.tendon_sections.items()), system.tendons)).encode())
+    return h.hexdigest()
