@@ -46,6 +46,8 @@ _EXACT = {
     "max_tracking_error": "rad (angles), m (positions)", "largest_scaled_eig": "- (scaled)",
     # the automatic deployment path (docs/guides/deployment.md)
     "min_margin": "-", "min_margin_progress": "-", "resolution": "- (progress s)", "hinf_gamma": "-",
+    # the COM's membrane-mode count (docs/guides/com.md)
+    "membrane_mode_choice": "reference_hz, com_hz in Hz; tolerance and differences relative (-)",
 }
 _SUFFIX = [(r".*_deg$", "deg"), (r".*_hz$", "Hz"), (r".*_MPa$", "MPa"), (r".*_mm$", "mm"),
            (r".*_m$", "m"), (r".*_N$", "N"), (r".*_s$", "s"), (r".*_J$", "J"),

@@ -266,7 +266,7 @@ def lpv_setup(system, plant, *, model_at: str = "final"):
     as ``tmfem control lpv``): :func:`tmfem.control.lpv.deployment.lpv_deployment` with the file's ``[lpv]`` parameters
     (another System, e.g. with stiffer bars, for a perturbation study of an FE plant)."""
     from tmfem.control.lpv.deployment import lpv_deployment
-    from tmfem.models.com.model import default_membrane_modes
+    from tmfem.control.lpv.plant import lpv_membrane_modes
     from tmfem.reference.tables import deployment_bases
     if isinstance(system, str):
         from tmfem.system.presets import load_preset
@@ -284,5 +284,5 @@ def lpv_setup(system, plant, *, model_at: str = "final"):
                           theta_e=np.radians(p.theta_e_deg), psi_0=np.radians(p.psi0_deg),
                           omega_r=p.omega_r,
                           bases=deployment_bases(system), output_points=inside_points(system, pts),
-                          membrane_modes=p.membrane_modes or default_membrane_modes(system),
+                          membrane_modes=lpv_membrane_modes(system),
                           model_at=model_at)

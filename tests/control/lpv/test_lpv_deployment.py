@@ -143,8 +143,11 @@ def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
     png, a, b = tmp_path / "cmp.png", tmp_path / "mtc.csv", tmp_path / "com.csv"
     assert main(["deploy", "--preset", "2-3-lpv", "--lpv-controller", str(path), "--plant", "mtc",
                  "--plant-mesh", "2", "--compare-plant", "com", "--t-end", "0.3", "--csv", str(a),
-                 "--compare-csv", str(b), "--compare-plot", str(png), "--json"]) == 0
+                 "--compare-csv", str(b), "--compare-plot", str(png), "--json", "--allow-infeasible"]) == 0
     out = json.loads(capsys.readouterr().out)
+    # the 2 x 2 plant's start-up takes the recovered tendon stress past nylon's yield: a named
+    # failed check, accepted here by --allow-infeasible
+    assert out["failed_checks"] == out["strength_checks_failed"]
     c = out["compare"]
     assert png.stat().st_size > 10_000 and c["plot"] == str(png)
     assert c["plant"] == "com" and c["failure"] is None and out["failure"] is None

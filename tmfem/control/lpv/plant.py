@@ -23,7 +23,7 @@ from scipy.interpolate import RegularGridInterpolator, make_interp_spline
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.errors import InputError
 from tmfem.models.com.linearize import linearize
-from tmfem.models.com.model import ControlOrientedModel
+from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.system.geometry import membrane_corners_regular
 
 log = logging.getLogger(__name__)
@@ -255,7 +255,17 @@ def choose_membrane_points(model, *, rings=(0.2, 0.4, 0.6), per_ring: int = 12) 
     return [cands[i] for i in picked]
 
 
-def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int = 4,
+def lpv_membrane_modes(system) -> int:
+    """K of the LPV plant of ``system``: its ``[lpv] membrane_modes``, else that of the
+    control-oriented model (:func:`tmfem.models.com.model.default_membrane_modes`: the
+    file's ``[models.com]``, else the automatic choice)."""
+    lpv = system.problem.lpv
+    if lpv is not None and lpv.membrane_modes is not None:
+        return int(lpv.membrane_modes)
+    return default_membrane_modes(system)
+
+
+def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int | None = None,
                   membrane_points=None, mesh_n: int = 10, damping: float = 0.0,
                   rate_bounds=None, progress=None) -> GriddedLPV:
     """Gridded LPV plant of a symmetric system from COM linearisations (8.3, eqs. 5.33, 5.97).
@@ -271,6 +281,8 @@ def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int = 4,
     ----------
     theta, psi : arrays [rad]
         Grid axes.
+    membrane_modes : int, optional
+        K of the COM at every grid point; default :func:`lpv_membrane_modes`.
     rate_bounds : (2, 2) array, optional
         [[min, max] of d theta/dt, [min, max] of d psi/dt] [rad/s]; default +-10 deg/s (8.3).
     progress : callable, optional
@@ -282,6 +294,8 @@ def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int = 4,
         rb = np.radians(10.0)
         rate_bounds = [[-rb, rb], [-rb, rb]]
     pts = membrane_points
+    if membrane_modes is None:
+        membrane_modes = lpv_membrane_modes(system)
     shape = (theta.size, psi.size)
     mats, names = {}, None
     total = theta.size * psi.size
