@@ -110,8 +110,21 @@ class _MessageFormatter(logging.Formatter):
         return f"tmfem: {text}"
 
 
+def _once(record) -> bool:
+    """Handler filter: each WARNING text once per run (a command's warnings, the library's
+    log lines and the Python warnings alike; :func:`_setup_logging` starts a run)."""
+    if record.levelno != logging.WARNING:
+        return True
+    text = record.getMessage()
+    if text in _SHOWN:
+        return False
+    _SHOWN.add(text)
+    return True
+
+
 _HANDLER = logging.StreamHandler(sys.stderr)
 _HANDLER.setFormatter(_MessageFormatter())
+_HANDLER.addFilter(_once)
 
 
 def _setup_logging(*, quiet: bool = False) -> None:

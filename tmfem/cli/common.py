@@ -232,6 +232,12 @@ def say(command: str, text: str) -> None:
         print(f"tmfem {command}: {text}", file=sys.stderr, flush=True)
 
 
+def warn(command: str, text: str) -> None:
+    """A command's warning through the CLI's message channel: ``tmfem: WARNING: <text>`` on
+    stderr (the ``tmfem`` logger), each text once per run, also with ``--quiet``."""
+    logging.getLogger(f"tmfem.cli.{command}").warning(text)
+
+
 def progress_options() -> dict:
     """tqdm options of the CLI's bars: drawn on stderr only when it is a terminal, never
     with ``--quiet`` or ``TQDM_DISABLE`` set (not empty, 0 or false); plain ASCII with
