@@ -110,3 +110,48 @@ def check_membrane_modes(K: int, *, given: str = "--membrane-modes") -> None:
         raise cls(f"{given} {K}: expected 0 <= K <= {MAX_MEMBRANE_MODES} (the model's "
                   f"equations are built symbolically; K = 40 takes ~25 s, the cost grows faster "
                   f"than K^2)")
+
+
+
+#: CPU seconds of the control-oriented model's set-up (the constraint solver, the membrane
+#: basis and the CasADi graphs of eqs. 5.19-5.34, built symbolically) with n_q coordinates and
+#: K membrane modes: ``t0 + a n_q^p + b K^2`` (t0, a, p, b), the least-squares fit of
+#: benchmarks/bench_com_setup.py (towers of 2 to 128 stages of three bars, n_q 21 to 1911, K
+#: 4 to 40; 128 stages: 25 s).
+COM_SETUP_FIT = (0.59, 1.26e-4, 1.613, 2.23e-3)
+#: Peak memory of the same set-up over :data:`BASE_BYTES`: ``c n_q^2 + d K^2`` bytes (c, d),
+#: rounded up from the same measurements (n_q = 1911: 1.29 GB; K = 40: +0.25 GB).
+COM_MEMORY_FIT = (300.0, 1.5e5)
+#: Longest set-up of the control-oriented model a command starts [CPU s]: about 340 stages of
+#: three bars (docs/guides/cli.md, "Limits").
+MAX_COM_SETUP_S = 120.0
+
+
+def com_setup_seconds(*, n_q: int, K: int) -> float:
+    """CPU seconds to set up the control-oriented model (:data:`COM_SETUP_FIT`)."""
+    t0, a, p, b = COM_SETUP_FIT
+    return t0 + a * float(n_q) ** p + b * float(K) ** 2
+
+
+def com_setup_bytes(*, n_q: int, K: int) -> float:
+    """Peak memory [bytes] of that set-up: :data:`BASE_BYTES` + :data:`COM_MEMORY_FIT`."""
+    c, d = COM_MEMORY_FIT
+    return BASE_BYTES + c * float(n_q) ** 2 + d * float(K) ** 2
+
+
+def check_com_budget(system, *, K: int, source: str = "") -> float:
+    """Refuse a control-oriented model whose set-up would exceed :data:`MAX_COM_SETUP_S` or
+    the memory limit, before anything is built; the message names the stages, bars and
+    coordinates, the membrane modes K (:func:`check_membrane_modes`) and the estimate.
+    ``source`` names the system (default its name). Returns the time estimate [CPU s]."""
+    check_membrane_modes(K, given="membrane_modes")
+    M, N, n_q = system.M, system.N, len(system.q_names)
+    given = (f"{source or system.name}: {M} stage{'s' if M != 1 else ''} x {N} bars ({n_q} "
+             f"coordinates q), membrane_modes {K}")
+    what = "the control-oriented model's set-up (symbolic equations of motion, eqs. 5.19-5.34)"
+    require_memory(com_setup_bytes(n_q=n_q, K=K), given=given, what=what)
+    t = com_setup_seconds(n_q=n_q, K=K)
+    if t > MAX_COM_SETUP_S:
+        raise ResourceLimit(f"{given}: {what} takes about {t:.0f} s of CPU; the limit is "
+                            f"{MAX_COM_SETUP_S:.0f} s")
+    return t

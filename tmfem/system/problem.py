@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from tmfem.errors import InputError
+from tmfem.resources import check_membrane_modes
 
 #: keys of each table (anything else is refused)
 KEYS = {
@@ -286,6 +287,8 @@ def _lpv(t: dict, where: str) -> LPVParameters:
     K = t.get("membrane_modes")
     if K is not None and not (isinstance(K, int) and not isinstance(K, bool) and K >= 1):
         raise InputError(f"{w}: expected 'membrane_modes' to be an integer >= 1, found {K!r}")
+    if K is not None:
+        check_membrane_modes(K, given=f"{w} membrane_modes")
     d = LPVParameters()
     return LPVParameters(omega_r=_positive(t, "omega_r", w, d.omega_r),
                          membrane_modes=K, points=_points(t, "points", w),
