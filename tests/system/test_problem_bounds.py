@@ -41,3 +41,18 @@ def test_implausible_values_refused_on_reading(tmp_path, preset, table, key, val
 def test_the_bound_itself_is_accepted(tmp_path, table, key):
     value = UPPER[key] if key != "rbf_centres" else int(UPPER[key])
     assert load(tmp_path, "2-3-deploy", table, key, value).problem.deployment is not None
+
+
+
+def test_packaged_holds_no_problem_tables(tmp_path):
+    # [packaged] [packaged] used to be merged and reported as a stage-count error of the
+    # nested table
+    d = copy.deepcopy(preset_dict("2-3-deploy"))
+    d["packaged"]["packaged"] = {"symmetric": {"l": [2.0]}}
+    d["packaged"]["deployment"] = {"omega_r": 1.0}
+    p = tmp_path / "f.toml"
+    p.write_bytes(tomli_w.dumps(d).encode())
+    with pytest.raises(InputError, match=r"\[packaged\]: expected overrides of the structure's "
+                                         r"tables, found the problem table\(s\) \['deployment', "
+                                         r"'packaged'\]"):
+        load_system(p)

@@ -369,6 +369,10 @@ def problem_from_dict(d: dict, where: str, build) -> Problem:
         p = d["packaged"]
         if not isinstance(p, dict):
             raise InputError(f"{where}: expected [packaged] to be a table of overrides, found {p!r}")
+        nested = sorted(set(p) & set(TABLES))
+        if nested:
+            raise InputError(f"{where} [packaged]: expected overrides of the structure's tables, "
+                             f"found the problem table(s) {nested} (they belong to the file itself)")
         rest = {k: v for k, v in d.items() if k not in TABLES}
         merged = deep_merge(rest, p)
         if "rest_lengths" in p:                       # rest lengths are replaced, not merged
