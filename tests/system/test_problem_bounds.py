@@ -7,7 +7,7 @@ import pytest
 import tomli_w
 
 from tmfem.errors import InputError
-from tmfem.system import load_system
+from tmfem.system import load_preset, load_system
 from tmfem.system.presets import preset_dict
 from tmfem.system.problem import UPPER
 
@@ -56,3 +56,15 @@ def test_packaged_holds_no_problem_tables(tmp_path):
                                          r"tables, found the problem table\(s\) \['deployment', "
                                          r"'packaged'\]"):
         load_system(p)
+
+
+
+@pytest.mark.parametrize("key, value", [("theta0_deg", 150.0), ("theta_e_deg", 60.0),
+                                        ("psi0_deg", 9.5)])
+def test_scheduling_values_on_the_grid(tmp_path, key, value):
+    # theta0_deg = 150 ran the synthesis for minutes before the deployment refused it; the
+    # file stays valid for a design (control lpv), the deployment refuses it before any work
+    system = load(tmp_path, "2-3-lpv", "lpv", key, value)
+    with pytest.raises(InputError, match=rf"\[lpv\]: expected '{key}' inside its grid .* found {value:g}"):
+        system.problem.lpv.check_schedule(system.name)
+    load_preset("2-3-lpv").problem.lpv.check_schedule("2-3-lpv")         # the preset is on it

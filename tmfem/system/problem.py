@@ -188,6 +188,16 @@ class LPVParameters:
     theta_e_deg: float | None = None
     psi0_deg: float | None = None
 
+    def check_schedule(self, where: str) -> None:
+        """The scheduling values of eq. 5.100 on the design grid (a deployment: the reference
+        would leave the grid, found otherwise only after the synthesis)."""
+        for key, axis in (("theta0_deg", self.theta_grid_deg), ("theta_e_deg", self.theta_grid_deg),
+                          ("psi0_deg", self.psi_grid_deg)):
+            v = getattr(self, key)
+            if v is not None and axis is not None and not axis[0] <= v <= axis[-1]:
+                raise InputError(f"{where} [lpv]: expected '{key}' inside its grid [{axis[0]:g}, "
+                                 f"{axis[-1]:g}] deg (eq. 5.100 on the design grid), found {v:g}")
+
 
 @dataclass(frozen=True)
 class ReportSettings:
