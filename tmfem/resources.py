@@ -110,3 +110,100 @@ def check_membrane_modes(K: int, *, given: str = "--membrane-modes") -> None:
         raise cls(f"{given} {K}: expected 0 <= K <= {MAX_MEMBRANE_MODES} (the model's "
                   f"equations are built symbolically; K = 40 takes ~25 s, the cost grows faster "
                   f"than K^2)")
+
+
+
+#: CPU seconds of the control-oriented model's set-up (the constraint solver, the membrane
+#: basis and the CasADi graphs of eqs. 5.19-5.34, built symbolically) with n_q coordinates and
+#: K membrane modes: ``t0 + a n_q^p + b K^2`` (t0, a, p, b), the least-squares fit of
+#: benchmarks/bench_com_setup.py (towers of 2 to 128 stages of three bars, n_q 21 to 1911, K
+#: 4 to 40; 128 stages: 25 s).
+COM_SETUP_FIT = (0.59, 1.26e-4, 1.613, 2.23e-3)
+#: Peak memory of the same set-up over :data:`BASE_BYTES`: ``c n_q^2 + d K^2`` bytes (c, d),
+#: rounded up from the same measurements (n_q = 1911: 1.29 GB; K = 40: +0.25 GB).
+COM_MEMORY_FIT = (300.0, 1.5e5)
+#: Longest set-up of the control-oriented model a command starts [CPU s]: about 340 stages of
+#: three bars (docs/guides/cli.md, "Limits").
+MAX_COM_SETUP_S = 120.0
+
+
+def com_setup_seconds(*, n_q: int, K: int) -> float:
+    """CPU seconds to set up the control-oriented model (:data:`COM_SETUP_FIT`)."""
+    t0, a, p, b = COM_SETUP_FIT
+    return t0 + a * float(n_q) ** p + b * float(K) ** 2
+
+
+def com_setup_bytes(*, n_q: int, K: int) -> float:
+    """Peak memory [bytes] of that set-up: :data:`BASE_BYTES` + :data:`COM_MEMORY_FIT`."""
+    c, d = COM_MEMORY_FIT
+    return BASE_BYTES + c * float(n_q) ** 2 + d * float(K) ** 2
+
+
+def check_com_budget(system, *, K: int, source: str = "") -> float:
+    """Refuse a control-oriented model whose set-up would exceed :data:`MAX_COM_SETUP_S` or
+    the memory limit, before anything is built; the message names the stages, bars and
+    coordinates, the membrane modes K (:func:`check_membrane_modes`) and the estimate.
+    ``source`` names the system (default its name). Returns the time estimate [CPU s]."""
+    check_membrane_modes(K, given="membrane_modes")
+    M, N, n_q = system.M, system.N, len(system.q_names)
+    given = (f"{source or system.name}: {M} stage{'s' if M != 1 else ''} x {N} bars ({n_q} "
+             f"coordinates q), membrane_modes {K}")
+    what = "the control-oriented model's set-up (symbolic equations of motion, eqs. 5.19-5.34)"
+    require_memory(com_setup_bytes(n_q=n_q, K=K), given=given, what=what)
+    t = com_setup_seconds(n_q=n_q, K=K)
+    if t > MAX_COM_SETUP_S:
+        raise ResourceLimit(f"{given}: {what} takes about {t:.0f} s of CPU; the limit is "
+                            f"{MAX_COM_SETUP_S:.0f} s")
+    return t
+
+
+#: CPU seconds of :func:`tmfem.control.linear.hinf_synthesis.hinfsyn` by route for a plant of
+#: n states: the Riccati bisection ``a n^3`` (dense Hamiltonian Schur forms of size 2n at every
+#: level; measured 5 s at n = 100, 19 s at n = 200) and the LMI route ``b (n / 20)^5.5`` (an
+#: SDP in X, Y of n(n + 1)/2 unknowns each; measured 2.2 s at n = 20, 100 s at n = 40).
+SYNTHESIS_FIT = {"riccati": 5e-6, "lmi": 2.2}
+#: Peak memory of the LMI route over :data:`BASE_BYTES`: ``c n^4`` bytes (the interior-point
+#: solver's dense Schur complement in the unknowns; measured 0.93 GB at n = 40).
+LMI_BYTES_PER_N4 = 500.0
+#: Longest H-infinity synthesis a call starts [CPU s] (docs/guides/cli.md, "Limits").
+MAX_SYNTHESIS_S = 3600.0
+
+
+def synthesis_seconds(*, route: str, n: int) -> float:
+    """CPU seconds of the H-infinity synthesis route ``route`` ("riccati", "slicot": the
+    Riccati estimate; "lmi") for a plant of ``n`` states (:data:`SYNTHESIS_FIT`)."""
+    if route == "lmi":
+        return SYNTHESIS_FIT["lmi"] * (n / 20.0) ** 5.5
+    return SYNTHESIS_FIT["riccati"] * float(n) ** 3
+
+
+def check_synthesis_budget(*, route: str, n: int, given: str = "hinfsyn") -> float:
+    """Refuse an H-infinity synthesis whose estimate (:func:`synthesis_seconds`, and the LMI
+    route's memory) exceeds :data:`MAX_SYNTHESIS_S` or the memory limit, naming the route and
+    the plant's states. Returns the time estimate [CPU s]."""
+    where = f"{given}: a plant of {n} states by the {route} route"
+    if route == "lmi":
+        require_memory(BASE_BYTES + LMI_BYTES_PER_N4 * float(n) ** 4, given=where,
+                       what="the LMI synthesis (an SDP in two n x n symmetric unknowns)")
+    t = synthesis_seconds(route=route, n=n)
+    if t > MAX_SYNTHESIS_S:
+        raise ResourceLimit(f"{where} takes about {t:.0f} s of CPU; the limit is "
+                            f"{MAX_SYNTHESIS_S:.0f} s (reduce the plant: fewer membrane modes, "
+                            "a balanced truncation)")
+    return t
+
+
+def check_lpv_budget(*, design_points: int, verify_points: int, vertices: int, n: int, m: int,
+                     p: int, given: str = "lpvsyn") -> float:
+    """Refuse a gridded LPV synthesis whose plant data and LMIs cannot fit the memory limit:
+    the plant's matrices ((n + p) x (n + m)) at every design and verification point, and one
+    dense LMI of size 2n + m + p per design point and rate vertex, three copies each (the
+    problem, the solver's scaling and its factor), 8 bytes an entry. A lower bound of the
+    solver's needs; it bounds the grid a call may ask for. Returns the estimate in bytes."""
+    s = 2 * n + m + p
+    need = BASE_BYTES + 8.0 * ((n + p) * (n + m) * (design_points + verify_points)
+                               + 3.0 * s * s * design_points * vertices)
+    return require_memory(need, given=f"{given}: {design_points:,} design points x {vertices} rate "
+                                      f"vertices, {verify_points:,} verification points, a plant of "
+                                      f"{n} states",
+                          what="the gridded plant and its LMIs")

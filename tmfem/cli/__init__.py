@@ -110,8 +110,21 @@ class _MessageFormatter(logging.Formatter):
         return f"tmfem: {text}"
 
 
+def _once(record) -> bool:
+    """Handler filter: each WARNING text once per run (a command's warnings, the library's
+    log lines and the Python warnings alike; :func:`_setup_logging` starts a run)."""
+    if record.levelno != logging.WARNING:
+        return True
+    text = record.getMessage()
+    if text in _SHOWN:
+        return False
+    _SHOWN.add(text)
+    return True
+
+
 _HANDLER = logging.StreamHandler(sys.stderr)
 _HANDLER.setFormatter(_MessageFormatter())
+_HANDLER.addFilter(_once)
 
 
 def _setup_logging(*, quiet: bool = False) -> None:
@@ -148,7 +161,7 @@ SIGNAL_EXITS = {signal.SIGINT: (130, "interrupted"), signal.SIGTERM: (143, "term
 SIGTERM_GRACE_S = 5.0
 
 
-def _install_interrupt_handler(command: str, cleanup=None):
+def _install_interrupt_handler(command: str, cleanup=None, *, ranks=None):
     """Ctrl-C (SIGINT) and SIGTERM: one line (``interrupted`` / ``terminated``) and exit
     code 130 / 143, at once. A KeyboardInterrupt raised inside compiled callbacks (CasADi
     functions of the control-oriented model) is swallowed there and resurfaces as an
@@ -162,27 +175,46 @@ def _install_interrupt_handler(command: str, cleanup=None):
     first steps), which would end the process without a word. The thread hands it to the
     main thread (``_thread.interrupt_main``), so that nothing is written while the handler
     cleans up; when the main thread stays in a compiled call for :data:`SIGTERM_GRACE_S`,
-    the thread ends the process itself. Returns a function that puts the previous handling
-    back (None off the main thread)."""
+    the thread ends the process itself.
+
+    Under mpiexec (``ranks``, a :class:`_Ranks`) both signals are taken by that thread and
+    end the rank at once: its main thread may wait in a collective call for a rank that has
+    ended, and mpiexec kills the job about a second after a rank ends. The rank that
+    receives the signal first passes it on to the other ranks of its host (mpiexec passes
+    its own SIGINT and SIGTERM on to every rank), and only rank 0 prints the line, so that
+    every rank exits with the same code and the job says it once. Returns a function that
+    puts the previous handling back (None off the main thread)."""
     if threading.current_thread() is not threading.main_thread():
         return None
+    ending = threading.Lock()
 
     def end(signum):
+        if not ending.acquire(blocking=False):      # the other path is ending the process
+            return
         code, what = SIGNAL_EXITS[signum]
+        if ranks is not None:
+            ranks.forward(signum)
         sys.stdout.flush()
         if cleanup is not None:
             cleanup()
-        # on a line of its own: a progress bar may be half drawn
-        print(f"\ntmfem {command}: {what}", file=sys.stderr, flush=True)
+        if ranks is None or ranks.rank == 0:
+            # on a line of its own: a progress bar may be half drawn
+            print(f"\ntmfem {command}: {what}", file=sys.stderr, flush=True)
+        else:
+            ranks.wait_for_root()
         os._exit(code)
 
     previous = {sig: signal.signal(sig, lambda signum, frame: end(signum)) for sig in SIGNAL_EXITS}
-    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+    waited = set(SIGNAL_EXITS) if ranks is not None else {signal.SIGTERM}
+    signal.pthread_sigmask(signal.SIG_BLOCK, waited)
     state = {"stopping": False}
 
     def wait():
-        signal.sigwait({signal.SIGTERM})
+        signum = signal.sigwait(waited)
         if state["stopping"]:
+            return
+        if ranks is not None:
+            end(signum)
             return
         _thread.interrupt_main(signal.SIGTERM)     # the handler runs on the main thread
         time.sleep(SIGTERM_GRACE_S)
@@ -194,10 +226,61 @@ def _install_interrupt_handler(command: str, cleanup=None):
         state["stopping"] = True
         signal.pthread_kill(waiter.ident, signal.SIGTERM)
         waiter.join()
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGTERM})
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, waited)
         for sig, handler in previous.items():
             signal.signal(sig, handler)
     return restore
+
+
+class _Ranks:
+    """The rank of this process under mpiexec and the process ids of the ranks on its host
+    (filled by :meth:`meet`, a collective call), to which a signal is passed on.
+
+    A rank other than 0 that ends on a signal first waits for rank 0 to end (at most
+    :data:`RANK_END_WAIT_S`): rank 0's main thread may be inside a compiled collective call
+    that holds the interpreter lock and completes only while the other ranks still take
+    part; once rank 0 has printed its line and removed its files, the others follow."""
+
+    def __init__(self, rank: int):
+        self.rank = rank
+        self.peers: list[int] = []
+        self.root: int | None = None
+
+    def meet(self, comm) -> None:
+        import socket
+        here = (socket.gethostname(), os.getpid())
+        everyone = comm.allgather(here)
+        self.peers = [pid for host, pid in everyone if host == here[0] and pid != here[1]]
+        if everyone[0][0] == here[0] and self.rank != 0:
+            self.root = everyone[0][1]
+
+    def forward(self, signum) -> None:
+        for pid in self.peers:
+            try:
+                os.kill(pid, signum)
+            except OSError:                        # that rank has ended already
+                pass
+
+    def wait_for_root(self) -> None:
+        """Return when rank 0 has ended (or after :data:`RANK_END_WAIT_S`)."""
+        t0 = time.monotonic()
+        while self.root is not None and _running(self.root):
+            if time.monotonic() - t0 > RANK_END_WAIT_S:
+                return
+            time.sleep(0.01)
+
+
+#: Seconds a rank other than 0 waits for rank 0 to end after a signal (:class:`_Ranks`).
+RANK_END_WAIT_S = 3.0
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` runs (neither gone nor a zombie)."""
+    try:
+        with open(f"/proc/{pid}/stat") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
 
 
 #: Options that name an output: a file (``static --vtk s.vtu``, ``mesh OUT.msh``), whose
@@ -332,9 +415,10 @@ def _mpi_size() -> int:
 def _main_mpi(args, mod) -> int:
     """Under ``mpiexec -n P`` (P > 1): the PETSc backend only; the command runs on every rank,
     rank 0 alone prints and writes the output files (docs/guides/backends.md#mpi), an error is
-    printed once with a non-zero exit, never a hang."""
-    import contextlib
-    import io
+    printed once with a non-zero exit, never a hang. Rank 0 takes the output locks and the
+    ``INCOMPLETE`` mark; a run refused there (a directory in use) is refused on every rank
+    at once. SIGINT or SIGTERM to mpiexec or to any rank ends every rank with one line and
+    exit 130 / 143 (:func:`_install_interrupt_handler`)."""
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
     backend = getattr(args, "backend", "scipy")   # a command without --backend solves with scipy
     if backend is None:
@@ -345,8 +429,31 @@ def _main_mpi(args, mod) -> int:
                   f"--backend petsc, found --backend {getattr(args, 'backend', None) or 'scipy'} "
                   "(every rank would solve the whole problem alone)", file=sys.stderr)
         return 2
+    from tmfem.io.atomic import remove_pending
+    from tmfem.io.lock import OutputLock
+    lock, ranks = OutputLock(), _Ranks(rank)
+
+    def cleanup():
+        remove_pending()
+        lock.release()
+    # before MPI starts: the threads of MPI and PETSc inherit the blocked signals
+    restore = _install_interrupt_handler(args.command, cleanup, ranks=ranks)
+    try:
+        return _run_ranks(args, mod, ranks, lock)
+    finally:
+        cleanup()
+        if restore is not None:
+            restore()
+
+
+def _run_ranks(args, mod, ranks, lock) -> int:
+    """The body of :func:`_main_mpi` on one rank; returns its exit code."""
+    import contextlib
+    import io
+
     from tmfem.cli.common import OUTPUT_SUFFIXES, check_outputs
-    from tmfem.solvers.distributed import collective, mpi_main
+    from tmfem.solvers.distributed import collective, comm_world, mpi_main
+    rank = ranks.rank
     if rank != 0:
         # the other ranks compute the same result (and take part in every collective call)
         # but write nothing: no output files, no progress, no log lines
@@ -355,13 +462,18 @@ def _main_mpi(args, mod) -> int:
                 setattr(args, dest, None)
         logging.getLogger("tmfem").setLevel(logging.CRITICAL)
         logging.getLogger("py.warnings").setLevel(logging.CRITICAL)
-    result = {}
+    result, marks = {}, []
 
     def body():
+        ranks.meet(comm_world())
         with collective(what=f"tmfem {args.command}"):
-            # the output paths are checked by rank 0 before any work: every rank learns of a
-            # refused one at once instead of waiting for rank 0 in the first collective call
+            # the output paths are checked and locked by rank 0 before any work: every rank
+            # learns of a refused one at once instead of waiting for rank 0 in the first
+            # collective call
             if rank == 0:
+                for d in output_directories(args):
+                    lock.acquire(d, label=f"tmfem {args.command}")
+                marks.append(_mark_incomplete(args))
                 check_outputs(args, args.command)
         with contextlib.redirect_stderr(sys.stderr if rank == 0 else io.StringIO()):
             try:
@@ -373,6 +485,8 @@ def _main_mpi(args, mod) -> int:
         return render(args, mod, result["value"])
     code = mpi_main(body, report=rank_report(f"tmfem {args.command}: "))
     if code == 0:
+        if marks and marks[0] is not None:
+            marks[0].unlink(missing_ok=True)
         code = _checks_exit(args, result["value"], printing=rank == 0)
     return code
 

@@ -232,6 +232,12 @@ def say(command: str, text: str) -> None:
         print(f"tmfem {command}: {text}", file=sys.stderr, flush=True)
 
 
+def warn(command: str, text: str) -> None:
+    """A command's warning through the CLI's message channel: ``tmfem: WARNING: <text>`` on
+    stderr (the ``tmfem`` logger), each text once per run, also with ``--quiet``."""
+    logging.getLogger(f"tmfem.cli.{command}").warning(text)
+
+
 def progress_options() -> dict:
     """tqdm options of the CLI's bars: drawn on stderr only when it is a terminal, never
     with ``--quiet`` or ``TQDM_DISABLE`` set (not empty, 0 or false); plain ASCII with
@@ -319,16 +325,18 @@ def output_dir(path, *, option: str) -> Path:
 MAX_STEPS = 200_000
 
 
-def check_time_steps(*, t_end: float, dt: float, states: int | None = None) -> int:
+def check_time_steps(*, t_end: float, dt: float, states: int | None = None,
+                     given: str = "--t-end") -> int:
     """Number of time steps of a run of ``t_end`` s in steps of ``dt`` s, refused when it
     is zero (dt > t_end), over ``MAX_STEPS`` or when the histories (``states`` values per
-    step, 8 bytes each, position and velocity) would not fit in memory."""
+    step, 8 bytes each, position and velocity) would not fit in memory; ``given`` names where
+    ``t_end`` comes from (the option, or a file's field)."""
     from tmfem.simulation.driver import check_time_grid
 
     steps = check_time_grid(t_end, dt)
     if steps > MAX_STEPS:
-        raise ResourceLimit(f"--t-end {t_end:g} s / --dt {dt:g} s = {steps:,} steps; the limit "
-                            f"is {MAX_STEPS:,} (raise --dt or lower --t-end)")
+        raise ResourceLimit(f"{given} {t_end:g} s / --dt {dt:g} s = {steps:,} steps; the limit "
+                            f"is {MAX_STEPS:,} (raise --dt or lower {given})")
     if states is not None:
         need = 2 * 8.0 * states * steps
         limit = MEMORY_FRACTION * machine_memory()

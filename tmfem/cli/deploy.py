@@ -7,14 +7,13 @@ Every option and output path is checked before the controller design (docs/guide
 """
 from __future__ import annotations
 
-import sys
 import time
 from dataclasses import astuple
 
 from tmfem import reference
 from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_frames, check_mesh_budget, check_time_steps, output_dir,
-                              output_file, positive_float, progress_bar)
+                              output_file, positive_float, progress_bar, warn)
 from tmfem.errors import InputError
 from tmfem.models.com.mode_count import MembraneModeChoice, membrane_mode_choice
 from tmfem.reference.deployments import (CONTROLLERS, LPV_CONTROLLERS, UNCERTAINTIES, check_choices,
@@ -196,7 +195,7 @@ def run(args) -> dict:
               tendon_law=tendons, gains=args.gains)
     warnings = plants.tendon_model_warnings(tendons)
     for w in warnings:
-        print(f"tmfem deploy: warning: {w}", file=sys.stderr)
+        warn(NAME, w)
     r = _run_on(args, s, args.plant, mesh_n)
     # the controller's options, the same on both plants of a comparison (docs/guides/fe-plant.md)
     ctrl = {"controller": args.controller, "uncertainty": s.adaptive.uncertainty,

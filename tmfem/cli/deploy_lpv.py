@@ -59,6 +59,7 @@ def check(args) -> None:
     """Refusals before any work: options of the 7.4 deployments, the paths (the FE plant's
     options are those of the 7.4 deployments, checked by :mod:`tmfem.cli.deploy`)."""
     bad = given(args, NOT_LPV)
+    args.system.problem.lpv.check_schedule(args.system.name)
     own = args.system.problem.lpv.path
     if args.path not in (None, own):
         bad.append(f"--path {args.path}")

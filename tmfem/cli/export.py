@@ -8,11 +8,10 @@ positions impose, or as the polygon B_M1..B_MN with ``--mesh 0``.
 """
 from __future__ import annotations
 
-import sys
 
 import numpy as np
 
-from tmfem.cli.common import add_system_args, check_mesh_budget, output_file, system_from_args
+from tmfem.cli.common import add_system_args, check_mesh_budget, output_file, system_from_args, warn
 from tmfem.errors import InfeasibleDesign, InputError
 
 NAME = "export"
@@ -68,7 +67,7 @@ def run(args) -> dict:
                         f"{np.array2string(radial, precision=4)} m; its linear plane-stress "
                         "field is compressive and only shows the misfit")
     for w in warnings:
-        print(f"tmfem export: warning: {w}", file=sys.stderr)
+        warn(NAME, w)
     if args.mesh == 0:
         membrane = None
     elif d is not None:     # the design solved this membrane already (same mesh, same q)

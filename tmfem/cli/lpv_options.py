@@ -110,7 +110,8 @@ def check_synthesis(args, *, solver: str, system) -> dict:
     th, ps = lpv_grid(args.grid, system)
     fine_n = [(a.size - 1) * refine + 1 for a in (th, ps)]
     if fine_n[0] * fine_n[1] > MAX_VERIFY_POINTS:
-        raise ResourceLimit(f"--grid {args.grid or f'{th.size}x{ps.size}'} --refine {refine}: the verification grid "
+        grid = f"--grid {args.grid}" if args.grid else f"the [lpv] grid {th.size}x{ps.size} of {system.name}"
+        raise ResourceLimit(f"{grid} --refine {refine}: the verification grid "
                             f"has {fine_n[0]} x {fine_n[1]} = {fine_n[0] * fine_n[1]:,} points, one COM "
                             f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
     check_iteration_limits(args, fine_points=fine_n[0] * fine_n[1], design_points=th.size * ps.size)

@@ -44,6 +44,7 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
+    from tmfem.reference.deployments import CONTROLLERS
     from tmfem.reference.report import STEPS, report_deployment, write_report
 
     system = system_from_args(args)
@@ -61,7 +62,11 @@ def run(args) -> dict:
                          "deployment in the report (its file has no [report] deployment and no "
                          "[packaged] with [deployment])")
     if deployment is not None and not args.no_deploy:
-        check_time_steps(t_end=deployment["t_end"], dt=args.dt)
+        where = "[report] deployment"
+        check_time_steps(t_end=deployment["t_end"], dt=args.dt, given=f"{where} t_end")
+        if deployment["controller"] not in CONTROLLERS:
+            raise InputError(f"{where}: expected 'controller' one of {sorted(CONTROLLERS)}, found "
+                             f"{deployment['controller']!r}")
     out = output_dir(args.out, option="--out")
     with Progress(total=len(STEPS), desc=f"report {system.name}") as bar:
         bar.note(STEPS[0])

@@ -1,7 +1,6 @@
 """``tmfem static``: equilibrium of a finite-element model reached from the undeformed membrane (6.2)."""
 from __future__ import annotations
 
-import sys
 
 from tmfem.cli.common import (add_model_args, add_system_args, default_monitor, model_from_args,
                               requested_files, say, with_backend)
@@ -39,8 +38,7 @@ def static_progress(enabled: bool):
         return None
 
     def show(it, rn, mu=0.0, rho=float("nan")):
-        print(f"  static it {it:3d}  |r| = {rn:.3e} N  mu = {mu:.3g}  rho = {rho:.3g}",
-              file=sys.stderr)
+        say(NAME, f"static it {it:3d}  |r| = {rn:.3e} N  mu = {mu:.3g}  rho = {rho:.3g}")
     return show
 
 

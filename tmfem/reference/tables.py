@@ -241,6 +241,11 @@ def deployment_bases(system, *, z_ratio: float = 0.7, Delta: float = 1e-3, sigma
     def bases(theta, psi):
         r2 = top_radius_for_delta(l_M=c.l[1], theta_M=theta, psi_rel=psi, r_mb=system.r_mb,
                                   Delta=Delta, N=system.N)
+        if not r2 > 0:
+            raise InputError(f"path table-7-7-bases of {system.name}: the stage-2 base radius of "
+                             f"eq. 3.22 at theta = {np.degrees(theta):.4g} deg, psi = "
+                             f"{np.degrees(psi):.4g} deg is {r2:.4g} m; expected > 0 (a configuration "
+                             "outside the rule's range, e.g. [packaged]; use --path linear)")
         return {"r": np.array([c.r[0], r2]), "z": np.array([0.0, z_ratio * c.l[0] * np.cos(theta)]),
                 "sigma": np.array([0.0, sg2])}
 

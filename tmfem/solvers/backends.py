@@ -99,6 +99,10 @@ class ScipyBackend:
                                      "numerically singular one (non-finite solution; a mechanism or "
                                      "an unloaded cable/membrane direction?)")
             return x
+        # smallest / largest |pivot| (SuperLU's U carries them): a caller that must not solve a
+        # numerically singular matrix compares it with SINGULAR_PIVOT_RATIO
+        u = np.abs(lu.U.diagonal())
+        solve.pivot_ratio = float(u.min() / u.max()) if u.size and u.max() > 0 else 0.0
         return solve
 
     def _permuted(self, A):

@@ -17,6 +17,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.backends import SingularMatrix, get_backend
+from tmfem.solvers.singular import SINGULAR_PIVOT_RATIO
 
 
 def free_index(free, n: int) -> np.ndarray:
@@ -80,13 +81,14 @@ def factorize(A, backend, *, equilibrate: bool = False):
         def solve(b):
             dd = d if np.ndim(b) == 1 else d[:, None]
             return dd * solve_scaled(dd * np.asarray(b, dtype=float))
+        solve.pivot_ratio = getattr(solve_scaled, "pivot_ratio", None)
         return solve
     if not isinstance(A, np.ndarray):        # sparse, or a backend's own (distributed) matrix
         return backend.factorize(A)
     A = np.asarray(A, dtype=float)
     lu, piv = sla.lu_factor(A, check_finite=False)
     d = np.abs(np.diag(lu))
-    if A.size and (not np.all(np.isfinite(d)) or d.min() <= 1e-14 * max(d.max(), 1e-300)):
+    if A.size and (not np.all(np.isfinite(d)) or d.min() <= SINGULAR_PIVOT_RATIO * max(d.max(), 1e-300)):
         raise SingularMatrix(f"linear solve: expected a non-singular {A.shape[0]}x{A.shape[0]} "
                              f"matrix, found a singular one (smallest LU pivot {d.min():.3e})")
     return lambda b: sla.lu_solve((lu, piv), b, check_finite=False)

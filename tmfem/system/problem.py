@@ -30,7 +30,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.errors import InputError, shorten
+from tmfem.resources import check_membrane_modes
 
 #: keys of each table (anything else is refused)
 KEYS = {
@@ -49,6 +50,8 @@ UNCERTAINTIES = ("initial", "no-MG", "exact")
 PATHS = ("delta", "auto", "table-7-7-bases", "linear")
 #: the stage-base rules of an LPV grid (``[lpv] path``)
 LPV_PATHS = ("table-7-7-bases",)
+#: Most angles on an axis of the [lpv] grid (as --grid and --map-grid: 60 points a side).
+MAX_GRID_AXIS = 60
 COM_PRESTRESS = ("designed", "printed-tendon-stress")
 
 
@@ -62,14 +65,22 @@ def _keys(t, kind: str, where: str) -> dict:
     return t
 
 
+#: Upper plausibility bounds of the problem tables' numbers (docs/guides/system-file.md): a
+#: reference or gain beyond them overflows the closed forms (exp(omega_r t)) or cannot be
+#: resolved by the time step; every RBF centre is evaluated at every step.
+UPPER = {"omega_r": 100.0, "omega_0": 1e6, "omega_e": 1e6, "tau": 1e6, "d_c": 1e6,
+         "w_bar": 1e12, "gamma": 1e12, "r_min": 1e3, "rbf_centres": 1000, "alpha": 1e6,
+         "u_m": 1e3, "W_e": 1e12, "W_d": 1e12, "rate_bound_deg": 1e4}
+
+
 def _positive(t: dict, key: str, where: str, default=None, *, zero: bool = False):
     if key not in t:
         return default
     v = t[key]
     ok = isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
-    if not ok or v < 0 or (v == 0 and not zero):
-        raise InputError(f"{where}: expected '{key}' to be a finite number {'>=' if zero else '>'} 0, "
-                         f"found {v!r}")
+    if not ok or v < 0 or (v == 0 and not zero) or v > UPPER.get(key, math.inf):
+        raise InputError(f"{where}: expected '{key}' to be a finite number {'>=' if zero else '>'} 0"
+                         + (f" and <= {UPPER[key]:g}" if key in UPPER else "") + f", found {v!r}")
     return float(v)
 
 
@@ -191,6 +202,16 @@ class LPVParameters:
     theta_e_deg: float | None = None
     psi0_deg: float | None = None
 
+    def check_schedule(self, where: str) -> None:
+        """The scheduling values of eq. 5.100 on the design grid (a deployment: the reference
+        would leave the grid, found otherwise only after the synthesis)."""
+        for key, axis in (("theta0_deg", self.theta_grid_deg), ("theta_e_deg", self.theta_grid_deg),
+                          ("psi0_deg", self.psi_grid_deg)):
+            v = getattr(self, key)
+            if v is not None and axis is not None and not axis[0] <= v <= axis[-1]:
+                raise InputError(f"{where} [lpv]: expected '{key}' inside its grid [{axis[0]:g}, "
+                                 f"{axis[-1]:g}] deg (eq. 5.100 on the design grid), found {v:g}")
+
 
 @dataclass(frozen=True)
 class ReportSettings:
@@ -281,8 +302,9 @@ def _deployment(t: dict, where: str) -> DeploymentParameters:
         raise InputError(f"{w}: expected xi_r = 1 (eq. 5.68 critically damped, the reference "
                          f"implemented), found {xi}")
     n = t.get("rbf_centres", d.rbf_centres)
-    if not (isinstance(n, int) and not isinstance(n, bool) and n >= 2):
-        raise InputError(f"{w}: expected 'rbf_centres' to be an integer >= 2, found {n!r}")
+    if not (isinstance(n, int) and not isinstance(n, bool) and 2 <= n <= UPPER["rbf_centres"]):
+        raise InputError(f"{w}: expected 'rbf_centres' to be an integer in 2..{UPPER['rbf_centres']}, "
+                         f"found {n!r}")
     return DeploymentParameters(
         omega_r=_positive(t, "omega_r", w, d.omega_r), xi_r=xi,
         gains=_gains(t["gains"], w) if "gains" in t else d.gains,
@@ -308,7 +330,10 @@ def _axis(t: dict, key: str, where: str):
         isinstance(x, (int, float)) and not isinstance(x, bool) and -180.0 <= x <= 180.0 for x in v)
     if not ok or any(b <= a for a, b in zip(v, v[1:])):
         raise InputError(f"{where}: expected '{key}' as a strictly increasing list of angles in "
-                         f"degrees, found {v!r}")
+                         f"degrees, found {shorten(v) if isinstance(v, list) else repr(v)}")
+    if len(v) > MAX_GRID_AXIS:
+        raise InputError(f"{where}: expected '{key}' with at most {MAX_GRID_AXIS} angles (every "
+                         f"grid point is one linearisation of the model), found {len(v)}")
     return tuple(float(x) for x in v)
 
 
@@ -318,6 +343,8 @@ def _lpv(t: dict, where: str) -> LPVParameters:
     K = t.get("membrane_modes")
     if K is not None and not (isinstance(K, int) and not isinstance(K, bool) and K >= 1):
         raise InputError(f"{w}: expected 'membrane_modes' to be an integer >= 1, found {K!r}")
+    if K is not None:
+        check_membrane_modes(K, given=f"{w} membrane_modes")
     d = LPVParameters()
     return LPVParameters(omega_r=_positive(t, "omega_r", w, d.omega_r),
                          membrane_modes=K, points=_points(t, "points", w),
@@ -402,6 +429,10 @@ def problem_from_dict(d: dict, where: str, build) -> Problem:
         p = d["packaged"]
         if not isinstance(p, dict):
             raise InputError(f"{where}: expected [packaged] to be a table of overrides, found {p!r}")
+        nested = sorted(set(p) & set(TABLES))
+        if nested:
+            raise InputError(f"{where} [packaged]: expected overrides of the structure's tables, "
+                             f"found the problem table(s) {nested} (they belong to the file itself)")
         rest = {k: v for k, v in d.items() if k not in TABLES}
         merged = deep_merge(rest, p)
         if "rest_lengths" in p:                       # rest lengths are replaced, not merged

@@ -55,6 +55,7 @@ from tmfem.control.linear.lmi import SolverReport
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.control.linear.pbh import require_stabilizable_detectable
 from tmfem.errors import InfeasibleController, InputError
+from tmfem.resources import check_synthesis_budget
 
 log = logging.getLogger(__name__)
 
@@ -163,6 +164,7 @@ def _route(G0, method, alpha, gamma_tol, solver):
     times = {}
 
     def run(name):
+        check_synthesis_budget(route=name, n=G0.A.shape[0])      # before the route starts
         t0 = time.perf_counter()
         try:
             if name == "riccati":
@@ -376,6 +378,8 @@ def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "auto", alpha: float = 0.
     t0 = time.perf_counter()
     _check_options(alpha, gamma_tol, method, METHODS)
     G = _plant(P, nmeas, ncon)
+    # before the PBH test, itself an eigendecomposition of A (the routes check their own)
+    check_synthesis_budget(route="lmi" if method == "lmi" else "riccati", n=G.A.shape[0])
     require_stabilizable_detectable(G.A, G.B2, G.C2, alpha=alpha, state_names=G.state_names)
     shift = bool(np.any(G.D22 != 0))
     G0 = GeneralizedPlant(**{**G.__dict__, "D22": np.zeros_like(G.D22)}) if shift else G
@@ -413,6 +417,8 @@ def hinfsyn_state(P, ncon: int, *, method: str = "auto", alpha: float = 0.0,
     else:
         raise InputError(f"hinfsyn_state: expected a python-control StateSpace or TransferFunction, "
                          f"found {type(P).__name__}")
+    # the Riccati estimate (the state-feedback LMI has one n x n unknown, the route's own cost)
+    check_synthesis_budget(route="riccati", n=G.A.shape[0], given="hinfsyn_state")
     require_stabilizable_detectable(G.A, G.B2, np.eye(G.A.shape[0]), alpha=alpha,
                                     state_names=G.state_names)
     full_rank = numerical_rank(G.D12) == G.B2.shape[1]

@@ -81,6 +81,7 @@ from tmfem.control.lpv.cost import check_lpvsyn_cost, lpvsyn_cost
 from tmfem.control.lpv.gridded_plant import PlantFunction, grid_axes, plant_function
 from tmfem.control.lpv.generalized_plant import state_scaling
 from tmfem.errors import InfeasibleController, InputError
+from tmfem.resources import check_lpv_budget
 
 log = logging.getLogger(__name__)
 
@@ -346,10 +347,18 @@ def _resolve_basis(basis, n_par: int, axes, what: str) -> Basis:
                      f"than one grid value, eq. 5.99), found {basis!r}")
 
 
+def refinement(factor) -> int:
+    """The verification refinement ``factor`` as an int (an integer >= 1, also as a float)."""
+    ok = (isinstance(factor, (int, float, np.integer, np.floating)) and not isinstance(factor, bool)
+          and np.isfinite(factor) and int(factor) == factor and factor >= 1)
+    if not ok:
+        raise InputError(f"verification refinement: expected an integer >= 1, found {factor!r}")
+    return int(factor)
+
+
 def refined_axes(axes, factor: int) -> list:
     """Axes ``factor`` times finer, the design points kept."""
-    if int(factor) != factor or factor < 1:
-        raise InputError(f"verification refinement: expected an integer >= 1, found {factor!r}")
+    factor = refinement(factor)
     return [a if a.size == 1 else np.concatenate(
         [np.linspace(a[i], a[i + 1], int(factor) + 1)[:-1] for i in range(a.size - 1)] + [a[-1:]])
         for a in axes]
@@ -447,8 +456,13 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
         raise InputError(f"LPV synthesis: expected 0 < ncon < {m} inputs and 0 <= nmeas < {p} outputs (at "
                          f"least one w and one p), found ncon = {ncon}, nmeas = {nmeas}")
     rb = _rate_box(rate_bounds, n_par)
+    f = refinement(verify_refine)
+    # before any point is listed or evaluated: the grids' sizes are products of the axes'
+    check_lpv_budget(design_points=int(np.prod([a.size for a in axes])),
+                     verify_points=int(np.prod([(a.size - 1) * f + 1 for a in axes])),
+                     vertices=len(_vertices(rb)), n=n, m=m, p=p)
     design = _points(axes)
-    dense_axes = refined_axes(axes, verify_refine)
+    dense_axes = refined_axes(axes, f)
     dense = _points(dense_axes)
     lyap = _resolve_basis(basis, n_par, axes, "basis")
     gain = _resolve_basis(gain_basis if gain_basis is not None else basis, n_par, axes, "gain_basis")

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from tmfem.errors import ConvergenceError, InputError
+from tmfem.errors import ConvergenceError, InputError, shorten
 from tmfem.fem.beam import BeamElement
 from tmfem.fem.constraints import ConstraintMap
 from tmfem.fem.dofmap import DofMap
@@ -44,6 +44,7 @@ from tmfem.solvers import lowest_modes
 from tmfem.solvers.backends import get_backend
 from tmfem.solvers.continuation import follow, negative_pivots
 from tmfem.solvers.newton import factorize, newton, submatrix
+from tmfem.solvers.singular import SINGULAR_PIVOT_RATIO, SingularMatrix
 
 log = logging.getLogger(__name__)
 
@@ -162,8 +163,13 @@ class Structure:
     def __init__(self, *, points, dofs, backend="scipy"):
         self.backend = get_backend(backend)
         self.X = np.asarray(points, dtype=float)
-        if self.X.ndim != 2 or self.X.shape[0] != 3:
-            raise InputError(f"structure: expected points of shape (3, n), found {self.X.shape}")
+        if self.X.ndim != 2 or self.X.shape[0] != 3 or self.X.shape[1] == 0:
+            raise InputError(f"structure: expected points of shape (3, n) with n >= 1, found "
+                             f"{self.X.shape}")
+        if not np.all(np.isfinite(self.X)):
+            bad = np.flatnonzero(~np.all(np.isfinite(self.X), axis=0))
+            raise InputError(f"structure: expected finite node coordinates, found non-finite ones "
+                             f"at nodes {shorten(bad.tolist())}")
         counts = np.broadcast_to(np.asarray(dofs, dtype=np.int64), (self.X.shape[1],))
         self.dofmap = DofMap(counts.copy())
         self.elements: list = []
@@ -620,7 +626,14 @@ class Structure:
         up = cm.reduce(self._prescribed) if np.any(self._prescribed) else np.zeros(cm.n_reduced)
         rhs = rhs - K @ up
         u = up.copy()
-        u[idx] = factorize(K[idx][:, idx], self.backend, equilibrate=True)(rhs[idx])
+        solve = factorize(K[idx][:, idx], self.backend, equilibrate=True)
+        ratio = getattr(solve, "pivot_ratio", None)       # the dense path checks it itself
+        if ratio is not None and ratio <= SINGULAR_PIVOT_RATIO:
+            raise SingularMatrix(f"structure: linear statics: expected supports that hold every "
+                                 f"rigid-body motion and no mechanism, found a singular stiffness "
+                                 f"(smallest/largest pivot {ratio:.1e} of the equilibrated matrix; "
+                                 "fix, symmetry or pin more dofs)")
+        u[idx] = solve(rhs[idx])
         return StructureState(state=s0.advanced(cm.full(u), self.dofmap), lam=1.0, iterations=1,
                               reaction=self._reaction(K @ u - cm.residual(f0)), linear=True,
                               increment=cm.full(u))

@@ -40,6 +40,7 @@ from tmfem.models.com import linearize as linearization
 from tmfem.models.com.membrane_modes import build_membrane_basis
 from tmfem.models.com.mode_count import membrane_mode_choice, membrane_modes_of
 from tmfem.models.com.plant import COMPlant
+from tmfem.resources import check_com_budget
 from tmfem.solvers.newton import newton
 from tmfem.system.geometry import rotation_ef
 
@@ -102,6 +103,7 @@ class ControlOrientedModel:
             raise InputError(f"damping c_m: expected >= 0, found {damping!r}")
         if not (np.isfinite(prestress_scale) and prestress_scale > 0):
             raise InputError(f"prestress_scale: expected > 0, found {prestress_scale!r}")
+        check_com_budget(system, K=membrane_modes)      # the stages and K scale the set-up
         self.system = system
         self.mesh_n, self.membrane_law = mesh_n, membrane_law
         self.formulation = formulation
