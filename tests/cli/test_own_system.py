@@ -207,6 +207,14 @@ def test_report_of_a_1_3_takes_the_modes_its_com_has(tmp_path, capsys):
     # (the point-attached corners make every model's frequencies depend on the mesh)
     f = r["frequencies_hz"]
     assert f["COM designed"][0] == pytest.approx(f["MTC designed"][0], rel=0.02)
+    # a system without printed values: its tables have no printed and no rel. diff columns
+    # (the input r_1 named in the source of the eq. 3.33 row, not put in a printed column)
+    for name in ("equilibrium.csv", "statics.csv"):
+        head = (tmp_path / "r" / name).read_text().splitlines()[0]
+        assert "printed" not in head and "rel_diff" not in head, (name, head)
+    md = (tmp_path / "r" / "equilibrium.md").read_text()
+    assert "| quantity | unit | value | source |" in md and "carries no printed values" in md
+    assert "eq. 3.33 (input r_1 = " in md and "printed column" not in md
 
 
 def test_report_of_a_deployable_uses_sbc_com_and_its_own_deployment(tmp_path, capsys):

@@ -29,6 +29,7 @@ import numpy as np
 from tabulate import tabulate
 
 from tmfem.io.atomic import atomic_open, write_text
+from tmfem.reference.study import has_printed
 
 log = logging.getLogger(__name__)
 
@@ -438,6 +439,15 @@ def _static_brief(s: dict) -> dict:
 
 
 def _statics_rows(system, statics: dict) -> list:
+    """Rows [quantity, unit, printed, (ours, rel. diff) per case]; without printed values
+    (:func:`tmfem.reference.study.has_printed`) [quantity, unit, ours per case]."""
+    rows = _statics_rows_printed(system, statics)
+    if has_printed(system=system):
+        return rows
+    return [r[:2] + r[3::2] for r in rows]
+
+
+def _statics_rows_printed(system, statics: dict) -> list:
     p = system.printed
     rows = []
     spec = [("max tendon stress", "MPa", "tendon_stress_max_MPa", p.get("tendon_max_stress"), 1e-6),
@@ -461,7 +471,9 @@ def _statics_rows(system, statics: dict) -> list:
     return rows
 
 
-def _statics_header(statics: dict, fe: str = "MTC") -> list:
+def _statics_header(system, statics: dict, fe: str = "MTC") -> list:
+    if not has_printed(system=system):
+        return ["quantity", "unit"] + [f"{fe} {label}" for label in statics]
     h = ["quantity", "unit", "printed"]
     for label in statics:
         h += [f"{fe} {label}", f"rel_diff {label}"]
@@ -470,7 +482,7 @@ def _statics_header(statics: dict, fe: str = "MTC") -> list:
 
 def _statics_table(path: Path, system, statics: dict, fe: str) -> Path:
     rows = _statics_rows(system, statics)
-    return _csv(path, _statics_header(statics, fe),
+    return _csv(path, _statics_header(system, statics, fe),
                 [[r[0], r[1]] + [_num(v, 6) for v in r[2:]] for r in rows])
 
 
@@ -633,10 +645,11 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
           f"Files: {link('statics.csv')}, " + ", ".join(
               link(f"static_{k}.vtu") for k in statics) + ".", ""]
     rows = _statics_rows(system, statics)
-    L.append(tabulate([[r[0], r[1]] + [_num(v) if j % 2 == 1 or j == 0 else
+    with_printed = has_printed(system=system)
+    L.append(tabulate([[r[0], r[1]] + [_num(v) if not with_printed or j % 2 == 1 or j == 0 else
                                         ("" if v is None else f"{100 * v:+.1f} %")
                                         for j, v in enumerate(r[2:])] for r in rows],
-                      headers=_statics_header(statics, fe), tablefmt="github",
+                      headers=_statics_header(system, statics, fe), tablefmt="github",
                       disable_numparse=True))
     L += ["", "Membrane stresses are element values (means over the Gauss points in the "
           "stress maps, maxima over Gauss points in the table); the peaks sit at the "

@@ -38,8 +38,12 @@ def table_rows(d, system) -> list[dict]:
                 add(f"z_{i + 1}", "m", c.z[i], None, "input")
         add("r_mb", "m", system.r_mb, None, "input")
     if d.closed_form is not None and "r1_equilibrium" in d.closed_form:
-        add("r_1 of eq. 3.33 (printed column: input r_1)", "m", d.closed_form["r1_equilibrium"], c.r[0],
-            "eq. 3.33")
+        if has_printed(system=system):
+            add("r_1 of eq. 3.33 (printed column: input r_1)", "m", d.closed_form["r1_equilibrium"], c.r[0],
+                "eq. 3.33")
+        else:
+            add("r_1 of eq. 3.33", "m", d.closed_form["r1_equilibrium"], None,
+                f"eq. 3.33 (input r_1 = {c.r[0]:.6g} m)")
     if d.Delta is not None:
         add("Delta", "mm", d.Delta * 1e3, None, "eq. 3.22")
     add("F_Delta", "N", d.F_Delta, None, "plane-stress FE (3.2)")
@@ -68,6 +72,15 @@ def table_rows(d, system) -> list[dict]:
     return rows
 
 
+def has_printed(rows_of=None, *, system=None) -> bool:
+    """Whether a design table has a printed column: some row of ``rows_of`` carries a printed
+    value, or ``system`` carries printed values (a file's ``[printed]`` table beyond its
+    ``source``). A system without printed values gets no printed and no rel. diff columns."""
+    if system is not None:
+        return any(k != "source" for k in dict(system.printed))
+    return any(r["printed"] is not None for r in rows_of)
+
+
 def fmt(v, nd=6):
     """Number for the tables; ``n/a`` where there is none (a tendon that would push has no
     rest length, eqs. 3.8-3.9)."""
@@ -80,6 +93,10 @@ def markdown_table(rows) -> str:
     """The design table (rows of :func:`table_rows`) as a compact GitHub Markdown table
     (unpadded cells, so that a row reads ``| rest length S1 | m | ...`` in the source too;
     tabulate's Markdown formats pad every cell)."""
+    if not has_printed(rows):
+        md = ["| quantity | unit | value | source |", "|---|---|---|---|"]
+        md += [f"| {r['quantity']} | {r['unit']} | {fmt(r['ours'])} | {r['source']} |" for r in rows]
+        return "\n".join(md)
     md = ["| quantity | unit | ours | printed | rel. diff | source |", "|---|---|---|---|---|---|"]
     for r in rows:
         rd = "" if r["rel_diff"] is None else f"{100 * r['rel_diff']:+.2f} %"
@@ -90,6 +107,10 @@ def markdown_table(rows) -> str:
 
 def text_table(rows) -> str:
     """The design table as plain text (tabulate), for the terminal."""
+    if not has_printed(rows):
+        return tabulate([[r["quantity"], r["unit"], fmt(r["ours"])] for r in rows],
+                        headers=["quantity", "unit", "value"], tablefmt="simple", disable_numparse=True,
+                        colalign=("left", "right", "right"))
     body = [[r["quantity"], r["unit"], fmt(r["ours"]), fmt(r["printed"]),
              "" if r["rel_diff"] is None else f"{100 * r['rel_diff']:+.2f}%"] for r in rows]
     return tabulate(body, headers=["quantity", "unit", "ours", "printed", "rel. diff"],
@@ -102,9 +123,10 @@ def write_tables(out: Path, d, system, *, notes=()) -> dict:
     (units in the headers) and ``equilibrium.md`` (the table, ``notes`` explaining it, the
     checks) into ``out``; CSV line endings are ``\n``."""
     rows = table_rows(d, system)
+    columns = (["quantity", "unit", "ours", "printed", "rel_diff", "source"] if has_printed(rows)
+               else ["quantity", "unit", "ours", "source"])
     with atomic_open(out / "equilibrium.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["quantity", "unit", "ours", "printed", "rel_diff", "source"],
-                           lineterminator="\n")
+        w = csv.DictWriter(f, fieldnames=columns, lineterminator="\n", extrasaction="ignore")
         w.writeheader()
         for row in rows:
             w.writerow({k: (fmt(v, 8) if isinstance(v, float) else v) for k, v in row.items()})
@@ -130,8 +152,8 @@ def write_tables(out: Path, d, system, *, notes=()) -> dict:
           f"({d.membrane_model.mesh.t.shape[1]} quads), "
           + (f"distributed corners (patch radius {d.membrane_model.patch:.4g} m). "
              if d.membrane_model.attachment == "distributed" else "point corners. ")
-          + f"Printed values: "
-          f"{system.printed.get('source', 'none')}.", "", markdown_table(rows)]
+          + (f"Printed values: {system.printed.get('source', 'none')}." if has_printed(rows)
+             else "The system carries no printed values."), "", markdown_table(rows)]
     if notes:
         md += ["", "## Why ours and the printed values differ", ""] + [f"- {n}" for n in notes]
     md += ["", "## Checks", ""]
