@@ -34,7 +34,7 @@ def test_a_renamed_copy_of_the_preset_gives_the_preset_numbers(tmp_path, capsys)
     f.write_text(preset_text_renamed("my-two-stage", printed=False))
     ours = bound_only([str(f), "--grid", "2x1"], capsys)
     ref = bound_only(["--preset", "2-3-lpv", "--grid", "2x1"], capsys)
-    assert ours["preset"] == "my-two-stage" and ours["grid"] == ref["grid"] == [2, 1]
+    assert ours["system"] == "my-two-stage" and ours["grid"] == ref["grid"] == [2, 1]
     assert ours["rate_bound_deg"] == ref["rate_bound_deg"] == 10.0
     np.testing.assert_allclose(ours["pointwise_gamma"], ref["pointwise_gamma"], rtol=1e-10)
     np.testing.assert_allclose(ours["lpv_gamma_lower_bound_at"], ref["lpv_gamma_lower_bound_at"], rtol=1e-12)
@@ -97,7 +97,7 @@ def test_the_lpv_deployment_of_a_renamed_copy_is_the_presets(design21, tmp_path,
         assert main(["deploy", *spec, "--lpv-controller", str(path), "--t-end", "0.2", "--json"]) == 0
         runs.append(json.loads(capsys.readouterr().out))
     ours, ref = runs
-    assert ours["preset"] == "my-two-stage" and ours["controller"] == ref["controller"] == "lpv"
+    assert ours["system"] == "my-two-stage" and ours["controller"] == ref["controller"] == "lpv"
     for key in ("t_end_s", "max_membrane_deflection_m", "max_tendon_stress_Pa", "peak_bar_compression_N"):
         assert ours[key] == pytest.approx(ref[key], rel=1e-10), key
 
@@ -107,7 +107,7 @@ def test_a_user_two_stage_system_gets_its_own_lpv_bound(capsys):
     # its theta grid at the middle psi: the frozen plants at the file's points, no printed bound,
     # and the pointwise optimum tight (the norm a static gain at 1.01 x it achieves lies between)
     out = bound_only([str(DATA / "pentagon-2-5-lpv.toml"), "--grid", "2x1"], capsys)
-    assert out["preset"] == "pentatower-lpv" and out["grid"] == [2, 1] and "printed_gamma_bound" not in out
+    assert out["system"] == "pentatower-lpv" and out["grid"] == [2, 1] and "printed_gamma_bound" not in out
     g = np.asarray(out["pointwise_gamma"]).ravel()
     assert np.all(np.isfinite(g)) and np.all(g > 0)
     assert out["lpv_gamma_lower_bound"] == pytest.approx(g.max(), rel=1e-12)

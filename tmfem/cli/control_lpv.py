@@ -127,7 +127,7 @@ def run(args) -> dict:
 def format_text(r: dict) -> str:
     deg = [f"{np.degrees(a):.2f} deg" for a in r["lpv_gamma_lower_bound_at"]]
     printed = f" (printed ||G_pw|| < {r['printed_gamma_bound']})" if "printed_gamma_bound" in r else ""
-    lines = [f"LPV state feedback, {r['preset']}, grid {r['grid'][0]}x{r['grid'][1]}, "
+    lines = [f"LPV state feedback, {r['system']}, grid {r['grid'][0]}x{r['grid'][1]}, "
              f"rates +-{r['rate_bound_deg']:g} deg/s",
              f"pointwise state-feedback lower bound of gamma: {r['lpv_gamma_lower_bound']:.4g} at "
              f"(theta_13, psi_13) = ({', '.join(deg)}){printed}"]

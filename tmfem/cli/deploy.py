@@ -201,7 +201,7 @@ def run(args) -> dict:
     ctrl = {"controller": args.controller, "uncertainty": s.adaptive.uncertainty,
             "allocation": s.adaptive.allocation, "pfl_at": pfl_at, "pfl_tendon_model": tendons,
             "pfl_gains": list(astuple(s.adaptive.gains))}
-    out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
+    out = {"system": args.system.name, "plant": args.plant, **plants.summary(args.plant, mesh_n),
            **ctrl, "path": args.path or own_path(args.system),
            **r.summary(), **s.info}
     title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
@@ -306,7 +306,7 @@ def format_text(r: dict) -> str:
             "max_eta_energy_J", "B_q_condition_max", "wall_time_s"]
     keys += [k for k in r if k.startswith("plant_")] + ["failure"]
     keys += [k for k in ("gamma", "max_tracking_error") if k in r]
-    lines = [f"deployment {r['preset']} on the {r['plant']} plant ({r['controller']}, "
+    lines = [f"deployment {r['system']} on the {r['plant']} plant ({r['controller']}, "
              f"uncertainty {r['uncertainty']})"]
     if "membrane_mode_choice" in r:
         lines.append("  COM: " + MembraneModeChoice(**r["membrane_mode_choice"]).text)

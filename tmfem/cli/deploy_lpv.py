@@ -166,7 +166,7 @@ def run(args, *, mesh_n) -> dict:
             if args.controller == "lpv-output" else None,
             "estimator_refine": (args.estimator_refine or 1) if args.controller == "lpv-output" else None}
     plants = reference.FEPlantOptions.of(args)
-    out = {"preset": args.preset, "plant": args.plant, **plants.summary(args.plant, mesh_n),
+    out = {"system": args.system.name, "plant": args.plant, **plants.summary(args.plant, mesh_n),
            **ctrl, "path": args.system.problem.lpv.path, **r.summary(), **s.info,
            **_figures(r), **info}
     title = f"{args.preset} deployment on the {args.plant} plant: {args.controller} (gamma = {d.gamma:.4g}), eq. 5.100"

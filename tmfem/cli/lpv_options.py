@@ -154,7 +154,7 @@ def design_plant(cfg: dict, *, rate_deg: float | None = None, command: str = "co
     say(command, f"{cfg['preset']}: linearising at {th.size * ps.size} grid points")
     p = lpv.design_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bound=np.radians(rate_deg),
                               progress=progress)
-    out = {"preset": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,
+    out = {"system": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,
            **p.bound.to_dict()}
     printed = (s.printed or {}).get("lpv_gamma_bound")
     if printed is not None:

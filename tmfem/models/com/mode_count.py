@@ -119,11 +119,17 @@ def membrane_modes_of(system, K: int | None = None) -> MembraneModeChoice:
     return membrane_mode_choice(system) if K is None else MembraneModeChoice(K=int(K), source="given")
 
 
+def declared_membrane_modes(system) -> int | None:
+    """K of the system's ``[models.com] membrane_modes``, None when the file declares none."""
+    K = system.model_defaults.get("com", {}).get("membrane_modes")
+    return None if K is None else int(K)
+
+
 def membrane_mode_choice(system) -> MembraneModeChoice:
     """K of the system's ``[models.com] membrane_modes`` (the presets carry the
     dissertation's: 5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6D), else
     :func:`choose_membrane_modes` (computed once per system content)."""
-    K = system.model_defaults.get("com", {}).get("membrane_modes")
+    K = declared_membrane_modes(system)
     if K is not None:
         return MembraneModeChoice(K=int(K), source="file")
     key = _fingerprint(system)

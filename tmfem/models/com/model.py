@@ -38,7 +38,8 @@ from tmfem.models.com.graphs import BufferedFunction, build_graphs, output_graph
 from tmfem.models.base import Equilibrium
 from tmfem.models.com import linearize as linearization
 from tmfem.models.com.membrane_modes import build_membrane_basis
-from tmfem.models.com.mode_count import membrane_mode_choice, membrane_modes_of
+from tmfem.models.com.mode_count import (K_SEARCH, declared_membrane_modes, membrane_mode_choice,
+                                         membrane_modes_of)
 from tmfem.models.com.plant import COMPlant
 from tmfem.resources import check_com_budget
 from tmfem.solvers.newton import newton
@@ -103,7 +104,10 @@ class ControlOrientedModel:
             raise InputError(f"damping c_m: expected >= 0, found {damping!r}")
         if not (np.isfinite(prestress_scale) and prestress_scale > 0):
             raise InputError(f"prestress_scale: expected > 0, found {prestress_scale!r}")
-        check_com_budget(system, K=membrane_modes)      # the stages and K scale the set-up
+        # the stages and K scale the set-up (K: given, else the file's, else the automatic
+        # choice's search, which builds a model with K_SEARCH modes)
+        check_com_budget(system, K=next(k for k in (membrane_modes, declared_membrane_modes(system), K_SEARCH)
+                                        if k is not None))
         self.system = system
         self.mesh_n, self.membrane_law = mesh_n, membrane_law
         self.formulation = formulation
