@@ -17,7 +17,7 @@ NAME = "control"
 HELP = ("linear control: PBH tests, H-infinity LMI synthesis at a deployed configuration (7.3-7.4), "
         "gridded LPV state feedback (ch. 8)")
 
-_HINF_ONLY = ("alpha", "u_m", "save", "plot", "solver", "method")
+_HINF_ONLY = ("alpha", "u_m", "save", "plot", "solver", "method", "exclude_uncontrollable")
 
 
 def configure(parser) -> None:
@@ -47,6 +47,9 @@ def configure(parser) -> None:
                              "independent, the one `tmfem deploy` uses (docs/guides/control.md)")
     parser.add_argument("--pbh-tol", type=float, default=None,
                         help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
+    parser.add_argument("--exclude-uncontrollable", action="store_true", default=None,
+                        help="design for the plant without the modes no tendon reaches (listed; in closed "
+                             "loop they keep their undamped open-loop dynamics); default: refuse such a plant")
     parser.add_argument("--save", help="write plant and controller to this .npz")
     parser.add_argument("--plot", help="write the closed-loop analysis figure (PNG)")
     control_lpv.configure(parser)
@@ -114,7 +117,8 @@ def run(args) -> dict:
     res = deployed_hinf(system, alpha=args.alpha, u_m=args.u_m, membrane_modes=args.membrane_modes,
                         solver=args.solver, synthesize=args.action == "hinf",
                         pbh_tol=args.pbh_tol,
-                        method=args.method or ("lmi" if args.solver else DEFAULT_METHOD))
+                        method=args.method or ("lmi" if args.solver else DEFAULT_METHOD),
+                        uncontrollable="exclude" if args.exclude_uncontrollable else "refuse")
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
         from tmfem.control.linear.loop_plots import damping_table

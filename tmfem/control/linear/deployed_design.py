@@ -22,7 +22,7 @@ from tmfem.control.linear.hinf_synthesis import hinfsyn
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.control.linear.pbh import PBHResult, pbh_ss
 from tmfem.control.linear.generalized_plant import DeployedPlant, deployed_plant, generalized_plant
-from tmfem.errors import InputError
+from tmfem.errors import InfeasibleController, InputError
 from tmfem.system.problem import default_u_m
 
 log = logging.getLogger(__name__)
@@ -46,6 +46,7 @@ class DeployedDesign:
     design: HinfDesign | None
     u_m: float
     notes: tuple = ()
+    excluded_modes: tuple = ()
 
     def summary(self) -> dict:
         out = {"system": self.plant.model.system.name,
@@ -56,6 +57,9 @@ class DeployedDesign:
                "membrane_modes": self.plant.membrane_modes.K,
                "membrane_mode_choice": self.plant.membrane_modes.to_dict(),
                "u_m": self.u_m, "pbh": self.pbh.as_dict()}
+        if self.excluded_modes:
+            out["excluded_modes"] = [{"eigenvalue": [float(m.real), float(m.imag)],
+                                      "frequency_hz": float(abs(m) / (2 * np.pi))} for m in self.excluded_modes]
         notes = list(self.notes)
         if self.design is not None:
             d = self.design.summary()
@@ -79,7 +83,7 @@ class DeployedDesign:
 def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = None,
                   membrane_modes: int | None = None, solver: str | None = None,
                   synthesize: bool = True, pbh_tol: float | None = None,
-                  method: str = DEFAULT_METHOD) -> DeployedDesign:
+                  method: str = DEFAULT_METHOD, uncontrollable: str = "refuse") -> DeployedDesign:
     """Plant, PBH and H-infinity controller of a deployed system (7.3-7.4).
 
     Parameters
@@ -105,7 +109,16 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         (:func:`~tmfem.control.linear.hinf_slicot.hinf_slicot`) or the central
         (minimum-entropy) controller at 1.01 gamma_opt
         (:func:`~tmfem.control.linear.hinf_central.hinf_central`: the deployments' controller).
+    uncontrollable : {"refuse", "exclude"}
+        What to do with modes that no tendon reaches (PBH, eq. 5.71; on the undamped COM they
+        sit on the imaginary axis, so no controller makes the loop stable): ``"refuse"``
+        (default) names the first one; ``"exclude"`` designs for the plant without them
+        (:meth:`~tmfem.control.linear.partitioned_plant.GeneralizedPlant.reachable_part`: in
+        Fig. 7.1 no exogenous input drives the states either, so the loop from w to p is
+        unchanged) and lists them: in closed loop they keep their open-loop dynamics.
     """
+    if uncontrollable not in ("refuse", "exclude"):
+        raise InputError(f"uncontrollable: expected 'refuse' or 'exclude', found {uncontrollable!r}")
     if method not in METHODS:
         raise InputError(f"method: expected one of {METHODS}, found {method!r}")
     if solver is not None and method not in ("lmi", "auto"):
@@ -132,6 +145,18 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     kw = {} if pbh_tol is None else {"tol": pbh_tol}
     res = pbh_ss(plant.ss, **kw)
     gen = generalized_plant(plant, u_m=u_m, W_e=w.W_e, W_d=w.W_d)
+    hidden = tuple(res.eigenvalues[res.controllability_margin <= res.tol])
+    listed = ", ".join(f"{abs(m) / (2 * np.pi):.4g} Hz" for m in hidden if m.imag >= 0)
+    if synthesize and hidden and uncontrollable == "refuse" and np.max(np.real(hidden)) > -alpha:
+        raise InfeasibleController(
+            f"{system.name}: the modes at {listed} are not reached by any tendon (PBH margin <= "
+            f"{res.tol:g}, eq. 5.71), so no controller places them left of -alpha_1 = -{alpha:.4g}; "
+            "design without them (--exclude-uncontrollable, uncontrollable='exclude': they keep "
+            "their open-loop dynamics) or change the actuation")
+    if uncontrollable == "exclude" and hidden:
+        gen = _without(gen, hidden, tol=res.tol)
+        notes.append(f"modes no tendon reaches (PBH margin <= {res.tol:g}) left out of the design: {listed}; "
+                     "no input excites them, and in closed loop they keep their open-loop (undamped) dynamics")
     design = None
     if synthesize:
         if method == "auto":
@@ -148,7 +173,21 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         else:
             design = hinf_slicot(gen, alpha=alpha, operating_point=plant.operating_point)
     return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design, u_m=float(u_m),
-                          notes=tuple(notes))
+                          notes=tuple(notes), excluded_modes=hidden if uncontrollable == "exclude" else ())
+
+
+def _without(gen: GeneralizedPlant, hidden: tuple, *, tol: float) -> GeneralizedPlant:
+    """``gen`` without the ``hidden`` modes (uncontrollable from u by PBH): its reachable part,
+    which must have dropped exactly as many states (else an exogenous input drives one of
+    them, and it cannot be left out)."""
+    reduced = gen.reachable_part(tol=tol)
+    dropped = gen.A.shape[0] - reduced.A.shape[0]
+    if dropped != len(hidden):
+        raise InputError(f"uncontrollable modes: expected the {len(hidden)} modes no tendon reaches to be "
+                         f"out of reach of every input, found {dropped} states removed by the "
+                         "controllable staircase of (A, [B1 B2]): an exogenous input drives them, so "
+                         "they cannot be left out of the design")
+    return reduced
 
 
 def default_alpha(plant: DeployedPlant) -> float:

@@ -197,7 +197,6 @@ def check_regular(P, *, alpha: float = 0.0) -> None:
     InputError
         naming the failed condition (such plants go to the LMI route).
     """
-    import control
     nu, ny = P.B2.shape[1], P.C2.shape[0]
     r12, r21 = numerical_rank(P.D12), numerical_rank(P.D21)
     if r12 < nu or r21 < ny:
@@ -205,9 +204,9 @@ def check_regular(P, *, alpha: float = 0.0) -> None:
                          f"D21 full row rank {ny}), found ranks {r12} and {r21}: use the LMI "
                          "route (method='lmi')")
     Aa = P.A + alpha * np.eye(P.A.shape[0])
-    for name, sys in (("(A, B2, C1, D12)", control.ss(Aa, P.B2, P.C1, P.D12)),
-                      ("(A, B1, C2, D21)", control.ss(Aa, P.B1, P.C2, P.D21))):
-        z = np.atleast_1d(control.zeros(sys)) if P.A.shape[0] else np.zeros(0)
+    for name, (B, C, D) in (("(A, B2, C1, D12)", (P.B2, P.C1, P.D12)),
+                            ("(A, B1, C2, D21)", (P.B1, P.C2, P.D21))):
+        z = invariant_zeros(Aa, B, C, D)
         z = z[np.isfinite(z)]
         scale = max(1.0, float(np.linalg.norm(P.A, 1)))
         on = z[np.abs(z.real) <= 1e-9 * scale]
@@ -215,6 +214,25 @@ def check_regular(P, *, alpha: float = 0.0) -> None:
             raise InputError(f"Riccati route: expected no invariant zero of {name} on the "
                              f"imaginary axis, found one at {on[0]:.4g}: use the LMI route "
                              "(method='lmi')")
+
+
+def invariant_zeros(A, B, C, D) -> np.ndarray:
+    """Invariant zeros of (A, B, C, D): the finite s where the Rosenbrock pencil
+    [[A - s I, B], [C, D]] loses rank, by SLICOT AB08ND (the reduction python-control's
+    ``zeros`` uses) and the generalized eigenvalues of its reduced pencil. The workspace is
+    SLICOT's documented minimum, max(1, min(p, m) + max(3 m - 1, n), min(p, n) + max(3 p - 1,
+    n + p, n + m)); slycot's default, n + 3 max(m, p), is below it when n < min(p, m) - 1."""
+    import scipy.linalg as sla
+    from slycot import ab08nd
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    if n == 0:
+        return np.zeros(0, dtype=complex)
+    ldwork = max(1, min(p, m) + max(3 * m - 1, n), min(p, n) + max(3 * p - 1, n + p, n + m))
+    out = ab08nd(n, m, p, A, B, C, D, ldwork=ldwork)
+    nu = out[0]
+    if nu == 0:
+        return np.zeros(0, dtype=complex)
+    return sla.eigvals(out[8][:nu, :nu], out[9][:nu, :nu]).astype(complex)
 
 
 def numerical_rank(D: np.ndarray, rtol: float = 1e-9) -> int:

@@ -111,6 +111,29 @@ class GeneralizedPlant:
                               u_names=self.u_names, p_names=self.p_names, y_names=self.y_names)
         return sp, t
 
+    def reachable_part(self, *, tol: float = 1e-8) -> "GeneralizedPlant":
+        """The plant without the states that no input reaches: the controllable part of
+        (A, [B1 B2]) by SLICOT TB01PD (job "C", an orthogonal staircase transformation, no
+        balancing), with C1, C2 in the new coordinates. The transfer functions from [w; u] to
+        [p; y] are unchanged, so is any controller's closed loop from w to p; the removed
+        modes keep their own dynamics, which no input excites. ``tol``: TB01PD's rank
+        tolerance. The states are renamed ``x_1`` .. ``x_nr`` (mixtures of the original ones).
+        """
+        from slycot import tb01pd
+        n, nw, nu = self.A.shape[0], self.B1.shape[1], self.B2.shape[1]
+        npo, ny = self.C1.shape[0], self.C2.shape[0]
+        m, p = nw + nu, npo + ny
+        B = np.zeros((n, max(m, p)))
+        B[:, :m] = np.hstack([self.B1, self.B2])
+        C = np.zeros((max(1, m, p), n))
+        C[:p] = np.vstack([self.C1, self.C2])
+        Ar, Br, Cr, nr = tb01pd(n, m, p, self.A, B, C, job="C", equil="N", tol=tol)
+        Ar, Br, Cr = (np.ascontiguousarray(M) for M in (Ar[:nr, :nr], Br[:nr, :m], Cr[:p, :nr]))
+        return GeneralizedPlant(A=Ar, B1=Br[:, :nw], B2=Br[:, nw:], C1=Cr[:npo], C2=Cr[npo:],
+                                D11=self.D11, D12=self.D12, D21=self.D21, D22=self.D22,
+                                state_names=[f"x_{i + 1}" for i in range(nr)], w_names=self.w_names,
+                                u_names=self.u_names, p_names=self.p_names, y_names=self.y_names)
+
     def shifted(self, alpha: float) -> "GeneralizedPlant":
         """The plant with A + alpha I (the alpha-shift of 7.3: a controller whose closed loop
         with the shifted plant is stable has closed-loop poles left of -alpha with the
