@@ -130,7 +130,8 @@ def test_every_response_is_read_by_name():
 
 def test_variables_that_change_the_geometry_or_do_not_exist_are_refused():
     m = MTCModel(load_preset("1-4"), mesh_n=2)
-    for variables, text in ((["psi_11"], "ch. 3 design geometry"), (["theta_11"], "ch. 3 design geometry"),
+    for variables, text in ((["psi_11"], "a stage 1..1"), (["theta_11"], "a stage 1..1"),
+                            (["r_1"], "only the angles"),
                             (["d_Q"], "expected a tendon group"), (["S1", "S1"], "distinct"),
                             (["S1", "S_11"], "two variables"), ([], "at least one")):
         with pytest.raises(InputError, match=text):

@@ -49,6 +49,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
+from tmfem.design.configuration import rest_length_rates
 from tmfem.design.kinematics import MTCKinematics, kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
 from tmfem.design.variables import Variable, area_derivative, parse_variables, with_membrane_radius
@@ -170,6 +171,8 @@ def _rest_length_map(model, vs: list) -> np.ndarray:
     for j, v in enumerate(vs):
         if v.kind == "rest_length":
             G[list(v.tendons), j] = 1.0
+        elif v.kind == "angle":
+            G[:, j] = rest_length_rates(model, v.angle, v.stage)
     return G
 
 
@@ -243,7 +246,7 @@ def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndar
     nt, nb = len(model.system.tendons), Ncr.size
     tendons, bars = model.tendons, getattr(model, "bars", None)
     zt, zb = np.zeros(tendons.ne), np.zeros(nb)
-    if v.kind == "rest_length":
+    if v.kind in ("rest_length", "angle"):         # an angle moves the rest lengths (configuration)
         dR = T.T @ (truss_rest_length_derivatives(x, tendons, dofmap=model.dofmap) @ dL)
         lumped = model.lumped_tendon_mass
         dM = T.T @ (truss_mass(dataclasses.replace(tendons, L=tendons.L + dL), model.dofmap, lumped=lumped)
@@ -410,8 +413,10 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     dlam = np.zeros((k, n_var))
     dNb_state = np.zeros((Ncr.size, n_var))
     for j in range(n_var):
-        # the step moves the state by `scale` at most, whatever the variable's units
-        h = scale / max(1.0, float(np.abs(du[:, j]).max()), float(np.abs(G[:, j]).max()))
+        # the step moves the state by `scale` at most, whatever the variable's units; an angle's
+        # (per degree, rates of 1e-2 m) by `scale` exactly: a smaller move loses digits to rounding
+        floor = 0.0 if vs[j].kind == "angle" else 1.0
+        h = scale / max(floor, float(np.abs(du[:, j]).max()), float(np.abs(G[:, j]).max()))
         Kpm, Mpm, Npm = [], [], []
         try:
             for sgn in (1.0, -1.0):

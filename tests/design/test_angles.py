@@ -1,0 +1,117 @@
+"""The configuration angles theta_i, psi_i of symmetric M-N systems as design variables:
+every response's derivative against central finite differences of the re-designed (ch. 3
+design at the moved angles) and re-solved MTC equilibrium, Richardson-extrapolated
+(4 D(h) - D(2h)) / 3 with a step h that moves the rest lengths by at most 5e-4 m (as on the
+rest-length variables; 0.002 to 0.04 deg), on the 2-3 preset and the
+user system tests/data/systems/square-2-4.toml (mesh_n=4, equilibrium to a residual of 1e-12
+of the member forces)."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tmfem.design import design_sensitivities
+from tmfem.design.configuration import redesign_of, rest_length_rates, with_angles
+from tmfem.design.optimize import optimize
+from tmfem.design.variables import apply_design, parse_variables, variable_values
+from tmfem.errors import InfeasibleDesign, InputError
+from tmfem.models.mtc.model import MTCModel
+from tmfem.system import dump_system, load_preset, load_system
+from tests.design.test_responses import OPTIONS, SCALARS, VECTORS, rel_err, stacked
+
+SQUARE = Path(__file__).parents[1] / "data" / "systems" / "square-2-4.toml"
+NAMES = [n for n in SCALARS if n != "surface_rms"] + VECTORS        # flat membranes by symmetry
+
+
+def fd_check(system, variables):
+    m = MTCModel(system, mesh_n=4)
+    r0 = m.rest_lengths.copy()
+    eq = m.equilibrium(tol=1e-12)
+    vs = parse_variables(system, variables)
+    p0 = variable_values(system, r0, vs)
+    f0, exact = stacked(design_sensitivities(m, equilibrium=eq, variables=variables, **OPTIONS), NAMES)
+    redesign = redesign_of(m)
+    fd = np.zeros_like(exact)
+    for j, v in enumerate(vs):
+        # a step that moves a rest length by 5e-4 m, as on the rest-length variables
+        h = 5e-4 / np.abs(rest_length_rates(m, v.angle, v.stage)).max() if v.kind == "angle" else 5e-4
+        central = []
+        for step in (h, 2 * h):
+            vals = []
+            for sgn in (1, -1):
+                p = p0.copy()
+                p[j] += sgn * step
+                sj, rj = apply_design(system, r0, vs, p, redesign=redesign)
+                mj = MTCModel(sj, mesh_n=4, rest_lengths=rj)
+                ej = mj.equilibrium(x0=eq.state, tol=1e-12)
+                vals.append(stacked(design_sensitivities(mj, equilibrium=ej, variables=variables,
+                                                         **OPTIONS), NAMES)[0])
+            central.append((vals[0] - vals[1]) / (2 * step))
+        fd[:, j] = (4 * central[0] - central[1]) / 3
+    return exact, fd, f0, p0
+
+
+@pytest.mark.parametrize("system, variables", [
+    (load_preset("2-3"), ["theta_1", "psi_1", "theta_2", "psi_2", "S1"]),
+    (load_system(SQUARE), ["theta_2", "psi_1", "V2"]),
+], ids=["2-3", "square-2-4"])
+def test_responses_of_the_angles_match_finite_differences_of_the_redesigned_system(system, variables):
+    exact, fd, f0, p0 = fd_check(system, variables)
+    assert np.abs(exact[:, :-1]).max() > 0                # the angles do move the responses
+    err = rel_err(exact, fd, f0, p0)
+    assert np.all(err < 1e-5), err.max(axis=0)
+
+
+def test_the_fe_residual_depends_on_the_angles_only_through_the_rest_lengths():
+    # the premise of the angle sensitivities: at the same reduced state and rest lengths the
+    # MTC residual of the moved configuration is the same (bars' l, membrane mesh and the
+    # pinned bases A_1j do not move with the angles)
+    system = load_preset("2-3")
+    m = MTCModel(system, mesh_n=3)
+    eq = m.equilibrium()
+    moved = MTCModel(with_angles(system, {("theta", 0): 50.0, ("psi", 1): -20.0}), mesh_n=3,
+                     rest_lengths=m.rest_lengths.copy())
+    xr = m.reduce(eq.state)
+    R0, R1 = m.residual(xr, tangent=False)[0], moved.residual(xr, tangent=False)[0]
+    assert np.array_equal(R0, R1)
+    assert np.array_equal(m.full(xr), moved.full(xr))
+
+
+def test_an_angle_optimum_is_written_back_with_its_angles_and_rest_lengths(tmp_path):
+    system = load_preset("2-3")
+    res = optimize(system, objective="max:freq_1", mesh_n=4, k=2, max_iter=2,
+                   variables={"theta_1": (54.0, 56.0)})
+    opt = res.system
+    assert res.optimum[0] < 55.0               # d freq_1 / d theta_1 < 0 at the start (checked above)
+    assert np.degrees(opt.symmetric.theta[0]) == pytest.approx(res.optimum[0], rel=1e-12)
+    dump_system(opt, tmp_path / "optimal.toml")
+    back = load_system(tmp_path / "optimal.toml")
+    assert np.degrees(back.symmetric.theta[0]) == pytest.approx(res.optimum[0], rel=1e-12)
+    assert np.allclose(back.q, opt.q, rtol=0, atol=1e-12)
+    assert np.allclose(back.rest_lengths, opt.rest_lengths, rtol=1e-12)
+
+
+@pytest.mark.parametrize("system, variables, text", [
+    (load_preset("1-4"), ["theta_1"], "eq. 3.33"),
+    (load_preset("2-3"), ["psi_3"], "stage 1..2"),
+    (load_preset("2-3"), ["theta_1", "d_bar"], "rest lengths only"),
+    (load_preset("2-3"), ["sigma_2"], "only the angles"),
+])
+def test_angle_variables_that_have_no_design_are_refused(system, variables, text):
+    with pytest.raises(InputError, match=text):
+        parse_variables(system, variables)
+
+
+def test_an_angle_without_a_design_names_the_angle():
+    # the 2-3 preset's membrane is stretched by Delta = 1 mm; theta_2 2 deg lower slackens it
+    system = load_preset("2-3")
+    m = MTCModel(system, mesh_n=2)
+    vs = parse_variables(system, ["theta_2"])
+    with pytest.raises(InfeasibleDesign, match="theta_2 = 53 deg"):
+        apply_design(system, m.rest_lengths, vs, [53.0], redesign=redesign_of(m))
+
+
+def test_angles_on_the_sbc_model_are_refused():
+    with pytest.raises(InputError, match="MTC model"):
+        optimize(load_preset("2-3"), objective="max:freq_1", model="sbc", mesh_n=2,
+                 variables={"theta_1": (50.0, 60.0)})
