@@ -64,7 +64,7 @@ def test_options_that_do_not_apply_are_refused(tmp_path, capsys):
     for argv, text in ((["--model", "sbc", "--objective", "max:freq", "--variable", "d_bar=0.01:0.04"],
                         "expected rest-length variables"),
                        ([], "expected --objective"),
-                       (["--objective", "max:freq", "--variable", "theta_11=50:70"], "ch. 3 design geometry"),
+                       (["--objective", "max:freq", "--variable", "theta_11=50:70"], "a stage 1..1"),
                        (["--objective", "max:freq", "--variable", "S1=1.4"], "NAME=LOWER:UPPER")):
         rc = main(["optimize", str(path), "--mesh", "2"] + argv)
         assert rc == 2 and text in capsys.readouterr().err

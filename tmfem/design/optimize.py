@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize, nnls
 
-from tmfem.design.configuration import redesign_of
+from tmfem.design.configuration import on_supports, redesign_of
 from tmfem.design.sensitivities import RESPONSES, design_sensitivities
 from tmfem.design.variables import apply_design, parse_variables, variable_values
 from tmfem.errors import ConvergenceError, InputError
@@ -158,7 +158,8 @@ class _Evaluator:
         sysp, r = apply_design(self.system, self.r0, self.vars, p, redesign=self.redesign)
         m = self.Model(sysp, mesh_n=self.mesh_n, rest_lengths=r, **self.model_options)
         try:
-            eq = m.equilibrium(**({} if self.x is None else {self.start: self.x}))
+            start = self.x if self.redesign is None or self.x is None else on_supports(m, self.x)
+            eq = m.equilibrium(**({} if start is None else {self.start: start}))
         except ConvergenceError:
             if self.x is None:
                 raise

@@ -8,7 +8,9 @@ internal force, tangent and mass of the membrane are linear in h, those of the b
 tendon family linear in their area A at fixed positions: dR/dA = f / A, dK/dA = K / A,
 dM/dA = M / A, and dA/dd = pi d / 2; the membrane radius scales the membrane's reference mesh,
 whose partial derivatives are central differences of the assembled quantities at fixed
-positions (:func:`with_radius`). Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
+positions (:func:`with_radius`); the configuration angles of a symmetric system are
+rest-length directions G = dr/dp of the re-made ch. 3 design with the bases' motion prescribed
+(:mod:`tmfem.design.configuration`). Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
 eigenvalues lambda = omega^2 of (K_T - lambda M) phi = 0 (eq. 5.32), the total mass, the tendon
 forces and stresses (the slack margin is the smallest force), the bars' compression against
 the Euler load (eq. 5.31), the membrane stresses (eqs. 5.29-5.30, KS aggregates), the corner
@@ -49,7 +51,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from tmfem.design.configuration import rest_length_rates
+from tmfem.design.configuration import design_rates, support_rates
 from tmfem.design.kinematics import MTCKinematics, kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
 from tmfem.design.variables import Variable, area_derivative, parse_variables, with_membrane_radius
@@ -166,13 +168,15 @@ def variable_map(model, variables):
     return [v.name for v in vs], _rest_length_map(model, vs)
 
 
-def _rest_length_map(model, vs: list) -> np.ndarray:
+def _rest_length_map(model, vs: list, rates: dict | None = None) -> np.ndarray:
+    """G (module docstring); ``rates``: {j: :func:`design_rates`} of the angle variables
+    (computed here when not given)."""
     G = np.zeros((len(model.system.tendons), len(vs)))
     for j, v in enumerate(vs):
         if v.kind == "rest_length":
             G[list(v.tendons), j] = 1.0
         elif v.kind == "angle":
-            G[:, j] = rest_length_rates(model, v.angle, v.stage)
+            G[:, j] = (rates[j] if rates else design_rates(model, v.angle, v.stage))[0]
     return G
 
 
@@ -378,7 +382,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     eq = model.equilibrium() if equilibrium is None else equilibrium
     kin = kinematics(model, eq)
     names = [v.name for v in vs]
-    G = _rest_length_map(model, vs)
+    rates = {j: design_rates(model, v.angle, v.stage) for j, v in enumerate(vs) if v.kind == "angle"}
+    G = _rest_length_map(model, vs, rates)
     n_var = len(vs)
     topo, free = model.topology, model.free
     x = kin.x
@@ -394,8 +399,11 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     # the assembled tangent (a distributed backend's equilibrium holds its own matrix type)
     K = eq.tangent if eq.tangent is not None and not distributed else kin.tangent(kin.point(np.zeros(n_red)))
     solve = model.backend.factorize(sp.csr_matrix(K)[free][:, free])
+    # an angle of a 1-N system moves the pinned bases: their motion is prescribed
     du = np.zeros((n_red, n_var))
-    du[free] = solve(-dR[free]).reshape(-1, n_var)
+    for j, (_, base_rate) in rates.items():
+        du[:, j] = support_rates(model, base_rate)
+    du[free] = solve(-(dR + sp.csr_matrix(K) @ du)[free]).reshape(-1, n_var)
     dx = np.stack([kin.positions(du[:, j]) for j in range(n_var)], axis=-1)   # (3, nn, n_var)
 
     # eigenvalues: two extra modes so that a cluster at the k-th is complete

@@ -11,7 +11,8 @@ Names (:func:`parse_variables`):
 * ``"r_mb"``: the circumradius of a regular membrane [m] (its corners and reference mesh
   scale; the bars and the rest lengths stay);
 * ``"theta_<i>"``, ``"psi_<i>"``: the declination and azimuth of stage i of a symmetric M-N
-  system [deg]; the rest lengths follow the ch. 3 design (:mod:`tmfem.design.configuration`).
+  or 1-N system [deg]; the rest lengths follow the ch. 3 design, a 1-N system's base radius
+  eq. 3.33 (:mod:`tmfem.design.configuration`).
 
 The other coordinates of the design configuration (sigma, z, r, l) are refused (:data:`GEOMETRY`).
 """
