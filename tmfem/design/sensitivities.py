@@ -1,5 +1,5 @@
-"""Exact design sensitivities of the MTC model (and, for the rest lengths, of the SBC model) at
-its static equilibrium.
+"""Exact design sensitivities of the MTC model (and, for the rest lengths, the thickness and the
+diameters, of the SBC model) at its static equilibrium.
 
 Variables p (:mod:`tmfem.design.variables`): tendon rest lengths, per group (``"S1"``,
 ``"V2"``: every tendon of the group moves together, r = r_0 + G p) or per tendon, the membrane
@@ -54,7 +54,8 @@ import scipy.sparse as sp
 from tmfem.design.configuration import design_rates, support_rates
 from tmfem.design.kinematics import MTCKinematics, kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
-from tmfem.design.variables import Variable, area_derivative, parse_variables, with_membrane_radius
+from tmfem.design.variables import (Variable, apply_design, area_derivative, parse_variables, variable_values,
+                                    with_membrane_radius)
 from tmfem.errors import InputError
 from tmfem.fem.element import State
 from tmfem.fem.truss import (TrussSet, truss_axial_force_derivatives, truss_internal, truss_mass,
@@ -298,16 +299,54 @@ def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndar
                      float(sub.rhoA @ sub.L) * s)
 
 
+def rebuilt(model, system):
+    """The model of ``model``'s kind, options (mesh density, elements, attachment, law) and
+    rest lengths for ``system``."""
+    topo = model.topology
+    common = dict(mesh_n=topo.mesh.n, tendon_elements=topo.tendon_elements, attachment=topo.attachment,
+                  patch=model.patch, rest_lengths=model.rest_lengths.copy(), membrane_law=model.membrane_law)
+    if model.name == "sbc":
+        from tmfem.models.sbc.model import SBCModel
+        per_bar = model.numbering.bar_elements // (2 if system.deployable else 1)   # two segments with H_1j
+        return SBCModel(system, bar_elements=per_bar, **common)
+    from tmfem.models.mtc.model import MTCModel
+    return MTCModel(system, lumped_tendon_mass=model.lumped_tendon_mass, rigid_bar_points=system.deployable,
+                    tendon_law=model.tendon_law, **common)
+
+
 def with_radius(model, r_mb: float):
     """The MTC model of ``model``'s system with the membrane radius r_mb (same mesh density,
     options and rest lengths): its membrane mesh is the same mesh scaled."""
-    from tmfem.models.mtc.model import MTCModel
-    topo = model.topology
-    return MTCModel(model.system.replace(**with_membrane_radius(model.system, r_mb)), mesh_n=topo.mesh.n,
-                    tendon_elements=topo.tendon_elements, attachment=topo.attachment, patch=model.patch,
-                    rest_lengths=model.rest_lengths.copy(), lumped_tendon_mass=model.lumped_tendon_mass,
-                    membrane_law=model.membrane_law, rigid_bar_points=model.system.deployable,
-                    tendon_law=model.tendon_law)
+    return rebuilt(model, model.system.replace(**with_membrane_radius(model.system, r_mb)))
+
+
+def _section_partials(model, v: Variable, state, Ncr: np.ndarray) -> _Partials:
+    """The :class:`_Partials` of a thickness or diameter variable v of the SBC model at
+    ``state``: the five-point central difference (8 (F(d) - F(-d)) - (F(2d) - F(-2d))) / 12d of
+    the residual, tangent, mass, member forces and total mass of the model rebuilt with
+    p0 + k d, d = 1 % of p0. Exact (to rounding) for a polynomial of degree <= 4 in p: the
+    beams' A, I, J go as d^2, d^4, d^4, the tendons' A as d^2; the degenerated shell's
+    thickness also enters its metric (not a polynomial): truncation O(d^4), about 1e-8."""
+    p0 = variable_values(model.system, model.rest_lengths, [v])[0]
+    d = 1e-2 * p0
+    ms = {k: rebuilt(model, apply_design(model.system, model.rest_lengths, [v], [p0 + k * d])[0])
+          for k in (2, 1, -1, -2)}
+
+    def rate(y: dict):
+        return (8 * (y[1] - y[-1]) - (y[2] - y[-2])) / (12 * d)
+
+    RK = {k: m.residual(state) for k, m in ms.items()}
+    forces = {k: m.member_forces(state) for k, m in ms.items()}
+    dK = rate({k: K for k, (_, K) in RK.items()})
+    dA = np.zeros(len(model.system.tendons))
+    if v.kind == "tendon_diameter":
+        dA[list(v.tendons)] = area_derivative(p0)
+    dNcr = 4.0 * Ncr / p0 if v.kind == "bar_diameter" else np.zeros(Ncr.size)
+    return _Partials(rate({k: R for k, (R, _) in RK.items()}), 0.5 * (dK + dK.T),
+                     rate({k: m.mass(state) for k, m in ms.items()}),
+                     rate({k: f["tendon_element"] for k, f in forces.items()}),
+                     rate({k: f["bar"] for k, f in forces.items()}), dA, dNcr,
+                     float(rate({k: total_mass(m) for k, m in ms.items()})))
 
 
 def total_mass(model) -> float:
@@ -329,7 +368,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     Parameters
     ----------
     model : MTCModel or SBCModel
-        The SBC model with rest-length variables only. On the PETSc backend (one rank) the
+        The SBC model with rest-length, thickness and diameter variables (their partials:
+        :func:`_section_partials`). On the PETSc backend (one rank) the
         matrices are assembled serially and factorised and eigen-solved by PETSc.
     equilibrium : Equilibrium, optional
         A converged ``model.equilibrium()`` at the model's current rest lengths (default:
@@ -375,10 +415,10 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     if thickness and "h_membrane" not in [v.name for v in vs]:
         vs.append(Variable("h_membrane", "thickness"))
     sbc = model.name == "sbc"
-    if sbc and any(v.kind != "rest_length" for v in vs):
-        raise InputError(f"sensitivities of the SBC model: expected rest-length variables, found "
-                         f"{[v.name for v in vs if v.kind != 'rest_length']} (its shells and beams bend: "
-                         f"not linear in the thickness and the diameters; use the MTC model)")
+    if sbc and any(v.kind in ("membrane_radius", "angle") for v in vs):
+        raise InputError(f"sensitivities of the SBC model: expected rest-length, thickness or diameter "
+                         f"variables, found {[v.name for v in vs if v.kind in ('membrane_radius', 'angle')]} "
+                         f"(they move the shells' and beams' reference geometry; use the MTC model)")
     eq = model.equilibrium() if equilibrium is None else equilibrium
     kin = kinematics(model, eq)
     names = [v.name for v in vs]
@@ -393,7 +433,9 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
                         shape=(tendons.ne, G.shape[0]))
     dL = e2t @ G                                                       # dL_e / dp  (ne, n_var)
     Ncr = np.array([model.system.bar.euler_critical_load(l) for l in model.system.l.ravel()])
-    parts = [_partials(model, v, G[:, j], x, dL[:, j], Ncr, kin.T) for j, v in enumerate(vs)]
+    state0 = kin.point(np.zeros(model.free.size)) if sbc else None
+    parts = [_section_partials(model, v, state0, Ncr) if sbc and v.kind != "rest_length"
+             else _partials(model, v, G[:, j], x, dL[:, j], Ncr, kin.T) for j, v in enumerate(vs)]
     dR = np.column_stack([p.dR for p in parts])
     n_red = dR.shape[0]
     # the assembled tangent (a distributed backend's equilibrium holds its own matrix type)
@@ -443,6 +485,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
         if parts[j].dK is not None:
             dK = dK + parts[j].dK
         dM = (Mpm[0] - Mpm[1]) / (2 * h) if sbc else parts[j].dM
+        if sbc and parts[j].dK is not None:          # a section's own part (rest lengths: in Mpm)
+            dM = dM + parts[j].dM
         if sbc:
             dNb_state[:, j] = (Npm[0] - Npm[1]) / (2 * h)
         for c in clusters:
@@ -467,7 +511,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     dA = np.column_stack([p.dA_t for p in parts])
     dstress = dN / area[:, None] - (N / area**2)[:, None] * dA[topo.tendon_of_element]
     if sbc:                              # the beams' axial forces, along (du/dp, dp)
-        Nb, dNb = kin.bar_forces(kin.point(np.zeros(n_red))), dNb_state
+        Nb, dNb = kin.bar_forces(kin.point(np.zeros(n_red))), dNb_state + np.column_stack([p.dN_b for p in parts])
     else:
         Nb, dNb = member_forces(model.bars, np.column_stack([p.dN_b for p in parts]))
     dNcr = np.column_stack([p.dNcr for p in parts])
