@@ -6,6 +6,7 @@ rest-length variables) and the bases by at most 1e-4 m (0.001 to 0.02 deg), on t
 1-4 presets and the user systems tests/data/systems/square-2-4.toml and triangle-1-3.toml
 (1-N systems: their bases move with r_1 of eq. 3.33), mesh_n=4, equilibrium to a residual of
 1e-12 of the member forces."""
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -16,6 +17,7 @@ from tmfem.design.configuration import design_rates, on_supports, redesign_of, w
 from tmfem.design.optimize import optimize
 from tmfem.design.variables import apply_design, parse_variables, variable_values
 from tmfem.equilibrium.design import design_equilibrium
+from tmfem.equilibrium.symmetric import delta_1N, force_density_ratio_1N, r1_1N, s1_length
 from tmfem.errors import InfeasibleDesign, InputError
 from tmfem.models.mtc.model import MTCModel
 from tmfem.system import dump_system, load_preset, load_system
@@ -65,6 +67,34 @@ def test_responses_of_the_angles_match_finite_differences_of_the_redesigned_syst
     assert np.abs(exact[:, :-1]).max() > 0                # the angles do move the responses
     err = rel_err(exact, fd, f0, p0)
     assert np.all(err < 1e-5), err.max(axis=0)
+
+
+def test_the_design_rates_of_a_1_n_system_match_its_closed_form():
+    # eqs. 3.30, 3.33, 3.34, 3.36: with r_1 of eq. 3.33 every tendon S carries T = |S_1| ratio(psi)
+    # F_Delta / (Delta + r_mb) with F_Delta = k Delta (the linear membrane; k from the design at
+    # the start), and r = EA |S_1| / (T + EA); its derivatives by complex step (exact to rounding)
+    base = load_system(TRIANGLE)
+    c, N, r_mb = base.symmetric, base.N, base.r_mb
+    cfg = dataclasses.replace(c, r=[r1_1N(l1=c.l[0], theta1=c.theta[0], psi1=c.psi[0], N=N)])
+    system = base.replace(symmetric=cfg, **cfg.system_arrays(N))
+    m = MTCModel(system, mesh_n=4)
+    start = design_equilibrium(system, mesh_n=4)
+    k, EA, l1 = start.F_Delta / start.Delta, system.tendon_EA[0], c.l[0]
+
+    def closed(theta, psi):
+        r1 = r1_1N(l1=l1, theta1=theta, psi1=psi, N=N)
+        L = s1_length(l1=l1, theta1=theta, psi1=psi, r1=r1, N=N)
+        delta = delta_1N(l1=l1, theta1=theta, psi1=psi, r_mb=r_mb, N=N)
+        T = L * force_density_ratio_1N(psi1=psi, N=N) * k * delta / (delta + r_mb)
+        return EA * L / (T + EA), r1
+
+    assert np.allclose(start.rest_lengths, closed(c.theta[0], c.psi[0])[0], rtol=1e-10, atol=0)
+    for angle, unit in (("theta", (1, 0)), ("psi", (0, 1))):
+        h = 1e-30
+        r, r1 = closed(c.theta[0] + 1j * h * unit[0], c.psi[0] + 1j * h * unit[1])
+        dr, da = design_rates(m, angle, 0)
+        assert np.allclose(dr, np.radians(r.imag / h), rtol=1e-9, atol=0)
+        assert np.allclose(da, system.base / cfg.r[0] * np.radians(r1.imag / h), rtol=1e-7, atol=1e-12)
 
 
 def test_a_1_n_base_follows_eq_3_33_and_keeps_an_equilibrium_design():

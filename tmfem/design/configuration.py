@@ -30,7 +30,8 @@ degrees of freedom: K_ff du_f = -dR_f/dp - K_fs dA/dp (:func:`design_rates`,
 dr_D/dp and dA/dp are the fourth-order central differences (8 (r(h) - r(-h)) - (r(2h) -
 r(-2h))) / 12h of the re-designed rest lengths and bases (no FE solve: one linear
 plane-stress solve per design), step h = 0.001 deg: truncation O(h^4) below 1e-12 relative,
-rounding of the design (its equilibrium residual about 1e-15) / h about 1e-10. Not analytic.
+rounding of the design (its equilibrium residual about 1e-15) / h about 1e-10. Not analytic;
+on a 1-N system they agree with the closed form's derivative (eqs. 3.30-3.36) within 1e-10.
 """
 from __future__ import annotations
 
