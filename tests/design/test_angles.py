@@ -152,7 +152,7 @@ def test_angle_variables_that_have_no_design_are_refused(system, variables, text
 
 
 def test_an_angle_without_a_design_names_the_angle():
-    # the 2-3 preset's membrane is stretched by Delta = 1 mm; theta_2 2 deg lower slackens it
+    # the 2-3 preset's membrane is stretched by Delta = 1 mm; theta_2 0.1 deg lower slackens it
     system = load_preset("2-3")
     m = MTCModel(system, mesh_n=2)
     vs = parse_variables(system, ["theta_2"])
