@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize, nnls
 
+from tmfem.design.configuration import on_supports, redesign_of
 from tmfem.design.sensitivities import RESPONSES, design_sensitivities
 from tmfem.design.variables import apply_design, parse_variables, variable_values
 from tmfem.errors import ConvergenceError, InputError
@@ -139,6 +140,12 @@ class _Evaluator:
         m = self.Model(system, mesh_n=mesh_n, **model_options)
         self.r0 = m.rest_lengths.copy()
         self.vars = parse_variables(system, names)
+        self.redesign = None
+        if any(v.kind == "angle" for v in self.vars):
+            if model != "mtc":
+                raise InputError(f"optimize: angle variables need the MTC model (its rest lengths follow "
+                                 f"the ch. 3 design), found model {model!r}")
+            self.redesign = redesign_of(m)
         self.p0 = variable_values(system, self.r0, self.vars)
         self.x = None
         self.last = None
@@ -148,10 +155,11 @@ class _Evaluator:
         p = np.asarray(p, dtype=float)
         if self.last is not None and np.array_equal(self.last[0], p):
             return self.last[1]
-        sysp, r = apply_design(self.system, self.r0, self.vars, p)
+        sysp, r = apply_design(self.system, self.r0, self.vars, p, redesign=self.redesign)
         m = self.Model(sysp, mesh_n=self.mesh_n, rest_lengths=r, **self.model_options)
         try:
-            eq = m.equilibrium(**({} if self.x is None else {self.start: self.x}))
+            start = self.x if self.redesign is None or self.x is None else on_supports(m, self.x)
+            eq = m.equilibrium(**({} if start is None else {self.start: start}))
         except ConvergenceError:
             if self.x is None:
                 raise
@@ -187,7 +195,7 @@ def optimize(system, *, objective: str, constraints=(), variables=None, model: s
     variables : dict {name: (lower, upper)}, optional
         Design variables and bounds; default the system file's ``[design] variables``.
     model : {"mtc", "sbc"}
-        The finite-element model (the SBC model: rest-length variables only).
+        The finite-element model (the SBC model: no membrane radius, no angles).
     mesh_n : int
         Membrane elements per side of the MTC model.
     k : int
@@ -260,7 +268,7 @@ def optimize(system, *, objective: str, constraints=(), variables=None, model: s
         """Scaled g(z) <= 0 rows and their Jacobian, equality rows flagged; rows identical at
         the start (members equal by symmetry) are one row, the largest of them."""
         g, J, eqf = all_rows(z)
-        pick = np.array([grp[int(np.argmax(g[grp]))] for grp in groups])
+        pick = np.array([grp[int(np.argmax(g[grp]))] for grp in groups], dtype=int)
         return g[pick], J[pick], eqf[pick]
 
     def all_rows(z):

@@ -87,7 +87,8 @@ def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: f
         top = float(np.abs(kin.positions(du[:, j])).max())
         if top == 0.0 and j not in moved:
             continue
-        h = 1e-4 * size / max(top, 1.0)
+        # a node moves by 1e-4 of the size (a moved design by at most that: its own step)
+        h = 1e-4 * size / (max(top, 1.0) if j in moved else top)
         diffs = []
         for step in (h, 2 * h):
             if j in moved:

@@ -1,5 +1,5 @@
-"""Exact design sensitivities of the MTC model (and, for the rest lengths, of the SBC model) at
-its static equilibrium.
+"""Exact design sensitivities of the MTC model (and, for the rest lengths, the thickness and the
+diameters, of the SBC model) at its static equilibrium.
 
 Variables p (:mod:`tmfem.design.variables`): tendon rest lengths, per group (``"S1"``,
 ``"V2"``: every tendon of the group moves together, r = r_0 + G p) or per tendon, the membrane
@@ -8,7 +8,9 @@ internal force, tangent and mass of the membrane are linear in h, those of the b
 tendon family linear in their area A at fixed positions: dR/dA = f / A, dK/dA = K / A,
 dM/dA = M / A, and dA/dd = pi d / 2; the membrane radius scales the membrane's reference mesh,
 whose partial derivatives are central differences of the assembled quantities at fixed
-positions (:func:`with_radius`). Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
+positions (:func:`with_radius`); the configuration angles of a symmetric system are
+rest-length directions G = dr/dp of the re-made ch. 3 design with the bases' motion prescribed
+(:mod:`tmfem.design.configuration`). Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
 eigenvalues lambda = omega^2 of (K_T - lambda M) phi = 0 (eq. 5.32), the total mass, the tendon
 forces and stresses (the slack margin is the smallest force), the bars' compression against
 the Euler load (eq. 5.31), the membrane stresses (eqs. 5.29-5.30, KS aggregates), the corner
@@ -49,9 +51,11 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
+from tmfem.design.configuration import design_rates, support_rates
 from tmfem.design.kinematics import MTCKinematics, kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
-from tmfem.design.variables import Variable, area_derivative, parse_variables, with_membrane_radius
+from tmfem.design.variables import (Variable, apply_design, area_derivative, parse_variables, variable_values,
+                                    with_membrane_radius)
 from tmfem.errors import InputError
 from tmfem.fem.element import State
 from tmfem.fem.truss import (TrussSet, truss_axial_force_derivatives, truss_internal, truss_mass,
@@ -165,11 +169,15 @@ def variable_map(model, variables):
     return [v.name for v in vs], _rest_length_map(model, vs)
 
 
-def _rest_length_map(model, vs: list) -> np.ndarray:
+def _rest_length_map(model, vs: list, rates: dict | None = None) -> np.ndarray:
+    """G (module docstring); ``rates``: {j: :func:`design_rates`} of the angle variables
+    (computed here when not given)."""
     G = np.zeros((len(model.system.tendons), len(vs)))
     for j, v in enumerate(vs):
         if v.kind == "rest_length":
             G[list(v.tendons), j] = 1.0
+        elif v.kind == "angle":
+            G[:, j] = (rates[j] if rates else design_rates(model, v.angle, v.stage))[0]
     return G
 
 
@@ -243,7 +251,7 @@ def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndar
     nt, nb = len(model.system.tendons), Ncr.size
     tendons, bars = model.tendons, getattr(model, "bars", None)
     zt, zb = np.zeros(tendons.ne), np.zeros(nb)
-    if v.kind == "rest_length":
+    if v.kind in ("rest_length", "angle"):         # an angle moves the rest lengths (configuration)
         dR = T.T @ (truss_rest_length_derivatives(x, tendons, dofmap=model.dofmap) @ dL)
         lumped = model.lumped_tendon_mass
         dM = T.T @ (truss_mass(dataclasses.replace(tendons, L=tendons.L + dL), model.dofmap, lumped=lumped)
@@ -291,16 +299,54 @@ def _partials(model, v: Variable, g: np.ndarray, x, dL: np.ndarray, Ncr: np.ndar
                      float(sub.rhoA @ sub.L) * s)
 
 
+def rebuilt(model, system):
+    """The model of ``model``'s kind, options (mesh density, elements, attachment, law) and
+    rest lengths for ``system``."""
+    topo = model.topology
+    common = dict(mesh_n=topo.mesh.n, tendon_elements=topo.tendon_elements, attachment=topo.attachment,
+                  patch=model.patch, rest_lengths=model.rest_lengths.copy(), membrane_law=model.membrane_law)
+    if model.name == "sbc":
+        from tmfem.models.sbc.model import SBCModel
+        per_bar = model.numbering.bar_elements // (2 if system.deployable else 1)   # two segments with H_1j
+        return SBCModel(system, bar_elements=per_bar, **common)
+    from tmfem.models.mtc.model import MTCModel
+    return MTCModel(system, lumped_tendon_mass=model.lumped_tendon_mass, rigid_bar_points=system.deployable,
+                    tendon_law=model.tendon_law, **common)
+
+
 def with_radius(model, r_mb: float):
     """The MTC model of ``model``'s system with the membrane radius r_mb (same mesh density,
     options and rest lengths): its membrane mesh is the same mesh scaled."""
-    from tmfem.models.mtc.model import MTCModel
-    topo = model.topology
-    return MTCModel(model.system.replace(**with_membrane_radius(model.system, r_mb)), mesh_n=topo.mesh.n,
-                    tendon_elements=topo.tendon_elements, attachment=topo.attachment, patch=model.patch,
-                    rest_lengths=model.rest_lengths.copy(), lumped_tendon_mass=model.lumped_tendon_mass,
-                    membrane_law=model.membrane_law, rigid_bar_points=model.system.deployable,
-                    tendon_law=model.tendon_law)
+    return rebuilt(model, model.system.replace(**with_membrane_radius(model.system, r_mb)))
+
+
+def _section_partials(model, v: Variable, state, Ncr: np.ndarray) -> _Partials:
+    """The :class:`_Partials` of a thickness or diameter variable v of the SBC model at
+    ``state``: the five-point central difference (8 (F(d) - F(-d)) - (F(2d) - F(-2d))) / 12d of
+    the residual, tangent, mass, member forces and total mass of the model rebuilt with
+    p0 + k d, d = 1 % of p0. Exact (to rounding) for a polynomial of degree <= 4 in p: the
+    beams' A, I, J go as d^2, d^4, d^4, the tendons' A as d^2; the degenerated shell's
+    thickness also enters its metric (not a polynomial): truncation O(d^4), about 1e-8."""
+    p0 = variable_values(model.system, model.rest_lengths, [v])[0]
+    d = 1e-2 * p0
+    ms = {k: rebuilt(model, apply_design(model.system, model.rest_lengths, [v], [p0 + k * d])[0])
+          for k in (2, 1, -1, -2)}
+
+    def rate(y: dict):
+        return (8 * (y[1] - y[-1]) - (y[2] - y[-2])) / (12 * d)
+
+    RK = {k: m.residual(state) for k, m in ms.items()}
+    forces = {k: m.member_forces(state) for k, m in ms.items()}
+    dK = rate({k: K for k, (_, K) in RK.items()})
+    dA = np.zeros(len(model.system.tendons))
+    if v.kind == "tendon_diameter":
+        dA[list(v.tendons)] = area_derivative(p0)
+    dNcr = 4.0 * Ncr / p0 if v.kind == "bar_diameter" else np.zeros(Ncr.size)
+    return _Partials(rate({k: R for k, (R, _) in RK.items()}), 0.5 * (dK + dK.T),
+                     rate({k: m.mass(state) for k, m in ms.items()}),
+                     rate({k: f["tendon_element"] for k, f in forces.items()}),
+                     rate({k: f["bar"] for k, f in forces.items()}), dA, dNcr,
+                     float(rate({k: total_mass(m) for k, m in ms.items()})))
 
 
 def total_mass(model) -> float:
@@ -322,7 +368,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     Parameters
     ----------
     model : MTCModel or SBCModel
-        The SBC model with rest-length variables only. On the PETSc backend (one rank) the
+        The SBC model with rest-length, thickness and diameter variables (their partials:
+        :func:`_section_partials`). On the PETSc backend (one rank) the
         matrices are assembled serially and factorised and eigen-solved by PETSc.
     equilibrium : Equilibrium, optional
         A converged ``model.equilibrium()`` at the model's current rest lengths (default:
@@ -368,14 +415,15 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     if thickness and "h_membrane" not in [v.name for v in vs]:
         vs.append(Variable("h_membrane", "thickness"))
     sbc = model.name == "sbc"
-    if sbc and any(v.kind != "rest_length" for v in vs):
-        raise InputError(f"sensitivities of the SBC model: expected rest-length variables, found "
-                         f"{[v.name for v in vs if v.kind != 'rest_length']} (its shells and beams bend: "
-                         f"not linear in the thickness and the diameters; use the MTC model)")
+    if sbc and any(v.kind in ("membrane_radius", "angle") for v in vs):
+        raise InputError(f"sensitivities of the SBC model: expected rest-length, thickness or diameter "
+                         f"variables, found {[v.name for v in vs if v.kind in ('membrane_radius', 'angle')]} "
+                         f"(they move the shells' and beams' reference geometry; use the MTC model)")
     eq = model.equilibrium() if equilibrium is None else equilibrium
     kin = kinematics(model, eq)
     names = [v.name for v in vs]
-    G = _rest_length_map(model, vs)
+    rates = {j: design_rates(model, v.angle, v.stage) for j, v in enumerate(vs) if v.kind == "angle"}
+    G = _rest_length_map(model, vs, rates)
     n_var = len(vs)
     topo, free = model.topology, model.free
     x = kin.x
@@ -385,14 +433,19 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
                         shape=(tendons.ne, G.shape[0]))
     dL = e2t @ G                                                       # dL_e / dp  (ne, n_var)
     Ncr = np.array([model.system.bar.euler_critical_load(l) for l in model.system.l.ravel()])
-    parts = [_partials(model, v, G[:, j], x, dL[:, j], Ncr, kin.T) for j, v in enumerate(vs)]
+    state0 = kin.point(np.zeros(model.free.size)) if sbc else None
+    parts = [_section_partials(model, v, state0, Ncr) if sbc and v.kind != "rest_length"
+             else _partials(model, v, G[:, j], x, dL[:, j], Ncr, kin.T) for j, v in enumerate(vs)]
     dR = np.column_stack([p.dR for p in parts])
     n_red = dR.shape[0]
     # the assembled tangent (a distributed backend's equilibrium holds its own matrix type)
     K = eq.tangent if eq.tangent is not None and not distributed else kin.tangent(kin.point(np.zeros(n_red)))
     solve = model.backend.factorize(sp.csr_matrix(K)[free][:, free])
+    # an angle of a 1-N system moves the pinned bases: their motion is prescribed
     du = np.zeros((n_red, n_var))
-    du[free] = solve(-dR[free]).reshape(-1, n_var)
+    for j, (_, base_rate) in rates.items():
+        du[:, j] = support_rates(model, base_rate)
+    du[free] = solve(-(dR + sp.csr_matrix(K) @ du)[free]).reshape(-1, n_var)
     dx = np.stack([kin.positions(du[:, j]) for j in range(n_var)], axis=-1)   # (3, nn, n_var)
 
     # eigenvalues: two extra modes so that a cluster at the k-th is complete
@@ -410,8 +463,10 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     dlam = np.zeros((k, n_var))
     dNb_state = np.zeros((Ncr.size, n_var))
     for j in range(n_var):
-        # the step moves the state by `scale` at most, whatever the variable's units
-        h = scale / max(1.0, float(np.abs(du[:, j]).max()), float(np.abs(G[:, j]).max()))
+        # the step moves the state by `scale` at most, whatever the variable's units; an angle's
+        # (per degree, rates of 1e-2 m) by `scale` exactly: a smaller move loses digits to rounding
+        floor = 0.0 if vs[j].kind == "angle" else 1.0
+        h = scale / max(floor, float(np.abs(du[:, j]).max()), float(np.abs(G[:, j]).max()))
         Kpm, Mpm, Npm = [], [], []
         try:
             for sgn in (1.0, -1.0):
@@ -430,6 +485,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
         if parts[j].dK is not None:
             dK = dK + parts[j].dK
         dM = (Mpm[0] - Mpm[1]) / (2 * h) if sbc else parts[j].dM
+        if sbc and parts[j].dK is not None:          # a section's own part (rest lengths: in Mpm)
+            dM = dM + parts[j].dM
         if sbc:
             dNb_state[:, j] = (Npm[0] - Npm[1]) / (2 * h)
         for c in clusters:
@@ -454,7 +511,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     dA = np.column_stack([p.dA_t for p in parts])
     dstress = dN / area[:, None] - (N / area**2)[:, None] * dA[topo.tendon_of_element]
     if sbc:                              # the beams' axial forces, along (du/dp, dp)
-        Nb, dNb = kin.bar_forces(kin.point(np.zeros(n_red))), dNb_state
+        Nb, dNb = kin.bar_forces(kin.point(np.zeros(n_red))), dNb_state + np.column_stack([p.dN_b for p in parts])
     else:
         Nb, dNb = member_forces(model.bars, np.column_stack([p.dN_b for p in parts]))
     dNcr = np.column_stack([p.dNcr for p in parts])

@@ -9,10 +9,12 @@ Names (:func:`parse_variables`):
 * ``"d_bar"``: the diameter of the (solid circular) bars [m];
 * ``"d_<family>"`` (``"d_S"``, ``"d_V"``): the diameter of every tendon of that family [m];
 * ``"r_mb"``: the circumradius of a regular membrane [m] (its corners and reference mesh
-  scale; the bars and the rest lengths stay).
+  scale; the bars and the rest lengths stay);
+* ``"theta_<i>"``, ``"psi_<i>"``: the declination and azimuth of stage i of a symmetric M-N
+  or 1-N system [deg]; the rest lengths follow the ch. 3 design, a 1-N system's base radius
+  eq. 3.33 (:mod:`tmfem.design.configuration`).
 
-The configuration angles (theta, psi) and the other coordinates of the design configuration
-move the bars themselves (the ch. 3 equilibrium design); they are refused (:data:`GEOMETRY`).
+The other coordinates of the design configuration (sigma, z, r, l) are refused (:data:`GEOMETRY`).
 """
 from __future__ import annotations
 
@@ -22,11 +24,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.errors import InputError
+from tmfem.design.configuration import angle_value, parse_angle, with_angles
+from tmfem.errors import InfeasibleDesign, InputError
 from tmfem.system.geometry import membrane_corners_regular
 
 #: kinds of variable
-KINDS = ("rest_length", "thickness", "bar_diameter", "tendon_diameter", "membrane_radius")
+KINDS = ("rest_length", "thickness", "bar_diameter", "tendon_diameter", "membrane_radius", "angle")
 #: names of variables that change the design configuration (refused)
 GEOMETRY = ("theta", "psi", "sigma", "z", "r", "l")
 
@@ -41,12 +44,16 @@ class Variable:
         The tendons it acts on (rest lengths and tendon diameters; empty otherwise).
     family : str
         The tendon family of a tendon diameter ("" otherwise).
+    angle, stage : str, int
+        An angle variable's angle ("theta" or "psi") and stage index (0-based).
     """
 
     name: str
     kind: str
     tendons: tuple = ()
     family: str = ""
+    angle: str = ""
+    stage: int = 0
 
 
 def group_names(system) -> list:
@@ -95,15 +102,21 @@ def parse_variables(system, variables) -> list:
             fam = n[2:]
             out.append(Variable(n, "tendon_diameter", tuple(i for i, t in enumerate(tendons)
                                                             if t.family == fam), fam))
+        elif parse_angle(system, n) is not None:
+            angle, stage = parse_angle(system, n)
+            out.append(Variable(n, "angle", angle=angle, stage=stage))
         elif n.split("_")[0] in GEOMETRY:
-            raise InputError(f"design variable {n!r}: the configuration (theta, psi, ...) changes "
-                             f"the ch. 3 design geometry of the bars, which the sensitivities do "
-                             f"not differentiate; expected rest lengths, 'h_membrane', 'd_bar', "
-                             f"'d_<family>' or 'r_mb'")
+            raise InputError(f"design variable {n!r}: of the configuration only the angles "
+                             f"theta_<stage> and psi_<stage> are variables; expected rest lengths, "
+                             f"'h_membrane', 'd_bar', 'd_<family>', 'r_mb', 'theta_<i>' or 'psi_<i>'")
         else:
             raise InputError(f"design variable {n!r}: expected a tendon group {groups}, a tendon "
                              f"name, 'h_membrane', 'd_bar', 'r_mb' or one of "
                              f"{['d_' + f for f in families]}")
+    other = [v.name for v in out if v.kind not in ("rest_length", "angle")]
+    if other and any(v.kind == "angle" for v in out):
+        raise InputError(f"variables: angle variables combine with rest lengths only (the design "
+                         f"they re-make depends on the sections and the membrane), found {other}")
     rest = [i for v in out if v.kind == "rest_length" for i in v.tendons]
     if len(set(rest)) != len(rest):
         raise InputError(f"variables: a tendon's rest length appears in two variables of {names}")
@@ -122,6 +135,8 @@ def variable_values(system, rest_lengths: np.ndarray, variables: list) -> np.nda
             vals.append(system.bar.d)
         elif v.kind == "membrane_radius":
             vals.append(system.r_mb)
+        elif v.kind == "angle":
+            vals.append(angle_value(system, v.angle, v.stage))
         else:
             vals.append(system.tendon_section(system.tendons[v.tendons[0]]).d)
     return np.array(vals)
@@ -139,10 +154,12 @@ def _family_section(system, family: str, d: float) -> dict:
     return {**keep, family: sec}
 
 
-def apply_design(system, rest_lengths: np.ndarray, variables: list, p) -> tuple:
+def apply_design(system, rest_lengths: np.ndarray, variables: list, p, *, redesign=None) -> tuple:
     """The system and rest lengths of the design ``p`` (one value per variable): rest-length
     variables move their tendons by p - (current value); the others replace the membrane
-    thickness, the bar diameter or a tendon family's diameter."""
+    thickness, the bar diameter or a tendon family's diameter; angle variables replace the
+    configuration and move the rest lengths by the change of the design ``redesign(system)``
+    (:func:`tmfem.design.configuration.redesign_of`; required with angle variables)."""
     p = np.asarray(p, dtype=float)
     if p.shape != (len(variables),) or not np.all(np.isfinite(p)):
         raise InputError(f"design: expected {len(variables)} finite values, found {p}")
@@ -150,6 +167,7 @@ def apply_design(system, rest_lengths: np.ndarray, variables: list, p) -> tuple:
     now = variable_values(system, r, variables)
     changes = {}
     secs = dict(system.tendon_sections)
+    angles = {(v.angle, v.stage): x for v, x in zip(variables, p) if v.kind == "angle"}
     for v, x, x0 in zip(variables, p, now):
         if v.kind == "rest_length":
             r[list(v.tendons)] += x - x0
@@ -159,10 +177,23 @@ def apply_design(system, rest_lengths: np.ndarray, variables: list, p) -> tuple:
             changes["bar"] = dataclasses.replace(system.bar, d=float(x))
         elif v.kind == "membrane_radius":
             changes.update(with_membrane_radius(system, float(x)))
+        elif v.kind == "angle":
+            continue
         else:
             secs = _family_section(system.replace(tendon_sections=secs), v.family, x)
     if any(v.kind == "tendon_diameter" for v in variables):
         changes["tendon_sections"] = secs
+    if angles:
+        if redesign is None:
+            raise InputError("design: angle variables need the design rule of the model (redesign)")
+        moved = with_angles(system, angles)
+        try:
+            r += redesign(moved) - redesign(system)
+        except InfeasibleDesign as e:
+            at = ", ".join(f"{v.name} = {x:.6g} deg" for v, x in zip(variables, p) if v.kind == "angle")
+            raise type(e)(f"design: no ch. 3 equilibrium design at {at} ({e}); expected angle bounds "
+                          f"within which the design exists") from e
+        changes.update(symmetric=moved.symmetric, q=moved.q, base=moved.base, l=moved.l)
     if np.any(r <= 0):
         raise InputError(f"design: expected positive rest lengths, found {r}")
     return system.replace(**changes, rest_lengths=r), r

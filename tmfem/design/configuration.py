@@ -1,0 +1,139 @@
+"""The configuration angles theta_i, psi_i of a symmetric M-N system as design variables.
+
+A change of the declination theta_i or the azimuth psi_i of stage i (eqs. 3.19-3.20) moves
+the bars and changes the ch. 3 equilibrium design: the node coordinates, the corner
+displacements and forces of the membrane, the tendon forces that balance them (the null
+vector of A(q), eq. 3.16) and the rest lengths r = EA |d| / (T + EA) (eqs. 3.8-3.9). The
+finite-element model takes from the design its rest lengths; an angle variable moves them by
+the change of the design,
+
+    r(theta, psi) = r_0 + r_D(theta, psi) - r_D(theta_0, psi_0),
+
+(r_0 the model's rest lengths, r_D the design on the model's membrane mesh, corner attachment
+and membrane law: the rule ``"design"``), so that a system whose rest lengths are its design
+stays designed, and offsets of rest-length variables are kept.
+
+In a 1-N system eq. 3.33 ties the base radius to the angles, r_1 = l_1 sin(theta_1)
+sin(psi_1) / cos(pi / N) (no equilibrium design exists otherwise): an angle of a 1-N system
+moves the base A_1j with r_1 (the bases scale with r_1 about the origin), r_1 = r_1,0
+r_3.33(theta, psi) / r_3.33(theta_0, psi_0), so that a start given to printed precision (the
+1-4 preset's r_1 = 0.6429 m) is the start.
+
+What the MTC model takes from the design: the rest lengths and the pinned bases. The bars'
+reference lengths l and the membrane's reference mesh do not change with the angles, and the
+design configuration is only the start of the static solve. In the direct method of
+:mod:`tmfem.design.sensitivities` an angle is a rest-length direction dr/dp (the residual's
+partial derivative is analytic) with the bases' motion dA/dp prescribed on the pinned
+degrees of freedom: K_ff du_f = -dR_f/dp - K_fs dA/dp (:func:`design_rates`,
+:func:`support_rates`).
+
+dr_D/dp and dA/dp are the fourth-order central differences (8 (r(h) - r(-h)) - (r(2h) -
+r(-2h))) / 12h of the re-designed rest lengths and bases (no FE solve: one linear
+plane-stress solve per design), step h = 0.001 deg: truncation O(h^4) below 1e-12 relative,
+rounding of the design (its equilibrium residual about 1e-15) / h about 1e-10. Not analytic;
+on a 1-N system they agree with the closed form's derivative (eqs. 3.30-3.36) within 1e-10.
+"""
+from __future__ import annotations
+
+import dataclasses
+import re
+
+import numpy as np
+
+from tmfem.equilibrium.symmetric import r1_1N
+from tmfem.errors import InputError
+
+#: the angle names; a variable is ``theta_<stage>`` or ``psi_<stage>`` [deg]
+ANGLES = ("theta", "psi")
+#: step of the design's central difference [deg]
+STEP_DEG = 1e-3
+
+_NAME = re.compile(r"^(theta|psi)_(\d+)$")
+
+
+def parse_angle(system, name: str):
+    """(angle, stage index) of an angle variable ``name`` (``"theta_2"``: ("theta", 1)), or
+    None when ``name`` is not of that form; InputError when the system cannot take it."""
+    m = _NAME.match(name)
+    if m is None:
+        return None
+    angle, stage = m.group(1), int(m.group(2))
+    if system.symmetric is None:
+        raise InputError(f"design variable {name!r}: expected a symmetric system ([symmetric] "
+                         f"theta_deg, psi_deg), found one given by its coordinates")
+    if not 1 <= stage <= system.M:
+        raise InputError(f"design variable {name!r}: expected {angle}_<stage> of a stage 1..{system.M} "
+                         f"(one angle per stage), found stage {stage}")
+    if system.deployable:
+        raise InputError(f"design variable {name!r}: expected an M-N or 1-N system, found a 1-N(D) "
+                         f"system (its MTC model holds H_1j rigidly on the bars, not the ch. 3 design)")
+    return angle, stage - 1
+
+
+def angle_value(system, angle: str, stage: int) -> float:
+    """The angle [deg] of a stage of a symmetric system."""
+    return float(np.degrees(getattr(system.symmetric, angle)[stage]))
+
+
+def with_angles(system, values: dict):
+    """``system`` with the angles ``{(angle, stage): value [deg]}`` changed: its symmetric
+    configuration and the fields it fixes (q, base, l); a 1-N system's base radius r_1
+    follows eq. 3.33."""
+    c = system.symmetric
+    arrays = {a: getattr(c, a).copy() for a in ANGLES}
+    for (a, i), v in values.items():
+        arrays[a][i] = np.radians(v)
+    if system.M == 1:               # eq. 3.33, relative to the start (given to printed precision)
+        arrays["r"] = c.r * (r1_1N(l1=c.l[0], theta1=arrays["theta"][0], psi1=arrays["psi"][0], N=system.N)
+                             / r1_1N(l1=c.l[0], theta1=c.theta[0], psi1=c.psi[0], N=system.N))
+    cfg = dataclasses.replace(c, **arrays)
+    return system.replace(symmetric=cfg, **cfg.system_arrays(system.N))
+
+
+def design_rest_lengths(system, *, mesh_n: int, attachment: str = "point", patch=None,
+                        membrane_law: str = "svk") -> np.ndarray:
+    """Rest lengths r_D (eqs. 3.8-3.9) of the ch. 3 design of ``system`` on the N x n x n
+    membrane mesh with the given corner attachment and law; raises (SlackTendon,
+    SlackMembrane, InfeasibleDesign) where the configuration has no design."""
+    from tmfem.equilibrium.design import design_equilibrium
+    d = design_equilibrium(system, mesh_n=mesh_n, attachment=attachment, patch=patch,
+                           membrane_law=membrane_law)
+    return np.asarray(d.rest_lengths, dtype=float)
+
+
+def redesign_of(model):
+    """``system -> r_D`` on the mesh, attachment and law of an MTC ``model``."""
+    topo = model.topology
+
+    def redesign(system):
+        return design_rest_lengths(system, mesh_n=topo.mesh.n, attachment=topo.attachment,
+                                   patch=model.patch, membrane_law=model.membrane_law)
+    return redesign
+
+
+def design_rates(model, angle: str, stage: int) -> tuple:
+    """dr/dp [m/deg] (n_tendons,) and dA/dp [m/deg] (3, N) of the bases A_1j of the angle
+    variable (angle, stage) of ``model``'s system (module docstring: the design's fourth-order
+    central difference)."""
+    redesign = redesign_of(model)
+    p0 = angle_value(model.system, angle, stage)
+    moved = {k: with_angles(model.system, {(angle, stage): p0 + k * STEP_DEG}) for k in (2, 1, -1, -2)}
+    r = {k: redesign(s) for k, s in moved.items()}
+    a = {k: s.base for k, s in moved.items()}
+    return tuple((8 * (f[1] - f[-1]) - (f[2] - f[-2])) / (12 * STEP_DEG) for f in (r, a))
+
+
+def support_rates(model, base_rate: np.ndarray) -> np.ndarray:
+    """The reduced increment (n_red,) that moves the pinned bases A_1j of ``model`` by
+    ``base_rate`` (3, N) and nothing else."""
+    x = np.zeros((3, model.topology.n_nodes))
+    x[:, model.topology.fixed_nodes] = base_rate
+    return model.reduce(x)
+
+
+def on_supports(model, x: np.ndarray) -> np.ndarray:
+    """Positions x (3, n_nodes) with the pinned bases moved to ``model``'s system's A_1j: a
+    warm start of the static solve of a design whose bases moved (1-N angles)."""
+    x = np.array(x, dtype=float)
+    x[:, model.topology.fixed_nodes] = model.system.base
+    return x
