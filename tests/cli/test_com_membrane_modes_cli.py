@@ -8,6 +8,7 @@ from pathlib import Path
 
 from tmfem.cli import main
 from tmfem.models.com.mode_count import choose_membrane_modes
+from tmfem.models.com.model import ControlOrientedModel
 from tmfem.system import load_system
 
 SYSTEMS = Path(__file__).resolve().parents[1] / "data" / "systems"
@@ -19,7 +20,7 @@ def test_modal_com_of_a_file_without_k_prints_the_chosen_k(capsys):
     n_q + K >= 12), in the JSON with where it came from and in the text output."""
     assert main(["modal", TRIANGLE, "--model", "com", "--modes", "12", "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
-    c = choose_membrane_modes(load_system(TRIANGLE))
+    c = choose_membrane_modes(load_system(TRIANGLE), model_class=ControlOrientedModel)
     assert r["membrane_modes"] == c.K and r["membrane_mode_choice"]["source"] == "automatic"
     assert r["membrane_mode_choice"]["reference"] == "MTC" and len(r["freq_hz"]) == 12
     assert main(["modal", TRIANGLE, "--model", "com", "--modes", "4"]) == 0

@@ -14,7 +14,7 @@ import pytest
 
 from tmfem.design import design_sensitivities
 from tmfem.design.configuration import design_rates, on_supports, redesign_of, with_angles
-from tmfem.design.optimize import optimize
+from tmfem.design.optimizer import optimize
 from tmfem.design.variables import apply_design, parse_variables, variable_values
 from tmfem.equilibrium.design import design_equilibrium
 from tmfem.equilibrium.symmetric import delta_1N, force_density_ratio_1N, r1_1N, s1_length

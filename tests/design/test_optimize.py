@@ -9,7 +9,7 @@ import pytest
 from scipy.optimize import nnls
 
 from tmfem.design import design_sensitivities, optimize
-from tmfem.design.optimize import parse_constraint, parse_objective
+from tmfem.design.optimizer import parse_constraint, parse_objective
 from tmfem.design.variables import apply_design, parse_variables
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.models.mtc.model import MTCModel

@@ -15,7 +15,8 @@ from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_frames, check_mesh_budget, check_time_steps, output_dir,
                               output_file, positive_float, progress_bar, warn)
 from tmfem.errors import InputError
-from tmfem.models.com.mode_count import MembraneModeChoice, membrane_mode_choice
+from tmfem.models.com.mode_count import MembraneModeChoice
+from tmfem.models.com.model import membrane_modes_of
 from tmfem.reference.deployments import (CONTROLLERS, LPV_CONTROLLERS, UNCERTAINTIES, check_choices,
                                          VTK_EVERY, own_path, setup, write_outputs)
 
@@ -209,7 +210,7 @@ def run(args) -> dict:
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
                              gif=args.gif, vtk=args.vtk, title=title))
     out["warnings"] = warnings
-    out["membrane_mode_choice"] = membrane_mode_choice(args.system).to_dict()
+    out["membrane_mode_choice"] = membrane_modes_of(args.system).to_dict()
     if args.compare_plant:
         def rerun(kind):
             s2 = setup(args.system, controller=args.controller, uncertainty=args.uncertainty,

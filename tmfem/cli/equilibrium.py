@@ -70,6 +70,7 @@ def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point
 
 
 def run(args) -> dict:
+    from tmfem.control.deployment.packaged import packaged_configurations
     from tmfem.equilibrium import assist
     from tmfem.errors import InfeasibleDesign
     system = system_from_args(args)
@@ -81,7 +82,7 @@ def run(args) -> dict:
         return {"system": system.name, "assist": "bases", **assist.feasible_bases(system)}
     if args.packaged is not None:
         return {"system": system.name, "assist": "packaged",
-                **assist.packaged_configurations(system, theta_deg=args.packaged)}
+                **packaged_configurations(system, theta_deg=args.packaged)}
     radius = None
     if args.target_delta is not None:
         radius = assist.membrane_radius_for_delta(system, delta=args.target_delta * 1e-3)

@@ -43,7 +43,7 @@ def _variables(items) -> dict:
 
 
 def run(args) -> dict:
-    from tmfem.design.optimize import optimize, result_dict
+    from tmfem.design.optimizer import optimize, result_dict
     from tmfem.design.plots import plot_history
     from tmfem.design.sensitivities import RESPONSES
     from tmfem.system import dump_system

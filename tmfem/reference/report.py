@@ -145,7 +145,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     from tmfem.io.units import with_units
     from tmfem.io.writer import write_configuration, write_modes
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
-    from tmfem.models.com.mode_count import membrane_mode_choice
+    from tmfem.models.com.model import membrane_modes_of
     from tmfem.models.mtc.model import MTCModel
     from tmfem.models.fe.outputs import q_from_positions
     from tmfem.models.mtc.post import member_state, static_summary
@@ -313,7 +313,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
                "unstable_modes": unstable_modes(freqs), "com_disagreement": disagreement,
-               "com_membrane_modes": membrane_mode_choice(system).to_dict(),
+               "com_membrane_modes": membrane_modes_of(system).to_dict(),
                "printed_frequencies_hz": printed, "vibration": vibration,
                "deployment": deployment}
     summary = finite_or_none(summary)

@@ -17,7 +17,7 @@ may carry:
 * ``[report]``: what ``tmfem report`` adds for this system: the free-vibration perturbation,
   a second prestress case with its source, explanatory notes, and the deployment it runs;
 * ``[design]``: the design variables of ``tmfem optimize`` with their bounds, and optionally
-  its objective, constraints and wrinkling aperture (:mod:`tmfem.design.optimize`).
+  its objective, constraints and wrinkling aperture (:mod:`tmfem.design.optimizer`).
 
 Everything is read from the :class:`System` the library is given (``system.problem``); a file
 that does not declare a table gets the documented defaults, which depend on the system only.

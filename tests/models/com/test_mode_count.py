@@ -37,7 +37,7 @@ def test_kapton_gets_the_smallest_k_that_matches_the_mtc_band(kapton):
     """The 3 m Kapton 1-4 (a floppy membrane: many membrane modes among the 12 lowest): K = 4
     puts modes 8-12 up to 50 % above the MTC's; the chosen K brings all twelve within 5 % of an
     independent MTC modal analysis, and K - 1 does not."""
-    c = mode_count.choose_membrane_modes(kapton)
+    c = mode_count.choose_membrane_modes(kapton, model_class=ControlOrientedModel)
     assert c.source == "automatic" and c.reference == "MTC" and not c.disagreeing_modes
     mtc = MTCModel(kapton, rest_lengths="design")
     ref = mtc.modes(k=12, at=mtc.equilibrium()).freq_hz
@@ -57,7 +57,7 @@ def test_a_band_that_no_k_brings_within_tolerance_is_named(caplog):
     the smallest K whose band no longer changes and the warning names the modes."""
     s = load_system(SYSTEMS / "square-2-4.toml")
     with caplog.at_level(logging.WARNING, logger="tmfem.models.com.mode_count"):
-        c = mode_count.choose_membrane_modes(s)
+        c = mode_count.choose_membrane_modes(s, model_class=ControlOrientedModel)
     assert c.K == mode_count.K_MIN and 1 in c.disagreeing_modes and 2 in c.disagreeing_modes
     assert "modes [1, 2" in caplog.text and "any K up to 16" in caplog.text
     assert "still differ" in c.text
@@ -66,7 +66,7 @@ def test_a_band_that_no_k_brings_within_tolerance_is_named(caplog):
 def test_the_file_decides_when_it_declares_k(kapton):
     """`[models.com] membrane_modes` wins: no search (source "file"), the model records it."""
     s = load_preset("1-4")
-    assert mode_count.membrane_mode_choice(s).source == "file" and default_membrane_modes(s) == 5
+    assert mode_count.membrane_mode_choice(s, model_class=ControlOrientedModel).source == "file" and default_membrane_modes(s) == 5
     import dataclasses
     declared = dataclasses.replace(kapton, model_defaults={"com": {"membrane_modes": 6}})
     m = ControlOrientedModel(declared, output_points=[])

@@ -200,7 +200,7 @@ def test_compare_warns_where_the_pfl_tendon_model_is_not_the_plants(capsys):
     assert out["pfl_tendon_model"] == out["compare"]["pfl_tendon_model"] == "cable"
     assert (out["plant_tendons"], out["compare"]["plant_tendons"]) == ("cable", "fixed-rate")
     assert len(out["warnings"]) == 1 and "com plant's tendon law (fixed-rate)" in out["warnings"][0]
-    assert "warning: the PFL's tendon model (cable)" in cap.err
+    assert "WARNING: the PFL's tendon model (cable)" in cap.err
 
 
 @pytest.mark.slow

@@ -186,7 +186,7 @@ def deployed_plant(system, *, membrane_modes: int | None = None, points=None, me
     """
     from tmfem.models.com.linearize import linearize
     from tmfem.models.com.model import ControlOrientedModel
-    from tmfem.models.com.mode_count import membrane_modes_of
+    from tmfem.models.com.model import membrane_modes_of
     import control
     choice = membrane_modes_of(system, membrane_modes)
     K = choice.K

@@ -114,9 +114,13 @@ class MembraneModeChoice:
 _CHOICES: dict[str, MembraneModeChoice] = {}
 
 
-def membrane_modes_of(system, K: int | None = None) -> MembraneModeChoice:
-    """``K`` when given (``source="given"``), else :func:`membrane_mode_choice`."""
-    return membrane_mode_choice(system) if K is None else MembraneModeChoice(K=int(K), source="given")
+def membrane_modes_of(system, K: int | None = None, *, model_class) -> MembraneModeChoice:
+    """``K`` when given (``source="given"``), else :func:`membrane_mode_choice`.
+    ``model_class``: the control-oriented model's class (passed in by
+    :func:`tmfem.models.com.model.membrane_modes_of`, so that this module stays below it)."""
+    if K is not None:
+        return MembraneModeChoice(K=int(K), source="given")
+    return membrane_mode_choice(system, model_class=model_class)
 
 
 def declared_membrane_modes(system) -> int | None:
@@ -125,7 +129,7 @@ def declared_membrane_modes(system) -> int | None:
     return None if K is None else int(K)
 
 
-def membrane_mode_choice(system) -> MembraneModeChoice:
+def membrane_mode_choice(system, *, model_class) -> MembraneModeChoice:
     """K of the system's ``[models.com] membrane_modes`` (the presets carry the
     dissertation's: 5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6D), else
     :func:`choose_membrane_modes` (computed once per system content)."""
@@ -134,23 +138,23 @@ def membrane_mode_choice(system) -> MembraneModeChoice:
         return MembraneModeChoice(K=int(K), source="file")
     key = _fingerprint(system)
     if key not in _CHOICES:
-        _CHOICES[key] = choose_membrane_modes(system)
+        _CHOICES[key] = choose_membrane_modes(system, model_class=model_class)
     return _CHOICES[key]
 
 
-def choose_membrane_modes(system, *, band_modes: int = BAND_MODES, tolerance: float = TOLERANCE,
-                          k_search: int = K_SEARCH) -> MembraneModeChoice:
+def choose_membrane_modes(system, *, model_class, band_modes: int = BAND_MODES,
+                          tolerance: float = TOLERANCE, k_search: int = K_SEARCH) -> MembraneModeChoice:
     """The smallest K in K_MIN..k_search whose COM frequencies in the band (the ``band_modes``
     lowest) agree with the finite-element model's within ``tolerance`` (module docstring);
     else the smallest K whose band is within :data:`CONVERGED` of the k_search model's, with a
-    warning naming the modes that disagree."""
-    from tmfem.models.com.model import ControlOrientedModel
+    warning naming the modes that disagree. ``model_class``: the control-oriented model's class
+    (:class:`tmfem.models.com.model.ControlOrientedModel`)."""
     from tmfem.resources import check_membrane_modes, check_mesh_budget
 
     check_membrane_modes(k_search, given="the automatic membrane-mode search")
     check_mesh_budget(N=system.N, n=FE_MESH, option=f"the automatic membrane-mode search's FE mesh {FE_MESH}")
     rest = "design" if system.rest_lengths is None else "system"
-    com = ControlOrientedModel(system, membrane_modes=k_search, rest_lengths=rest, output_points=[])
+    com = model_class(system, membrane_modes=k_search, rest_lengths=rest, output_points=[])
     lin = com.linearization()
     nq, k_hi = com.nq, com.K
     n = min(band_modes, nq + k_hi)

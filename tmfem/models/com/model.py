@@ -38,8 +38,8 @@ from tmfem.models.com.graphs import BufferedFunction, build_graphs, output_graph
 from tmfem.models.base import Equilibrium
 from tmfem.models.com import linearize as linearization
 from tmfem.models.com.membrane_modes import build_membrane_basis
-from tmfem.models.com.mode_count import (K_SEARCH, declared_membrane_modes, membrane_mode_choice,
-                                         membrane_modes_of)
+from tmfem.models.com import mode_count
+from tmfem.models.com.mode_count import K_SEARCH, MembraneModeChoice, declared_membrane_modes
 from tmfem.models.com.plant import COMPlant
 from tmfem.resources import check_com_budget
 from tmfem.solvers.newton import newton
@@ -49,7 +49,14 @@ def default_membrane_modes(system) -> int:
     """K of the system's ``[models.com] membrane_modes`` (the presets carry the
     dissertation's: 5 for 1-4, 4 for 2-3, 3 for 1-4(D), 5 for 1-6D), else the automatic
     choice of :func:`tmfem.models.com.mode_count.membrane_mode_choice`."""
-    return membrane_mode_choice(system).K
+    return membrane_modes_of(system).K
+
+
+def membrane_modes_of(system, K: int | None = None) -> MembraneModeChoice:
+    """K and where it comes from: ``K`` when given, else the file's ``[models.com]
+    membrane_modes``, else the automatic choice
+    (:func:`tmfem.models.com.mode_count.membrane_modes_of` with :class:`ControlOrientedModel`)."""
+    return mode_count.membrane_modes_of(system, K, model_class=ControlOrientedModel)
 
 
 class ControlOrientedModel:
