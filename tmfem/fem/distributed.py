@@ -75,14 +75,17 @@ class DistributedElements:
         self.n = self.elements[0].dofmap.ndof
         self.T, self.free = sp.csr_matrix(T), np.asarray(free, bool)
         self.root = self.comm.rank == 0
-        groups, self._shares, self._entries = [], [], []
+        groups, self._shares, self._entries, self._dofs = [], [], [], []
         for e in self.elements:
             if _shares(e):
                 dofs = np.asarray(e.element_dofs)
                 share = element_share(dofs.shape[0], self.comm)
-                groups.append((dofs[share], "element"))
+                mine = dofs[share].copy()          # this rank's elements only are kept
+                del dofs
+                groups.append((mine, "element"))
                 self._shares.append(share)
                 self._entries.append(None)
+                self._dofs.append(mine)
             else:
                 K0 = _structure(e.internal(state0, tangent=True)[1])
                 share = element_share(K0.nnz, self.comm)
@@ -90,6 +93,7 @@ class DistributedElements:
                 groups.append((np.stack([rows[share], K0.indices[share]], axis=1), "entry"))
                 self._shares.append(share)
                 self._entries.append((K0.indptr.copy(), K0.indices.copy()))
+                self._dofs.append(None)
         self.assembler = DistributedAssembler(groups, self.n, T=self.T, keep=self.free,
                                               comm=self.comm)
         self._K = []
@@ -110,11 +114,10 @@ class DistributedElements:
         rotations)."""
         f = np.zeros(self.n)
         values = []
-        for e, share, entries in zip(self.elements, self._shares, self._entries):
+        for e, share, entries, dofs in zip(self.elements, self._shares, self._entries, self._dofs):
             if entries is None:
                 fe, Ke = e.element_arrays(state, tangent=tangent, elements=share)
-                f += np.bincount(np.asarray(e.element_dofs)[share].ravel(), weights=fe.ravel(),
-                                 minlength=self.n)
+                f += np.bincount(dofs.ravel(), weights=fe.ravel(), minlength=self.n)
                 if tangent and symmetric:
                     Ke = 0.5 * (Ke + np.swapaxes(Ke, 1, 2))
                 values.append(Ke)
@@ -158,8 +161,28 @@ class DistributedElements:
         (n, n), the same on every rank, its entries shared out over the ranks; by default
         the sum of the sets' masses, assembled once and kept (pass M for a mass that
         depends on the state: the rotary inertia of shells and beams at the current
-        directors)."""
+        directors).
+
+        The default mass of sets that provide ``element_mass(elements=slice)`` (element
+        mass matrices (ne, nd, nd) of a block, like ``element_arrays``; the membrane) and
+        of the whole-set ones comes through the tangent's assembler: each rank evaluates
+        the element masses of its share only (no full mass matrix on any rank), and the
+        mass has the tangent's pattern (the node blocks of the same elements), so that
+        K - sigma M of the eigen solve is a numeric refactorisation of the static solve's
+        analysis."""
         if M is None and self._M is not None:
+            return self._M
+        if M is None and all(entries is not None or hasattr(e, "element_mass")
+                             for e, entries in zip(self.elements, self._entries)):
+            values = []
+            for e, share, entries in zip(self.elements, self._shares, self._entries):
+                if entries is None:
+                    values.append(e.element_mass(elements=share))
+                else:
+                    Ms = sp.csr_matrix(e.mass())
+                    Ms.sort_indices()
+                    values.append(_on_pattern(Ms, *entries).data[share])
+            self._M = self.assembler.matrix(*values)
             return self._M
         keep = M is None
         M = sp.csr_matrix(sum(e.mass() for e in self.elements) if keep else M)
@@ -200,8 +223,8 @@ def _on_pattern(K: sp.csr_matrix, indptr, indices) -> sp.csr_matrix:
     n = K.shape[1]
     keys = np.repeat(np.arange(K.shape[0]), np.diff(indptr)) * n + indices
     kk = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)) * n + K.indices
-    pos = np.minimum(np.searchsorted(keys, kk), keys.size - 1)
-    if keys.size == 0 or np.any(keys[pos] != kk):
+    pos = np.minimum(np.searchsorted(keys, kk), max(keys.size - 1, 0))
+    if kk.size and (keys.size == 0 or np.any(keys[pos] != kk)):
         raise InputError(f"distributed assembly: expected the tangent of an element set on its "
                          f"pattern of {indices.size} entries, found entries outside it")
     data = np.zeros(indices.size)

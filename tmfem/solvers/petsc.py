@@ -30,6 +30,7 @@ SLEPc its ``eps_`` options (``-eps_tol``, ``-eps_ncv``).
 """
 from __future__ import annotations
 
+import gc
 import hashlib
 import logging
 import shlex
@@ -478,6 +479,8 @@ class PetscBackend:
         the arguments of :func:`tmfem.solvers.trust_region.trust_region_newton` with every
         dof free and a distributed tangent, the fields of its result as a dict)."""
         from tmfem.solvers.petsc_snes import snes_equilibrium
+        gc.collect()          # a model gone in a cycle (a coarse level) retires its factors
+        self._reap()
         return snes_equilibrium(self, residual, energy, u0, **kwargs)
 
     # ------------------------------------------------------------------ eigenproblems
@@ -523,7 +526,7 @@ class PetscBackend:
         if entry is None or not entry.symmetric or any(key.startswith("st_") for key in self.options) \
                 or any(key.startswith("st_") for key in self.PETSc.Options().getAll()):
             return None
-        subset = entry.mass_within.get(M.pattern)
+        subset = True if M.pattern is K.pattern else entry.mass_within.get(M.pattern)
         if subset is None:
             subset = entry.mass_within[M.pattern] = self._subset(M.mat, K.mat)
         return entry if subset else None
