@@ -9,7 +9,10 @@ Configurations (each run in a fresh process, so that peak memory is per run):
            all elements)
   petsc2   the same under ``mpiexec -n 2``: each rank evaluates and assembles half of the
            membrane elements into one parallel matrix; MUMPS on both ranks; eigen: SLEPc
-           on the parallel factors
+           on the parallel factors (``petscP``: P ranks)
+The static solves run tmfem's trust-region Newton on the backend's factorisations (the
+timing wrapper has no SNES of its own), so that every factorisation and solve is timed; the
+SNES path of ``--backend petsc`` runs the same factorisations in about as many iterations.
 Columns: free DOFs, iterations of the static solve on the finest mesh, time per iteration
 (static time over all iterations, mesh sequencing from n = 10 included), static time, eigen
 time, time inside the backend's factorisations (incl. MUMPS/SuperLU analysis; their number)
@@ -162,8 +165,9 @@ def launch(mesh: int, config: str, args) -> dict:
     env["OPENBLAS_NUM_THREADS"] = "1"
     cmd = [sys.executable, HERE, "--run", str(mesh), config, "--rest-length", str(args.rest_length),
            "--sequence", str(args.sequence)]
-    if config == "petsc2":
-        cmd = ([shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"]
+    ranks = int(config[5:] or 1) if config.startswith("petsc") else 1     # petscP: P ranks
+    if ranks > 1:
+        cmd = ([shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", str(ranks)]
                + (["--mca", "mpi_yield_when_idle", "1"] if args.mpi_yield else []) + cmd)
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:

@@ -45,6 +45,9 @@ def for_backend(backend, elements, state0, T, free):
     or under ``mpiexec``), else None (the model assembles scipy matrices)."""
     if not getattr(backend, "distributed_assembly", False):
         return None
+    release = getattr(backend, "release_retired", None)
+    if release is not None:
+        release()                   # the factors of a model gone (a coarse level) go first
     return DistributedElements(elements, state0, T, free)
 
 
