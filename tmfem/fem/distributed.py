@@ -167,38 +167,42 @@ class DistributedElements:
         directors).
 
         The default mass of sets that provide ``element_mass(elements=slice)`` (element
-        mass matrices (ne, nd, nd) of a block, like ``element_arrays``; the membrane) and
-        of the whole-set ones comes through the tangent's assembler: each rank evaluates
-        the element masses of its share only (no full mass matrix on any rank), and the
-        mass has the tangent's pattern (the node blocks of the same elements), so that
-        K - sigma M of the eigen solve is a numeric refactorisation of the static solve's
-        analysis."""
+        mass matrices (ne, nd, nd) of a block, like ``element_arrays``; the membrane) comes
+        from each rank's element masses (no full mass matrix on any rank), their entries
+        where any element of the share has one (the membrane's node blocks are diagonal: 48
+        of 144), the other sets' from their assembled masses as above."""
         if M is None and self._M is not None:
             return self._M
-        if M is None and all(entries is not None or hasattr(e, "element_mass")
-                             for e, entries in zip(self.elements, self._entries)):
-            values = []
-            for e, share, entries in zip(self.elements, self._shares, self._entries):
-                if entries is None:
-                    values.append(e.element_mass(elements=share))
-                else:
-                    Ms = sp.csr_matrix(e.mass())
-                    Ms.sort_indices()
-                    values.append(_on_pattern(Ms, *entries).data[share])
-            self._M = self.assembler.matrix(*values)
-            return self._M
         keep = M is None
-        M = sp.csr_matrix(sum(e.mass() for e in self.elements) if keep else M)
-        M.sort_indices()
-        rows = np.repeat(np.arange(self.n), np.diff(M.indptr))
-        share = element_share(M.nnz, self.comm)
-        asm = DistributedAssembler([(np.stack([rows[share], M.indices[share]], axis=1), "entry")],
-                                   self.n, T=self.T, keep=self.free, comm=self.comm)
-        Md = asm.matrix(M.data[share])
+        if keep and all(entries is not None or hasattr(e, "element_mass")
+                        for e, entries in zip(self.elements, self._entries)):
+            groups, values = [], []
+            for e, entries, dofs, share in zip(self.elements, self._entries, self._dofs, self._shares):
+                if entries is None:
+                    Me = np.asarray(e.element_mass(elements=share))
+                    I, J = np.nonzero(np.any(Me != 0.0, axis=0))
+                    groups.append((np.stack([dofs[:, I].ravel(), dofs[:, J].ravel()], axis=1), "entry"))
+                    values.append(Me[:, I, J].ravel())
+                else:
+                    rows, cols, data = self._entry_share(e.mass())
+                    groups.append((np.stack([rows, cols], axis=1), "entry"))
+                    values.append(data)
+        else:
+            rows, cols, data = self._entry_share(sum(e.mass() for e in self.elements) if keep else M)
+            groups, values = [(np.stack([rows, cols], axis=1), "entry")], [data]
+        asm = DistributedAssembler(groups, self.n, T=self.T, keep=self.free, comm=self.comm)
+        Md = asm.matrix(*values)
         if keep:
             self._M = Md
         return Md
 
+    def _entry_share(self, M):
+        """(rows, cols, values) of this rank's share of the entries of a full matrix (n, n)."""
+        M = sp.csr_matrix(M)
+        M.sort_indices()
+        rows = np.repeat(np.arange(self.n), np.diff(M.indptr))
+        share = element_share(M.nnz, self.comm)
+        return rows[share], M.indices[share], M.data[share]
 
     def modes(self, K, M, *, k: int, sigma: float, backend):
         """The k lowest modes of (M omega^2 - K) phi = 0 (eq. 5.32) of a distributed tangent

@@ -532,7 +532,7 @@ class PetscBackend:
         if entry is None or not entry.symmetric or any(key.startswith("st_") for key in self.options) \
                 or any(key.startswith("st_") for key in self.PETSc.Options().getAll()):
             return None
-        subset = True if M.pattern is K.pattern else entry.mass_within.get(M.pattern)
+        subset = entry.mass_within.get(M.pattern)
         if subset is None:
             subset = entry.mass_within[M.pattern] = self._subset(M.mat, K.mat)
         return entry if subset else None
