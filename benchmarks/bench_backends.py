@@ -9,7 +9,10 @@ Configurations (each run in a fresh process, so that peak memory is per run):
            all elements)
   petsc2   the same under ``mpiexec -n 2``: each rank evaluates and assembles half of the
            membrane elements into one parallel matrix; MUMPS on both ranks; eigen: SLEPc
-           on the parallel factors
+           on the parallel factors (``petscP``: P ranks)
+The static solves run tmfem's trust-region Newton on the backend's factorisations (the
+timing wrapper has no SNES of its own), so that every factorisation and solve is timed; the
+SNES path of ``--backend petsc`` runs the same factorisations in about as many iterations.
 Columns: free DOFs, iterations of the static solve on the finest mesh, time per iteration
 (static time over all iterations, mesh sequencing from n = 10 included), static time, eigen
 time, time inside the backend's factorisations (incl. MUMPS/SuperLU analysis; their number)
@@ -47,6 +50,11 @@ class TimedBackend:
         self.t_factor = self.t_solve = self.t_eig = 0.0
         self.c_factor = self.c_solve = 0.0          # CPU time of this process
         self.n_factor = 0
+        self.mumps = None
+
+    def release_retired(self):
+        if hasattr(self.inner, "release_retired"):
+            self.inner.release_retired()
 
     def factorize(self, A):
         t, c = time.perf_counter(), time.process_time()
@@ -54,6 +62,7 @@ class TimedBackend:
         self.t_factor += time.perf_counter() - t
         self.c_factor += time.process_time() - c
         self.n_factor += 1
+        self.mumps = mumps_work(self.inner) or self.mumps
 
         def timed(b):
             t, c = time.perf_counter(), time.process_time()
@@ -68,6 +77,24 @@ class TimedBackend:
         out = self.inner.eigsh(K, M, k, sigma)
         self.t_eig += time.perf_counter() - t
         return out
+
+
+def mumps_work(backend) -> dict | None:
+    """Work of the last MUMPS factorisation of a PETSc backend: elimination flops and factor
+    entries of this rank (RINFO(3), INFO(9)) and of all ranks (RINFOG(3), INFOG(9))."""
+    cache = getattr(backend, "_cache", None)
+    if not cache:
+        return None
+    entry = max(cache.values(), key=lambda e: e.serial)
+    pc = entry.ksp.getPC()
+    if pc.getFactorSolverType() != "mumps":
+        return None
+    F = pc.getFactorMatrix()
+
+    def count(v):                      # MUMPS: a negative count is in millions
+        return float(-v * 1e6 if v < 0 else v)
+    return dict(flops=F.getMumpsRinfo(3), flops_total=F.getMumpsRinfog(3),
+                entries=count(F.getMumpsInfo(9)), entries_total=count(F.getMumpsInfog(9)))
 
 
 #: the columns of the second table (rank 0's static time by phase)
@@ -144,8 +171,13 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     t3, c3 = time.perf_counter(), time.process_time()
     its = (res.level_iterations or [res.iterations])[-1]
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    mumps = be.mumps
     if comm is not None:
-        rss = comm.allreduce(rss, op=__import__("mpi4py").MPI.MAX)
+        MAX = __import__("mpi4py").MPI.MAX
+        rss = comm.allreduce(rss, op=MAX)
+        if mumps is not None:          # the largest rank's share of the work
+            mumps = dict(mumps, flops=comm.allreduce(mumps["flops"], op=MAX),
+                         entries=comm.allreduce(mumps["entries"], op=MAX))
     return dict(config=config, ranks=size, mesh=f"4x{mesh}x{mesh}", dofs=m.ndof, build_s=t1 - t0,
                 iterations=its, total_iterations=res.iterations, s_per_it=(t2 - t1) / res.iterations,
                 static_s=t2 - t1, eigen_s=t3 - t2, factor_s=be.t_factor, n_factor=be.n_factor,
@@ -153,7 +185,7 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
                 static_factor_s=f_static, static_cpu_factor_s=c_static, static_solve_s=s_static,
                 static_cpu_solve_s=cs_static, cpu_s=c3 - c1, cpu_static_s=c2 - c1,
                 cpu_eigen_s=c3 - c2, cpu_phases=cpu_phases, wall_phases=wall_phases, rss_mb=rss,
-                f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0])
+                f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0], mumps=mumps)
 
 
 def launch(mesh: int, config: str, args) -> dict:
@@ -162,8 +194,9 @@ def launch(mesh: int, config: str, args) -> dict:
     env["OPENBLAS_NUM_THREADS"] = "1"
     cmd = [sys.executable, HERE, "--run", str(mesh), config, "--rest-length", str(args.rest_length),
            "--sequence", str(args.sequence)]
-    if config == "petsc2":
-        cmd = ([shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", "2"]
+    ranks = int(config[5:] or 1) if config.startswith("petsc") else 1     # petscP: P ranks
+    if ranks > 1:
+        cmd = ([shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", str(ranks)]
                + (["--mca", "mpi_yield_when_idle", "1"] if args.mpi_yield else []) + cmd)
     p = subprocess.run(cmd, capture_output=True, text=True, env=env)
     if p.returncode != 0:

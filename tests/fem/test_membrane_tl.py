@@ -215,6 +215,13 @@ def test_consistent_mass(mem):
     from skfem.helpers import dot
     Mf = BilinearForm(lambda u, v, w: KAPTON.rho * KAPTON.h * dot(u, v)).assemble(mem.basis)
     assert abs(M - Mf).max() <= 1e-14 * abs(Mf).max()
+    # the element mass matrices of two blocks of elements assemble to the same matrix
+    from tmfem.fem.assembly import Assembler, element_dofs
+    half = mem.ne // 2
+    Me = np.concatenate([mem.element_mass(elements=slice(0, half)),
+                         mem.element_mass(elements=slice(half, None))])
+    Ma = Assembler(element_dofs(mem.skmesh.t, 3), mem.ndof).matrix(Me)
+    assert abs(Ma - Mf).max() <= 1e-14 * abs(Mf).max()
 
 
 def test_gauss_points_and_area_from_the_kernel_arrays(mem):
@@ -261,8 +268,15 @@ def test_gauss_arrays_equal_scikit_fem_basis(mem):
     # source: scikit-fem's Basis(mesh, ElementQuad1(), intorder=3) on the distorted mesh
     from skfem import Basis, ElementQuad1
     sb = Basis(mem.skmesh, ElementQuad1(), intorder=3)
+    N, dN, dx = mem._gauss(slice(None))
     for k in range(4):
-        np.testing.assert_allclose(mem._N[k], np.asarray(sb.basis[k][0]), atol=1e-14)
-        np.testing.assert_allclose(mem._dN[k], np.array(sb.basis[k][0].grad), rtol=1e-12,
-                                   atol=1e-12 * np.abs(mem._dN).max())
-    np.testing.assert_allclose(mem._dx, np.array(sb.dx), rtol=1e-13)
+        np.testing.assert_allclose(N[k], np.asarray(sb.basis[k][0]), atol=1e-14)
+        np.testing.assert_allclose(dN[k], np.array(sb.basis[k][0].grad), rtol=1e-12,
+                                   atol=1e-12 * np.abs(dN).max())
+    np.testing.assert_allclose(dx, np.array(sb.dx), rtol=1e-13)
+    # a block of elements: the same values (the arrays a rank of a distributed assembly keeps)
+    mem._gauss_cache = None
+    part = mem._gauss(slice(3, 7))
+    for whole, block, axis in zip((N, dN, dx), part, (1, 2, 0)):
+        np.testing.assert_allclose(block, np.take(whole, range(3, 7), axis=axis), rtol=1e-15, atol=0)
+    assert mem._gauss_cache[:2] == (3, 7)

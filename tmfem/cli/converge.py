@@ -131,7 +131,8 @@ def format_text(r: dict) -> str:
     if not rows:
         return "no runs"
     nf = sum(1 for k in rows[0] if k.startswith("f") and k[1:].isdigit())
-    head = f"{'n':>3s} {'k':>2s} {'elem':>6s} {'dofs':>7s} {'Delta mm':>9s} {'sp1 MPa':>8s} {'vm MPa':>8s} " \
+    head = f"{'n':>3s} {'k':>2s} {'elem':>6s} {'dofs':>7s} {'backend':>7s} {'Delta mm':>9s} " \
+           f"{'sp1 MPa':>8s} {'vm MPa':>8s} " \
            + " ".join(f"{'f' + str(i + 1):>7s}" for i in range(nf))
     fixed = r.get("rest_lengths")
     lines = [f"{r['system']} {r.get('model', 'mtc').upper()} convergence, {r['attachment']} attachment, "
@@ -140,6 +141,7 @@ def format_text(r: dict) -> str:
              + (": " + shorten(f"{k}={v:.5f} m" for k, v in fixed.items()) if fixed else ""), head]
     for w in rows:
         lines.append(f"{w['mesh_n']:3d} {w['tendon_elements']:2d} {w['elements']:6d} {w['dofs']:7d} "
+                     f"{w.get('backend', ''):>7s} "
                      f"{w['Delta_mm']:9.4f} {w['sigma_p1_max_MPa']:8.3f} {w['von_mises_max_MPa']:8.3f} "
                      + " ".join(f"{w[f'f{i + 1}']:7.4f}" for i in range(nf)))
     fit = r.get("fit")

@@ -7,7 +7,7 @@ import numpy as np
 
 from tmfem.cli.common import (add_model_args, add_system_args, check_frames, check_time_steps,
                               finite_float, model_from_args, parse_perturbation, positive_int,
-                              progress_bar, say)
+                              progress_bar, say, with_backend)
 from tmfem.errors import InputError
 from tmfem.simulation.vibration import model_free_vibration
 from tmfem.system.collapse import check_equilibrium
@@ -60,10 +60,11 @@ def run(args) -> dict:
                                    scheme=args.scheme, progress=bar, vtk_dir=args.vtk,
                                    vtk_every=args.vtk_every)
     title = f"{system.name} {name} free vibration, {size}"
-    return {"system": system.name, "model": spec.name, **model.describe(), "t_end": args.t_end,
-            "dt": args.dt, "perturbation": pert, "scheme": args.scheme,
-            **{o.name: options[o.name] for o in spec.options if o.stage == "dynamics"},
-            "static_time_s": eq.time, **_run_summary(res, args, title=title), **res.summary()}
+    out = {"system": system.name, "model": spec.name, **model.describe(), "t_end": args.t_end,
+           "dt": args.dt, "perturbation": pert, "scheme": args.scheme,
+           **{o.name: options[o.name] for o in spec.options if o.stage == "dynamics"},
+           "static_time_s": eq.time, **_run_summary(res, args, title=title), **res.summary()}
+    return with_backend(out, model) if spec.uses_backend else out
 
 
 def _run_summary(res, args, *, title: str) -> dict:
@@ -106,7 +107,7 @@ def format_text(r: dict) -> str:
 
 def _format_fe(r: dict) -> str:
     lines = [f"{r['system']} {r['model'].upper()} free vibration ({r['ndof']} DOFs): {r['steps']} steps of "
-             f"{r['dt']} s ({r['scheme']}), {r['wall_time_s']:.2f} s wall (static "
+             f"{r['dt']} s ({r['scheme']}, backend {r['backend']}), {r['wall_time_s']:.2f} s wall (static "
              f"{r['static_time_s']:.2f} s), {r['newton_iterations']} Newton iterations, "
              f"{r['jacobian_evaluations']} Jacobians",
              "perturbation: " + ", ".join(f"{k}={v:g}" for k, v in r["perturbation"].items()),

@@ -45,6 +45,9 @@ def for_backend(backend, elements, state0, T, free):
     or under ``mpiexec``), else None (the model assembles scipy matrices)."""
     if not getattr(backend, "distributed_assembly", False):
         return None
+    release = getattr(backend, "release_retired", None)
+    if release is not None:
+        release()                   # the factors of a model gone (a coarse level) go first
     return DistributedElements(elements, state0, T, free)
 
 
@@ -75,14 +78,17 @@ class DistributedElements:
         self.n = self.elements[0].dofmap.ndof
         self.T, self.free = sp.csr_matrix(T), np.asarray(free, bool)
         self.root = self.comm.rank == 0
-        groups, self._shares, self._entries = [], [], []
+        groups, self._shares, self._entries, self._dofs = [], [], [], []
         for e in self.elements:
             if _shares(e):
                 dofs = np.asarray(e.element_dofs)
                 share = element_share(dofs.shape[0], self.comm)
-                groups.append((dofs[share], "element"))
+                mine = dofs[share].copy()          # this rank's elements only are kept
+                del dofs
+                groups.append((mine, "element"))
                 self._shares.append(share)
                 self._entries.append(None)
+                self._dofs.append(mine)
             else:
                 K0 = _structure(e.internal(state0, tangent=True)[1])
                 share = element_share(K0.nnz, self.comm)
@@ -90,6 +96,7 @@ class DistributedElements:
                 groups.append((np.stack([rows[share], K0.indices[share]], axis=1), "entry"))
                 self._shares.append(share)
                 self._entries.append((K0.indptr.copy(), K0.indices.copy()))
+                self._dofs.append(None)
         self.assembler = DistributedAssembler(groups, self.n, T=self.T, keep=self.free,
                                               comm=self.comm)
         self._K = []
@@ -110,11 +117,10 @@ class DistributedElements:
         rotations)."""
         f = np.zeros(self.n)
         values = []
-        for e, share, entries in zip(self.elements, self._shares, self._entries):
+        for e, share, entries, dofs in zip(self.elements, self._shares, self._entries, self._dofs):
             if entries is None:
                 fe, Ke = e.element_arrays(state, tangent=tangent, elements=share)
-                f += np.bincount(np.asarray(e.element_dofs)[share].ravel(), weights=fe.ravel(),
-                                 minlength=self.n)
+                f += np.bincount(dofs.ravel(), weights=fe.ravel(), minlength=self.n)
                 if tangent and symmetric:
                     Ke = 0.5 * (Ke + np.swapaxes(Ke, 1, 2))
                 values.append(Ke)
@@ -158,21 +164,45 @@ class DistributedElements:
         (n, n), the same on every rank, its entries shared out over the ranks; by default
         the sum of the sets' masses, assembled once and kept (pass M for a mass that
         depends on the state: the rotary inertia of shells and beams at the current
-        directors)."""
+        directors).
+
+        The default mass of sets that provide ``element_mass(elements=slice)`` (element
+        mass matrices (ne, nd, nd) of a block, like ``element_arrays``; the membrane) comes
+        from each rank's element masses (no full mass matrix on any rank), their entries
+        where any element of the share has one (the membrane's node blocks are diagonal: 48
+        of 144), the other sets' from their assembled masses as above."""
         if M is None and self._M is not None:
             return self._M
         keep = M is None
-        M = sp.csr_matrix(sum(e.mass() for e in self.elements) if keep else M)
-        M.sort_indices()
-        rows = np.repeat(np.arange(self.n), np.diff(M.indptr))
-        share = element_share(M.nnz, self.comm)
-        asm = DistributedAssembler([(np.stack([rows[share], M.indices[share]], axis=1), "entry")],
-                                   self.n, T=self.T, keep=self.free, comm=self.comm)
-        Md = asm.matrix(M.data[share])
+        if keep and all(entries is not None or hasattr(e, "element_mass")
+                        for e, entries in zip(self.elements, self._entries)):
+            groups, values = [], []
+            for e, entries, dofs, share in zip(self.elements, self._entries, self._dofs, self._shares):
+                if entries is None:
+                    Me = np.asarray(e.element_mass(elements=share))
+                    I, J = np.nonzero(np.any(Me != 0.0, axis=0))
+                    groups.append((np.stack([dofs[:, I].ravel(), dofs[:, J].ravel()], axis=1), "entry"))
+                    values.append(Me[:, I, J].ravel())
+                else:
+                    rows, cols, data = self._entry_share(e.mass())
+                    groups.append((np.stack([rows, cols], axis=1), "entry"))
+                    values.append(data)
+        else:
+            rows, cols, data = self._entry_share(sum(e.mass() for e in self.elements) if keep else M)
+            groups, values = [(np.stack([rows, cols], axis=1), "entry")], [data]
+        asm = DistributedAssembler(groups, self.n, T=self.T, keep=self.free, comm=self.comm)
+        Md = asm.matrix(*values)
         if keep:
             self._M = Md
         return Md
 
+    def _entry_share(self, M):
+        """(rows, cols, values) of this rank's share of the entries of a full matrix (n, n)."""
+        M = sp.csr_matrix(M)
+        M.sort_indices()
+        rows = np.repeat(np.arange(self.n), np.diff(M.indptr))
+        share = element_share(M.nnz, self.comm)
+        return rows[share], M.indices[share], M.data[share]
 
     def modes(self, K, M, *, k: int, sigma: float, backend):
         """The k lowest modes of (M omega^2 - K) phi = 0 (eq. 5.32) of a distributed tangent
@@ -200,8 +230,8 @@ def _on_pattern(K: sp.csr_matrix, indptr, indices) -> sp.csr_matrix:
     n = K.shape[1]
     keys = np.repeat(np.arange(K.shape[0]), np.diff(indptr)) * n + indices
     kk = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)) * n + K.indices
-    pos = np.minimum(np.searchsorted(keys, kk), keys.size - 1)
-    if keys.size == 0 or np.any(keys[pos] != kk):
+    pos = np.minimum(np.searchsorted(keys, kk), max(keys.size - 1, 0))
+    if kk.size and (keys.size == 0 or np.any(keys[pos] != kk)):
         raise InputError(f"distributed assembly: expected the tangent of an element set on its "
                          f"pattern of {indices.size} entries, found entries outside it")
     data = np.zeros(indices.size)

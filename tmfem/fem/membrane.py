@@ -79,7 +79,7 @@ def _q1_gauss_arrays(p: np.ndarray, t: np.ndarray):
     element and quadrature (so the values equal those of ``Basis(mesh, ElementQuad1(),
     intorder=3)``), evaluated in closed form on the elements (the Basis object holds ~10 kB
     per element, 4 GB transient at 4 x 320 x 320): J_ia = sum_k X_i(node k) dphi_k/dxi_a,
-    dN_k = J^-T dphi_k."""
+    dN_k = J^-T dphi_k. N is the same on every element (a broadcast view, no copy)."""
     from skfem import ElementQuad1
     from skfem.quadrature import get_quadrature
     from skfem.refdom import RefQuad
@@ -92,7 +92,7 @@ def _q1_gauss_arrays(p: np.ndarray, t: np.ndarray):
     det = J[0, 0] * J[1, 1] - J[0, 1] * J[1, 0]
     Jinv = np.stack([np.stack([J[1, 1], -J[0, 1]]), np.stack([-J[1, 0], J[0, 0]])]) / det
     dN = np.einsum("kaq,aieq->kieq", dphi, Jinv)                      # Jinv[a, i] = dxi_a/dX_i
-    N = np.broadcast_to(phi[:, None, :], (4, t.shape[1], Xq.shape[1])).copy()
+    N = np.broadcast_to(phi[:, None, :], (4, t.shape[1], Xq.shape[1]))
     return N, dN, np.abs(det) * Wq
 
 
@@ -205,7 +205,8 @@ class MembraneTL:
         self.X = np.vstack([p, np.zeros((1, self.nn))])
         self.law = membrane_law(law, material)
         self._M = None
-        self._N, self._dN, self._dx = _q1_gauss_arrays(p, t)
+        self.ne = t.shape[1]
+        self._gauss_cache = None
         self._asm_cache = None
         if not np.array_equal(np.asarray(self.skmesh.t), np.asarray(mesh.t)):
             raise RuntimeError("scikit-fem reordered the quadrilateral connectivity")
@@ -222,6 +223,25 @@ class MembraneTL:
                                    "node-interleaved nodal_dofs (dof = 3 node + component)")
             self._basis = basis
         return self._basis
+
+    def _gauss(self, elements: slice, *, keep: bool = True):
+        """Shape functions N (4, ne, nqp), gradients dN (4, 2, ne, nqp) and weights dx
+        (ne, nqp) of the ``elements`` (a slice; :func:`_q1_gauss_arrays`). The arrays of the
+        last block asked for that the kept ones do not cover are kept (with ``keep``): a
+        rank of a distributed assembly, which asks for its own share only, holds the data
+        of its own elements only (~0.4 kB per element)."""
+        lo, hi, step = elements.indices(self.ne)
+        need = (lo, hi) if step == 1 else (0, self.ne)
+        c = self._gauss_cache
+        if c is None or need[0] < c[0] or need[1] > c[1]:
+            arrays = _q1_gauss_arrays(np.asarray(self.mesh.p, dtype=float),
+                                      np.asarray(self.mesh.t)[:, need[0]:need[1]])
+            c = (*need, *arrays)
+            if keep:
+                self._gauss_cache = c
+        at = slice(lo - c[0], hi - c[0]) if step == 1 else np.arange(lo, hi, step)
+        N, dN, dx = c[2:]
+        return N[:, at], dN[:, :, at], dx[at]
 
     # ------------------------------------------------------------------ kinematics
     def _check_x(self, x) -> np.ndarray:
@@ -240,7 +260,7 @@ class MembraneTL:
     def _strain_u(self, u, elements: slice):
         """:meth:`strain` from the displacements u = x - X (3, nn)."""
         ue = u[:, self.skmesh.t[:, elements]]                           # (3, 4, ne)
-        F = np.einsum("ike,kaeq->iaeq", ue, self._dN[:, :, elements], optimize=True)
+        F = np.einsum("ike,kaeq->iaeq", ue, self._gauss(elements)[1], optimize=True)
         F[0, 0] += 1.0
         F[1, 1] += 1.0
         C = np.einsum("ia...,ib...->ab...", F, F)
@@ -262,7 +282,7 @@ class MembraneTL:
         ``elements`` (a slice; default all)."""
         _, Eg = self.strain(x, elements=elements)
         dens = self.law.energy_density(Eg)
-        return self.material.h * float(np.sum(dens * self._dx[elements]))
+        return self.material.h * float(np.sum(dens * self._gauss(elements)[2]))
 
     def wrinkling(self, x) -> dict:
         """State of each element under the mixed criterion of the law
@@ -308,7 +328,8 @@ class MembraneTL:
         the kernel's temporaries (~7 kB per element) stay chunk-sized.
         """
         u = self._check_x(x) - self.X
-        lo, hi, step = elements.indices(self.skmesh.t.shape[1])
+        self._gauss(elements)               # the block's quadrature data, for all its chunks
+        lo, hi, step = elements.indices(self.ne)
         ne = max(hi - lo, 0)
         if ne <= KERNEL_CHUNK or step != 1:
             return self._element_arrays(u, tangent, elements)
@@ -327,7 +348,7 @@ class MembraneTL:
         F, Eg = self._strain_u(u, elements)
         S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
-        dN, dx = self._dN[:, :, elements], self._dx[elements]
+        _, dN, dx = self._gauss(elements)
         P = h * np.einsum("ia...,ab...->ib...", F, S)                 # (3, 2, ne, nqp)
         fe = np.einsum("ibeq,kbeq,eq->eki", P, dN, dx).reshape(-1, 12)
         if not tangent:
@@ -370,8 +391,7 @@ class MembraneTL:
         N_k N_l dx_q (the 2 x 2 Gauss points of the kernels) times the 3 x 3 identity
         (kron with the node-interleaved dofs 3 node + component)."""
         if self._M is None:
-            rhoh = self.material.rho * self.material.h
-            me = rhoh * np.einsum("keq,leq,eq->ekl", self._N, self._N, self._dx)
+            me = self._node_mass()
             t = np.asarray(self.skmesh.t)
             rows = np.broadcast_to(t.T[:, :, None], me.shape).ravel()
             cols = np.broadcast_to(t.T[:, None, :], me.shape).ravel()
@@ -379,9 +399,21 @@ class MembraneTL:
             self._M = sp.kron(Ms, sp.identity(3), format="csr")
         return self._M
 
+    def _node_mass(self, elements: slice = slice(None)) -> np.ndarray:
+        """Scalar element mass blocks rho h sum_q N_k N_l dx_q (ne, 4, 4) of the ``elements``."""
+        rhoh = self.material.rho * self.material.h
+        N, _, dx = self._gauss(elements)
+        return rhoh * np.einsum("keq,leq,eq->ekl", N, N, dx)
+
+    def element_mass(self, *, elements: slice = slice(None)) -> np.ndarray:
+        """Element mass matrices (ne, 12, 12) of the ``elements``, local dofs node-major as in
+        :meth:`element_arrays`: the blocks of :meth:`_node_mass` times the 3 x 3 identity."""
+        me = self._node_mass(elements)
+        return np.einsum("ekl,ij->ekilj", me, np.eye(3)).reshape(-1, 12, 12)
+
     def area(self) -> float:
         """Reference area of the membrane."""
-        return float(np.sum(self._dx))
+        return float(np.sum(self._gauss(slice(None), keep=False)[2]))
 
     # ------------------------------------------------------------------ stresses
     def stresses(self, x) -> MembraneStresses:
@@ -407,7 +439,7 @@ class MembraneTL:
         U /= np.sqrt(C[0, 0] + C[1, 1] + 2.0 * j)
         sig = np.einsum("ab...,bc...,cd...->ad...", U, S, U) / J
         cauchy = np.stack([sig[0, 0], sig[1, 1], sig[0, 1]])
-        points = np.einsum("keq,jke->jeq", self._N, self.X[:2, self.skmesh.t])
+        points = np.einsum("keq,jke->jeq", self._gauss(slice(None))[0], self.X[:2, self.skmesh.t])
         return MembraneStresses(S=np.stack([S[0, 0], S[1, 1], S[0, 1]]),
                                 cauchy=cauchy, principal=principal_stresses(cauchy),
                                 von_mises=von_mises(cauchy), points=points)
@@ -423,8 +455,6 @@ class MembraneElement:
             raise InputError(f"membrane element: expected {membrane.nn} global nodes, found "
                              f"{nodes.shape}")
         self.membrane, self.nodes, self.dofmap = membrane, nodes, dofmap
-        t = np.asarray(membrane.skmesh.t)
-        self._dofs = dofmap.element_dofs(nodes[t])
         self._asm_cache = None
         self._M = None
 
@@ -438,7 +468,7 @@ class MembraneElement:
         """The CSR assembler on the global dofs, built on first use (the distributed
         assembly has its own)."""
         if self._asm_cache is None:
-            self._asm_cache = Assembler(self._dofs, self.dofmap.ndof)
+            self._asm_cache = Assembler(self.element_dofs, self.dofmap.ndof)
         return self._asm_cache
 
     def energy(self, state, *, elements: slice = slice(None)) -> float:
@@ -448,14 +478,20 @@ class MembraneElement:
     @property
     def element_dofs(self) -> np.ndarray:
         """(n_elements, 12) global dofs of each quadrilateral (its assembly numbering; the
-        share protocol of :class:`tmfem.fem.distributed.DistributedElements`)."""
-        return self._dofs
+        share protocol of :class:`tmfem.fem.distributed.DistributedElements`), evaluated on
+        each call (not kept: a distributed assembly keeps its share of them)."""
+        return self.dofmap.element_dofs(self.nodes[np.asarray(self.membrane.skmesh.t)])
 
     def element_arrays(self, state, *, tangent: bool = True, elements: slice = slice(None)):
         """Element forces (ne, 12) and tangents (ne, 12, 12) of the ``elements`` at ``state``
         (:meth:`MembraneTL.element_arrays`), local dofs ordered as :attr:`element_dofs`."""
         return self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent,
                                             elements=elements)
+
+    def element_mass(self, *, elements: slice = slice(None)) -> np.ndarray:
+        """Element mass matrices (ne, 12, 12) of the ``elements`` (:meth:`MembraneTL.element_mass`),
+        local dofs ordered as :attr:`element_dofs`."""
+        return self.membrane.element_mass(elements=elements)
 
     def mass(self) -> sp.csr_matrix:
         """Consistent mass (:meth:`MembraneTL.mass`) on the global dofs."""

@@ -24,7 +24,7 @@ ROW_KEYS = ("mesh_n", "tendon_elements", "attachment", "elements", "h", "dofs", 
             "static_s", "modal_s", "Delta_mm", "tendon_stress_max_MPa", "bar_load_max_N",
             "sigma_p1_max_MPa", "von_mises_max_MPa", "sigma_p1_elem_max_MPa",
             "von_mises_elem_max_MPa", "membrane_law", "wrinkled_fraction", "slack_fraction",
-            "model")
+            "model", "backend")
 
 
 #: Rest-length rule of a study of a system without rest lengths: the ch. 3 design of 6.2
@@ -135,7 +135,7 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
             row = {"mesh_n": int(n), "tendon_elements": int(k), "attachment": attachment,
                    "elements": ne, "h": float(np.sqrt(m.membrane_area() / ne)),
                    "dofs": vals.pop("dofs", m.ndof), "iterations": its, "static_s": t1 - t0,
-                   "modal_s": t2 - t1, **vals, "model": model}
+                   "modal_s": t2 - t1, **vals, "model": model, "backend": m.backend.name}
             for i, f in enumerate(freq):
                 row[f"f{i + 1}"] = float(f)
             if progress:

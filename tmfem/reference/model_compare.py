@@ -100,6 +100,7 @@ def model_frequencies(system, *, modes: int = 12, mesh_n: int = 10, tendon_eleme
     times["COM"] = time.perf_counter() - t0
     return {"freq_hz": {k: np.asarray(out[k], dtype=float) for k in MODELS}, "time_s": times,
             "settings": {"mesh_n": mesh_n, "tendon_elements": tendon_elements,
+                         "backend": {k: m.backend.name for k, m in fe.items()},
                          "rest_lengths": fe["MTC"].rest_lengths.tolist(),
                          "com_membrane_modes": com.K, "com_prestress_scale": com.prestress_scale}}
 
@@ -143,7 +144,8 @@ def format_compare(r: dict) -> str:
     s = r["settings"]
     head = (f"{r['system']}: SBC, MTC and COM natural frequencies [Hz]"
             + (f" beside {r['source']}" if r["printed"] else "")
-            + f" (mesh {s['mesh_n']}, {s['tendon_elements']} elements/tendon, COM K = "
+            + f" (mesh {s['mesh_n']}, {s['tendon_elements']} elements/tendon, backend "
+            + ", ".join(f"{k} {v}" for k, v in s["backend"].items()) + ", COM K = "
             f"{s['com_membrane_modes']}, prestress x{s['com_prestress_scale']:.4f})")
     if not r["printed"]:
         lines = [head, f"{'mode':>4} " + " ".join(f"{m + ' ours':>9}" for m in MODELS)

@@ -105,10 +105,10 @@ def three_model_vibration(system, *, t_end: float, dt: float = 0.01, perturb=Non
         if r.t.shape != t.shape:
             raise InputError(f"three-model vibration: {k} stopped at t = {r.t[-1]:.4g} s of {t[-1]:.4g} s")
     signals = {k: _signals(system, results[k], k) for k in MODELS}
-    return {"t": t, "signals": signals, "results": results,
-            "comparison": compare_histories(name, t, signals, system=system, perturb=pert,
-                                            results=results, static=static, mesh_n=mesh_n,
-                                            tendon_elements=tendon_elements)}
+    comparison = compare_histories(name, t, signals, system=system, perturb=pert, results=results,
+                                   static=static, mesh_n=mesh_n, tendon_elements=tendon_elements)
+    comparison["backend"] = {k: m.backend.name for k, m in fe.items()}
+    return {"t": t, "signals": signals, "results": results, "comparison": comparison}
 
 
 @contextmanager
@@ -167,7 +167,8 @@ def format_vibration_compare(c: dict, system) -> str:
     lines = [f"{c['system']}: free vibration in the three models, "
              + ", ".join(f"{k}={v:g}" for k, v in c["perturbation"].items())
              + f", {c['t_end']:g} s at dt = {c['dt']:g} s, FE mesh {c['mesh_n']}, "
-             f"{c['tendon_elements']} elements/tendon",
+             f"{c['tendon_elements']} elements/tendon"
+             + "".join(f", {k} backend {v}" for k, v in c.get("backend", {}).items()),
              f"{'signal':>22} {'SBC p-p':>11} {'MTC p-p':>11} {'COM p-p':>11} "
              f"{'rms diff vs SBC: MTC':>21} {'COM':>8} {'first ' + format(c['early_window_s'], 'g') + ' s: MTC':>17} "
              f"{'COM':>8}"]

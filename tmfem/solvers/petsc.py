@@ -30,6 +30,7 @@ SLEPc its ``eps_`` options (``-eps_tol``, ``-eps_ncv``).
 """
 from __future__ import annotations
 
+import gc
 import hashlib
 import logging
 import shlex
@@ -478,7 +479,15 @@ class PetscBackend:
         the arguments of :func:`tmfem.solvers.trust_region.trust_region_newton` with every
         dof free and a distributed tangent, the fields of its result as a dict)."""
         from tmfem.solvers.petsc_snes import snes_equilibrium
+        self.release_retired()
         return snes_equilibrium(self, residual, energy, u0, **kwargs)
+
+    def release_retired(self) -> None:
+        """Free the factorisations (MUMPS factors, SNES) of patterns that are gone, also of
+        models that went in a reference cycle (a coarse level of a mesh sequencing), before
+        a new model's matrices take their memory. Collective (every rank calls it)."""
+        gc.collect()
+        self._reap()
 
     # ------------------------------------------------------------------ eigenproblems
     def eigsh(self, K, M, k, sigma):

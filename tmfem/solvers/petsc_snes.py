@@ -135,6 +135,14 @@ class _Problem:
             log.debug("SNES: unsymmetric tangent, MUMPS LU")
         P.assemble()
 
+    def release(self) -> None:
+        """Drop the model's callbacks and matrices: the SNES, kept by the backend with its
+        factorisation, holds this object through its callbacks, and must not keep the model
+        (its assembler, whose lifetime ends the factorisation's: a coarse level of a mesh
+        sequencing) alive."""
+        self.residual = self.update = self.J = None
+        self.cache = {}
+
     def rebase(self, snes, its: int) -> None:
         """SNESSetUpdate: move the base to the current iterate and the increment to 0."""
         X = snes.getSolution()
@@ -263,6 +271,7 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         ksp = snes.getKSP()
         snes.cancelMonitor()
         backend.adopt(K, P, ksp, symmetric=ksp.getPC().getType() == "cholesky", owner=snes)
+        prob.release()
         F.destroy()
         X.destroy()
     rn = float(np.linalg.norm(r))

@@ -286,7 +286,8 @@ class MTCModel(FEModel, Tendons, Placement):
         free = self.free
         idx = {lab: self.topology.system_node[self.system.node_index(lab)] for lab in monitor}
         hist = {lab: [x[:, n].copy()] for lab, n in idx.items()}
-        Md = np.asarray(self.mass().diagonal())[free]
+        dist = self.distributed
+        Md = np.asarray(self.mass().diagonal())[free] if dist is None else dist.mass().diagonal()
 
         def record(it, xr, rn, mu, rho):
             xf = self.full(xr)
@@ -296,7 +297,6 @@ class MTCModel(FEModel, Tendons, Placement):
                 progress(it, rn, mu, rho)
 
         xr0 = self.reduce(x)
-        dist = self.distributed
         if dist is None:                   # unknowns: all independent positions xr
             residual, energy, u0, unknowns = self.residual, self.energy, xr0, free
 
