@@ -12,7 +12,7 @@ import copy
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.system.test_fuzz_spec import PRESETS, _check, _paths, _set, _toml_bytes
+from tests.system.test_fuzz_spec import PRESETS, _paths, _set, check_document
 
 TABLES = ("control", "deployment", "packaged", "lpv", "report", "monitor", "models")
 #: the presets that carry each table (every table is in at least one)
@@ -58,12 +58,7 @@ def table_documents(draw):
                                                                     HealthCheck.function_scoped_fixture])
 @given(doc=table_documents())
 def test_problem_tables_load_or_raise_tmfem_error(tmp_path, doc):
-    data = _toml_bytes(doc)
-    if data is None:
-        return
-    p = tmp_path / "fuzz.toml"
-    p.write_bytes(data)
-    _check(p)
+    check_document(tmp_path, doc)
 
 
 def test_every_table_is_fuzzed():

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane
+from tmfem.errors import InputError, SlackMembrane
 
 
 def symmetric_parameters(system, what: str):

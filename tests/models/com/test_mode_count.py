@@ -66,7 +66,8 @@ def test_a_band_that_no_k_brings_within_tolerance_is_named(caplog):
 def test_the_file_decides_when_it_declares_k(kapton):
     """`[models.com] membrane_modes` wins: no search (source "file"), the model records it."""
     s = load_preset("1-4")
-    assert mode_count.membrane_mode_choice(s, model_class=ControlOrientedModel).source == "file" and default_membrane_modes(s) == 5
+    assert mode_count.membrane_mode_choice(s, model_class=ControlOrientedModel).source == "file"
+    assert default_membrane_modes(s) == 5
     import dataclasses
     declared = dataclasses.replace(kapton, model_defaults={"com": {"membrane_modes": 6}})
     m = ControlOrientedModel(declared, output_points=[])
