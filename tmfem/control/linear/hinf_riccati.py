@@ -220,14 +220,16 @@ def invariant_zeros(A, B, C, D) -> np.ndarray:
     """Invariant zeros of (A, B, C, D): the finite s where the Rosenbrock pencil
     [[A - s I, B], [C, D]] loses rank, by SLICOT AB08ND (the reduction python-control's
     ``zeros`` uses) and the generalized eigenvalues of its reduced pencil. The workspace is
-    SLICOT's documented minimum, max(1, min(p, m) + max(3 m - 1, n), min(p, n) + max(3 p - 1,
-    n + p, n + m)); slycot's default, n + 3 max(m, p), is below it when n < min(p, m) - 1."""
+    at least SLICOT's documented minimum, max(1, min(p, m) + max(3 m - 1, n), min(p, n) +
+    max(3 p - 1, n + p, n + m)), and slycot's default, n + 3 max(m, p), which the wrapper also
+    requires but which is below that minimum when n < min(p, m) - 1."""
     import scipy.linalg as sla
     from slycot import ab08nd
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     if n == 0:
         return np.zeros(0, dtype=complex)
-    ldwork = max(1, min(p, m) + max(3 * m - 1, n), min(p, n) + max(3 * p - 1, n + p, n + m))
+    ldwork = max(1, min(p, m) + max(3 * m - 1, n), min(p, n) + max(3 * p - 1, n + p, n + m),
+                 n + 3 * max(m, p))
     out = ab08nd(n, m, p, A, B, C, D, ldwork=ldwork)
     nu = out[0]
     if nu == 0:
