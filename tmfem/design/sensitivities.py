@@ -82,6 +82,9 @@ RESPONSES = {
     "membrane_von_mises": ("KS aggregate of the von Mises stress (eq. 5.30), >= its maximum", "Pa"),
     "membrane_min_principal": ("KS aggregate of the minor principal stress (eq. 5.29) inside "
                                "the aperture, <= its minimum; >= 0: no wrinkling", "Pa"),
+    "wrinkled_area": ("smoothed area where the minor principal stress is below zero, sum_g "
+                      "H_w(-sigma_2) dA_g (logistic H_w of width `wrinkle_width`); -> the tension-field "
+                      "law's wrinkled and slack area as w -> 0", "m^2"),
     "corner_delta": ("corner displacements Delta_j of the membrane corners, vector", "m"),
     "corner_delta_max": ("largest corner displacement Delta", "m"),
     "surface_rms": ("RMS distance of the membrane from its best-fit plane", "m"),
@@ -360,7 +363,7 @@ def total_mass(model) -> float:
 def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int = 4,
                          node: str | None = None, axis: int = 2, thickness: bool = False,
                          aperture: float | None = None, ks_width: float | None = None,
-                         step: float = 1e-4) -> Sensitivities:
+                         wrinkle_width: float | None = None, step: float = 1e-4) -> Sensitivities:
     """Responses of an MTC or SBC model at its static equilibrium and their exact derivatives
     with respect to the design variables (module docstring: direct method, eigenvalue and
     cluster derivatives; :mod:`tmfem.design.kinematics` for the SBC model's rotations).
@@ -389,6 +392,9 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     ks_width : float, optional
         Width w of the KS aggregates of the membrane stresses [Pa] (default 1e-6 E of the
         membrane: within w ln(n) of the extreme of n Gauss points).
+    wrinkle_width : float, optional
+        Width w of the smooth step of the wrinkled area ``wrinkled_area`` [Pa] (default
+        1e-6 E of the membrane; :func:`tmfem.design.responses.smooth_step`).
     step : float
         Relative step of the directional central difference of the tangent.
     """
@@ -410,6 +416,9 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     width = 1e-6 * model.system.membrane.E if ks_width is None else ks_width
     if not (isinstance(width, (int, float)) and width > 0):
         raise InputError(f"ks_width: expected a positive stress [Pa], found {ks_width!r}")
+    wrinkle_w = 1e-6 * model.system.membrane.E if wrinkle_width is None else wrinkle_width
+    if not (isinstance(wrinkle_w, (int, float)) and wrinkle_w > 0):
+        raise InputError(f"wrinkle_width: expected a positive stress [Pa], found {wrinkle_width!r}")
     node_at = None if node is None else model.topology.system_node[model.system.node_index(node)]
     vs = parse_variables(model.system, variables)
     if thickness and "h_membrane" not in [v.name for v in vs]:
@@ -548,8 +557,11 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
 
     moved = {j: radius_fields(j) for j, v in enumerate(vs) if v.kind == "membrane_radius"}
     for name, (val, grad) in membrane_aggregates(model, kin, du, width=width, aperture=aperture,
-                                                 moved=moved).items():
+                                                 wrinkle_width=wrinkle_w, moved=moved).items():
         values[name], grads[name] = val, grad
+    # the Gauss points' areas scale with r_mb^2: d(sum H dA) = sum dH dA + 2 A_w / r_mb
+    for j in (j for j, v in enumerate(vs) if v.kind == "membrane_radius"):
+        grads["wrinkled_area"][j] += 2.0 * values["wrinkled_area"] / model.system.r_mb
     values["surface_rms"], grads["surface_rms"] = surface_rms(model, x, dx)
     if position is not None:
         values["position"], grads["position"] = position, d_position
