@@ -14,13 +14,22 @@ the model's own numbering, (3, n)), ``point(du)`` (the residual's argument after
 increment du), ``tangent(point)``, ``mass(point)`` (the MTC model's does not depend on it),
 ``positions(du)`` (the translations (3, n) of a reduced increment), ``membrane(point)`` (von
 Mises and minor principal stresses and the reference points (2, ne, nqp) where they are
-evaluated) and, for the SBC model, ``bar_forces(point)``.
+evaluated), ``areas()`` (the reference areas dA_g (ne, nqp) of those points: the MTC
+membrane's Gauss weights |det J| w; the SBC shells' element areas / 4, their Gauss points
+being those of the same 2 x 2 rule on the same mesh) and, for the SBC model,
+``bar_forces(point)``.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from tmfem.design.responses import minor_principal
+from tmfem.fem.membrane import _q1_gauss_arrays
+
+
+def _gauss_areas(mesh) -> np.ndarray:
+    """Reference areas |det J| w (ne, 4) of the 2 x 2 Gauss points of the quadrilateral ``mesh``."""
+    return _q1_gauss_arrays(np.asarray(mesh.p, dtype=float), np.asarray(mesh.t))[2]
 
 
 class MTCKinematics:
@@ -48,6 +57,9 @@ class MTCKinematics:
     def membrane(self, point):
         st = self.model.membrane.stresses(self.model.full(point)[:, :self.n_mesh])
         return st.von_mises, minor_principal(st.cauchy), st.points
+
+    def areas(self) -> np.ndarray:
+        return _gauss_areas(self.model.topology.mesh)
 
 
 class SBCKinematics:
@@ -81,6 +93,9 @@ class SBCKinematics:
         from tmfem.models.sbc.post import shell_stresses
         g = shell_stresses(self.model, point)["gauss"]
         return g["von_mises"][1], g["sigma_p2"][1], self._points
+
+    def areas(self) -> np.ndarray:
+        return np.repeat(_gauss_areas(self.model.topology.mesh).mean(axis=1, keepdims=True), 4, axis=1)
 
     def bar_forces(self, point) -> np.ndarray:
         return self.model.member_forces(point)["bar"]

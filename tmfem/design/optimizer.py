@@ -195,7 +195,7 @@ def optimize(system, *, objective: str, constraints=(), variables=None, model: s
     variables : dict {name: (lower, upper)}, optional
         Design variables and bounds; default the system file's ``[design] variables``.
     model : {"mtc", "sbc"}
-        The finite-element model (the SBC model: no membrane radius, no angles).
+        The finite-element model (the SBC model: no angles).
     mesh_n : int
         Membrane elements per side of the MTC model.
     k : int

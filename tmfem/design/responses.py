@@ -19,6 +19,15 @@ dependence is added by :func:`tmfem.design.sensitivities.design_sensitivities`.
   1e-4 of the model's size: the membrane strains are small (1e-6 to 1e-4) and formed from
   F^T F - I, so a smaller step loses digits to rounding (1e-7: 1e-4 relative), while at 1e-4
   the extrapolated difference agrees with 3e-5 and 3e-4 to 1e-9.
+* :func:`smooth_step`: the logistic H_w(s) = 1 / (1 + exp(-s / w)) of width w, a smooth
+  Heaviside step (H_w -> 1 for s >> w, 0 for s << -w, H_w(0) = 1/2). The wrinkled area
+  A_w = sum_g H_w(-sigma_2,g) dA_g over the membrane's Gauss points (dA_g their reference
+  areas) is a smooth measure of the area where the minor principal stress is below zero;
+  where sigma_2 is the elastic (SVK) law's, its sign is the tension-field law's criterion
+  (:mod:`tmfem.fem.tension_field`: taut iff S_2 > 0, and U S U / J has the signs of S), so
+  A_w tends to the tension-field law's wrinkled-and-slack area at the same state as w -> 0,
+  with an error bounded by the area of the points with |sigma_2| below a few w. Its
+  derivative, sum_g -H_w'(-sigma_2,g) dsigma_2,g dA_g, is differenced as the aggregates are.
 * :func:`surface_rms`: the RMS distance of the membrane from its best-fit plane,
   rms = sqrt(lambda_min(C)), C = sum_i w_i (x_i - xbar)(x_i - xbar)^T / sum w (w_i the nodal
   areas of the lumped membrane mass); d lambda_min = n^T dC n with n the plane's normal.
@@ -28,6 +37,7 @@ dependence is added by :func:`tmfem.design.sensitivities.design_sensitivities`.
 from __future__ import annotations
 
 import numpy as np
+from scipy.special import expit
 
 from tmfem.errors import InputError
 from tmfem.system.topology import label
@@ -41,6 +51,13 @@ def ks_max(g: np.ndarray, width: float):
     e = np.exp((g - gm) / width)
     s = float(e.sum())
     return gm + width * np.log(s), e / s
+
+
+def smooth_step(s: np.ndarray, width: float):
+    """The logistic H_w(s) = 1 / (1 + exp(-s / w)) (module docstring) and its derivative
+    dH_w/ds = H_w (1 - H_w) / w."""
+    H = expit(np.asarray(s, dtype=float) / width)
+    return H, H * (1.0 - H) / width
 
 
 def minor_principal(cauchy: np.ndarray) -> np.ndarray:
@@ -64,10 +81,12 @@ def aperture_mask(model, points: np.ndarray, aperture: float | None) -> np.ndarr
 
 
 def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: float | None,
-                        moved=None) -> dict:
+                        wrinkle_width: float, moved=None) -> dict:
     """KS aggregates of the von Mises and (with -KS(-g)) the minor principal stress over
-    the membrane's Gauss points (the minor one inside the ``aperture``), and their
-    derivatives along the reduced increments du (n_red, n_var) (module docstring); ``kin``
+    the membrane's Gauss points (the minor one inside the ``aperture``), the wrinkled area
+    A_w of the smooth step of width ``wrinkle_width`` over the whole membrane, and their
+    derivatives along the reduced increments du (n_red, n_var) (module docstring), A_w's at
+    fixed Gauss-point areas dA_g (``kin.areas()``); ``kin``
     moves the model's state (:mod:`tmfem.design.kinematics`). ``moved``: {j: fields(step)},
     the stresses at the state and design moved by +-step along variable j, for a variable
     on which the stresses depend at fixed positions (the membrane radius). Returns
@@ -80,8 +99,11 @@ def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: f
                          f"found none on this mesh (enlarge the aperture or refine the mesh)")
     vm_ks, w_vm = ks_max(vm, width)
     mp_ks, w_mp = ks_max(-mp[inside], width)
+    areas = kin.areas()
+    H, dH = smooth_step(-mp, wrinkle_width)
+    w_wr = -(dH * areas).ravel()
     n_var = du.shape[-1]
-    d_vm, d_mp = np.zeros(n_var), np.zeros(n_var)
+    d_vm, d_mp, d_wr = np.zeros(n_var), np.zeros(n_var), np.zeros(n_var)
     size = float(np.ptp(kin.x, axis=1).max())
     for j in range(n_var):
         top = float(np.abs(kin.positions(du[:, j])).max())
@@ -96,9 +118,11 @@ def membrane_aggregates(model, kin, du: np.ndarray, *, width: float, aperture: f
             else:
                 vp, mpp, _ = kin.membrane(kin.point(step * du[:, j]))
                 vmn, mpn, _ = kin.membrane(kin.point(-step * du[:, j]))
-            diffs.append(np.array([w_vm @ (vp - vmn).ravel(), w_mp @ (mpp - mpn)[inside]]) / (2 * step))
-        d_vm[j], d_mp[j] = (4 * diffs[0] - diffs[1]) / 3
-    return {"membrane_von_mises": (vm_ks, d_vm), "membrane_min_principal": (-mp_ks, d_mp)}
+            diffs.append(np.array([w_vm @ (vp - vmn).ravel(), w_mp @ (mpp - mpn)[inside],
+                                   w_wr @ (mpp - mpn).ravel()]) / (2 * step))
+        d_vm[j], d_mp[j], d_wr[j] = (4 * diffs[0] - diffs[1]) / 3
+    return {"membrane_von_mises": (vm_ks, d_vm), "membrane_min_principal": (-mp_ks, d_mp),
+            "wrinkled_area": (float(np.sum(H * areas)), d_wr)}
 
 
 def surface_rms(model, x: np.ndarray, dx: np.ndarray):

@@ -1,5 +1,5 @@
-"""Exact design sensitivities of the MTC model (and, for the rest lengths, the thickness and the
-diameters, of the SBC model) at its static equilibrium.
+"""Exact design sensitivities of the MTC model (and, for all but the configuration angles, of
+the SBC model) at its static equilibrium.
 
 Variables p (:mod:`tmfem.design.variables`): tendon rest lengths, per group (``"S1"``,
 ``"V2"``: every tendon of the group moves together, r = r_0 + G p) or per tendon, the membrane
@@ -52,7 +52,7 @@ import scipy.linalg
 import scipy.sparse as sp
 
 from tmfem.design.configuration import design_rates, support_rates
-from tmfem.design.kinematics import MTCKinematics, kinematics
+from tmfem.design.kinematics import kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
 from tmfem.design.variables import (Variable, apply_design, area_derivative, parse_variables, variable_values,
                                     with_membrane_radius)
@@ -82,6 +82,9 @@ RESPONSES = {
     "membrane_von_mises": ("KS aggregate of the von Mises stress (eq. 5.30), >= its maximum", "Pa"),
     "membrane_min_principal": ("KS aggregate of the minor principal stress (eq. 5.29) inside "
                                "the aperture, <= its minimum; >= 0: no wrinkling", "Pa"),
+    "wrinkled_area": ("smoothed area where the minor principal stress is below zero, sum_g "
+                      "H_w(-sigma_2) dA_g (logistic H_w of width `wrinkle_width`); -> the tension-field "
+                      "law's wrinkled and slack area as w -> 0", "m^2"),
     "corner_delta": ("corner displacements Delta_j of the membrane corners, vector", "m"),
     "corner_delta_max": ("largest corner displacement Delta", "m"),
     "surface_rms": ("RMS distance of the membrane from its best-fit plane", "m"),
@@ -315,20 +318,23 @@ def rebuilt(model, system):
 
 
 def with_radius(model, r_mb: float):
-    """The MTC model of ``model``'s system with the membrane radius r_mb (same mesh density,
+    """The model (MTC or SBC) of ``model``'s system with the membrane radius r_mb (same mesh density,
     options and rest lengths): its membrane mesh is the same mesh scaled."""
     return rebuilt(model, model.system.replace(**with_membrane_radius(model.system, r_mb)))
 
 
 def _section_partials(model, v: Variable, state, Ncr: np.ndarray) -> _Partials:
-    """The :class:`_Partials` of a thickness or diameter variable v of the SBC model at
-    ``state``: the five-point central difference (8 (F(d) - F(-d)) - (F(2d) - F(-2d))) / 12d of
-    the residual, tangent, mass, member forces and total mass of the model rebuilt with
+    """The :class:`_Partials` of a thickness, diameter or membrane-radius variable v of the SBC
+    model at ``state``: the five-point central difference (8 (F(d) - F(-d)) - (F(2d) - F(-2d))) / 12d
+    of the residual, tangent, mass, member forces and total mass of the model rebuilt with
     p0 + k d, d = 1 % of p0. Exact (to rounding) for a polynomial of degree <= 4 in p: the
     beams' A, I, J go as d^2, d^4, d^4, the tendons' A as d^2; the degenerated shell's
-    thickness also enters its metric (not a polynomial): truncation O(d^4), about 1e-8."""
+    thickness also enters its metric (not a polynomial): truncation O(d^4), about 1e-8. The
+    membrane radius scales the shells' reference mesh at the fixed state (not a polynomial
+    either), with d = 1e-4 r_mb as on the MTC model (:func:`_partials`): the shells' stresses
+    respond to du/dp by E / (element size)."""
     p0 = variable_values(model.system, model.rest_lengths, [v])[0]
-    d = 1e-2 * p0
+    d = (1e-4 if v.kind == "membrane_radius" else 1e-2) * p0
     ms = {k: rebuilt(model, apply_design(model.system, model.rest_lengths, [v], [p0 + k * d])[0])
           for k in (2, 1, -1, -2)}
 
@@ -360,7 +366,7 @@ def total_mass(model) -> float:
 def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int = 4,
                          node: str | None = None, axis: int = 2, thickness: bool = False,
                          aperture: float | None = None, ks_width: float | None = None,
-                         step: float = 1e-4) -> Sensitivities:
+                         wrinkle_width: float | None = None, step: float = 1e-4) -> Sensitivities:
     """Responses of an MTC or SBC model at its static equilibrium and their exact derivatives
     with respect to the design variables (module docstring: direct method, eigenvalue and
     cluster derivatives; :mod:`tmfem.design.kinematics` for the SBC model's rotations).
@@ -368,7 +374,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     Parameters
     ----------
     model : MTCModel or SBCModel
-        The SBC model with rest-length, thickness and diameter variables (their partials:
+        The SBC model with rest-length, thickness, diameter and membrane-radius variables (their partials:
         :func:`_section_partials`). On the PETSc backend (one rank) the
         matrices are assembled serially and factorised and eigen-solved by PETSc.
     equilibrium : Equilibrium, optional
@@ -389,6 +395,9 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     ks_width : float, optional
         Width w of the KS aggregates of the membrane stresses [Pa] (default 1e-6 E of the
         membrane: within w ln(n) of the extreme of n Gauss points).
+    wrinkle_width : float, optional
+        Width w of the smooth step of the wrinkled area ``wrinkled_area`` [Pa] (default
+        1e-6 E of the membrane; :func:`tmfem.design.responses.smooth_step`).
     step : float
         Relative step of the directional central difference of the tangent.
     """
@@ -410,15 +419,18 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     width = 1e-6 * model.system.membrane.E if ks_width is None else ks_width
     if not (isinstance(width, (int, float)) and width > 0):
         raise InputError(f"ks_width: expected a positive stress [Pa], found {ks_width!r}")
+    wrinkle_w = 1e-6 * model.system.membrane.E if wrinkle_width is None else wrinkle_width
+    if not (isinstance(wrinkle_w, (int, float)) and wrinkle_w > 0):
+        raise InputError(f"wrinkle_width: expected a positive stress [Pa], found {wrinkle_width!r}")
     node_at = None if node is None else model.topology.system_node[model.system.node_index(node)]
     vs = parse_variables(model.system, variables)
     if thickness and "h_membrane" not in [v.name for v in vs]:
         vs.append(Variable("h_membrane", "thickness"))
     sbc = model.name == "sbc"
-    if sbc and any(v.kind in ("membrane_radius", "angle") for v in vs):
-        raise InputError(f"sensitivities of the SBC model: expected rest-length, thickness or diameter "
-                         f"variables, found {[v.name for v in vs if v.kind in ('membrane_radius', 'angle')]} "
-                         f"(they move the shells' and beams' reference geometry; use the MTC model)")
+    if sbc and any(v.kind == "angle" for v in vs):
+        raise InputError(f"sensitivities of the SBC model: expected rest-length, thickness, diameter or "
+                         f"membrane-radius variables, found {[v.name for v in vs if v.kind == 'angle']} "
+                         f"(they move the beams' reference geometry; use the MTC model)")
     eq = model.equilibrium() if equilibrium is None else equilibrium
     kin = kinematics(model, eq)
     names = [v.name for v in vs]
@@ -472,7 +484,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
             for sgn in (1.0, -1.0):
                 model.set_tendon_lengths(r0 + sgn * h * G[:, j])
                 pt = kin.point(sgn * h * du[:, j])
-                if vs[j].kind == "membrane_radius":    # the state and the reference mesh together
+                if vs[j].kind == "membrane_radius" and not sbc:   # the state and the reference mesh together
                     Kpm.append(with_radius(model, model.system.r_mb + sgn * h).residual(pt)[1])
                     continue
                 Kpm.append(kin.tangent(pt))
@@ -542,14 +554,17 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
         values[name], grads[name] = float(values[vec][i]), grads[vec][i].copy()
     def radius_fields(j):
         def fields(step):
-            return [MTCKinematics(with_radius(model, model.system.r_mb + sgn * step), eq).membrane(
+            return [kinematics(with_radius(model, model.system.r_mb + sgn * step), eq).membrane(
                 kin.point(sgn * step * du[:, j])) for sgn in (1.0, -1.0)]
         return fields
 
     moved = {j: radius_fields(j) for j, v in enumerate(vs) if v.kind == "membrane_radius"}
     for name, (val, grad) in membrane_aggregates(model, kin, du, width=width, aperture=aperture,
-                                                 moved=moved).items():
+                                                 wrinkle_width=wrinkle_w, moved=moved).items():
         values[name], grads[name] = val, grad
+    # the Gauss points' areas scale with r_mb^2: d(sum H dA) = sum dH dA + 2 A_w / r_mb
+    for j in (j for j, v in enumerate(vs) if v.kind == "membrane_radius"):
+        grads["wrinkled_area"][j] += 2.0 * values["wrinkled_area"] / model.system.r_mb
     values["surface_rms"], grads["surface_rms"] = surface_rms(model, x, dx)
     if position is not None:
         values["position"], grads["position"] = position, d_position
