@@ -9,7 +9,7 @@ import pytest
 from tmfem.design import design_sensitivities
 from tmfem.design.optimizer import optimize, parse_constraint
 from tmfem.errors import InputError
-from tmfem.fem.membrane import _q1_gauss_arrays
+from tmfem.fem.membrane import q1_gauss_arrays
 from tmfem.fem.tension_field import TAUT, TensionFieldLaw
 from tmfem.models.mtc.model import MTCModel
 from tmfem.system import load_preset
@@ -24,7 +24,7 @@ def test_wrinkled_area_tends_to_the_tension_field_area_as_the_width_shrinks():
     eq = m.equilibrium(tol=1e-12)
     xm = eq.state[:, :m.topology.n_mesh]
     _, E = m.membrane.strain(xm)
-    dA = _q1_gauss_arrays(np.asarray(m.topology.mesh.p, dtype=float), np.asarray(m.topology.mesh.t))[2]
+    dA = q1_gauss_arrays(np.asarray(m.topology.mesh.p, dtype=float), np.asarray(m.topology.mesh.t))[2]
     a_tf = float(np.sum(dA * (TensionFieldLaw(system.membrane).state(E) != TAUT)))
     assert 0.05 < a_tf / dA.sum() < 0.5
     sigma_2 = np.abs(m.membrane.stresses(xm).principal[1])

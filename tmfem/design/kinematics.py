@@ -24,12 +24,12 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.design.responses import minor_principal
-from tmfem.fem.membrane import _q1_gauss_arrays
+from tmfem.fem.membrane import q1_gauss_arrays
 
 
 def _gauss_areas(mesh) -> np.ndarray:
     """Reference areas |det J| w (ne, 4) of the 2 x 2 Gauss points of the quadrilateral ``mesh``."""
-    return _q1_gauss_arrays(np.asarray(mesh.p, dtype=float), np.asarray(mesh.t))[2]
+    return q1_gauss_arrays(np.asarray(mesh.p, dtype=float), np.asarray(mesh.t))[2]
 
 
 class MTCKinematics:

@@ -72,7 +72,7 @@ def _forms():
     return residual, tangent
 
 
-def _q1_gauss_arrays(p: np.ndarray, t: np.ndarray):
+def q1_gauss_arrays(p: np.ndarray, t: np.ndarray):
     """Shape functions N (4, ne, nqp), their reference-plane gradients dN (4, 2, ne, nqp) and
     the weights dx = |det J| w (ne, nqp) of four-node quadrilaterals (nodes p (2, nn),
     connectivity t (4, ne)) at scikit-fem's intorder-3 (2 x 2 Gauss) points: its reference
@@ -226,7 +226,7 @@ class MembraneTL:
 
     def _gauss(self, elements: slice, *, keep: bool = True):
         """Shape functions N (4, ne, nqp), gradients dN (4, 2, ne, nqp) and weights dx
-        (ne, nqp) of the ``elements`` (a slice; :func:`_q1_gauss_arrays`). The arrays of the
+        (ne, nqp) of the ``elements`` (a slice; :func:`q1_gauss_arrays`). The arrays of the
         last block asked for that the kept ones do not cover are kept (with ``keep``): a
         rank of a distributed assembly, which asks for its own share only, holds the data
         of its own elements only (~0.4 kB per element)."""
@@ -234,7 +234,7 @@ class MembraneTL:
         need = (lo, hi) if step == 1 else (0, self.ne)
         c = self._gauss_cache
         if c is None or need[0] < c[0] or need[1] > c[1]:
-            arrays = _q1_gauss_arrays(np.asarray(self.mesh.p, dtype=float),
+            arrays = q1_gauss_arrays(np.asarray(self.mesh.p, dtype=float),
                                       np.asarray(self.mesh.t)[:, need[0]:need[1]])
             c = (*need, *arrays)
             if keep:
