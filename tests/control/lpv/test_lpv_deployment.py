@@ -67,9 +67,12 @@ def test_cli_lpv_deployment_tracks_without_slack(design21, tmp_path, capsys):
     pl, d, path = design21
     t_end = 6.0 if REDUCED else 20.0
     csv = tmp_path / "lpv.csv"
+    # the 2-3's D_2j tendons pass nylon's 94.8 MPa (about 106 MPa, the assumed ch. 8 base;
+    # docs/validation/reproduction.md): a named failed check, accepted by --allow-infeasible
     assert main(["deploy", "--preset", "2-3-lpv", "--lpv-controller", str(path), "--t-end", str(t_end),
-                 "--csv", str(csv), "--json"]) == 0
+                 "--csv", str(csv), "--json", "--allow-infeasible"]) == 0
     out = json.loads(capsys.readouterr().out)
+    assert all(c.startswith("tendon yield: D_2") for c in out["failed_checks"]), out["failed_checks"]
     # the JSON keys of the 7.4 deployments (a 0.05 s adaptive 1-4(D) run), but the adaptive
     # PFL's own set-up (its RBF network, its tendon model and the warnings about that model)
     assert main(["deploy", "--preset", "1-4D", "--controller", "adaptive", "--t-end", "0.05", "--json"]) == 0
@@ -107,7 +110,7 @@ def _fe_and_com_runs(path, tmp_path, capsys, plant, extra, t_end):
     for p, opts in ((plant, extra), ("com", [])):
         csv = tmp_path / f"{p}.csv"
         assert main(["deploy", "--preset", "2-3-lpv", "--lpv-controller", str(path), "--plant", p,
-                     *opts, "--t-end", t_end, "--csv", str(csv), "--json"]) == 0
+                     *opts, "--t-end", t_end, "--csv", str(csv), "--json", "--allow-infeasible"]) == 0
         out = json.loads(capsys.readouterr().out)
         rows = list(_csv.reader(open(csv)))
         head = [h.split(" [")[0] for h in rows[0]]
