@@ -92,3 +92,23 @@ def test_bounded_inversion_of_a_square_B_q_is_unchanged_bit_for_bit():
     R = np.linalg.cholesky(0.5 * (terms.M_q + terms.M_q.T)).T
     old = np.clip(lsq_linear(R @ terms.B_q, R @ v, bounds=(lower, upper), method="bvls").x, lower, upper)
     assert active and np.array_equal(u, old)
+
+
+def test_path_rest_lengths_at_the_ends_are_the_designed_ones():
+    """u_d(s) of the 3-3 (the reference of its inversion) at the deployed and the packaged
+    configurations against the rest lengths the equilibrium design gives those two systems
+    (tmfem.reference.deployments.checked_configurations, an independent design routine)."""
+    from tmfem.control.deployment.run import path_rest_length_reference
+    from tmfem.control.deployment.reference_trajectory import DeploymentReference
+    from tmfem.reference.deployments import checked_configurations
+    from tmfem.system import load_system
+    from tests.cli.test_own_system import SYSTEMS
+    final = checked_configurations(load_system(SYSTEMS / "tower-3-3.toml"))
+    packaged = final.problem.packaged
+    ref = DeploymentReference(initial=packaged.symmetric, final=final.symmetric, N=final.N,
+                              q_names=list(final.q_names), omega_r=0.5)
+    u_d = path_rest_length_reference(final, ref)
+    assert np.allclose(u_d(0.0), packaged.rest_lengths, rtol=1e-10)
+    assert np.allclose(u_d(1e3), final.rest_lengths, rtol=1e-10)
+    # a square system has no reference (its B_q leaves no freedom)
+    assert path_rest_length_reference(load_system(SYSTEMS / "pentagon-2-5.toml"), ref) is None
