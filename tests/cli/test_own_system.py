@@ -174,13 +174,31 @@ def test_deploy_refuses_a_2_5_without_a_path_naming_the_obstacle(tmp_path, capsy
                      r"no positive null vector of 3.3.2: force sign of .*P2", err), err
 
 
-def test_deploy_refuses_a_three_stage_system_before_any_design(capsys):
-    """The 3-3 has a path (tests/control/deployment/test_automatic_path.py) but 13 N = 39
-    tendons for 12 N = 36 bar coordinates (eqs. 3.1-3.2: 2N + 5N per upper stage): the square
-    B_q of eq. 5.46 does not exist, and the file is refused at once, saying so."""
-    assert main(["deploy", str(SYSTEMS / "tower-3-3.toml")]) == 2
-    err = capsys.readouterr().err
-    assert "square B_q of eq. 5.46" in err and "39 tendons for 36 bar coordinates" in err
+def test_deploy_of_an_over_actuated_3_3_tracks_and_switches_with_every_tendon_taut(tmp_path, capsys):
+    """`deploy FILE` of the three-stage 3-3 (13 N = 39 tendons for 12 N = 36 bar coordinates,
+    eqs. 3.1-3.2: a wide B_q of eq. 5.46) on its automatic path, coarse step: B_q of full row
+    rank all along (its condition number finite), the PFL tracking to the switch to the
+    H-infinity controller (eq. 5.70, R_c = 0.01, after the reference of eq. 5.68 with omega_r =
+    0.5 rad/s has settled to 1 %: t > 13.3 s), the error below R_c at the end, every tendon in
+    tension (forces > 0 in the CSV: the extra tendons keep half the path's elongation), every
+    rest length inside [r_min, |tendon|) and no failed strength check."""
+    import csv
+    r, out = run(["deploy", str(SYSTEMS / "tower-3-3.toml"), "--t-end", "20", "--dt", "0.02",
+                  "--csv", str(tmp_path / "d.csv")], capsys)
+    assert r["path"] == "auto" and r["path_check"]["min_margin"] > 0
+    assert 1 <= r["B_q_condition_max"] < 1e10
+    assert r["switch_time_s"] is not None and 13.3 < r["switch_time_s"] < 20
+    assert r["final_tracking_error"] < 0.01 and r["failure"] is None
+    assert r["min_rest_length_margin_m"] > 0
+    assert r["peak_bar_compression_N"] < r["bar_critical_load_N"] and r["failed_checks"] == []
+    with open(tmp_path / "d.csv") as fh:
+        rows = list(csv.reader(fh))
+    head, data = rows[0], np.array([[float(v) for v in row[:-1]] for row in rows[1:]])
+    cols = {p: [k for k, h in enumerate(head) if h.startswith(p)] for p in ("T_", "r_", "L_")}
+    T, u, L = (data[:, cols[p]] for p in ("T_", "r_", "L_"))
+    assert T.shape[1] == u.shape[1] == 39 and T.min() > 0
+    assert u.min() >= 1e-3 and np.all(u < L)
+    assert_no_dissertation(out)
 
 
 def test_deploy_refuses_a_file_without_a_packaged_configuration(capsys):

@@ -210,7 +210,7 @@ def run(args) -> dict:
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
                              gif=args.gif, vtk=args.vtk, title=title))
     out["warnings"] = warnings
-    out["membrane_mode_choice"] = membrane_modes_of(args.system).to_dict()
+    out["membrane_mode_choice"] = membrane_modes_of(s.model.system).to_dict()
     if args.compare_plant:
         def rerun(kind):
             s2 = setup(args.system, controller=args.controller, uncertainty=args.uncertainty,

@@ -97,7 +97,6 @@ def path_feasibility(system, cfg: SymmetricConfig, *, kappa: float | None = None
     r = L EA / (EA + T) (eq. 3.9) in [r_min, L) with T = (T_MN / F_Delta) kappa Delta."""
     from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
     from tmfem.equilibrium.symmetric_map import with_configuration
-    from tmfem.fem.truss import linear_rest_length
     s = with_configuration(system, cfg)
     D = cfg.membrane_delta(system.N, system.r_mb)
     S = symmetric_matrix(s)
@@ -113,15 +112,42 @@ def path_feasibility(system, cfg: SymmetricConfig, *, kappa: float | None = None
         return PathPoint(min(nv.margin, D), D, f"membrane not stretched: Delta = {D:.4g} m <= 0 (eq. 3.22)")
     if kappa is None:
         return PathPoint(float(nv.margin), D)
-    groups = {g: x / nv.x[-1] * kappa * D for g, x in zip(S.cols[:-1], nv.x[:-1])}
-    T = np.array([groups[t.group] for t in s.tendons])
-    L = s.tendon_lengths()
-    r = linear_rest_length(L, T, s.tendon_EA)
+    r = _self_stress_rest_lengths(s, S, nv, kappa=kappa, Delta=D)
     k = int(np.argmin(r - r_min))
     if r[k] < r_min:
         name = s.tendon_names()[k]
         return PathPoint(-1.0, D, f"rest length of {name} {r[k]:.4g} m below the limit r_min = {r_min:.4g} m")
     return PathPoint(float(nv.margin), D)
+
+
+def _self_stress_rest_lengths(s, S, nv, *, kappa: float, Delta: float) -> np.ndarray:
+    """Rest lengths r = L EA / (EA + T) (eq. 3.9) of the system ``s`` with the tendon forces
+    of the null vector ``nv`` of its reduced matrix ``S`` (3.3.2) scaled to F_Delta =
+    kappa Delta, in the order of ``s.tendons``."""
+    from tmfem.fem.truss import linear_rest_length
+    groups = {g: x / nv.x[-1] * kappa * Delta for g, x in zip(S.cols[:-1], nv.x[:-1])}
+    T = np.array([groups[t.group] for t in s.tendons])
+    return linear_rest_length(s.tendon_lengths(), T, s.tendon_EA)
+
+
+def path_rest_lengths(system, cfg: SymmetricConfig, *, kappa: float) -> np.ndarray:
+    """Rest lengths u_d [m] of the symmetric equilibrium ``cfg`` of the M >= 2 ``system``
+    (in the order of its tendons): eq. 3.9 with the tendon forces of the positive null vector
+    of 3.3.2 scaled to the membrane force F_Delta = kappa Delta (:func:`path_feasibility`).
+
+    Raises
+    ------
+    InfeasibleDesign
+        ``cfg`` is not a feasible equilibrium (the condition of :func:`path_feasibility`).
+    """
+    from tmfem.equilibrium.general import positive_null_vector, symmetric_matrix
+    from tmfem.equilibrium.symmetric_map import with_configuration
+    p = path_feasibility(system, cfg)
+    if p.reason:
+        raise InfeasibleDesign(f"rest lengths along the deployment path: {p.reason}")
+    s = with_configuration(system, cfg)
+    S = symmetric_matrix(s)
+    return _self_stress_rest_lengths(s, S, positive_null_vector(S.A), kappa=kappa, Delta=p.Delta)
 
 
 @dataclass

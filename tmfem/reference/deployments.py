@@ -149,16 +149,15 @@ def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None 
 
 def check_choices(system, *, controller: str = "adaptive-hinf", uncertainty=None,
                   path=None) -> None:
-    """Refuse a system without a deployment, one whose tendons do not match its bar
-    coordinates one to one (the square B_q of eq. 5.46), an unknown controller, uncertainty
-    model or path (before any work: ``tmfem deploy`` calls it first)."""
+    """Refuse a system without a deployment, one with fewer tendons than bar coordinates (B_q
+    of eq. 5.46 without full row rank), an unknown controller, uncertainty model or path
+    (before any work: ``tmfem deploy`` calls it first)."""
     system = deployable_system(system)
     nt, nq = len(system.tendons), len(system.q_names)
-    if nt != nq:
-        raise InputError(f"deploy {system.name}: the adaptive PFL inverts the square B_q of eq. 5.46 "
-                         f"(one actuated tendon per bar coordinate, as in 1-N(D) and two-stage "
-                         f"systems); this {system.M}-{system.N} system has {nt} tendons for {nq} bar "
-                         f"coordinates")
+    if nt < nq:
+        raise InputError(f"deploy {system.name}: the adaptive PFL needs at least one actuated tendon "
+                         f"per bar coordinate (a B_q of eq. 5.46 with full row rank); this "
+                         f"{system.M}-{system.N} system has {nt} tendons for {nq} bar coordinates")
     own = own_path(system)
     allowed = ["linear", own] + (["auto"] if system.M >= 2 and own != "auto" else [])
     if path is not None and path not in allowed:

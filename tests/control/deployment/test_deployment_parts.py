@@ -77,11 +77,14 @@ def test_partition_gives_the_models_acceleration(model14):
     assert c == pytest.approx(s[0] / s[-1])
 
 
-def test_input_matrix_check_refuses_singular_and_nonsquare():
-    with pytest.raises(SingularInputMatrix, match="square"):
-        check_input_matrix(np.ones((3, 4)))
+def test_input_matrix_check_refuses_singular_and_too_few_tendons():
+    with pytest.raises(SingularInputMatrix, match="at least as many actuated tendons"):
+        check_input_matrix(np.ones((4, 3)))
     with pytest.raises(SingularInputMatrix, match="condition number"):
         check_input_matrix(np.diag([1.0, 1e-14]))
+    # a wide B_q of rank 1 < 3 rows (all columns equal): no full row rank, its condition named
+    with pytest.raises(SingularInputMatrix, match="full-row-rank B_q .*found"):
+        check_input_matrix(np.ones((3, 4)))
 
 
 def test_rbf_values():

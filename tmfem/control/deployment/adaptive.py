@@ -56,6 +56,29 @@ on u + du). The COM's B_q of a 1-N(D) system is ill-conditioned (1-4(D): conditi
 cancel on the rigid bars -- eq. 5.46 commands large tendon-force changes that an elastic
 structure answers differently (docs/guides/fe-plant.md); the damping leaves the strong
 directions inverted and bounds the gain of the weak ones at 1 / (2 mu s_1).
+
+Over-actuated systems (M >= 3 stages: n_t > n_q, a wide B_q of full row rank): eq. 5.58 is
+met by an affine space of rest lengths (the null space of B_q: self-stress changes that
+leave the bar accelerations alone); the controller takes the one closest to a reference
+u_ref, u = u_ref + B_q^+ (v - B_q u_ref)
+(:func:`tmfem.control.deployment.pfl.exact_inversion`); with active limits the bounded
+problem is regularised toward u_ref (:func:`tmfem.control.deployment.pfl.bounded_inversion`).
+u_ref is the reference trajectory's own rest lengths u_d(t) (``rest_length_reference``: the
+self-stress of the path's equilibrium at the progress s(t), scaled to the membrane force,
+:func:`tmfem.equilibrium.deployment_path.path_rest_lengths`): the null-space part of u then
+carries the prestress the path was designed with. Without it, the previous sample's rest
+lengths (the first sample: ``u_initial``) give the smallest actuator change per sample, but
+the prestress then drifts with the rotating null space of B_q (on the 3-3 of the tests its
+R_2 and S_3 tendons reach their tendon lengths, slack, for 6 s).
+
+The limits of 7.4 (r_min <= u <= |tendon|) let a tendon go slack at its upper bound, and the
+solution closest to u_d does so where the commanded acceleration lowers a tendon's force
+below zero (on the 3-3: R_2 and S_3 for 7 s, although a solution with every tendon in
+tension exists). With a reference u_d(t) the extra tendons are used to keep the prestress:
+the upper limit becomes |tendon| - TENSION_FLOOR (L_d - u_d), L_d the tendon lengths at the
+reference configuration, so every tendon keeps at least half its elongation (its force, at
+a given rate) along the path; the bounded problem finds the acceleration within these
+limits. A square B_q leaves no such freedom and keeps the limits of 7.4.
 """
 from __future__ import annotations
 
@@ -63,7 +86,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from tmfem.control.deployment.pfl import PFLTerms, bounded_inversion, check_input_matrix, partition
+from tmfem.control.deployment.pfl import (PFLTerms, bounded_inversion, check_input_matrix,
+                                          exact_inversion, partition)
 from tmfem.control.deployment.limits import tendon_lengths
 from tmfem.control.deployment.rbf import GaussianRBF, euler_step
 from tmfem.errors import InputError, SingularInputMatrix
@@ -72,6 +96,9 @@ UNCERTAINTY = ("initial", "no-MG", "exact")
 ALLOCATION = ("bounded", "clip")
 EVALUATION = ("state", "reference")
 TENDON_LAWS = ("fixed-rate", "cable")
+#: fraction of the path's own tendon elongation L_d - u_d that an over-actuated system's
+#: tendons keep (the upper rest-length limit L - TENSION_FLOOR (L_d - u_d), module docstring)
+TENSION_FLOOR = 0.5
 
 
 @dataclass
@@ -135,6 +162,14 @@ class AdaptivePFL:
         printed; mu > 0 inverts the feedforward part exactly and the feedback part
         D_q e' + K_q e by the damped least squares of
         :func:`tmfem.control.deployment.pfl.bounded_inversion`.
+    u_initial : array, optional
+        Rest lengths [m] at the start (the packaged configuration's), the reference of the
+        first sample's inversion of a wide B_q (module docstring, "Over-actuated systems");
+        default the model's u_0.
+    rest_length_reference : callable, optional
+        ``u_d(t)`` [m], the rest lengths of the reference trajectory's equilibria, the
+        reference of the inversion of a wide B_q (module docstring); default: the previous
+        sample's commanded rest lengths.
     """
 
     name = "adaptive-pfl"
@@ -143,7 +178,8 @@ class AdaptivePFL:
                  gamma: float = 0.01, alpha: float = 1.0, beta: float = 1.0,
                  uncertainty: str = "initial", z_initial=None, allocation: str = "bounded",
                  r_min: float = 1e-3, cond_every: int = 10, evaluation: str = "state",
-                 tendon_law: str = "fixed-rate", feedback_damping: float = 0.0):
+                 tendon_law: str = "fixed-rate", feedback_damping: float = 0.0, u_initial=None,
+                 rest_length_reference=None):
         if not (np.isfinite(feedback_damping) and feedback_damping >= 0):
             raise InputError(f"feedback_damping: expected a number >= 0, found {feedback_damping!r}")
         self.feedback_damping = float(feedback_damping)
@@ -190,6 +226,9 @@ class AdaptivePFL:
         self.allocation_active: list = []
         self.cond_every = int(cond_every)
         self._samples = 0
+        self._u_initial = model.u0 if u_initial is None else np.asarray(u_initial, dtype=float)
+        self._u_previous = self._u_initial
+        self.rest_length_reference = rest_length_reference
         self.dt = None
 
     def reset(self, t0, y0, dt):
@@ -198,6 +237,7 @@ class AdaptivePFL:
         self.condition_numbers = []
         self.allocation_active = []
         self._samples = 0
+        self._u_previous = self._u_initial
         self._cache = (None, None)
         return np.zeros(self.rbf.m * self.nq)
 
@@ -243,24 +283,32 @@ class AdaptivePFL:
         v_fb = d_q * ed + k_q * e
         v = -F_q - W.T @ phi - qdd_d + v_fb
         L = tendon_lengths(self.model.system, q).copy()
+        # over-actuated (wide B_q): the solution closest to u_d(t), else to the previous sample's
+        u_ref = self._u_previous if self.rest_length_reference is None else self.rest_length_reference(t)
+        if self.rest_length_reference is not None:
+            L_d = tendon_lengths(self.model.system, self.reference(t)[0])
+            L = L - TENSION_FLOOR * np.maximum(L_d - u_ref, 0.0)
         if self.tendon_law == "cable":
             terms, v, lower, upper = self._cable(exact, v, q_model, L)
+            u_ref = 1.0 / u_ref
         else:
             terms, lower, upper = exact, self.r_min, L
         # the feedforward (v at e = e' = 0) inverted exactly, the feedback part damped
-        u_ff = np.linalg.solve(terms.B_q, v - v_fb) if self.feedback_damping else 0.0
+        u_ff = exact_inversion(terms.B_q, v - v_fb, u_ref=u_ref) if self.feedback_damping else 0.0
         v_inv = v_fb if self.feedback_damping else v
+        u_ref = None if self.feedback_damping else u_ref
         if self.allocation == "bounded":
             u, active = bounded_inversion(terms, v_inv, lower=lower - u_ff, upper=upper - u_ff,
-                                          damping=self.feedback_damping)
+                                          damping=self.feedback_damping, u_ref=u_ref)
             if active:
                 self.allocation_active.append(float(t))
         else:
             u = bounded_inversion(terms, v_inv, lower=-np.inf, upper=np.inf,
-                                  damping=self.feedback_damping)[0]
+                                  damping=self.feedback_damping, u_ref=u_ref)[0]
         u = u + u_ff
         if self.tendon_law == "cable":
             u = 1.0 / u
+        self._u_previous = u
         Y = -self.gamma * np.outer(phi, self.alpha * e + self.beta * ed)        # eq. 5.51
         out = (u, Y, W, e)
         self._cache = (key, out)

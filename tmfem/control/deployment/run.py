@@ -32,7 +32,7 @@ from tmfem.control.deployment.adaptive import ALLOCATION, AdaptivePFL, reference
 from tmfem.control.deployment.limits import RestLengthLimits
 from tmfem.control.deployment.rbf import GaussianRBF
 from tmfem.control.deployment.recovery import StressRecovery
-from tmfem.control.deployment.reference_trajectory import DeploymentReference
+from tmfem.control.deployment.reference_trajectory import DeploymentReference, angle_mask
 from tmfem.control.deployment.switching import SwitchingController, relative_error
 from tmfem.control.linear.deployed_design import deployed_hinf
 from tmfem.equilibrium.deployment_path import path_feasibility
@@ -114,7 +114,7 @@ HINF_NAMES = {"central": "hinf-central", "lmi": "hinf-lmi", "riccati": "hinf-shi
 HINF_STARTS = {"central": "estimate", "lmi": "bumpless", "riccati": "bumpless"}
 
 
-def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central"):
+def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central", z_e=None):
     """The H-infinity controller of 7.3 (eqs. 5.62-5.67, :func:`tmfem.control.linear.deployed_design.
     deployed_hinf` with the 7.4 weights and alpha_1: the central controller at 1.01
     gamma_opt (default, solver-independent, :mod:`tmfem.control.linear.hinf_central`), the
@@ -123,7 +123,9 @@ def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central")
     plant) as a :class:`LinearController`, with ``measure`` mapping the
     modal state y = [z, z'] of :class:`StatePlant` onto the design's measured signals
     [q, v, q', v'] (membrane point coordinates of eq. 5.18: z_points = P^-1 z_modal, the
-    same linear map for the rates).
+    same linear map for the rates). ``z_e``: the run's equilibrium state, whose angles
+    (theta, psi) may lie on another 2 pi branch than the design's (a path continued through
+    psi = 180 deg); the controller's set point is then moved onto that branch.
 
     Returns
     -------
@@ -134,7 +136,13 @@ def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central")
     d = deployed_hinf(system, membrane_modes=membrane_modes, method=method)
     pl = d.plant
     P = pl.model.P
-    y_e = np.concatenate([pl.z_e, np.zeros(pl.z_e.size)])
+    z_set = pl.z_e
+    if z_e is not None:
+        nq = len(system.q_names)
+        turns = np.zeros(z_set.size)
+        turns[:nq] = np.where(angle_mask(system.q_names), np.round((z_e[:nq] - z_set[:nq]) / (2 * np.pi)), 0)
+        z_set = z_set + 2 * np.pi * turns if turns.any() else z_set
+    y_e = np.concatenate([z_set, np.zeros(pl.z_e.size)])
     ctrl = LinearController(d.design.controller, u_e=pl.u_e, y_e=y_e, name=HINF_NAMES[method])
     nz = P.shape[0]
 
@@ -357,7 +365,9 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     C, sig = reference_centers(ref, t_end=t_settle, m=n_centers)
     ad = AdaptivePFL(model=model, reference=ref, gains=gains, rbf=GaussianRBF(centers=C, sigma=sig),
                      w_bar=w_bar, gamma=gamma, uncertainty=uncertainty, allocation=allocation,
-                     r_min=r_min, evaluation=evaluation, tendon_law=tendon_law)
+                     r_min=r_min, evaluation=evaluation, tendon_law=tendon_law,
+                     u_initial=initial.rest_lengths,
+                     rest_length_reference=path_rest_length_reference(final, ref))
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
     z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)])).state
     info = {"rbf_centres": n_centers, "rbf_sigma": sig, "w_bar": w_bar, "K": K, **(info or {})}
@@ -366,7 +376,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     start = "bumpless"
     if linear != "none":
         if linear == "lmi":
-            lin_ctrl, measure, g = lmi_hinf_controller(final, membrane_modes=K, method=hinf_method)
+            lin_ctrl, measure, g = lmi_hinf_controller(final, membrane_modes=K, method=hinf_method,
+                                                       z_e=z_e)
             info["hinf_gamma"] = g
             start = HINF_STARTS[hinf_method]
         elif linear == "lqr":
@@ -380,6 +391,27 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                                    q_e=ref.q_e, measure=measure, R_c=R_c, start=start)
     return DeploymentSetup(model=model, reference=ref, adaptive=ad, controller=ctrl,
                            linear=lin_ctrl, z0=z0, z_e=z_e, info=info)
+
+
+def path_rest_length_reference(final, ref, *, n: int = 101):
+    """u_d(t) [m] of an over-actuated M >= 2 system (more tendons than bar coordinates): the
+    rest lengths of the reference's equilibria (:func:`tmfem.equilibrium.deployment_path.
+    path_rest_lengths`, forces scaled with the membrane stiffness of the deployed design) at
+    n evenly spaced progress values, linear in s between them, at the progress s(t) of the
+    reference ``ref``; None for any other system (its B_q is square)."""
+    from tmfem.equilibrium.deployment_path import membrane_stiffness, path_rest_lengths
+    from tmfem.equilibrium.design import design_equilibrium
+    if final.M < 2 or len(final.tendons) <= len(final.q_names):
+        return None
+    kappa = membrane_stiffness(design_equilibrium(final.replace(rest_lengths=None), strict=False))
+    ss = np.linspace(0.0, 1.0, n)
+    U = np.array([path_rest_lengths(final, ref.config(s), kappa=kappa) for s in ss])
+
+    def u_d(t):
+        s = float(np.clip(ref.progress(t)[0], 0.0, 1.0)) * (n - 1)
+        i = min(int(s), n - 2)
+        return U[i] + (s - i) * (U[i + 1] - U[i])
+    return u_d
 
 
 def equilibrium_checker(system):
