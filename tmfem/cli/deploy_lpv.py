@@ -21,6 +21,7 @@ from tmfem import reference, simulation
 from tmfem.cli import lpv_options
 from tmfem.cli.common import progress_bar, say
 from tmfem.control import lpv
+from tmfem.control.lpv.plant import lpv_membrane_mode_choice
 from tmfem.errors import InfeasibleController, InputError
 from tmfem.reference.tables import deployment_bases
 
@@ -168,7 +169,8 @@ def run(args, *, mesh_n) -> dict:
     plants = reference.FEPlantOptions.of(args)
     out = {"system": args.system.name, "plant": args.plant, **plants.summary(args.plant, mesh_n),
            **ctrl, "path": args.system.problem.lpv.path, **r.summary(), **s.info,
-           **_figures(r), **info}
+           **_figures(r), **info,
+           "membrane_mode_choice": lpv_membrane_mode_choice(args.system).to_dict()}
     title = f"{args.preset} deployment on the {args.plant} plant: {args.controller} (gamma = {d.gamma:.4g}), eq. 5.100"
     out.update(reference.write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
                                        vtk=args.vtk, title=title))

@@ -99,7 +99,7 @@ def format_modal(r: dict) -> str:
     if "printed_bar_load_prestress_scale" in r:
         lines.append(f"prestress implied by the printed stage-1 bar load: x{r['printed_bar_load_prestress_scale']:.4f}")
     ref = r.get("dissertation", {}).get("COM", [])
-    lines.append(f"{'mode':>4} {'ours [Hz]':>10} {'printed':>10} {'rel.diff':>9}")
+    lines.append(f"{'mode':>4} {'ours [Hz]':>10}" + (f" {'printed':>10} {'rel.diff':>9}" if ref else ""))
     for i, f in enumerate(r["freq_hz"]):
         if i < len(ref):
             lines.append(f"{i + 1:>4} {f:>10.4f} {ref[i]:>10.4f} {f / ref[i] - 1:>+9.2%}")

@@ -23,7 +23,8 @@ from scipy.interpolate import RegularGridInterpolator, make_interp_spline
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.errors import InputError
 from tmfem.models.com.linearize import linearize
-from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
+from tmfem.models.com.mode_count import MembraneModeChoice
+from tmfem.models.com.model import ControlOrientedModel, membrane_modes_of
 from tmfem.system.geometry import membrane_corners_regular
 
 log = logging.getLogger(__name__)
@@ -255,14 +256,19 @@ def choose_membrane_points(model, *, rings=(0.2, 0.4, 0.6), per_ring: int = 12) 
     return [cands[i] for i in picked]
 
 
-def lpv_membrane_modes(system) -> int:
-    """K of the LPV plant of ``system``: its ``[lpv] membrane_modes``, else that of the
-    control-oriented model (:func:`tmfem.models.com.model.default_membrane_modes`: the
-    file's ``[models.com]``, else the automatic choice)."""
+def lpv_membrane_mode_choice(system) -> MembraneModeChoice:
+    """K of the LPV plant of ``system`` and where it comes from: its ``[lpv] membrane_modes``,
+    else that of the control-oriented model (:func:`tmfem.models.com.model.membrane_modes_of`:
+    the file's ``[models.com]``, else the automatic choice)."""
     lpv = system.problem.lpv
     if lpv is not None and lpv.membrane_modes is not None:
-        return int(lpv.membrane_modes)
-    return default_membrane_modes(system)
+        return MembraneModeChoice(K=int(lpv.membrane_modes), source="file")
+    return membrane_modes_of(system)
+
+
+def lpv_membrane_modes(system) -> int:
+    """K of :func:`lpv_membrane_mode_choice`."""
+    return lpv_membrane_mode_choice(system).K
 
 
 def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int | None = None,

@@ -39,8 +39,11 @@ def design_rest_lengths(system, static, q0, zeta0) -> StaticDesign:
     """Tendon forces making the design q0 an equilibrium of the COM, then rest lengths.
 
     Static equilibrium of the q equations (eq. 3.16 with the COM's membrane energy):
-    sum_t T_t d|d_t|/dq + dU_m/dq = 0, solved for the tendon forces T by least squares; rest
-    lengths r = EA |d| / (EA + T) (eqs. 3.8-3.9). A small residual (rounded design values,
+    sum_t T_t d|d_t|/dq + dU_m/dq = 0, solved for the tendon forces T by least squares (the
+    minimum-norm solution; when it is not positive and the system has a self-stress, as with
+    more tendons than independent equations, the solution closest to the tendon forces of the
+    ch. 3 design, :func:`tmfem.equilibrium.design.design_equilibrium`); rest lengths
+    r = EA |d| / (EA + T) (eqs. 3.8-3.9). A small residual (rounded design values,
     e.g. r_1 = 0.4286 m of Table 6.2) is accepted up to 1e-3 relative; the model's
     ``equilibrium`` then finds the exact equilibrium nearby.
 
@@ -55,7 +58,13 @@ def design_rest_lengths(system, static, q0, zeta0) -> StaticDesign:
     JL, gm, L = (np.asarray(a) for a in static(q0, zeta0))
     L = L.ravel()
     gm = gm.ravel()
-    T, *_ = np.linalg.lstsq(JL.T, -gm, rcond=None)
+    T, _, rank, _ = np.linalg.lstsq(JL.T, -gm, rcond=None)
+    if np.any(T <= 0) and rank < JL.shape[0]:
+        # more tendons than independent equations (a self-stress, e.g. M >= 3): of the forces
+        # that balance the COM's membrane, the ones closest to the ch. 3 design's
+        from tmfem.equilibrium.design import design_equilibrium
+        T_3 = np.asarray(design_equilibrium(system, q=q0, strict=False).tendon_forces, dtype=float)
+        T = T_3 + np.linalg.lstsq(JL.T, -gm - JL.T @ T_3, rcond=None)[0]
     res = np.linalg.norm(JL.T @ T + gm) / max(np.linalg.norm(gm), 1e-300)
     if res > 1e-3:
         raise InfeasibleDesign(f"system {system.name!r}: the design q is not an equilibrium "
