@@ -84,3 +84,9 @@ def test_2_3_plant_on_a_2_x_1_grid_reproduces_the_bisection():
         K = ref.gain(rho)
         np.testing.assert_allclose(r.controller.at(rho)[3], K, rtol=1e-8, atol=1e-10 * np.abs(K).max())
     assert r.verification["passed"]                              # at the design points
+
+
+def test_options_of_the_other_route_are_refused():
+    gp = oscillator_gp()
+    with pytest.raises(InputError, match=r"\['backoff'\] belong to the SDP route"):
+        lpvsyn(gp, 0, 1, grid=gp.axes, rate_bounds=gp.rate_bounds, basis="affine", method="eigopt", backoff=0.1)

@@ -483,10 +483,7 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     kind = "state" if nmeas == 0 else "output"
     if method not in ("auto", "sdp", "eigopt"):
         raise InputError(f"LPV synthesis: expected method 'auto', 'sdp' or 'eigopt', found {method!r}")
-    eig_opts = {"gamma": (gamma, None), "fixed_gamma": (fixed_gamma, False), "gamma_rtol": (gamma_rtol, GAMMA_RTOL),
-                "time_budget": (time_budget, TIME_BUDGET), "start": (start, None), "max_iter": (max_iter, None),
-                "sample_time": (sample_time, None), "bound": (bound, None), "progress": (progress, None)}
-    eig_given = [k for k, (v, d) in eig_opts.items() if v is not d and v != d]
+    given = _given_options(locals())
     if constant not in ("X", "Y", None):
         raise InputError(f"LPV synthesis: expected constant in 'X', 'Y' or None, found {constant!r}")
     if kind == "state" and constant == "Y":
@@ -531,6 +528,9 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     method, reason = _route(method, cost=cost, why_not=why_not,
                             what=f"lpvsyn: {n} states, {len(design)} grid points x {len(_vertices(rb))} rate vertices")
     if method == "eigopt":
+        if given["sdp"]:
+            raise InputError(f"LPV synthesis: options {given['sdp']} belong to the SDP route, found them with the "
+                             f"EIGOPT route ({reason})")
         gp = eigopt_route.generalized_on_grid(P, plant, axes=axes, rb=rb, ncon=ncon)
         t_syn = time.perf_counter()
         sf, record = eigopt_route.synthesize_eigopt(gp, gamma=gamma, fixed_gamma=fixed_gamma, rtol=gamma_rtol,
@@ -548,9 +548,9 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
                 "plant_interpolated": plant.interpolated, **record}
         return _verified(ctrl, sf.gamma, info, design_axes=axes, check_axes=dense_axes, t_start=t_start,
                          require_verified=require_verified, design=sf)
-    if eig_given:
-        raise InputError(f"LPV synthesis: options {eig_given} belong to the EIGOPT route, found them with the SDP "
-                         f"route ({reason})")
+    if given["eigopt"]:
+        raise InputError(f"LPV synthesis: options {given['eigopt']} belong to the EIGOPT route, found them with the "
+                         f"SDP route ({reason})")
     centre = tuple((a.size - 1) // 2 for a in axes)
     T = state_scaling(plant.at([a[i] for a, i in zip(axes, centre)])[0]) if scale else np.ones(n)
     verts = _vertices(rb)
@@ -585,6 +585,20 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
             "rate_dependent_controller": ctrl.rate_dependent, "plant_interpolated": plant.interpolated}
     return _verified(ctrl, g_min, info, design_axes=axes, check_axes=dense_axes, t_start=t_start,
                      require_verified=require_verified)
+
+
+_ROUTE_OPTIONS = {"sdp": ("backoff", "budget", "gamma_max", "solver", "eps"),
+                  "eigopt": ("gamma", "fixed_gamma", "gamma_rtol", "time_budget", "start", "max_iter", "sample_time",
+                             "bound", "progress")}
+
+
+def _given_options(values: dict) -> dict:
+    """route -> the options of :func:`lpvsyn` that belong to that route only and were given a
+    value other than their default (``values``: the call's arguments)."""
+    import inspect
+    defaults = inspect.signature(lpvsyn).parameters
+    return {route: [k for k in names if values[k] is not defaults[k].default and values[k] != defaults[k].default]
+            for route, names in _ROUTE_OPTIONS.items()}
 
 
 def _route(method: str, *, cost, why_not: str, what: str) -> tuple:
