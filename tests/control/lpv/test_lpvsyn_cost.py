@@ -50,5 +50,9 @@ def test_the_2_3_design_is_refused_up_front_with_the_estimate():
         return A0 + rho[0] * np.eye(n), B, C, D
     t0 = time.perf_counter()
     with pytest.raises(ResourceLimit, match=r"lpvsyn: 71 states, 18 grid points x 4 rate vertices.*GiB"):
-        lpvsyn(plant, 0, nu, grid=[theta, psi], rate_bounds=0.17, basis="affine")
+        lpvsyn(plant, 0, nu, grid=[theta, psi], rate_bounds=0.17, basis="affine", method="sdp")
+    # with method="auto" the affine state feedback goes to the EIGOPT route (test_lpvsyn_eigopt_route.py);
+    # a basis that route does not carry is refused with the estimate and the reason
+    with pytest.raises(ResourceLimit, match=r"GiB.*EIGOPT route does not apply: it uses the affine basis"):
+        lpvsyn(plant, 0, nu, grid=[theta, psi], rate_bounds=0.17, basis="constant")
     assert time.perf_counter() - t0 < 5.0

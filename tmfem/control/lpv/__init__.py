@@ -9,7 +9,9 @@ design workflow of ``tmfem control lpv`` is :mod:`tmfem.control.lpv.workflow`
 (:func:`design_plant`, :func:`synthesize_design`, :func:`refined_plant`, :func:`verify_design`,
 :func:`output_feedback_design`). The general gridded synthesis on any plant, with basis
 functions of one's choice for the parameter dependence, is :func:`lpvsyn`
-(:mod:`tmfem.control.lpv.gridded_synthesis`, docs/guides/lpvsyn.md).
+(:mod:`tmfem.control.lpv.gridded_synthesis`, docs/guides/lpvsyn.md); it carries the 2-3
+design too, on its EIGOPT route (:mod:`tmfem.control.lpv.eigopt_route`), which the workflow
+calls.
 """
 from tmfem._lazy import lazy_exports
 

@@ -76,11 +76,14 @@ import scipy.sparse as sp
 
 from tmfem.control.linear.lmi import solve, sym
 from tmfem.control.linear.pbh import pbh
+from tmfem.control.lpv import eigopt_route
 from tmfem.control.lpv.basis import Basis
 from tmfem.control.lpv.cost import check_lpvsyn_cost, lpvsyn_cost
 from tmfem.control.lpv.gridded_plant import PlantFunction, grid_axes, plant_function
+from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
 from tmfem.control.lpv.generalized_plant import state_scaling
-from tmfem.errors import InfeasibleController, InputError
+from tmfem.control.lpv.state_feedback import LPVStateFeedback
+from tmfem.errors import InfeasibleController, InputError, ResourceLimit
 from tmfem.resources import check_lpv_budget
 
 log = logging.getLogger(__name__)
@@ -307,6 +310,9 @@ class LPVSynthesis:
         :func:`verify_design` records (``passed`` and the worst values with where they occur).
     info : dict
         Solver statuses and times, sizes, condition measures.
+    design : LPVStateFeedback or None
+        The EIGOPT route's controller in the form of eq. 5.99 (what the deployment of 8.4
+        and ``tmfem control lpv --save`` use); None on the SDP route.
     """
 
     gamma: float
@@ -315,6 +321,7 @@ class LPVSynthesis:
     certificate: Certificate
     verification: dict
     info: dict = field(default_factory=dict)
+    design: LPVStateFeedback | None = None
 
 
 # ---------------------------------------------------------------------- the entry point
@@ -376,9 +383,21 @@ def _vertices(rb: np.ndarray) -> np.ndarray:
 def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gain_basis=None,
            constant: str | None = "X", backoff: float = 0.01, budget: float = 10.0, gamma_max: float = 1e6,
            verify_refine: int = 4, solver: str = "CLARABEL", eps: float = 1e-7, scale: bool = True,
-           interpolation: str = "multilinear", require_verified: bool = True) -> LPVSynthesis:
+           interpolation: str = "multilinear", require_verified: bool = True, method: str = "auto",
+           gamma: float | None = None, fixed_gamma: bool = False, gamma_rtol: float = GAMMA_RTOL,
+           time_budget: float = TIME_BUDGET, start=None, max_iter: int | None = None,
+           sample_time: float | None = None, bound=None, progress=None) -> LPVSynthesis:
     """Gridded LPV H-infinity synthesis (module docstring): minimise gamma, back off to a
     well-conditioned controller, verify off the grid.
+
+    Two routes (``info["method"]``, the choice explained in ``info["route_reason"]``):
+    ``"sdp"``, the interior-point SDP of the module docstring (any basis, state and output
+    feedback), and ``"eigopt"``, the gamma bisection over eigenvalue-optimisation levels of
+    :mod:`tmfem.control.lpv.eigopt_route` (state feedback with the affine basis of eq. 5.99,
+    scalable to the 2-3 plant of ch. 8). ``method="auto"`` takes the SDP unless its memory
+    estimate exceeds this machine's limit, then the EIGOPT route when the problem has its
+    structure; otherwise it refuses (:class:`~tmfem.errors.ResourceLimit` with the estimate
+    and the reason).
 
     Parameters
     ----------
@@ -415,19 +434,36 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     require_verified : bool
         Raise :class:`InfeasibleController` when the off-grid verification fails (default);
         False returns the design with ``verification["passed"]`` false, to inspect it.
+    method : {"auto", "sdp", "eigopt"}
+        The route (above).
+    gamma, fixed_gamma, gamma_rtol, time_budget, start, max_iter, sample_time, bound, progress
+        EIGOPT route only (refused by the SDP route): the bisection's upper level (default
+        twice the pointwise lower bound) or with ``fixed_gamma`` the one level solved, its
+        relative bracket width and time budget [s], a starting design
+        (:class:`~tmfem.control.lpv.state_feedback.LPVStateFeedback`), the L-BFGS iterations
+        per level, the zero-order-hold step at which the sampled frozen loops must also be
+        stable, the pointwise lower bound when already computed
+        (:class:`~tmfem.control.lpv.bounds.PointwiseBound`), and ``progress(seconds)``
+        called after each level
+        (:func:`tmfem.control.lpv.eigopt_route.synthesize_eigopt`).
 
     Returns
     -------
     LPVSynthesis
+        With the EIGOPT route ``gamma_min = gamma`` (no back-off: the lowest level where a
+        point was found) and ``design`` the controller in the form of eq. 5.99.
 
     Raises
     ------
     InputError
-        Inconsistent shapes, a grid without the plant's design points, a basis that is not
-        finite or smooth or is linearly dependent on the grid, options out of range.
+        An unknown method or an option of the other route, the EIGOPT route asked for a
+        problem without its structure, inconsistent shapes, a grid without the plant's design
+        points, a basis that is not finite or smooth or is linearly dependent on the grid,
+        options out of range.
     ResourceLimit
         An SDP whose interior-point memory estimate (:mod:`tmfem.control.lpv.cost`) exceeds
-        this machine's limit, before anything is built.
+        this machine's limit, before anything is built, on a problem the EIGOPT route cannot
+        carry (the message names why).
     InfeasibleController
         Infeasible or failed SDP, with the solver status and the likely cause; a design whose
         verification failed (with ``require_verified``).
@@ -445,6 +481,9 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     if not (np.isfinite(eps) and eps > 0):
         raise InputError(f"LPV synthesis: expected eps > 0, found {eps!r}")
     kind = "state" if nmeas == 0 else "output"
+    if method not in ("auto", "sdp", "eigopt"):
+        raise InputError(f"LPV synthesis: expected method 'auto', 'sdp' or 'eigopt', found {method!r}")
+    given = _given_options(locals())
     if constant not in ("X", "Y", None):
         raise InputError(f"LPV synthesis: expected constant in 'X', 'Y' or None, found {constant!r}")
     if kind == "state" and constant == "Y":
@@ -482,11 +521,36 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     else:
         bases = {"X": gbC if constant == "X" else gbL, "Y": gbC if constant == "Y" else gbL,
                  "A^": gbG, "B^": gbG, "C^": gbG, "D^": gbG}
-    cost = check_lpvsyn_cost(lpvsyn_cost(n=n, nw=m - ncon, np_=p - nmeas, nu=ncon, ny=nmeas, points=len(design),
-                                         vertices=len(_vertices(rb)), lyapunov_basis=len(lyap),
-                                         gain_basis=len(gain), constant=constant),
-                             what=f"lpvsyn: {n} states, {len(design)} grid points x {len(_vertices(rb))} rate "
-                                  f"vertices")
+    cost = lpvsyn_cost(n=n, nw=m - ncon, np_=p - nmeas, nu=ncon, ny=nmeas, points=len(design),
+                       vertices=len(_vertices(rb)), lyapunov_basis=len(lyap), gain_basis=len(gain), constant=constant)
+    why_not = eigopt_route.unsupported(nmeas=nmeas, lyap=lyap, gain=gain, points=dense, rb=rb,
+                                       affine=_resolve_basis("affine", n_par, axes, "basis"))
+    method, reason = _route(method, cost=cost, why_not=why_not,
+                            what=f"lpvsyn: {n} states, {len(design)} grid points x {len(_vertices(rb))} rate vertices")
+    if method == "eigopt":
+        if given["sdp"]:
+            raise InputError(f"LPV synthesis: options {given['sdp']} belong to the SDP route, found them with the "
+                             f"EIGOPT route ({reason})")
+        gp = eigopt_route.generalized_on_grid(P, plant, axes=axes, rb=rb, ncon=ncon)
+        t_syn = time.perf_counter()
+        sf, record = eigopt_route.synthesize_eigopt(gp, gamma=gamma, fixed_gamma=fixed_gamma, rtol=gamma_rtol,
+                                                    time_budget=time_budget, start=start, max_iter=max_iter,
+                                                    sample_time=sample_time, bound=bound, progress=progress)
+        T = eigopt_route.scaling(gp, scale=scale)
+        cert = Certificate(gamma=sf.gamma, kind=kind, T=T, n_parameters=n_par, rate_bounds=rb,
+                           bases={"P": GridBasis(basis=lyap, W=np.eye(len(lyap))),
+                                  "Q": GridBasis(basis=gain, W=np.eye(len(gain)))},
+                           coefficients={"P": [Pk / np.outer(T, T) for Pk in sf.P], "Q": [Qk / T for Qk in sf.Q]})
+        ctrl = GriddedController(kind=kind, certificate=cert, plant=plant, ncon=ncon, nmeas=nmeas, T=T)
+        info = {"kind": kind, "method": "eigopt", "route_reason": reason, "sizes": sf.sizes, "solver": sf.solver,
+                "status": sf.status, "solve_time_s": sf.solve_time, "synthesis_time_s": time.perf_counter() - t_syn,
+                "memory_estimate_sdp_gib": cost.memory_bytes / 2**30, "sample_time_s": sample_time,
+                "plant_interpolated": plant.interpolated, **record}
+        return _verified(ctrl, sf.gamma, info, design_axes=axes, check_axes=dense_axes, t_start=t_start,
+                         require_verified=require_verified, design=sf)
+    if given["eigopt"]:
+        raise InputError(f"LPV synthesis: options {given['eigopt']} belong to the EIGOPT route, found them with the "
+                         f"SDP route ({reason})")
     centre = tuple((a.size - 1) // 2 for a in axes)
     T = state_scaling(plant.at([a[i] for a, i in zip(axes, centre)])[0]) if scale else np.ones(n)
     verts = _vertices(rb)
@@ -514,22 +578,65 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
     cert = Certificate(gamma=g_b, kind=kind, bases=bases, coefficients=prob.values(), T=T, n_parameters=n_par,
                        rate_bounds=rb)
     ctrl = GriddedController(kind=kind, certificate=cert, plant=plant, ncon=ncon, nmeas=nmeas, T=T)
-    t_ver = time.perf_counter()
-    ver = verify_design(ctrl, design_axes=axes, check_axes=dense_axes)
-    info = {"kind": kind, "sizes": sizes, "solver": solver, "status_gamma": rep1.status,
-            "status_backoff": rep2.status, "solve_time_gamma_s": rep1.solve_time_s,
+    info = {"kind": kind, "method": "sdp", "route_reason": reason, "sizes": sizes, "solver": solver,
+            "status_gamma": rep1.status, "status_backoff": rep2.status, "solve_time_gamma_s": rep1.solve_time_s,
             "solve_time_backoff_s": rep2.solve_time_s, "build_time_s": t_build - t_start,
-            "verify_time_s": time.perf_counter() - t_ver, "total_time_s": time.perf_counter() - t_start,
             "condition": cond, "constant": constant if kind == "output" else None,
             "rate_dependent_controller": ctrl.rate_dependent, "plant_interpolated": plant.interpolated}
-    log.info("lpvsyn: gamma_min = %.6g, gamma_b = %.6g, verification %s", g_min, g_b,
+    return _verified(ctrl, g_min, info, design_axes=axes, check_axes=dense_axes, t_start=t_start,
+                     require_verified=require_verified)
+
+
+_ROUTE_OPTIONS = {"sdp": ("backoff", "budget", "gamma_max", "solver", "eps"),
+                  "eigopt": ("gamma", "fixed_gamma", "gamma_rtol", "time_budget", "start", "max_iter", "sample_time",
+                             "bound", "progress")}
+
+
+def _given_options(values: dict) -> dict:
+    """route -> the options of :func:`lpvsyn` that belong to that route only and were given a
+    value other than their default (``values``: the call's arguments)."""
+    import inspect
+    defaults = inspect.signature(lpvsyn).parameters
+    return {route: [k for k in names if values[k] is not defaults[k].default and values[k] != defaults[k].default]
+            for route, names in _ROUTE_OPTIONS.items()}
+
+
+def _route(method: str, *, cost, why_not: str, what: str) -> tuple:
+    """The route of :func:`lpvsyn` and why: ``method`` as asked, or with "auto" the SDP when its
+    memory estimate fits, else the EIGOPT route when ``why_not`` is empty; refused otherwise
+    (:class:`ResourceLimit` with the estimate and ``why_not``)."""
+    if method == "eigopt":
+        if why_not:
+            raise InputError(f"LPV synthesis: the EIGOPT route does not apply: {why_not}")
+        return method, "asked for (method='eigopt')"
+    try:
+        check_lpvsyn_cost(cost, what=what)
+    except ResourceLimit as exc:
+        if method == "sdp" or why_not:
+            raise ResourceLimit(f"{exc}; the EIGOPT route does not apply"
+                                f"{': ' + why_not if why_not else ' (method=sdp asked for)'}") from None
+        return "eigopt", (f"the interior-point SDP needs about {cost.memory_bytes / 2**30:.1f} GiB, over "
+                          "this machine's limit")
+    return "sdp", ("asked for (method='sdp')" if method == "sdp" else
+                   f"the interior-point SDP fits (about {cost.memory_bytes / 2**30:.2f} GiB)")
+
+
+def _verified(ctrl: GriddedController, g_min: float, info: dict, *, design_axes, check_axes, t_start: float,
+              require_verified: bool, design=None) -> LPVSynthesis:
+    """The off-grid verification (:func:`verify_design`) of ``ctrl`` and the result of
+    :func:`lpvsyn`; raises with ``require_verified`` when it fails."""
+    cert = ctrl.certificate
+    t_ver = time.perf_counter()
+    ver = verify_design(ctrl, design_axes=design_axes, check_axes=check_axes)
+    info.update(verify_time_s=time.perf_counter() - t_ver, total_time_s=time.perf_counter() - t_start)
+    log.info("lpvsyn (%s): gamma_min = %.6g, gamma = %.6g, verification %s", info["method"], g_min, cert.gamma,
              "passed" if ver["passed"] else "FAILED")
     if require_verified and not ver["passed"]:
-        raise InfeasibleController(f"LPV synthesis: gamma_b = {g_b:.6g} but the off-grid verification failed "
+        raise InfeasibleController(f"LPV synthesis: gamma = {cert.gamma:.6g} but the off-grid verification failed "
                                    f"({ver['summary']}); expected a certificate that holds between grid "
                                    "points (refine the grid)")
-    return LPVSynthesis(gamma=g_b, gamma_min=g_min, controller=ctrl, certificate=cert, verification=ver,
-                        info=info)
+    return LPVSynthesis(gamma=cert.gamma, gamma_min=g_min, controller=ctrl, certificate=cert, verification=ver,
+                        info=info, design=design)
 
 
 # ---------------------------------------------------------------------- the SDP

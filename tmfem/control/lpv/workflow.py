@@ -23,11 +23,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.lpv.bisect import bisect_gamma
 from tmfem.control.lpv.bounds import PointwiseBound, pointwise_state_feedback_bound
 from tmfem.control.lpv.certificate import rate_bounded_certificate, refine_certificate
 from tmfem.control.lpv.defaults import CERTIFICATE_PER_ROUND, GAMMA_RTOL, TIME_BUDGET, W_E, W_U
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, interconnection_8_1
+from tmfem.control.lpv.gridded_synthesis import lpvsyn
 from tmfem.control.lpv.output_feedback import (LPVOutputFeedback, design_output_feedback,
                                                verify_output_feedback)
 from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant
@@ -132,10 +132,11 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
     bound : PointwiseBound
         Its pointwise lower bound of gamma (:func:`design_plant`).
     solver : {"EIGOPT", "CLARABEL", "SCS"}
-        "EIGOPT" without ``fixed_gamma``: the gamma bisection
-        (:func:`~tmfem.control.lpv.bisect.bisect_gamma`) between the bound and ``gamma``
-        (default 2 x the bound) to relative width ``rtol`` within ``time_budget`` s, from
-        ``start`` when given; with ``fixed_gamma`` one feasible point at ``gamma``.
+        "EIGOPT": :func:`~tmfem.control.lpv.gridded_synthesis.lpvsyn` on its EIGOPT route
+        (affine basis, verified at the design points; :mod:`tmfem.control.lpv.eigopt_route`):
+        without ``fixed_gamma`` the gamma bisection between the bound and ``gamma`` (default
+        2 x the bound) to relative width ``rtol`` within ``time_budget`` s, from ``start`` when
+        given; with ``fixed_gamma`` one feasible point at ``gamma``.
         "CLARABEL" or "SCS": their minimisation of gamma
         (:func:`~tmfem.control.lpv.synthesis.synthesize_state_feedback`).
     max_iter : int, optional
@@ -149,7 +150,7 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
     -------
     (LPVStateFeedback, dict)
         The design and its JSON entries (gamma, solver, status, sizes, times; the bisection's
-        levels and bracket).
+        levels and bracket; EIGOPT: ``route``, the lpvsyn route and why it was taken).
 
     Raises
     ------
@@ -159,24 +160,25 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
         No controller found (the message holds the pointwise lower bound).
     """
     try:
-        if solver == "EIGOPT" and not fixed_gamma:
-            upper = gamma if gamma is not None else 2.0 * bound.lower_bound
-            if upper <= bound.lower_bound:
-                raise InputError(f"gamma {upper:g}: expected an upper level above the pointwise lower "
-                                 f"bound {bound.lower_bound:.5g} (no controller below it)")
+        if solver == "EIGOPT":
             with progress(time_budget, "gamma bisection (s of budget)") as bar:
-                t0 = time.perf_counter()
-                ctrl, br = bisect_gamma(generalized, lower=bound.lower_bound, upper=upper, rtol=rtol,
-                                        time_budget=time_budget, max_iter=max_iter or 150,
-                                        sample_time=sample_time, start=start,
-                                        progress=lambda w: bar(int(min(time.perf_counter() - t0, time_budget)),
-                                                               time_budget))
-            extra = br.to_dict()
-        else:
-            ctrl = synthesize_state_feedback(generalized, solver=solver, max_iter=max_iter, gamma=gamma,
-                                             sample_time=sample_time)
-            extra = {}
+                res = lpvsyn(generalized, 0, generalized.sizes["n_u"], grid=generalized.axes,
+                             rate_bounds=generalized.rate_bounds, basis="affine", method="eigopt", verify_refine=1,
+                             gamma=gamma, fixed_gamma=fixed_gamma, gamma_rtol=rtol, time_budget=time_budget,
+                             start=start, max_iter=max_iter, sample_time=sample_time, bound=bound,
+                             progress=lambda t: bar(int(t), time_budget))
+            ctrl = res.design
+            extra = {k: v for k, v in res.info.items() if k.startswith("gamma_")}     # the bisection's bracket
+            extra["route"] = {"lpvsyn": res.info["method"], "reason": res.info["route_reason"],
+                              "verified_at_design_points": res.verification["passed"]}
+            return ctrl, {"gamma": ctrl.gamma, "solver": ctrl.solver, "status": ctrl.status, "sizes": ctrl.sizes,
+                          "solve_time_s": ctrl.solve_time, "sample_time_s": sample_time, **extra}
+        ctrl = synthesize_state_feedback(generalized, solver=solver, max_iter=max_iter, gamma=gamma,
+                                         sample_time=sample_time)
+        extra = {}
     except InfeasibleController as exc:
+        if solver == "EIGOPT":      # the EIGOPT route's messages name the pointwise lower bound
+            raise
         raise InfeasibleController(f"{exc} (pointwise state-feedback lower bound of gamma: "
                                    f"{bound.lower_bound:.4g} at rho = {bound.at})") from None
     return ctrl, {"gamma": ctrl.gamma, "solver": ctrl.solver, "status": ctrl.status, "sizes": ctrl.sizes,
