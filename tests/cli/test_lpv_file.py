@@ -86,6 +86,7 @@ def test_bad_lpv_fields_are_refused(line, msg, tmp_path):
         load_system(f)
 
 
+@pytest.mark.slow
 def test_the_lpv_deployment_of_a_renamed_copy_is_the_presets(design21, tmp_path, capsys):
     # the 8.4 deployment reads its grid, path and eq. 5.100 values from [lpv]: a user file that
     # is the preset under another name deploys with the same saved controller to the same run
@@ -102,6 +103,7 @@ def test_the_lpv_deployment_of_a_renamed_copy_is_the_presets(design21, tmp_path,
         assert ours[key] == pytest.approx(ref[key], rel=1e-10), key
 
 
+@pytest.mark.slow
 def test_a_user_two_stage_system_gets_its_own_lpv_bound(capsys):
     # a 2-5 of our own (tests/data/systems/pentagon-2-5-lpv.toml), reduced to the two ends of
     # its theta grid at the middle psi: the frozen plants at the file's points, no printed bound,

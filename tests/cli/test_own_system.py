@@ -84,6 +84,7 @@ def test_report_of_a_renamed_preset_is_its_own(which, impostors, tmp_path, capsy
     assert_no_dissertation(text.replace('"implied_prestress": null', "") + index)
 
 
+@pytest.mark.slow
 def test_hinf_of_a_deployable_named_like_a_preset_uses_its_own_scales(impostors, capsys):
     """`control hinf` on a 1-5(D) named '1-4D': no printed f_max, alpha_1 and u_m from the
     system's own scales (0.1 x 2 pi f_1 and 0.5 % of the bar length), not 7.4's 0.5 and 0.01."""
@@ -112,6 +113,7 @@ def test_user_system_modes_and_design(file, modes, capsys):
     assert_no_dissertation(out)
 
 
+@pytest.mark.slow
 def test_deploy_of_a_user_1_5d_tracks_and_switches(tmp_path, capsys):
     """`deploy FILE`: the 1-5(D) from its packaged configuration (its own [packaged] table) to
     the deployed one: tracking error small at the end, the switch to the H-infinity controller
@@ -124,6 +126,7 @@ def test_deploy_of_a_user_1_5d_tracks_and_switches(tmp_path, capsys):
     assert_no_dissertation(out)
 
 
+@pytest.mark.slow
 def test_deploy_of_a_user_2_5_on_the_automatic_path(tmp_path, capsys):
     """`deploy FILE` of a two-stage five-bar system (its own [packaged] and [deployment]; no
     path declared: the automatic path of M >= 2 systems, which corrects the stage-2 base where
@@ -155,6 +158,7 @@ def test_deploy_of_a_user_2_5_on_the_automatic_path(tmp_path, capsys):
     assert_no_dissertation(out)
 
 
+@pytest.mark.slow
 def test_deploy_refuses_a_2_5_without_a_path_naming_the_obstacle(tmp_path, capsys):
     """The 2-5 packaged at theta = 78 deg, psi = 28 deg with its stage-2 base at sigma_2 =
     -60 deg (a feasible equilibrium, checked before the path): no path through the symmetric
@@ -174,6 +178,7 @@ def test_deploy_refuses_a_2_5_without_a_path_naming_the_obstacle(tmp_path, capsy
                      r"no positive null vector of 3.3.2: force sign of .*P2", err), err
 
 
+@pytest.mark.slow
 def test_deploy_of_an_over_actuated_3_3_tracks_and_switches_with_every_tendon_taut(tmp_path, capsys):
     """`deploy FILE` of the three-stage 3-3 (13 N = 39 tendons for 12 N = 36 bar coordinates,
     eqs. 3.1-3.2: a wide B_q of eq. 5.46) on its automatic path, coarse step: B_q of full row
@@ -235,6 +240,7 @@ def test_report_of_a_1_3_takes_the_modes_its_com_has(tmp_path, capsys):
     assert "eq. 3.33 (input r_1 = " in md and "printed column" not in md
 
 
+@pytest.mark.slow
 def test_report_of_a_deployable_uses_sbc_com_and_its_own_deployment(tmp_path, capsys):
     """`report` on the 1-5(D): the SBC model in place of the MTC (no H_1j nodes), the COM, and
     the system's own deployment ([packaged], [deployment]), shortened here."""

@@ -78,6 +78,7 @@ def design_fd_check(preset, variables, rel_step, names, **options):
 
 
 @pytest.mark.parametrize("preset", ["1-4", "1-4D"])
+@pytest.mark.slow
 def test_sbc_thickness_and_diameter_gradients_match_finite_differences(preset):
     # Richardson-extrapolated differences with 1 % and 2 % of each variable; the partial
     # derivatives of the shells and beams are the five-point difference of the rebuilt model

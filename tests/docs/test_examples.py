@@ -56,6 +56,7 @@ def test_control_model(monkeypatch, tmp_path):
     assert poles.real.max() < 0
 
 
+@pytest.mark.slow
 def test_controller_on_fe_plant(monkeypatch, tmp_path):
     """The LQR designed on the COM damps the push on both plants: the last second of the run
     is below the open loop's on each plant."""

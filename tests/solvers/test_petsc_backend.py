@@ -282,6 +282,7 @@ def test_rank_local_pattern_changes_neither_hang_nor_mislead():
 
 
 @needs_mpi
+@pytest.mark.slow
 def test_failure_on_one_rank_one_error_nonzero_exit():
     # non-finite element matrices on rank 1: caught collectively, one message from rank 0
     p = _mpirun(2, "1-4", "4", "--nan-rank", "1")
@@ -455,6 +456,7 @@ def test_sbc_one_and_two_ranks_agree_with_scipy(sbc_scipy):
 
 
 @needs_mpi
+@pytest.mark.slow
 def test_sbc_failure_on_one_rank_one_error_nonzero_exit():
     # non-finite shell matrices on rank 1 only: caught collectively, one message from rank 0
     p = _mpirun(2, "1-4", "4", "--model", "sbc", "--nan-rank", "1")

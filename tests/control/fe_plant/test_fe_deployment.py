@@ -63,6 +63,7 @@ def test_pfl_options_refused(deploy23, kw, needle):
         _pfl(deploy23, **kw)
 
 
+@pytest.mark.slow
 def test_pfl_at_the_state_diverges_at_the_reference_tracks():
     """The diagnosis of docs/guides/fe-plant.md, on the 3 x 10 x 10 MTC plant with the COM's
     fixed-rate tendons over the first 1.5 s: the law of eq. 5.58 with its terms at the

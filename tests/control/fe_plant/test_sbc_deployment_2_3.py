@@ -91,6 +91,7 @@ def test_lpv_start_loop_with_stiff_bars_is_the_mtc_one(design21, mtc_start):  # 
 
 
 @pytest.mark.parametrize("bars", [None, "chord"])
+@pytest.mark.slow
 def test_2_3_adaptive_deployment_on_the_sbc_plant_is_the_mtc_one(bars, capsys):
     # the 7.4 deployment of the 2-3 system (adaptive PFL at the reference, cable tendons) runs
     # on the SBC plant with q measured as the bars' rigid fit (the default) and as their

@@ -111,6 +111,7 @@ def test_rest_length_for_tension_against_the_mtc_elements(law):
         rest_length_for_tension(dyn.model, le, -T - 1.0)
 
 
+@pytest.mark.slow
 def test_force_actuated_run_follows_the_com_run(dep):
     """The 7.4 1-4(D) controller on the force-actuated 4 x 4 x 4 SBC plant against the same
     controller on the COM plant, 0.5 s: no divergence, no commanded rest length above the

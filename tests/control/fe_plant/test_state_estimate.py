@@ -46,6 +46,7 @@ def test_other_system_refused(models):
         COMStateEstimator(com, MTCDynamics(other, other.equilibrium().x))
 
 
+@pytest.mark.slow
 def test_lqr_designed_on_the_com_damps_the_mtc_plant(models):
     """A state feedback designed on the COM linearisation (eq. 5.33, LQR with R = I / u_m^2)
     closed around the MTC plant through the estimate: from theta_11' = 0.02 rad/s (6.5.2

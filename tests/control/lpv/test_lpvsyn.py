@@ -275,6 +275,7 @@ def wu_1996(rho):
     return A, B, np.vstack([C1, C1[:2]]), D
 
 
+@pytest.mark.slow
 def test_the_wu_1996_example_certifies_above_its_frozen_optimum():
     grid = np.arange(-5, 6) * np.pi / 5                                  # the grid of the demo
     r = lpvsyn(wu_1996, 2, 2, grid=grid, rate_bounds=1.0, basis=Basis.trigonometric(), backoff=0.05)

@@ -60,6 +60,7 @@ def test_structures_the_eigopt_route_does_not_carry_are_refused_with_the_reason(
         lpvsyn(gp, 0, 1, grid=gp.axes, rate_bounds=gp.rate_bounds, basis="affine", method="lmi")
 
 
+@pytest.mark.slow
 def test_2_3_plant_on_a_2_x_1_grid_reproduces_the_bisection():
     # the design of `tmfem control lpv --preset 2-3-lpv` (EIGOPT bisection, its default rtol,
     # budget and upper level) on the 2 x 1 grid of the design21 fixture: lpvsyn chooses the EIGOPT
