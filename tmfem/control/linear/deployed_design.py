@@ -151,8 +151,8 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         raise InfeasibleController(
             f"{system.name}: the modes at {listed} are not reached by any tendon (PBH margin <= "
             f"{res.tol:g}, eq. 5.71), so no controller places them left of -alpha_1 = -{alpha:.4g}; "
-            "design without them (--exclude-uncontrollable, uncontrollable='exclude': they keep "
-            "their open-loop dynamics) or change the actuation")
+            "design without them (`tmfem control hinf --exclude-uncontrollable`, or "
+            "uncontrollable='exclude' in Python: they keep their open-loop dynamics) or change the actuation")
     if uncontrollable == "exclude" and hidden:
         gen = _without(gen, hidden, tol=res.tol)
         notes.append(f"modes no tendon reaches (PBH margin <= {res.tol:g}) left out of the design: {listed}; "
