@@ -171,14 +171,17 @@ def test_fifo_endless_and_silent_writers(tmp_path):
     os.mkfifo(fifo)
     # an endless writer of its own process: it ends on SIGPIPE when the reader stops (a
     # thread here would take the test process with it where a library reset SIGPIPE)
-    writer = subprocess.Popen(["sh", "-c", f"yes '# comment' > '{fifo}'"])
+    writer = subprocess.Popen(["sh", "-c", f"exec yes '# comment' > '{fifo}'"])
     try:
         with pytest.raises(InputError, match="found more"):
             load_system(fifo)
     finally:
         writer.kill()
         writer.wait(10)
-    # a FIFO whose writer holds it open and sends nothing: refused after the timeout
+    # a FIFO whose writer holds it open and sends nothing: refused after the timeout (a FIFO
+    # of its own, so nothing the endless writer left in flight can reach it)
+    fifo = tmp_path / "silent.toml"
+    os.mkfifo(fifo)
     fd = os.open(fifo, os.O_RDWR)          # a writer that never writes (and does not block)
     try:
         t0 = time.perf_counter()
