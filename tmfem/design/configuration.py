@@ -27,11 +27,12 @@ partial derivative is analytic) with the bases' motion dA/dp prescribed on the p
 degrees of freedom: K_ff du_f = -dR_f/dp - K_fs dA/dp (:func:`design_rates`,
 :func:`support_rates`).
 
-dr_D/dp and dA/dp are the fourth-order central differences (8 (r(h) - r(-h)) - (r(2h) -
-r(-2h))) / 12h of the re-designed rest lengths and bases (no FE solve: one linear
-plane-stress solve per design), step h = 0.001 deg: truncation O(h^4) below 1e-12 relative,
-rounding of the design (its equilibrium residual about 1e-15) / h about 1e-10. Not analytic;
-on a 1-N system they agree with the closed form's derivative (eqs. 3.30-3.36) within 1e-10.
+dr_D/dp is exact: the forward-mode derivative of the design along the angle's direction
+(:mod:`tmfem.design.design_derivative`: node coordinates, corner constraints, the linear
+membrane solve, the least-squares tendon forces of eq. 3.16 and eqs. 3.8-3.9), with the
+configuration's rate from eqs. 3.19-3.20 (:func:`angle_direction`): theta_ij' = 1 (or
+psi_ij' = 1) on every bar of the stage and, for a 1-N system, A_1j' = A_1j r_1' / r_1 with
+r_1' / r_1 = cot(theta_1) (or cot(psi_1)) from eq. 3.33 (the bases scale with r_1).
 """
 from __future__ import annotations
 
@@ -40,13 +41,13 @@ import re
 
 import numpy as np
 
+from tmfem.design.design_derivative import design_rate
 from tmfem.equilibrium.symmetric import r1_1N
 from tmfem.errors import InputError
+from tmfem.system.coordinates import q_index
 
 #: the angle names; a variable is ``theta_<stage>`` or ``psi_<stage>`` [deg]
 ANGLES = ("theta", "psi")
-#: step of the design's central difference [deg]
-STEP_DEG = 1e-3
 
 _NAME = re.compile(r"^(theta|psi)_(\d+)$")
 
@@ -90,14 +91,19 @@ def with_angles(system, values: dict):
     return system.replace(symmetric=cfg, **cfg.system_arrays(system.N))
 
 
-def design_rest_lengths(system, *, mesh_n: int, attachment: str = "point", patch=None,
-                        membrane_law: str = "svk") -> np.ndarray:
-    """Rest lengths r_D (eqs. 3.8-3.9) of the ch. 3 design of ``system`` on the N x n x n
-    membrane mesh with the given corner attachment and law; raises (SlackTendon,
+def design_of(system, *, mesh_n: int, attachment: str = "point", patch=None, membrane_law: str = "svk"):
+    """The ch. 3 design (:func:`tmfem.equilibrium.design.design_equilibrium`) of ``system`` on
+    the N x n x n membrane mesh with the given corner attachment and law; raises (SlackTendon,
     SlackMembrane, InfeasibleDesign) where the configuration has no design."""
     from tmfem.equilibrium.design import design_equilibrium
-    d = design_equilibrium(system, mesh_n=mesh_n, attachment=attachment, patch=patch,
-                           membrane_law=membrane_law)
+    return design_equilibrium(system, mesh_n=mesh_n, attachment=attachment, patch=patch,
+                              membrane_law=membrane_law)
+
+
+def design_rest_lengths(system, *, mesh_n: int, attachment: str = "point", patch=None,
+                        membrane_law: str = "svk") -> np.ndarray:
+    """Rest lengths r_D (eqs. 3.8-3.9) of the ch. 3 design of ``system`` (:func:`design_of`)."""
+    d = design_of(system, mesh_n=mesh_n, attachment=attachment, patch=patch, membrane_law=membrane_law)
     return np.asarray(d.rest_lengths, dtype=float)
 
 
@@ -111,16 +117,29 @@ def redesign_of(model):
     return redesign
 
 
+def angle_direction(system, angle: str, stage: int) -> tuple:
+    """The rates [per deg] of q (n_q,) and of the stage-1 base A_1j (3, N) of ``system`` along
+    its angle (angle, stage) (eqs. 3.19-3.20 and, for a 1-N system, eq. 3.33: module
+    docstring)."""
+    c = system.symmetric
+    _, th, ps = q_index(system.M, system.N)
+    dq = np.zeros(system.q.size)
+    dq[(th if angle == "theta" else ps)[stage]] = np.pi / 180
+    dbase = np.zeros_like(system.base)
+    if system.M == 1:               # r_1 ~ sin(theta_1) sin(psi_1): r_1' / r_1 = cot of the angle
+        dbase = system.base * (np.pi / 180) / np.tan(getattr(c, angle)[0])
+    return dq, dbase
+
+
 def design_rates(model, angle: str, stage: int) -> tuple:
     """dr/dp [m/deg] (n_tendons,) and dA/dp [m/deg] (3, N) of the bases A_1j of the angle
-    variable (angle, stage) of ``model``'s system (module docstring: the design's fourth-order
-    central difference)."""
-    redesign = redesign_of(model)
-    p0 = angle_value(model.system, angle, stage)
-    moved = {k: with_angles(model.system, {(angle, stage): p0 + k * STEP_DEG}) for k in (2, 1, -1, -2)}
-    r = {k: redesign(s) for k, s in moved.items()}
-    a = {k: s.base for k, s in moved.items()}
-    return tuple((8 * (f[1] - f[-1]) - (f[2] - f[-2])) / (12 * STEP_DEG) for f in (r, a))
+    variable (angle, stage) of ``model``'s system: the exact rate of the ch. 3 design on the
+    model's mesh, attachment and law (module docstring)."""
+    topo = model.topology
+    design = design_of(model.system, mesh_n=topo.mesh.n, attachment=topo.attachment, patch=model.patch,
+                       membrane_law=model.membrane_law)
+    dq, dbase = angle_direction(model.system, angle, stage)
+    return design_rate(design, dq=dq, dbase=dbase).rest_lengths, dbase
 
 
 def support_rates(model, base_rate: np.ndarray) -> np.ndarray:
