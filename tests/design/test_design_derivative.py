@@ -52,8 +52,10 @@ def test_the_design_rate_matches_the_central_difference_of_the_redesigned_system
     p0 = float(np.degrees(getattr(system.symmetric, angle)[stage]))
     fd = central(redesigned(system, angle, stage, attachment=attachment, mesh_n=mesh_n), p0)
     nt, nn = len(system.tendons), d.nodes.size
-    parts = (("rest lengths", slice(0, nt), d.rest_lengths), ("tendon forces", slice(nt, 2 * nt), d.tendon_forces),
-             ("nodes", slice(2 * nt, 2 * nt + nn), d.nodes), ("corner forces", slice(2 * nt + nn, None), d.corner_forces))
+    parts = (("rest lengths", slice(0, nt), d.rest_lengths),
+             ("tendon forces", slice(nt, 2 * nt), d.tendon_forces),
+             ("nodes", slice(2 * nt, 2 * nt + nn), d.nodes),
+             ("corner forces", slice(2 * nt + nn, None), d.corner_forces))
     assert np.abs(fd[:2 * nt]).min() > 0                       # the angle moves every tendon
     for part, sl, value in parts:
         # relative to the rate, or to the value per degree where the angle does not move the
