@@ -2,10 +2,12 @@
 every response's derivative against central finite differences of the re-designed (ch. 3
 design at the moved angles) and re-solved MTC equilibrium, Richardson-extrapolated
 (4 D(h) - D(2h)) / 3 with a step h that moves the rest lengths by at most 5e-4 m (as on the
-rest-length variables) and the bases by at most 1e-4 m (0.001 to 0.02 deg), on the 2-3 and
-1-4 presets and the user systems tests/data/systems/square-2-4.toml and triangle-1-3.toml
-(1-N systems: their bases move with r_1 of eq. 3.33), mesh_n=4, equilibrium to a residual of
-1e-12 of the member forces."""
+rest-length variables) and the bases by at most 1e-4 m (0.001 to 0.02 deg), on the 2-3,
+1-4 and 1-4D presets (1-4D on the MTC model with H_1j held rigidly on the bars, as the ch. 3
+design holds it) and the user systems tests/data/systems/square-2-4.toml and triangle-1-3.toml
+(1-N systems: their bases move with r_1 of eq. 3.33; a 1-N(D) system's r_1 stays), mesh_n=4,
+equilibrium to a residual of 1e-12 of the member forces. The same check on the SBC model is in
+test_sbc_sensitivities.py."""
 import dataclasses
 from pathlib import Path
 
@@ -13,7 +15,7 @@ import numpy as np
 import pytest
 
 from tmfem.design import design_sensitivities
-from tmfem.design.configuration import design_rates, on_supports, redesign_of, with_angles
+from tmfem.design.configuration import design_rates, redesign_of, warm_start, with_angles
 from tmfem.design.optimizer import optimize
 from tmfem.design.variables import apply_design, parse_variables, variable_values
 from tmfem.equilibrium.design import design_equilibrium
@@ -28,20 +30,22 @@ SQUARE, TRIANGLE, PENTAGON_D = DATA / "square-2-4.toml", DATA / "triangle-1-3.to
 NAMES = [n for n in SCALARS if n != "surface_rms"] + VECTORS        # flat membranes by symmetry
 
 
-def fd_check(system, variables):
-    m = MTCModel(system, mesh_n=4)
+def fd_check(system, variables, Model=MTCModel, names=NAMES, **options):
+    """Exact and Richardson-extrapolated derivatives of ``names`` on ``Model`` (MTCModel or
+    SBCModel) at mesh_n=4 with the model's ``options``, with the values and the design."""
+    m = Model(system, mesh_n=4, **options)
     r0 = m.rest_lengths.copy()
     eq = m.equilibrium(tol=1e-12)
     vs = parse_variables(system, variables)
     p0 = variable_values(system, r0, vs)
-    f0, exact = stacked(design_sensitivities(m, equilibrium=eq, variables=variables, **OPTIONS), NAMES)
+    f0, exact = stacked(design_sensitivities(m, equilibrium=eq, variables=variables, **OPTIONS), names)
     redesign = redesign_of(m)
 
     def values(p):
         sj, rj = apply_design(system, r0, vs, p, redesign=redesign)
-        mj = MTCModel(sj, mesh_n=4, rest_lengths=rj)
-        ej = mj.equilibrium(x0=on_supports(mj, eq.state), tol=1e-12)
-        return stacked(design_sensitivities(mj, equilibrium=ej, variables=variables, **OPTIONS), NAMES)[0]
+        mj = Model(sj, mesh_n=4, rest_lengths=rj, **options)
+        ej = mj.equilibrium(tol=1e-12, **warm_start(mj, eq.state))
+        return stacked(design_sensitivities(mj, equilibrium=ej, variables=variables, **OPTIONS), names)[0]
 
     steps = []
     for v in vs:
@@ -56,14 +60,15 @@ def fd_check(system, variables):
     return exact, richardson(values, p0, steps), f0, p0
 
 
-@pytest.mark.parametrize("system, variables", [
-    (load_preset("2-3"), ["theta_1", "psi_1", "theta_2", "psi_2", "S1"]),
-    (load_system(SQUARE), ["theta_2", "psi_1", "V2"]),
-    (load_preset("1-4"), ["theta_1", "psi_1", "S1"]),
-    (load_system(TRIANGLE), ["theta_1", "psi_1"]),
-], ids=["2-3", "square-2-4", "1-4", "triangle-1-3"])
-def test_responses_of_the_angles_match_finite_differences_of_the_redesigned_system(system, variables):
-    exact, fd, f0, p0 = fd_check(system, variables)
+@pytest.mark.parametrize("system, variables, options", [
+    (load_preset("2-3"), ["theta_1", "psi_1", "theta_2", "psi_2", "S1"], {}),
+    (load_system(SQUARE), ["theta_2", "psi_1", "V2"], {}),
+    (load_preset("1-4"), ["theta_1", "psi_1", "S1"], {}),
+    (load_system(TRIANGLE), ["theta_1", "psi_1"], {}),
+    (load_preset("1-4D"), ["theta_1", "psi_1"], {"rigid_bar_points": True}),
+], ids=["2-3", "square-2-4", "1-4", "triangle-1-3", "1-4D"])
+def test_responses_of_the_angles_match_finite_differences_of_the_redesigned_system(system, variables, options):
+    exact, fd, f0, p0 = fd_check(system, variables, **options)
     assert np.abs(exact[:, :-1]).max() > 0                # the angles do move the responses
     err = rel_err(exact, fd, f0, p0)
     assert np.all(err < 1e-5), err.max(axis=0)
@@ -141,7 +146,6 @@ def test_an_angle_optimum_is_written_back_with_its_angles_and_rest_lengths(tmp_p
 
 
 @pytest.mark.parametrize("system, variables, text", [
-    (load_system(PENTAGON_D), ["theta_1"], "1-N\\(D\\)"),
     (load_preset("2-3"), ["psi_3"], "stage 1..2"),
     (load_preset("2-3"), ["theta_1", "d_bar"], "rest lengths only"),
     (load_preset("2-3"), ["sigma_2"], "only the angles"),
@@ -160,7 +164,13 @@ def test_an_angle_without_a_design_names_the_angle():
         apply_design(system, m.rest_lengths, vs, [53.0], redesign=redesign_of(m))
 
 
-def test_angles_on_the_sbc_model_are_refused():
-    with pytest.raises(InputError, match="MTC model"):
-        optimize(load_preset("2-3"), objective="max:freq_1", model="sbc", mesh_n=2,
-                 variables={"theta_1": (50.0, 60.0)})
+def test_an_angle_optimum_on_the_sbc_model_moves_the_bases_and_the_rest_lengths():
+    # 1-4: d freq_1 / d theta_1 > 0 at the start (0.80 Hz/deg on both models), so the
+    # optimum is the upper bound; the written design has r_1 of eq. 3.33 at 61 deg
+    system = load_preset("1-4")
+    res = optimize(system, objective="max:freq_1", model="sbc", mesh_n=4, k=2, max_iter=2,
+                   variables={"theta_1": (59.0, 61.0)})
+    assert res.optimum[0] == pytest.approx(61.0, abs=1e-9)
+    assert res.optimum_responses["freq_1"] > res.start_responses["freq_1"]
+    ratio = res.system.symmetric.r[0] / system.symmetric.r[0]
+    assert ratio == pytest.approx(np.sin(np.radians(61)) / np.sin(np.radians(60)), rel=1e-12)

@@ -65,9 +65,6 @@ def parse_angle(system, name: str):
     if not 1 <= stage <= system.M:
         raise InputError(f"design variable {name!r}: expected {angle}_<stage> of a stage 1..{system.M} "
                          f"(one angle per stage), found stage {stage}")
-    if system.deployable:
-        raise InputError(f"design variable {name!r}: expected an M-N or 1-N system, found a 1-N(D) "
-                         f"system (its MTC model holds H_1j rigidly on the bars, not the ch. 3 design)")
     return angle, stage - 1
 
 
@@ -79,12 +76,12 @@ def angle_value(system, angle: str, stage: int) -> float:
 def with_angles(system, values: dict):
     """``system`` with the angles ``{(angle, stage): value [deg]}`` changed: its symmetric
     configuration and the fields it fixes (q, base, l); a 1-N system's base radius r_1
-    follows eq. 3.33."""
+    follows eq. 3.33 (a 1-N(D) system's stays: eq. 3.41 bounds it, no equation fixes it)."""
     c = system.symmetric
     arrays = {a: getattr(c, a).copy() for a in ANGLES}
     for (a, i), v in values.items():
         arrays[a][i] = np.radians(v)
-    if system.M == 1:               # eq. 3.33, relative to the start (given to printed precision)
+    if system.M == 1 and not system.deployable:   # eq. 3.33, relative to the start (printed precision)
         arrays["r"] = c.r * (r1_1N(l1=c.l[0], theta1=arrays["theta"][0], psi1=arrays["psi"][0], N=system.N)
                              / r1_1N(l1=c.l[0], theta1=c.theta[0], psi1=c.psi[0], N=system.N))
     cfg = dataclasses.replace(c, **arrays)
@@ -126,7 +123,7 @@ def angle_direction(system, angle: str, stage: int) -> tuple:
     dq = np.zeros(system.q.size)
     dq[(th if angle == "theta" else ps)[stage]] = np.pi / 180
     dbase = np.zeros_like(system.base)
-    if system.M == 1:               # r_1 ~ sin(theta_1) sin(psi_1): r_1' / r_1 = cot of the angle
+    if system.M == 1 and not system.deployable:   # r_1 ~ sin(theta_1) sin(psi_1): r_1' / r_1 = cot
         dbase = system.base * (np.pi / 180) / np.tan(getattr(c, angle)[0])
     return dq, dbase
 
@@ -142,17 +139,14 @@ def design_rates(model, angle: str, stage: int) -> tuple:
     return design_rate(design, dq=dq, dbase=dbase).rest_lengths, dbase
 
 
-def support_rates(model, base_rate: np.ndarray) -> np.ndarray:
-    """The reduced increment (n_red,) that moves the pinned bases A_1j of ``model`` by
-    ``base_rate`` (3, N) and nothing else."""
-    x = np.zeros((3, model.topology.n_nodes))
-    x[:, model.topology.fixed_nodes] = base_rate
-    return model.reduce(x)
-
-
-def on_supports(model, x: np.ndarray) -> np.ndarray:
-    """Positions x (3, n_nodes) with the pinned bases moved to ``model``'s system's A_1j: a
-    warm start of the static solve of a design whose bases moved (1-N angles)."""
-    x = np.array(x, dtype=float)
+def warm_start(model, state) -> dict:
+    """The keyword of ``model.equilibrium`` that starts it from the equilibrium ``state`` of
+    a neighbouring design (MTC: positions (3, n_nodes); SBC: a State) with the pinned bases
+    moved to ``model``'s system's A_1j (1-N angles). The SBC model's start is the state of its
+    own positions (:meth:`~tmfem.models.sbc.model.SBCModel.state_from_mtc`: directors and bar
+    triads turned onto the deformed geometry from its own reference), since the rotations of
+    ``state`` are relative to the neighbour's reference."""
+    sbc = model.name == "sbc"
+    x = np.array(state.x[:, :model.numbering.n_mtc_nodes] if sbc else state, dtype=float)
     x[:, model.topology.fixed_nodes] = model.system.base
-    return x
+    return {"start": model.state_from_mtc(x)} if sbc else {"x0": x}

@@ -14,9 +14,13 @@ rate of an angle variable), analytically, without a difference step:
    (X_c the corner differences), and the membrane columns of A(q) (eq. 3.11),
    Y_q = G_y^-1 X_q, move by Y_q' = G_y^-1 (X_q' - G_y' Y_q), where G_y' needs the second
    derivatives of R^ef (:func:`euler_R_second_derivatives`).
-3. **Membrane forces**: the plane-stress solve on the fixed membrane mesh is linear in the
-   corner displacements (law ``"svk"``), so F' = F(Delta'), one more solve of the same,
-   already factorised, membrane. The membrane's stiffness does not depend on the angles.
+3. **Membrane forces**: on the fixed membrane mesh the plane-stress solve's stiffness does not
+   depend on the angles; the corner forces F (the multipliers mu of the corner coupling C,
+   K x = C^T mu, C x = Delta; C the corner rows of the identity for the point attachment)
+   move by the bordered solve [[K_t, C^T], [C, 0]] (x', -F') = (0, Delta') with the law's
+   tangent K_t at the design's membrane state (the constant K of the linear law ``"svk"``;
+   the consistent tangent of the tension-field law, exact where no element changes between
+   taut, wrinkled and slack).
 4. **Tendon forces** (eq. 3.16): the design takes the least-squares solution of
    A_T T = b, b = -A_F f (f the free corner forces), which is the null vector of
    A(q) = [A_F A_T] normalised by the membrane's own forces f (the last column block is
@@ -31,14 +35,14 @@ rate of an angle variable), analytically, without a difference step:
    r = EA L / (T + EA): r' = EA (L' (T + EA) - L T') / (T + EA)^2.
 
 Limits: a design whose tendon network alone has self-stress (its forces picked by a linear
-programme, not smooth in the configuration) and the tension-field membrane law (corner forces
-not linear in the corner displacements) are refused with InputError.
+programme, not smooth in the configuration) is refused with InputError.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from tmfem.equilibrium.general import (_G_jacobian, corner_array, euler_R_derivatives, free_components,
                                        node_jacobian)
@@ -155,6 +159,22 @@ def _corner_rates(design, dX: np.ndarray, dJ: np.ndarray) -> tuple:
     return dfree, dYq[3:].T
 
 
+def corner_force_rate(membrane, solution, ddelta: np.ndarray) -> np.ndarray:
+    """F' (2, N) of the plane-stress ``membrane`` (:class:`tmfem.fem.plane_stress.PlaneStressMembrane`)
+    at its ``solution`` for the corner displacement rate ddelta (2, N) (module docstring, step
+    3; the coupling rows scaled to the stiffness as in the membrane's own bordered solve)."""
+    basis = membrane.basis
+    x = np.zeros(basis.N)
+    x[basis.nodal_dofs] = solution.u
+    K = membrane.tangent(x)
+    C = membrane.coupling
+    s = float(np.abs(K.diagonal()).mean())
+    A = sp.bmat([[K, s * C.T], [s * C, None]], format="csc")
+    rhs = np.concatenate([np.zeros(basis.N), s * np.asarray(ddelta, dtype=float).T.ravel()])
+    y = membrane.backend.factorize(A)(rhs)
+    return (-s * y[basis.N:]).reshape(-1, 2).T
+
+
 def design_rate(design, *, dq: np.ndarray, dbase: np.ndarray) -> DesignRate:
     """The exact rate of the ch. 3 design ``design`` (an :class:`EquilibriumDesign` of
     :func:`tmfem.equilibrium.design.design_equilibrium`) along the configuration rate dq
@@ -163,13 +183,9 @@ def design_rate(design, *, dq: np.ndarray, dbase: np.ndarray) -> DesignRate:
     Raises
     ------
     InputError
-        the membrane law is not linear, or the tendon network alone has self-stress.
+        the tendon network alone has self-stress.
     """
     system, E = design.system, design.matrix
-    if design.membrane_model.law.name != "svk":
-        raise InputError(f"design rates: expected the linear membrane law 'svk', found "
-                         f"{design.membrane_model.law.name!r} (its corner forces are not linear in the "
-                         f"corner displacements)")
     if design.self_stress_dim:
         raise InputError(f"design rates: expected tendon forces fixed by eq. 3.16, found a tendon network "
                          f"with {design.self_stress_dim} self-stress states of its own (the design picks "
@@ -189,8 +205,8 @@ def design_rate(design, *, dq: np.ndarray, dbase: np.ndarray) -> DesignRate:
     # step 2: corner displacements and membrane columns
     dfree, dAF = _corner_rates(design, dX, dJ)
     ddelta = corner_array(dfree, system.N)
-    # step 3: membrane corner forces (linear solve)
-    dF = design.membrane_model.solve(ddelta[:2]).corner_forces
+    # step 3: membrane corner forces
+    dF = corner_force_rate(design.membrane_model, design.membrane, ddelta[:2])
     f, df = free_components(design.corner_forces), free_components(dF)
     # step 4: tendon forces and rest lengths
     AT, AF, T = E.A_T, E.A_F, design.tendon_forces

@@ -12,7 +12,9 @@ sensitivities (:func:`tmfem.design.sensitivities.design_sensitivities`).
 Each adapter gives: ``T`` (the reduced-to-full map of the residual), ``x`` (node positions of
 the model's own numbering, (3, n)), ``point(du)`` (the residual's argument after the reduced
 increment du), ``tangent(point)``, ``mass(point)`` (the MTC model's does not depend on it),
-``positions(du)`` (the translations (3, n) of a reduced increment), ``membrane(point)`` (von
+``positions(du)`` (the translations (3, n) of a reduced increment), ``supports(rate)`` (the
+reduced increment that moves the pinned bases A_1j by ``rate`` (3, N) and nothing else: a
+1-N system's angle moves them), ``membrane(point)`` (von
 Mises and minor principal stresses and the reference points (2, ne, nqp) where they are
 evaluated), ``areas()`` (the reference areas dA_g (ne, nqp) of those points: the MTC
 membrane's Gauss weights |det J| w; the SBC shells' element areas / 4, their Gauss points
@@ -54,6 +56,11 @@ class MTCKinematics:
     def positions(self, du) -> np.ndarray:
         return self.model.full(du)
 
+    def supports(self, rate) -> np.ndarray:
+        x = np.zeros((3, self.model.topology.n_nodes))
+        x[:, self.model.topology.fixed_nodes] = rate
+        return self.model.reduce(x)
+
     def membrane(self, point):
         st = self.model.membrane.stresses(self.model.full(point)[:, :self.n_mesh])
         return st.von_mises, minor_principal(st.cauchy), st.points
@@ -88,6 +95,11 @@ class SBCKinematics:
 
     def positions(self, du) -> np.ndarray:
         return self.model.constraints.full(du)[self._tr].T
+
+    def supports(self, rate) -> np.ndarray:
+        u = np.zeros(self.model.dofmap.ndof)
+        u[self._tr[self.model.topology.fixed_nodes]] = np.asarray(rate).T
+        return self.model.constraints.reduce(u)
 
     def membrane(self, point):
         from tmfem.models.sbc.post import shell_stresses

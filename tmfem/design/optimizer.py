@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import minimize, nnls
 
-from tmfem.design.configuration import on_supports, redesign_of
+from tmfem.design.configuration import redesign_of, warm_start
 from tmfem.design.sensitivities import RESPONSES, design_sensitivities
 from tmfem.design.variables import apply_design, parse_variables, variable_values
 from tmfem.errors import ConvergenceError, InputError
@@ -140,12 +140,7 @@ class _Evaluator:
         m = self.Model(system, mesh_n=mesh_n, **model_options)
         self.r0 = m.rest_lengths.copy()
         self.vars = parse_variables(system, names)
-        self.redesign = None
-        if any(v.kind == "angle" for v in self.vars):
-            if model != "mtc":
-                raise InputError(f"optimize: angle variables need the MTC model (its rest lengths follow "
-                                 f"the ch. 3 design), found model {model!r}")
-            self.redesign = redesign_of(m)
+        self.redesign = redesign_of(m) if any(v.kind == "angle" for v in self.vars) else None
         self.p0 = variable_values(system, self.r0, self.vars)
         self.x = None
         self.last = None
@@ -158,8 +153,10 @@ class _Evaluator:
         sysp, r = apply_design(self.system, self.r0, self.vars, p, redesign=self.redesign)
         m = self.Model(sysp, mesh_n=self.mesh_n, rest_lengths=r, **self.model_options)
         try:
-            start = self.x if self.redesign is None or self.x is None else on_supports(m, self.x)
-            eq = m.equilibrium(**({} if start is None else {self.start: start}))
+            if self.x is None:
+                eq = m.equilibrium()
+            else:
+                eq = m.equilibrium(**({self.start: self.x} if self.redesign is None else warm_start(m, self.x)))
         except ConvergenceError:
             if self.x is None:
                 raise
@@ -195,7 +192,7 @@ def optimize(system, *, objective: str, constraints=(), variables=None, model: s
     variables : dict {name: (lower, upper)}, optional
         Design variables and bounds; default the system file's ``[design] variables``.
     model : {"mtc", "sbc"}
-        The finite-element model (the SBC model: no angles).
+        The finite-element model.
     mesh_n : int
         Membrane elements per side of the MTC model.
     k : int

@@ -51,7 +51,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from tmfem.design.configuration import design_rates, support_rates
+from tmfem.design.configuration import design_rates
 from tmfem.design.kinematics import kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
 from tmfem.design.variables import (Variable, apply_design, area_derivative, parse_variables, variable_values,
@@ -427,10 +427,6 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     if thickness and "h_membrane" not in [v.name for v in vs]:
         vs.append(Variable("h_membrane", "thickness"))
     sbc = model.name == "sbc"
-    if sbc and any(v.kind == "angle" for v in vs):
-        raise InputError(f"sensitivities of the SBC model: expected rest-length, thickness, diameter or "
-                         f"membrane-radius variables, found {[v.name for v in vs if v.kind == 'angle']} "
-                         f"(they move the beams' reference geometry; use the MTC model)")
     eq = model.equilibrium() if equilibrium is None else equilibrium
     kin = kinematics(model, eq)
     names = [v.name for v in vs]
@@ -446,7 +442,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     dL = e2t @ G                                                       # dL_e / dp  (ne, n_var)
     Ncr = np.array([model.system.bar.euler_critical_load(l) for l in model.system.l.ravel()])
     state0 = kin.point(np.zeros(model.free.size)) if sbc else None
-    parts = [_section_partials(model, v, state0, Ncr) if sbc and v.kind != "rest_length"
+    parts = [_section_partials(model, v, state0, Ncr) if sbc and v.kind not in ("rest_length", "angle")
              else _partials(model, v, G[:, j], x, dL[:, j], Ncr, kin.T) for j, v in enumerate(vs)]
     dR = np.column_stack([p.dR for p in parts])
     n_red = dR.shape[0]
@@ -456,7 +452,7 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     # an angle of a 1-N system moves the pinned bases: their motion is prescribed
     du = np.zeros((n_red, n_var))
     for j, (_, base_rate) in rates.items():
-        du[:, j] = support_rates(model, base_rate)
+        du[:, j] = kin.supports(base_rate)
     du[free] = solve(-(dR + sp.csr_matrix(K) @ du)[free]).reshape(-1, n_var)
     dx = np.stack([kin.positions(du[:, j]) for j in range(n_var)], axis=-1)   # (3, nn, n_var)
 
