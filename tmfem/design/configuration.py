@@ -104,13 +104,19 @@ def design_rest_lengths(system, *, mesh_n: int, attachment: str = "point", patch
     return np.asarray(d.rest_lengths, dtype=float)
 
 
-def redesign_of(model):
-    """``system -> r_D`` on the mesh, attachment and law of an MTC ``model``."""
+def design_options(model) -> dict:
+    """The design's options of an MTC or SBC ``model``: its membrane mesh, attachment and law."""
     topo = model.topology
+    return {"mesh_n": topo.mesh.n, "attachment": topo.attachment, "patch": model.patch,
+            "membrane_law": model.membrane_law}
+
+
+def redesign_of(model):
+    """``system -> r_D`` on the mesh, attachment and law of an MTC or SBC ``model``."""
+    options = design_options(model)
 
     def redesign(system):
-        return design_rest_lengths(system, mesh_n=topo.mesh.n, attachment=topo.attachment,
-                                   patch=model.patch, membrane_law=model.membrane_law)
+        return design_rest_lengths(system, **options)
     return redesign
 
 
@@ -128,13 +134,11 @@ def angle_direction(system, angle: str, stage: int) -> tuple:
     return dq, dbase
 
 
-def design_rates(model, angle: str, stage: int) -> tuple:
+def design_rates(model, angle: str, stage: int, *, design=None) -> tuple:
     """dr/dp [m/deg] (n_tendons,) and dA/dp [m/deg] (3, N) of the bases A_1j of the angle
-    variable (angle, stage) of ``model``'s system: the exact rate of the ch. 3 design on the
-    model's mesh, attachment and law (module docstring)."""
-    topo = model.topology
-    design = design_of(model.system, mesh_n=topo.mesh.n, attachment=topo.attachment, patch=model.patch,
-                       membrane_law=model.membrane_law)
+    variable (angle, stage) of ``model``'s system: the exact rate of the ch. 3 design
+    (``design``, default the design of :func:`design_options`) (module docstring)."""
+    design = design_of(model.system, **design_options(model)) if design is None else design
     dq, dbase = angle_direction(model.system, angle, stage)
     return design_rate(design, dq=dq, dbase=dbase).rest_lengths, dbase
 

@@ -51,7 +51,7 @@ import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 
-from tmfem.design.configuration import design_rates
+from tmfem.design.configuration import design_of, design_options, design_rates
 from tmfem.design.kinematics import kinematics
 from tmfem.design.responses import corner_deltas, membrane_aggregates, surface_rms
 from tmfem.design.variables import (Variable, apply_design, area_derivative, parse_variables, variable_values,
@@ -430,7 +430,8 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     eq = model.equilibrium() if equilibrium is None else equilibrium
     kin = kinematics(model, eq)
     names = [v.name for v in vs]
-    rates = {j: design_rates(model, v.angle, v.stage) for j, v in enumerate(vs) if v.kind == "angle"}
+    design = design_of(model.system, **design_options(model)) if any(v.kind == "angle" for v in vs) else None
+    rates = {j: design_rates(model, v.angle, v.stage, design=design) for j, v in enumerate(vs) if v.kind == "angle"}
     G = _rest_length_map(model, vs, rates)
     n_var = len(vs)
     topo, free = model.topology, model.free
