@@ -21,7 +21,7 @@ def configure(parser) -> None:
                         help="a design variable and its bounds (repeatable); default the file's "
                              "[design] variables")
     parser.add_argument("--model", choices=["mtc", "sbc"], default="mtc",
-                        help="finite-element model (sbc: no angles)")
+                        help="finite-element model")
     parser.add_argument("--mesh", type=positive_int, default=10, help="membrane elements per side")
     parser.add_argument("--modes", type=positive_int, default=4, help="eigenvalues in the bound formulation")
     parser.add_argument("--aperture", type=positive_float, default=None,

@@ -1,4 +1,5 @@
-"""The configuration angles theta_i, psi_i of a symmetric M-N system as design variables.
+"""The configuration angles theta_i, psi_i of a symmetric M-N, 1-N or 1-N(D) system as design
+variables.
 
 A change of the declination theta_i or the azimuth psi_i of stage i (eqs. 3.19-3.20) moves
 the bars and changes the ch. 3 equilibrium design: the node coordinates, the corner
@@ -19,9 +20,10 @@ moves the base A_1j with r_1 (the bases scale with r_1 about the origin), r_1 = 
 r_3.33(theta, psi) / r_3.33(theta_0, psi_0), so that a start given to printed precision (the
 1-4 preset's r_1 = 0.6429 m) is the start.
 
-What the MTC model takes from the design: the rest lengths and the pinned bases. The bars'
-reference lengths l and the membrane's reference mesh do not change with the angles, and the
-design configuration is only the start of the static solve. In the direct method of
+What the MTC and SBC models take from the design: the rest lengths and the pinned bases. The
+bars' reference lengths l and the membrane's reference mesh do not change with the angles, and
+the design configuration is only the start of the static solve (the SBC model's reference
+placement of its beams and shells follows it rigidly, which moves no equilibrium). In the direct method of
 :mod:`tmfem.design.sensitivities` an angle is a rest-length direction dr/dp (the residual's
 partial derivative is analytic) with the bases' motion dA/dp prescribed on the pinned
 degrees of freedom: K_ff du_f = -dR_f/dp - K_fs dA/dp (:func:`design_rates`,

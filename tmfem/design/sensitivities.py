@@ -1,5 +1,4 @@
-"""Exact design sensitivities of the MTC model (and, for all but the configuration angles, of
-the SBC model) at its static equilibrium.
+"""Exact design sensitivities of the MTC and SBC models at their static equilibrium.
 
 Variables p (:mod:`tmfem.design.variables`): tendon rest lengths, per group (``"S1"``,
 ``"V2"``: every tendon of the group moves together, r = r_0 + G p) or per tendon, the membrane
@@ -9,8 +8,10 @@ tendon family linear in their area A at fixed positions: dR/dA = f / A, dK/dA = 
 dM/dA = M / A, and dA/dd = pi d / 2; the membrane radius scales the membrane's reference mesh,
 whose partial derivatives are central differences of the assembled quantities at fixed
 positions (:func:`with_radius`); the configuration angles of a symmetric system are
-rest-length directions G = dr/dp of the re-made ch. 3 design with the bases' motion prescribed
-(:mod:`tmfem.design.configuration`). Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
+rest-length directions G = dr/dp, the exact rate of the ch. 3 design
+(:mod:`tmfem.design.design_derivative`), with the bases' motion prescribed
+(:mod:`tmfem.design.configuration`), on either model.
+Responses at the equilibrium R(u, p) = 0 (:data:`RESPONSES`): the lowest k
 eigenvalues lambda = omega^2 of (K_T - lambda M) phi = 0 (eq. 5.32), the total mass, the tendon
 forces and stresses (the slack margin is the smallest force), the bars' compression against
 the Euler load (eq. 5.31), the membrane stresses (eqs. 5.29-5.30, KS aggregates), the corner
@@ -374,9 +375,10 @@ def design_sensitivities(model, *, equilibrium=None, variables="groups", k: int 
     Parameters
     ----------
     model : MTCModel or SBCModel
-        The SBC model with rest-length, thickness, diameter and membrane-radius variables (their partials:
-        :func:`_section_partials`). On the PETSc backend (one rank) the
-        matrices are assembled serially and factorised and eigen-solved by PETSc.
+        On the SBC model the partials of the thickness, diameter and membrane-radius variables are
+        :func:`_section_partials`; its rest lengths and angles are those of the MTC model. On the
+        PETSc backend (one rank) the matrices are assembled serially and factorised and
+        eigen-solved by PETSc.
     equilibrium : Equilibrium, optional
         A converged ``model.equilibrium()`` at the model's current rest lengths (default:
         solved here from the undeformed membrane).

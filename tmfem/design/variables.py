@@ -10,9 +10,9 @@ Names (:func:`parse_variables`):
 * ``"d_<family>"`` (``"d_S"``, ``"d_V"``): the diameter of every tendon of that family [m];
 * ``"r_mb"``: the circumradius of a regular membrane [m] (its corners and reference mesh
   scale; the bars and the rest lengths stay);
-* ``"theta_<i>"``, ``"psi_<i>"``: the declination and azimuth of stage i of a symmetric M-N
-  or 1-N system [deg]; the rest lengths follow the ch. 3 design, a 1-N system's base radius
-  eq. 3.33 (:mod:`tmfem.design.configuration`).
+* ``"theta_<i>"``, ``"psi_<i>"``: the declination and azimuth of stage i of a symmetric M-N,
+  1-N or 1-N(D) system [deg]; the rest lengths follow the ch. 3 design, a 1-N system's base
+  radius eq. 3.33 (:mod:`tmfem.design.configuration`).
 
 The other coordinates of the design configuration (sigma, z, r, l) are refused (:data:`GEOMETRY`).
 """
