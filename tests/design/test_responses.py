@@ -148,7 +148,8 @@ def test_variables_that_change_the_geometry_or_do_not_exist_are_refused():
 @pytest.mark.parametrize("Model, variables", [(MTCModel, ["S1", "h_membrane", "d_bar", "d_S"]),
                                                (MTCModel, ["S1", "theta_1", "psi_1"]),
                                                (SBCModel, "groups"),
-                                               (SBCModel, ["S1", "h_membrane", "d_bar", "d_S"])])
+                                               (SBCModel, ["S1", "h_membrane", "d_bar", "d_S"]),
+                                               (SBCModel, ["S1", "theta_1", "psi_1"])])
 def test_petsc_backend_gives_the_gradients_of_scipy(Model, variables):
     # the same responses and gradients with PETSc's factorisation and SLEPc's modes on the
     # PETSc backend's equilibrium (measured: within 2e-8 of each column's largest)
