@@ -6,6 +6,7 @@ O(h^4) below 1e-12 relative, rounding of the design (its residual about 1e-15) /
 1e-10. On the 1-4, 2-3 and 1-4D presets and the user 1-N system tests/data/systems/triangle-1-3.toml,
 mesh_n=4 with the point attachment, and on 1-4 also mesh_n=12 with the distributed one (its
 patch needs nodes)."""
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ import pytest
 from tmfem.design.configuration import angle_direction, design_of, with_angles
 from tmfem.design.design_derivative import design_rate, euler_R_second_derivatives, node_rates
 from tmfem.equilibrium.general import euler_R_derivatives, node_jacobian
+from tmfem.errors import InputError
 from tmfem.system import load_preset, load_system
 
 TRIANGLE = Path(__file__).parents[1] / "data" / "systems" / "triangle-1-3.toml"
@@ -70,11 +72,10 @@ def test_the_node_and_rotation_second_derivatives_match_their_first_derivatives_
     system = load_preset("2-3")
     rng = np.random.default_rng(1)
     dq = rng.standard_normal(system.q.size)
-    _, dJ = node_rates(system, dq=dq, dbase=np.zeros_like(system.base))
+    J, _, dJ = node_rates(system, dq=dq, dbase=np.zeros_like(system.base))
     h = 1e-30
-    J = node_jacobian(system)
-    # J depends on q only through the bar angles: its rate is the difference quotient of J at
-    # q + t dq, with a step small enough that O(t) truncation is at rounding level
+    # J depends on q only through the bar angles; the central difference of J along dq with
+    # t = 1e-7 has truncation O(t^2), 1e-14, and rounding eps / t, 1e-9
     t = 1e-7
     fd = (node_jacobian(system, system.q + t * dq) - node_jacobian(system, system.q - t * dq)) / (2 * t)
     assert np.abs(dJ - fd).max() < 1e-7 * np.abs(J).max()
@@ -99,6 +100,14 @@ def test_the_tension_field_design_rate_matches_the_central_difference(attachment
         fd = central(lambda p: design_of(with_angles(system, {(angle, 0): p}), mesh_n=mesh_n, attachment=attachment,
                                          membrane_law="tension-field").rest_lengths, p0)
         assert np.abs(exact - fd).max() < 1e-8 * np.abs(fd).max()
+
+
+def test_a_design_with_a_tendon_self_stress_of_its_own_has_no_rate():
+    # such a design picks its forces among the self-stress states by a linear programme
+    d = design_of(load_preset("2-3"), mesh_n=2)
+    dq, dbase = angle_direction(d.system, "theta", 0)
+    with pytest.raises(InputError, match="2 self-stress states"):
+        design_rate(dataclasses.replace(d, self_stress_dim=2), dq=dq, dbase=dbase)
 
 
 def _dofs(design):

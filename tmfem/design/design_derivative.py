@@ -8,7 +8,7 @@ rate of an angle variable), analytically, without a difference step:
    u = (sin theta cos psi, sin theta sin psi, cos theta). Along the rates (theta', psi') of
    the bars' angles and the rate A_1' of the stage-1 base, X' = J q' + A_1' on A_1j, B_1j
    (J = dX/dq, :func:`tmfem.equilibrium.general.node_jacobian`), and the rate of J itself
-   has the second derivatives of u in its angle columns (:func:`node_jacobian_rate`).
+   has the second derivatives of u in its angle columns (:func:`node_rates`).
 2. **Corner displacements** (eq. 3.5, B_Mi - B_MN = R^ef(gamma) (P_i + Delta_i)): with
    y = (gamma, Delta_free) and G_y the Jacobian of the right-hand side, y' = G_y^-1 X_c'
    (X_c the corner differences), and the membrane columns of A(q) (eq. 3.11),
@@ -67,20 +67,16 @@ class DesignRate:
     rest_lengths: np.ndarray
 
 
-def _bar_direction_derivatives(theta, psi) -> tuple:
-    """First and second derivatives of u(theta, psi) (3, ...): u_t, u_p, u_tt, u_tp, u_pp."""
+def _bar_direction_second_derivatives(theta, psi) -> tuple:
+    """Second derivatives u_tt, u_tp, u_pp (3, ...) of the bar direction u(theta, psi)."""
     st, ct, sp_, cp = np.sin(theta), np.cos(theta), np.sin(psi), np.cos(psi)
     zero = np.zeros_like(st)
-    u_t = np.array([ct * cp, ct * sp_, -st])
-    u_p = np.array([-st * sp_, st * cp, zero])
-    u_tt = np.array([-st * cp, -st * sp_, -ct])
-    u_tp = np.array([-ct * sp_, ct * cp, zero])
-    u_pp = np.array([-st * cp, -st * sp_, zero])
-    return u_t, u_p, u_tt, u_tp, u_pp
+    return (np.array([-st * cp, -st * sp_, -ct]), np.array([-ct * sp_, ct * cp, zero]),
+            np.array([-st * cp, -st * sp_, zero]))
 
 
 def node_rates(system, *, dq: np.ndarray, dbase: np.ndarray) -> tuple:
-    """X' (3, n_nodes) and J' = d(dX/dq) (3, n_nodes, n_q) of ``system`` at its q along the
+    """J = dX/dq (3, n_nodes, n_q) of ``system`` at its q, and X' (3, n_nodes) and J' along the
     rate dq of q and dbase (3, N) of the stage-1 base A_1j (eqs. 3.19-3.20; module docstring)."""
     M, N = system.M, system.N
     J = node_jacobian(system)
@@ -88,7 +84,7 @@ def node_rates(system, *, dq: np.ndarray, dbase: np.ndarray) -> tuple:
     _, theta, psi = system.split_q()
     _, th, ps = q_index(M, N)
     dth, dps = dq[th], dq[ps]                             # (M, N)
-    _, _, u_tt, u_tp, u_pp = _bar_direction_derivatives(theta, psi)
+    u_tt, u_tp, u_pp = _bar_direction_second_derivatives(theta, psi)
     l = system.l
     dJB = np.zeros((3, M, N, dq.size))
     ii, jj = np.meshgrid(np.arange(M), np.arange(N), indexing="ij")
@@ -103,7 +99,7 @@ def node_rates(system, *, dq: np.ndarray, dbase: np.ndarray) -> tuple:
     if system.deployable:                                 # H_1j = A_1j + k_H (B_1j - A_1j)
         dJ[:, 2 * nb:] = system.k_H * dJB[:, 0]
         dX[:, 2 * nb:] += dbase
-    return dX, dJ
+    return J, dX, dJ
 
 
 def euler_R_second_derivatives(gamma) -> np.ndarray:
@@ -128,7 +124,7 @@ def euler_R_second_derivatives(gamma) -> np.ndarray:
     return out
 
 
-def _corner_rates(design, dX: np.ndarray, dJ: np.ndarray) -> tuple:
+def _corner_rates(design, J: np.ndarray, dX: np.ndarray, dJ: np.ndarray) -> tuple:
     """Delta_free' (3N-6,) and A_F' (n_q, 3N-6) of the corner constraints eq. 3.5 (module
     docstring, step 2)."""
     system, st = design.system, design.matrix.state
@@ -141,7 +137,6 @@ def _corner_rates(design, dX: np.ndarray, dJ: np.ndarray) -> tuple:
         Zc = Z[:, b:b + N - 1] - Z[:, [b + N - 1]]
         return np.moveaxis(Zc, 0, 1).reshape(3 * (N - 1), *Z.shape[2:])
 
-    J = node_jacobian(system)
     Yq = np.linalg.solve(Gy, corner_differences(J))
     dy = np.linalg.solve(Gy, corner_differences(dX))
     dgamma, dfree = dy[:3], dy[3:]
@@ -190,7 +185,7 @@ def design_rate(design, *, dq: np.ndarray, dbase: np.ndarray) -> DesignRate:
         raise InputError(f"design rates: expected tendon forces fixed by eq. 3.16, found a tendon network "
                          f"with {design.self_stress_dim} self-stress states of its own (the design picks "
                          f"among them by a linear programme, not smoothly in the configuration)")
-    dX, dJ = node_rates(system, dq=np.asarray(dq, dtype=float), dbase=np.asarray(dbase, dtype=float))
+    J, dX, dJ = node_rates(system, dq=np.asarray(dq, dtype=float), dbase=np.asarray(dbase, dtype=float))
     # step 1: tendon columns of A(q) and tendon lengths
     c = system.tendon_connectivity
     D = system.tendon_vectors()
@@ -199,11 +194,10 @@ def design_rate(design, *, dq: np.ndarray, dbase: np.ndarray) -> DesignRate:
     dD = dX[:, c[1]] - dX[:, c[0]]
     dL = np.einsum("ck,ck->k", n, dD)
     dn = (dD - n * dL) / L
-    J = node_jacobian(system)
     JD, dJD = J[:, c[1]] - J[:, c[0]], dJ[:, c[1]] - dJ[:, c[0]]
     dAT = np.einsum("ck,ckq->qk", dn, JD) + np.einsum("ck,ckq->qk", n, dJD)
     # step 2: corner displacements and membrane columns
-    dfree, dAF = _corner_rates(design, dX, dJ)
+    dfree, dAF = _corner_rates(design, J, dX, dJ)
     ddelta = corner_array(dfree, system.N)
     # step 3: membrane corner forces
     dF = corner_force_rate(design.membrane_model, design.membrane, ddelta[:2])
