@@ -23,11 +23,11 @@ r_3.33(theta, psi) / r_3.33(theta_0, psi_0), so that a start given to printed pr
 What the MTC and SBC models take from the design: the rest lengths and the pinned bases. The
 bars' reference lengths l and the membrane's reference mesh do not change with the angles, and
 the design configuration is only the start of the static solve (the SBC model's reference
-placement of its beams and shells follows it rigidly, which moves no equilibrium). In the direct method of
-:mod:`tmfem.design.sensitivities` an angle is a rest-length direction dr/dp (the residual's
-partial derivative is analytic) with the bases' motion dA/dp prescribed on the pinned
-degrees of freedom: K_ff du_f = -dR_f/dp - K_fs dA/dp (:func:`design_rates`,
-:func:`support_rates`).
+placement of its beams and shells follows it rigidly, which moves no equilibrium). In the
+direct method of :mod:`tmfem.design.sensitivities` an angle is a rest-length direction dr/dp
+(the residual's partial derivative is analytic) with the bases' motion dA/dp prescribed on the
+pinned degrees of freedom: K_ff du_f = -dR_f/dp - K_fs dA/dp (:func:`design_rates`; the
+adapters' ``supports`` of :mod:`tmfem.design.kinematics`).
 
 dr_D/dp is exact: the forward-mode derivative of the design along the angle's direction
 (:mod:`tmfem.design.design_derivative`: node coordinates, corner constraints, the linear
