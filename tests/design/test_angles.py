@@ -98,8 +98,9 @@ def test_the_design_rates_of_a_1_n_system_match_its_closed_form():
         h = 1e-30
         r, r1 = closed(c.theta[0] + 1j * h * unit[0], c.psi[0] + 1j * h * unit[1])
         dr, da = design_rates(m, angle, 0)
-        assert np.allclose(dr, np.radians(r.imag / h), rtol=1e-9, atol=0)
-        assert np.allclose(da, system.base / cfg.r[0] * np.radians(r1.imag / h), rtol=1e-7, atol=1e-12)
+        # the design's exact rates: measured within 2.5e-13 (rest lengths) and 2e-16 (bases)
+        assert np.allclose(dr, np.radians(r.imag / h), rtol=1e-11, atol=0)
+        assert np.allclose(da, system.base / cfg.r[0] * np.radians(r1.imag / h), rtol=1e-13, atol=1e-15)
 
 
 def test_a_1_n_base_follows_eq_3_33_and_keeps_an_equilibrium_design():
