@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from tmfem.equilibrium.general import (_G_jacobian, corner_array, euler_R_derivatives, free_components,
+from tmfem.equilibrium.general import (corner_constraint_jacobian, corner_array, euler_R_derivatives, free_components,
                                        node_jacobian)
 from tmfem.errors import InputError
 from tmfem.system.coordinates import q_index
@@ -131,7 +131,7 @@ def _corner_rates(design, J: np.ndarray, dX: np.ndarray, dJ: np.ndarray) -> tupl
     M, N = system.M, system.N
     P = np.vstack([system.membrane_corners, np.zeros((1, N))])
     b = (2 * M - 1) * N                                   # B_M1 in the node order
-    Gy = _G_jacobian(st.gamma, st.free, P, N)
+    Gy = corner_constraint_jacobian(st.gamma, st.free, P, N)
 
     def corner_differences(Z):                            # (3, N, ...) -> (3(N-1), ...), corner-major
         Zc = Z[:, b:b + N - 1] - Z[:, [b + N - 1]]

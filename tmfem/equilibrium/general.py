@@ -156,8 +156,9 @@ def _G(gamma, free, P, N):
     return rotation_ef(gamma) @ (P + corner_array(free, N))[:, :N - 1]
 
 
-def _G_jacobian(gamma, free, P, N) -> np.ndarray:
-    """d vec(G)/d(gamma, free), shape (3(N-1), 3N-3); vec is column-major over corners."""
+def corner_constraint_jacobian(gamma, free, P, N) -> np.ndarray:
+    """Jacobian d vec(G)/d(gamma, free) of the corner constraints of eq. 3.5 (G of :func:`_G`),
+    shape (3(N-1), 3N-3); vec is column-major over corners."""
     comps = free_corner_components(N)
     R = rotation_ef(gamma)
     dR = euler_R_derivatives(gamma)
@@ -194,7 +195,7 @@ def solve_corner_constraints(system, q=None, *, gamma0=None, free0=None, tol: fl
     x = X.T.ravel()
 
     def residual(yy):
-        return _G(yy[:3], yy[3:], P, N).T.ravel() - x, _G_jacobian(yy[:3], yy[3:], P, N)
+        return _G(yy[:3], yy[3:], P, N).T.ravel() - x, corner_constraint_jacobian(yy[:3], yy[3:], P, N)
     try:
         res = newton(residual, y, tol=tol, scale=scale, max_iter=maxiter, line_search=False)
     except ConvergenceError as exc:
@@ -220,7 +221,7 @@ def delta_gradient(system, q=None, state: CornerState | None = None) -> np.ndarr
     b = system.M * system.N + (M - 1) * N        # index of B_M1 in the node order
     JB = J[:, b:b + N, :]
     Xq = (JB[:, :N - 1, :] - JB[:, [N - 1], :]).transpose(1, 0, 2).reshape(3 * (N - 1), -1)
-    Gy = _G_jacobian(st.gamma, st.free, P, N)
+    Gy = corner_constraint_jacobian(st.gamma, st.free, P, N)
     dy = np.linalg.solve(Gy, Xq)
     return dy[3:].T
 
