@@ -326,6 +326,19 @@ def test_mesh_interpolation_is_linear_and_matches_scipy_interpolate():
     assert np.allclose(xf[:, :nm][:, ok], ref[:, ok], rtol=0, atol=1e-12)
 
 
+def test_mesh_sequencing_reaches_the_direct_equilibrium():
+    # source: the same model solved from the undeformed membrane without sequencing (an
+    # independent path to the same equilibrium); the coarse level stops at the looser
+    # COARSE_TOL, the finest one at the requested tol
+    s = load_preset("1-4")
+    m = MTCModel(s, mesh_n=12, tendon_elements=1)
+    direct = m.equilibrium(tol=1e-9)
+    seq = m.equilibrium(tol=1e-9, sequence=6)
+    assert len(seq.level_iterations) == 2
+    assert np.abs(seq.x - direct.x).max() <= 1e-9 * np.abs(direct.x).max()
+    assert seq.residual_history[-1] <= 1e-9 * m._force_scale(seq.x)
+
+
 def test_modes_reuse_the_static_tangent(paper_prestress_modes):
     # source: the tangent assembled again at the equilibrium (the same kernels at the same
     # positions: the same entries, bit for bit) and the modes of it (two ARPACK runs on one

@@ -46,6 +46,11 @@ from tmfem.solvers.backends import get_backend
 from tmfem.solvers.eigen import lowest_modes
 from tmfem.solvers.trust_region import trust_region_newton
 
+#: relative tolerance of the coarser levels of a mesh-sequenced static solve
+#: (:meth:`MTCModel.equilibrium`): their solution only starts the next level, whose
+#: interpolation residual is orders of magnitude above it
+COARSE_TOL = 1e-4
+
 
 class MTCModel(FEModel, Tendons, Placement):
     """Membrane-truss-cable model of a ``System`` (4.4, 6.2).
@@ -267,8 +272,8 @@ class MTCModel(FEModel, Tendons, Placement):
                               attachment=self.topology.attachment, rest_lengths=self.rest_lengths,
                               lumped_tendon_mass=self.lumped_tendon_mass, backend=self.backend,
                               membrane_law=self.membrane_law)
-            rc = coarse.equilibrium(start=start, tol=tol, max_iter=max_iter, monitor=monitor,
-                                     progress=progress, sequence=sequence)
+            rc = coarse.equilibrium(start=start, tol=max(tol, COARSE_TOL), max_iter=max_iter,
+                                     monitor=monitor, progress=progress, sequence=sequence)
             x_fine = self.interpolate_from(coarse, rc.x)
             rc.tangent = None          # with the coarse model: its element arrays and
             del coarse                 # factorisations go before the fine level
