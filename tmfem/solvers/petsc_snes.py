@@ -246,6 +246,11 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                     if total < max_iter:
                         continue
             elif ok:
+                if its == 0 and reason > 0:
+                    # the state meets the tolerance already (a loose tol): the final Newton
+                    # solve from it, not a harder regularisation of a step that cannot move
+                    mu = 0.0
+                    continue
                 Wn = energy(un)
                 if np.isfinite(Wn) and Wn < W:
                     u, r, K, W = un, rr, KK, Wn
