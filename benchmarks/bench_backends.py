@@ -20,7 +20,9 @@ and solves, CPU time of rank 0 (static + eigen: the wall times of a shared machi
 its load, printed in the header and per row), peak resident memory per rank (max over
 ranks), first frequency. A second table splits rank 0's static time by phase
 (:class:`PhaseTimer`: element kernels and assembly, pattern set-up, interpolation, model
-builds, factorisations, solves, the rest: trust-region algebra, MPI waits).
+builds, factorisations, solves, the rest: trust-region algebra, MPI waits), a third the PETSc
+configurations' eigen time (PETSc's event log: factorisation, shift-invert solves and their
+number, orthogonalisation).
 OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
 --mpi-yield: petsc2's waiting ranks yield the core (Open MPI ``--mca mpi_yield_when_idle 1``;
 helps on a loaded machine: busy-waiting takes the core from the working rank and other jobs).
@@ -100,6 +102,22 @@ def mumps_work(backend) -> dict | None:
 #: the columns of the second table (rank 0's static time by phase)
 PHASES = ("model", "patterns", "interp", "build", "factor", "solve", "rest")
 
+#: PETSc log events of the eigen split (third table): the factorisation of K - sigma M, the
+#: shift-invert solves, SLEPc's orthogonalisation of the Krylov basis
+EIGEN_EVENTS = {"factor": ("MatCholFctrSym", "MatCholFctrNum", "MatLUFactorSym", "MatLUFactorNum"),
+                "solves": ("MatSolve",), "orthogonalize": ("BVOrthogonalizeV",)}
+
+
+def petsc_events() -> dict:
+    """(count, wall s) of this rank's PETSc log events of :data:`EIGEN_EVENTS` so far."""
+    from tmfem.solvers.petsc_loader import petsc_modules
+    PETSc, _ = petsc_modules()
+    out = {}
+    for key, names in EIGEN_EVENTS.items():
+        infos = [PETSc.Log.Event(name).getPerfInfo() for name in names]
+        out[key] = (sum(i["count"] for i in infos), sum(i["time"] for i in infos))
+    return out
+
 
 class PhaseTimer:
     """CPU and wall time of this process inside the model-side calls of a run, by phase
@@ -157,6 +175,7 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     else:
         from tmfem.solvers.petsc import PetscBackend
         inner = PetscBackend()
+        inner.PETSc.Log.begin()            # the eigen split (PETSc's own event log)
     be = TimedBackend(inner)
     system = system_1_4(rest_length)
     t0 = time.perf_counter()
@@ -167,8 +186,13 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     t2, c2 = time.perf_counter(), time.process_time()
     cpu_phases, wall_phases = dict(phases.cpu), dict(phases.wall)     # of the static solve
     f_static, c_static, s_static, cs_static = be.t_factor, be.c_factor, be.t_solve, be.c_solve
+    before = petsc_events() if comm is not None else None
     modes = m.modes(k=12, at=res)
     t3, c3 = time.perf_counter(), time.process_time()
+    eigen_split = None
+    if before is not None:
+        after = petsc_events()
+        eigen_split = {k: (after[k][0] - before[k][0], after[k][1] - before[k][1]) for k in after}
     its = (res.level_iterations or [res.iterations])[-1]
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     mumps = be.mumps
@@ -185,7 +209,8 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
                 static_factor_s=f_static, static_cpu_factor_s=c_static, static_solve_s=s_static,
                 static_cpu_solve_s=cs_static, cpu_s=c3 - c1, cpu_static_s=c2 - c1,
                 cpu_eigen_s=c3 - c2, cpu_phases=cpu_phases, wall_phases=wall_phases, rss_mb=rss,
-                f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0], mumps=mumps)
+                f1_hz=float(modes.freq_hz[0]), load=os.getloadavg()[0], mumps=mumps,
+                eigen_split=eigen_split)
 
 
 def launch(mesh: int, config: str, args) -> dict:
@@ -268,6 +293,18 @@ def main(argv=None) -> int:
         print(f"{row['config']:>7s} {row['mesh']:>11s} {row['static_s']:7.2f} ({row['cpu_static_s']:6.2f}) "
               + " ".join(f"{w[p]:6.2f} ({c[p]:6.2f})" for p in PHASES)
               + f" {row['eigen_s']:7.2f} ({row['cpu_eigen_s']:6.2f})")
+    split = [row for row in rows if row.get("eigen_split")]
+    if split:
+        print("\n# rank 0's eigen time (wall s) in PETSc's event log: the factorisation of K - sigma M,"
+              " the shift-invert solves (their number), SLEPc's orthogonalisation; rest: Rayleigh-Ritz,"
+              " gathers, set-up")
+        print(f"{'config':>7s} {'mesh':>11s} {'eigen':>7s} {'factor':>7s} {'solves':>7s} {'n':>4s} "
+              f"{'orthog':>7s} {'rest':>7s}")
+        for row in split:
+            e = row["eigen_split"]
+            rest = row["eigen_s"] - e["factor"][1] - e["solves"][1] - e["orthogonalize"][1]
+            print(f"{row['config']:>7s} {row['mesh']:>11s} {row['eigen_s']:7.2f} {e['factor'][1]:7.2f} "
+                  f"{e['solves'][1]:7.2f} {e['solves'][0]:4d} {e['orthogonalize'][1]:7.2f} {rest:7.2f}")
     return 0
 
 
