@@ -26,8 +26,8 @@ number, orthogonalisation).
 OPENBLAS_NUM_THREADS=1 is set for every run (2 threads were slower on 2 cores).
 --mpi-yield: petsc2's waiting ranks yield the core (Open MPI ``--mca mpi_yield_when_idle 1``;
 helps on a loaded machine: busy-waiting takes the core from the working rank and other jobs).
-Targets (2 cores): 78k DOF static + 12 modes < 6 s; 4x160x160 on 2 ranks < 2x the
-scipy time of 4x80x80; 1.2 M DOF < 5 min and < 16 GB.
+Targets (one thread): 78k DOF static + 12 modes < 3 s; 1.2 M DOF < 150 s and < 8 GB on one
+rank. The memory per rank of 2-rank runs: benchmarks/bench_memory_ranks.py.
 """
 from __future__ import annotations
 
