@@ -1,0 +1,114 @@
+"""The LPV grid on the automatic deployment path (`[lpv] path = "auto"`, the default for
+M >= 3): the stage bases at a grid point (theta, psi) are the path's at the progress whose
+theta is the grid's. The three-stage 3-3 of tests/data/systems/tower-3-3-lpv.toml (39
+tendons, 36 bar coordinates) against the path of the 7.4 deployment
+(tmfem.equilibrium.deployment_path.automatic_path, checked there at 101 points), eq. 3.22
+(Delta), eqs. 3.8-3.9 (rest lengths below the tendon lengths)."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tmfem.errors import InfeasibleDesign, InputError
+from tmfem.system import load_system
+from tmfem.system.problem import lpv_path
+
+SYSTEMS = Path(__file__).resolve().parents[2] / "data" / "systems"
+TOWER = SYSTEMS / "tower-3-3-lpv.toml"
+
+
+@pytest.fixture(scope="module")
+def tower():
+    from tmfem.reference.deployments import automatic_path_of, checked_configurations, lpv_bases
+    s = load_system(TOWER)
+    path = automatic_path_of(checked_configurations(s), r_min=1e-3).path
+    return s, lpv_bases(s), path
+
+
+def test_the_default_rule_is_the_automatic_path_beyond_two_stages():
+    assert lpv_path(load_system(TOWER)) == "auto"
+    assert lpv_path(load_system(SYSTEMS / "pentagon-2-5-lpv.toml")) == "table-7-7-bases"
+    assert lpv_path(load_system(SYSTEMS / "pentagon-2-5.toml")) == "table-7-7-bases"
+
+
+@pytest.mark.parametrize("theta", [55.0, 57.5, 60.0])
+def test_grid_points_on_the_paths_azimuth_are_the_paths_configurations(tower, theta):
+    # psi = 10 deg is the path's own azimuth (both ends psi_i - sigma_i = 10 deg): the grid's
+    # configuration of eq. 5.97 is the path's at s = (theta - 60) / (55 - 60)
+    from tmfem.equilibrium.symmetric_map import configuration_5_97
+    s, bases, path = tower
+    th, ps = np.radians(theta), np.radians(10.0)
+    cfg = configuration_5_97(s, th, ps, **bases(th, ps))
+    ref = path.config((theta - 60.0) / (55.0 - 60.0))
+    for k in ("theta", "psi", "sigma", "z", "r"):
+        np.testing.assert_allclose(getattr(cfg, k), getattr(ref, k), rtol=0, atol=1e-9, err_msg=k)
+
+
+def test_off_the_paths_azimuth_the_membrane_keeps_the_paths_stretch(tower):
+    # psi = 12 deg: r_3 from eq. 3.22 for the path's Delta(s); the other bases are the path's
+    from tmfem.equilibrium.symmetric_map import configuration_5_97
+    s, bases, path = tower
+    th, ps = np.radians(57.5), np.radians(12.0)
+    b = bases(th, ps)
+    cfg = configuration_5_97(s, th, ps, **b)
+    ref = path.config(0.5)
+    assert cfg.membrane_delta(s.N, s.r_mb) == pytest.approx(path.delta(0.5), rel=1e-10)
+    np.testing.assert_allclose(b["z"], ref.z, atol=1e-12)
+    np.testing.assert_allclose(b["sigma"], ref.sigma, atol=1e-12)
+    np.testing.assert_allclose(b["r"][:-1], ref.r[:-1], atol=1e-12)
+    assert b["r"][-1] != pytest.approx(ref.r[-1], abs=1e-4)
+
+
+def test_outside_the_paths_angles_the_nearer_ends_bases_are_taken(tower):
+    s, bases, path = tower
+    for theta, end in ((54.0, path.final), (61.0, path.initial)):
+        b = bases(np.radians(theta), np.radians(10.0))
+        np.testing.assert_allclose(b["z"], end.z, atol=1e-12)
+        np.testing.assert_allclose(b["sigma"], end.sigma, atol=1e-12)
+
+
+def test_an_infeasible_grid_point_names_theta_psi_and_the_condition(tower):
+    s, bases, _ = tower
+    with pytest.raises(InfeasibleDesign, match=r"theta = 57\.5 deg, psi = 30 deg .*positive null vector"):
+        bases(np.radians(57.5), np.radians(30.0))
+
+
+def test_a_one_stage_system_has_no_lpv_grid():
+    from tmfem.reference.deployments import lpv_bases
+    with pytest.raises(InputError, match="M = 1: the grid over .theta, psi. schedules the bar attitude of stage 1"):
+        lpv_bases(load_system(SYSTEMS / "pentagon-1-5D.toml"))
+
+
+def test_the_auto_path_needs_a_packaged_configuration(tmp_path):
+    from tmfem.reference.deployments import lpv_bases
+    text = TOWER.read_text()
+    start = text.index("[packaged]")
+    f = tmp_path / "t.toml"
+    f.write_text(text[:start] + text[text.index("[deployment]"):])
+    with pytest.raises(InputError, match=r"expected a symmetric \[packaged\] configuration"):
+        lpv_bases(load_system(f))
+
+
+def test_the_grids_equilibria_are_the_paths_designs(tower):
+    # a 3 x 2 grid (theta 55, 57.5, 60 deg; psi 10, 12 deg) of COM linearisations: at psi =
+    # 10 deg the equilibrium q_e of every point is the path's configuration (eqs. 3.19-3.20),
+    # at psi = 12 deg it has the path's Delta; every rest length u_e lies in (r_min, |tendon|)
+    # (every tendon in tension, eqs. 3.8-3.9) and the 39 inputs stay in the plant
+    from tmfem.control.deployment.limits import tendon_lengths
+    from tmfem.control.lpv.plant import com_lpv_plant
+    from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
+    s, bases, path = tower
+    th, ps = np.radians([55.0, 57.5, 60.0]), np.radians([10.0, 12.0])
+    pl = com_lpv_plant(s, theta=th, psi=ps, bases=bases)
+    assert pl.grid_shape == (3, 2) and pl.nu == 39 and pl.nx == 2 * (36 + 3)
+    nq = 36
+    for a, theta in enumerate([55.0, 57.5, 60.0]):
+        q = pl.x_e[a, 0, :nq]
+        np.testing.assert_allclose(q, path.config((theta - 60.0) / -5.0).to_q(s.N), rtol=0, atol=1e-6)
+        for b in range(2):
+            cfg = configuration_5_97(s, th[a], ps[b], **bases(th[a], ps[b]))
+            sb = with_configuration(s, cfg)
+            L = tendon_lengths(sb, pl.x_e[a, b, :nq])
+            assert np.all(pl.u_e[a, b] > 1e-3) and np.all(pl.u_e[a, b] < L)
+        d12 = configuration_5_97(s, th[a], ps[1], **bases(th[a], ps[1])).membrane_delta(s.N, s.r_mb)
+        assert d12 == pytest.approx(path.delta((theta - 60.0) / -5.0), rel=1e-10)
