@@ -338,9 +338,11 @@ def lpv_setup(system, plant, *, model_at: str = "final"):
         raise InputError(f"LPV deployment of {system.name}: expected {missing} (eq. 5.100) in the "
                          "system file's [lpv] table")
     pts = p.points if p.points is not None else measured_points(system)
+    from tmfem.system.problem import DeploymentParameters
+    dp = system.problem.deployment or DeploymentParameters()
     return lpv_deployment(system, plant, theta_0=np.radians(p.theta0_deg),
                           theta_e=np.radians(p.theta_e_deg), psi_0=np.radians(p.psi0_deg),
                           omega_r=p.omega_r,
                           bases=lpv_bases(system), output_points=inside_points(system, pts),
                           membrane_modes=lpv_membrane_modes(system),
-                          model_at=model_at)
+                          model_at=model_at, floor=dp.floor, r_min=dp.r_min)

@@ -112,3 +112,60 @@ def test_the_grids_equilibria_are_the_paths_designs(tower):
             assert np.all(pl.u_e[a, b] > 1e-3) and np.all(pl.u_e[a, b] < L)
         d12 = configuration_5_97(s, th[a], ps[1], **bases(th[a], ps[1])).membrane_delta(s.N, s.r_mb)
         assert d12 == pytest.approx(path.delta((theta - 60.0) / -5.0), rel=1e-10)
+
+
+class Command:
+    """A controller that commands fixed rest lengths (the protocol of tmfem.simulation.controllers)."""
+
+    name = "fixed"
+
+    def __init__(self, u):
+        self.u = u
+
+    def reset(self, t0, y0, dt):
+        return np.zeros(0)
+
+    def output(self, t, y, xc):
+        return self.u
+
+    def update(self, t, y, xc):
+        return xc
+
+
+def test_an_over_actuated_command_outside_the_limits_is_allocated_as_the_pfl_inverts(tower):
+    # the 3-3's COM at its deployed design (39 rest lengths, 36 bar coordinates, a wide B_q of
+    # eq. 5.41): a command whose first tendon is 5 mm longer than its tendon is replaced by the
+    # admissible rest lengths whose bar acceleration is closest to the command's in the metric
+    # M_q (compared with SLSQP on the same problem without the regularisation, an independent
+    # solver), inside [r_min, |tendon| - f (L_d - u_d)]; a command inside passes unchanged
+    from scipy.optimize import minimize
+    from tmfem.control.deployment.limits import tendon_lengths
+    from tmfem.control.deployment.pfl import partition
+    from tmfem.control.lpv.deployment import MinimumChangeAllocation
+    from tmfem.models.com.model import ControlOrientedModel
+    from tmfem.reference.deployments import checked_configurations
+    s = checked_configurations(tower[0])
+    m = ControlOrientedModel(s, membrane_modes=3, rest_lengths="system")
+    z = m.equilibrium(m.u0).state
+    y = np.concatenate([z, np.zeros(m.nz)])
+    L = tendon_lengths(s, z[:m.nq]).copy()
+    ref = lambda t: (z[:m.nq], None, None)                                   # noqa: E731
+    inside = MinimumChangeAllocation(Command(m.u0), model=m, reference=ref, u_d=lambda t: m.u0)
+    assert np.array_equal(inside.output(0.0, y, None), m.u0) and inside.allocation_active == []
+    u_c = m.u0.copy()
+    u_c[0] = L[0] + 5e-3
+    a = MinimumChangeAllocation(Command(u_c), model=m, reference=ref, u_d=lambda t: m.u0, floor=0.5)
+    u = a.output(0.0, y, None)
+    upper = L - 0.5 * (L - m.u0)
+    assert a.allocation_active == [0.0]
+    assert np.all(u >= 1e-3) and np.all(u <= upper + 1e-12)
+    terms = partition(*m.matrices(z, np.zeros(m.nz)), nq=m.nq)
+    R = np.linalg.cholesky(0.5 * (terms.M_q + terms.M_q.T)).T
+    A = R @ terms.B_q
+    cost = lambda v: float(np.sum((A @ (v - u_c))**2))                      # noqa: E731
+    ref_sol = minimize(cost, np.clip(u_c, 1e-3, upper), jac=lambda v: 2 * A.T @ (A @ (v - u_c)),
+                       bounds=list(zip(np.full(u.size, 1e-3), upper)), method="SLSQP",
+                       options={"ftol": 1e-16, "maxiter": 500})
+    assert cost(u) <= ref_sol.fun * (1 + 1e-6) + 1e-14
+    # clipping the first tendon alone misses the commanded acceleration by more
+    assert cost(np.clip(u_c, 1e-3, upper)) > 10 * cost(u)

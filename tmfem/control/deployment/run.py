@@ -293,6 +293,8 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     for c in (controller, getattr(controller, "first", None)):
         if c is not None and hasattr(c, "condition_numbers"):
             cond, alloc = c.condition_numbers, getattr(c, "allocation_active", [])
+        elif c is not None and hasattr(c, "allocation_active"):     # an LPV deployment's allocation
+            alloc = c.allocation_active
     return DeploymentResult(
         t=t_rec, z=z, zd=zd, u=u, u_commanded=u, lengths=L, w=w, q_d=q_d,
         controller=C, eta_energy=E, relative_error=rel,
