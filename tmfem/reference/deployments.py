@@ -280,9 +280,8 @@ def lpv_bases(system):
     Raises
     ------
     InputError
-        A one-stage system (its configuration has no stage bases, and the 1-N(D) grid of
-        the scheduled stage alone is not an LPV plant of the deployment: docs/guides/lpv.md),
-        or "auto" without a symmetric ``[packaged]`` configuration.
+        A one-stage system (:func:`_one_stage_refusal`), or "auto" without a symmetric
+        ``[packaged]`` configuration.
     InfeasibleDesign
         The packaged or deployed configuration, or every path between them, infeasible.
     """
@@ -290,14 +289,11 @@ def lpv_bases(system):
     known = _LPV_BASES.get(id(system))
     if known is not None and known[0]() is system:
         return known[1]
+    if system.symmetric is None:
+        raise InputError(f"LPV grid of {system.name}: expected a symmetric system ([symmetric]), found none")
+    if system.M == 1:
+        raise _one_stage_refusal(system)
     path = lpv_path(system)
-    if system.symmetric is None or system.M < 2:
-        raise InputError(f"LPV grid of {system.name}: expected a symmetric system with M >= 2 stages, found "
-                         + ("no [symmetric] configuration" if system.symmetric is None else
-                            f"M = {system.M}: the grid over (theta, psi) schedules the bar attitude of "
-                            "stage 1 against the stage bases above it; a one-stage system's (theta, psi) "
-                            "is its whole configuration and its deployment follows the Delta rule of "
-                            "eq. 3.22 (tmfem deploy FILE, docs/guides/lpv.md)"))
     if path == "table-7-7-bases":
         from tmfem.reference.tables import deployment_bases
         rule = deployment_bases(system)
@@ -314,8 +310,33 @@ def lpv_bases(system):
         auto = automatic_path_of(final, r_min=r_min)
         kappa = membrane_stiffness(design_equilibrium(final.replace(rest_lengths=None), strict=False))
         rule = PathBases(path=auto.path, kappa=kappa, r_min=r_min)
+    return _remember(system, rule)
+
+
+def _remember(system, rule):
+    """``rule`` kept as ``system``'s for :func:`lpv_bases` (while the system lives)."""
     _LPV_BASES[id(system)] = (weakref.ref(system, lambda _, k=id(system), d=_LPV_BASES: d.pop(k, None)), rule)
     return rule
+
+
+def _one_stage_refusal(system) -> InputError:
+    """Why a one-stage system gets no LPV grid (docs/guides/lpv.md): the reference of eq.
+    5.100 moves theta at a fixed psi_0, while a 1-N(D) system deploys along the Delta rule of
+    eq. 3.22, psi moving with theta; a 1-N system's equilibria form a curve in (theta, psi)."""
+    if not system.deployable:
+        why = ("a 1-N system's reduced equilibrium matrix of 3.3.2 is square, so its equilibria form a curve in "
+               "(theta, psi), not a region a grid covers")
+    else:
+        pk = system.problem.packaged
+        ends = "" if pk is None or pk.symmetric is None else (
+            f" (its packaged ({np.degrees(pk.symmetric.theta[0]):.4g}, {np.degrees(pk.symmetric.psi[0]):.4g}) deg "
+            f"and deployed ({np.degrees(system.symmetric.theta[0]):.4g}, "
+            f"{np.degrees(system.symmetric.psi[0]):.4g}) deg)")
+        why = ("a 1-N(D) system deploys along the Delta rule of eq. 3.22, psi moving with theta" + ends
+               + ", which the reference of eq. 5.100 (theta at a fixed psi_0) cannot follow; its deployment is "
+               "the 7.4 one (tmfem deploy FILE: adaptive PFL, then the H-infinity switch)")
+    return InputError(f"LPV grid of {system.name}: expected a symmetric system with M >= 2 stages, found "
+                      f"M = 1: {why} (docs/guides/lpv.md)")
 
 
 def lpv_setup(system, plant, *, model_at: str = "final"):

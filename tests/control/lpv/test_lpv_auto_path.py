@@ -75,8 +75,12 @@ def test_an_infeasible_grid_point_names_theta_psi_and_the_condition(tower):
 
 def test_a_one_stage_system_has_no_lpv_grid():
     from tmfem.reference.deployments import lpv_bases
-    with pytest.raises(InputError, match="M = 1: the grid over .theta, psi. schedules the bar attitude of stage 1"):
+    # a 1-N(D) deploys with psi moving (eq. 3.22): packaged (87.6, 30.4), deployed (75, 24) deg
+    with pytest.raises(InputError, match=r"M = 1: a 1-N\(D\) system deploys along the Delta rule of eq. 3.22.*"
+                                         r"packaged \(87.6, 30.4\) deg and deployed \(75, 24\) deg"):
         lpv_bases(load_system(SYSTEMS / "pentagon-1-5D.toml"))
+    with pytest.raises(InputError, match="M = 1: a 1-N system's reduced equilibrium matrix of 3.3.2 is square"):
+        lpv_bases(load_system(SYSTEMS / "pentagon-1-5.toml"))
 
 
 def test_the_auto_path_needs_a_packaged_configuration(tmp_path):
