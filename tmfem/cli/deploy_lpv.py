@@ -173,7 +173,7 @@ def run(args, *, mesh_n) -> dict:
            "membrane_mode_choice": lpv_membrane_mode_choice(args.system).to_dict()}
     title = f"{args.preset} deployment on the {args.plant} plant: {args.controller} (gamma = {d.gamma:.4g}), eq. 5.100"
     out.update(reference.write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
-                                       vtk=args.vtk, title=title))
+                                       vtk=args.vtk, title=title, lpv=True))
     if args.compare_plant:
         def rerun(kind):
             _, r2 = _run_on(args, dep, d, kind, mesh_n, est)
