@@ -1,11 +1,11 @@
-"""The LPV deployment of the 2-3 system (dissertation 8.4): reference of eq. 5.100, the
-COM plant, the measurement of the LPV states and scheduling parameters, and any controller
-on them.
+"""The LPV deployment of dissertation 8.4 (the 2-3 system; any symmetric M >= 2 system on
+its grid's stage-base rule): reference of eq. 5.100, the COM plant, the measurement of the
+LPV states and scheduling parameters, and any controller on them.
 
 Reference (eq. 5.100): theta_r'' + 2 xi_r omega_r theta_r' + omega_r^2 theta_r =
 omega_r^2 theta_e with theta_r(0) = theta_0, theta_r'(0) = 0 and psi_r = psi_0 (xi_r = 1,
 omega_r = 0.3 rad/s, theta 77.32 -> 63 deg, psi_0 = 8.36 deg); q_d follows from eq. 5.97 with
-the stage bases of the design grid (:func:`tmfem.reference.tables.deployment_bases`), the
+the stage bases of the design grid (:func:`tmfem.reference.deployments.lpv_bases`), the
 closed form and path of :class:`tmfem.control.deployment.reference_trajectory.DeploymentReference`
 (eq. 5.100 is eq. 5.68 with a constant psi).
 
