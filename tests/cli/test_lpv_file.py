@@ -119,9 +119,9 @@ def test_a_user_two_stage_system_gets_its_own_lpv_bound(capsys):
     assert g.max() * (1 - 1e-4) <= nrm <= 1.01 * g.max() * (1 + 1e-6)
 
 
-def test_an_lpv_path_other_than_the_grid_rule_is_refused(tmp_path):
+def test_an_lpv_path_other_than_the_grid_rules_is_refused(tmp_path):
     text = (DATA / "pentagon-2-5-lpv.toml").read_text().replace('path = "table-7-7-bases"', 'path = "linear"')
     f = tmp_path / "s.toml"
     f.write_text(text)
-    with pytest.raises(InputError, match=re.escape("expected 'path' to be one of ['table-7-7-bases']")):
+    with pytest.raises(InputError, match=re.escape("expected 'path' to be one of ['table-7-7-bases', 'auto']")):
         load_system(f)

@@ -170,12 +170,16 @@ def run(args) -> dict:
     output_file(args.compare_plot, option="--compare-plot", suffixes=(".png",))
     output_file(args.compare_csv, option="--compare-csv", suffixes=(".csv",))
     deployed_system(args)
-    lpv = args.system.problem.lpv is not None and args.system.problem.deployment is None
-    args.controller = args.controller or ("lpv" if lpv else "adaptive-hinf")
-    if lpv != (args.controller in LPV_CONTROLLERS):
+    # a file with [lpv] and without [deployment] deploys by LPV; one with both, by the 7.4 PFL
+    # unless an LPV controller is asked for
+    pr = args.system.problem
+    args.controller = args.controller or ("lpv" if pr.lpv is not None and pr.deployment is None else "adaptive-hinf")
+    lpv = args.controller in LPV_CONTROLLERS
+    if not (pr.lpv is not None if lpv else pr.deployment is not None or pr.lpv is None):
+        own = not lpv                                  # the deployment the file carries
         raise InputError(f"--controller {args.controller}: expected one of "
-                         f"{list(LPV_CONTROLLERS) if lpv else sorted(CONTROLLERS)} for the "
-                         f"{'LPV deployment (8.4)' if lpv else '7.4 deployment'} of {args.preset}")
+                         f"{list(LPV_CONTROLLERS) if own else sorted(CONTROLLERS)} for the "
+                         f"{'LPV deployment (8.4)' if own else '7.4 deployment'} of {args.preset}")
     if lpv:
         deploy_lpv.check(args)
         return deploy_lpv.run(args, mesh_n=check_plant(args))
@@ -208,7 +212,7 @@ def run(args) -> dict:
     title = (f"{args.preset} deployment on the {args.plant} plant: {args.controller}, "
              f"uncertainty {s.adaptive.uncertainty}")
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
-                             gif=args.gif, vtk=args.vtk, title=title))
+                             gif=args.gif, vtk=args.vtk, title=title, lpv=False))
     out["warnings"] = warnings
     out["membrane_mode_choice"] = membrane_modes_of(s.model.system).to_dict()
     if args.compare_plant:

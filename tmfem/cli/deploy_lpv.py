@@ -23,7 +23,7 @@ from tmfem.cli.common import progress_bar, say
 from tmfem.control import lpv
 from tmfem.control.lpv.plant import lpv_membrane_mode_choice
 from tmfem.errors import InfeasibleController, InputError
-from tmfem.reference.tables import deployment_bases
+from tmfem.system.problem import lpv_path
 
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
 SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
@@ -61,7 +61,7 @@ def check(args) -> None:
     options are those of the 7.4 deployments, checked by :mod:`tmfem.cli.deploy`)."""
     bad = given(args, NOT_LPV)
     args.system.problem.lpv.check_schedule(args.system.name)
-    own = args.system.problem.lpv.path
+    own = lpv_path(args.system)
     if args.path not in (None, own):
         bad.append(f"--path {args.path}")
     if bad:
@@ -92,7 +92,7 @@ def design(args, preset: str):
         n = int(np.prod([a.size for a in d.axes]))
         say("deploy", f"{preset}: rebuilding the design plant at its {n} grid points")
         try:
-            plant = lpv.saved_design_plant(d, s, bases=deployment_bases(s), progress=lpv_options.progress)
+            plant = lpv.saved_design_plant(d, s, bases=reference.lpv_bases(s), progress=lpv_options.progress)
         except InputError as exc:
             raise InputError(f"--lpv-controller {args.lpv_controller}: {exc}") from None
         v = lpv.verify_design(d, plant, tracked=s.q_names, sample_time=args.dt)
@@ -168,12 +168,12 @@ def run(args, *, mesh_n) -> dict:
             "estimator_refine": (args.estimator_refine or 1) if args.controller == "lpv-output" else None}
     plants = reference.FEPlantOptions.of(args)
     out = {"system": args.system.name, "plant": args.plant, **plants.summary(args.plant, mesh_n),
-           **ctrl, "path": args.system.problem.lpv.path, **r.summary(), **s.info,
+           **ctrl, "path": lpv_path(args.system), **r.summary(), **s.info,
            **_figures(r), **info,
            "membrane_mode_choice": lpv_membrane_mode_choice(args.system).to_dict()}
     title = f"{args.preset} deployment on the {args.plant} plant: {args.controller} (gamma = {d.gamma:.4g}), eq. 5.100"
     out.update(reference.write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot, gif=args.gif,
-                                       vtk=args.vtk, title=title))
+                                       vtk=args.vtk, title=title, lpv=True))
     if args.compare_plant:
         def rerun(kind):
             _, r2 = _run_on(args, dep, d, kind, mesh_n, est)

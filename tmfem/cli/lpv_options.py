@@ -9,11 +9,11 @@ from pathlib import Path
 
 import numpy as np
 
+from tmfem import reference
 from tmfem.cli.common import progress_bar, say
 from tmfem.control import lpv
 from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
 from tmfem.errors import InputError, ResourceLimit
-from tmfem.reference.tables import deployment_bases
 
 #: Largest verification grid: every point is one COM linearisation (~2 s for 2-3 on this
 #: machine under load), so 500 points is about a quarter of an hour.
@@ -152,7 +152,7 @@ def design_plant(cfg: dict, *, rate_deg: float | None = None, command: str = "co
     s, th, ps = cfg["system"], cfg["theta"], cfg["psi"]
     rate_deg = s.problem.lpv.rate_bound_deg if rate_deg is None else rate_deg
     say(command, f"{cfg['preset']}: linearising at {th.size * ps.size} grid points")
-    p = lpv.design_plant(s, theta=th, psi=ps, bases=deployment_bases(s), rate_bound=np.radians(rate_deg),
+    p = lpv.design_plant(s, theta=th, psi=ps, bases=reference.lpv_bases(s), rate_bound=np.radians(rate_deg),
                               progress=progress)
     out = {"system": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,
            **p.bound.to_dict()}
@@ -174,7 +174,7 @@ def synthesize(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
 def refined_plant(s, plant, factor: int, *, what: str):
     """The plant of system ``s`` on the grid ``factor`` times finer than ``plant``'s
     (:func:`tmfem.control.lpv.workflow.refined_plant`)."""
-    return lpv.refined_plant(s, plant, factor=factor, bases=deployment_bases(s), what=what,
+    return lpv.refined_plant(s, plant, factor=factor, bases=reference.lpv_bases(s), what=what,
                                   progress=progress)
 
 

@@ -182,6 +182,11 @@ class SymmetricPath:
         rel0 = a.psi - a.sigma
         self._rel_e = rel0 + wrap_angle((b.psi - b.sigma) - rel0)
 
+    def delta(self, s: float) -> float:
+        """Delta(s) = Delta_0 + s (Delta_e - Delta_0) [m], the membrane stretch of eq. 3.22
+        along the path (module docstring)."""
+        return float(self._Delta[0] + s * (self._Delta[1] - self._Delta[0]))
+
     def config(self, s: float) -> SymmetricConfig:
         """The configuration at progress s (module docstring).
 
@@ -202,7 +207,7 @@ class SymmetricPath:
         sigma[1:] += corr[nr + M - 1:]
         theta = lerp(a.theta, b.theta)
         psi = sigma + lerp(a.psi - a.sigma, self._rel_e)
-        D = lerp(*self._Delta)
+        D = self.delta(s)
         r[-1] = top_radius_for_delta(l_M=a.l[-1], theta_M=theta[-1], psi_rel=psi[-1] - sigma[-1],
                                      r_mb=self.system.r_mb, Delta=D, N=self.system.N, near=r[-1])
         return SymmetricConfig(theta=theta, psi=psi, sigma=sigma, z=z, r=r, l=a.l)
@@ -302,3 +307,64 @@ def automatic_path(system, initial: SymmetricConfig, *, kappa: float, r_min: flo
                                f"found fails at s = {s:.3g} ({where}): {points[k].reason}")
     return PathReport(path=path, checked=fine, min_margin=float(points[k].margin), at=float(fine[k]),
                       evaluations=evaluations)
+
+
+@dataclass(frozen=True)
+class PathBases:
+    """Stage bases of the eq. 5.97 family at any (theta, psi) from an automatic path: the
+    rule ``bases(theta, psi) -> {"r", "z", "sigma"}`` of an LPV grid over the bar attitude of
+    stage 1 (8.3) for any symmetric M >= 2 system.
+
+    At (theta, psi) the path's progress is s = (theta - theta_0) / (theta_e - theta_0), held
+    in [0, 1] (outside the path's angles the bases of its nearer end); r_i (2 <= i < M), z_i
+    and sigma_i are the path's at s, and the top-stage radius r_M is eq. 3.22 solved for the
+    path's membrane stretch Delta(s) at the grid's theta and psi
+    (:func:`top_radius_for_delta`, the root nearest to the path's). On the path's own azimuth
+    (psi = psi_i(s) - sigma_i) the configuration is the path's at s; off it, the membrane
+    keeps the path's stretch, as the stage-2 rule of Table 7.7 keeps Delta = 1 mm. Every
+    configuration is checked (:func:`path_feasibility` with the membrane stiffness ``kappa``
+    [N/m] and the rest-length limit ``r_min`` [m]).
+    """
+
+    path: SymmetricPath
+    kappa: float
+    r_min: float = 0.0
+
+    def __post_init__(self):
+        th0, the = self.path.initial.theta[0], self.path.final.theta[0]
+        if abs(the - th0) < 1e-9:
+            raise InputError("LPV grid on the automatic path: expected different packaged and deployed "
+                             f"declination angles theta_1 (the grid's progress), found both "
+                             f"{np.degrees(th0):.6g} deg")
+
+    def progress(self, theta: float) -> float:
+        """s of the grid angle ``theta`` [rad] on the path, held in [0, 1]."""
+        th0, the = self.path.initial.theta[0], self.path.final.theta[0]
+        return float(np.clip((theta - th0) / (the - th0), 0.0, 1.0))
+
+    def __call__(self, theta: float, psi: float) -> dict:
+        """{"r", "z", "sigma"} (length M) at (theta, psi) [rad] (class docstring).
+
+        Raises
+        ------
+        InfeasibleDesign
+            No top radius reaches the membrane, or the configuration is not a feasible
+            equilibrium; the message names theta, psi and the condition.
+        """
+        where = f"LPV grid point theta = {np.degrees(theta):.4g} deg, psi = {np.degrees(psi):.4g} deg"
+        s = self.progress(theta)
+        c = self.path.config(s)
+        system = self.path.system
+        r = np.array(c.r, dtype=float)
+        try:
+            r[-1] = top_radius_for_delta(l_M=c.l[-1], theta_M=theta, psi_rel=psi, r_mb=system.r_mb,
+                                         Delta=self.path.delta(s), N=system.N, near=r[-1])
+        except InputError as exc:
+            raise InfeasibleDesign(f"{where} (path progress s = {s:.3g}): {exc}") from None
+        sigma = np.array(c.sigma, dtype=float)
+        cfg = SymmetricConfig(theta=np.full(c.M, theta), psi=psi + sigma, sigma=sigma, z=c.z, r=r, l=c.l)
+        p = path_feasibility(system, cfg, kappa=self.kappa, r_min=self.r_min)
+        if p.reason:
+            raise InfeasibleDesign(f"{where} (path progress s = {s:.3g}) is not a feasible equilibrium: "
+                                   f"{p.reason}")
+        return {"r": r, "z": np.array(c.z, dtype=float), "sigma": sigma}

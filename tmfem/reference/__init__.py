@@ -11,6 +11,7 @@ from tmfem._lazy import lazy_exports
 __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "setup": "tmfem.reference.deployments",
     "lpv_setup": "tmfem.reference.deployments",
+    "lpv_bases": "tmfem.reference.deployments",
     "write_outputs": "tmfem.reference.deployments",
     "FEPlantOptions": "tmfem.reference.deployment_plants",
     "compare_plants": "tmfem.reference.deployment_plants",

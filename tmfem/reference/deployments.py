@@ -12,6 +12,7 @@ fall inside the mesh (docs/validation/errata.md). ``tmfem deploy`` and ``tmfem r
 from __future__ import annotations
 
 import csv
+import weakref
 from pathlib import Path
 
 import numpy as np
@@ -143,7 +144,7 @@ def setup(system, *, controller: str = "adaptive-hinf", uncertainty: str | None 
                             delta_path=path == "delta", allocation=allocation,
                             evaluation=evaluation, tendon_law=tendon_law,
                             n_centers=p.rbf_centres, w_bar=p.w_bar, gamma=p.gamma, r_min=p.r_min,
-                            path=None if auto is None else auto.path.config,
+                            path=None if auto is None else auto.path.config, tension_floor=p.floor,
                             info=None if auto is None else {"path_check": auto.to_dict()})
 
 
@@ -158,6 +159,11 @@ def check_choices(system, *, controller: str = "adaptive-hinf", uncertainty=None
         raise InputError(f"deploy {system.name}: the adaptive PFL needs at least one actuated tendon "
                          f"per bar coordinate (a B_q of eq. 5.46 with full row rank); this "
                          f"{system.M}-{system.N} system has {nt} tendons for {nq} bar coordinates")
+    if system.problem.deployment.tension_floor is not None and nt == nq:
+        raise InputError(f"deploy {system.name}: [deployment] tension_floor applies to an over-actuated "
+                         f"system (more tendons than bar coordinates, whose spare tendons keep the "
+                         f"prestress); this {system.M}-{system.N} system has {nt} tendons for {nq} bar "
+                         "coordinates (a square B_q of eq. 5.46, no freedom to keep a floor)")
     own = own_path(system)
     allowed = ["linear", own] + (["auto"] if system.M >= 2 and own != "auto" else [])
     if path is not None and path not in allowed:
@@ -258,15 +264,89 @@ def write_outputs(s, r, *, preset: str, title: str, csv_path=None, plot=None, gi
 LPV_CONTROLLERS = ("lpv", "lpv-output")
 
 
+#: the stage-base rules of LPV grids already built: id(system) -> (weak reference, rule)
+_LPV_BASES: dict = {}
+
+
+def lpv_bases(system):
+    """The stage-base rule ``bases(theta, psi)`` of ``system``'s LPV grid (8.3, eq. 5.97) by
+    its ``[lpv] path`` (:func:`tmfem.system.problem.lpv_path`): "table-7-7-bases",
+    :func:`tmfem.reference.tables.deployment_bases` (two-stage systems); "auto", the
+    automatic deployment path from the file's ``[packaged]`` to its deployed configuration
+    (:func:`automatic_path_of`, both ends checked and designed first; the rest-length limit
+    ``[deployment] r_min`` when the file has that table) read at every grid point by
+    :class:`tmfem.equilibrium.deployment_path.PathBases`. Built once per system.
+
+    Raises
+    ------
+    InputError
+        A one-stage system (:func:`_one_stage_refusal`), or "auto" without a symmetric
+        ``[packaged]`` configuration.
+    InfeasibleDesign
+        The packaged or deployed configuration, or every path between them, infeasible.
+    """
+    from tmfem.system.problem import DeploymentParameters, lpv_path
+    known = _LPV_BASES.get(id(system))
+    if known is not None and known[0]() is system:
+        return known[1]
+    if system.symmetric is None:
+        raise InputError(f"LPV grid of {system.name}: expected a symmetric system ([symmetric]), found none")
+    if system.M == 1:
+        raise _one_stage_refusal(system)
+    path = lpv_path(system)
+    if path == "table-7-7-bases":
+        from tmfem.reference.tables import deployment_bases
+        rule = deployment_bases(system)
+    else:
+        from tmfem.equilibrium.deployment_path import PathBases, membrane_stiffness
+        from tmfem.equilibrium.design import design_equilibrium
+        pk = system.problem.packaged
+        if pk is None or pk.symmetric is None:
+            raise InputError(f"LPV grid of {system.name} on the automatic path: expected a symmetric "
+                             "[packaged] configuration in the system file (the path's start), found "
+                             + ("none" if pk is None else "a non-symmetric one"))
+        r_min = (system.problem.deployment or DeploymentParameters()).r_min
+        final = checked_configurations(system)
+        auto = automatic_path_of(final, r_min=r_min)
+        kappa = membrane_stiffness(design_equilibrium(final.replace(rest_lengths=None), strict=False))
+        rule = PathBases(path=auto.path, kappa=kappa, r_min=r_min)
+    return _remember(system, rule)
+
+
+def _remember(system, rule):
+    """``rule`` kept as ``system``'s for :func:`lpv_bases` (while the system lives)."""
+    _LPV_BASES[id(system)] = (weakref.ref(system, lambda _, k=id(system), d=_LPV_BASES: d.pop(k, None)), rule)
+    return rule
+
+
+def _one_stage_refusal(system) -> InputError:
+    """Why a one-stage system gets no LPV grid (docs/guides/lpv.md): the reference of eq.
+    5.100 moves theta at a fixed psi_0, while a 1-N(D) system deploys along the Delta rule of
+    eq. 3.22, psi moving with theta; a 1-N system's equilibria form a curve in (theta, psi)."""
+    if not system.deployable:
+        why = ("a 1-N system's reduced equilibrium matrix of 3.3.2 is square, so its equilibria form a curve in "
+               "(theta, psi), not a region a grid covers")
+    else:
+        pk = system.problem.packaged
+        ends = "" if pk is None or pk.symmetric is None else (
+            f" (its packaged ({np.degrees(pk.symmetric.theta[0]):.4g}, {np.degrees(pk.symmetric.psi[0]):.4g}) deg "
+            f"and deployed ({np.degrees(system.symmetric.theta[0]):.4g}, "
+            f"{np.degrees(system.symmetric.psi[0]):.4g}) deg)")
+        why = ("a 1-N(D) system deploys along the Delta rule of eq. 3.22, psi moving with theta" + ends
+               + ", which the reference of eq. 5.100 (theta at a fixed psi_0) cannot follow; its deployment is "
+               "the 7.4 one (tmfem deploy FILE: adaptive PFL, then the H-infinity switch)")
+    return InputError(f"LPV grid of {system.name}: expected a symmetric system with M >= 2 stages, found "
+                      f"M = 1: {why} (docs/guides/lpv.md)")
+
+
 def lpv_setup(system, plant, *, model_at: str = "final"):
     """The deployment of 8.4 of ``system`` (a System with an ``[lpv]`` table and the
     scheduling values theta0_deg, theta_e_deg, psi0_deg of eq. 5.100, or a preset name) for
-    the design plant ``plant`` (its grid built with :func:`tmfem.reference.tables.deployment_bases`,
-    as ``tmfem control lpv``): :func:`tmfem.control.lpv.deployment.lpv_deployment` with the file's ``[lpv]`` parameters
+    the design plant ``plant`` (its grid built with the stage bases of :func:`lpv_bases`, as
+    ``tmfem control lpv``): :func:`tmfem.control.lpv.deployment.lpv_deployment` with the file's ``[lpv]`` parameters
     (another System, e.g. with stiffer bars, for a perturbation study of an FE plant)."""
     from tmfem.control.lpv.deployment import lpv_deployment
     from tmfem.control.lpv.plant import lpv_membrane_modes
-    from tmfem.reference.tables import deployment_bases
     if isinstance(system, str):
         from tmfem.system.presets import load_preset
         system = load_preset(system)
@@ -279,9 +359,11 @@ def lpv_setup(system, plant, *, model_at: str = "final"):
         raise InputError(f"LPV deployment of {system.name}: expected {missing} (eq. 5.100) in the "
                          "system file's [lpv] table")
     pts = p.points if p.points is not None else measured_points(system)
+    from tmfem.system.problem import DeploymentParameters
+    dp = system.problem.deployment or DeploymentParameters()
     return lpv_deployment(system, plant, theta_0=np.radians(p.theta0_deg),
                           theta_e=np.radians(p.theta_e_deg), psi_0=np.radians(p.psi0_deg),
                           omega_r=p.omega_r,
-                          bases=deployment_bases(system), output_points=inside_points(system, pts),
+                          bases=lpv_bases(system), output_points=inside_points(system, pts),
                           membrane_modes=lpv_membrane_modes(system),
-                          model_at=model_at)
+                          model_at=model_at, floor=dp.floor, r_min=dp.r_min)

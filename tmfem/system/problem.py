@@ -37,7 +37,7 @@ from tmfem.resources import check_membrane_modes
 KEYS = {
     "control": {"alpha", "u_m", "W_e", "W_d", "points", "coordinate_points"},
     "deployment": {"omega_r", "xi_r", "gains", "uncertainty", "path", "rbf_centres", "w_bar",
-                   "gamma", "r_min"},
+                   "gamma", "r_min", "tension_floor"},
     "lpv": {"omega_r", "membrane_modes", "points", "path", "theta_grid_deg", "psi_grid_deg", "theta0_deg",
             "theta_e_deg", "psi0_deg", "rate_bound_deg"},
     "report": {"perturbation", "implied_rest_lengths", "implied_source", "notes_design",
@@ -48,8 +48,11 @@ KEYS = {
 GAIN_KEYS = ("omega_0", "omega_e", "tau", "d_c")
 UNCERTAINTIES = ("initial", "no-MG", "exact")
 PATHS = ("delta", "auto", "table-7-7-bases", "linear")
+#: default fraction of its path elongation an over-actuated system's tendon keeps
+#: (``[deployment] tension_floor``, :mod:`tmfem.control.deployment.adaptive`)
+TENSION_FLOOR = 0.5
 #: the stage-base rules of an LPV grid (``[lpv] path``)
-LPV_PATHS = ("table-7-7-bases",)
+LPV_PATHS = ("table-7-7-bases", "auto")
 #: Most angles on an axis of the [lpv] grid (as --grid and --map-grid: 60 points a side).
 MAX_GRID_AXIS = 60
 COM_PRESTRESS = ("designed", "printed-tendon-stress")
@@ -152,6 +155,12 @@ class DeploymentParameters:
     rbf_centres, w_bar, gamma : RBF centres along the reference, the bound of the weights and
         the adaptation gain (eq. 5.58-5.60).
     r_min : smallest admissible rest length [m] (the rest-length limit of the PFL).
+    tension_floor : float or None
+        An over-actuated system's (more tendons than bar coordinates) fraction f in [0, 1) of
+        each tendon's elongation on the path, L_d - u_d, that the PFL's inversion keeps (the
+        upper rest-length limit |tendon| - f (L_d - u_d), :mod:`tmfem.control.deployment.adaptive`);
+        None: :data:`TENSION_FLOOR` (0.5). A square system has no tendon to spare: the key is
+        refused there (:func:`tmfem.reference.deployments.check_choices`).
     """
 
     omega_r: float = 0.5
@@ -163,6 +172,12 @@ class DeploymentParameters:
     w_bar: float = 100.0
     gamma: float = 0.01
     r_min: float = 1e-3
+    tension_floor: float | None = None
+
+    @property
+    def floor(self) -> float:
+        """The tension floor of the run: ``tension_floor``, else :data:`TENSION_FLOOR`."""
+        return TENSION_FLOOR if self.tension_floor is None else self.tension_floor
 
 
 @dataclass(frozen=True)
@@ -184,17 +199,21 @@ class LPVParameters:
         K of the COM; None: ``[models.com]``.
     points : tuple of (x_f, y_f) or None
         Monitored membrane points of eq. 5.101 [m]; None: as ``[control]``.
-    path : str
+    path : str or None
         The stage bases over the grid (:data:`LPV_PATHS`): "table-7-7-bases", the rule of
         :func:`tmfem.reference.tables.deployment_bases` for any two-stage system (sigma_2
-        fixed, z_2 = 0.7 l cos(theta), r_2 from eq. 3.22 for Delta = 1 mm), the only rule the
-        LPV grid implements.
+        fixed, z_2 = 0.7 l cos(theta), r_2 from eq. 3.22 for Delta = 1 mm); "auto", the
+        automatic deployment path of :mod:`tmfem.equilibrium.deployment_path` from the
+        file's ``[packaged]`` to its deployed configuration, any symmetric M >= 2 system
+        (:class:`tmfem.equilibrium.deployment_path.PathBases`: the path's bases at the
+        progress whose theta is the grid's). None: "table-7-7-bases" for M = 2, "auto" for
+        M >= 3 (:func:`lpv_path`).
     """
 
     omega_r: float = 0.3
     membrane_modes: int | None = None
     points: tuple | None = None
-    path: str = "table-7-7-bases"
+    path: str | None = None
     theta_grid_deg: tuple | None = None
     psi_grid_deg: tuple | None = None
     rate_bound_deg: float = 10.0
@@ -310,7 +329,18 @@ def _deployment(t: dict, where: str) -> DeploymentParameters:
         gains=_gains(t["gains"], w) if "gains" in t else d.gains,
         uncertainty=_choice(t, "uncertainty", w, UNCERTAINTIES, d.uncertainty),
         path=_choice(t, "path", w, PATHS), rbf_centres=n, w_bar=_positive(t, "w_bar", w, d.w_bar),
-        gamma=_positive(t, "gamma", w, d.gamma), r_min=_positive(t, "r_min", w, d.r_min))
+        gamma=_positive(t, "gamma", w, d.gamma), r_min=_positive(t, "r_min", w, d.r_min),
+        tension_floor=_fraction(t, "tension_floor", w))
+
+
+def _fraction(t: dict, key: str, where: str):
+    """A number in [0, 1) or None when absent."""
+    if key not in t:
+        return None
+    v = t[key]
+    if not (isinstance(v, (int, float)) and not isinstance(v, bool) and 0.0 <= v < 1.0):
+        raise InputError(f"{where}: expected '{key}' to be a number in [0, 1), found {v!r}")
+    return float(v)
 
 
 def _angle(t: dict, key: str, where: str):
@@ -348,7 +378,7 @@ def _lpv(t: dict, where: str) -> LPVParameters:
     d = LPVParameters()
     return LPVParameters(omega_r=_positive(t, "omega_r", w, d.omega_r),
                          membrane_modes=K, points=_points(t, "points", w),
-                         path=_choice(t, "path", w, LPV_PATHS, LPV_PATHS[0]),
+                         path=_choice(t, "path", w, LPV_PATHS),
                          theta_grid_deg=_axis(t, "theta_grid_deg", w), psi_grid_deg=_axis(t, "psi_grid_deg", w),
                          rate_bound_deg=_positive(t, "rate_bound_deg", w, d.rate_bound_deg, zero=True),
                          theta0_deg=_angle(t, "theta0_deg", w), theta_e_deg=_angle(t, "theta_e_deg", w),
@@ -447,6 +477,16 @@ def problem_from_dict(d: dict, where: str, build) -> Problem:
                    report=_report(d["report"], where) if "report" in d else ReportSettings(),
                    packaged=packaged, raw=raw,
                    design=_design(d["design"], where) if "design" in d else None)
+
+
+def lpv_path(system) -> str:
+    """The stage-base rule of ``system``'s LPV grid: its ``[lpv] path``, else
+    "table-7-7-bases" for a two-stage system and "auto" for M >= 3 stages (where the Table 7.7
+    rule, a stage-2 rule, does not apply)."""
+    p = system.problem.lpv.path if system.problem.lpv is not None else None
+    if p is not None:
+        return p
+    return "table-7-7-bases" if system.M == 2 else "auto"
 
 
 def default_u_m(system) -> float:

@@ -75,9 +75,10 @@ The limits of 7.4 (r_min <= u <= |tendon|) let a tendon go slack at its upper bo
 solution closest to u_d does so where the commanded acceleration lowers a tendon's force
 below zero (on the 3-3: R_2 and S_3 for 7 s, although a solution with every tendon in
 tension exists). With a reference u_d(t) the extra tendons are used to keep the prestress:
-the upper limit becomes |tendon| - TENSION_FLOOR (L_d - u_d), L_d the tendon lengths at the
-reference configuration, so every tendon keeps at least half its elongation (its force, at
-a given rate) along the path; the bounded problem finds the acceleration within these
+the upper limit becomes |tendon| - f (L_d - u_d), L_d the tendon lengths at the reference
+configuration and f the tension floor (``tension_floor``, the file's ``[deployment]
+tension_floor``, default 0.5), so every tendon keeps at least the fraction f of its elongation
+(its force, at a given rate) along the path; the bounded problem finds the acceleration within these
 limits. A square B_q leaves no such freedom and keeps the limits of 7.4.
 """
 from __future__ import annotations
@@ -91,14 +92,12 @@ from tmfem.control.deployment.pfl import (PFLTerms, bounded_inversion, check_inp
 from tmfem.control.deployment.limits import tendon_lengths
 from tmfem.control.deployment.rbf import GaussianRBF, euler_step
 from tmfem.errors import InputError, SingularInputMatrix
+from tmfem.system.problem import TENSION_FLOOR
 
 UNCERTAINTY = ("initial", "no-MG", "exact")
 ALLOCATION = ("bounded", "clip")
 EVALUATION = ("state", "reference")
 TENDON_LAWS = ("fixed-rate", "cable")
-#: fraction of the path's own tendon elongation L_d - u_d that an over-actuated system's
-#: tendons keep (the upper rest-length limit L - TENSION_FLOOR (L_d - u_d), module docstring)
-TENSION_FLOOR = 0.5
 
 
 @dataclass
@@ -170,6 +169,9 @@ class AdaptivePFL:
         ``u_d(t)`` [m], the rest lengths of the reference trajectory's equilibria, the
         reference of the inversion of a wide B_q (module docstring); default: the previous
         sample's commanded rest lengths.
+    tension_floor : float
+        f in [0, 1): with ``rest_length_reference``, the fraction of each tendon's path
+        elongation L_d - u_d that the upper limit keeps (module docstring).
     """
 
     name = "adaptive-pfl"
@@ -179,7 +181,10 @@ class AdaptivePFL:
                  uncertainty: str = "initial", z_initial=None, allocation: str = "bounded",
                  r_min: float = 1e-3, cond_every: int = 10, evaluation: str = "state",
                  tendon_law: str = "fixed-rate", feedback_damping: float = 0.0, u_initial=None,
-                 rest_length_reference=None):
+                 rest_length_reference=None, tension_floor: float = TENSION_FLOOR):
+        if not (np.isfinite(tension_floor) and 0 <= tension_floor < 1):
+            raise InputError(f"tension_floor: expected a number in [0, 1), found {tension_floor!r}")
+        self.tension_floor = float(tension_floor)
         if not (np.isfinite(feedback_damping) and feedback_damping >= 0):
             raise InputError(f"feedback_damping: expected a number >= 0, found {feedback_damping!r}")
         self.feedback_damping = float(feedback_damping)
@@ -287,7 +292,7 @@ class AdaptivePFL:
         u_ref = self._u_previous if self.rest_length_reference is None else self.rest_length_reference(t)
         if self.rest_length_reference is not None:
             L_d = tendon_lengths(self.model.system, self.reference(t)[0])
-            L = L - TENSION_FLOOR * np.maximum(L_d - u_ref, 0.0)
+            L = L - self.tension_floor * np.maximum(L_d - u_ref, 0.0)
         if self.tendon_law == "cable":
             terms, v, lower, upper = self._cable(exact, v, q_model, L)
             u_ref = 1.0 / u_ref

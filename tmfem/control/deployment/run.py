@@ -39,6 +39,7 @@ from tmfem.equilibrium.deployment_path import path_feasibility
 from tmfem.equilibrium.symmetric import check_1ND
 from tmfem.equilibrium.symmetric_map import with_configuration
 from tmfem.errors import ConvergenceError, InputError, SlackMembrane, SlackTendon
+from tmfem.system.problem import TENSION_FLOOR
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
 from tmfem.models.com.plant import COMPlant
@@ -292,6 +293,8 @@ def run_deployment(*, model, reference, controller, z0, t_end: float, dt: float 
     for c in (controller, getattr(controller, "first", None)):
         if c is not None and hasattr(c, "condition_numbers"):
             cond, alloc = c.condition_numbers, getattr(c, "allocation_active", [])
+        elif c is not None and hasattr(c, "allocation_active"):     # an LPV deployment's allocation
+            alloc = c.allocation_active
     return DeploymentResult(
         t=t_rec, z=z, zd=zd, u=u, u_commanded=u, lengths=L, w=w, q_d=q_d,
         controller=C, eta_energy=E, relative_error=rel,
@@ -333,7 +336,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      check_path: bool = True, bases=None, allocation: str = "bounded",
                      hinf_method: str = "central", r_min: float = 1e-3,
                      delta_path: bool = False, evaluation: str = "state",
-                     tendon_law: str = "fixed-rate", path=None, info=None) -> DeploymentSetup:
+                     tendon_law: str = "fixed-rate", path=None, info=None,
+                     tension_floor: float = TENSION_FLOOR) -> DeploymentSetup:
     """The model (built at the final configuration with its printed rest lengths), the
     reference from ``initial`` to ``final`` (:class:`DeploymentReference`, stage bases from
     ``bases`` when given, psi_r from eq. 3.22 with Delta linear in s when ``delta_path``,
@@ -347,7 +351,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     Riccati on [q, w]). ``evaluation``: where the PFL evaluates its model terms, at the
     measured state (eq. 5.58) or at the reference; ``tendon_law``: the PFL's tendon model,
     the rates of eq. 5.19 or k = EA / u (:mod:`tmfem.control.deployment.adaptive`); ``info``: entries
-    added to the set-up's ``info`` (the JSON of a run)."""
+    added to the set-up's ``info`` (the JSON of a run); ``tension_floor``: the fraction of its
+    path elongation an over-actuated system's tendon keeps (:class:`AdaptivePFL`)."""
     if allocation not in ALLOCATION:
         raise InputError(f"allocation: expected one of {ALLOCATION}, found {allocation!r}")
     if linear not in ("lmi", "lqr", "hinf", "none"):
@@ -367,7 +372,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
                      w_bar=w_bar, gamma=gamma, uncertainty=uncertainty, allocation=allocation,
                      r_min=r_min, evaluation=evaluation, tendon_law=tendon_law,
                      u_initial=initial.rest_lengths,
-                     rest_length_reference=path_rest_length_reference(final, ref))
+                     rest_length_reference=path_rest_length_reference(final, ref),
+                     tension_floor=tension_floor)
     z0 = np.concatenate([ref.q_0, np.zeros(model.K)])
     z_e = model.equilibrium(model.u0, z0=np.concatenate([ref.q_e, np.zeros(model.K)])).state
     info = {"rbf_centres": n_centers, "rbf_sigma": sig, "w_bar": w_bar, "K": K, **(info or {})}

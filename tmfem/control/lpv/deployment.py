@@ -1,11 +1,11 @@
-"""The LPV deployment of the 2-3 system (dissertation 8.4): reference of eq. 5.100, the
-COM plant, the measurement of the LPV states and scheduling parameters, and any controller
-on them.
+"""The LPV deployment of dissertation 8.4 (the 2-3 system; any symmetric M >= 2 system on
+its grid's stage-base rule): reference of eq. 5.100, the COM plant, the measurement of the
+LPV states and scheduling parameters, and any controller on them.
 
 Reference (eq. 5.100): theta_r'' + 2 xi_r omega_r theta_r' + omega_r^2 theta_r =
 omega_r^2 theta_e with theta_r(0) = theta_0, theta_r'(0) = 0 and psi_r = psi_0 (xi_r = 1,
 omega_r = 0.3 rad/s, theta 77.32 -> 63 deg, psi_0 = 8.36 deg); q_d follows from eq. 5.97 with
-the stage bases of the design grid (:func:`tmfem.reference.tables.deployment_bases`), the
+the stage bases of the design grid (:func:`tmfem.reference.deployments.lpv_bases`), the
 closed form and path of :class:`tmfem.control.deployment.reference_trajectory.DeploymentReference`
 (eq. 5.100 is eq. 5.68 with a constant psi).
 
@@ -14,6 +14,15 @@ designed rest lengths, in modal membrane coordinates, started at rest in the ini
 configuration (as the 7.4 deployments, :func:`tmfem.control.deployment.run.run_deployment`: Park's
 method, rest-length limits), or an FE plant through its COM-state estimate started in its own
 equilibrium of :meth:`LPVDeployment.packaged` (docs/guides/fe-plant.md).
+
+Over-actuated systems (more tendons than bar coordinates, M >= 3): the scheduled feedback
+commands every rest length; where its command leaves the rest-length limits, the limits are
+met as in the 7.4 deployment (:class:`MinimumChangeAllocation`: the admissible rest lengths
+whose bar acceleration is closest to the commanded one, the bounded inversion of
+:func:`tmfem.control.deployment.pfl.bounded_inversion` regularised toward the command, with the
+tension floor of :mod:`tmfem.control.deployment.adaptive` about u_e(rho_r(t))), not by
+clipping each rest length on its own (a square system keeps the clipping of 8.4: its inversion
+has no freedom, and the limits change the acceleration either way).
 
 Measurement (:meth:`LPVDeployment.measure`): the plant's y = [z, z'] (modal) mapped onto the
 signals of the LPV design, y_lpv = [x_z, rho] with x_z = [q, v, q', v'] (v = T_v_eta eta, the
@@ -29,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tmfem.control.deployment.limits import tendon_lengths
+from tmfem.control.deployment.pfl import bounded_inversion, partition
 from tmfem.control.deployment.reference_trajectory import DeploymentReference
 from tmfem.control.deployment.run import DeploymentSetup
 from tmfem.control.lpv.controller import LPVController
@@ -38,6 +48,7 @@ from tmfem.errors import InputError
 from tmfem.models.com.coordinates import point_coordinates
 from tmfem.models.com.model import ControlOrientedModel
 from tmfem.system.geometry import wrap_angle
+from tmfem.system.problem import TENSION_FLOOR
 
 class Measured:
     """A controller on y_lpv = measure(y): the protocol of :mod:`tmfem.simulation.controllers`
@@ -63,6 +74,53 @@ class Measured:
         return self.inner.update(t, self.measure(y), xc)
 
 
+class MinimumChangeAllocation:
+    """The rest-length limits of an over-actuated LPV deployment met by the 7.4 inversion.
+
+    With the command u_c of ``inner`` (reading the plant outputs y = [z, z'], modal), the PFL
+    terms of eq. 5.41 at the measured state (M_q, B_q: the bar accelerations q'' = -F_q* -
+    B_q u) and the limits r_min <= u <= |tendon|(q) - f (L_d - u_d) (L_d the tendon lengths at
+    q_d(t), u_d = ``u_d(t)``, f the tension floor), u_c itself when it lies inside, else
+
+        min_u |R B_q (u - u_c)|^2 + eps^2 |u - u_c|^2   subject to the limits,
+
+    M_q = R^T R, eps = 1e-6 s_1 (:func:`tmfem.control.deployment.pfl.bounded_inversion` with
+    v = B_q u_c and u_ref = u_c): the admissible rest lengths whose acceleration is closest
+    to the commanded one, the smallest change of u among them. ``allocation_active``: the
+    times the limits changed the command.
+    """
+
+    def __init__(self, inner, *, model, reference, u_d, r_min: float = 1e-3, floor: float = TENSION_FLOOR):
+        if not (np.isfinite(floor) and 0 <= floor < 1):
+            raise InputError(f"tension floor: expected a number in [0, 1), found {floor!r}")
+        self.inner, self.model, self.reference, self.u_d = inner, model, reference, u_d
+        self.r_min, self.floor = float(r_min), float(floor)
+        self.allocation_active: list = []
+
+    @property
+    def name(self) -> str:
+        return self.inner.name
+
+    def reset(self, t0, y0, dt):
+        self.allocation_active = []
+        return self.inner.reset(t0, y0, dt)
+
+    def update(self, t, y, xc):
+        return self.inner.update(t, y, xc)
+
+    def output(self, t, y, xc):
+        u = np.asarray(self.inner.output(t, y, xc), dtype=float)
+        m, y = self.model, np.asarray(y, dtype=float)
+        ud = self.u_d(t)
+        L_d = tendon_lengths(m.system, np.asarray(self.reference(t)[0], dtype=float)).copy()
+        upper = tendon_lengths(m.system, y[:m.nq]) - self.floor * np.maximum(L_d - ud, 0.0)
+        if np.all(u >= self.r_min) and np.all(u <= upper):
+            return u
+        terms = partition(*m.matrices(y[:m.nz], y[m.nz:2 * m.nz]), nq=m.nq)
+        self.allocation_active.append(float(t))
+        return bounded_inversion(terms, terms.B_q @ u, lower=self.r_min, upper=upper, u_ref=u)[0]
+
+
 @dataclass
 class LPVDeployment:
     """Model, reference and measurement of the 8.4 deployment (module docstring); ``plant``
@@ -77,6 +135,8 @@ class LPVDeployment:
     rho_q: list
     info: dict
     initial: object = None
+    floor: float = TENSION_FLOOR
+    r_min: float = 1e-3
 
     def packaged(self):
         """The initial (packaged) configuration as a designed System: its rest lengths those
@@ -110,18 +170,26 @@ class LPVDeployment:
         """The :class:`tmfem.control.deployment.run.DeploymentSetup` of ``controller`` (any object with
         the reset/output/update/name protocol on y_lpv) for :func:`~tmfem.control.deployment.run.
         run_deployment` and :func:`tmfem.reference.deployments.write_outputs`."""
+        c = Measured(controller, self.measure)
+        info = dict(self.info)
+        if self.model.n_t > self.model.nq:              # over-actuated: the 7.4 inversion
+            c = MinimumChangeAllocation(c, model=self.model, reference=self.reference, r_min=self.r_min,
+                                        floor=self.floor,
+                                        u_d=lambda t: self.plant.interpolate("u_e", self.reference_rho(t)))
+            info.update(allocation="minimum-change", tension_floor=self.floor)
         return DeploymentSetup(model=self.model, reference=self.reference, adaptive=None,
-                               controller=Measured(controller, self.measure), linear=None, z0=self.z0,
-                               z_e=self.z_e, info=dict(self.info))
+                               controller=c, linear=None, z0=self.z0, z_e=self.z_e, info=info)
 
 
 def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: float, omega_r: float,
-                   bases, output_points, membrane_modes: int = 4, model_at: str = "final") -> LPVDeployment:
+                   bases, output_points, membrane_modes: int = 4, model_at: str = "final",
+                   floor: float = TENSION_FLOOR, r_min: float = 1e-3) -> LPVDeployment:
     """The deployment of 8.4 of ``system`` from theta_0 to theta_e at psi_0 [rad] (eq. 5.100,
     xi_r = 1, ``omega_r`` [rad/s]) for the design plant ``plant``
     (:func:`~tmfem.control.lpv.plant.com_lpv_plant` of the same system with the same
     ``bases`` rule; its membrane points define v); ``output_points``: the monitored membrane
-    points (eq. 5.101).
+    points (eq. 5.101); ``floor`` and ``r_min``: the tension floor and the smallest rest
+    length of an over-actuated system's allocation (:class:`MinimumChangeAllocation`).
 
     Raises
     ------
@@ -153,7 +221,7 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
             "lpv_grid": list(plant.grid_shape)}
     return LPVDeployment(model=model, reference=ref, plant=plant, T_veta=T_veta, z0=z0, z_e=z_e,
                          rho_q=[list(final.q_names).index(n) for n in plant.parameter_names], info=info,
-                         initial=initial)
+                         initial=initial, floor=floor, r_min=r_min)
 
 
 def state_feedback_controller(dep: LPVDeployment, design):

@@ -277,7 +277,7 @@ def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int | None 
     """Gridded LPV plant of a symmetric system from COM linearisations (8.3, eqs. 5.33, 5.97).
 
     At each (theta, psi) of the grid the symmetric configuration of eq. 5.97 (stage bases
-    from ``bases(theta, psi)``, e.g. :func:`tmfem.reference.tables.deployment_bases`) is
+    from ``bases(theta, psi)``, e.g. :func:`tmfem.reference.deployments.lpv_bases`) is
     built, the control-oriented model designs its rest lengths there (the equilibrium u_e,
     eq. 3.16) and is linearised (eq. 5.33) with the membrane point coordinates of eq. 5.17
     (``membrane_points``; default :func:`choose_membrane_points` at the first grid point).

@@ -64,12 +64,13 @@ def design_plant(system, *, theta, psi, bases, rate_bound: float, progress=no_pr
     Parameters
     ----------
     system : System
-        A symmetric 2-stage system (rho = theta_13, psi_13).
+        A symmetric M >= 2 system (rho = theta_13, psi_13).
     theta, psi : array_like
         The grid axes [rad].
     bases : callable
         ``bases(theta, psi) -> {"r", "z", "sigma"}`` of the stage bases along the grid, e.g.
-        :func:`tmfem.reference.tables.deployment_bases`.
+        :func:`tmfem.reference.deployments.lpv_bases` (the file's ``[lpv] path``: the Table 7.7
+        rule or the automatic deployment path).
     rate_bound : float
         |d rho_k / dt| <= ``rate_bound`` [rad/s] for both parameters.
     progress : callable, optional
