@@ -311,18 +311,30 @@ def test_compare_of_user_systems_sets_the_three_models_side_by_side(file, tmp_pa
     3.8-3.9 are softer than the FE models' Green-Lagrange trusses,
     tests/models/com/test_com_tendon_strain.py)."""
     r, out = run(["compare", str(SYSTEMS / file), "--modes", "4", "--mesh", "6",
-                  "--csv", str(tmp_path / "c.csv")], capsys)
+                  "--csv", str(tmp_path / "c.csv"), "--plot", str(tmp_path / "c.png")], capsys)
     assert r["printed"] is None and r["stated"] is None
     assert abs(r["vs_SBC"]["ours"]["MTC"][0]) < 0.01 and abs(r["vs_SBC"]["ours"]["COM"][0]) < 0.10
     assert (tmp_path / "c.csv").read_text().startswith("mode,SBC_ours_hz")
+    assert (tmp_path / "c.png").stat().st_size > 10_000     # the three models, no printed markers
     assert_no_dissertation(out)
 
 
-def test_compare_refuses_a_deployable_and_a_plot_without_printed_values(capsys):
+def test_compare_plot_without_printed_values_draws_the_three_models_only(tmp_path):
+    """The figure of a system without printed frequencies: one line per model in the top
+    panel, the MTC and COM differences to the SBC model in the bottom one, no printed markers
+    and no stated bound."""
+    from tmfem.post.compare import plot_model_frequencies
+    ours = {"SBC": [1.0, 2.0], "MTC": [1.01, 2.1], "COM": [0.99, 2.05]}
+    r = {"system": "mine", "ours": ours, "printed": None, "stated_bound": None, "stated": None,
+         "source": None, "vs_SBC": {"ours": {m: [a / b - 1 for a, b in zip(ours[m], ours["SBC"])]
+                                             for m in ("MTC", "COM")}}}
+    png = plot_model_frequencies(tmp_path / "f.png", r)
+    assert png.stat().st_size > 10_000
+
+
+def test_compare_refuses_a_deployable(capsys):
     assert main(["compare", str(SYSTEMS / "pentagon-1-5D.toml")]) == 2
     assert "1-N(D)" in capsys.readouterr().err
-    assert main(["compare", str(SYSTEMS / "triangle-1-3.toml"), "--plot", "/tmp/x.png"]) == 2
-    assert "printed frequencies" in capsys.readouterr().err
 
 
 def test_converge_sbc_of_a_deployable_user_system(capsys):
@@ -332,6 +344,9 @@ def test_converge_sbc_of_a_deployable_user_system(capsys):
                 "--modes", "3"], capsys)
     f1 = [row["f1"] for row in r["rows"]]
     assert f1[1] == pytest.approx(f1[0], rel=0.01)
+    from tmfem.cli.converge import format_text
+    header = format_text(r).splitlines()[2].split()     # every column with its unit
+    assert header[-6:] == ["f1", "Hz", "f2", "Hz", "f3", "Hz"]
 
 
 def test_report_values_that_could_not_be_computed_are_absent_not_nan():
@@ -347,3 +362,21 @@ def test_vibrate_without_perturb_starts_from_the_files_perturbation(capsys):
     r, _ = run(["vibrate", str(SYSTEMS / "triangle-1-3.toml"), "--t-end", "0.5"], capsys)
     assert r["perturbation"] == {"theta_11_dot": 0.01}
     assert abs(r["final"]["theta_11"] - r["final"]["theta_12"]) > 1e-4
+
+
+@pytest.mark.parametrize("model", ["mtc", "sbc"])
+def test_static_text_of_a_user_system_has_units_and_no_printed_column(model, capsys):
+    """`static FILE` (text): the results table has the model's column only (the file has no
+    `[printed]`), and every check states its values with their unit (stresses in MPa, the
+    yield stresses of the file: 61 MPa membrane, 94.8 MPa tendons; loads in N)."""
+    assert main(["static", str(SYSTEMS / "pentagon-1-5D.toml" if model == "sbc" else SYSTEMS / "pentagon-1-5.toml"),
+                 "--model", model, "--mesh", "4", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert_no_dissertation(out)
+    header = next(line for line in out.splitlines() if line.strip() == model.upper())
+    assert "printed" not in header
+    checks = [line for line in out.splitlines() if line.startswith("check ")]
+    assert checks and all(re.search(r"\(\S+ (MPa|N|slack tendons) vs \S+ (MPa|N|slack tendons),", c)
+                          for c in checks), checks
+    if model == "sbc":
+        assert any("vs 61 MPa" in c for c in checks) and any("vs 94.8 MPa" in c for c in checks)

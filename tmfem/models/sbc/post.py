@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.models.fe.outputs import q_from_positions
-from tmfem.models.fe.summary import bar_loads, check_lines, design_checks, printed_rows
+from tmfem.models.fe.summary import bar_loads, check_lines, design_checks, printed_lines
 from tmfem.system.coordinates import q_index
 from tmfem.system.topology import label
 
@@ -155,10 +155,8 @@ def format_static(r: dict) -> str:
              f"points [MPa], sigma_p1 bottom/mid/top "
              + "/".join(f"{r[f'membrane_max_sigma_p1_{s}'] / 1e6:.3f}" for s in SURFACES)
              + ", von Mises " + "/".join(f"{r[f'membrane_max_von_mises_{s}'] / 1e6:.3f}" for s in SURFACES)
-             + f"; element-centre sigma_p1 {r['membrane_max_sigma_p1_element_centre'] / 1e6:.3f}",
-             f"{'':32s} {'SBC':>12s} {'dissertation':>12s}"]
-    lines += [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
-              for a, b, c in printed_rows(r)]
+             + f"; element-centre sigma_p1 {r['membrane_max_sigma_p1_element_centre'] / 1e6:.3f}"]
+    lines += printed_lines(r, "SBC")
     if r["tendon_slack"]:
         lines.append(f"SLACK tendons: {r['tendon_slack']}")
     lines += check_lines(r["checks"])
