@@ -380,3 +380,22 @@ def test_static_text_of_a_user_system_has_units_and_no_printed_column(model, cap
                           for c in checks), checks
     if model == "sbc":
         assert any("vs 61 MPa" in c for c in checks) and any("vs 94.8 MPa" in c for c in checks)
+
+
+def test_report_of_a_deployable_system_whose_switch_cannot_be_designed(tmp_path, capsys):
+    """A 1-4(D) whose COM (K = 4) has a membrane mode that no tendon reaches (PBH margin 0,
+    eq. 5.71): the deployment's H-infinity switch cannot be designed, and the report still
+    writes every other section, says in section 5 why there is no deployment, and exits 1
+    with the deployment among the failed checks (never "checks passed")."""
+    out = tmp_path / "rep"
+    rc = main(["report", str(SYSTEMS / "square-1-4D.toml"), "--out", str(out), "--mesh", "4",
+               "--t-end", "0.5", "--no-render", "--quiet"])
+    text = capsys.readouterr().out
+    assert rc == 1
+    assert "checks FAILED: deployment not run" in text and "not reached by any tendon" in text
+    r = json.loads((out / "report.json").read_text())
+    assert r["failed_checks"] == ["deployment not run"] and "4.276 Hz" in r["deployment"]["not_run"]
+    index = (out / "index.md").read_text()
+    assert "was not run: " in index.split("## 5. Deployment")[1]
+    assert (out / "vibration_sbc.png").exists() and not (out / "INCOMPLETE").exists()
+    assert_no_dissertation(text)
