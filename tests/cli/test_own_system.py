@@ -399,3 +399,20 @@ def test_report_of_a_deployable_system_whose_switch_cannot_be_designed(tmp_path,
     assert "was not run: " in index.split("## 5. Deployment")[1]
     assert (out / "vibration_sbc.png").exists() and not (out / "INCOMPLETE").exists()
     assert_no_dissertation(text)
+
+
+def test_sbc_static_says_when_the_bars_bending_takes_the_membrane_prestress(capsys):
+    """The 1-4(D) at 3 m: its bars bend by about 1 mm at H_1j, and the SBC model's membrane
+    keeps about a third of the design's corner displacement (1 mm). The JSON gives both Delta,
+    the design's equal to eq. 3.22 of the file, and the text says what it means."""
+    from tmfem.equilibrium.symmetric import membrane_delta_system
+    from tmfem.system import load_system
+    f = SYSTEMS / "square-1-4D.toml"
+    r, _ = run(["static", str(f), "--model", "sbc", "--mesh", "4", "--quiet"], capsys)
+    assert r["Delta_design_mean"] == pytest.approx(membrane_delta_system(load_system(f)), rel=1e-9)
+    assert 0 < r["Delta_mean"] < 0.5 * r["Delta_design_mean"] and min(r["bar_bow"]) > 5e-4
+    assert main(["static", str(f), "--model", "sbc", "--mesh", "4", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"note: the membrane keeps \d+ % of the design's corner displacement", out)
+    assert main(["static", str(SYSTEMS / "pentagon-1-5D.toml"), "--model", "sbc", "--mesh", "4", "--quiet"]) == 0
+    assert "note: the membrane keeps" not in capsys.readouterr().out
