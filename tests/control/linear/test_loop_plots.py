@@ -15,8 +15,9 @@ def test_a_refused_route_is_written_inside_the_panel_and_the_layout_holds():
     (which collapsed the constrained layout of the whole figure)."""
     fig = new_figure(figsize=(6, 4))
     a = fig.subplots()
-    _routes(a, {"riccati": (0.5005, 0.5), "lmi": "the LMI of eq. 5.67 has no solution at this size", "slicot": (0.5, 0.5)},
-            SimpleNamespace(gamma=0.5005), 0.5, True)
+    routes = {"riccati": (0.5005, 0.5), "lmi": "the LMI of eq. 5.67 has no solution at this size",
+              "slicot": (0.5, 0.5)}
+    _routes(a, routes, SimpleNamespace(gamma=0.5005), 0.5, True)
     canvas = FigureCanvasAgg(fig)
     with warnings.catch_warnings():
         warnings.simplefilter("error")       # "constrained_layout not applied ..." is a UserWarning
