@@ -132,6 +132,8 @@ def string_rest(tmp_path):
     (["equilibrium", "/dev/zero"], BAD_INPUT, "at most 1,048,576 bytes"),
     (["static", "--preset", "1-4", "--png", "OUT/a.png", "--stress-plot", "OUT/a.png"], BAD_INPUT,
      "expected its own output path, found the one of --png"),
+    (["export", "tests/data/systems/triangle-1-3.toml"], BAD_INPUT, "the output file comes after the system file"),
+    (["mesh", "tests/data/systems/triangle-1-3.toml", "--mesh", "4"], BAD_INPUT, "found only"),
     (["compare", "--preset", "1-4", "--mesh", "2000"], TOO_LARGE, "GiB"),
     (["compare", "--preset", "1-4", "--vibrate", "--mesh", "2000"], TOO_LARGE, "GiB"),
     (["vibrate", "--preset", "1-4", "--t-end", "1000", "--vtk", "OUT/s", "--vtk-every", "1"],

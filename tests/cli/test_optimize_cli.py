@@ -70,3 +70,20 @@ def test_options_that_do_not_apply_are_refused(tmp_path, capsys):
     bad = design_file(tmp_path, {"variables": {"S1": [1.5, 1.4]}})
     rc = main(["optimize", str(bad), "--objective", "max:freq"])
     assert rc == 2 and "lower < upper" in capsys.readouterr().err
+
+
+def test_a_constraint_the_optimum_cannot_meet_is_named_and_exits_1(tmp_path, capsys):
+    """mass <= 1 kg on the 1-4 (44.7 kg) with the rest lengths as the only variables (they do not
+    change the mass): the returned design violates it, the result names it (with the violation
+    scaled by the bound, (mass - 1 kg) / 1 kg) and only it (not the rows of the bound
+    formulation of max:freq), and the run exits 1 with it."""
+    path = design_file(tmp_path, {"variables": {"S1": [1.40, 1.52]}, "objective": "max:freq",
+                                  "constraints": ["mass<=1"]})
+    rc, r = run(["optimize", str(path), "--mesh", "4", "--max-iter", "3"], capsys)
+    assert rc == 1 and not r["ok"]
+    (v,) = r["violated"]
+    assert v["constraint"] == "mass<=1" and v["violation"] == pytest.approx(r["optimum_responses"]["mass"] - 1.0)
+    assert "mass<=1 violated" in r["failed_checks"]
+    assert main(["optimize", str(path), "--mesh", "4", "--max-iter", "3"]) == 1
+    out = capsys.readouterr().out
+    assert "VIOLATED at the returned design" in out and "mass [kg]" in out

@@ -311,18 +311,30 @@ def test_compare_of_user_systems_sets_the_three_models_side_by_side(file, tmp_pa
     3.8-3.9 are softer than the FE models' Green-Lagrange trusses,
     tests/models/com/test_com_tendon_strain.py)."""
     r, out = run(["compare", str(SYSTEMS / file), "--modes", "4", "--mesh", "6",
-                  "--csv", str(tmp_path / "c.csv")], capsys)
+                  "--csv", str(tmp_path / "c.csv"), "--plot", str(tmp_path / "c.png")], capsys)
     assert r["printed"] is None and r["stated"] is None
     assert abs(r["vs_SBC"]["ours"]["MTC"][0]) < 0.01 and abs(r["vs_SBC"]["ours"]["COM"][0]) < 0.10
     assert (tmp_path / "c.csv").read_text().startswith("mode,SBC_ours_hz")
+    assert (tmp_path / "c.png").stat().st_size > 10_000     # the three models, no printed markers
     assert_no_dissertation(out)
 
 
-def test_compare_refuses_a_deployable_and_a_plot_without_printed_values(capsys):
+def test_compare_plot_without_printed_values_draws_the_three_models_only(tmp_path):
+    """The figure of a system without printed frequencies: one line per model in the top
+    panel, the MTC and COM differences to the SBC model in the bottom one, no printed markers
+    and no stated bound."""
+    from tmfem.post.compare import plot_model_frequencies
+    ours = {"SBC": [1.0, 2.0], "MTC": [1.01, 2.1], "COM": [0.99, 2.05]}
+    r = {"system": "mine", "ours": ours, "printed": None, "stated_bound": None, "stated": None,
+         "source": None, "vs_SBC": {"ours": {m: [a / b - 1 for a, b in zip(ours[m], ours["SBC"])]
+                                             for m in ("MTC", "COM")}}}
+    png = plot_model_frequencies(tmp_path / "f.png", r)
+    assert png.stat().st_size > 10_000
+
+
+def test_compare_refuses_a_deployable(capsys):
     assert main(["compare", str(SYSTEMS / "pentagon-1-5D.toml")]) == 2
     assert "1-N(D)" in capsys.readouterr().err
-    assert main(["compare", str(SYSTEMS / "triangle-1-3.toml"), "--plot", "/tmp/x.png"]) == 2
-    assert "printed frequencies" in capsys.readouterr().err
 
 
 def test_converge_sbc_of_a_deployable_user_system(capsys):
@@ -332,6 +344,9 @@ def test_converge_sbc_of_a_deployable_user_system(capsys):
                 "--modes", "3"], capsys)
     f1 = [row["f1"] for row in r["rows"]]
     assert f1[1] == pytest.approx(f1[0], rel=0.01)
+    from tmfem.cli.converge import format_text
+    header = format_text(r).splitlines()[2].split()     # every column with its unit
+    assert header[-6:] == ["f1", "Hz", "f2", "Hz", "f3", "Hz"]
 
 
 def test_report_values_that_could_not_be_computed_are_absent_not_nan():
@@ -347,3 +362,57 @@ def test_vibrate_without_perturb_starts_from_the_files_perturbation(capsys):
     r, _ = run(["vibrate", str(SYSTEMS / "triangle-1-3.toml"), "--t-end", "0.5"], capsys)
     assert r["perturbation"] == {"theta_11_dot": 0.01}
     assert abs(r["final"]["theta_11"] - r["final"]["theta_12"]) > 1e-4
+
+
+@pytest.mark.parametrize("model", ["mtc", "sbc"])
+def test_static_text_of_a_user_system_has_units_and_no_printed_column(model, capsys):
+    """`static FILE` (text): the results table has the model's column only (the file has no
+    `[printed]`), and every check states its values with their unit (stresses in MPa, the
+    yield stresses of the file: 61 MPa membrane, 94.8 MPa tendons; loads in N)."""
+    assert main(["static", str(SYSTEMS / "pentagon-1-5D.toml" if model == "sbc" else SYSTEMS / "pentagon-1-5.toml"),
+                 "--model", model, "--mesh", "4", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert_no_dissertation(out)
+    header = next(line for line in out.splitlines() if line.strip() == model.upper())
+    assert "printed" not in header
+    checks = [line for line in out.splitlines() if line.startswith("check ")]
+    assert checks and all(re.search(r"\(\S+ (MPa|N|slack tendons) vs \S+ (MPa|N|slack tendons),", c)
+                          for c in checks), checks
+    if model == "sbc":
+        assert any("vs 61 MPa" in c for c in checks) and any("vs 94.8 MPa" in c for c in checks)
+
+
+def test_report_of_a_deployable_system_whose_switch_cannot_be_designed(tmp_path, capsys):
+    """A 1-4(D) whose COM (K = 4) has a membrane mode that no tendon reaches (PBH margin 0,
+    eq. 5.71): the deployment's H-infinity switch cannot be designed, and the report still
+    writes every other section, says in section 5 why there is no deployment, and exits 1
+    with the deployment among the failed checks (never "checks passed")."""
+    out = tmp_path / "rep"
+    rc = main(["report", str(SYSTEMS / "square-1-4D.toml"), "--out", str(out), "--mesh", "4",
+               "--t-end", "0.5", "--no-render", "--quiet"])
+    text = capsys.readouterr().out
+    assert rc == 1
+    assert "checks FAILED: deployment not run" in text and "not reached by any tendon" in text
+    r = json.loads((out / "report.json").read_text())
+    assert r["failed_checks"] == ["deployment not run"] and "4.276 Hz" in r["deployment"]["not_run"]
+    index = (out / "index.md").read_text()
+    assert "was not run: " in index.split("## 5. Deployment")[1]
+    assert (out / "vibration_sbc.png").exists() and not (out / "INCOMPLETE").exists()
+    assert_no_dissertation(text)
+
+
+def test_sbc_static_says_when_the_bars_bending_takes_the_membrane_prestress(capsys):
+    """The 1-4(D) at 3 m: its bars bend by about 1 mm at H_1j, and the SBC model's membrane
+    keeps about a third of the design's corner displacement (1 mm). The JSON gives both Delta,
+    the design's equal to eq. 3.22 of the file, and the text says what it means."""
+    from tmfem.equilibrium.symmetric import membrane_delta_system
+    from tmfem.system import load_system
+    f = SYSTEMS / "square-1-4D.toml"
+    r, _ = run(["static", str(f), "--model", "sbc", "--mesh", "4", "--quiet"], capsys)
+    assert r["Delta_design_mean"] == pytest.approx(membrane_delta_system(load_system(f)), rel=1e-9)
+    assert 0 < r["Delta_mean"] < 0.5 * r["Delta_design_mean"] and min(r["bar_bow"]) > 5e-4
+    assert main(["static", str(f), "--model", "sbc", "--mesh", "4", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"note: the membrane keeps \d+ % of the design's corner displacement", out)
+    assert main(["static", str(SYSTEMS / "pentagon-1-5D.toml"), "--model", "sbc", "--mesh", "4", "--quiet"]) == 0
+    assert "note: the membrane keeps" not in capsys.readouterr().out

@@ -134,3 +134,14 @@ def test_packaged_psi_of_a_1_3d_skips_a_start_whose_path_leaves_the_equilibria(c
     assert r["theta_max_deg"] == pytest.approx(np.degrees(np.arcsin((s.r_mb + Delta_e + c.r[0]) / c.l[0])))
     assert main(["equilibrium", f, "--packaged", "80"]) == 0
     assert f"reachable only for theta <= {r['theta_max_deg']:.4g} deg" in capsys.readouterr().out
+
+
+def test_bases_print_the_file_angle_as_written(tmp_path):
+    """--bases at theta = 60 deg prints theta_deg = [60.0, 60.0] (not the radian round trip's
+    59.99999999999999), as the file has it."""
+    from tmfem.equilibrium.assist import feasible_bases
+    from tmfem.system import load_system
+    d = tomllib.loads((SYSTEMS / "square-2-4.toml").read_text())
+    d["symmetric"].update(theta_deg=[60.0, 60.0])
+    r = feasible_bases(load_system(write(tmp_path, d)), starts=1)
+    assert r["symmetric"]["theta_deg"] == [60.0, 60.0]

@@ -29,3 +29,26 @@ def test_free_vibration_panels_follow_the_monitored_points(tmp_path):
     for k, (nodes, n_w, panels) in enumerate(cases):
         png = plot_free_vibration(_result(nodes, n_w), tmp_path / f"v{k}.png", title="t")
         assert _height(png) == round((2.4 * panels + 0.8) * 120), (k, panels)
+
+
+def test_many_bar_coordinates_keep_the_title_and_the_histories_in_view(tmp_path, monkeypatch):
+    """A 1-7 system without monitored points plots its 14 bar angles: the legend stands beside
+    the panel (it hides no history) and a long title is wrapped inside the figure."""
+    import tmfem.post.plots as plots
+    names = [f"{a}_1{j}" for j in range(1, 8) for a in ("theta", "psi")]
+    z = 1e-3 * np.sin(np.outer(T, np.arange(1, 15)))
+    res = SimpleNamespace(t=T, nodes={}, w=np.zeros((T.size, 0)), z=z, columns=["t"] + names)
+    figs = []
+    monkeypatch.setattr(plots, "save_figure", lambda fig, png: figs.append(fig) or png)
+    plot_free_vibration(res, tmp_path / "v.png", title="a-user-system COM free vibration, " * 3)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    fig = figs[0]
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    ax = fig.axes[0]
+    renderer = canvas.get_renderer()
+    legend, axes_box = ax.get_legend().get_window_extent(renderer), ax.get_window_extent(renderer)
+    assert legend.x0 >= axes_box.x1                        # beside the panel, not over it
+    title = ax.title.get_window_extent(renderer)
+    assert 0 <= title.x0 and title.x1 <= fig.bbox.width and legend.x1 <= fig.bbox.width
+    assert len({(line.get_color(), line.get_linestyle()) for line in ax.get_lines()}) == 14

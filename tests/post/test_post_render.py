@@ -123,3 +123,19 @@ def test_membrane_colour_range_ignores_corner_peaks():
     lo, hi = _robust_range(v)
     assert lo == 1.0 and hi == pytest.approx(np.percentile(v, 98)) and hi < 3.0
     assert _robust_range(np.linspace(1.0, 2.0, 50)) == [1.0, 2.0]     # no outliers: full range
+
+
+def test_the_legend_of_a_render_stays_inside_the_picture(tmp_path):
+    """The legend's text (bar, membrane: the tendons have a colour bar) at the default window
+    size is drawn whole: it starts at the left edge, where the picture has room for text longer
+    than the legend's box, and nothing of it touches the right edge of the picture's top rows."""
+    from tmfem.post.render import render_configuration
+    from tmfem.system import load_system
+    from tests.cli.test_own_system import SYSTEMS
+
+    s = load_system(SYSTEMS / "pentagon-1-5.toml")
+    p = render_configuration(tmp_path / "c.png", s, tendon_forces=np.full(len(s.tendons), 10.0), title="t")
+    fg = _non_background(_rgb(p))
+    top = fg[: fg.shape[0] // 8]
+    assert top[:, : fg.shape[1] // 8].any()          # the legend, at the upper left
+    assert not top[:, -3:].any()                     # no text cut by the right edge

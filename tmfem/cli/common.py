@@ -32,6 +32,11 @@ def add_system_args(parser: argparse.ArgumentParser) -> None:
 def system_from_args(args: argparse.Namespace) -> System:
     """The system named by ``spec`` or ``--preset`` (exactly one)."""
     if (args.spec is None) == (args.preset is None):
+        out = getattr(args, "out", None)
+        if args.spec is None and isinstance(out, str) and out.lower().endswith(".toml"):
+            # `export FILE.toml` alone: argparse gives the one positional to the output file
+            raise InputError(f"expected a system file and an output file, found only {out!r}: "
+                             f"the output file comes after the system file")
         raise InputError("expected exactly one of a system file or --preset NAME")
     if args.preset is not None:
         return load_preset(args.preset, as_printed=args.as_printed)

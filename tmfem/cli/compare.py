@@ -62,10 +62,6 @@ def run(args) -> dict:
                        tendon_elements=args.tendon_elements, modes=args.modes, dofs_per_node=6)
     output_file(args.csv, option="--csv", suffixes=(".csv",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
-    if args.plot and not args.vibrate and "frequencies_hz" not in args.system.printed:
-        raise InputError(f"--plot: option does not apply: the plot sets the three models beside "
-                         f"printed frequencies, and {args.preset} has none ([printed."
-                         "frequencies_hz]); use --csv")
     return run_vibration(args) if args.vibrate else run_frequencies(args)
 
 

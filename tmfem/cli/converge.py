@@ -133,7 +133,7 @@ def format_text(r: dict) -> str:
     nf = sum(1 for k in rows[0] if k.startswith("f") and k[1:].isdigit())
     head = f"{'n':>3s} {'k':>2s} {'elem':>6s} {'dofs':>7s} {'backend':>7s} {'Delta mm':>9s} " \
            f"{'sp1 MPa':>8s} {'vm MPa':>8s} " \
-           + " ".join(f"{'f' + str(i + 1):>7s}" for i in range(nf))
+           + " ".join(f"{'f' + str(i + 1) + ' Hz':>7s}" for i in range(nf))
     fixed = r.get("rest_lengths")
     lines = [f"{r['system']} {r.get('model', 'mtc').upper()} convergence, {r['attachment']} attachment, "
              f"{r.get('membrane_law', 'svk')} membrane",

@@ -69,14 +69,18 @@ def run(args) -> dict:
         plot_history(res.history, out / "history.png", objective=f"{res.objective} [{unit}]")
         r["files"] = {k: str(out / f) for k, f in (("history", "history.csv"), ("plot", "history.png"),
                                                    ("system", "optimal.toml"))}
-    r["ok"] = res.success
+    r["ok"] = res.success and not res.violated
+    r["failed_checks"] = ([f"{v['constraint']} violated" for v in res.violated]
+                          + ([] if res.success else [f"optimiser: {res.message}"]))
     resp_units = {k: RESPONSES.get(k, RESPONSES.get(k.rpartition("_")[0], ("", "-")))[1]
                   for k in res.start_responses}
     r["units"] = {"lower": "m", "upper": "m", "start": "m", "optimum": "m", "kkt_residual": "-",
                   "time_s": "s", "start_responses": resp_units, "optimum_responses": resp_units,
                   "active": "multipliers of the scaled problem (objective / |start value|, "
                             "constraints / |bound|, variables / their range): -",
-                  "history": "[iteration, objective in its response's unit, scaled violation -, step m]"}
+                  "history": "[iteration, objective in its response's unit, scaled violation -, step m]",
+                  "violated": "violation scaled by the constraint's bound: -"}
+    r["response_units"] = resp_units
     return r
 
 
@@ -85,13 +89,17 @@ def format_text(r: dict) -> str:
              f"{'variable':14s} {'lower':>10s} {'start':>12s} {'optimum':>12s} {'upper':>10s}"]
     for n, lo, a, b, hi in zip(r["names"], r["lower"], r["start"], r["optimum"], r["upper"]):
         lines.append(f"{n:14s} {lo:10.5g} {a:12.6g} {b:12.6g} {hi:10.5g}")
-    lines.append(f"{'response':24s} {'start':>24s} {'optimum':>24s}")
+    lines.append(f"{'response':30s} {'start':>24s} {'optimum':>24s}")
+    units = r.get("response_units", {})
     for k, v in r["start_responses"].items():
         w = r["optimum_responses"][k]
         fmt = (lambda x: ", ".join(f"{y:.5g}" for y in x)) if isinstance(v, list) else (lambda x: f"{x:.6g}")
-        lines.append(f"{k:24s} {fmt(v):>24s} {fmt(w):>24s}")
+        lines.append(f"{k + ' [' + units.get(k, '-') + ']':30s} {fmt(v):>24s} {fmt(w):>24s}")
     lines.append("active constraints (Lagrange multiplier, scaled):")
     lines += [f"  {a['constraint']:36s} {a['multiplier']:.4g}" for a in r["active"]] or ["  none"]
+    if r.get("violated"):
+        lines.append("VIOLATED at the returned design (violation scaled by the bound):")
+        lines += [f"  {v['constraint']:36s} {v['violation']:.3g}" for v in r["violated"]]
     lines.append(f"KKT residual {r['kkt_residual']:.2e}; {r['message']}; {len(r['history'])} iterations, "
                  f"{r['evaluations']} evaluations, {r['time_s']:.1f} s")
     for k, f in r.get("files", {}).items():

@@ -117,7 +117,10 @@ def format_text(r: dict) -> str:
     for k, m in unstable.items():
         lines.insert(-1, f"{k}: the equilibrium is unstable in mode(s) {m} (omega^2 < 0, eq. 5.32)")
     d = r.get("deployment")
-    if d:
+    if d and "not_run" in d:
+        lines.insert(-1, f"deployment {d['system']} not run: {d['not_run']}")
+        lines.insert(-1, "")
+    elif d:
         lines.insert(-1, f"deployment {d['system']} ({d['controller']}, uncertainty "
                          f"{d['uncertainty']}): switch at {d['switch_time_s']} s, max w "
                          f"{1e3 * d['max_membrane_deflection_m']:.2f} mm, final tracking error "

@@ -42,6 +42,8 @@ log = logging.getLogger(__name__)
 SENSES = ("<=", ">=", "==")
 #: a constraint is active when its scaled value is within this of its bound
 ACTIVE_TOL = 1e-4
+#: a constraint is violated at a design when its scaled value exceeds its bound by more than this
+VIOLATION_TOL = 1e-6
 
 
 @dataclass(frozen=True)
@@ -101,7 +103,8 @@ class OptimizationResult:
     stationarity residual relative to |grad f|; history : rows (iteration, objective,
     max_violation, step); system : the optimal System (rest lengths included); state : the
     MTC positions (3, n_nodes) at the optimum (a warm start for further solves);
-    success, message, evaluations, time_s.
+    success, message, evaluations, time_s; violated : the constraints the returned design
+    violates by more than :data:`VIOLATION_TOL` (scaled by their bound), with the violation.
     """
 
     names: list
@@ -122,6 +125,7 @@ class OptimizationResult:
     objective: str = ""
     constraints: list = field(default_factory=list)
     state: np.ndarray | None = None
+    violated: list = field(default_factory=list)
 
 
 class _Evaluator:
@@ -357,13 +361,17 @@ def optimize(system, *, objective: str, constraints=(), variables=None, model: s
         mu, resid = np.zeros(0), gobj
     kkt = float(np.linalg.norm(resid) / max(np.linalg.norm(gobj), 1e-30))
     active = [{"constraint": lab, "multiplier": float(m)} for lab, m in zip(act_labels, mu)]
+    over = np.where(eqf, np.abs(g), g)
+    n_obj = _entries(s, obj)[0].size if vector_obj else 0        # the bound formulation's rows: not the user's
+    violated = [{"constraint": labels[i], "violation": float(over[i])} for i in np.flatnonzero(over > VIOLATION_TOL)
+                if groups[i][0] >= n_obj]
     wanted = [obj] + [c.response for c in cons]
     return OptimizationResult(
         names=names, lower=lo, upper=hi, start=p0, optimum=p,
         start_responses=_responses(s0, wanted), optimum_responses=_responses(s, wanted),
         active=active, kkt_residual=kkt, history=hist, system=sysp, success=bool(res.success),
         message=str(res.message), evaluations=ev.count, time_s=time.perf_counter() - t0,
-        objective=f"{sense}:{obj}", constraints=[c.label() for c in cons], state=ev.x)
+        objective=f"{sense}:{obj}", constraints=[c.label() for c in cons], state=ev.x, violated=violated)
 
 
 def _identical_rows(g, J, eqf) -> list:

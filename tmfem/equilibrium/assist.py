@@ -75,7 +75,7 @@ def feasible_bases(system, *, starts: int = 8, delta: float = 1e-3) -> dict:
     sigma = np.asarray(b["sigma"], dtype=float)
     return {"feasible": bool(b["feasible"]), "margin": float(b["margin"]), "Delta": float(b["Delta"]),
             "r_mb": None if r_mb is None else float(r_mb),
-            "symmetric": {"theta_deg": [float(np.degrees(theta))] * c.M,
+            "symmetric": {"theta_deg": [round(float(np.degrees(theta)), 6)] * c.M,
                           "psi_deg": np.degrees(psi + sigma).round(6).tolist(),
                           "sigma_deg": np.degrees(sigma).round(6).tolist(),
                           "z": np.round(b["z"], 6).tolist(), "r": np.round(b["r"], 6).tolist(),

@@ -165,7 +165,7 @@ def write_static_files(model, result, *, vtk=None, png=None, stress_plot=None,
 def format_static(r: dict) -> str:
     """Text of :func:`static_summary`: landing against the design, the printed rows of Tables
     6.3/6.5, tendon forces and the design checks."""
-    from tmfem.models.fe.summary import check_lines, printed_rows
+    from tmfem.models.fe.summary import check_lines, printed_lines
     from tmfem.models.fe.rest_lengths import describe_rule
     lines = [f"MTC equilibrium of {r['system']}: mesh n={r['mesh_n']}, {r['tendon_elements']} "
              f"elements/tendon, {r['attachment']} attachment, {r.get('membrane_law', 'svk')} "
@@ -186,10 +186,7 @@ def format_static(r: dict) -> str:
         h = np.asarray(h)
         lines.append(f"history of {lab}: start {np.round(h[0], 5).tolist()} -> "
                      f"{np.round(h[-1], 5).tolist()} (design {np.round(r['nodes'][lab]['design'], 5).tolist()})")
-    rows = printed_rows(r)
-    lines.append(f"{'':32s} {'MTC':>12s} {'dissertation':>12s}")
-    lines += [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
-              for a, b, c in rows]
+    lines += printed_lines(r, "MTC")
     lines.append("tendon forces [N]: " + ", ".join(f"{k}={v:.3f}" for k, v in
                                                    list(r["tendon_force"].items())[:12]))
     if r["tendon_slack"]:

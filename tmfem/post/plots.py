@@ -6,6 +6,7 @@ comparison. Each function writes one PNG and returns its path.
 """
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -244,11 +245,14 @@ def plot_free_vibration(result, path, *, title: str = "") -> str:
             ax.set_ylabel("w [mm]")
         else:
             fam, unit, labels = name
-            for k, lab in enumerate(labels):
-                ax.plot(result.t, X[:, k], label=f"{lab} - {lab}(0)")
+            for k, (lab, style) in enumerate(zip(labels, mode_styles(len(labels)))):
+                ax.plot(result.t, X[:, k], label=f"{lab} - {lab}(0)", ms=3,
+                        markevery=max(1, len(result.t) // 12), **style)
             ax.set_ylabel(f"{fam} [{unit}]")
-        ax.legend(loc="upper right", fontsize=7, ncol=2)
+        many = len(ax.get_lines()) > 6     # beside the panel, so that it hides no history
+        ax.legend(fontsize=7, ncol=2 if many and len(ax.get_lines()) > 16 else (1 if many else 2),
+                  **({"loc": "upper left", "bbox_to_anchor": (1.01, 1.0)} if many else {"loc": "upper right"}))
     axes[-1].set_xlabel("t [s]")
     if title or note:
-        axes[0].set_title(title + note)
+        axes[0].set_title(textwrap.fill(title, 80) + note, fontsize=10)
     return str(save_figure(fig, path))

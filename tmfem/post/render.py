@@ -213,7 +213,7 @@ def render_configuration(png_path, system, *, q=None, tendon_forces=None, membra
     if title:
         p.add_text(title, position="upper_edge", font_size=12, color="black")
     p.add_legend(legend, bcolor="white", border=True, size=(0.2, 0.035 * len(legend)),
-                 loc="upper right", face="rectangle")
+                 loc="upper left", face="rectangle")    # text may run past its box: into the picture
     _set_view(p, X)
     p.camera.zoom(1.1)          # reset_camera frames the model; 1.3 cropped the 2-3's lowest node
     return _screenshot(p, png_path)

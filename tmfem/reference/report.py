@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 from tabulate import tabulate
 
+from tmfem.errors import ConvergenceError, InfeasibleController, InfeasibleDesign
 from tmfem.io.atomic import atomic_open, write_text
 from tmfem.reference.study import has_printed
 
@@ -301,14 +302,20 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     deployment = None
     spec = report_deployment(system) if deploy else None
     if spec is not None:
-        deployment = _deployment(out, spec, dt=dt, add=add,
-                                 progress=_run_progress(run_progress, "deployment"))
+        try:
+            deployment = _deployment(out, spec, dt=dt, add=add,
+                                     progress=_run_progress(run_progress, "deployment"))
+        except (InfeasibleController, InfeasibleDesign, ConvergenceError) as exc:
+            # the rest of the report stands; section 5 and the failed checks say why it has no run
+            deployment = {"system": spec["system"].name, "controller": spec["controller"],
+                          "uncertainty": spec["uncertainty"], "t_end": spec["t_end"], "not_run": str(exc)}
     step(STEPS[8])
 
     vibration = {"COM": _vibration_summary(r_com), fe: _vibration_summary(r_fe)}
     summary = {"system": name, "fe_model": fe, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
                "perturbation": perturb, "design_ok": bool(d.ok),
-               "failed_checks": [c.name for c in d.failed] + _result_failures(statics, freqs, fe),
+               "failed_checks": [c.name for c in d.failed] + _result_failures(statics, freqs, fe)
+               + (["deployment not run"] if deployment and "not_run" in deployment else []),
                "implied_prestress": implied,
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
@@ -571,6 +578,10 @@ def _deployment_section(d, link, img) -> list[str]:
     """Section 5 of the index: the deployment run of :func:`report_deployment`."""
     if not d:
         return []
+    if "not_run" in d:
+        return ["## 5. Deployment (7.4)", "",
+                f"The deployment of `{d['system']}` (`--controller {d['controller']}`, `--uncertainty "
+                f"{d['uncertainty']}`) was not run: {d['not_run']}", ""]
     p = d["file_stem"]
     rows = [("switching time to the linear controller", "s", d["switch_time_s"]),
             ("largest membrane deflection w", "mm", 1e3 * d["max_membrane_deflection_m"]),

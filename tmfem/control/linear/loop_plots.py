@@ -163,8 +163,9 @@ def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
     for k, name in enumerate(names):
         v = routes[name]
         if isinstance(v, str):
-            a.text(k, 0.0, "refused:\n" + "\n".join(v[i:i + 28] for i in range(0, min(len(v), 112), 28)),
-                   ha="center", va="bottom", fontsize=6, rotation=0)
+            # at the foot of the panel whatever the gamma scale (x in data, y in axes units)
+            a.text(k, 0.02, "refused:\n" + "\n".join(v[i:i + 28] for i in range(0, min(len(v), 112), 28)),
+                   ha="center", va="bottom", fontsize=6, rotation=0, transform=a.get_xaxis_transform())
             continue
         a.bar(k - 0.18, v[0], width=0.36, color="C0", label="gamma" if k == 0 else None)
         a.bar(k + 0.18, v[1], width=0.36, color="C1", label="verified ||T_pw||_inf" if k == 0 else None)

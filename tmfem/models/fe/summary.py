@@ -27,38 +27,51 @@ def design_checks(system, *, sigma_p1, von_mises, tendon_stress, tendon_yield, t
     """The checks of the equilibrium design at a computed state: membrane peaks against the
     yield stress (eqs. 5.29-5.30), tendon stresses against theirs (6.2), no slack tendon
     (3.18), bar loads below the Euler critical load (eq. 5.31). Each a dict (check, value,
-    limit, ok, equation)."""
+    limit, unit, ok, equation)."""
     checks = []
 
-    def check(name, value, limit, ok, eq):
-        checks.append({"check": name, "value": float(value), "limit": float(limit),
+    def check(name, value, limit, ok, eq, unit):
+        checks.append({"check": name, "value": float(value), "limit": float(limit), "unit": unit,
                        "ok": bool(ok), "equation": eq})
 
     mat = system.membrane
     if mat.yield_stress:
         check("membrane max sigma_p1 <= yield", sigma_p1, mat.yield_stress,
-              sigma_p1 <= mat.yield_stress, "5.29")
+              sigma_p1 <= mat.yield_stress, "5.29", "Pa")
         check("membrane max von Mises <= yield", von_mises, mat.yield_stress,
-              von_mises <= mat.yield_stress, "5.30")
+              von_mises <= mat.yield_stress, "5.30", "Pa")
     ty = np.asarray(tendon_yield, dtype=float)
     if np.any(np.isfinite(ty)):
         s = np.asarray(tendon_stress)
         k = int(np.nanargmax(s / ty))
         ok = np.isfinite(ty)
-        check("tendon stress <= yield", s[k], ty[k], np.all(s[ok] <= ty[ok]), "6.2")
+        check("tendon stress <= yield", s[k], ty[k], np.all(s[ok] <= ty[ok]), "6.2", "Pa")
     slack = np.asarray(tendon_slack, dtype=bool)
-    check("no slack tendon", int(slack.sum()), 0, not slack.any(), "3.18")
+    check("no slack tendon", int(slack.sum()), 0, not slack.any(), "3.18", "slack tendons")
     load = -np.asarray(bar_force, dtype=float)
     Fcrit = critical_loads(system)
     k = int(np.argmax(load / Fcrit))
-    check("bar load <= Euler critical load", load[k], Fcrit[k], np.all(load <= Fcrit), "5.31")
+    check("bar load <= Euler critical load", load[k], Fcrit[k], np.all(load <= Fcrit), "5.31", "N")
     return checks
 
 
 def check_lines(checks) -> list:
-    """One text line per check of :func:`design_checks`."""
+    """One text line per check of :func:`design_checks`, stresses in MPa, forces in N."""
+    def amount(c, v):
+        unit = c.get("unit", "")
+        return f"{v / 1e6:.4g} MPa" if unit == "Pa" else f"{v:.4g} {unit}".rstrip()
     return [f"check {c['check']:36s} {'ok' if c['ok'] else 'VIOLATED'}  "
-            f"({c['value']:.4g} vs {c['limit']:.4g}, eq. {c['equation']})" for c in checks]
+            f"({amount(c, c['value'])} vs {amount(c, c['limit'])}, eq. {c['equation']})" for c in checks]
+
+
+def printed_lines(r: dict, model: str) -> list:
+    """The rows of :func:`printed_rows` under a header: ``model``'s values, and beside them a
+    column of printed values only when the system's ``[printed]`` table gives any."""
+    rows = printed_rows(r)
+    has_printed = any(np.isfinite(c) for _, _, c in rows)
+    return ([f"{'':32s} {model:>12s}" + (f" {'printed':>12s}" if has_printed else "")]
+            + [f"{a:32s} {b:12.4g} {c:12.4g}" if np.isfinite(c) else f"{a:32s} {b:12.4g}"
+               for a, b, c in rows])
 
 
 def printed_rows(r: dict) -> list:
