@@ -260,7 +260,7 @@ class MembraneTL:
     def _strain_u(self, u, elements: slice):
         """:meth:`strain` from the displacements u = x - X (3, nn)."""
         ue = u[:, self.skmesh.t[:, elements]]                           # (3, 4, ne)
-        F = np.einsum("ike,kaeq->iaeq", ue, self._gauss(elements)[1])
+        F = np.einsum("ike,kaeq->iaeq", ue, self._gauss(elements)[1], optimize=True)
         F[0, 0] += 1.0
         F[1, 1] += 1.0
         C = np.einsum("ia...,ib...->ab...", F, F)
@@ -344,44 +344,29 @@ class MembraneTL:
         return fe, Ke
 
     def _element_arrays(self, u, tangent: bool, elements: slice):
-        """:meth:`element_arrays` of one chunk of elements, from u = x - X.
-
-        Element-major throughout ((ne, nqp, ...), one contiguous copy of the chunk's shape
-        function gradients first): every product is a batched matmul over contiguous
-        memory (the cached gradients (4, 2, ne, nqp) are strided by the element count
-        between their leading indices, which made the broadcasts of a point-major kernel
-        several times slower)."""
-        _, dN, dx = self._gauss(elements)
-        ne, nq = dx.shape
-        dNt = np.ascontiguousarray(np.transpose(dN, (2, 3, 1, 0)))      # (ne, nq, a, k) = N_k,a
-        ue = np.transpose(u[:, self.skmesh.t[:, elements]], (2, 1, 0))   # (ne, k, i)
-        Ft = np.matmul(dNt, ue[:, None])                                 # (ne, nq, a, i) = F_ia
-        Ft[:, :, 0, 0] += 1.0
-        Ft[:, :, 1, 1] += 1.0
-        Eg = 0.5 * np.matmul(Ft, np.swapaxes(Ft, 2, 3))                  # (ne, nq, a, b) = C_ab / 2
-        Eg[:, :, 0, 0] -= 0.5
-        Eg[:, :, 1, 1] -= 0.5
-        S, D = self.law.stress(np.transpose(Eg, (2, 3, 0, 1)), tangent=tangent)
+        """:meth:`element_arrays` of one chunk of elements, from u = x - X."""
+        F, Eg = self._strain_u(u, elements)
+        S, D = self.law.stress(Eg, tangent=tangent)
         h = self.material.h
-        hdx = (h * dx)[:, :, None, None]
-        St = np.transpose(S, (2, 3, 0, 1)) * hdx                         # (ne, nq, a, b) h dx S_ab
-        # fe_ki = sum_q,b N_k,b P_ib dx with P = h F S (first Piola-Kirchhoff resultant)
-        Pt = np.matmul(np.swapaxes(St, 2, 3), Ft)                        # (ne, nq, b, i)
-        fe = np.matmul(np.swapaxes(dNt.reshape(ne, nq * 2, 4), 1, 2),
-                       Pt.reshape(ne, nq * 2, 3)).reshape(ne, 12)
+        _, dN, dx = self._gauss(elements)
+        P = h * np.einsum("ia...,ab...->ib...", F, S)                 # (3, 2, ne, nqp)
+        fe = np.einsum("ibeq,kbeq,eq->eki", P, dN, dx).reshape(-1, 12)
         if not tangent:
             return fe, None
-        # B (ne, nq, 3 Voigt, 12 = (node k, component i)): the variation of the Voigt strain,
-        # [F_i1 N_k,1, F_i2 N_k,2, F_i1 N_k,2 + F_i2 N_k,1], outer products as matmuls
+        ne, nq = dx.shape
+        # B (ne, nq, 3 Voigt, 12 = (node k, component i)), element-major for batched matmuls
+        Ft = np.transpose(F, (2, 3, 1, 0))                            # (ne, nq, a, i)
+        dNt = np.transpose(dN, (2, 3, 1, 0))                          # (ne, nq, a, k)
         B = np.empty((ne, nq, 3, 4, 3))
-        np.matmul(dNt[..., None], Ft[:, :, :, None, :], out=B[:, :, :2])
-        np.matmul(dNt[:, :, 1, :, None], Ft[:, :, 0, None, :], out=B[:, :, 2])
-        B[:, :, 2] += np.matmul(dNt[:, :, 0, :, None], Ft[:, :, 1, None, :])
+        B[:, :, 0] = dNt[:, :, 0, :, None] * Ft[:, :, 0, None, :]
+        B[:, :, 1] = dNt[:, :, 1, :, None] * Ft[:, :, 1, None, :]
+        B[:, :, 2] = dNt[:, :, 1, :, None] * Ft[:, :, 0, None, :] + dNt[:, :, 0, :, None] * Ft[:, :, 1, None, :]
         B = B.reshape(ne, nq, 3, 12)
+        hdx = (h * dx)[:, :, None, None]
         DB = np.matmul(np.transpose(D, (2, 3, 0, 1)) * hdx, B)        # (ne, nq, 3, 12)
         Km = np.matmul(np.swapaxes(B.reshape(ne, nq * 3, 12), 1, 2), DB.reshape(ne, nq * 3, 12))
         # initial-stress part: delta_ij N_k,a S_ab N_l,b
-        SdN = np.matmul(St, dNt)                                          # (ne, nq, a, l)
+        SdN = np.matmul(np.transpose(S, (2, 3, 0, 1)) * hdx, dNt)      # (ne, nq, b, l)
         g = np.matmul(np.swapaxes(dNt.reshape(ne, nq * 2, 4), 1, 2), SdN.reshape(ne, nq * 2, 4))
         K4 = Km.reshape(ne, 4, 3, 4, 3)
         for i in range(3):
