@@ -181,7 +181,8 @@ class COMStateEstimator:
         xf = self.dyn.positions(x)
         q = self.bar_coordinates(x, xf)
         if self.psi_branch is not None:
-            q[self._psi] = self.psi_branch + wrap_angle(q[self._psi] - self.psi_branch)
+            # whole turns only: an azimuth already on the branch's turn is returned bit for bit
+            q[self._psi] += 2 * np.pi * np.round((self.psi_branch - q[self._psi]) / (2 * np.pi))
         xm = xf[:, :self._n_mesh]
         r = to_floating((self._I @ xm.T).T, xm[:, self._corners])
         delta = self.com.zeta(q)[:self._nd]
