@@ -33,7 +33,8 @@ def tower():
 def test_an_azimuth_passing_pi_is_measured_on_its_turn(tower):
     """Two placements of the COM's field (fe_state_of), the packaged configuration and the
     same with psi_32 turned by +0.05 rad past pi, are estimated back as placed, psi_32 =
-    3.168 rad (to 1e-9, the round-off of the placement), rates included; an estimate without the start's turn reads 3.168 - 2 pi."""
+    3.168 rad (to 1e-9, the round-off of the placement), rates included; an estimate
+    without the start's turn reads 3.168 - 2 pi."""
     s, com, dyn, initial, z_a = tower
     k = list(s.q_names).index("psi_32")
     assert np.pi - 0.05 < z_a[k] < np.pi
