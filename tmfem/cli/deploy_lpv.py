@@ -155,8 +155,8 @@ def run(args, *, mesh_n) -> dict:
     if args.estimator_interpolation:
         est["interpolation"] = args.estimator_interpolation
     if (args.estimator_refine or 1) > 1:
-        est["estimator_plant"] = lpv_options.refined_plant(dep.model.system, plant, args.estimator_refine,
-                                                           what="estimator plant")
+        est["estimator_plant"] = dep.on_turn(lpv_options.refined_plant(dep.model.system, plant, args.estimator_refine,
+                                                                       what="estimator plant"))
     s, r = _run_on(args, dep, d, args.plant, mesh_n, est)
     # the keys of the 7.4 deployments (tmfem.cli.deploy.run; no PFL: uncertainty, allocation and
     # pfl_at None), then the design's

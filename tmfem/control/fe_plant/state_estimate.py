@@ -165,6 +165,7 @@ class COMStateEstimator:
         self._corners = topo.mesh.corners
         _, _, psi = q_index(com.system.M, com.system.N)
         self._psi = psi.ravel()
+        self.psi_branch = None
 
     def bar_coordinates(self, x, xf=None) -> np.ndarray:
         """q of the free-DOF FE state x (the rigid fit or the chords, ``bars``); ``xf``: its
@@ -175,9 +176,13 @@ class COMStateEstimator:
         return q_from_positions(self.com.system, xf[:, self._system_node])
 
     def modal(self, x) -> np.ndarray:
-        """[q, eta] (modal coordinates) of the free-DOF FE positions x."""
+        """[q, eta] (modal coordinates) of the free-DOF FE positions x; the azimuths psi on the
+        turn of ``psi_branch`` (each within pi of it) when it is set."""
         xf = self.dyn.positions(x)
         q = self.bar_coordinates(x, xf)
+        if self.psi_branch is not None:
+            # whole turns only: an azimuth already on the branch's turn is returned bit for bit
+            q[self._psi] += 2 * np.pi * np.round((self.psi_branch - q[self._psi]) / (2 * np.pi))
         xm = xf[:, :self._n_mesh]
         r = to_floating((self._I @ xm.T).T, xm[:, self._corners])
         delta = self.com.zeta(q)[:self._nd]
@@ -185,9 +190,13 @@ class COMStateEstimator:
         return np.concatenate([q, self.com.membrane.modal_coordinates(d_rel)])
 
     def state(self, x, v) -> tuple[np.ndarray, np.ndarray]:
-        """(z, z') in the COM's coordinates (modal, or the point coordinates of eq. 5.18)."""
+        """(z, z') in the COM's coordinates (modal, or the point coordinates of eq. 5.18).
+        The azimuths psi are counted continuously, as a multi-turn encoder would: each on the
+        turn nearest to the previous estimate's (``psi_branch``, which this call updates), so
+        that a bar whose azimuth passes +-pi does not jump by 2 pi."""
         x, v = np.asarray(x, dtype=float), np.asarray(v, dtype=float)
         zm = self.modal(x)
+        self.psi_branch = zm[self._psi].copy()
         vmax = float(np.max(np.abs(v))) if v.size else 0.0
         if vmax == 0.0:
             zdm = np.zeros_like(zm)
@@ -217,14 +226,20 @@ class FEStatePlant:
         lengths (default, the dissertation's actuators) or be turned into the COM's tendon
         tension at the measured q, which tension-servoed winches realise on the FE tendons
         (:mod:`tmfem.control.fe_plant.tension_actuation`).
+    q_start : array, optional
+        Bar coordinates of the start (the COM's q of the packaged design): the turn on which
+        the estimate counts the azimuths psi from the first sample on
+        (:meth:`COMStateEstimator.state`); default the turn (-pi, pi].
     """
 
     def __init__(self, dyn, com, *, x0=None, v0=None, bars: str | None = None,
-                 actuation: str = "rest-length"):
+                 actuation: str = "rest-length", q_start=None):
         if actuation not in ACTUATIONS:
             raise InputError(f"plant actuation: expected one of {ACTUATIONS}, found {actuation!r}")
         self.actuation, self.com = actuation, com
         self.dyn, self.estimator = dyn, COMStateEstimator(com, dyn, bars=bars)
+        if q_start is not None:
+            self.estimator.psi_branch = np.asarray(q_start, dtype=float)[self.estimator._psi]
         self.input_names = list(dyn.input_names)
         if self.input_names != list(com.input_names):
             raise InputError(f"FE plant: expected the COM's inputs {com.input_names}, found "
@@ -434,7 +449,7 @@ def mtc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     fe.set_tendon_lengths(start_rest_lengths(initial, tendon_law, com.u0))
     st = fe.equilibrium(x0=com_positions(com, fe, packaged_state(com, initial)))
     fe.set_tendon_lengths(com.u0)
-    return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free], actuation=actuation)
+    return FEStatePlant(dyn, com, x0=fe.reduce(st.x)[fe.free], actuation=actuation, q_start=initial.q)
 
 
 def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int = 3,
@@ -473,7 +488,7 @@ def sbc_deployment_plant(com, initial, *, mesh_n: int = 10, tendon_elements: int
     sbc.set_tendon_lengths(com.u0)
     dyn = SBCDynamics(sbc, st.state, output_points=com.output_points, beta=beta,
                       damping_tangent=deployment_damping_tangent(damping_tangent, beta))
-    return FEStatePlant(dyn, com, bars=bars, actuation=actuation)
+    return FEStatePlant(dyn, com, bars=bars, actuation=actuation, q_start=initial.q)
 
 
 #: the plants a deployment can run on: the COM it is designed on and the two FE models

@@ -39,7 +39,7 @@ import numpy as np
 
 from tmfem.control.deployment.limits import tendon_lengths
 from tmfem.control.deployment.pfl import bounded_inversion, partition
-from tmfem.control.deployment.reference_trajectory import DeploymentReference
+from tmfem.control.deployment.reference_trajectory import DeploymentReference, angle_mask
 from tmfem.control.deployment.run import DeploymentSetup
 from tmfem.control.lpv.controller import LPVController
 from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
@@ -138,6 +138,16 @@ class LPVDeployment:
     floor: float = TENSION_FLOOR
     r_min: float = 1e-3
 
+    def on_turn(self, plant):
+        """``plant`` (a gridded plant of this deployment's system) with the bar angles of its
+        equilibria on the turn of the reference's start q_d(0) (:meth:`GriddedLPV.on_turn`):
+        the measured angles of the plant (a COM state, integrated; an FE plant's estimate,
+        counted continuously) stay on that turn, so x_z - x_e(rho_r) holds no whole turn."""
+        names = list(self.model.system.q_names)
+        q0 = np.asarray(self.reference(0.0)[0], dtype=float)
+        angles = {n: float(v) for n, v, a in zip(names, q0, angle_mask(names)) if a}
+        return plant.on_turn(self.reference_rho(0.0), angles)
+
     def packaged(self):
         """The initial (packaged) configuration as a designed System: its rest lengths those
         the run starts with, u_e of the design grid at rho_r(0) (the controller's first
@@ -219,9 +229,11 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
     info = {"omega_r": omega_r, "xi_r": 1.0, "theta_0_deg": float(np.degrees(theta_0)),
             "theta_e_deg": float(np.degrees(theta_e)), "psi_0_deg": float(np.degrees(psi_0)), "K": model.K,
             "lpv_grid": list(plant.grid_shape)}
-    return LPVDeployment(model=model, reference=ref, plant=plant, T_veta=T_veta, z0=z0, z_e=z_e,
-                         rho_q=[list(final.q_names).index(n) for n in plant.parameter_names], info=info,
-                         initial=initial, floor=floor, r_min=r_min)
+    dep = LPVDeployment(model=model, reference=ref, plant=plant, T_veta=T_veta, z0=z0, z_e=z_e,
+                        rho_q=[list(final.q_names).index(n) for n in plant.parameter_names], info=info,
+                        initial=initial, floor=floor, r_min=r_min)
+    dep.plant = dep.on_turn(plant)
+    return dep
 
 
 def state_feedback_controller(dep: LPVDeployment, design):

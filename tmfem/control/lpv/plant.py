@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import itertools
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator, make_interp_spline
@@ -152,6 +152,34 @@ class GriddedLPV:
                 raise InputError(f"LPV plant: {self.parameter_names[k]} = {r:.6g} outside the grid "
                                  f"[{a[0]:.6g}, {a[-1]:.6g}]")
         return np.clip(rho, [a[0] for a in self.axes], [a[-1] for a in self.axes])
+
+    def on_turn(self, rho, angles: dict) -> "GriddedLPV":
+        """This plant with the angles among x_e and y_e (the entries named in ``angles``, e.g.
+        the bar angles theta_ij, psi_ij; not their rates) counted continuously over the grid,
+        each on the turn of ``angles`` ({name: value [rad]}) at ``rho``.
+
+        The grid points' equilibria give every azimuth on (-pi, pi]: an azimuth that passes
+        +-pi between two grid points (psi_32 of the three-stage tower from 3.118 rad at
+        theta_13 = 60 deg to -3.094 at 57.5 deg) would be interpolated across the wrap, through
+        0. Each such entry is unwrapped along every axis (``numpy.unwrap``: whole turns added
+        where consecutive points differ by more than pi; untouched otherwise), then moved by
+        whole turns to the value nearest ``angles[name]`` at ``rho`` (a reference that
+        starts there). A plant whose angles neither wrap nor differ by a turn from ``angles``
+        is returned unchanged."""
+        X = {"x_e": self.x_e.copy(), "y_e": self.y_e.copy()}
+        names = {"x_e": self.state_names, "y_e": self.output_names}
+        idx = {k: [i for i, n in enumerate(names[k]) if n in angles] for k in X}
+        for k, ii in idx.items():
+            for ax in range(len(self.axes)):
+                X[k][..., ii] = np.unwrap(X[k][..., ii], axis=ax)
+        unwrapped = replace(self, x_e=X["x_e"], y_e=X["y_e"], _interp={})
+        for k, ii in idx.items():
+            at = unwrapped.interpolate(k, rho)
+            for i in ii:
+                X[k][..., i] += 2 * np.pi * np.round((angles[names[k][i]] - at[i]) / (2 * np.pi))
+        if all(np.array_equal(X[k], getattr(self, k)) for k in X):
+            return self
+        return replace(self, x_e=X["x_e"], y_e=X["y_e"], _interp={})
 
     def interpolate(self, name: str, rho) -> np.ndarray:
         """``A``, ``B``, ``C``, ``D``, ``x_e``, ``u_e`` or ``y_e`` at ``rho`` (inside the grid;
