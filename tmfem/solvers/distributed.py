@@ -214,6 +214,12 @@ class DistributedMatrix:
             self._vecs = self.mat.createVecs()
         return self._vecs
 
+    def destroy(self) -> None:
+        """Free the PETSc matrix and work vectors (collective)."""
+        for obj in (self._vecs or ()) + (self.mat,):
+            obj.destroy()
+        self._vecs = None
+
     def diagonal(self) -> np.ndarray:
         """The diagonal (N,) on every rank."""
         d, _ = self.vecs()
@@ -297,6 +303,7 @@ class DistributedAssembler:
             g = _EntryMap(np.asarray(dofs, dtype=np.int64), kind, n, T, number)
             self._groups.append(g)
             gkeys, ginv = g.pattern(self.N)
+            g.drop_pattern_tables()
             keys.append(gkeys)
             local.append((offset, gkeys.size, ginv))
             offset += gkeys.size
@@ -520,6 +527,14 @@ class _EntryMap:
         R, Cc = self._rows_cols()
         self._set_valid(R, Cc)
         return keys, (inverse if self.all_valid else inverse[self.valid])
+
+    def drop_pattern_tables(self) -> None:
+        """Free what only :meth:`pattern` needs (the (n, p) table of every full dof's
+        unknowns, the element dofs and their unknowns; the weights when they are all 1):
+        the tables over all n full dofs are as large on every rank as on one."""
+        self.Cd = self.C = self.dofs = None
+        if self.unit:
+            self.W = None
 
     def weighted(self, X) -> np.ndarray:
         """Values of the valid entries: T_ia T_jb X_ij, flattened like :meth:`keys`."""
