@@ -363,16 +363,24 @@ class DistributedAssembler:
         if len(values) != len(self._groups):
             raise InputError(f"distributed matrix: expected {len(self._groups)} arrays (one per "
                              f"group), found {len(values)}")
-        parts = [g.weighted(v) for g, v in zip(self._groups, self._check(values, "distributed matrix"))]
-        vals = np.bincount(self._inverse, weights=np.concatenate(parts) if parts else None,
-                           minlength=self._nu)
-        del parts
+        # sums in place, group by group in the order of the entries (np.add.at: the sums of
+        # one np.bincount of all groups' values, without their concatenation and without
+        # bincount's int64 copy of the int32 key indices)
+        vals = np.zeros(self._nu)
+        off = 0
+        for g, v in zip(self._groups, self._check(values, "distributed matrix")):
+            part = g.weighted(v)
+            np.add.at(vals, self._inverse[off:off + part.size], part)
+            off += part.size
         if self._recv_inverse is None:
             data = vals
         else:
             recv = np.empty(int(self._recvcounts.sum()))
             self.comm.Alltoallv([vals, self._sendcounts], [recv, self._recvcounts])
-            data = np.bincount(self._recv_inverse, weights=recv, minlength=self._nnz)
+            del vals                 # sent: the peak of an assembly is the matrix' own arrays
+            data = np.zeros(self._nnz)
+            np.add.at(data, self._recv_inverse, recv)
+            del recv
         PETSc = self.PETSc
         nloc = self.hi - self.lo
         if out is None:

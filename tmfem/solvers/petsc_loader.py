@@ -8,6 +8,8 @@ machine without PETSc and ``import tmfem`` never loads it (docs/architecture.md,
 """
 from __future__ import annotations
 
+import ctypes
+import functools
 import os
 
 from tmfem.errors import BackendUnavailable
@@ -28,7 +30,28 @@ def petsc_modules():
     except ImportError as exc:
         raise BackendUnavailable(f"backend 'petsc': expected petsc4py and slepc4py importable, found "
                                  f"{exc}; install with: {PETSC_INSTALL}") from None
+    _restore_malloc()
     return PETSc, SLEPc
+
+
+@functools.cache
+def _restore_malloc() -> None:
+    """Give freed memory back to the system again after PETSc has loaded (once).
+
+    A library PETSc links (SuperLU_DIST's CombBLAS, in Debian's build) sets glibc's
+    ``M_MMAP_MAX`` to 0 and ``M_TRIM_THRESHOLD`` to -1 when it loads: every allocation then
+    comes from the heap and the heap never shrinks, so each transient array (a pattern
+    set-up's keys, an assembly's element matrices) stays resident to the end of the run.
+    This puts back glibc's defaults (large blocks mapped on their own and unmapped when
+    freed, the heap top trimmed)."""
+    try:
+        libc = ctypes.CDLL(None)
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):       # not glibc
+        return
+    M_TRIM_THRESHOLD, M_MMAP_MAX = -1, -4
+    mallopt(M_MMAP_MAX, 65536)
+    mallopt(M_TRIM_THRESHOLD, 128 * 1024)
 
 
 def petsc_available() -> bool:
