@@ -5,13 +5,14 @@ rank 0 prints one JSON document.
 
 usage: python tests/mpi/fe_distributed.py PRESET MESH_N [--model mtc|sbc]
                                           [--start design|undeformed] [--fail-rank R] [--nan-rank R]
-                                          [--options="-snes_type newtonls ..."]
+                                          [--options="-snes_type newtonls ..."] [--sequence N]
 --model: the MTC model (membrane, bars, tendons; default) or the SBC model (MITC4 shells,
 beams, cables; static from the undeformed membrane through the MTC predictor);
 --start: the MTC model's start; --fail-rank R: the membrane/shell kernel of rank R raises
 (a failure on one rank: the other ranks wait in a collective call, mpi_main aborts the
 job); --nan-rank R: rank R's element matrices are not finite (caught collectively by the
-assembler: one clean error); --options: PETSc options of the backend. The MTC document has
+assembler: one clean error); --options: PETSc options of the backend; --sequence: the MTC
+static solve with mesh sequencing down to N (coarse levels built, solved and released). The MTC document has
 ``m_orth``: max |Phi^T M Phi - I| of the modes with the scipy mass of the model.
 """
 import argparse
@@ -33,6 +34,7 @@ def main():
     ap.add_argument("--fail-rank", type=int, default=None)
     ap.add_argument("--nan-rank", type=int, default=None)
     ap.add_argument("--options", default=None)
+    ap.add_argument("--sequence", type=int, default=None)
     args = ap.parse_args()
     from tmfem.solvers.petsc import PetscBackend
     from tmfem.system import load_preset
@@ -58,7 +60,7 @@ def main():
         element.element_arrays = nan
     out = {"ranks": comm.size, "distributed": model.distributed is not None}
     if args.model == "mtc":
-        st = model.equilibrium(start=args.start)
+        st = model.equilibrium(start=args.start, sequence=args.sequence)
         md = model.modes(k=12, at=st.x)
         S = md.shapes
         m_orth = np.abs(S.T @ (model.mass() @ S) - np.eye(S.shape[1])).max()

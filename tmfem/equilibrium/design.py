@@ -23,7 +23,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import linprog
 
 from tmfem.equilibrium.general import (EquilibriumMatrix, equilibrium_matrix, free_components,
                                        null_space, positive_null_vector, symmetric_matrix)
@@ -223,6 +222,7 @@ def tendon_forces_for(E: EquilibriumMatrix, F: np.ndarray, *, rtol: float = 1e-9
         C = 10.0 * max(np.abs(T0).max(), 1.0)
         c = np.zeros(k + 1)
         c[-1] = -1.0
+        from scipy.optimize import linprog     # 16 MB resident: only where used
         res = linprog(c, A_ub=np.hstack([-Z, np.ones((Z.shape[0], 1))]), b_ub=T0,
                       bounds=[(-C, C)] * k + [(None, None)], method="highs")
         if res.status == 0:

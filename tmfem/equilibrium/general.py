@@ -21,7 +21,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import linprog
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.newton import newton
@@ -381,6 +380,7 @@ def positive_null_vector(A: np.ndarray, positive=None, *, rtol: float = 1e-9) ->
     A_ub = np.hstack([-Zp, np.ones((Zp.shape[0], 1))])     # t - Zp c <= 0
     b_ub = np.zeros(Zp.shape[0])
     A_eq = np.hstack([Zp.sum(axis=0)[None, :], [[0.0]]])
+    from scipy.optimize import linprog     # 16 MB resident: only where used
     res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=[1.0],
                   bounds=[(None, None)] * k + [(None, 1.0)], method="highs")
     if res.status != 0:

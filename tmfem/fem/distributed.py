@@ -149,6 +149,15 @@ class DistributedElements:
         self._K.append(K)
         return r, K
 
+    def release(self) -> None:
+        """Free the PETSc matrices (tangents, mass) and work vectors assembled here
+        (petsc4py 3.18 frees a PETSc object on ``destroy()`` only, not when it is garbage
+        collected): for a model that is done, such as a coarse level of a mesh sequencing.
+        Collective (every rank calls it at the same point); the matrices are unusable after."""
+        for D in self._K + ([self._M] if self._M is not None else []):
+            D.destroy()
+        self._K, self._M = [], None
+
     def energy(self, state) -> float:
         """Strain energy [J] of all sets, summed over the ranks (the same on every rank)."""
         local = 0.0

@@ -214,6 +214,12 @@ class DistributedMatrix:
             self._vecs = self.mat.createVecs()
         return self._vecs
 
+    def destroy(self) -> None:
+        """Free the PETSc matrix and work vectors (collective)."""
+        for obj in (self._vecs or ()) + (self.mat,):
+            obj.destroy()
+        self._vecs = None
+
     def diagonal(self) -> np.ndarray:
         """The diagonal (N,) on every rank."""
         d, _ = self.vecs()
@@ -297,6 +303,7 @@ class DistributedAssembler:
             g = _EntryMap(np.asarray(dofs, dtype=np.int64), kind, n, T, number)
             self._groups.append(g)
             gkeys, ginv = g.pattern(self.N)
+            g.drop_pattern_tables()
             keys.append(gkeys)
             local.append((offset, gkeys.size, ginv))
             offset += gkeys.size
@@ -356,16 +363,24 @@ class DistributedAssembler:
         if len(values) != len(self._groups):
             raise InputError(f"distributed matrix: expected {len(self._groups)} arrays (one per "
                              f"group), found {len(values)}")
-        parts = [g.weighted(v) for g, v in zip(self._groups, self._check(values, "distributed matrix"))]
-        vals = np.bincount(self._inverse, weights=np.concatenate(parts) if parts else None,
-                           minlength=self._nu)
-        del parts
+        # sums in place, group by group in the order of the entries (np.add.at: the sums of
+        # one np.bincount of all groups' values, without their concatenation and without
+        # bincount's int64 copy of the int32 key indices)
+        vals = np.zeros(self._nu)
+        off = 0
+        for g, v in zip(self._groups, self._check(values, "distributed matrix")):
+            part = g.weighted(v)
+            np.add.at(vals, self._inverse[off:off + part.size], part)
+            off += part.size
         if self._recv_inverse is None:
             data = vals
         else:
             recv = np.empty(int(self._recvcounts.sum()))
             self.comm.Alltoallv([vals, self._sendcounts], [recv, self._recvcounts])
-            data = np.bincount(self._recv_inverse, weights=recv, minlength=self._nnz)
+            del vals                 # sent: the peak of an assembly is the matrix' own arrays
+            data = np.zeros(self._nnz)
+            np.add.at(data, self._recv_inverse, recv)
+            del recv
         PETSc = self.PETSc
         nloc = self.hi - self.lo
         if out is None:
@@ -520,6 +535,14 @@ class _EntryMap:
         R, Cc = self._rows_cols()
         self._set_valid(R, Cc)
         return keys, (inverse if self.all_valid else inverse[self.valid])
+
+    def drop_pattern_tables(self) -> None:
+        """Free what only :meth:`pattern` needs (the (n, p) table of every full dof's
+        unknowns, the element dofs and their unknowns; the weights when they are all 1):
+        the tables over all n full dofs are as large on every rank as on one."""
+        self.Cd = self.C = self.dofs = None
+        if self.unit:
+            self.W = None
 
     def weighted(self, X) -> np.ndarray:
         """Values of the valid entries: T_ia T_jb X_ij, flattened like :meth:`keys`."""

@@ -219,10 +219,11 @@ class PetscBackend:
             base.mat.copy(M, structure=self.PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             entry.generation += 1      # earlier solves of this Mat are stale now
         if base is not A:
-            d, _ = M.createVecs()
+            d = M.createVecLeft()
             lo, hi = M.getOwnershipRange()
             d.setArray(A.d[lo:hi])
             M.setDiagonal(d, addv=self.PETSc.InsertMode.ADD_VALUES)
+            d.destroy()         # petsc4py 3.18 frees a PETSc object on destroy() only
         return M, key
 
     def adopt(self, A, mat, ksp, symmetric: bool, owner=None) -> None:
@@ -295,7 +296,10 @@ class PetscBackend:
         M.multTranspose(x, z)
         scale = y.norm()
         z.axpy(-1.0, y)
-        return bool(z.norm() <= 1e-12 * max(scale, 1e-300))
+        symmetric = bool(z.norm() <= 1e-12 * max(scale, 1e-300))
+        for v in (x, y, z):
+            v.destroy()
+        return symmetric
 
     def _configure(self, ksp, symmetric: bool, prefix: str = "") -> None:
         """Defaults of the module docstring, then the options database (PETSC_OPTIONS and
@@ -603,12 +607,13 @@ class PetscBackend:
             if nconv < k:
                 raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "
                                        f"sigma={sigma:g} in {E.getIterationNumber()} restarts")
-            vr, _ = Kp.createVecs()
+            vr = Kp.createVecRight()
             w = np.empty(nconv)
             V = np.empty((n, nconv))
             for i in range(nconv):
                 w[i] = E.getEigenpair(i, vr).real
                 V[:, i] = self.gather(vr)
+            vr.destroy()
         finally:
             E.destroy()
         return w, V

@@ -122,10 +122,11 @@ class _Problem:
         _, _, K = self.evaluate(gather(X))
         K.mat.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         if self.mu > 0:
-            d, _ = P.createVecs()
+            d = P.createVecLeft()
             lo, hi = P.getOwnershipRange()
             d.setArray(self.mu * self.D[lo:hi])
             P.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
+            d.destroy()         # petsc4py 3.18 frees a PETSc object on destroy() only
         sym = self.backend._symmetric(K, K.mat)
         P.setOption(PETSc.Mat.Option.SYMMETRIC, sym)
         pc = snes.getKSP().getPC()

@@ -275,8 +275,10 @@ class MTCModel(FEModel, Tendons, Placement):
             rc = coarse.equilibrium(start=start, tol=max(tol, COARSE_TOL), max_iter=max_iter,
                                      monitor=monitor, progress=progress, sequence=sequence)
             x_fine = self.interpolate_from(coarse, rc.x)
-            rc.tangent = None          # with the coarse model: its element arrays and
-            del coarse                 # factorisations go before the fine level
+            rc.tangent = None          # with the coarse model: its element arrays,
+            if coarse._dist is not None:   # matrices and factorisations go before the fine level
+                coarse._dist.release()
+            del coarse
             fine = self.equilibrium(x0=x_fine, tol=tol, max_iter=max_iter, monitor=monitor,
                                      progress=progress)
             return Equilibrium(
