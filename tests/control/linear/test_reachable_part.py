@@ -99,3 +99,16 @@ def test_design_on_the_reachable_part_leaves_the_excluded_modes_open_loop():
     assert max(near) < 1e-6 * np.abs(hidden[0])
     rest = ev[np.min(np.abs(ev[:, None] - hidden[None, :]), axis=1) > 1e-6 * np.abs(hidden[0])]
     assert rest.size == ev.size - 2 and np.max(rest.real) < -d.design.alpha
+
+
+def test_exclude_on_a_fully_reachable_plant_is_the_same_design():
+    """The 1-4D preset (every mode reached, 7.4's PBH verdict): "exclude" is a policy with
+    nothing to exclude, and gives the same controller as "refuse" (as `control hinf
+    --exclude-uncontrollable` there)."""
+    from tmfem.control.linear.deployed_design import deployed_hinf
+    from tmfem.system import load_preset
+    s = load_preset("1-4D")
+    a, b = deployed_hinf(s), deployed_hinf(s, uncontrollable="exclude")
+    assert b.excluded_modes == () and "excluded_modes" not in b.summary()
+    for M in ("A", "B", "C", "D"):
+        assert np.array_equal(getattr(a.design.controller, M), getattr(b.design.controller, M))
