@@ -87,3 +87,22 @@ def test_a_constraint_the_optimum_cannot_meet_is_named_and_exits_1(tmp_path, cap
     assert main(["optimize", str(path), "--mesh", "4", "--max-iter", "3"]) == 1
     out = capsys.readouterr().out
     assert "VIOLATED at the returned design" in out and "mass [kg]" in out
+
+
+def test_no_wrinkling_over_a_point_held_membrane_says_why_and_names_the_aperture(capsys):
+    """`membrane_min_principal>=0` without an aperture on the 1-4 (corners held by points): the
+    start design is already in compression (minor principal stress < 0, docs/guides/design.md:
+    -57 kPa at mesh 10), the constraint stays violated, and the output says why in one line
+    and names the aperture; with `--aperture 0.8` (taut there, +3.4 kPa at mesh 10) no such hint."""
+    argv = ["optimize", "--preset", "1-4", "--objective", "max:freq", "--constraint",
+            "membrane_min_principal>=0", "--variable", "S1=1.40:1.52", "--mesh", "4", "--max-iter", "5"]
+    rc, r = run(argv, capsys)
+    assert rc == 1 and r["start_responses"]["membrane_min_principal"] < 0
+    (v,) = r["violated"]
+    assert v["constraint"].startswith("membrane_min_principal>=0")
+    assert "held at its corners by points" in v["hint"] and "--aperture" in v["hint"]
+    assert main(argv + ["--quiet"]) == 1
+    hints = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("hint:")]
+    assert len(hints) == 1 and "compression near its corners" in hints[0] and "[design] aperture" in hints[0]
+    rc, r = run(argv + ["--aperture", "0.8"], capsys)
+    assert all("hint" not in v for v in r["violated"])

@@ -395,6 +395,8 @@ def test_report_of_a_deployable_system_whose_switch_cannot_be_designed(tmp_path,
     assert "checks FAILED: deployment not run" in text and "not reached by any tendon" in text
     r = json.loads((out / "report.json").read_text())
     assert r["failed_checks"] == ["deployment not run"] and "4.276 Hz" in r["deployment"]["not_run"]
+    assert "--exclude-uncontrollable" in r["deployment"]["not_run"]
+    assert 'uncontrollable = "exclude"' in r["deployment"]["not_run"]
     index = (out / "index.md").read_text()
     assert "was not run: " in index.split("## 5. Deployment")[1]
     assert (out / "vibration_sbc.png").exists() and not (out / "INCOMPLETE").exists()

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from tmfem.cli import control_lpv
 from tmfem.cli.common import add_system_args, output_file, say, system_from_args
+from tmfem.cli.uncontrollable import add_uncontrollable_arg
 from tmfem.errors import InputError, ResourceLimit
 
 NAME = "control"
@@ -47,9 +48,7 @@ def configure(parser) -> None:
                              "independent, the one `tmfem deploy` uses (docs/guides/control.md)")
     parser.add_argument("--pbh-tol", type=float, default=None,
                         help="PBH margin below which a mode is uncontrollable/unobservable (default 1e-8)")
-    parser.add_argument("--exclude-uncontrollable", action="store_true", default=None,
-                        help="design for the plant without the modes no tendon reaches (listed; in closed "
-                             "loop they keep their undamped open-loop dynamics); default: refuse such a plant")
+    add_uncontrollable_arg(parser, what="the H-infinity controller (hinf)")
     parser.add_argument("--save", help="write plant and controller to this .npz")
     parser.add_argument("--plot", help="write the closed-loop analysis figure (PNG)")
     control_lpv.configure(parser)
@@ -118,7 +117,7 @@ def run(args) -> dict:
                         solver=args.solver, synthesize=args.action == "hinf",
                         pbh_tol=args.pbh_tol,
                         method=args.method or ("lmi" if args.solver else DEFAULT_METHOD),
-                        uncontrollable="exclude" if args.exclude_uncontrollable else "refuse")
+                        uncontrollable="exclude" if args.exclude_uncontrollable else None)
     out = {"action": args.action, **res.summary()}
     if args.action == "hinf":
         from tmfem.control.linear.loop_plots import damping_table

@@ -14,6 +14,7 @@ from tmfem import reference
 from tmfem.cli import deploy_lpv
 from tmfem.cli.common import (check_frames, check_mesh_budget, check_time_steps, output_dir,
                               output_file, positive_float, progress_bar, warn)
+from tmfem.cli.uncontrollable import add_uncontrollable_arg, excluded_text, with_uncontrollable
 from tmfem.errors import InputError
 from tmfem.models.com.mode_count import MembraneModeChoice
 from tmfem.models.com.model import membrane_modes_of
@@ -112,6 +113,7 @@ def configure(parser) -> None:
                              "15,150,20,1.5). A crossover below the FE plant's unmodelled "
                              "dynamics, e.g. 10,0,20,1 with --uncertainty no-MG, deploys 1-4D on "
                              "the SBC plant (docs/guides/fe-plant.md)")
+    add_uncontrollable_arg(parser, what="the deployment's switch")
     parser.add_argument("--t-end", type=positive_float, default=20.0, help="duration [s]")
     parser.add_argument("--dt", type=positive_float, default=0.01, help="sample time [s]")
     parser.add_argument("--allow-infeasible", action="store_true",
@@ -181,6 +183,7 @@ def run(args) -> dict:
                          f"{list(LPV_CONTROLLERS) if own else sorted(CONTROLLERS)} for the "
                          f"{'LPV deployment (8.4)' if own else '7.4 deployment'} of {args.preset}")
     if lpv:
+        with_uncontrollable(args.system, exclude=args.exclude_uncontrollable, controller=args.controller)
         deploy_lpv.check(args)
         return deploy_lpv.run(args, mesh_n=check_plant(args))
     lpv_opts = deploy_lpv.given(args, ("lpv_controller", "noise", "estimator_interpolation",
@@ -188,6 +191,8 @@ def run(args) -> dict:
     if lpv_opts:
         raise InputError(f"options {lpv_opts} apply to --controller lpv only, found --controller {args.controller}")
     args.allocation = args.allocation or "bounded"
+    args.system = with_uncontrollable(args.system, exclude=args.exclude_uncontrollable,
+                                      controller=args.controller)
     check_choices(args.system, controller=args.controller, uncertainty=args.uncertainty,
                   path=args.path)
     mesh_n = check_plant(args)
@@ -315,6 +320,8 @@ def format_text(r: dict) -> str:
              f"uncertainty {r['uncertainty']})"]
     if "membrane_mode_choice" in r:
         lines.append("  COM: " + MembraneModeChoice(**r["membrane_mode_choice"]).text)
+    if "excluded_modes_hz" in r:
+        lines.append("  " + excluded_text(r["excluded_modes_hz"]))
     lines += [f"  {k}: {r[k]:.6g}" if isinstance(r[k], float) else f"  {k}: {r[k]}" for k in keys]
     if "compare" in r:
         c = r["compare"]

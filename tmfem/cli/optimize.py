@@ -100,6 +100,7 @@ def format_text(r: dict) -> str:
     if r.get("violated"):
         lines.append("VIOLATED at the returned design (violation scaled by the bound):")
         lines += [f"  {v['constraint']:36s} {v['violation']:.3g}" for v in r["violated"]]
+        lines += [f"hint: {h}" for h in dict.fromkeys(v["hint"] for v in r["violated"] if "hint" in v)]
     lines.append(f"KKT residual {r['kkt_residual']:.2e}; {r['message']}; {len(r['history'])} iterations, "
                  f"{r['evaluations']} evaluations, {r['time_s']:.1f} s")
     for k, f in r.get("files", {}).items():

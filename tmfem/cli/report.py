@@ -14,6 +14,7 @@ import textwrap
 from tmfem.cli.common import (Progress, add_system_args, check_com_modes, check_model_budget,
                               check_time_steps, output_dir, positive_float, positive_int,
                               say, system_from_args)
+from tmfem.cli.uncontrollable import add_uncontrollable_arg, excluded_text, with_uncontrollable
 from tmfem.errors import InputError
 
 NAME = "report"
@@ -41,6 +42,7 @@ def configure(parser) -> None:
                         help="skip the deployment of 7.4 (default: run it when the system file "
                              "declares one: [report] deployment, or [packaged] with [deployment]; "
                              "the preset 1-4 runs 1-4D)")
+    add_uncontrollable_arg(parser, what="the deployment's switch")
 
 
 def run(args) -> dict:
@@ -67,6 +69,12 @@ def run(args) -> dict:
         if deployment["controller"] not in CONTROLLERS:
             raise InputError(f"{where}: expected 'controller' one of {sorted(CONTROLLERS)}, found "
                              f"{deployment['controller']!r}")
+    if args.exclude_uncontrollable:
+        if deployment is None or args.no_deploy:
+            raise InputError("--exclude-uncontrollable: option does not apply: the report of "
+                             f"{system.name!r} runs no deployment")
+        # refused for a deployment controller without the H-infinity switch
+        with_uncontrollable(deployment["system"], exclude=True, controller=deployment["controller"])
     out = output_dir(args.out, option="--out")
     with Progress(total=len(STEPS), desc=f"report {system.name}") as bar:
         bar.note(STEPS[0])
@@ -74,7 +82,8 @@ def run(args) -> dict:
         result = write_report(system, out, mesh_n=args.mesh, modes=args.modes, t_end=args.t_end,
                               dt=args.dt, render=not args.no_render, deploy=not args.no_deploy,
                               progress=lambda done: bar.step(next(nxt, "done")),
-                              run_progress=lambda label: bar.callback(label))
+                              run_progress=lambda label: bar.callback(label),
+                              uncontrollable="exclude" if args.exclude_uncontrollable else None)
     say("report", f"done: {out / 'index.md'}, web page {out / 'report.html'}")
     return result
 
@@ -125,6 +134,8 @@ def format_text(r: dict) -> str:
                          f"{d['uncertainty']}): switch at {d['switch_time_s']} s, max w "
                          f"{1e3 * d['max_membrane_deflection_m']:.2f} mm, final tracking error "
                          f"{d['final_tracking_error']:.2g}")
+        if d.get("excluded_modes_hz"):
+            lines.insert(-1, "  " + excluded_text(d["excluded_modes_hz"]))
         lines.insert(-1, "")
     if r.get("notes"):
         lines += ["", "notes of the system file:"]

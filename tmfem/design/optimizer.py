@@ -58,6 +58,14 @@ class Constraint:
         return f"{self.response}{self.sense}{'start' if self.bound is None else f'{self.bound:g}'}"
 
 
+#: why a no-wrinkling constraint over a whole membrane held at its corners by points fails
+WRINKLING_HINT = ("the membrane is held at its corners by points, so it is in compression near its corners and "
+                  "free edges whatever the prestress and membrane_min_principal >= 0 over the whole membrane "
+                  "is infeasible: restrict it to the usable surface with an aperture (--aperture A, "
+                  "[design] aperture or aperture=A: a fraction of the inradius, e.g. 0.8; "
+                  "docs/guides/design.md, Aperture)")
+
+
 def parse_objective(text: str) -> tuple:
     """``"max:freq"`` / ``"min:mass"`` (also ``"max freq"``) -> (sense, response)."""
     parts = str(text).replace(":", " ").split()
@@ -104,7 +112,8 @@ class OptimizationResult:
     max_violation, step); system : the optimal System (rest lengths included); state : the
     MTC positions (3, n_nodes) at the optimum (a warm start for further solves);
     success, message, evaluations, time_s; violated : the constraints the returned design
-    violates by more than :data:`VIOLATION_TOL` (scaled by their bound), with the violation.
+    violates by more than :data:`VIOLATION_TOL` (scaled by their bound), with the violation
+    (and, for a no-wrinkling constraint without an aperture, :data:`WRINKLING_HINT` as ``hint``).
     """
 
     names: list
@@ -363,8 +372,8 @@ def optimize(system, *, objective: str, constraints=(), variables=None, model: s
     active = [{"constraint": lab, "multiplier": float(m)} for lab, m in zip(act_labels, mu)]
     over = np.where(eqf, np.abs(g), g)
     n_obj = _entries(s, obj)[0].size if vector_obj else 0        # the bound formulation's rows: not the user's
-    violated = [{"constraint": labels[i], "violation": float(over[i])} for i in np.flatnonzero(over > VIOLATION_TOL)
-                if groups[i][0] >= n_obj]
+    violated = [{"constraint": labels[i], "violation": float(over[i]), **_hint(labels[i], aperture)}
+                for i in np.flatnonzero(over > VIOLATION_TOL) if groups[i][0] >= n_obj]
     wanted = [obj] + [c.response for c in cons]
     return OptimizationResult(
         names=names, lower=lo, upper=hi, start=p0, optimum=p,
@@ -372,6 +381,11 @@ def optimize(system, *, objective: str, constraints=(), variables=None, model: s
         active=active, kkt_residual=kkt, history=hist, system=sysp, success=bool(res.success),
         message=str(res.message), evaluations=ev.count, time_s=time.perf_counter() - t0,
         objective=f"{sense}:{obj}", constraints=[c.label() for c in cons], state=ev.x, violated=violated)
+
+
+def _hint(label: str, aperture) -> dict:
+    """``{"hint": WRINKLING_HINT}`` for a violated no-wrinkling constraint without an aperture."""
+    return {"hint": WRINKLING_HINT} if aperture is None and label.startswith("membrane_min_principal>") else {}
 
 
 def _identical_rows(g, J, eqf) -> list:

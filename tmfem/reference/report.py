@@ -112,7 +112,7 @@ def _num(v, nd=5):
 
 def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float = 10.0,
                  dt: float = 0.01, render: bool = True, deploy: bool = True, progress=None,
-                 run_progress=None) -> dict:
+                 run_progress=None, uncontrollable: str | None = None) -> dict:
     """Run the complete analysis of ``system`` and write it to the directory ``out``.
 
     Parameters
@@ -132,6 +132,9 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
         Draw the pyvista renders.
     deploy : bool
         Run the deployment of :func:`report_deployment` (when the system has one).
+    uncontrollable : {"refuse", "exclude"}, optional
+        The ``[control] uncontrollable`` of the deployed system, overriding its file's
+        (:func:`tmfem.control.linear.deployed_design.deployed_hinf`).
     progress : callable, optional
         ``progress(step_name)`` after each entry of :data:`STEPS`.
     run_progress : callable, optional
@@ -301,6 +304,9 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     step(STEPS[7])
     deployment = None
     spec = report_deployment(system) if deploy else None
+    if spec is not None and uncontrollable is not None:
+        from tmfem.control.linear.deployed_design import with_uncontrollable
+        spec["system"] = with_uncontrollable(spec["system"], uncontrollable)
     if spec is not None:
         try:
             deployment = _deployment(out, spec, dt=dt, add=add,
@@ -416,8 +422,9 @@ def _deployment(out: Path, spec: dict, *, dt: float, add, progress) -> dict:
     scalars = {k: float(v) for k, v in s.info.items() if np.isscalar(v)}
     ys = [s.model.system.tendon_section(t).yield_stress for t in s.model.system.tendons]
     yield_mpa = min(ys) / 1e6 if all(ys) else None
+    excluded = {k: s.info[k] for k in ("excluded_modes_hz",) if k in s.info}
     return {**spec, "system": deployed.name, "file_stem": p, "dt_s": dt, **r.summary(), **scalars,
-            "tendon_yield_MPa": yield_mpa}
+            "tendon_yield_MPa": yield_mpa, **excluded}
 
 
 def file_stem(name: str) -> str:
@@ -595,6 +602,7 @@ def _deployment_section(d, link, img) -> list[str]:
             ("wall time", "s", d["wall_time_s"])]
     how = (f"--preset {d['source']}" if d.get("source") and not d["source"].endswith(".toml")
            else "SYSTEM.toml")
+    excluded = d.get("excluded_modes_hz", [])
     return ["## 5. Deployment (7.4)", "",
             f"`{d['system']}` from its packaged configuration to the deployed one: adaptive "
             "partial feedback linearisation (the gains of the file's [deployment] table, eq. 5.69; "
@@ -603,7 +611,12 @@ def _deployment_section(d, link, img) -> list[str]:
             "the H-infinity controller of 7.3: the central one at 1.01 gamma_opt), "
             f"{d['t_end']:g} s at dt = {d['dt_s']:g} s, the controller's model error "
             f"`--uncertainty {d['uncertainty']}`. Same run: `tmfem deploy "
-            f"{how} --uncertainty {d['uncertainty']} --t-end {d['t_end']:g}`.", "",
+            f"{how} --uncertainty {d['uncertainty']} --t-end {d['t_end']:g}"
+            f"{' --exclude-uncontrollable' if excluded else ''}`.", "",
+            *(["Modes no tendon reaches (PBH, eq. 5.71), left out of the H-infinity design "
+               "([control] uncontrollable = \"exclude\" or --exclude-uncontrollable): "
+               f"{', '.join(f'{f:.4g} Hz' for f in excluded)}. They stay open loop, neither damped "
+               "nor excited by the linear controller.", ""] if excluded else []),
             f"Files: {link(f'deploy-{p}.csv')} (every signal, units in the header), "
             f"{link(f'deploy-{p}.png')}, {link(f'deploy-{p}.gif')} (animation), "
             f"{link(f'deploy-{p}.pvd')} (ParaView series).", "",

@@ -35,7 +35,7 @@ from tmfem.resources import check_membrane_modes
 
 #: keys of each table (anything else is refused)
 KEYS = {
-    "control": {"alpha", "u_m", "W_e", "W_d", "points", "coordinate_points"},
+    "control": {"alpha", "u_m", "W_e", "W_d", "points", "coordinate_points", "uncontrollable"},
     "deployment": {"omega_r", "xi_r", "gains", "uncertainty", "path", "rbf_centres", "w_bar",
                    "gamma", "r_min", "tension_floor"},
     "lpv": {"omega_r", "membrane_modes", "points", "path", "theta_grid_deg", "psi_grid_deg", "theta0_deg",
@@ -56,6 +56,8 @@ LPV_PATHS = ("table-7-7-bases", "auto")
 #: Most angles on an axis of the [lpv] grid (as --grid and --map-grid: 60 points a side).
 MAX_GRID_AXIS = 60
 COM_PRESTRESS = ("designed", "printed-tendon-stress")
+#: ``[control] uncontrollable``: what the H-infinity design does with modes no tendon reaches
+UNCONTROLLABLE = ("refuse", "exclude")
 
 
 def _keys(t, kind: str, where: str) -> dict:
@@ -130,6 +132,10 @@ class HinfWeights:
     coordinate_points : tuple of (x_f, y_f) or None
         Points that complete the coordinates v of eq. 5.18 to K after the measured ones [m];
         None: chosen greedily inside the membrane (the same function).
+    uncontrollable : {"refuse", "exclude"}
+        Modes no tendon reaches (PBH, eq. 5.71): ``"refuse"`` (default) the design naming
+        them, or ``"exclude"`` them from it (they stay open loop, neither damped nor excited by
+        the linear controller; :func:`tmfem.control.linear.deployed_design.deployed_hinf`).
     """
 
     alpha: float | None = None
@@ -138,6 +144,7 @@ class HinfWeights:
     W_d: float = 0.001
     points: tuple | None = None
     coordinate_points: tuple | None = None
+    uncontrollable: str = "refuse"
 
 
 @dataclass(frozen=True)
@@ -294,7 +301,8 @@ def _control(t: dict, where: str) -> HinfWeights:
     return HinfWeights(alpha=_positive(t, "alpha", w), u_m=_positive(t, "u_m", w),
                        W_e=_positive(t, "W_e", w, d.W_e), W_d=_positive(t, "W_d", w, d.W_d),
                        points=_points(t, "points", w),
-                       coordinate_points=_points(t, "coordinate_points", w))
+                       coordinate_points=_points(t, "coordinate_points", w),
+                       uncontrollable=_choice(t, "uncontrollable", w, UNCONTROLLABLE, d.uncontrollable))
 
 
 def _gains(v, where: str) -> tuple:

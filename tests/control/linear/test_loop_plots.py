@@ -1,8 +1,11 @@
 """The closed-loop analysis figure of `tmfem control hinf --plot`: a synthesis route that was
-refused is said so inside its panel, whatever the scale of the gamma bars."""
+refused is said so inside its panel, whatever the scale of the gamma bars; the regulation
+panel is the closed loop released from an offset of each tracked coordinate."""
 import warnings
 from types import SimpleNamespace
 
+import numpy as np
+import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from tmfem.control.linear.loop_plots import _routes
@@ -26,3 +29,52 @@ def test_a_refused_route_is_written_inside_the_panel_and_the_layout_holds():
     (text,) = [t for t in a.texts if t.get_text().startswith("refused")]
     tb = text.get_window_extent(canvas.get_renderer())
     assert box.y0 <= tb.y0 and tb.y1 <= box.y1
+
+
+def oscillator_of_figure_7_1(*, W_e=0.5, W_d=1e-3, u_m=0.1):
+    """A 1-DOF undamped oscillator x'' = -4 x + u in the form of Fig. 7.1: w = [ref_x, n_x,
+    n_xd], p = [ed_x = W_e (ref_x - x), eu_r = u / u_m], y = [x + W_d n_x - ref_x, xd + W_d n_xd]."""
+    from tmfem.control.linear.partitioned_plant import GeneralizedPlant
+    return GeneralizedPlant(
+        A=np.array([[0.0, 1.0], [-4.0, 0.0]]), B1=np.zeros((2, 3)), B2=np.array([[0.0], [1.0]]),
+        C1=np.array([[-W_e, 0.0], [0.0, 0.0]]), C2=np.eye(2),
+        D11=np.array([[W_e, 0, 0], [0, 0, 0]]), D12=np.array([[0.0], [1 / u_m]]),
+        D21=np.array([[-1.0, W_d, 0], [0, 0, W_d]]), D22=np.zeros((2, 1)),
+        state_names=["x", "xd"], w_names=["ref_x", "n_x", "n_xd"], u_names=["r"],
+        p_names=["ed_x", "eu_r"], y_names=["y_x", "y_xd"])
+
+
+def test_regulation_panel_is_the_closed_loop_released_from_an_offset(tmp_path):
+    """The lower-left panel of `control hinf --plot`: the tracked coordinate x released from
+    x(0) = 1 with the controller at rest, equal to the first state of expm(A_cl t) [1, 0, 0..]
+    (A_cl assembled by hand from the plant and the controller, independent of python-control's
+    interconnect), never a panel of zeros, with the envelope exp(-alpha_1 t) drawn; the
+    reference step that panel used to show is zero for this design class (the controller
+    leaves x at rest: ed_x = W_e ref_x)."""
+    import control
+    from scipy.linalg import expm
+    from tmfem.control.linear.hinf_synthesis import hinfsyn
+    from tmfem.control.linear.loop_plots import _regulation, plot_design
+    P = oscillator_of_figure_7_1()
+    alpha = 0.5
+    d = hinfsyn(P, 2, 1, alpha=alpha).design
+    K = d.controller
+    Acl = np.block([[P.A + P.B2 @ K.D @ P.C2, P.B2 @ K.C], [K.B @ P.C2, K.A]])
+    fig = new_figure(figsize=(6, 4))
+    a = fig.subplots()
+    _regulation(a, d.closed_loop, d)
+    lines = {ln.get_label(): ln for ln in a.get_lines()}
+    line = lines["x released from x(0) = 1"]
+    t, s = line.get_xdata(), line.get_ydata()
+    x0 = np.zeros(Acl.shape[0])
+    x0[0] = 1.0
+    ref = np.array([(expm(Acl * tk) @ x0)[0] for tk in t[::100]])
+    assert s[::100] == pytest.approx(ref, abs=1e-6)
+    assert np.max(np.abs(s)) == pytest.approx(1.0) and abs(s[-1]) < 1e-2
+    env = lines[f"+- exp(-alpha_1 t), alpha_1 = {alpha:g} 1/s"]
+    assert env.get_ydata() == pytest.approx(np.exp(-alpha * t))
+    assert a.get_xlabel() == "t [s]" and "[-]" in a.get_ylabel()
+    step = control.step_response(d.closed_loop[0, 0], T=t)        # ref_x -> ed_x
+    assert np.squeeze(step.outputs) == pytest.approx(0.5, abs=1e-6)  # x stays at 0
+    plot_design(d, open_loop=P, path=tmp_path / "loop.png")
+    assert (tmp_path / "loop.png").stat().st_size > 10_000

@@ -9,6 +9,7 @@ import pytest
 from tmfem.cli import main
 from tmfem.control import hinfsyn
 from tmfem.control.linear.hinf_riccati import invariant_zeros
+from tmfem.control.linear.generalized_plant import generalized_plant
 from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tests.cli.test_own_system import SYSTEMS
 
@@ -69,10 +70,45 @@ def test_deployed_design_names_unreachable_modes_and_leaves_them_out_on_request(
     f = str(SYSTEMS / "kapton-1-4.toml")
     assert main(["control", "hinf", f]) == 1
     err = capsys.readouterr().err.strip().splitlines()[-1]
-    assert "6.457 Hz, 4.644 Hz are not reached by any tendon" in err and "--exclude-uncontrollable" in err
+    assert "4.644 Hz, 6.457 Hz are not reached by any tendon" in err and "--exclude-uncontrollable" in err
     assert main(["control", "hinf", f, "--exclude-uncontrollable", "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     hz = sorted(m["frequency_hz"] for m in r["excluded_modes"])
     assert hz == pytest.approx([4.644, 4.644, 6.457, 6.457], abs=1e-3)      # each pair +- j omega
     assert r["gamma"] >= r["closed_loop_hinf_norm"] and r["closed_loop_max_real_part"] < -r["alpha"]
     assert main(["control", "pbh", f, "--exclude-uncontrollable"]) == 2       # applies to hinf only
+
+
+def test_design_on_the_reachable_part_leaves_the_excluded_modes_open_loop():
+    """square-1-4D (user 1-4(D), K = 4) with `[control] uncontrollable = "exclude"` in the
+    System: the controller designed on the reachable part, closed around the *full* plant of
+    Fig. 7.1 (u = K y, D22 = 0), has the excluded pair +- j 2 pi 4.276 Hz as eigenvalues
+    (undamped, unexcited: the open-loop A's own) and every other pole left of -alpha_1."""
+    from tmfem.control.linear.deployed_design import deployed_hinf, with_uncontrollable
+    from tmfem.system import load_system
+    system = with_uncontrollable(load_system(SYSTEMS / "square-1-4D.toml"), "exclude")
+    d = deployed_hinf(system)
+    hidden = np.array(d.excluded_modes)
+    assert hidden.size == 2 and np.allclose(hidden.real, 0, atol=1e-9)
+    assert np.abs(hidden[0]) / (2 * np.pi) == pytest.approx(4.2756, abs=1e-4)
+    full = generalized_plant(d.plant, u_m=d.u_m)
+    K = d.design.controller
+    A = np.block([[full.A + full.B2 @ K.D @ full.C2, full.B2 @ K.C], [K.B @ full.C2, K.A]])
+    ev = np.linalg.eigvals(A)
+    near = [np.min(np.abs(ev - h)) for h in hidden]
+    assert max(near) < 1e-6 * np.abs(hidden[0])
+    rest = ev[np.min(np.abs(ev[:, None] - hidden[None, :]), axis=1) > 1e-6 * np.abs(hidden[0])]
+    assert rest.size == ev.size - 2 and np.max(rest.real) < -d.design.alpha
+
+
+def test_exclude_on_a_fully_reachable_plant_is_the_same_design():
+    """The 1-4D preset (every mode reached, 7.4's PBH verdict): "exclude" is a policy with
+    nothing to exclude, and gives the same controller as "refuse" (as `control hinf
+    --exclude-uncontrollable` there)."""
+    from tmfem.control.linear.deployed_design import deployed_hinf
+    from tmfem.system import load_preset
+    s = load_preset("1-4D")
+    a, b = deployed_hinf(s), deployed_hinf(s, uncontrollable="exclude")
+    assert b.excluded_modes == () and "excluded_modes" not in b.summary()
+    for M in ("A", "B", "C", "D"):
+        assert np.array_equal(getattr(a.design.controller, M), getattr(b.design.controller, M))

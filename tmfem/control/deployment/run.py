@@ -34,7 +34,7 @@ from tmfem.control.deployment.rbf import GaussianRBF
 from tmfem.control.deployment.recovery import StressRecovery
 from tmfem.control.deployment.reference_trajectory import DeploymentReference, angle_mask
 from tmfem.control.deployment.switching import SwitchingController, relative_error
-from tmfem.control.linear.deployed_design import deployed_hinf
+from tmfem.control.linear.deployed_design import deployed_hinf, mode_frequencies_hz
 from tmfem.equilibrium.deployment_path import path_feasibility
 from tmfem.equilibrium.symmetric import check_1ND
 from tmfem.equilibrium.symmetric_map import with_configuration
@@ -130,7 +130,8 @@ def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central",
 
     Returns
     -------
-    controller, measure, gamma
+    controller, measure, design
+        ``design``: the :class:`~tmfem.control.linear.deployed_design.DeployedDesign`.
     """
     if method not in HINF_NAMES:
         raise InputError(f"H-infinity method: expected one of {sorted(HINF_NAMES)}, found {method!r}")
@@ -150,7 +151,7 @@ def lmi_hinf_controller(system, *, membrane_modes: int, method: str = "central",
     def measure(y):
         y = np.asarray(y)
         return np.linalg.solve(P, np.column_stack([y[:nz], y[nz:2 * nz]])).T.ravel()
-    return ctrl, measure, float(d.design.gamma)
+    return ctrl, measure, d
 
 
 @dataclass
@@ -380,11 +381,16 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
     lin_ctrl = None
     ctrl = ad
     start = "bumpless"
+    estimate = None
     if linear != "none":
         if linear == "lmi":
-            lin_ctrl, measure, g = lmi_hinf_controller(final, membrane_modes=K, method=hinf_method,
+            lin_ctrl, measure, d = lmi_hinf_controller(final, membrane_modes=K, method=hinf_method,
                                                        z_e=z_e)
-            info["hinf_gamma"] = g
+            info["hinf_gamma"] = float(d.design.gamma)
+            if d.excluded_modes:
+                info["excluded_modes_hz"] = mode_frequencies_hz(d.excluded_modes)
+                # the design's states are Z_r^T x (C2 = Z_r of the measured y = x, Fig. 7.1)
+                estimate = np.linalg.pinv(d.generalized.C2)
             start = HINF_STARTS[hinf_method]
         elif linear == "lqr":
             lin_ctrl, _ = lqr_state_feedback(model, u_e=model.u0, z_e=z_e, u_m=u_m)
@@ -394,7 +400,8 @@ def build_deployment(*, final, initial, omega_r: float, gains, uncertainty: str,
             measure = output_measure(model)
             info["hinf_gamma"] = g
         ctrl = SwitchingController(first=ad, second=lin_ctrl, q_of_y=lambda y: y[: model.nq],
-                                   q_e=ref.q_e, measure=measure, R_c=R_c, start=start)
+                                   q_e=ref.q_e, measure=measure, R_c=R_c, start=start,
+                                   estimate=estimate)
     return DeploymentSetup(model=model, reference=ref, adaptive=ad, controller=ctrl,
                            linear=lin_ctrl, z0=z0, z_e=z_e, info=info)
 

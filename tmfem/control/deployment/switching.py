@@ -20,7 +20,9 @@ y_lin. The linear controller's state x_c at the switch (``start``):
 * ``"estimate"``: x_c = y_lin - y_e, for a controller whose state estimates the measured
   state perturbation in the coordinates of y_lin (an observer, such as the central
   H-infinity controller, :mod:`tmfem.control.linear.hinf_central`): it starts with zero estimation
-  error; the input then jumps to the controller's own.
+  error; the input then jumps to the controller's own. A controller designed on the reachable
+  part of the plant (:meth:`tmfem.control.linear.partitioned_plant.GeneralizedPlant.reachable_part`,
+  states x_r = Z_r^T x) starts at x_c = E (y_lin - y_e) with ``estimate`` E = Z_r^T.
 
 A static gain has no state. The jump in u at the switch is reported (``switch_jump``).
 """
@@ -63,15 +65,19 @@ class SwitchingController:
         Switching radius (7.4: 0.01).
     start : {"bumpless", "estimate"}
         The linear controller's state at the switch (module docstring).
+    estimate : array, optional
+        E of an ``"estimate"`` start, x_c = E (y_lin - y_e) (module docstring); default the
+        identity.
     """
 
     def __init__(self, *, first, second, q_of_y, q_e, measure, R_c: float = 0.01,
-                 start: str = "bumpless"):
+                 start: str = "bumpless", estimate=None):
         if not R_c > 0:
             raise InputError(f"R_c: expected > 0, found {R_c!r}")
         if start not in STARTS:
             raise InputError(f"start: expected one of {STARTS}, found {start!r}")
         self.start = start
+        self.estimate = None if estimate is None else np.asarray(estimate, dtype=float)
         self.first, self.second = first, second
         self.q_of_y, self.q_e, self.measure, self.R_c = q_of_y, np.asarray(q_e, float), measure, R_c
         relative_error(self.q_e, self.q_e)                   # refuses zero entries of q_e
@@ -101,6 +107,8 @@ class SwitchingController:
         yl = np.asarray(self.measure(y), dtype=float)
         x2 = np.asarray(self.second.reset(t, yl, self.dt), dtype=float)
         _, _, C, D = self.second.discrete
+        if x2.size and self.start == "estimate" and self.estimate is not None:
+            return self.estimate @ (yl - self.second.y_e)
         if x2.size and self.start == "estimate":
             if x2.size != yl.size:
                 raise InputError(f"start 'estimate': expected a controller of order "

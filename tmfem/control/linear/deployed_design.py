@@ -23,7 +23,7 @@ from tmfem.control.linear.partitioned_plant import GeneralizedPlant
 from tmfem.control.linear.pbh import PBHResult, pbh_ss
 from tmfem.control.linear.generalized_plant import DeployedPlant, deployed_plant, generalized_plant
 from tmfem.errors import InfeasibleController, InputError
-from tmfem.system.problem import default_u_m
+from tmfem.system.problem import UNCONTROLLABLE, default_u_m
 
 log = logging.getLogger(__name__)
 
@@ -83,7 +83,7 @@ class DeployedDesign:
 def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = None,
                   membrane_modes: int | None = None, solver: str | None = None,
                   synthesize: bool = True, pbh_tol: float | None = None,
-                  method: str = DEFAULT_METHOD, uncontrollable: str = "refuse") -> DeployedDesign:
+                  method: str = DEFAULT_METHOD, uncontrollable: str | None = None) -> DeployedDesign:
     """Plant, PBH and H-infinity controller of a deployed system (7.3-7.4).
 
     Parameters
@@ -109,16 +109,17 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         (:func:`~tmfem.control.linear.hinf_slicot.hinf_slicot`) or the central
         (minimum-entropy) controller at 1.01 gamma_opt
         (:func:`~tmfem.control.linear.hinf_central.hinf_central`: the deployments' controller).
-    uncontrollable : {"refuse", "exclude"}
+    uncontrollable : {"refuse", "exclude"}, optional
         What to do with modes that no tendon reaches (PBH, eq. 5.71; on the undamped COM they
-        sit on the imaginary axis, so no controller makes the loop stable): ``"refuse"``
-        (default) names the first one; ``"exclude"`` designs for the plant without them
+        sit on the imaginary axis, so no controller makes the loop stable); default the file's
+        ``[control] uncontrollable`` (itself "refuse" by default): ``"refuse"`` names them;
+        ``"exclude"`` designs for the plant without them
         (:meth:`~tmfem.control.linear.partitioned_plant.GeneralizedPlant.reachable_part`: in
         Fig. 7.1 no exogenous input drives the states either, so the loop from w to p is
         unchanged) and lists them: in closed loop they keep their open-loop dynamics.
     """
-    if uncontrollable not in ("refuse", "exclude"):
-        raise InputError(f"uncontrollable: expected 'refuse' or 'exclude', found {uncontrollable!r}")
+    if uncontrollable not in (None,) + UNCONTROLLABLE:
+        raise InputError(f"uncontrollable: expected one of {list(UNCONTROLLABLE)}, found {uncontrollable!r}")
     if method not in METHODS:
         raise InputError(f"method: expected one of {METHODS}, found {method!r}")
     if solver is not None and method not in ("lmi", "auto"):
@@ -127,6 +128,7 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
         raise InputError(f"solver: expected CLARABEL or SCS with method 'auto' (the SDP solver of "
                          f"its LMI fallback), found {solver!r}")
     w = system.problem.control
+    uncontrollable = uncontrollable or w.uncontrollable
     notes = []
     if u_m is None and w.u_m is None:
         u_m = default_u_m(system)
@@ -146,13 +148,14 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
     res = pbh_ss(plant.ss, **kw)
     gen = generalized_plant(plant, u_m=u_m, W_e=w.W_e, W_d=w.W_d)
     hidden = tuple(res.eigenvalues[res.controllability_margin <= res.tol])
-    listed = ", ".join(f"{abs(m) / (2 * np.pi):.4g} Hz" for m in hidden if m.imag >= 0)
+    listed = ", ".join(f"{f:.4g} Hz" for f in mode_frequencies_hz(hidden))
     if synthesize and hidden and uncontrollable == "refuse" and np.max(np.real(hidden)) > -alpha:
         raise InfeasibleController(
             f"{system.name}: the modes at {listed} are not reached by any tendon (PBH margin <= "
             f"{res.tol:g}, eq. 5.71), so no controller places them left of -alpha_1 = -{alpha:.4g}; "
-            "design without them (`tmfem control hinf --exclude-uncontrollable`, or "
-            "uncontrollable='exclude' in Python: they keep their open-loop dynamics) or change the actuation")
+            "design without them (option --exclude-uncontrollable of `tmfem control hinf`, `deploy` "
+            "and `report`, or uncontrollable = \"exclude\" in the file's [control] table: they stay "
+            "open loop, neither damped nor excited by the controller) or change the actuation")
     if uncontrollable == "exclude" and hidden:
         gen = _without(gen, hidden, tol=res.tol)
         notes.append(f"modes no tendon reaches (PBH margin <= {res.tol:g}) left out of the design: {listed}; "
@@ -174,6 +177,23 @@ def deployed_hinf(system, *, alpha: float | None = None, u_m: float | None = Non
             design = hinf_slicot(gen, alpha=alpha, operating_point=plant.operating_point)
     return DeployedDesign(plant=plant, generalized=gen, pbh=res, design=design, u_m=float(u_m),
                           notes=tuple(notes), excluded_modes=hidden if uncontrollable == "exclude" else ())
+
+
+def with_uncontrollable(system, choice: str):
+    """``system`` with ``[control] uncontrollable = choice`` (``"refuse"`` or ``"exclude"``,
+    :func:`deployed_hinf`)."""
+    import dataclasses
+    if choice not in UNCONTROLLABLE:
+        raise InputError(f"uncontrollable: expected one of {list(UNCONTROLLABLE)}, found {choice!r}")
+    pr = system.problem
+    return system.replace(problem=dataclasses.replace(
+        pr, control=dataclasses.replace(pr.control, uncontrollable=choice)))
+
+
+def mode_frequencies_hz(modes) -> list:
+    """|lambda| / 2 pi [Hz] of the eigenvalues ``modes`` with Im >= 0 (one per complex pair),
+    ascending."""
+    return sorted(float(abs(m) / (2 * np.pi)) for m in modes if m.imag >= 0)
 
 
 def _without(gen: GeneralizedPlant, hidden: tuple, *, tol: float) -> GeneralizedPlant:

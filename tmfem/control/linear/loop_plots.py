@@ -8,9 +8,12 @@ One PNG with four panels:
   control efforts), of the open-loop channel w -> p (u = 0) and of the plant u -> y, with
   gamma and, where the feedthrough bound max(||Pi_12 D11||, ||D11 Pi_21||) sets gamma (no
   controller can go below it), that bound drawn and named;
-* step responses of the tracked coordinates: for each reference input ``ref_<s>`` with a
-  tracking error ``ed_<s> = W (ref - s)``, the coordinate s = ref - ed / W for a unit step of
-  the reference (otherwise the performance outputs for a step of the first exogenous input);
+* regulation: each tracked coordinate (a reference input ``ref_<s>`` with a tracking error
+  ``ed_<s> = W (ref - s)``) released from a unit offset, the controller at rest, beside the
+  envelope e^(-alpha_1 t) (otherwise the performance outputs for a step of the first exogenous
+  input). The reference's step response is not drawn: in Fig. 7.1 the controller regulates
+  about the deployed equilibrium and gamma is set by the feedthrough ||D11||, so the
+  designs leave the coordinates at rest for a reference step (a panel of zeros);
 * the level gamma and the verified closed-loop norm of each synthesis route on the same
   plant (or the reason a route refused it).
 """
@@ -112,13 +115,8 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
     a.set_ylabel("singular value [-]")
     a.set_title(f"singular values: ||T_pw||_inf = {design.closed_loop_norm:.5g}")
     a.legend(loc="upper right", fontsize=7)
-    # step responses of the tracked coordinates
-    a = ax[1, 0]
-    _steps(a, T, design)
-    if sets:
-        a.text(0.02, 0.5, "gamma is the feedthrough bound: the H-infinity objective does not ask\n"
-               "this loop to track (its tracking is whatever the chosen controller does)",
-               transform=a.transAxes, fontsize=8, bbox=dict(fc="w", ec="k", alpha=0.85))
+    # regulation of the tracked coordinates from an offset
+    _regulation(ax[1, 0], T, design)
     # gamma of each route
     a = ax[1, 1]
     _routes(a, routes or {}, design, bound, sets)
@@ -126,34 +124,64 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
     save_figure(fig, path)
 
 
-def _steps(a, T, design) -> None:
+def _regulation(a, T, design) -> None:
+    """The regulation panel: each tracked coordinate s (a reference input ``ref_<s>`` with a
+    tracking error ``ed_<s> = W (ref - s)``, so s = -ed_s / W at ref = 0) released from a unit
+    offset of the measured y_s (plant state x_0 = C2^+ e_s: e_s for C2 = I of Fig. 7.1, its
+    projection Z_r^T e_s on the reachable part), the controller at rest, with the envelope
+    e^(-alpha_1 t) that the closed-loop poles (Re s < -alpha_1) impose on its decay. Without
+    such pairs: the performance outputs for a step of the first exogenous input."""
     import control
     tf = 8.0 / max(design.alpha, max(-np.max(T.poles().real), 0.1))
     t = np.linspace(0, tf, 1500)
     ins, outs = list(T.input_labels), list(T.output_labels)
     D = np.asarray(T.D)
+    P = design.plant
+    ys = list(P.y_names)
     pairs = []
     for j, s in enumerate(ins):
-        if s.startswith("ref_") and f"ed_{s[4:]}" in outs:
+        if s.startswith("ref_") and f"ed_{s[4:]}" in outs and f"y_{s[4:]}" in ys:
             i = outs.index(f"ed_{s[4:]}")
             if D[i, j] != 0:
-                pairs.append((j, i, s[4:]))
-    if pairs:
-        for j, i, name in pairs[:4]:
-            r = control.step_response(T[i, j], T=t)
-            a.plot(r.time, 1.0 - np.squeeze(r.outputs) / D[i, j], label=f"{name} (ref_{name} = 1)")
-        a.axhline(1.0, color="0.5", ls=":")
-        a.set_ylabel("tracked coordinate per unit reference step [-]")
-        a.set_title("step responses of the tracked coordinates (linear closed loop)")
-    else:
+                pairs.append((i, D[i, j], s[4:]))
+    if not pairs:
         r = control.step_response(T[: min(4, T.noutputs), 0], T=t)
         y = np.atleast_2d(np.squeeze(r.outputs))
         for k in range(y.shape[0]):
             a.plot(r.time, y[k], label=outs[k])
         a.set_ylabel("performance output per unit step [-]")
         a.set_title(f"step responses from {ins[0]}")
+        a.set_xlabel("t [s]")
+        a.legend(loc="best", fontsize=7)
+        return
+    offsets = np.linalg.pinv(P.C2)
+    n = P.A.shape[0]
+    kinds = {}
+    for i, w, name in pairs:                  # the first coordinate of each kind (theta, psi, v, ...)
+        kinds.setdefault(name.split("_")[0], (i, w, name))
+    peak = np.zeros(t.size)
+    for i, w, name in pairs:
+        x0 = np.zeros(T.nstates)
+        x0[:n] = offsets[:, ys.index(f"y_{name}")]
+        s_t = -np.squeeze(control.initial_response(T[i, :], T=t, X0=x0).outputs) / w
+        peak = np.maximum(peak, np.abs(s_t))
+        if (i, w, name) in kinds.values():
+            a.plot(t, s_t, lw=1.5, label=f"{name} released from {name}(0) = 1")
+    a.plot(t, peak, color="k", lw=0.8, label=f"largest |s(t)| of all {len(pairs)} coordinates")
+    env = np.exp(-design.alpha * t)
+    a.plot(t, env, color="C3", ls="--", label=f"+- exp(-alpha_1 t), alpha_1 = {design.alpha:g} 1/s")
+    a.plot(t, -env, color="C3", ls="--")
+    a.axhline(0.0, color="0.5", lw=0.5)
+    if n < len(ys):
+        a.text(0.02, 0.02, f"designed on the reachable part ({n} of {len(ys)} states): each offset is "
+               "projected onto it;\nits part along the modes no tendon reaches stays open loop, "
+               "not drawn", transform=a.transAxes, fontsize=7, va="bottom",
+               bbox=dict(fc="w", ec="k", alpha=0.85))
     a.set_xlabel("t [s]")
-    a.legend(loc="best", fontsize=7)
+    a.set_ylabel("coordinate / its initial offset [-]")
+    a.set_title("regulation: each tracked coordinate released from an offset\n"
+                "(linear closed loop, controller at rest)")
+    a.legend(loc="upper right", fontsize=7)
 
 
 def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
