@@ -32,6 +32,19 @@ log = logging.getLogger(__name__)
 
 #: how a gridded plant is evaluated between its grid points (:meth:`GriddedLPV.interpolate`)
 INTERPOLATIONS = ("multilinear", "spline")
+#: Scheduling parameters that are angles [rad] (rho_1 = theta_13, rho_2 = psi_13 of 8.3):
+#: shown in degrees in messages and logs.
+ANGLE_PARAMETERS = ("theta_13", "psi_13")
+
+
+def grid_point_text(names, rho) -> str:
+    """A grid point ``rho`` of the parameters ``names`` as text with units: the angles of
+    :data:`ANGLE_PARAMETERS` in degrees ("theta_13 = 64 deg, psi_13 = 25 deg"), other
+    parameters as given; "none" when ``rho`` is None."""
+    if rho is None:
+        return "none"
+    return ", ".join(f"{nm} = {np.degrees(v):.4g} deg" if nm in ANGLE_PARAMETERS else f"{nm} = {v:.4g}"
+                     for nm, v in zip(names, np.atleast_1d(rho)))
 
 
 @dataclass

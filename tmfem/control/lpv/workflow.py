@@ -30,7 +30,7 @@ from tmfem.control.lpv.generalized_plant import GeneralizedLPV, interconnection_
 from tmfem.control.lpv.gridded_synthesis import lpvsyn
 from tmfem.control.lpv.output_feedback import (LPVOutputFeedback, design_output_feedback,
                                                verify_output_feedback)
-from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant
+from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant, grid_point_text
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.control.lpv.verify import Verification, verify
@@ -180,8 +180,9 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
     except InfeasibleController as exc:
         if solver == "EIGOPT":      # the EIGOPT route's messages name the pointwise lower bound
             raise
+        at = grid_point_text(generalized.parameter_names, bound.at)
         raise InfeasibleController(f"{exc} (pointwise state-feedback lower bound of gamma: "
-                                   f"{bound.lower_bound:.4g} at rho = {bound.at})") from None
+                                   f"{bound.lower_bound:.4g} at {at})") from None
     return ctrl, {"gamma": ctrl.gamma, "solver": ctrl.solver, "status": ctrl.status, "sizes": ctrl.sizes,
                   "solve_time_s": ctrl.solve_time, "sample_time_s": sample_time, **extra}
 
