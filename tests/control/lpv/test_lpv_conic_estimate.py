@@ -42,17 +42,18 @@ def test_the_user_sized_problem_is_refused_up_front_with_its_estimate():
     assert "16 LMIs of order 260" in msg and "44,020 variables" in msg
     days = SECONDS_PER_VARIABLE_CUBED * 44020.0**3 / 86400
     assert f"{days:.3g} days of CPU" in msg
-    assert f"the time limit is {MAX_SYNTHESIS_S:g} CPU s (time_budget, `tmfem control lpv --time-budget` " \
+    assert f"the time limit {MAX_SYNTHESIS_S:g} CPU s (time_budget, `tmfem control lpv --time-budget` " \
            "raises it)" in msg
-    # SCS's KKT factor: about 7 GB at this size (the run that did not finish), within the limit
+    # more than the ~7 GB the run that did not finish had reached
     scs = conic_cost({"decision_variables": 44020, "n_x": 134, "n_u": 42, "n_w": 42, "n_p": 84,
                       "grid_points": 4, "rate_vertices": 4}, solver="SCS")
-    assert 6e9 < scs.memory_bytes < 9e9 < memory_limit()
+    assert scs.memory_bytes > 7e9
+    assert ("exceeds the memory limit" in msg) == (scs.memory_bytes > memory_limit())
 
 
 def test_the_interior_point_solver_is_refused_on_memory_whatever_the_time_budget():
-    with pytest.raises(ResourceLimit, match=r"LPV state-feedback synthesis \(CLARABEL\): 134 states.*needs "
-                                            r"about [\d.]+ GiB; the limit is"):
+    with pytest.raises(ResourceLimit, match=r"LPV state-feedback synthesis \(CLARABEL\): 134 states.*exceeds "
+                                            r"the memory limit [\d.]+ GiB \(60% of this machine's"):
         synthesize_state_feedback(plant(134, 42, 42, 84), solver="CLARABEL", time_budget=1e12)
 
 

@@ -13,7 +13,9 @@ holds the cones' vectorised maps besides, so the memory grows as
 
 (:data:`BYTES_PER_SCALING_ENTRY` measured, see there). The first-order SCS keeps no scaling
 blocks; its memory is the factor of its KKT matrix, dense in the variables (every LMI involves
-all of them): ``BASE_BYTES + SCS_BYTES_PER_VARIABLE_PAIR nvar^2``. The time of either solver
+all of them), ``SCS_BYTES_PER_VARIABLE_PAIR nvar^2``. Both solvers' programs are built as
+sparse maps of ``conic_nonzeros`` entries (one triangle of A P, B2 Q, C1 P, D12 Q per LMI
+and basis function: n^3 + n^2 nu + np n^2 + np n nu), :data:`BYTES_PER_NONZERO` each. The time of either solver
 grows as the cube of the variables (the dense factorisation in every iteration):
 ``SECONDS_PER_VARIABLE_CUBED nvar^3`` CPU seconds (measured, see there). Decision variables
 (basis functions n_L of the Lyapunov matrices, n_G of the gains): state feedback n_L n (n +
@@ -25,7 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from tmfem.errors import ResourceLimit
-from tmfem.resources import BASE_BYTES, MAX_SYNTHESIS_S, require_memory
+from tmfem.resources import BASE_BYTES, MAX_SYNTHESIS_S, MEMORY_FRACTION, machine_memory, memory_limit
 
 #: Peak resident memory per entry of the cones' dense scaling blocks (module docstring),
 #: measured with random plants (benchmarks/bench_lpvsyn.py --states N --feedback state --basis
@@ -42,6 +44,11 @@ SECONDS_PER_VARIABLE_CUBED = 8.5e-8
 #: Bytes per pair of decision variables of SCS's KKT factor (module docstring): a 2-6
 #: two-stage plant on a 2 x 2 grid (44,020 variables) held about 7 GB
 SCS_BYTES_PER_VARIABLE_PAIR = 4.0
+#: Peak bytes per nonzero of the conic program's sparse maps (the Kronecker products, their
+#: sums and the solver's copy), measured with SCS (benchmarks/bench_lpvsyn.py --conic-states):
+#: 368,640 nonzeros (n = 16) 0.097 GB, 720,000 (n = 20) 0.20 GB above the interpreter: 263
+#: and 278 bytes
+BYTES_PER_NONZERO = 300.0
 
 
 @dataclass
@@ -108,9 +115,16 @@ def conic_cost(sizes: dict, *, solver: str) -> LPVSynCost:
     bases = (sizes["decision_variables"] - 1) // (n * (n + 1) // 2 + nu * n)
     c = lpvsyn_cost(n=n, nw=sizes["n_w"], np_=sizes["n_p"], nu=nu, ny=0, points=sizes["grid_points"],
                     vertices=sizes["rate_vertices"], lyapunov_basis=bases, gain_basis=bases)
+    build = BYTES_PER_NONZERO * conic_nonzeros(n=n, nu=nu, np_=sizes["n_p"], lmis=c.lmis, bases=bases)
     if solver == "SCS":
-        c = replace(c, memory_bytes=BASE_BYTES + SCS_BYTES_PER_VARIABLE_PAIR * float(c.decision_variables) ** 2)
-    return c
+        return replace(c, memory_bytes=BASE_BYTES + build
+                       + SCS_BYTES_PER_VARIABLE_PAIR * float(c.decision_variables) ** 2)
+    return replace(c, memory_bytes=c.memory_bytes + build)
+
+
+def conic_nonzeros(*, n: int, nu: int, np_: int, lmis: int, bases: int) -> float:
+    """Nonzeros of the conic program's LMI maps (module docstring)."""
+    return float(lmis) * bases * (n**3 + n * n * nu + np_ * n * n + np_ * n * nu)
 
 
 def check_lpvsyn_cost(cost: LPVSynCost, *, what: str, time_limit: float = MAX_SYNTHESIS_S,
@@ -120,9 +134,12 @@ def check_lpvsyn_cost(cost: LPVSynCost, *, what: str, time_limit: float = MAX_SY
     :data:`tmfem.resources.MAX_SYNTHESIS_S`): :class:`tmfem.errors.ResourceLimit` naming the
     sizes, the estimate and ``lifted_by``, the option that raises the time limit; ``what``
     names the problem."""
-    sdp = f"the SDP ({cost.text})"
-    require_memory(cost.memory_bytes, given=what, what=sdp)
+    over = []
+    if cost.memory_bytes > memory_limit():
+        over.append(f"the memory limit {memory_limit() / 2**30:.1f} GiB ({MEMORY_FRACTION:.0%} of this "
+                    f"machine's {machine_memory() / 2**30:.0f} GiB)")
     if cost.seconds > time_limit:
-        raise ResourceLimit(f"{what}: {sdp}; the time limit is {time_limit:g} CPU s"
-                            + (f" ({lifted_by} raises it)" if lifted_by else ""))
+        over.append(f"the time limit {time_limit:g} CPU s" + (f" ({lifted_by} raises it)" if lifted_by else ""))
+    if over:
+        raise ResourceLimit(f"{what}: the SDP ({cost.text}) exceeds " + " and ".join(over))
     return cost
