@@ -17,7 +17,9 @@ all of them), ``SCS_BYTES_PER_VARIABLE_PAIR nvar^2``. Both solvers' programs are
 sparse maps of ``conic_nonzeros`` entries (one triangle of A P, B2 Q, C1 P, D12 Q per LMI
 and basis function: n^3 + n^2 nu + np n^2 + np n nu), :data:`BYTES_PER_NONZERO` each. The time of either solver
 grows as the cube of the variables (the dense factorisation in every iteration):
-``SECONDS_PER_VARIABLE_CUBED nvar^3`` CPU seconds (measured, see there). Decision variables
+``SECONDS_PER_VARIABLE_CUBED nvar^3`` CPU seconds for the conic program of
+:mod:`tmfem.control.lpv.synthesis`, ``LPVSYN_SECONDS_PER_VARIABLE_CUBED nvar^3`` for lpvsyn's
+(both measured, see there). Decision variables
 (basis functions n_L of the Lyapunov matrices, n_G of the gains): state feedback n_L n (n +
 1) / 2 + n_G nu n; output feedback (X constant with ``constant="X"``, Y with ``"Y"``) n_X n (n
 + 1) / 2 + n_Y n (n + 1) / 2 + n_G (n^2 + n ny + nu n + nu ny), plus gamma.
@@ -41,6 +43,12 @@ BYTES_PER_SCALING_ENTRY = 160.0
 #: (6.5e-8, 6.8e-8, 8.5e-8 s nvar^-3); SCS at its tolerance 1e-7 took 4.5 s and 13 s at the
 #: first two and over 300 s at the third, so for SCS this is a lower bound
 SECONDS_PER_VARIABLE_CUBED = 8.5e-8
+#: The same for :func:`~tmfem.control.lpv.gridded_synthesis.lpvsyn`'s SDP route (cvxpy's
+#: canonicalisation, the gamma minimisation and the back-off re-solve), measured with
+#: benchmarks/bench_lpvsyn.py --states 8 12 16 --points 7 --feedback state --basis
+#: trigonometric --refine 1: 157 variables 1.2 s, 307: 3.8 s, 505: 28 s of CPU (3.1e-7,
+#: 1.3e-7, 2.2e-7 s nvar^-3; the smallest is dominated by fixed costs)
+LPVSYN_SECONDS_PER_VARIABLE_CUBED = 2.2e-7
 #: Bytes per pair of decision variables of SCS's KKT factor (module docstring): a 2-6
 #: two-stage plant on a 2 x 2 grid (44,020 variables) held about 7 GB
 SCS_BYTES_PER_VARIABLE_PAIR = 4.0
@@ -102,7 +110,7 @@ def lpvsyn_cost(*, n: int, nw: int, np_: int, nu: int, ny: int, points: int, ver
     cones = [d] * (points * vertices) + per_point * points
     mem = BASE_BYTES + BYTES_PER_SCALING_ENTRY * sum((k * (k + 1) / 2) ** 2 for k in cones)
     return LPVSynCost(decision_variables=nvar + 1, lmis=points * vertices, lmi_size=d, cone_orders=cones,
-                      memory_bytes=mem, seconds=SECONDS_PER_VARIABLE_CUBED * float(nvar + 1) ** 3)
+                      memory_bytes=mem, seconds=LPVSYN_SECONDS_PER_VARIABLE_CUBED * float(nvar + 1) ** 3)
 
 
 def conic_cost(sizes: dict, *, solver: str) -> LPVSynCost:
@@ -116,6 +124,7 @@ def conic_cost(sizes: dict, *, solver: str) -> LPVSynCost:
     c = lpvsyn_cost(n=n, nw=sizes["n_w"], np_=sizes["n_p"], nu=nu, ny=0, points=sizes["grid_points"],
                     vertices=sizes["rate_vertices"], lyapunov_basis=bases, gain_basis=bases)
     build = BYTES_PER_NONZERO * conic_nonzeros(n=n, nu=nu, np_=sizes["n_p"], lmis=c.lmis, bases=bases)
+    c = replace(c, seconds=SECONDS_PER_VARIABLE_CUBED * float(c.decision_variables) ** 3)
     if solver == "SCS":
         return replace(c, memory_bytes=BASE_BYTES + build
                        + SCS_BYTES_PER_VARIABLE_PAIR * float(c.decision_variables) ** 2)
