@@ -1,4 +1,5 @@
-"""Size and memory of the interior-point SDP of :func:`tmfem.control.lpv.lpvsyn`, before it is built.
+"""Size, memory and CPU time of the LPV syntheses' SDPs (:func:`tmfem.control.lpv.lpvsyn` and the
+conic program of :mod:`tmfem.control.lpv.synthesis`), before they are built.
 
 The gridded LMIs (:mod:`tmfem.control.lpv.gridded_synthesis`) are one semidefinite cone per
 design point and rate vertex, of order d = n + nw + np (state feedback) or 2 n + nw + np
@@ -14,12 +15,12 @@ holds the cones' vectorised maps besides, so the memory grows as
 (:data:`BYTES_PER_SCALING_ENTRY` measured, see there). The first-order SCS keeps no scaling
 blocks; its memory is the factor of its KKT matrix, dense in the variables (every LMI involves
 all of them), ``SCS_BYTES_PER_VARIABLE_PAIR nvar^2``. Both solvers' programs are built as
-sparse maps of ``conic_nonzeros`` entries (one triangle of A P, B2 Q, C1 P, D12 Q per LMI
-and basis function: n^3 + n^2 nu + np n^2 + np n nu), :data:`BYTES_PER_NONZERO` each. The time of either solver
-grows as the cube of the variables (the dense factorisation in every iteration):
-``SECONDS_PER_VARIABLE_CUBED nvar^3`` CPU seconds for the conic program of
-:mod:`tmfem.control.lpv.synthesis`, ``LPVSYN_SECONDS_PER_VARIABLE_CUBED nvar^3`` for lpvsyn's
-(both measured, see there). Decision variables
+sparse maps of :func:`conic_nonzeros` entries (one triangle of A P, B2 Q, C1 P, D12 Q per LMI
+and basis function: n^3 + n^2 nu + np n^2 + np n nu), :data:`BYTES_PER_NONZERO` each. The
+time of either solver grows as the cube of the variables (the dense factorisation in every
+iteration): ``SECONDS_PER_VARIABLE_CUBED nvar^3`` CPU seconds for the conic program of
+:mod:`tmfem.control.lpv.synthesis`, ``LPVSYN_SECONDS_PER_VARIABLE_CUBED nvar^3`` for
+lpvsyn's (both measured, see there). Decision variables
 (basis functions n_L of the Lyapunov matrices, n_G of the gains): state feedback n_L n (n +
 1) / 2 + n_G nu n; output feedback (X constant with ``constant="X"``, Y with ``"Y"``) n_X n (n
 + 1) / 2 + n_Y n (n + 1) / 2 + n_G (n^2 + n ny + nu n + nu ny), plus gamma.
@@ -49,8 +50,8 @@ SECONDS_PER_VARIABLE_CUBED = 8.5e-8
 #: trigonometric --refine 1: 157 variables 1.2 s, 307: 3.8 s, 505: 28 s of CPU (3.1e-7,
 #: 1.3e-7, 2.2e-7 s nvar^-3; the smallest is dominated by fixed costs)
 LPVSYN_SECONDS_PER_VARIABLE_CUBED = 2.2e-7
-#: Bytes per pair of decision variables of SCS's KKT factor (module docstring): a 2-6
-#: two-stage plant on a 2 x 2 grid (44,020 variables) held about 7 GB
+#: Bytes per pair of decision variables of SCS's KKT factor (module docstring): the lower
+#: triangle of a dense nvar x nvar block, 8 bytes an entry
 SCS_BYTES_PER_VARIABLE_PAIR = 4.0
 #: Peak bytes per nonzero of the conic program's sparse maps (the Kronecker products, their
 #: sums and the solver's copy), measured with SCS (benchmarks/bench_lpvsyn.py --conic-states):
