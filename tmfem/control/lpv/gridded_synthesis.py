@@ -854,7 +854,7 @@ def verify_design(ctrl: GriddedController, *, design_axes, check_axes, rtol: flo
     g = cert.gamma
     pts = _points(check_axes)
     verts = _vertices(cert.rate_bounds)
-    worst, worst_at, minpos = -np.inf, None, np.inf
+    worst, worst_at, worst_text, minpos = -np.inf, None, "", np.inf
     fn, fn_at, re_max = 0.0, None, -np.inf
     n = ctrl.T.size
     for rho in pts:
@@ -869,6 +869,8 @@ def verify_design(ctrl: GriddedController, *, design_axes, check_axes, rtol: flo
             e = float(np.linalg.eigvalsh((M + M.T) / 2).max())
             if e > worst:
                 worst, worst_at = e, [rho.tolist(), v.tolist()]
+                worst_text = ", ".join([ctrl.plant.point_text(rho)] + ([ctrl.plant.point_text(v, rates=True)]
+                                                                      if len(v) else []))
         a = cert.scaled_at(rho)
         L = a["P"] if cert.kind == "state" else np.block([[a["Y"], np.eye(n)], [np.eye(n), a["X"]]])
         minpos = min(minpos, float(np.linalg.eigvalsh((L + L.T) / 2).min()))
@@ -883,8 +885,8 @@ def verify_design(ctrl: GriddedController, *, design_axes, check_axes, rtol: flo
             fn, fn_at = np.inf, rho.tolist()
     cert_ok = worst < 0 and minpos > 0
     frozen_ok = re_max < 0 and fn <= g * (1 + rtol)
-    summary = (f"max LMI eigenvalue {worst:.3e} at rho, rho' = {worst_at}, min Lyapunov eigenvalue "
-               f"{minpos:.3e}, max frozen ||T_pw||_inf {fn:.6g} at rho = {fn_at} (gamma {g:.6g}), max "
+    summary = (f"max LMI eigenvalue {worst:.3e} at {worst_text}, min Lyapunov eigenvalue "
+               f"{minpos:.3e}, max frozen ||T_pw||_inf {fn:.6g} at {ctrl.plant.point_text(fn_at)} (gamma {g:.6g}), max "
                f"closed-loop Re {re_max:.4g}")
     log.info("lpvsyn verification on %s points: %s", len(pts), summary)
     return {"passed": bool(cert_ok and frozen_ok), "certificate_passed": bool(cert_ok),

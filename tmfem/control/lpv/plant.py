@@ -37,14 +37,16 @@ INTERPOLATIONS = ("multilinear", "spline")
 ANGLE_PARAMETERS = ("theta_13", "psi_13")
 
 
-def grid_point_text(names, rho) -> str:
+def grid_point_text(names, rho, *, rates: bool = False) -> str:
     """A grid point ``rho`` of the parameters ``names`` as text with units: the angles of
-    :data:`ANGLE_PARAMETERS` in degrees ("theta_13 = 64 deg, psi_13 = 25 deg"), other
-    parameters as given; "none" when ``rho`` is None."""
+    :data:`ANGLE_PARAMETERS` in degrees ("theta_13 = 64 deg, psi_13 = 25 deg"; with ``rates``
+    their rates in deg/s, "theta_13' = 10 deg/s"), other parameters as given; "none" when
+    ``rho`` is None."""
     if rho is None:
         return "none"
-    return ", ".join(f"{nm} = {np.degrees(v):.4g} deg" if nm in ANGLE_PARAMETERS else f"{nm} = {v:.4g}"
-                     for nm, v in zip(names, np.atleast_1d(rho)))
+    tick, unit = ("'", " deg/s") if rates else ("", " deg")
+    return ", ".join(f"{nm}{tick} = {np.degrees(v):.4g}{unit}" if nm in ANGLE_PARAMETERS else f"{nm}{tick} = {v:.4g}"
+                     for nm, v in zip(names, np.atleast_1d(np.asarray(rho, dtype=float))))
 
 
 @dataclass
