@@ -8,6 +8,8 @@ the forces they imply at the design geometry are shown beside the designed ones.
 """
 from __future__ import annotations
 
+from decimal import Decimal
+
 import numpy as np
 
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
@@ -82,7 +84,7 @@ def run(args) -> dict:
         return {"system": system.name, "assist": "bases", **assist.feasible_bases(system)}
     if args.packaged is not None:
         return {"system": system.name, "assist": "packaged",
-                **packaged_configurations(system, theta_deg=args.packaged)}
+                **on_scan_step(packaged_configurations(system, theta_deg=args.packaged))}
     radius = None
     if args.target_delta is not None:
         radius = assist.membrane_radius_for_delta(system, delta=args.target_delta * 1e-3)
@@ -100,6 +102,17 @@ def run(args) -> dict:
     if radius is not None:
         out["membrane_radius"] = radius
     return out
+
+
+def on_scan_step(r: dict) -> dict:
+    """The ``--packaged`` result with its psi values (a scan from -89 deg in steps of
+    ``step_deg``, accumulated in binary floating point) rounded to that grid and to the step's
+    decimals: psi = 30.5, not 30.499999999993207."""
+    decimals = max(0, -Decimal(repr(r["step_deg"])).as_tuple().exponent)
+
+    def snap(v: float) -> float:
+        return round(round(v / r["step_deg"]) * r["step_deg"], decimals)
+    return {**r, "psi_deg": snap(r["psi_deg"]), "psi_deg_bands": [[snap(a), snap(b)] for a, b in r["psi_deg_bands"]]}
 
 
 def format_assist(r: dict) -> str:

@@ -14,6 +14,7 @@ from tmfem.cli.common import progress_bar, say
 from tmfem.control import lpv
 from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
 from tmfem.errors import InputError, ResourceLimit
+from tmfem.resources import MAX_SYNTHESIS_S
 
 #: Largest verification grid: every point is one COM linearisation (~2 s for 2-3 on this
 #: machine under load), so 500 points is about a quarter of an hour.
@@ -38,7 +39,9 @@ def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
     parser.add_argument("--gamma-rtol", type=float, default=None,
                         help=prefix + f"EIGOPT: stop the bisection when (hi - lo) <= rtol hi (default {GAMMA_RTOL})")
     parser.add_argument("--time-budget", type=float, default=None,
-                        help=prefix + f"EIGOPT: seconds for the gamma bisection (default {TIME_BUDGET:g})")
+                        help=prefix + f"EIGOPT: seconds for the gamma bisection (default {TIME_BUDGET:g}); "
+                             f"CLARABEL, SCS: the longest solve started, against the estimate printed before it "
+                             f"(default {MAX_SYNTHESIS_S:g} CPU s)")
     parser.add_argument("--fixed-gamma", action="store_true", default=None,
                         help=prefix + "EIGOPT: a feasible point at --gamma only (no bisection)")
     parser.add_argument("--start", metavar="FILE.npz", default=None,
@@ -85,7 +88,7 @@ def check_synthesis(args, *, solver: str, system) -> dict:
     eig = {k: getattr(args, k, None) for k in ("gamma_rtol", "time_budget", "fixed_gamma", "start")}
     if solver != "EIGOPT":
         given = [k for k, v in {**eig, "gamma": args.gamma, "sample_time": getattr(args, "sample_time", None)}.items()
-                 if v is not None]
+                 if v is not None and k != "time_budget"]
         if given:
             raise InputError(f"options {['--' + k.replace('_', '-') for k in given]} apply to --solver EIGOPT "
                              f"only, found --solver {solver}")
@@ -116,7 +119,8 @@ def check_synthesis(args, *, solver: str, system) -> dict:
                             f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
     check_iteration_limits(args, fine_points=fine_n[0] * fine_n[1], design_points=th.size * ps.size)
     return {"system": system, "preset": system.name, "theta": th, "psi": ps, "refine": refine, "solver": solver,
-            "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget, "start": start}
+            "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget, "start": start,
+            "time_budget": eig["time_budget"]}
 
 
 def progress(total, label):
@@ -166,7 +170,7 @@ def synthesize(cfg: dict, gp, bound, *, max_iter=None, sample_time=None):
     """The controller of the settings ``cfg`` (:func:`tmfem.control.lpv.workflow.synthesize_design`)
     and its JSON entries."""
     return lpv.synthesize_design(gp, bound=bound, solver=cfg["solver"], gamma=cfg["gamma"],
-                                      fixed_gamma=cfg["fixed"], rtol=cfg["rtol"], time_budget=cfg["budget"],
+                                      fixed_gamma=cfg["fixed"], rtol=cfg["rtol"], time_budget=cfg["time_budget"],
                                       start=cfg["start"], max_iter=max_iter, sample_time=sample_time,
                                       progress=progress)
 

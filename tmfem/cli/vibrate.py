@@ -49,7 +49,7 @@ def run(args) -> dict:
     model, options, spec = model_from_args(args, NAME)
     system, name = model.system, spec.name.upper()
     pert = parse_perturbation(default_perturbation(args, system), model.perturbation_names)
-    size = ", ".join(f"{k} {v}" for k, v in model.describe().items())
+    size = model.describe_text()
     say(NAME, f"{system.name} {name}, {size}, static equilibrium")
     eq = model.equilibrium(**spec.equilibrium_kwargs(options))
     check_equilibrium(model, eq)

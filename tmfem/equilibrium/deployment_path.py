@@ -89,6 +89,11 @@ def membrane_stiffness(design) -> float:
     return float(design.F_Delta / design.Delta)
 
 
+def lpv_grid_point(theta: float, psi: float) -> str:
+    """The name of the LPV grid point (theta, psi) [rad] in messages, in degrees."""
+    return f"LPV grid point theta = {np.degrees(theta):.4g} deg, psi = {np.degrees(psi):.4g} deg"
+
+
 def path_feasibility(system, cfg: SymmetricConfig, *, kappa: float | None = None,
                      r_min: float = 0.0) -> PathPoint:
     """Whether ``cfg`` is a feasible equilibrium of the M >= 2 ``system`` (module docstring):
@@ -351,7 +356,7 @@ class PathBases:
             No top radius reaches the membrane, or the configuration is not a feasible
             equilibrium; the message names theta, psi and the condition.
         """
-        where = f"LPV grid point theta = {np.degrees(theta):.4g} deg, psi = {np.degrees(psi):.4g} deg"
+        where = lpv_grid_point(theta, psi)
         s = self.progress(theta)
         c = self.path.config(s)
         system = self.path.system

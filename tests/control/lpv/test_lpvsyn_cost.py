@@ -56,3 +56,21 @@ def test_the_2_3_design_is_refused_up_front_with_the_estimate():
     with pytest.raises(ResourceLimit, match=r"GiB.*EIGOPT route does not apply: it uses the affine basis"):
         lpvsyn(plant, 0, nu, grid=[theta, psi], rate_bounds=0.17, basis="constant")
     assert time.perf_counter() - t0 < 5.0
+
+
+def test_an_sdp_over_the_time_limit_is_refused_up_front_on_time_alone():
+    # 60 states, one w, u and p, 2 grid points x 2 rate vertices, affine basis: 3,781 variables,
+    # 2.2e-7 x 3781^3 ~ 11,900 CPU s by the measured cubic law, cones small enough for the memory
+    from tmfem.control.lpv.cost import LPVSYN_SECONDS_PER_VARIABLE_CUBED
+    from tmfem.resources import MAX_SYNTHESIS_S
+    n = 60
+    B, C, D = np.ones((n, 2)), np.eye(1, n), np.array([[0.0, 1.0]])
+    c = lpvsyn_cost(n=n, nw=1, np_=1, nu=1, ny=0, points=2, vertices=2, lyapunov_basis=2, gain_basis=2)
+    assert c.decision_variables == 2 * n * (n + 1) // 2 + 2 * n + 1 == 3781
+    assert c.memory_bytes < memory_limit() and c.seconds == LPVSYN_SECONDS_PER_VARIABLE_CUBED * 3781.0**3
+    t0 = time.perf_counter()
+    with pytest.raises(ResourceLimit, match=rf"3,781 variables: about [\d.]+ GiB and [\d.]+ h of CPU\) exceeds the "
+                                            rf"time limit {MAX_SYNTHESIS_S:g} CPU s; the EIGOPT route does not apply"):
+        lpvsyn(lambda rho: (-(1 + rho[0]) * np.eye(n), B, C, D), 0, 1, grid=np.array([0.0, 1.0]), rate_bounds=0.1,
+               basis="affine", method="sdp")
+    assert time.perf_counter() - t0 < 5.0

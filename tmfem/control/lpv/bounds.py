@@ -16,6 +16,7 @@ import numpy as np
 
 from tmfem.control.linear.hinf_riccati import state_feedback_gain, state_feedback_gamma
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, state_scaling
+from tmfem.control.lpv.plant import grid_point_text
 
 log = logging.getLogger(__name__)
 
@@ -65,5 +66,5 @@ def pointwise_state_feedback_bound(gp: GeneralizedLPV, *, eps: float = 1e-8,
     else:
         nrm = float(control.norm(control.ss(Acl, B1, C1 + D12 @ K, D11), p="inf"))
     log.info("pointwise state-feedback gamma: max %.5g at %s (min %.5g); a gain at 1.01 x it: "
-             "||T|| = %.5g", g.max(), at, g.min(), nrm)
+             "||T|| = %.5g", g.max(), grid_point_text(gp.parameter_names, at), g.min(), nrm)
     return PointwiseBound(gamma=g, lower_bound=float(g.max()), at=at, achieved_norm=nrm)

@@ -49,7 +49,7 @@ from tmfem.control.lpv.bisect import bisect_gamma
 from tmfem.control.lpv.coordinates import Coordinates, Tm_back
 from tmfem.control.lpv.eigopt import EigOpt
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, lmi_matrix
-from tmfem.control.lpv.plant import GriddedLPV
+from tmfem.control.lpv.plant import GriddedLPV, grid_point_text
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.control.lpv.verify import verify
 from tmfem.errors import InfeasibleController, InputError
@@ -105,7 +105,8 @@ def _frozen_norms(gp: GeneralizedLPV):
     for idx in np.ndindex(*gp.grid_shape):
         rho = [float(a[i]) for a, i in zip(gp.axes, idx)]
         if np.linalg.eigvals(gp.A[idx]).real.max() >= 0:
-            raise InfeasibleController(f"rate-bounded certificate: the frozen loop at rho = {rho} is unstable "
+            raise InfeasibleController(f"rate-bounded certificate: the frozen loop at "
+                                       f"{grid_point_text(gp.parameter_names, rho)} is unstable "
                                        "(expected stable at every design point)")
         nrm = float(control.norm(control.ss(gp.A[idx], gp.B1[idx], gp.C1[idx], gp.D11[idx]), p="inf"))
         if nrm > lo:
@@ -215,7 +216,7 @@ def rate_bounded_certificate(design, plant: GriddedLPV, *, W_e: float, W_u: floa
         raise InputError(f"rate-bounded certificate: expected an upper level above the largest frozen norm "
                          f"{lo:.6g} (no certificate below it), found {hi!r}")
     log.info("rate-bounded certificate: %d-state loops on %s, frozen norms up to %.6g at %s; levels (%.6g, %.6g]",
-             gp.A.shape[-1], gp.grid_shape, lo, lo_at, lo, hi)
+             gp.A.shape[-1], gp.grid_shape, lo, grid_point_text(gp.parameter_names, lo_at), lo, hi)
     info = {}
     try:
         start, info = separation_start(design, plant, gp, hi, time_budget=time_budget / 3)

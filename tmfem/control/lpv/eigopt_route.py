@@ -26,6 +26,7 @@ import numpy as np
 
 from tmfem.control.lpv.basis import Basis
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV
+from tmfem.control.lpv.plant import grid_point_text
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.errors import InputError
 
@@ -121,6 +122,7 @@ def synthesize_eigopt(gp: GeneralizedLPV, *, gamma: float | None, fixed_gamma: b
                                 progress=None if progress is None else
                                 (lambda w: progress(min(time.perf_counter() - t0, time_budget))))
     except InfeasibleController as exc:
+        at = grid_point_text(gp.parameter_names, bound.at)
         raise InfeasibleController(f"{exc} (pointwise state-feedback lower bound of gamma: "
-                                   f"{bound.lower_bound:.4g} at rho = {bound.at})") from None
+                                   f"{bound.lower_bound:.4g} at {at})") from None
     return ctrl, {**record, **br.to_dict()}

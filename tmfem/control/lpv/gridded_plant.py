@@ -18,14 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tmfem.control.lpv.plant import GriddedLPV
+from tmfem.control.lpv.plant import GriddedLPV, grid_point_text
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV
 from tmfem.errors import InputError
 
 
 @dataclass
 class PlantFunction:
-    """rho -> (A, B, C, D) with sizes; ``axes`` the plant's own grid (None for a function)."""
+    """rho -> (A, B, C, D) with sizes; ``axes`` the plant's own grid (None for a function);
+    ``parameter_names`` the gridded plant's (None: rho0, rho1, ...)."""
 
     evaluate: object
     n: int
@@ -34,6 +35,13 @@ class PlantFunction:
     axes: list | None
     interpolated: bool
     rate_bounds: np.ndarray | None = None
+    parameter_names: list | None = None
+
+    def point_text(self, rho, *, rates: bool = False) -> str:
+        """A parameter point (or with ``rates`` a rate vertex) as text with units
+        (:func:`~tmfem.control.lpv.plant.grid_point_text`)."""
+        names = self.parameter_names or [f"rho{k}" for k in range(np.size(rho))]
+        return grid_point_text(names, rho, rates=rates)
 
     def at(self, rho) -> tuple:
         A, B, C, D = _matrices(self.evaluate(np.asarray(rho, dtype=float)), rho)
@@ -127,7 +135,7 @@ def plant_function(P, *, axes, interpolation: str = "multilinear") -> PlantFunct
                                  f"{P.parameter_names[k]} = {off} not in {pa.tolist()}")
         gp = P
         return PlantFunction(evaluate=gp.at, n=gp.nx, m=gp.nu, p=gp.ny, axes=gp.axes, interpolated=True,
-                             rate_bounds=gp.rate_bounds)
+                             rate_bounds=gp.rate_bounds, parameter_names=list(gp.parameter_names))
     if interpolation != "multilinear":
         raise InputError(f"LPV plant: interpolation applies to a plant given on a grid, found "
                          f"interpolation={interpolation!r} with a {type(P).__name__}")

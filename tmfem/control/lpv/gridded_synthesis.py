@@ -461,8 +461,9 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
         points, a basis that is not finite or smooth or is linearly dependent on the grid,
         options out of range.
     ResourceLimit
-        An SDP whose interior-point memory estimate (:mod:`tmfem.control.lpv.cost`) exceeds
-        this machine's limit, before anything is built, on a problem the EIGOPT route cannot
+        An SDP whose interior-point memory or CPU-time estimate (:mod:`tmfem.control.lpv.cost`)
+        exceeds this machine's memory limit or :data:`tmfem.resources.MAX_SYNTHESIS_S`,
+        before anything is built, on a problem the EIGOPT route cannot
         carry (the message names why).
     InfeasibleController
         Infeasible or failed SDP, with the solver status and the likely cause; a design whose
@@ -525,6 +526,7 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
                        vertices=len(_vertices(rb)), lyapunov_basis=len(lyap), gain_basis=len(gain), constant=constant)
     why_not = eigopt_route.unsupported(nmeas=nmeas, lyap=lyap, gain=gain, points=dense, rb=rb,
                                        affine=_resolve_basis("affine", n_par, axes, "basis"))
+    log.info("lpvsyn: estimate of the interior-point SDP: %s", cost.text)
     method, reason = _route(method, cost=cost, why_not=why_not,
                             what=f"lpvsyn: {n} states, {len(design)} grid points x {len(_vertices(rb))} rate vertices")
     if method == "eigopt":
@@ -560,7 +562,8 @@ def lpvsyn(P, nmeas: int, ncon: int, *, grid, rate_bounds, basis="constant", gai
                     nu=ncon, ny=nmeas)
     sizes = {"grid_points": len(design), "rate_vertices": len(verts), "lmis": len(design) * len(verts),
              "lmi_size": prob.lmi_size, "n_x": n, "basis": list(lyap.names), "gain_basis": list(gain.names),
-             "decision_variables": prob.n_variables, "memory_estimate_gib": cost.memory_bytes / 2**30}
+             "decision_variables": prob.n_variables, "memory_estimate_gib": cost.memory_bytes / 2**30,
+             "cpu_seconds_estimate": cost.seconds}
     log.info("lpvsyn: %s feedback, %s", kind, sizes)
     try:
         g_min, rep1 = prob.minimize_gamma(solver, gamma_max=gamma_max, budget=budget)
@@ -603,7 +606,8 @@ def _given_options(values: dict) -> dict:
 
 def _route(method: str, *, cost, why_not: str, what: str) -> tuple:
     """The route of :func:`lpvsyn` and why: ``method`` as asked, or with "auto" the SDP when its
-    memory estimate fits, else the EIGOPT route when ``why_not`` is empty; refused otherwise
+    memory and time estimates fit (:func:`~tmfem.control.lpv.cost.check_lpvsyn_cost`), else
+    the EIGOPT route when ``why_not`` is empty; refused otherwise
     (:class:`ResourceLimit` with the estimate and ``why_not``)."""
     if method == "eigopt":
         if why_not:
@@ -615,10 +619,8 @@ def _route(method: str, *, cost, why_not: str, what: str) -> tuple:
         if method == "sdp" or why_not:
             raise ResourceLimit(f"{exc}; the EIGOPT route does not apply"
                                 f"{': ' + why_not if why_not else ' (method=sdp asked for)'}") from None
-        return "eigopt", (f"the interior-point SDP needs about {cost.memory_bytes / 2**30:.1f} GiB, over "
-                          "this machine's limit")
-    return "sdp", ("asked for (method='sdp')" if method == "sdp" else
-                   f"the interior-point SDP fits (about {cost.memory_bytes / 2**30:.2f} GiB)")
+        return "eigopt", f"the interior-point SDP is over this machine's limits ({cost.text})"
+    return "sdp", ("asked for (method='sdp')" if method == "sdp" else f"the interior-point SDP fits ({cost.text})")
 
 
 def _verified(ctrl: GriddedController, g_min: float, info: dict, *, design_axes, check_axes, t_start: float,
@@ -852,7 +854,7 @@ def verify_design(ctrl: GriddedController, *, design_axes, check_axes, rtol: flo
     g = cert.gamma
     pts = _points(check_axes)
     verts = _vertices(cert.rate_bounds)
-    worst, worst_at, minpos = -np.inf, None, np.inf
+    worst, worst_at, worst_text, minpos = -np.inf, None, "", np.inf
     fn, fn_at, re_max = 0.0, None, -np.inf
     n = ctrl.T.size
     for rho in pts:
@@ -867,6 +869,8 @@ def verify_design(ctrl: GriddedController, *, design_axes, check_axes, rtol: flo
             e = float(np.linalg.eigvalsh((M + M.T) / 2).max())
             if e > worst:
                 worst, worst_at = e, [rho.tolist(), v.tolist()]
+                worst_text = ", ".join([ctrl.plant.point_text(rho)] + ([ctrl.plant.point_text(v, rates=True)]
+                                                                      if len(v) else []))
         a = cert.scaled_at(rho)
         L = a["P"] if cert.kind == "state" else np.block([[a["Y"], np.eye(n)], [np.eye(n), a["X"]]])
         minpos = min(minpos, float(np.linalg.eigvalsh((L + L.T) / 2).min()))
@@ -881,8 +885,8 @@ def verify_design(ctrl: GriddedController, *, design_axes, check_axes, rtol: flo
             fn, fn_at = np.inf, rho.tolist()
     cert_ok = worst < 0 and minpos > 0
     frozen_ok = re_max < 0 and fn <= g * (1 + rtol)
-    summary = (f"max LMI eigenvalue {worst:.3e} at rho, rho' = {worst_at}, min Lyapunov eigenvalue "
-               f"{minpos:.3e}, max frozen ||T_pw||_inf {fn:.6g} at rho = {fn_at} (gamma {g:.6g}), max "
+    summary = (f"max LMI eigenvalue {worst:.3e} at {worst_text}, min Lyapunov eigenvalue "
+               f"{minpos:.3e}, max frozen ||T_pw||_inf {fn:.6g} at {ctrl.plant.point_text(fn_at)} (gamma {g:.6g}), max "
                f"closed-loop Re {re_max:.4g}")
     log.info("lpvsyn verification on %s points: %s", len(pts), summary)
     return {"passed": bool(cert_ok and frozen_ok), "certificate_passed": bool(cert_ok),

@@ -41,7 +41,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from tmfem.control.lpv.controller import Scheduled
-from tmfem.control.lpv.plant import GriddedLPV
+from tmfem.control.lpv.plant import GriddedLPV, grid_point_text
 from tmfem.control.lpv.certificate import closed_loop_lpv
 from tmfem.control.lpv.generalized_plant import state_scaling
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
@@ -209,7 +209,7 @@ def design_output_feedback(state_feedback: LPVStateFeedback, plant: GriddedLPV, 
     for idx, rho in plant.points():
         L[idx] = kalman_gain(plant.A[idx], plant.B[idx], C[idx], W_d=W_d, W_n=W_n, eps=eps)
         ev = np.linalg.eigvals(plant.A[idx] - L[idx] @ C[idx]).real.max()
-        log.info("Kalman estimator at rho = %s: max Re(A - L C) = %.3e", rho.tolist(), ev)
+        log.info("Kalman estimator at %s: max Re(A - L C) = %.3e", grid_point_text(plant.parameter_names, rho), ev)
     shp = plant.grid_shape
     est = GriddedLPV(axes=plant.axes, parameter_names=plant.parameter_names, A=plant.A,
                      B=np.concatenate([plant.B, L], -1), C=C, D=np.zeros(shp + (ny, plant.nu + ny)),
@@ -333,15 +333,16 @@ def verify_output_feedback(design: LPVOutputFeedback, plant: GriddedLPV, *, W_e:
                                      max_hinf_at=hn_at, dt=dt, max_sampled_radius=sr, max_sampled_radius_at=sr_at,
                                      state_feedback_sampled_radius=sf, passed=bool(ok), certificate=certificate,
                                      certificate_check=chk)
+    at = lambda rho: grid_point_text(plant.parameter_names, rho)          # noqa: E731
     log.info("LPV output feedback on %s: max closed-loop Re %.3e at %s, max ||T_pw|| %.4g at %s, "
-             "sampled radius %s at %s", plant.grid_shape, cl, cl_at, hn, hn_at, sr, sr_at)
+             "sampled radius %s at %s", plant.grid_shape, cl, at(cl_at), hn, at(hn_at), sr, at(sr_at))
     if not ok and not allow_failure:
         raise InfeasibleController(
             f"LPV output feedback fails its frozen-parameter verification on a {plant.grid_shape} grid: "
-            f"largest closed-loop real part {cl:.3e} at rho = {cl_at}"
-            + (f", largest sampled-data spectral radius {sr:.6f} at rho = {sr_at} (dt = {dt} s)" if dt else "")
+            f"largest closed-loop real part {cl:.3e} at {at(cl_at)}"
+            + (f", largest sampled-data spectral radius {sr:.6f} at {at(sr_at)} (dt = {dt} s)" if dt else "")
             + (f", rate-bounded LMI (gamma = {certificate.gamma:.5g}) largest relative eigenvalue "
-               f"{chk.max_lmi_eig:.3e} at rho = {chk.max_lmi_eig_at}" if chk is not None else "")
+               f"{chk.max_lmi_eig:.3e} at {at(chk.max_lmi_eig_at)}" if chk is not None else "")
             + "; expected < 0" + (" and < 1" if dt else ""))
     return res
 

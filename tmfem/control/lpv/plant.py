@@ -20,8 +20,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.interpolate import RegularGridInterpolator, make_interp_spline
 
+from tmfem.equilibrium.deployment_path import lpv_grid_point
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
-from tmfem.errors import InputError
+from tmfem.errors import InfeasibleDesign, InputError
 from tmfem.models.com.linearize import linearize
 from tmfem.models.com.mode_count import MembraneModeChoice
 from tmfem.models.com.model import ControlOrientedModel, membrane_modes_of
@@ -31,6 +32,21 @@ log = logging.getLogger(__name__)
 
 #: how a gridded plant is evaluated between its grid points (:meth:`GriddedLPV.interpolate`)
 INTERPOLATIONS = ("multilinear", "spline")
+#: Scheduling parameters that are angles [rad] (rho_1 = theta_13, rho_2 = psi_13 of 8.3):
+#: shown in degrees in messages and logs.
+ANGLE_PARAMETERS = ("theta_13", "psi_13")
+
+
+def grid_point_text(names, rho, *, rates: bool = False) -> str:
+    """A grid point ``rho`` of the parameters ``names`` as text with units: the angles of
+    :data:`ANGLE_PARAMETERS` in degrees ("theta_13 = 64 deg, psi_13 = 25 deg"; with ``rates``
+    their rates in deg/s, "theta_13' = 10 deg/s"), other parameters as given; "none" when
+    ``rho`` is None."""
+    if rho is None:
+        return "none"
+    tick, unit = ("'", " deg/s") if rates else ("", " deg")
+    return ", ".join(f"{nm}{tick} = {np.degrees(v):.4g}{unit}" if nm in ANGLE_PARAMETERS else f"{nm}{tick} = {v:.4g}"
+                     for nm, v in zip(names, np.atleast_1d(np.asarray(rho, dtype=float))))
 
 
 @dataclass
@@ -336,13 +352,18 @@ def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int | None 
     for a, th in enumerate(theta):
         for b, ps in enumerate(psi):
             rule = bases(th, ps) if bases else {}
-            s = with_configuration(system, configuration_5_97(system, th, ps, **rule))
-            if pts is None:                      # chosen once, at the first grid point
-                pts = choose_membrane_points(ControlOrientedModel(s, membrane_modes=membrane_modes,
-                                                                  mesh_n=mesh_n))
-            m = ControlOrientedModel(s, membrane_modes=membrane_modes, mesh_n=mesh_n, damping=damping,
-                                     membrane_points=pts)
-            L = linearize(m)
+            try:
+                s = with_configuration(system, configuration_5_97(system, th, ps, **rule))
+                if pts is None:                      # chosen once, at the first grid point
+                    pts = choose_membrane_points(ControlOrientedModel(s, membrane_modes=membrane_modes,
+                                                                      mesh_n=mesh_n))
+                m = ControlOrientedModel(s, membrane_modes=membrane_modes, mesh_n=mesh_n, damping=damping,
+                                         membrane_points=pts)
+                L = linearize(m)
+            except InfeasibleDesign as exc:
+                raise type(exc)(f"{lpv_grid_point(th, ps)} is not a feasible equilibrium of the grid's "
+                                f"stage-base rule: {exc}; expected a grid inside the region of feasible "
+                                "equilibria (narrow the [lpv] theta_grid_deg / psi_grid_deg)") from None
             got = (L.state_names, L.input_names, L.output_names)
             if names is None:
                 names = got

@@ -31,10 +31,12 @@ import numpy as np
 import scipy.sparse as sp
 
 from tmfem.control.lpv.coordinates import Coordinates, Tm_back, accepted_design
+from tmfem.control.lpv.cost import check_lpvsyn_cost, conic_cost
 from tmfem.control.lpv.eigopt import feasible_point
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.errors import InfeasibleController, InputError
+from tmfem.resources import MAX_SYNTHESIS_S
 
 log = logging.getLogger(__name__)
 
@@ -70,7 +72,8 @@ def _sym_basis(n: int) -> sp.csr_matrix:
 def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", margin: float = 1e-6,
                               scale: bool = True, accuracy: float = 1e-5,
                               max_iter: int | None = None, gamma: float | None = None,
-                              sample_time: float | None = None) -> LPVStateFeedback:
+                              sample_time: float | None = None,
+                              time_budget: float = MAX_SYNTHESIS_S) -> LPVStateFeedback:
     """Minimise gamma subject to eqs. 5.95-5.96 at every grid point and rate vertex (8.3).
 
     The LMIs are written directly as a sparse conic program (vec(M) = vec(M_0) + G x with
@@ -98,9 +101,15 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
     accuracy : float
         Largest accepted LMI eigenvalue re-computed from the solution (scaled coordinates);
         above it the solve is "inaccurate".
+    time_budget : float
+        "CLARABEL", "SCS": the longest solve started [CPU s]: the program's estimate
+        (:func:`~tmfem.control.lpv.cost.conic_cost`, logged before the build) must stay below it
+        and below this machine's memory limit.
 
     Raises
     ------
+    ResourceLimit
+        The estimate over ``time_budget`` or the memory limit, before anything is built.
     InfeasibleController
         Infeasible, unbounded or inaccurate solve (status and residuals in the message).
     """
@@ -125,6 +134,12 @@ def synthesize_state_feedback(gp: GeneralizedLPV, *, solver: str = "CLARABEL", m
     nvar = sizes["decision_variables"]
     In = sp.identity(n, format="csr")
     log.info("LPV synthesis: %s", sizes)
+    if solver != "EIGOPT":
+        cost = conic_cost(sizes, solver=solver)
+        log.info("LPV synthesis: estimate of the %s solve: %s", solver, cost.text)
+        check_lpvsyn_cost(cost, what=f"LPV state-feedback synthesis ({solver}): {n} states, {sizes['grid_points']} "
+                                     f"grid points x {len(verts)} rate vertices",
+                          time_limit=time_budget, lifted_by="time_budget, `tmfem control lpv --time-budget`")
     if solver == "EIGOPT":
         t1 = time.perf_counter()
         Ps, Qs, _, nev = feasible_point(gp, gamma, T=T, c_of=co.c_of, dvs=co.dvs, max_iter=max_iter or 150,

@@ -14,6 +14,7 @@ import numpy as np
 
 from tmfem.control.lpv.eigopt import zoh
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, lmi_matrix
+from tmfem.control.lpv.plant import grid_point_text
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.errors import InfeasibleController
 
@@ -85,14 +86,15 @@ def verify(controller: LPVStateFeedback, gp: GeneralizedLPV, *, allow_failure: b
     res = Verification(grid=gp.grid_shape, max_lmi_eig=worst, max_lmi_eig_at=worst_at, max_cl_real=cl,
                        max_cl_real_at=cl_at, passed=ok, sample_time=sample_time,
                        max_sampled_radius=sr if sampled else None, max_sampled_radius_at=sr_at)
+    at = lambda rho: grid_point_text(gp.parameter_names, rho)          # noqa: E731
     log.info("LPV verification on %s: max LMI eig %.3e at %s, max closed-loop Re %.3e at %s%s",
-             gp.grid_shape, worst, worst_at, cl, cl_at,
-             f", sampled at {sample_time} s: max spectral radius {sr:.6f} at {sr_at}" if sampled else "")
+             gp.grid_shape, worst, at(worst_at), cl, at(cl_at),
+             f", sampled at {sample_time} s: max spectral radius {sr:.6f} at {at(sr_at)}" if sampled else "")
     if not ok and not allow_failure:
         raise InfeasibleController(
             f"LPV controller fails its verification on a {gp.grid_shape} grid: largest LMI "
-            f"eigenvalue (eq. 5.95, relative) {worst:.3e} at rho = {worst_at} and largest closed-loop "
-            f"real part {cl:.3e} at rho = {cl_at}; expected both < 0"
-            + (f"; sampled at {sample_time} s the largest spectral radius is {sr:.6f} at rho = {sr_at} "
+            f"eigenvalue (eq. 5.95, relative) {worst:.3e} at {at(worst_at)} and largest closed-loop "
+            f"real part {cl:.3e} at {at(cl_at)}; expected both < 0"
+            + (f"; sampled at {sample_time} s the largest spectral radius is {sr:.6f} at {at(sr_at)} "
                "(expected < 1)" if sampled else ""))
     return res

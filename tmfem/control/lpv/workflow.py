@@ -30,7 +30,7 @@ from tmfem.control.lpv.generalized_plant import GeneralizedLPV, interconnection_
 from tmfem.control.lpv.gridded_synthesis import lpvsyn
 from tmfem.control.lpv.output_feedback import (LPVOutputFeedback, design_output_feedback,
                                                verify_output_feedback)
-from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant
+from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant, grid_point_text
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.control.lpv.verify import Verification, verify
@@ -121,7 +121,7 @@ def refined_plant(system, plant: GriddedLPV, *, factor: int, bases, what: str = 
 
 def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, solver: str = "EIGOPT",
                       gamma: float | None = None, fixed_gamma: bool = False, rtol: float = GAMMA_RTOL,
-                      time_budget: float = TIME_BUDGET, start: LPVStateFeedback | None = None,
+                      time_budget: float | None = None, start: LPVStateFeedback | None = None,
                       max_iter: int | None = None, sample_time: float | None = None,
                       progress=no_progress) -> tuple[LPVStateFeedback, dict]:
     """The state feedback of eqs. 5.95-5.99 on ``generalized`` and its JSON entries.
@@ -136,10 +136,14 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
         "EIGOPT": :func:`~tmfem.control.lpv.gridded_synthesis.lpvsyn` on its EIGOPT route
         (affine basis, verified at the design points; :mod:`tmfem.control.lpv.eigopt_route`):
         without ``fixed_gamma`` the gamma bisection between the bound and ``gamma`` (default
-        2 x the bound) to relative width ``rtol`` within ``time_budget`` s, from ``start`` when
+        2 x the bound) to relative width ``rtol`` within ``time_budget`` s (default
+        :data:`~tmfem.control.lpv.defaults.TIME_BUDGET`), from ``start`` when
         given; with ``fixed_gamma`` one feasible point at ``gamma``.
         "CLARABEL" or "SCS": their minimisation of gamma
-        (:func:`~tmfem.control.lpv.synthesis.synthesize_state_feedback`).
+        (:func:`~tmfem.control.lpv.synthesis.synthesize_state_feedback`) when its
+        estimate stays within ``time_budget`` CPU seconds (default
+        :data:`tmfem.resources.MAX_SYNTHESIS_S`) and the memory limit (refused up front:
+        :class:`~tmfem.errors.ResourceLimit`).
     max_iter : int, optional
         Iteration limit of each EIGOPT level or of the conic solver.
     sample_time : float, optional
@@ -162,6 +166,7 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
     """
     try:
         if solver == "EIGOPT":
+            time_budget = TIME_BUDGET if time_budget is None else time_budget
             with progress(time_budget, "gamma bisection (s of budget)") as bar:
                 res = lpvsyn(generalized, 0, generalized.sizes["n_u"], grid=generalized.axes,
                              rate_bounds=generalized.rate_bounds, basis="affine", method="eigopt", verify_refine=1,
@@ -175,13 +180,15 @@ def synthesize_design(generalized: GeneralizedLPV, *, bound: PointwiseBound, sol
             return ctrl, {"gamma": ctrl.gamma, "solver": ctrl.solver, "status": ctrl.status, "sizes": ctrl.sizes,
                           "solve_time_s": ctrl.solve_time, "sample_time_s": sample_time, **extra}
         ctrl = synthesize_state_feedback(generalized, solver=solver, max_iter=max_iter, gamma=gamma,
-                                         sample_time=sample_time)
+                                         sample_time=sample_time,
+                                         **({} if time_budget is None else {"time_budget": time_budget}))
         extra = {}
     except InfeasibleController as exc:
         if solver == "EIGOPT":      # the EIGOPT route's messages name the pointwise lower bound
             raise
+        at = grid_point_text(generalized.parameter_names, bound.at)
         raise InfeasibleController(f"{exc} (pointwise state-feedback lower bound of gamma: "
-                                   f"{bound.lower_bound:.4g} at rho = {bound.at})") from None
+                                   f"{bound.lower_bound:.4g} at {at})") from None
     return ctrl, {"gamma": ctrl.gamma, "solver": ctrl.solver, "status": ctrl.status, "sizes": ctrl.sizes,
                   "solve_time_s": ctrl.solve_time, "sample_time_s": sample_time, **extra}
 

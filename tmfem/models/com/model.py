@@ -207,6 +207,12 @@ class ControlOrientedModel:
         """Size of the model, for reports."""
         return {"membrane_modes": self.K, "membrane_modes_from": self.membrane_mode_choice.source}
 
+    def describe_text(self) -> str:
+        """:meth:`describe` as text for titles: "K = 9 membrane modes (automatic)"."""
+        how = {"file": "from the file", "given": "given", "automatic": "automatic"}
+        src = self.membrane_mode_choice.source
+        return f"K = {self.K} membrane mode{'s' if self.K != 1 else ''} ({how.get(src, src)})"
+
     @property
     def state_names(self) -> list[str]:
         return self.z_names + [n + "_dot" for n in self.z_names]

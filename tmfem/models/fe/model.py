@@ -75,6 +75,12 @@ class FEModel:
         return {"mesh": int(self.topology.mesh.n), "ndof": self.ndof,
                 "tendon_elements": self.topology.tendon_elements}
 
+    def describe_text(self) -> str:
+        """:meth:`describe` as text for titles: "mesh 10 x 10, 5,067 DOFs, 3 elements per tendon"."""
+        d = self.describe()
+        return (f"mesh {d['mesh']} x {d['mesh']}, {d['ndof']:,} DOFs, {d['tendon_elements']} "
+                f"element{'s' if d['tendon_elements'] != 1 else ''} per tendon")
+
     # ------------------------------------------------------------------ at=
     def _at(self, at):
         """(state, tangent) of ``at``: an :class:`Equilibrium` of this model, a configuration
