@@ -16,6 +16,7 @@ SYSTEMS = Path(__file__).resolve().parents[1] / "data" / "systems"
 TOWER = SYSTEMS / "tower-3-3-lpv.toml"
 
 
+@pytest.mark.slow
 def test_the_three_stage_grid_gives_its_pointwise_bound(capsys):
     # --grid 2x1: theta 55, 60 deg at psi 10 deg (the path's azimuth); the frozen plants'
     # optimum is tight (a static gain at 1.01 x it achieves a norm between)

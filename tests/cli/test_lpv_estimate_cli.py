@@ -5,10 +5,13 @@ with these solvers. The system: a 2-5 of our own on two grid points
 tests/control/lpv/test_lpv_conic_estimate.py."""
 import re
 
+import pytest
+
 from tmfem.cli import main
 from tests.cli.test_own_system_design import SYSTEMS
 
 
+@pytest.mark.slow
 def test_a_conic_lpv_synthesis_over_its_time_budget_is_refused_with_the_estimate(capsys):
     rc = main(["control", "lpv", str(SYSTEMS / "pentagon-2-5-lpv.toml"), "--grid", "2x1", "--solver", "CLARABEL",
                "--time-budget", "1e-6"])

@@ -41,6 +41,7 @@ def test_deploy_refuses_unreachable_modes_naming_option_and_key(capsys):
     assert "--exclude-uncontrollable" in err and 'uncontrollable = "exclude"' in err and "[control]" in err
 
 
+@pytest.mark.slow
 def test_deploy_with_excluded_modes_runs_and_names_them(tmp_path, capsys):
     """With the option: the excluded mode is the one `control pbh` finds unreachable, the
     switch happens and the run ends at the deployed configuration (eq. 5.70 error far below
@@ -80,6 +81,7 @@ def test_report_option_without_a_deployment_is_refused(tmp_path, capsys):
     assert "option does not apply" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_report_deploys_with_excluded_modes(tmp_path, capsys):
     """The report of the same system with the option: exit 0, the deployment section and the
     text name the excluded mode, the JSON lists it."""
