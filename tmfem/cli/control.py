@@ -37,8 +37,9 @@ def configure(parser) -> None:
                         help="hinf --method lmi: how the eliminated LMIs are solved: ARE (default; their Riccati "
                              "characterisation, bisection on gamma, LMIs re-checked), or the SDP "
                              "solvers CLARABEL / SCS (the 50-state 2-3 LMI fails in Clarabel; "
-                             "docs/guides/control.md); lpv: SCS (default), CLARABEL, or EIGOPT (eigenvalue "
-                             "optimisation: bisection on gamma, or one level with --fixed-gamma; docs/guides/lpv.md)")
+                             "docs/guides/control.md); lpv: EIGOPT (default; eigenvalue optimisation: bisection on "
+                             "gamma, or one level with --fixed-gamma; docs/guides/lpv.md), or the conic solvers "
+                             "SCS / CLARABEL (one SDP, a cross-check on small plants)")
     parser.add_argument("--method", choices=("auto", "lmi", "riccati", "central"), default=None,
                         help="auto (default): tmfem.control.hinfsyn's verified route (Riccati "
                              "bisection with the central controller on regular plants, else the "

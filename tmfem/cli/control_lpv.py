@@ -99,7 +99,7 @@ def run(args) -> dict:
         raise InputError(f"--noise: expected a weight > 0, found {noise}")
     if args.spec is None and args.preset is None:
         args.preset = "2-3-lpv"
-    cfg = lpv_options.check_synthesis(args, solver=args.solver or "SCS", system=system_from_args(args))
+    cfg = lpv_options.check_synthesis(args, solver=args.solver or "EIGOPT", system=system_from_args(args))
     R = check_estimator_refine(args.estimator_refine, refine=cfg["refine"], output_feedback=bool(args.output_feedback))
     plant, gp, bound, out = lpv_options.design_plant(cfg, rate_deg=rate)
     out = {"action": "lpv", **out}
