@@ -28,11 +28,14 @@ def configure(parser) -> None:
                              "feedback with rate bounds (ch. 8)")
     add_system_args(parser)
     parser.add_argument("--membrane-modes", type=int, default=None,
-                        help="K (default 7.4's: 3 for 1-4D, 5 for 1-6D, 4 for 2-3-deploy)")
+                        help="membrane modes K of the control-oriented model (default: the file's [models.com] "
+                             "membrane_modes, else chosen automatically against the FE model; docs/guides/com.md)")
     parser.add_argument("--alpha", type=float, default=None,
-                        help="alpha_1: closed-loop poles with Re < -alpha_1 (default 7.4's)")
+                        help="alpha_1 [1/s]: closed-loop poles with Re < -alpha_1 (default: the file's "
+                             "[control] alpha, else 0.1 x 2 pi f_1 of the deployed plant)")
     parser.add_argument("--u-m", type=float, default=None,
-                        help="u_m [m] of W_u = I/u_m (default 7.4's: 0.01, 0.02 for 1-6D)")
+                        help="u_m [m] of W_u = I/u_m (default: the file's [control] u_m, else 0.5 %% of the "
+                             "mean bar length)")
     parser.add_argument("--solver", choices=("ARE", "CLARABEL", "SCS", "EIGOPT"), default=None,
                         help="hinf --method lmi: how the eliminated LMIs are solved: ARE (default; their Riccati "
                              "characterisation, bisection on gamma, LMIs re-checked), or the SDP "

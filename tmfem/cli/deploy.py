@@ -41,7 +41,7 @@ def configure(parser) -> None:
                              "feedback on the "
                              "measured q and membrane points, docs/guides/lpv.md)")
     parser.add_argument("--uncertainty", choices=list(UNCERTAINTIES),
-                        help="controller model error (default: the 7.4 choice of the preset)")
+                        help="controller model error (default: the file's [deployment] uncertainty, else no-MG)")
     parser.add_argument("--path", choices=["delta", "auto", "table-7-7-bases", "linear"],
                         help="deployment path (default: the file's [deployment] path, else delta for "
                              "1-N(D) and auto for M >= 2 (stage bases continued through the symmetric "
@@ -109,8 +109,9 @@ def configure(parser) -> None:
     parser.add_argument("--gains", type=pfl_gains, metavar="OMEGA_0,OMEGA_E,TAU,D_C",
                         help="the adaptive PFL's gains of eq. 5.69, omega(t) = omega_0 + omega_e "
                              "(1 - exp(-t / tau)), d_q = 2 d_c omega, k_q = omega^2, in rad/s, "
-                             "rad/s, s and - (default: the preset's Table 7.1 row; 1-4D "
-                             "15,150,20,1.5). A crossover below the FE plant's unmodelled "
+                             "rad/s, s and - (default: the file's [deployment] gains, else 4,10,20,0.9; the "
+                             "presets carry their Table 7.1 rows, e.g. 1-4D 15,150,20,1.5). A crossover below the "
+                             "FE plant's unmodelled "
                              "dynamics, e.g. 10,0,20,1 with --uncertainty no-MG, deploys 1-4D on "
                              "the SBC plant (docs/guides/fe-plant.md)")
     add_uncontrollable_arg(parser, what="the deployment's switch")
