@@ -1,6 +1,7 @@
 """Upper bounds of the options that scale an LPV run's or a deployment's work, refused before
 any work with the limit and why (docs/guides/cli.md, "Limits, locks, partial files and
-signals"): ``control lpv --max-iter`` (exit 3), ``--certificate-rounds`` (exit 2), and the
+signals"): ``control lpv --max-iter`` (exit 3), ``--certificate-rounds`` and ``--verify-rounds``
+(exit 2), and the
 ParaView frames of ``deploy --vtk`` (exit 3, as ``vibrate --vtk``)."""
 import argparse
 import time
@@ -49,6 +50,16 @@ def test_deploy_frames_bounded_as_vibrate():
     (["control", "lpv", "--preset", "2-3-lpv", "--output-feedback", "--rate-certificate",
       "--certificate-rounds", "1000"], BAD_INPUT,
      "--certificate-rounds: expected at most 171 (each round re-solves"),
+    # the cutting-plane rounds of a design failing between its points: each imposes at least one
+    # verification-grid point beyond the design grid's (189 - 18 = 171)
+    (["control", "lpv", "--preset", "2-3-lpv", "--verify-rounds", "172"], BAD_INPUT,
+     "--verify-rounds: expected 0 to 171 (each round imposes"),
+    (["control", "lpv", "--preset", "2-3-lpv", "--verify-rounds", "-1"], BAD_INPUT,
+     "--verify-rounds: expected 0 to 171"),
+    (["control", "pbh", "--preset", "1-4D", "--verify-rounds", "2"], BAD_INPUT, "verify-rounds"),
+    (["deploy", "--preset", "2-3-lpv", "--lpv-controller", "x.npz", "--verify-rounds", "2"], BAD_INPUT,
+     "belong to a synthesis on the fly"),
+    (["deploy", "--preset", "1-4D", "--verify-rounds", "2"], BAD_INPUT, "apply to --controller lpv only"),
     # 1000 s / 0.01 s = 100 000 steps, a frame every 10: 10 001 frames
     (["deploy", "--preset", "1-4D", "--t-end", "1000", "--vtk", "OUT"], TOO_LARGE,
      "100,000 steps give 10,001 ParaView frames; the limit is 10,000"),

@@ -11,7 +11,7 @@ from tmfem.control.lpv.defaults import CERTIFICATE_ROUNDS
 from tmfem.errors import InputError
 
 # the options of `tmfem control` that only `lpv` takes (refused by the other actions)
-LPV_ONLY = ("grid", "rate_bound_deg", "refine", "max_iter", "bound_only", "gamma", "gamma_rtol",
+LPV_ONLY = ("grid", "rate_bound_deg", "refine", "verify_rounds", "max_iter", "bound_only", "gamma", "gamma_rtol",
             "time_budget", "fixed_gamma", "sample_time", "start", "output_feedback", "noise", "rate_certificate",
             "certificate_rounds", "estimator_interpolation", "estimator_refine")
 
@@ -108,8 +108,8 @@ def run(args) -> dict:
     ctrl, syn = lpv_options.synthesize(cfg, gp, bound, max_iter=args.max_iter, sample_time=args.sample_time)
     fine = lpv_options.refined_plant(cfg["system"], plant, cfg["refine"], what="verification plant")
     est = None if R == 1 else lpv_options.refined_plant(cfg["system"], plant, R, what="estimator plant")
-    v = lpv_options.verify_finer(cfg, plant, ctrl, sample_time=args.sample_time, fine=fine)
-    out = {**out, **syn, **v.to_dict()}
+    ctrl, v, checked = lpv_options.verify_finer(cfg, plant, ctrl, sample_time=args.sample_time, fine=fine)
+    out = {**out, **syn, **checked}
     saved = ctrl
     if args.output_feedback:
         saved, extra = lpv.output_feedback_design(
@@ -137,6 +137,14 @@ def format_text(r: dict) -> str:
                   f"{r['solve_time_s']:.1f} s, sizes {r['sizes']})",
                   f"verification on {r['verification_grid']}: max LMI eigenvalue {r['verification_max_eig']:.3e}, "
                   f"max closed-loop Re {r['closed_loop_max_real']:.3e}"]
+        if "design_refinement" in r:
+            ref = r["design_refinement"]
+            level = ("gamma kept" if ref["gamma"] == ref["design_gamma"] else
+                     f"gamma raised from {ref['design_gamma']:.5g} above the new points' pointwise optima")
+            lines.append(f"  the bisection's design failed between its grid points (largest LMI eigenvalue "
+                         f"{ref['rounds'][0]['fine_max_eig']:.3e}); cutting-plane refinement: {ref['stopped']} after "
+                         f"{len(ref['rounds']) - 1} re-solves, {ref['points_added']} points of the verification "
+                         f"grid imposed, {level} ({ref['time_s']:.0f} s)")
     if r.get("output_feedback"):
         lines += [f"output feedback on {len(r['measured'])} measured signals (W_n = {r['noise_weight']:g}): "
                   f"frozen max closed-loop Re {r['output_feedback_closed_loop_max_real']:.3e}, "

@@ -26,7 +26,7 @@ from tmfem.errors import InfeasibleController, InputError
 from tmfem.system.problem import lpv_path
 
 #: the synthesis options of an on-the-fly design (refused with --lpv-controller)
-SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start")
+SYNTHESIS = ("grid", "gamma", "solver", "gamma_rtol", "time_budget", "fixed_gamma", "refine", "start", "verify_rounds")
 #: options of the 7.4 deployments that do not apply to the LPV one (None or False: not given)
 NOT_LPV = ("uncertainty", "allocation", "pfl_at", "gains")
 
@@ -102,9 +102,9 @@ def design(args, preset: str):
     plant, gp, bound, out = lpv_options.design_plant(cfg, command="deploy")
     sample = args.dt if cfg["solver"] == "EIGOPT" else None
     ctrl, syn = lpv_options.synthesize(cfg, gp, bound, sample_time=sample)
-    v = lpv_options.verify_finer(cfg, plant, ctrl, sample_time=args.dt)
+    ctrl, _, checked = lpv_options.verify_finer(cfg, plant, ctrl, sample_time=args.dt)
     out.pop("preset")
-    return plant, ctrl, {**out, **syn, **v.to_dict()}
+    return plant, ctrl, {**out, **syn, **checked}
 
 
 #: --controller name -> design(args, preset) -> (design plant, design with ``gamma``, JSON entries)

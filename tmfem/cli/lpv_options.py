@@ -12,7 +12,7 @@ import numpy as np
 from tmfem import reference
 from tmfem.cli.common import progress_bar, say
 from tmfem.control import lpv
-from tmfem.control.lpv.defaults import GAMMA_RTOL, TIME_BUDGET
+from tmfem.control.lpv.defaults import DESIGN_PER_ROUND, DESIGN_ROUNDS, GAMMA_RTOL, TIME_BUDGET
 from tmfem.errors import InputError, ResourceLimit
 from tmfem.resources import MAX_SYNTHESIS_S
 
@@ -33,6 +33,11 @@ def configure_synthesis(parser, *, prefix: str = "lpv: ") -> None:
                              "ends; default all of it: 6x3 for 2-3-lpv, 8.3)")
     parser.add_argument("--refine", type=int, default=None,
                         help=prefix + "verification grid refinement factor (>= 4, default 4)")
+    parser.add_argument("--verify-rounds", type=int, default=None,
+                        help=prefix + "where the design fails its verification between the design points, at most "
+                             f"this many cutting-plane rounds on the verification grid (each imposes the "
+                             f"{DESIGN_PER_ROUND} worst failing points and re-solves at the design's gamma; default "
+                             f"{DESIGN_ROUNDS}; 0: refuse the design as it is)")
     parser.add_argument("--gamma", type=float, default=None,
                         help=prefix + "EIGOPT: the first (upper) level of the gamma bisection (default 2 x the "
                              "pointwise lower bound), or the only level with --fixed-gamma")
@@ -118,9 +123,15 @@ def check_synthesis(args, *, solver: str, system) -> dict:
                             f"has {fine_n[0]} x {fine_n[1]} = {fine_n[0] * fine_n[1]:,} points, one COM "
                             f"linearisation each (~2 s); the limit is {MAX_VERIFY_POINTS}")
     check_iteration_limits(args, fine_points=fine_n[0] * fine_n[1], design_points=th.size * ps.size)
+    extra = fine_n[0] * fine_n[1] - th.size * ps.size
+    rounds = min(DESIGN_ROUNDS, extra) if getattr(args, "verify_rounds", None) is None else args.verify_rounds
+    if not 0 <= rounds <= extra:
+        raise InputError(f"--verify-rounds: expected 0 to {extra} (each round "
+                         f"imposes at least one more of the verification grid's points beyond the design "
+                         f"grid's), found {rounds}")
     return {"system": system, "preset": system.name, "theta": th, "psi": ps, "refine": refine, "solver": solver,
             "gamma": args.gamma, "fixed": bool(args.fixed_gamma), "rtol": rtol, "budget": budget, "start": start,
-            "time_budget": eig["time_budget"]}
+            "time_budget": eig["time_budget"], "verify_rounds": rounds}
 
 
 def progress(total, label):
@@ -183,7 +194,11 @@ def refined_plant(s, plant, factor: int, *, what: str):
 
 
 def verify_finer(cfg: dict, plant, ctrl, *, sample_time=None, fine=None):
-    """:func:`tmfem.control.lpv.workflow.verify_design` on the grid ``refine`` times finer
-    (or ``fine`` when given); refuses a controller that fails there."""
+    """:func:`tmfem.control.lpv.workflow.verified_design` on the grid ``refine`` times finer
+    (or ``fine`` when given): (controller, verification, JSON entries); a controller that fails
+    there is refined by cutting planes (``--verify-rounds``), and refused when it still fails."""
     fine = refined_plant(cfg["system"], plant, cfg["refine"], what="verification plant") if fine is None else fine
-    return lpv.verify_design(ctrl, fine, tracked=cfg["system"].q_names, sample_time=sample_time)
+    ctrl, v, record = lpv.verified_design(ctrl, fine, tracked=cfg["system"].q_names, sample_time=sample_time,
+                                          rounds=cfg["verify_rounds"], time_budget=cfg["budget"], progress=progress)
+    refined = {} if record is None else {"design_refinement": record, "gamma": ctrl.gamma, "status": ctrl.status}
+    return ctrl, v, {**v.to_dict(), **refined}

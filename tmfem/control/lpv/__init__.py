@@ -6,7 +6,7 @@ of Figure 8.1 (:func:`interconnection_8_1`), state-feedback synthesis with rate 
 verification (:mod:`tmfem.control.lpv.verify`), the observer-based output feedback and its
 rate-bounded certificate, the gain-scheduled controllers and the LPV deployment of 8.4. The
 design workflow of ``tmfem control lpv`` is :mod:`tmfem.control.lpv.workflow`
-(:func:`design_plant`, :func:`synthesize_design`, :func:`refined_plant`, :func:`verify_design`,
+(:func:`design_plant`, :func:`synthesize_design`, :func:`refined_plant`, :func:`verify_design`, :func:`verified_design`,
 :func:`output_feedback_design`). The general gridded synthesis on any plant, with basis
 functions of one's choice for the parameter dependence, is :func:`lpvsyn`
 (:mod:`tmfem.control.lpv.gridded_synthesis`, docs/guides/lpvsyn.md); it carries the 2-3
@@ -45,6 +45,8 @@ __getattr__, __dir__, __all__ = lazy_exports(__name__, {
     "refined_plant": "tmfem.control.lpv.workflow",
     "saved_design_plant": "tmfem.control.lpv.workflow",
     "synthesize_design": "tmfem.control.lpv.workflow",
+    "verified_design": "tmfem.control.lpv.workflow",
+    "refine_state_feedback": "tmfem.control.lpv.refinement",
     "verify_design": "tmfem.control.lpv.workflow",
     "Basis": "tmfem.control.lpv.basis",
     "lpvsyn": "tmfem.control.lpv.gridded_synthesis",

@@ -39,6 +39,13 @@ class PointwiseBound:
                 "lpv_gamma_lower_bound_achieved_norm": self.achieved_norm}
 
 
+def scaled_point(gp: GeneralizedLPV, idx, T: np.ndarray) -> tuple:
+    """(A, B1, B2, C1, D11, D12) of the grid point ``idx`` of ``gp`` in the scaled states x = T x_s."""
+    Ti = 1.0 / T
+    return (Ti[:, None] * gp.A[idx] * T[None, :], Ti[:, None] * gp.B1[idx], Ti[:, None] * gp.B2[idx],
+            gp.C1[idx] * T[None, :], gp.D11[idx], gp.D12[idx])
+
+
 def pointwise_state_feedback_bound(gp: GeneralizedLPV, *, eps: float = 1e-8,
                                    rtol: float = 1e-5) -> PointwiseBound:
     """gamma_SF at every grid point of ``gp`` (states scaled as in the synthesis, diagonal
@@ -47,18 +54,12 @@ def pointwise_state_feedback_bound(gp: GeneralizedLPV, *, eps: float = 1e-8,
     import control
     shp = gp.grid_shape
     T = state_scaling(gp.A[tuple(s // 2 for s in shp)])
-    Ti = 1.0 / T
-
-    def scaled(idx):
-        return (Ti[:, None] * gp.A[idx] * T[None, :], Ti[:, None] * gp.B1[idx], Ti[:, None] * gp.B2[idx],
-                gp.C1[idx] * T[None, :], gp.D11[idx], gp.D12[idx])
-
     g = np.zeros(shp)
     for idx in np.ndindex(*shp):
-        g[idx] = state_feedback_gamma(*scaled(idx), eps=eps, rtol=rtol)
+        g[idx] = state_feedback_gamma(*scaled_point(gp, idx, T), eps=eps, rtol=rtol)
     k = np.unravel_index(int(np.argmax(g)), shp)
     at = [float(a[i]) for a, i in zip(gp.axes, k)]
-    A, B1, B2, C1, D11, D12 = scaled(k)
+    A, B1, B2, C1, D11, D12 = scaled_point(gp, k, T)
     K = state_feedback_gain(A, B1, B2, C1, D11, D12, 1.01 * float(g[k]), eps=eps)
     Acl = A + B2 @ K
     if np.max(np.linalg.eigvals(Acl).real) >= 0:

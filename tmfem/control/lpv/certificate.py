@@ -37,7 +37,6 @@ sampled loops are checked frozen only (:func:`~tmfem.control.lpv.output_feedback
 """
 from __future__ import annotations
 
-import itertools
 import logging
 import time
 from dataclasses import dataclass, field, replace
@@ -46,7 +45,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from tmfem.control.lpv.bisect import bisect_gamma
-from tmfem.control.lpv.coordinates import Coordinates, Tm_back
+from tmfem.control.lpv.coordinates import Coordinates, Tm_back, design_points_in
 from tmfem.control.lpv.eigopt import EigOpt
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, lmi_matrix
 from tmfem.control.lpv.plant import GriddedLPV, grid_point_text
@@ -295,14 +294,7 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
         raise InputError(f"certificate refinement: expected per_round >= 1, max_rounds >= 0 (integers) and a "
                          f"time budget > 0, found {per_round!r}, {max_rounds!r}, {time_budget!r}")
     X = certificate.lyapunov
-    design_idx = []
-    for rho in itertools.product(*X.axes):
-        hit = [np.flatnonzero(np.isclose(a, r, rtol=0, atol=1e-12 * max(1.0, np.abs(a).max())))
-               for a, r in zip(fine.axes, rho)]
-        if any(h.size == 0 for h in hit):
-            raise InputError(f"certificate refinement: expected the fine grid to contain every design point, "
-                             f"found none at rho = {list(rho)}")
-        design_idx.append(tuple(int(h[0]) for h in hit))
+    design_idx = design_points_in(X.axes, fine.axes, what="certificate refinement")
     t0, c0 = time.perf_counter(), time.process_time()
     deadline = t0 + time_budget
     gp = closed_loop_lpv(design, fine, W_e=W_e, W_u=W_u)

@@ -9,6 +9,7 @@ point (:func:`accepted_design`).
 """
 from __future__ import annotations
 
+import itertools
 import logging
 from dataclasses import dataclass
 
@@ -138,6 +139,26 @@ def accepted_design(gp, Pv, Qv, g, T, verts, center, half, varying, *, solver, s
                             rate_bounds=gp.rate_bounds.copy(), state_names=list(gp.state_names),
                             solver=solver, status=status, solve_time=solve, build_time=build,
                             sizes=sizes, max_lmi_eig=float(worst), min_P_eig=float(minP))
+
+
+def design_points_in(axes, fine_axes, *, what: str) -> list:
+    """The index tuples in the grid of ``fine_axes`` of every point of the grid of ``axes``
+    (a design grid inside a finer one, e.g. its refinement).
+
+    Raises
+    ------
+    InputError
+        A design point that is not a point of the finer grid (``what`` names the caller).
+    """
+    out = []
+    for rho in itertools.product(*axes):
+        hit = [np.flatnonzero(np.isclose(a, r, rtol=0, atol=1e-12 * max(1.0, np.abs(a).max())))
+               for a, r in zip(fine_axes, rho)]
+        if any(h.size == 0 for h in hit):
+            raise InputError(f"{what}: expected the fine grid to contain every design point, "
+                             f"found none at rho = {list(rho)}")
+        out.append(tuple(int(h[0]) for h in hit))
+    return out
 
 
 def Tm_back(Ps: np.ndarray, T: np.ndarray) -> np.ndarray:

@@ -25,12 +25,14 @@ import numpy as np
 
 from tmfem.control.lpv.bounds import PointwiseBound, pointwise_state_feedback_bound
 from tmfem.control.lpv.certificate import rate_bounded_certificate, refine_certificate
-from tmfem.control.lpv.defaults import CERTIFICATE_PER_ROUND, GAMMA_RTOL, TIME_BUDGET, W_E, W_U
+from tmfem.control.lpv.defaults import (CERTIFICATE_PER_ROUND, DESIGN_PER_ROUND, DESIGN_ROUNDS, GAMMA_RTOL,
+                                        TIME_BUDGET, W_E, W_U)
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, interconnection_8_1
 from tmfem.control.lpv.gridded_synthesis import lpvsyn
 from tmfem.control.lpv.output_feedback import (LPVOutputFeedback, design_output_feedback,
                                                verify_output_feedback)
 from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant, grid_point_text
+from tmfem.control.lpv.refinement import refine_state_feedback
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.control.lpv.synthesis import synthesize_state_feedback
 from tmfem.control.lpv.verify import Verification, verify
@@ -208,6 +210,45 @@ def verify_design(design: LPVStateFeedback, plant: GriddedLPV, *, tracked,
         Where the LMI does not hold or a frozen loop is unstable.
     """
     return verify(design, interconnection_8_1(plant, tracked=tracked), sample_time=sample_time)
+
+
+def verified_design(design: LPVStateFeedback, plant: GriddedLPV, *, tracked, sample_time: float | None = None,
+                    rounds: int = DESIGN_ROUNDS, per_round: int = DESIGN_PER_ROUND,
+                    time_budget: float = TIME_BUDGET, progress=no_progress) -> tuple:
+    """:func:`verify_design` of ``design`` on ``plant`` (a grid finer than the design's); where
+    it fails between the design points, the cutting-plane refinement of
+    :func:`tmfem.control.lpv.refinement.refine_state_feedback` on ``plant``'s grid (at most
+    ``rounds`` re-solves of ``per_round`` more points each, within ``time_budget`` seconds)
+    and the check again.
+
+    Returns
+    -------
+    (LPVStateFeedback, Verification, dict or None)
+        The design (refined when it was), its verification on ``plant`` and the refinement's
+        record (None when the design passed as it was).
+
+    Raises
+    ------
+    InfeasibleController
+        The design, refined or not, fails on ``plant`` (the message says what the refinement did).
+    """
+    gp = interconnection_8_1(plant, tracked=tracked)
+    if rounds == 0:
+        return design, verify(design, gp, sample_time=sample_time), None
+    v = verify(design, gp, sample_time=sample_time, allow_failure=True)
+    if v.passed:
+        return design, v, None
+    with progress(rounds, "cutting-plane refinement (rounds)") as bar:
+        refined, record = refine_state_feedback(design, gp, per_round=per_round, max_rounds=rounds,
+                                                time_budget=time_budget, sample_time=sample_time,
+                                                progress=lambda k: bar(k, rounds))
+    try:
+        v = verify(refined, gp, sample_time=sample_time)
+    except InfeasibleController as exc:
+        raise InfeasibleController(f"{exc}; the cutting-plane refinement on that grid stopped on "
+                                   f"{record['stopped']} after {len(record['rounds'])} checks "
+                                   f"({record['points_added']} points added)") from None
+    return refined, v, record
 
 
 def output_feedback_design(design: LPVStateFeedback, plant: GriddedLPV, fine: GriddedLPV, *, tracked,
