@@ -97,7 +97,9 @@ def test_slender_bars_bending_modes_have_no_counterpart_and_the_membrane_modes_p
     modes 11-12 (4.26 Hz) pair with MTC and COM modes 6-7 (MAC > 0.95, within 1.5 %), where the
     comparison by order sets SBC mode 6 against MTC mode 6, 20 % apart. Modes 1-5 pair in order."""
     csv_path = tmp_path / "c.csv"
-    r = _compare(["compare", str(SLENDER), "--modes", "12", "--mesh", "6", "--csv", str(csv_path)], capsys)
+    r = _compare(["compare", str(SLENDER), "--modes", "12", "--mesh", "6", "--csv", str(csv_path),
+                  "--plot", str(tmp_path / "c.png")], capsys)
+    assert (tmp_path / "c.png").stat().st_size > 10_000      # the paired differences, gaps at 6-10
     p = r["mode_pairs"]
     for m in ("MTC", "COM"):
         assert p[m]["mode"] == [1, 2, 3, 4, 5, None, None, None, None, None, 6, 7]
