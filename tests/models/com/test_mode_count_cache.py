@@ -38,6 +38,24 @@ def _choice(system):
     return mode_count.membrane_mode_choice(system, model_class=ControlOrientedModel)
 
 
+@pytest.fixture(scope="module")
+def stored(tmp_path_factory):
+    """A cache directory holding the triangle's choice, computed once for the module."""
+    d = tmp_path_factory.mktemp("stored-cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("TMFEM_CACHE_DIR", str(d))
+        mp.setattr(mode_count, "_CHOICES", {})
+        return d, _choice(load_system(SYSTEMS / "triangle-1-3.toml"))
+
+
+@pytest.fixture
+def with_entry(stored, fresh):
+    """``fresh`` with a copy of the stored entry (a process after the one that computed it)."""
+    import shutil
+    shutil.copytree(stored[0], fresh, dirs_exist_ok=True)
+    return fresh, stored[1]
+
+
 def test_a_new_process_reads_the_choice_from_disk_without_the_fe_model(fresh, monkeypatch):
     s = load_system(SYSTEMS / "triangle-1-3.toml")
     first = _choice(s)
@@ -51,34 +69,32 @@ def test_a_new_process_reads_the_choice_from_disk_without_the_fe_model(fresh, mo
     assert ControlOrientedModel(s, output_points=[]).K == first.K
 
 
-def test_another_tendon_diameter_is_another_entry(fresh, monkeypatch):
+def test_another_tendon_diameter_is_another_entry(with_entry, monkeypatch):
     s = load_system(SYSTEMS / "triangle-1-3.toml")
-    _choice(s)
-    monkeypatch.setattr(mode_count, "_CHOICES", {})
     monkeypatch.setattr(mode_count, "_fe_band", _forbid_fe)
+    assert _choice(s).cached
     sections = {k: dataclasses.replace(v, d=1.2 * v.d) for k, v in s.tendon_sections.items()}
     assert all(isinstance(v, TendonSection) for v in sections.values())
     with pytest.raises(FEModelRun):
         _choice(dataclasses.replace(s, tendon_sections=sections))
 
 
-def test_a_changed_constant_of_the_search_is_another_entry(fresh, monkeypatch):
+def test_a_changed_constant_of_the_search_is_another_entry(with_entry, monkeypatch):
     s = load_system(SYSTEMS / "triangle-1-3.toml")
-    _choice(s)
-    monkeypatch.setattr(mode_count, "_CHOICES", {})
     monkeypatch.setattr(mode_count, "_fe_band", _forbid_fe)
+    assert _choice(s).cached
+    monkeypatch.setattr(mode_count, "_CHOICES", {})
     monkeypatch.setattr(mode_count, "TOLERANCE", 0.04)
     with pytest.raises(FEModelRun):
         _choice(s)
 
 
 @pytest.mark.parametrize("text", ["{truncated", '{"key": 1}'])
-def test_a_corrupt_entry_is_recomputed_and_replaced(fresh, monkeypatch, caplog, text):
+def test_a_corrupt_entry_is_recomputed_and_replaced(with_entry, monkeypatch, caplog, text):
     s = load_system(SYSTEMS / "triangle-1-3.toml")
-    first = _choice(s)
+    fresh, first = with_entry
     (entry,) = (fresh / "membrane-modes").glob("*.json")
     entry.write_text(text)
-    monkeypatch.setattr(mode_count, "_CHOICES", {})
     with caplog.at_level(logging.INFO, logger="tmfem.cache"):
         again = _choice(s)
     assert "recomputing" in caplog.text
