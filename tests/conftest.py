@@ -14,6 +14,15 @@ import numpy as np  # noqa: E402  (after the BLAS thread count is set)
 import pytest  # noqa: E402
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _isolated_cache(tmp_path_factory):
+    """The suite's on-disk cache (tmfem.cache) is a directory of its own, shared by the session
+    and by the commands it starts (the environment is inherited): never the user's cache."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("TMFEM_CACHE_DIR", str(tmp_path_factory.mktemp("tmfem-cache")))
+        yield
+
+
 @pytest.fixture(scope="session")
 def design21(tmp_path_factory):
     """A 2 x 1 grid LPV design of the 2-3-lpv preset at gamma = 20 with the sampled-loop LMI at

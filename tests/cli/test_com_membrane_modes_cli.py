@@ -34,3 +34,21 @@ def test_the_option_and_the_preset_say_where_k_comes_from(capsys):
     assert main(["modal", "--preset", "2-3", "--model", "com", "--modes", "4", "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     assert r["membrane_modes"] == 4 and r["membrane_mode_choice"]["source"] == "file"
+
+
+def test_a_second_run_says_the_choice_came_from_the_cache(capsys, monkeypatch, tmp_path):
+    """A new process (empty in-process table) with the first run's cache directory reads K from
+    disk and says so; the JSON records it."""
+    from tmfem.models.com import mode_count
+    monkeypatch.setenv("TMFEM_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(mode_count, "_CHOICES", {})
+    assert main(["modal", TRIANGLE, "--model", "com", "--modes", "4"]) == 0
+    first = capsys.readouterr().out
+    assert "tolerance 5 %)" in first and "cached" not in first
+    monkeypatch.setattr(mode_count, "_CHOICES", {})
+    assert main(["modal", TRIANGLE, "--model", "com", "--modes", "4", "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["membrane_mode_choice"]["cached"] is True
+    monkeypatch.setattr(mode_count, "_CHOICES", {})
+    assert main(["modal", TRIANGLE, "--model", "com", "--modes", "4"]) == 0
+    assert "tolerance 5 %, cached)" in capsys.readouterr().out

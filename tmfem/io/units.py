@@ -48,6 +48,8 @@ _EXACT = {
     "min_margin": "-", "min_margin_progress": "-", "resolution": "- (progress s)", "hinf_gamma": "-",
     # the COM's membrane-mode count (docs/guides/com.md)
     "membrane_mode_choice": "reference_hz, com_hz in Hz; tolerance and differences relative (-)",
+    # the modes of compare paired by shape (docs/guides/sbc.md)
+    "mode_pairs": "freq_hz in Hz; mode numbers, MAC, fractions and differences (-)",
 }
 _SUFFIX = [(r".*_deg$", "deg"), (r".*_hz$", "Hz"), (r".*_MPa$", "MPa"), (r".*_mm$", "mm"),
            (r".*_m$", "m"), (r".*_N$", "N"), (r".*_s$", "s"), (r".*_J$", "J"),

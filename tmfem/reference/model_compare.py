@@ -16,6 +16,15 @@ Each model is taken at the prestress the file names (docs/validation/errata.md f
 
 Meshes as in 6.4: N x 10 x 10 membrane elements, one beam per bar (SBC), 3 truss elements per
 tendon, K of ``[models.com]`` membrane modes in the COM (5 for 1-4, 4 for 2-3).
+
+Modes are compared by shape, not by order: each SBC mode is paired with the MTC and COM modes
+of the same shape (:mod:`tmfem.reference.mode_pairing`: MAC on the bar-end and membrane
+translations the three models share, :mod:`tmfem.reference.shared_shapes`), and the model
+differences of the pairs are given beside the differences by order. An SBC mode without a
+counterpart (for example the bending of slender bars, which the MTC and COM models, with
+straight or rigid bars, do not have) is named with the bars' share of its strain energy.
+The printed tables compare by order; at their mesh the presets' pairing is the identity (the
+test suite checks it), so both agree there.
 """
 from __future__ import annotations
 
@@ -28,6 +37,8 @@ import numpy as np
 
 from tmfem.errors import InputError
 from tmfem.io.atomic import atomic_open
+from tmfem.reference.mode_pairing import CLUSTER_TOLERANCE, MAC_THRESHOLD, pair_modes
+from tmfem.reference.shared_shapes import beam_energy_share, com_shared_shapes, fe_shared_shapes
 from tmfem.reference.tables import printed_frequencies
 
 log = logging.getLogger(__name__)
@@ -78,27 +89,47 @@ def fe_models(system, *, mesh_n: int = 10, tendon_elements: int = 3, backend="sc
             "MTC": MTCModel(s, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend)}
 
 
+#: MTC and COM modes computed beyond ``modes`` for the pairing only: the partner of an SBC mode
+#: near the top of the band, or the other half of a degenerate pair that the last mode cuts,
+#: is then among them (the tables show the ``modes`` lowest)
+PAIRING_EXTRA = 4
+
+
 def model_frequencies(system, *, modes: int = 12, mesh_n: int = 10, tendon_elements: int = 3,
                       backend="scipy", progress=None) -> dict:
     """Natural frequencies [Hz] of the three models of ``system`` (module docstring):
-    ``freq_hz`` by model, wall times, and the settings. ``progress(label)`` before each model."""
+    ``freq_hz`` by model (the ``modes`` lowest), the modes' ``shared_shapes`` by model (columns,
+    :mod:`tmfem.reference.shared_shapes`; the MTC and COM models with :data:`PAIRING_EXTRA`
+    more modes, whose frequencies are ``pairing_hz``), the bars' share of the SBC modes'
+    strain energy (``sbc_beam_energy_share``), wall times, and the settings.
+    ``progress(label)`` before each model."""
     from tmfem.models.com.linearize import linearize
-    out, times = {}, {}
+    out, times, shapes = {}, {}, {}
     fe = fe_models(system, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend)
     for key, m in fe.items():
         if progress:
             progress(key)
         t0 = time.perf_counter()
         res = m.equilibrium()
-        out[key] = m.modes(k=modes, at=res).freq_hz
+        k = modes if key == "SBC" or modes >= m.max_modes else min(modes + PAIRING_EXTRA, m.max_modes)
+        md = m.modes(k=k, at=res)
+        out[key] = md.freq_hz
         times[key] = time.perf_counter() - t0
+        shapes[key] = fe_shared_shapes(m, md)
+        if key == "SBC":
+            beam_share = beam_energy_share(m, res.state, md)
     if progress:
         progress("COM")
     t0 = time.perf_counter()
     com = com_model(system, mesh_n=mesh_n)
-    out["COM"] = linearize(com).frequencies_hz()[:modes]
+    lin = linearize(com)
+    md = lin.modes(modes + PAIRING_EXTRA)
+    out["COM"] = md.freq_hz
     times["COM"] = time.perf_counter() - t0
-    return {"freq_hz": {k: np.asarray(out[k], dtype=float) for k in MODELS}, "time_s": times,
+    shapes["COM"] = com_shared_shapes(com, lin.z_e, md.shapes, mesh_nodes=fe["MTC"].topology.n_mesh)
+    return {"freq_hz": {k: np.asarray(out[k][:modes], dtype=float) for k in MODELS}, "time_s": times,
+            "shared_shapes": shapes, "pairing_hz": {k: np.asarray(v, dtype=float) for k, v in out.items()},
+            "sbc_beam_energy_share": beam_share,
             "settings": {"mesh_n": mesh_n, "tendon_elements": tendon_elements,
                          "backend": {k: m.backend.name for k, m in fe.items()},
                          "rest_lengths": fe["MTC"].rest_lengths.tolist(),
@@ -117,10 +148,13 @@ def compare_frequencies(system, *, modes: int = 12, **kwargs) -> dict:
     ours = r["freq_hz"]
     n = min(len(v) for v in ours.values())
     vs_sbc_ours = {k: ours[k][:n] / ours["SBC"][:n] - 1 for k in ("MTC", "COM")}
+    pairs = paired_modes(r)
     out = {"system": system.name, "modes": modes, "source": None,
            "ours": {k: v.tolist() for k, v in ours.items()},
            "vs_SBC": {"ours": {k: v.tolist() for k, v in vs_sbc_ours.items()}},
-           "max_abs_vs_SBC": {"ours": {k: float(np.abs(v).max()) for k, v in vs_sbc_ours.items()}},
+           "max_abs_vs_SBC": {"ours": {k: float(np.abs(v).max()) for k, v in vs_sbc_ours.items()},
+                              "paired": {k: _max_abs(pairs[k]["vs_SBC"]) for k in ("MTC", "COM")}},
+           "mode_pairs": pairs,
            "printed": None, "ours_vs_printed": None, "stated_bound": None, "stated": None,
            "settings": r["settings"], "time_s": r["time_s"]}
     printed = printed_frequencies(system)
@@ -139,6 +173,83 @@ def compare_frequencies(system, *, modes: int = 12, **kwargs) -> dict:
     return out
 
 
+def paired_modes(r: dict) -> dict:
+    """The MTC and COM modes paired with each SBC mode by shape (module docstring) from the
+    result of :func:`model_frequencies` (JSON-able): per model the 1-based partner ``mode``
+    (None: no counterpart), its ``mac``, its frequency ``freq_hz`` and its difference
+    ``vs_SBC`` = f / f_SBC - 1 (the partner may be one of the :data:`PAIRING_EXTRA` modes
+    above the table), the model's modes of the table paired with no SBC mode (``unpaired``)
+    and whether the pairing is the identity; the bars' share of each SBC mode's strain energy
+    (``SBC_beam_energy_fraction``); ``SBC_unpaired``: the SBC modes without a counterpart in
+    either model."""
+    f, shapes = r["pairing_hz"], r["shared_shapes"]
+    out = {"rule": {"mac_threshold": MAC_THRESHOLD, "cluster_tolerance": CLUSTER_TOLERANCE,
+                    "vector": "translations of the bar ends and of the membrane mesh nodes"}}
+    for k in ("MTC", "COM"):
+        p = pair_modes(shapes["SBC"], shapes[k], reference_hz=f["SBC"], other_hz=f[k])
+        out[k] = {"mode": [None if j is None else j + 1 for j in p.partner], "mac": p.mac,
+                  "freq_hz": [None if j is None else float(f[k][j]) for j in p.partner],
+                  "vs_SBC": [None if j is None else float(f[k][j] / f["SBC"][i] - 1)
+                             for i, j in enumerate(p.partner)],
+                  "unpaired": [j + 1 for j in p.unpaired_other if j < len(r["freq_hz"][k])],
+                  "identity": p.is_identity}
+    share = r["sbc_beam_energy_share"]
+    out["SBC_beam_energy_fraction"] = [float(v) for v in share]
+    out["SBC_unpaired"] = [{"mode": i + 1, "freq_hz": float(f["SBC"][i]),
+                            "without": [k for k in ("MTC", "COM") if out[k]["mode"][i] is None],
+                            "beam_energy_fraction": float(share[i])}
+                           for i in range(len(f["SBC"]))
+                           if any(out[k]["mode"][i] is None for k in ("MTC", "COM"))]
+    return out
+
+
+def _max_abs(values) -> float | None:
+    """Largest |v| of the values that are not None (None when there are none)."""
+    v = [abs(x) for x in values if x is not None]
+    return max(v) if v else None
+
+
+#: above this share of its strain energy in the bars an SBC mode is called a bar mode
+BAR_MODE_SHARE = 0.5
+
+
+def pairing_notes(r: dict) -> list[str]:
+    """Lines of text on the pairing: the rule, the unpaired modes of each model."""
+    p = r["mode_pairs"]
+    rule = p["rule"]
+    lines = [f"modes paired by shape: MAC of the {rule['vector']} (no mass weighting), one-to-one "
+             f"assignment, pairs below MAC {rule['mac_threshold']:g} dropped; MTC and COM modes within "
+             f"{100 * rule['cluster_tolerance']:g} % in frequency compared as one span"]
+    for u in p["SBC_unpaired"]:
+        share = u["beam_energy_fraction"]
+        kind = (f"the bars bend: {100 * share:.0f} % of its strain energy in the bars" if share > BAR_MODE_SHARE
+                else f"{100 * share:.0f} % of its strain energy in the bars")
+        lines.append(f"SBC mode {u['mode']} ({u['freq_hz']:.4f} Hz): no counterpart in "
+                     f"{' or '.join(u['without'])} among the computed modes ({kind})")
+    for k in ("MTC", "COM"):
+        if p[k]["unpaired"]:
+            lines.append(f"{k} modes {p[k]['unpaired']}: paired with no SBC mode among the computed modes")
+    return lines
+
+
+def _paired_table(r: dict) -> list[str]:
+    """The paired modes: SBC mode, and per model its paired mode, frequency, MAC, difference."""
+    p = r["mode_pairs"]
+    lines = [f"{'mode':>4} {'SBC ours':>9} " + " ".join(f"{m:>4} {m + ' ours':>9} {'MAC':>5} {m + '/SBC':>8}"
+                                                        for m in ("MTC", "COM"))]
+    for i, f in enumerate(r["ours"]["SBC"]):
+        row = f"{i + 1:>4} {f:9.4f}"
+        for m in ("MTC", "COM"):
+            j = p[m]["mode"][i]
+            row += (f" {'-':>4} {'':9} {p[m]['mac'][i]:5.2f} {'none':>8}" if j is None else
+                    f" {j:>4} {p[m]['freq_hz'][i]:9.4f} {p[m]['mac'][i]:5.2f} {100 * p[m]['vs_SBC'][i]:+7.2f}%")
+        lines.append(row)
+    mx = r["max_abs_vs_SBC"]["paired"]
+    lines.append("largest |model / SBC - 1| of the pairs: " + ", ".join(
+        f"{m} {'-' if mx[m] is None else f'{100 * mx[m]:.2f} %'}" for m in ("MTC", "COM")))
+    return lines + pairing_notes(r)
+
+
 def format_compare(r: dict) -> str:
     """Text table of :func:`compare_frequencies` (the printed columns when there are some)."""
     s = r["settings"]
@@ -148,13 +259,7 @@ def format_compare(r: dict) -> str:
             + ", ".join(f"{k} {v}" for k, v in s["backend"].items()) + ", COM K = "
             f"{s['com_membrane_modes']}, prestress x{s['com_prestress_scale']:.4f})")
     if not r["printed"]:
-        lines = [head, f"{'mode':>4} " + " ".join(f"{m + ' ours':>9}" for m in MODELS)
-                 + f" {'MTC/SBC':>8} {'COM/SBC':>8}"]
-        for i in range(len(r["vs_SBC"]["ours"]["MTC"])):
-            lines.append(f"{i + 1:>4} " + " ".join(f"{r['ours'][m][i]:9.4f}" for m in MODELS) + " "
-                         + " ".join(f"{100 * r['vs_SBC']['ours'][m][i]:+7.2f}%" for m in ("MTC", "COM")))
-        mx = r["max_abs_vs_SBC"]["ours"]
-        lines.append(f"largest |model / SBC - 1|: MTC {100 * mx['MTC']:.2f} %, COM {100 * mx['COM']:.2f} %")
+        lines = [head] + _paired_table(r)
         lines.append("times [s]: " + ", ".join(f"{k} {v:.2f}" for k, v in r["time_s"].items()))
         return "\n".join(lines)
     n = len(r["printed"]["SBC"])
@@ -176,6 +281,12 @@ def format_compare(r: dict) -> str:
                  f"{100 * mx['ours']['COM']:.2f} %; printed MTC {100 * mx['printed']['MTC']:.2f} %, "
                  f"COM {100 * mx['printed']['COM']:.2f} %"
                  + (f" (stated, {r['stated']})" if r["stated"] else ""))
+    if all(r["mode_pairs"][m]["identity"] for m in ("MTC", "COM")):
+        lowest = min(min(r["mode_pairs"][m]["mac"]) for m in ("MTC", "COM"))
+        lines.append(f"modes paired by shape: mode i with mode i in every model (smallest MAC {lowest:.2f}), "
+                     "so the comparison by order above is the paired one")
+    else:
+        lines += ["modes paired by shape (the printed table compares by order):"] + _paired_table(r)
     lines.append("times [s]: " + ", ".join(f"{k} {v:.2f}" for k, v in r["time_s"].items()))
     return "\n".join(lines)
 
@@ -183,18 +294,29 @@ def format_compare(r: dict) -> str:
 def write_compare_csv(path, r: dict) -> Path:
     """One row per mode: ours and printed per model, the differences of :func:`compare_frequencies`
     (without printed values: ours and the differences to the SBC model)."""
+    p = r["mode_pairs"]
+
+    def paired(i):
+        """The paired columns of SBC mode i ("" where there is no pair)."""
+        return [x for m in ("MTC", "COM") for x in
+                ("" if p[m]["mode"][i] is None else p[m]["mode"][i], p[m]["mac"][i],
+                 "" if p[m]["mode"][i] is None else p[m]["freq_hz"][i],
+                 "" if p[m]["mode"][i] is None else p[m]["vs_SBC"][i])]
+
+    paired_cols = [f"{m}_{c}" for m in ("MTC", "COM") for c in ("paired_mode", "mac", "paired_hz", "paired_vs_SBC")]
     if not r["printed"]:
-        with open(path, "w", newline="") as fh:
+        with atomic_open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["mode"] + [f"{m}_ours_hz" for m in MODELS] + ["MTC_vs_SBC", "COM_vs_SBC"])
+            w.writerow(["mode"] + [f"{m}_ours_hz" for m in MODELS] + ["MTC_vs_SBC", "COM_vs_SBC"] + paired_cols)
             for i in range(len(r["vs_SBC"]["ours"]["MTC"])):
                 w.writerow([i + 1] + [r["ours"][m][i] for m in MODELS]
-                           + [r["vs_SBC"]["ours"][m][i] for m in ("MTC", "COM")])
+                           + [r["vs_SBC"]["ours"][m][i] for m in ("MTC", "COM")] + paired(i))
         return Path(path)
     n = len(r["printed"]["SBC"])
     cols = (["mode"] + [f"{m}_ours_hz" for m in MODELS] + [f"{m}_printed_hz" for m in MODELS]
             + [f"{m}_vs_printed" for m in MODELS] + ["MTC_vs_SBC", "COM_vs_SBC",
-                                                    "MTC_vs_SBC_printed", "COM_vs_SBC_printed"])
+                                                    "MTC_vs_SBC_printed", "COM_vs_SBC_printed"]
+            + paired_cols)
     with atomic_open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
@@ -205,5 +327,5 @@ def write_compare_csv(path, r: dict) -> Path:
                     + [r["ours_vs_printed"][m][i] if has else "" for m in MODELS]
                     + [r["vs_SBC"]["ours"][m][i] if has else "" for m in ("MTC", "COM")]
                     + [r["vs_SBC"]["printed"][m][i] if has else "" for m in ("MTC", "COM")])
-            w.writerow([i + 1] + vals)
+            w.writerow([i + 1] + vals + paired(i))
     return Path(path)

@@ -18,8 +18,10 @@ Cost: one finite-element modal analysis (mesh 10, 3 elements per tendon) and one
 K = :data:`K_SEARCH`; the COM of K < K_SEARCH modes is the Galerkin truncation of that one
 (the first K of the same fixed-corner modes, eq. 5.1), so its linearised mass and stiffness
 (eq. 5.33) are the leading blocks of the K_SEARCH model's, exact about eta = 0. The choice is
-kept per system content, so the commands and functions that build several COMs of one system
-pay for it once.
+kept per system content, in the process and on disk (:mod:`tmfem.cache`, namespace
+``membrane-modes``, keyed by the system's content, this module's constants and tmfem's
+version), so the commands and functions that build COMs of one system pay for it once, also
+across runs.
 """
 from __future__ import annotations
 
@@ -29,6 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from tmfem.cache import JsonCache
 from tmfem.errors import TmfemError
 
 log = logging.getLogger(__name__)
@@ -70,6 +73,8 @@ class MembraneModeChoice:
         Modes (1-based) of the band still more than ``tolerance`` off.
     max_difference_by_K : dict
         K -> largest |relative difference| in the band (None: fewer than band_modes modes).
+    cached : bool
+        The automatic choice was read from the on-disk cache (:mod:`tmfem.cache`).
     """
 
     K: int
@@ -82,6 +87,7 @@ class MembraneModeChoice:
     relative_difference: list = field(default_factory=list)
     disagreeing_modes: list = field(default_factory=list)
     max_difference_by_K: dict = field(default_factory=dict)
+    cached: bool = False
 
     @property
     def text(self) -> str:
@@ -95,9 +101,9 @@ class MembraneModeChoice:
         if self.disagreeing_modes:
             worst = max(abs(self.relative_difference[i - 1] if self.relative_difference[i - 1] is not None
                             else np.inf) for i in self.disagreeing_modes)
-            return s + (f"; modes {self.disagreeing_modes} still differ, by up to {100 * worst:.1f} %, "
-                        "and more modes do not change them)")
-        return s + ")"
+            s += (f"; modes {self.disagreeing_modes} still differ, by up to {100 * worst:.1f} %, "
+                  "and more modes do not change them")
+        return s + (", cached)" if self.cached else ")")
 
     def to_dict(self) -> dict:
         """JSON-able (a non-finite difference -- an unstable mode -- becomes None)."""
@@ -108,10 +114,21 @@ class MembraneModeChoice:
                 "reference_hz": self.reference_hz, "com_hz": self.com_hz,
                 "relative_difference": [finite(v) for v in self.relative_difference],
                 "disagreeing_modes": self.disagreeing_modes,
-                "max_difference_by_K": {str(k): finite(v) for k, v in self.max_difference_by_K.items()}}
+                "max_difference_by_K": {str(k): finite(v) for k, v in self.max_difference_by_K.items()},
+                "cached": self.cached}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "MembraneModeChoice":
+        """The inverse of :meth:`to_dict` (integer K keys again); raises TypeError or ValueError
+        on a dict that is not one."""
+        d = dict(d)
+        d["max_difference_by_K"] = {int(k): v for k, v in d.get("max_difference_by_K", {}).items()}
+        return cls(**d)
 
 
 _CHOICES: dict[str, MembraneModeChoice] = {}
+#: the automatic choices kept between runs
+_STORE = JsonCache("membrane-modes")
 
 
 def membrane_modes_of(system, K: int | None = None, *, model_class) -> MembraneModeChoice:
@@ -138,8 +155,38 @@ def membrane_mode_choice(system, *, model_class) -> MembraneModeChoice:
         return MembraneModeChoice(K=int(K), source="file")
     key = _fingerprint(system)
     if key not in _CHOICES:
-        _CHOICES[key] = choose_membrane_modes(system, model_class=model_class)
+        _CHOICES[key] = _stored_choice(system, key, model_class=model_class)
     return _CHOICES[key]
+
+
+def _cache_key(fingerprint: str) -> dict:
+    """Everything the automatic choice depends on: the system's content and this module's
+    constants (tmfem's version is added by the cache)."""
+    return {"system": fingerprint, "BAND_MODES": BAND_MODES, "TOLERANCE": TOLERANCE, "CONVERGED": CONVERGED,
+            "K_MIN": K_MIN, "K_SEARCH": K_SEARCH, "FE_MESH": FE_MESH}
+
+
+def _stored_choice(system, fingerprint: str, *, model_class) -> MembraneModeChoice:
+    """:func:`choose_membrane_modes` through the on-disk cache: an entry of the same key is
+    read (``cached=True``; its warning repeated), else the choice is computed and stored."""
+    key = _cache_key(fingerprint)
+    entry = _STORE.get(key)
+    if entry is not None:
+        try:
+            choice = MembraneModeChoice.from_dict(entry)
+            if choice.source != "automatic" or choice.K < 1:
+                raise ValueError(f"source {choice.source!r}, K = {choice.K}")
+        except (TypeError, ValueError) as e:
+            log.info("%s: cached membrane-mode choice %s is not one (%s): recomputing",
+                     system.name, _STORE.path(key), e)
+        else:
+            choice.cached = True
+            log.debug("%s: %s", system.name, choice.text)
+            _warn_disagreeing(system, choice)
+            return choice
+    choice = choose_membrane_modes(system, model_class=model_class)
+    _STORE.put(key, {k: v for k, v in choice.to_dict().items() if k != "cached"})
+    return choice
 
 
 def choose_membrane_modes(system, *, model_class, band_modes: int = BAND_MODES,
@@ -189,13 +236,20 @@ def choose_membrane_modes(system, *, model_class, band_modes: int = BAND_MODES,
              system.name, fe_name, n, ", ".join(f"{k}: {'-' if w is None else f'{100 * w:.1f} %'}"
                                                  for k, w in worst.items()))
     log.debug("%s: %s", system.name, choice.text)
-    if bad:
-        log.warning("%s: COM frequencies of modes %s differ from the %s model's by more than %g %% with "
-                    "any K up to %d (largest %.1f %% at the chosen K = %d): the COM's own approximation "
-                    "(rigid bars, linear tendon springs of eqs. 3.8-3.9, membrane modes about the "
-                    "designed prestress, ch. 5; docs/guides/com.md)", system.name, bad,
-                    fe_name, 100 * tolerance, k_hi, 100 * float(np.max(np.abs(rel))), K)
+    _warn_disagreeing(system, choice, k_search=k_hi)
     return choice
+
+
+def _warn_disagreeing(system, choice: MembraneModeChoice, *, k_search: int = K_SEARCH) -> None:
+    """The warning that names the band's modes no K brings within the tolerance."""
+    if not choice.disagreeing_modes:
+        return
+    worst = max(np.inf if v is None else abs(v) for v in choice.relative_difference)
+    log.warning("%s: COM frequencies of modes %s differ from the %s model's by more than %g %% with "
+                "any K up to %d (largest %.1f %% at the chosen K = %d): the COM's own approximation "
+                "(rigid bars, linear tendon springs of eqs. 3.8-3.9, membrane modes about the "
+                "designed prestress, ch. 5; docs/guides/com.md)", system.name, choice.disagreeing_modes,
+                choice.reference, 100 * choice.tolerance, k_search, 100 * worst, choice.K)
 
 
 def _relative(f, ref) -> np.ndarray:

@@ -1,0 +1,122 @@
+"""tmfem's on-disk cache: small results that take long to compute and depend only on their
+inputs, kept as one JSON file per key so that the next process reads them instead.
+
+Directory (the XDG base-directory convention): ``$TMFEM_CACHE_DIR`` when set, else
+``$XDG_CACHE_HOME/tmfem`` (an absolute ``XDG_CACHE_HOME`` only, as the specification says),
+else ``~/.cache/tmfem``. Each kind of result has a subdirectory (:class:`JsonCache`
+``namespace``); an entry's file name is the SHA-256 of its key -- everything the result depends
+on, tmfem's version included -- and the file repeats the key, which a read checks.
+
+The cache never decides a result: a missing, unreadable, corrupt or mismatched entry is
+logged and ignored (the caller recomputes), and a directory that cannot be written is
+named in one warning per process, after which the results are just not stored. Entries are
+written to a temporary name in the same directory and renamed (``os.replace``, atomic on
+POSIX): a reader never sees half an entry. (:mod:`tmfem.io.atomic` does the same for the
+commands' outputs; it lives in a layer above the models, which use this cache.) Deleting the
+directory is always safe.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import logging
+import os
+import tempfile
+from pathlib import Path
+
+from tmfem import __version__
+
+log = logging.getLogger(__name__)
+
+#: environment variable that overrides the cache directory
+ENV_VAR = "TMFEM_CACHE_DIR"
+
+#: directories whose write failed (warned about once per process)
+_UNWRITABLE: set[Path] = set()
+
+
+def cache_dir() -> Path:
+    """The cache directory (module docstring); not created here."""
+    d = os.environ.get(ENV_VAR)
+    if d:
+        return Path(d).expanduser()
+    xdg = os.environ.get("XDG_CACHE_HOME", "")
+    base = Path(xdg) if os.path.isabs(xdg) else Path.home() / ".cache"
+    return base / "tmfem"
+
+
+class JsonCache:
+    """Entries of one kind of result under ``cache_dir() / namespace``.
+
+    Parameters
+    ----------
+    namespace : str
+        The subdirectory (one per kind of result).
+    """
+
+    def __init__(self, namespace: str):
+        self.namespace = namespace
+
+    @property
+    def directory(self) -> Path:
+        """``cache_dir() / namespace``, evaluated at each use (the environment may change)."""
+        return cache_dir() / self.namespace
+
+    @staticmethod
+    def full_key(key: dict) -> dict:
+        """``key`` with tmfem's version added (a new version recomputes)."""
+        return {**key, "tmfem": __version__}
+
+    def path(self, key: dict) -> Path:
+        """The entry's file: the SHA-256 of the key's canonical JSON."""
+        text = json.dumps(self.full_key(key), sort_keys=True, allow_nan=False)
+        return self.directory / f"{hashlib.sha256(text.encode()).hexdigest()}.json"
+
+    def get(self, key: dict) -> dict | None:
+        """The value stored under ``key``, or None (no entry; an unreadable, corrupt or
+        mismatched one is logged and ignored)."""
+        path = self.path(key)
+        try:
+            text = path.read_text()
+        except FileNotFoundError:
+            return None
+        except OSError as e:
+            log.info("cache entry %s is unreadable (%s): recomputing", path, e.strerror or e)
+            return None
+        try:
+            entry = json.loads(text)
+        except ValueError as e:
+            log.info("cache entry %s is not valid JSON (%s): recomputing", path, e)
+            return None
+        if not isinstance(entry, dict) or entry.get("key") != self.full_key(key) \
+                or not isinstance(entry.get("value"), dict):
+            log.info("cache entry %s does not hold this key or this tmfem version (%s): recomputing",
+                     path, __version__)
+            return None
+        log.debug("cache entry %s read", path)
+        return entry["value"]
+
+    def put(self, key: dict, value: dict) -> Path | None:
+        """Store ``value`` (JSON-able) under ``key``; returns the file, or None when the
+        directory cannot be written (one warning per directory and process)."""
+        path = self.path(key)
+        text = json.dumps({"key": self.full_key(key), "value": value}, sort_keys=True, allow_nan=False)
+        tmp = None
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".tmp")
+            with os.fdopen(fd, "w") as fh:
+                fh.write(text)
+            os.replace(tmp, path)
+            tmp = None
+        except OSError as e:
+            if path.parent not in _UNWRITABLE:
+                _UNWRITABLE.add(path.parent)
+                log.warning("cache directory %s is not writable (%s): results are not kept between runs "
+                            "(set %s to a writable directory)", path.parent, e.strerror or e, ENV_VAR)
+            return None
+        finally:
+            if tmp is not None and os.path.exists(tmp):
+                os.unlink(tmp)
+        log.debug("cache entry %s written", path)
+        return path
