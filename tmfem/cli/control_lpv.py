@@ -130,7 +130,7 @@ def format_text(r: dict) -> str:
     lines = [f"LPV state feedback, {r['system']}, grid {r['grid'][0]}x{r['grid'][1]}, "
              f"rates +-{r['rate_bound_deg']:g} deg/s",
              f"pointwise state-feedback lower bound of gamma: {r['lpv_gamma_lower_bound']:.4g} at "
-             f"(theta_13, psi_13) = ({', '.join(deg)}){printed}"]
+             f"({', '.join(r['scheduling_parameters'])}) = ({', '.join(deg)}){printed}"]
     if "gamma" in r:
         lines += [f"{'K(rho): ' if r.get('output_feedback') else ''}gamma = "
                   f"{r.get('state_feedback_gamma', r['gamma']):.5g} ({r['solver']}, {r['status']}, "

@@ -170,6 +170,7 @@ def design_plant(cfg: dict, *, rate_deg: float | None = None, command: str = "co
     p = lpv.design_plant(s, theta=th, psi=ps, bases=reference.lpv_bases(s), rate_bound=np.radians(rate_deg),
                               progress=progress)
     out = {"system": cfg["preset"], "grid": list(p.plant.grid_shape), "rate_bound_deg": rate_deg,
+           "scheduling_parameters": list(p.plant.parameter_names),
            **p.bound.to_dict()}
     printed = (s.printed or {}).get("lpv_gamma_bound")
     if printed is not None:

@@ -13,6 +13,7 @@ from tmfem.control.lpv.defaults import W_E, W_U
 from tmfem.control.lpv.workflow import (output_feedback_design, saved_design_plant, synthesize_design,
                                         verify_design)
 from tmfem.errors import InfeasibleController, InputError
+from tmfem.system import load_preset
 from tests.control.lpv.test_lpv_output_feedback import oscillator
 
 
@@ -85,5 +86,5 @@ def test_output_feedback_gamma_is_the_largest_frozen_norm(problem):
 
 def test_a_saved_design_on_other_parameters_is_refused(problem):
     pl, gp, bound, conic = problem
-    with pytest.raises(InputError, match=r"expected a design scheduled on \['theta_13', 'psi_13'\]"):
-        saved_design_plant(conic, system=None, bases=None)
+    with pytest.raises(InputError, match=r"expected a design scheduled on \['theta_13', 'psi_13'\] \(the 3-bar"):
+        saved_design_plant(conic, system=load_preset("2-3-lpv"), bases=None)

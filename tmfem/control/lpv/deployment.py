@@ -26,8 +26,8 @@ has no freedom, and the limits change the acceleration either way).
 
 Measurement (:meth:`LPVDeployment.measure`): the plant's y = [z, z'] (modal) mapped onto the
 signals of the LPV design, y_lpv = [x_z, rho] with x_z = [q, v, q', v'] (v = T_v_eta eta, the
-membrane point coordinates of eq. 5.17 at the design plant's points) and rho = [theta_13,
-psi_13] read from q (8.4 schedules on the measured angles). Any controller with the
+membrane point coordinates of eq. 5.17 at the design plant's points) and rho = [theta_1N,
+psi_1N] (theta_13, psi_13 for N = 3) read from q (8.4 schedules on the measured angles). Any controller with the
 reset/output/update/name protocol of :mod:`tmfem.simulation.controllers` on y_lpv deploys
 through :meth:`LPVDeployment.setup` (the state feedback: :func:`state_feedback_controller`).
 """
@@ -43,6 +43,7 @@ from tmfem.control.deployment.reference_trajectory import DeploymentReference, a
 from tmfem.control.deployment.run import DeploymentSetup
 from tmfem.control.lpv.controller import LPVController
 from tmfem.control.lpv.output_feedback import LPVOutputController, design_output_feedback
+from tmfem.control.lpv.plant import scheduling_parameters
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
 from tmfem.errors import InputError
 from tmfem.models.com.coordinates import point_coordinates
@@ -161,7 +162,7 @@ class LPVDeployment:
         return list(self.plant.state_names) + list(self.plant.parameter_names)
 
     def reference_rho(self, t) -> np.ndarray:
-        """rho_r(t) = [theta_13, psi_13] of the reference q_d(t) (eq. 5.100: theta_r, psi_0)."""
+        """rho_r(t) = [theta_1N, psi_1N] of the reference q_d(t) (eq. 5.100: theta_r, psi_0)."""
         r = np.asarray(self.reference(t)[0], dtype=float)[self.rho_q].copy()
         r[1] = wrap_angle(r[1])
         return r
@@ -206,7 +207,7 @@ def lpv_deployment(system, plant, *, theta_0: float, theta_e: float, psi_0: floa
     InputError
         The reference leaves the design grid, or the plant has no membrane points.
     """
-    for nm, v in (("theta_13", (theta_0, theta_e)), ("psi_13", (psi_0, psi_0))):
+    for nm, v in zip(scheduling_parameters(system.N), ((theta_0, theta_e), (psi_0, psi_0))):
         a = plant.axes[plant.parameter_names.index(nm)]
         if min(v) < a[0] - 1e-9 or max(v) > a[-1] + 1e-9:
             raise InputError(f"LPV deployment: expected the reference {nm} in "

@@ -8,8 +8,8 @@ on the parameter rates.
 
 :func:`com_lpv_plant` builds it for a symmetric tensegrity-membrane system from
 linearisations of the control-oriented model (eq. 5.33) at the symmetric equilibria of
-eq. 5.97 on a (theta, psi) grid, rho_1 = theta_13, rho_2 = psi_13 (8.3), with the membrane
-point deflections of eq. 5.17 as coordinates.
+eq. 5.97 on a (theta, psi) grid, rho = [theta_1N, psi_1N] (theta_13, psi_13 of 8.3), with the
+membrane point deflections of eq. 5.17 as coordinates.
 """
 from __future__ import annotations
 
@@ -27,26 +27,35 @@ from tmfem.models.com.linearize import linearize
 from tmfem.models.com.mode_count import MembraneModeChoice
 from tmfem.models.com.model import ControlOrientedModel, membrane_modes_of
 from tmfem.system.geometry import membrane_corners_regular
+from tmfem.system.topology import label
 
 log = logging.getLogger(__name__)
 
 #: how a gridded plant is evaluated between its grid points (:meth:`GriddedLPV.interpolate`)
 INTERPOLATIONS = ("multilinear", "spline")
-#: Scheduling parameters that are angles [rad] (rho_1 = theta_13, rho_2 = psi_13 of 8.3):
-#: shown in degrees in messages and logs.
-ANGLE_PARAMETERS = ("theta_13", "psi_13")
+#: Kinds of scheduling parameter that are angles [rad] (the bar angles theta_1N, psi_1N of
+#: :func:`scheduling_parameters`): shown in degrees in messages and logs.
+ANGLE_KINDS = ("theta_", "psi_")
+
+
+def scheduling_parameters(N: int) -> list:
+    """The scheduling parameters rho = [theta_1N, psi_1N] of an N-bar symmetric system: the
+    angles of the stage-1 bar whose azimuth is the configuration's psi (eq. 3.20:
+    psi_1j = psi_1 + 2 pi j / N, so j = N), which 8.3 writes theta_13, psi_13 for N = 3. The
+    other bars of stage 1 have the same theta and their psi a whole 2 pi j / N away."""
+    return [label("theta", 1, N), label("psi", 1, N)]
 
 
 def grid_point_text(names, rho, *, rates: bool = False) -> str:
     """A grid point ``rho`` of the parameters ``names`` as text with units: the angles of
-    :data:`ANGLE_PARAMETERS` in degrees ("theta_13 = 64 deg, psi_13 = 25 deg"; with ``rates``
+    :data:`ANGLE_KINDS` in degrees ("theta_13 = 64 deg, psi_13 = 25 deg"; with ``rates``
     their rates in deg/s, "theta_13' = 10 deg/s"), other parameters as given; "none" when
     ``rho`` is None."""
     if rho is None:
         return "none"
     tick, unit = ("'", " deg/s") if rates else ("", " deg")
-    return ", ".join(f"{nm}{tick} = {np.degrees(v):.4g}{unit}" if nm in ANGLE_PARAMETERS else f"{nm}{tick} = {v:.4g}"
-                     for nm, v in zip(names, np.atleast_1d(np.asarray(rho, dtype=float))))
+    return ", ".join(f"{nm}{tick} = {np.degrees(v):.4g}{unit}" if nm.startswith(ANGLE_KINDS)
+                     else f"{nm}{tick} = {v:.4g}" for nm, v in zip(names, np.atleast_1d(np.asarray(rho, dtype=float))))
 
 
 @dataclass
@@ -325,7 +334,8 @@ def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int | None 
     built, the control-oriented model designs its rest lengths there (the equilibrium u_e,
     eq. 3.16) and is linearised (eq. 5.33) with the membrane point coordinates of eq. 5.17
     (``membrane_points``; default :func:`choose_membrane_points` at the first grid point).
-    rho_1 = theta_13 = theta and rho_2 = psi_13 = psi (8.3).
+    rho = [theta_1N, psi_1N] = [theta, psi] (:func:`scheduling_parameters`; theta_13, psi_13 of
+    8.3 for N = 3).
 
     Parameters
     ----------
@@ -379,6 +389,6 @@ def com_lpv_plant(system, *, theta, psi, bases=None, membrane_modes: int | None 
                      np.degrees(th), np.degrees(ps))
             if progress is not None:
                 progress(a * psi.size + b + 1, total)
-    return GriddedLPV(axes=[theta, psi], parameter_names=["theta_13", "psi_13"],
+    return GriddedLPV(axes=[theta, psi], parameter_names=scheduling_parameters(system.N),
                       rate_bounds=np.asarray(rate_bounds, dtype=float), state_names=names[0],
                       input_names=names[1], output_names=names[2], membrane_points=list(pts), **mats)

@@ -31,7 +31,7 @@ from tmfem.control.lpv.generalized_plant import GeneralizedLPV, interconnection_
 from tmfem.control.lpv.gridded_synthesis import lpvsyn
 from tmfem.control.lpv.output_feedback import (LPVOutputFeedback, design_output_feedback,
                                                verify_output_feedback)
-from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant, grid_point_text
+from tmfem.control.lpv.plant import GriddedLPV, com_lpv_plant, grid_point_text, scheduling_parameters
 from tmfem.control.lpv.refinement import refine_state_feedback
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.control.lpv.synthesis import synthesize_state_feedback
@@ -66,7 +66,7 @@ def design_plant(system, *, theta, psi, bases, rate_bound: float, progress=no_pr
     Parameters
     ----------
     system : System
-        A symmetric M >= 2 system (rho = theta_13, psi_13).
+        A symmetric M >= 2 system (rho = theta_1N, psi_1N).
     theta, psi : array_like
         The grid axes [rad].
     bases : callable
@@ -320,11 +320,13 @@ def saved_design_plant(design: LPVStateFeedback, system, *, bases, progress=no_p
     Raises
     ------
     InputError
-        A design not scheduled on (theta_13, psi_13).
+        A design not scheduled on the system's [theta_1N, psi_1N]
+        (:func:`~tmfem.control.lpv.plant.scheduling_parameters`).
     """
-    if design.parameter_names != ["theta_13", "psi_13"] or len(design.axes) != 2:
-        raise InputError(f"expected a design scheduled on ['theta_13', 'psi_13'], found "
-                         f"{design.parameter_names}")
+    expected = scheduling_parameters(system.N)
+    if list(design.parameter_names) != expected or len(design.axes) != 2:
+        raise InputError(f"expected a design scheduled on {expected} (the {system.N}-bar system's), found "
+                         f"{list(design.parameter_names)}")
     with progress(design.axes[0].size * design.axes[1].size, "LPV plant (grid points)") as bar:
         return com_lpv_plant(system, theta=design.axes[0], psi=design.axes[1], bases=bases,
                              rate_bounds=design.rate_bounds, progress=bar)
