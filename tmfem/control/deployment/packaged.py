@@ -104,7 +104,8 @@ def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, sta
     * r_i (2 <= i < M), z_i and sigma_i (i >= 2) where the positive null vector of the
       reduced matrix of 3.3.2 has its largest margin (:func:`tmfem.equilibrium.
       symmetric_map.best_bases` with r_M held, ``starts`` Nelder-Mead starts, the first from
-      the deployed bases, ``maxiter`` iterations each);
+      the deployed bases, ``maxiter`` iterations each; radii in [0.025, 1.1] and heights in
+      [0.025, 1.4] times the mean bar length);
     * the bases rounded to 1e-4 deg and 1e-6 m (r_M recomputed from eq. 3.22 for the rounded
       angles), and the rounded configuration checked by :func:`tmfem.equilibrium.
       deployment_path.path_feasibility` (tendons in tension, membrane stretched, rest lengths
@@ -153,6 +154,7 @@ def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, sta
     r_min = (system.problem.deployment or DeploymentParameters()).r_min
     kappa = membrane_stiffness(design_equilibrium(system.replace(rest_lengths=None), strict=False))
     theta = np.radians(theta_deg)
+    l = float(np.mean(c.l))
 
     def top(psi, near):
         return top_radius_for_delta(l_M=c.l[-1], theta_M=theta, psi_rel=psi, r_mb=system.r_mb,
@@ -167,7 +169,8 @@ def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, sta
             failures["the top bars do not reach r_mb + Delta (no r_M of eq. 3.22)"] += 1
             continue
         for r_top in sorted(r for r in roots if r > 0):
-            b = best_bases(system, theta, psi, starts=starts, maxiter=maxiter, r_top=r_top)
+            b = best_bases(system, theta, psi, starts=starts, maxiter=maxiter, r_top=r_top,
+                           r_bounds=(0.025 * l, 1.1 * l), z_bounds=(0.025 * l, 1.4 * l))
             r, z = np.round(b["r"], 6), np.round(b["z"], 6)
             r[-1] = top(psi, r_top)
             cfg = configuration_5_97(system, theta, psi, r=r, z=z,
