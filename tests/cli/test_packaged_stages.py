@@ -9,6 +9,7 @@ import tomllib
 import numpy as np
 import pytest
 
+from tests.cli.test_cli_units import _unitless_numbers
 from tests.cli.test_own_system_design import SYSTEMS, run, write
 from tests.system.test_validate import general_2_3
 from tmfem.cli import main
@@ -21,6 +22,7 @@ def test_packaged_of_the_2_6_is_its_own_and_pastes_into_the_file(capsys):
     r, _ = run(["equilibrium", str(f), "--packaged", "75"], capsys)
     assert r["assist"] == "packaged-stages" and r["path"]["points_checked"] == 101
     assert r["path"]["min_margin"] > 0 and r["Delta"] == pytest.approx(r["Delta_deployed"], abs=1e-12)
+    assert _unitless_numbers({k: v for k, v in r.items() if k != "units"}) == []
     # the text's last two lines are a TOML table with the JSON's entries
     text = format_text(r)
     pasted = tomllib.loads("\n".join(text.splitlines()[-2:]))["packaged"]["symmetric"]
