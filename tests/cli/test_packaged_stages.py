@@ -52,7 +52,8 @@ def test_a_theta_without_packaged_equilibria_is_one_line(capsys):
     rc = main(["equilibrium", str(SYSTEMS / "pentagon-2-5.toml"), "--packaged", "30"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 1 and len(err) == 1
-    assert err[0].startswith("tmfem equilibrium: error: packaged configuration: no psi in [-80, 80] deg")
+    assert err[0].startswith("tmfem equilibrium: error: packaged configuration: no feasible equilibrium at "
+                             "theta = 30 deg (psi in [-80, 80] deg in steps down to 10 deg")
     assert "no positive null vector of 3.3.2" in err[0] and "eq. 3.22 has a top radius for" in err[0]
 
 

@@ -138,9 +138,9 @@ def format_assist(r: dict) -> str:
         entries = ", ".join(f"{k} = {v}" for k, v in r["symmetric"].items())
         return (f"{r['system']}: at theta = {r['theta_deg']:g} deg, {r['candidates']} feasible packaged "
                 f"equilibria with the deployed Delta = {1e3 * r['Delta_deployed']:.4g} mm (eq. 3.22; psi "
-                f"in steps of {r['psi_step_deg']:g} deg, rest lengths >= {1e3 * r['r_min']:.4g} mm); the "
-                f"automatic path from the one below (null-vector margin {r['margin']:.3g}, top bar ends "
-                f"{r['height']:.4g} m above the base; {r['tried']} tried) is feasible at its "
+                f"in steps down to {r['psi_step_deg']:g} deg, rest lengths >= {1e3 * r['r_min']:.4g} mm); "
+                f"the automatic path from the one below (null-vector margin {r['margin']:.3g}, top bar "
+                f"ends {r['height']:.4g} m above the base) is feasible at its "
                 f"{p['points_checked']} checked points (worst margin {p['min_margin']:.3g} at s = "
                 f"{p['min_margin_progress']:.3g}):\n[packaged]\nsymmetric = {{ {entries} }}")
     bands = ", ".join(f"[{a:g}, {b:g}]" for a, b in r["psi_deg_bands"])

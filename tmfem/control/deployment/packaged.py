@@ -88,15 +88,18 @@ def packaged_configurations(system, *, theta_deg: float, step_deg: float = 0.05,
             "step_deg": step_deg}
 
 
-def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, starts: int = 2,
-                    maxiter: int = 100) -> dict:
+def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, refinements: int = 2,
+                    starts: int = 2, maxiter: int = 100) -> dict:
     """A packaged configuration of the symmetric M >= 2 ``system`` at the bar declination
     ``theta_deg`` of every stage, from which :func:`tmfem.equilibrium.deployment_path.
     automatic_path` finds a feasible path to the deployed configuration (``[packaged]
     symmetric`` of 7.4 for any M and N).
 
     Candidates follow eq. 5.97: theta_i = theta, psi_i = psi + sigma_i (one azimuth relative
-    to the stage bases), psi on a grid of ``psi_step_deg`` in [-80, 80] deg. At each psi:
+    to the stage bases), psi on a grid of ``psi_step_deg`` in [-80, 80] deg, halved up to
+    ``refinements`` times (only the new azimuths are evaluated) while the grid has feasible
+    candidates but none with a path (a grid without any is refused: feasible psi bands are
+    wide where they exist, e.g. none on a 2.5 deg grid of the 3-3 at 70 deg). At each psi:
 
     * the top-stage radius r_M is eq. 3.22 solved for the deployed Delta (the packaged
       membrane keeps the deployed stretch; :func:`tmfem.equilibrium.deployment_path.
@@ -112,11 +115,12 @@ def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, sta
       of eq. 3.9 at least the file's ``[deployment] r_min``, with forces scaled by the
       membrane stiffness of the deployed design).
 
-    The feasible candidates are tried in order of the worst feasibility margin of the straight
-    path (every parameter linear in the progress, :class:`tmfem.equilibrium.deployment_path.
-    SymmetricPath` at 21 points) to the deployed configuration, the nearest to a feasible path
-    first (ties: the larger null-vector margin); the first from which the automatic path is
-    feasible is returned. Every candidate has the deployed Delta, so Delta does not rank them.
+    The feasible candidates of a grid are tried in order of the worst feasibility margin of the
+    straight path (every parameter linear in the progress, :class:`tmfem.equilibrium.
+    deployment_path.SymmetricPath` at 21 points) to the deployed configuration, the nearest to
+    a feasible path first (ties: the larger null-vector margin); the first from which the
+    automatic path is feasible is returned. Every candidate has the deployed Delta, so Delta
+    does not rank them.
 
     Returns
     -------
@@ -125,8 +129,8 @@ def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, sta
     :class:`~tmfem.system.geometry.SymmetricConfig`, not JSON), ``Delta`` and
     ``Delta_deployed`` [m], ``height`` [m] of the top bar ends above the stage-1 base,
     ``margin`` (null-vector margin), ``path`` (:meth:`~tmfem.equilibrium.deployment_path.
-    PathReport.to_dict`), ``candidates`` (feasible candidates), ``tried`` (paths tried),
-    ``psi_step_deg``, ``r_min`` [m].
+    PathReport.to_dict`), ``candidates`` (feasible candidates evaluated), ``psi_step_deg``
+    (the grid step where it was found), ``r_min`` [m].
 
     Raises
     ------
@@ -145,8 +149,9 @@ def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, sta
         raise InputError(f"packaged stages: expected a symmetric system with M >= 2 stages, found "
                          f"{system.M}-{system.N}{'(D)' if system.deployable else ''}")
     _check_theta(theta_deg)
-    if not (np.isfinite(psi_step_deg) and 0 < psi_step_deg <= 80):
-        raise InputError(f"packaged psi step: expected 0 < step <= 80 deg, found {psi_step_deg!r}")
+    if not (np.isfinite(psi_step_deg) and 0 < psi_step_deg <= 80 and refinements >= 0):
+        raise InputError(f"packaged psi grid: expected 0 < step <= 80 deg and refinements >= 0, found "
+                         f"{psi_step_deg!r} deg, {refinements!r}")
     target = float(membrane_delta_system(system))
     if not target > 0:
         raise InfeasibleDesign(f"packaged configuration: the deployed membrane is not stretched "
@@ -160,56 +165,68 @@ def packaged_stages(system, *, theta_deg: float, psi_step_deg: float = 10.0, sta
         return top_radius_for_delta(l_M=c.l[-1], theta_M=theta, psi_rel=psi, r_mb=system.r_mb,
                                     Delta=target, N=system.N, near=near)
 
-    candidates, failures = [], Counter()
-    for psi_deg in np.round(np.arange(-80.0, 80.0 + 1e-9, psi_step_deg), 6):
-        psi = np.radians(psi_deg)
-        try:
-            roots = {round(top(psi, near), 9) for near in (0.0, 1e9)}
-        except InputError:
-            failures["the top bars do not reach r_mb + Delta (no r_M of eq. 3.22)"] += 1
-            continue
-        for r_top in sorted(r for r in roots if r > 0):
-            b = best_bases(system, theta, psi, starts=starts, maxiter=maxiter, r_top=r_top,
-                           r_bounds=(0.025 * l, 1.1 * l), z_bounds=(0.025 * l, 1.4 * l))
-            r, z = np.round(b["r"], 6), np.round(b["z"], 6)
-            r[-1] = top(psi, r_top)
-            cfg = configuration_5_97(system, theta, psi, r=r, z=z,
-                                     sigma=np.radians(np.round(np.degrees(b["sigma"]), 4)))
-            p = path_feasibility(system, cfg, kappa=kappa, r_min=r_min)
-            if p.reason:
-                failures[p.reason.split(":")[0]] += 1
+    failures = Counter()
+
+    def candidates_at(psis) -> list:
+        """The feasible packaged candidates at the azimuths ``psis`` [deg], best first."""
+        found = []
+        for psi_deg in psis:
+            psi = np.radians(psi_deg)
+            try:
+                roots = {round(top(psi, near), 9) for near in (0.0, 1e9)}
+            except InputError:
+                failures["the top bars do not reach r_mb + Delta (no r_M of eq. 3.22)"] += 1
                 continue
-            straight = min(q.margin for q in SymmetricPath(system=system, initial=cfg, final=c).margins(
-                np.linspace(0.0, 1.0, 21), kappa=kappa, r_min=r_min))
-            candidates.append({"straight": straight, "margin": p.margin, "psi_deg": float(psi_deg), "config": cfg})
-    if not candidates:
-        reach = (system.r_mb + target) / (c.l[-1] * np.sin(theta))
-        band = ("every psi" if reach >= 1 else
-                f"|cos(psi + 180/N)| <= {reach:.4g}: psi in [{np.degrees(np.arccos(reach)) - 180 / system.N:.4g}, "
-                f"{180 - np.degrees(np.arccos(reach)) - 180 / system.N:.4g}] deg")
-        why = "; ".join(f"{k} ({n} candidates)" for k, n in failures.most_common())
-        raise InfeasibleDesign(f"packaged configuration: no psi in [-80, 80] deg gives a feasible "
-                               f"equilibrium at theta = {theta_deg:g} deg with the deployed Delta = "
-                               f"{1e3 * target:.4g} mm: {why}; eq. 3.22 has a top radius for {band}; "
-                               f"expected another theta (the deployed one is {np.degrees(c.theta[0]):.4g} deg)")
-    candidates.sort(key=lambda k: (-k["straight"], -k["margin"]))
-    last = ""
-    for tried, k in enumerate(candidates, start=1):
-        cfg = k["config"]
-        try:
-            rep = automatic_path(system, cfg, kappa=kappa, r_min=r_min)
-        except InfeasibleDesign as exc:
-            last = str(exc)
-            log.info("packaged candidate psi = %g deg: %s", k["psi_deg"], exc)
-            continue
-        return {"theta_deg": float(theta_deg), "config": cfg, "symmetric": _entries(cfg),
-                "Delta": float(cfg.membrane_delta(system.N, system.r_mb)), "Delta_deployed": target,
-                "height": float(cfg.z[-1] + cfg.l[-1] * np.cos(theta)), "margin": float(k["margin"]),
-                "path": rep.to_dict(), "candidates": len(candidates), "tried": tried,
-                "psi_step_deg": float(psi_step_deg), "r_min": float(r_min)}
-    raise InfeasibleDesign(f"packaged configuration: none of the {len(candidates)} feasible packaged "
-                           f"equilibria at theta = {theta_deg:g} deg has a path to the deployed "
-                           f"configuration; the last: {last}")
+            for r_top in sorted(r for r in roots if r > 0):
+                b = best_bases(system, theta, psi, starts=starts, maxiter=maxiter, r_top=r_top,
+                               r_bounds=(0.025 * l, 1.1 * l), z_bounds=(0.025 * l, 1.4 * l))
+                r, z = np.round(b["r"], 6), np.round(b["z"], 6)
+                r[-1] = top(psi, r_top)
+                cfg = configuration_5_97(system, theta, psi, r=r, z=z,
+                                         sigma=np.radians(np.round(np.degrees(b["sigma"]), 4)))
+                p = path_feasibility(system, cfg, kappa=kappa, r_min=r_min)
+                if p.reason:
+                    failures[p.reason.split(":")[0]] += 1
+                    continue
+                straight = min(q.margin for q in SymmetricPath(system=system, initial=cfg, final=c).margins(
+                    np.linspace(0.0, 1.0, 21), kappa=kappa, r_min=r_min))
+                found.append({"straight": straight, "margin": p.margin, "psi_deg": float(psi_deg), "config": cfg})
+        return sorted(found, key=lambda k: (-k["straight"], -k["margin"]))
+
+    scanned, count, last = set(), 0, ""
+    for level in range(refinements + 1):
+        step = psi_step_deg / 2**level
+        grid = [float(v) for v in np.round(np.arange(-80.0, 80.0 + 1e-9, step), 6) if float(v) not in scanned]
+        scanned.update(grid)
+        candidates = candidates_at(grid)
+        count += len(candidates)
+        for k in candidates:
+            cfg = k["config"]
+            try:
+                rep = automatic_path(system, cfg, kappa=kappa, r_min=r_min)
+            except InfeasibleDesign as exc:
+                last = str(exc)
+                log.info("packaged candidate psi = %g deg: %s", k["psi_deg"], exc)
+                continue
+            return {"theta_deg": float(theta_deg), "config": cfg, "symmetric": _entries(cfg),
+                    "Delta": float(cfg.membrane_delta(system.N, system.r_mb)), "Delta_deployed": target,
+                    "height": float(cfg.z[-1] + cfg.l[-1] * np.cos(theta)), "margin": float(k["margin"]),
+                    "path": rep.to_dict(), "candidates": count, "psi_step_deg": float(step), "r_min": float(r_min)}
+        if not count:                   # no feasible equilibrium on the grid: no refinement
+            break
+    where = (f"at theta = {theta_deg:g} deg (psi in [-80, 80] deg in steps down to {step:g} deg, the "
+             f"deployed Delta = {1e3 * target:.4g} mm)")
+    if count:
+        raise InfeasibleDesign(f"packaged configuration: none of the {count} feasible packaged equilibria "
+                               f"{where} has a path to the deployed configuration; the last: {last}")
+    reach = (system.r_mb + target) / (c.l[-1] * np.sin(theta))
+    band = ("every psi" if reach >= 1 else
+            f"|cos(psi + 180/N)| <= {reach:.4g}: psi in [{np.degrees(np.arccos(reach)) - 180 / system.N:.4g}, "
+            f"{180 - np.degrees(np.arccos(reach)) - 180 / system.N:.4g}] deg")
+    why = "; ".join(f"{k} ({n} candidates)" for k, n in failures.most_common())
+    raise InfeasibleDesign(f"packaged configuration: no feasible equilibrium {where}: {why}; eq. 3.22 "
+                           f"has a top radius for {band}; expected another theta (the deployed one is "
+                           f"{np.degrees(c.theta[0]):.4g} deg)")
 
 
 def _entries(cfg) -> dict:
