@@ -1,6 +1,11 @@
-"""The packaged configuration of a 1-N(D) system: a (theta, psi) from which its deployment
-path is a path of feasible equilibria (7.4; design assistance of ``tmfem equilibrium
---packaged``)."""
+"""The packaged configuration of a deployment (7.4; design assistance of ``tmfem equilibrium
+--packaged``): a configuration from which the deployment path is a path of feasible equilibria.
+
+* :func:`packaged_configurations`: a 1-N(D) system, a (theta, psi) on the ``delta`` path;
+* :func:`packaged_stages`: a symmetric M >= 2 system, theta, psi and the stage bases at the
+  deployed Delta (eq. 3.22) on the automatic path
+  (:func:`tmfem.equilibrium.deployment_path.automatic_path`).
+"""
 from __future__ import annotations
 
 import dataclasses
