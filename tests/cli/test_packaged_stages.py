@@ -61,3 +61,10 @@ def test_packaged_is_refused_on_a_general_system(tmp_path, capsys):
     rc = main(["equilibrium", write(tmp_path, general_2_3()), "--packaged", "70"])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "expected a symmetric system" in err and len(err.splitlines()) == 1
+
+
+def test_packaged_is_refused_on_a_one_stage_system_that_does_not_deploy(capsys):
+    rc = main(["equilibrium", str(SYSTEMS / "pentagon-1-5.toml"), "--packaged", "80"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and "expected a 1-N(D) system (deployable = true) or a symmetric system with M >= 2 " \
+                       "stages, found 1-5" in err

@@ -46,8 +46,8 @@ def packaged_configurations(system, *, theta_deg: float, step_deg: float = 0.05,
     """
     c = symmetric_parameters(system, "packaged configuration")
     if not system.deployable:
-        raise InputError(f"packaged configuration: expected a 1-N(D) system (deployable = true), "
-                         f"found {system.M}-{system.N}")
+        raise InputError(f"packaged configuration: expected a 1-N(D) system (deployable = true) or a "
+                         f"symmetric system with M >= 2 stages, found {system.M}-{system.N}")
     _check_theta(theta_deg)
     target = membrane_delta_system(system)
     x = (system.r_mb + target + c.r[0]) / c.l[0]
