@@ -68,3 +68,17 @@ def test_packaged_is_refused_on_a_one_stage_system_that_does_not_deploy(capsys):
     err = capsys.readouterr().err.strip()
     assert rc == 2 and "expected a 1-N(D) system (deployable = true) or a symmetric system with M >= 2 " \
                        "stages, found 1-5" in err
+
+
+@pytest.mark.slow
+def test_the_2_6_deploys_from_its_packaged_configuration(capsys):
+    """`deploy FILE` of the 2-6 from the [packaged] that `--packaged 70` gave, coarse step: the
+    automatic path checked at 101 points, the switch to the H-infinity controller (eq. 5.70,
+    R_c = 0.01, after the reference of eq. 5.68 with omega_r = 0.5 rad/s has settled to 1 %:
+    t > 13.3 s), no failed strength check (tendons below the file's 450 MPa yield stress), rest
+    lengths above r_min."""
+    r, _ = run(["deploy", str(SYSTEMS / "hexagon-2-6.toml"), "--t-end", "20", "--dt", "0.02"], capsys)
+    assert r["path"] == "auto" and r["path_check"]["points_checked"] == 101 and r["path_check"]["min_margin"] > 0
+    assert r["switch_time_s"] is not None and 13.3 < r["switch_time_s"] < 20
+    assert r["final_tracking_error"] < 0.01 and r["failure"] is None and r["failed_checks"] == []
+    assert r["max_tendon_stress_Pa"] < 450e6 and r["min_rest_length_margin_m"] > 0
