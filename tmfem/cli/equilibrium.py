@@ -37,9 +37,11 @@ def configure(parser) -> None:
                         "and Delta > 0 at the file's theta, psi; print them as [symmetric] entries "
                         "(degrees, metres)")
     g.add_argument("--packaged", type=float, metavar="THETA_DEG",
-                   help="1-N(D): the band of psi at this theta [deg] where the system is a feasible "
-                        "equilibrium, and the psi whose Delta matches the deployed one (a "
-                        "[packaged] configuration)")
+                   help="a [packaged] configuration at this theta [deg] with a feasible deployment "
+                        "path: 1-N(D): the band of psi where the system is a feasible equilibrium "
+                        "and the psi whose Delta matches the deployed one; symmetric M >= 2: the "
+                        "stage bases at the deployed Delta (eq. 3.22) from which the automatic "
+                        "path is feasible")
 
 
 def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point",
@@ -72,7 +74,7 @@ def design_result(system, *, mesh_n: int, strict: bool, attachment: str = "point
 
 
 def run(args) -> dict:
-    from tmfem.control.deployment.packaged import packaged_configurations
+    from tmfem.control.deployment.packaged import packaged_configurations, packaged_stages
     from tmfem.equilibrium import assist
     from tmfem.errors import InfeasibleDesign
     system = system_from_args(args)
@@ -82,6 +84,9 @@ def run(args) -> dict:
         raise InputError(f"expected at most one of --target-delta, --bases, --packaged, found {chosen}")
     if args.bases:
         return {"system": system.name, "assist": "bases", **assist.feasible_bases(system)}
+    if args.packaged is not None and system.M >= 2 and system.symmetric is not None:
+        r = packaged_stages(system, theta_deg=args.packaged)
+        return {"system": system.name, "assist": "packaged-stages", **{k: v for k, v in r.items() if k != "config"}}
     if args.packaged is not None:
         return {"system": system.name, "assist": "packaged",
                 **on_scan_step(packaged_configurations(system, theta_deg=args.packaged))}
@@ -128,6 +133,16 @@ def format_assist(r: dict) -> str:
             tail = [(f"no bases stretch the file's membrane; with these the membrane radius "
                      f"[membrane] r_mb = {r['r_mb']:.6g} m gives Delta = {1e3 * r['Delta']:.4g} mm")]
         return "\n".join([head, "[symmetric]"] + [f"{k} = {v}" for k, v in s.items()] + tail)
+    if r["assist"] == "packaged-stages":
+        p = r["path"]
+        entries = ", ".join(f"{k} = {v}" for k, v in r["symmetric"].items())
+        return (f"{r['system']}: at theta = {r['theta_deg']:g} deg, {r['candidates']} feasible packaged "
+                f"equilibria with the deployed Delta = {1e3 * r['Delta_deployed']:.4g} mm (eq. 3.22; psi "
+                f"in steps down to {r['psi_step_deg']:g} deg, rest lengths >= {1e3 * r['r_min']:.4g} mm); "
+                f"the automatic path from the one below (null-vector margin {r['margin']:.3g}, top bar "
+                f"ends {r['height']:.4g} m above the base) is feasible at its "
+                f"{p['points_checked']} checked points (worst margin {p['min_margin']:.3g} at s = "
+                f"{p['min_margin_progress']:.3g}):\n[packaged]\nsymmetric = {{ {entries} }}")
     bands = ", ".join(f"[{a:g}, {b:g}]" for a, b in r["psi_deg_bands"])
     return (f"{r['system']}: at theta = {r['theta_deg']:g} deg the system is a feasible 1-N(D) "
             f"equilibrium for psi in {bands} deg (steps of {r['step_deg']:g} deg)"

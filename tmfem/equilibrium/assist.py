@@ -7,7 +7,9 @@
   positive null vector of the reduced matrix of 3.3.2 and Delta > 0 at the file's theta, psi
   (eq. 5.97), in the file's units (degrees);
 * the packaged configuration of a 1-N(D) system along its deployment path is found by
-  :func:`tmfem.control.deployment.packaged.packaged_configurations` (it checks the path);
+  :func:`tmfem.control.deployment.packaged.packaged_configurations`, that of a symmetric
+  M >= 2 system (stage bases at the deployed Delta) by :func:`tmfem.control.deployment.
+  packaged.packaged_stages` (both check the path);
 * :func:`infeasibility_hint`: which parameter to change, and in which direction, for a slack
   membrane or slack tendons.
 """

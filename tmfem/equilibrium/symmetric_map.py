@@ -156,13 +156,17 @@ def equilibrium_map(system, *, theta, psi, bases=None, progress=None) -> Equilib
 
 
 def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int = 0,
-               r_bounds=(0.05, 2.0), z_bounds=(0.05, 2.5), maxiter: int = 300) -> dict:
+               r_bounds=(0.05, 2.0), z_bounds=(0.05, 2.5), maxiter: int = 300,
+               r_top: float | None = None) -> dict:
     """Stage bases (r_i, z_i, sigma_i, i >= 2) that maximise the null-vector margin at
     (theta, psi) of eq. 5.97 with Delta > 0 (eq. 3.22); a multi-start Nelder-Mead search.
 
     The bases are the free parameters of a symmetric M-N equilibrium (see the module
     docstring); this gives one admissible choice, e.g. a rule ``bases`` for
-    :func:`equilibrium_map`. r_1, l_i and r_mb are those of ``system``.
+    :func:`equilibrium_map`. r_1, l_i and r_mb are those of ``system``. ``r_top`` [m] holds
+    the top-stage radius r_M (e.g. eq. 3.22 solved for a given Delta,
+    :func:`tmfem.equilibrium.deployment_path.top_radius_for_delta`); the search is then over
+    r_i (2 <= i < M), z_i and sigma_i (i >= 2). The first start is the bases of ``system``.
 
     Returns
     -------
@@ -175,15 +179,16 @@ def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int =
         raise InputError("best_bases: expected a symmetric system with M >= 2 stages")
     M = c.M
     rng = np.random.default_rng(seed)
+    nr = M - 1 if r_top is None else M - 2          # free radii r_2 .. r_M (or r_{M-1})
+    top = [] if r_top is None else [float(r_top)]
 
     def unpack(p):
-        p = p.reshape(M - 1, 3)
-        return (np.concatenate([[c.r[0]], p[:, 0]]), np.concatenate([[0.0], p[:, 1]]),
-                np.concatenate([[0.0], p[:, 2]]))
+        return (np.concatenate([[c.r[0]], p[:nr], top]), np.concatenate([[0.0], p[nr:nr + M - 1]]),
+                np.concatenate([[0.0], p[nr + M - 1:]]))
 
     def evaluate(p):
         r, z, sg = unpack(p)
-        if np.any(r[1:] < r_bounds[0]) or np.any(r[1:] > r_bounds[1]) or \
+        if np.any(r[1:1 + nr] < r_bounds[0]) or np.any(r[1:1 + nr] > r_bounds[1]) or \
                 np.any(z[1:] < z_bounds[0]) or np.any(z[1:] > z_bounds[1]):
             return -np.inf, -np.inf
         cfg = configuration_5_97(system, theta, psi, r=r, z=z, sigma=sg)
@@ -199,10 +204,10 @@ def best_bases(system, theta: float, psi: float, *, starts: int = 8, seed: int =
 
     best = None
     for k in range(starts):
-        p0 = np.column_stack([rng.uniform(*r_bounds, M - 1), rng.uniform(*z_bounds, M - 1),
-                              rng.uniform(-np.pi, np.pi, M - 1)]).ravel()
+        p0 = np.concatenate([rng.uniform(*r_bounds, M - 1)[:nr], rng.uniform(*z_bounds, M - 1),
+                             rng.uniform(-np.pi, np.pi, M - 1)])
         if k == 0:
-            p0 = np.column_stack([c.r[1:], c.z[1:], c.sigma[1:]]).ravel()
+            p0 = np.concatenate([c.r[1:1 + nr], c.z[1:], c.sigma[1:]])
         res = minimize(objective, p0, method="Nelder-Mead",
                        options={"maxiter": maxiter, "xatol": 1e-6, "fatol": 1e-9})
         if best is None or res.fun < best.fun:
