@@ -46,9 +46,9 @@ import scipy.linalg as sla
 
 from tmfem.control.lpv.bisect import bisect_gamma
 from tmfem.control.lpv.coordinates import Coordinates, Tm_back, design_points_in
-from tmfem.control.lpv.eigopt import EigOpt
 from tmfem.control.lpv.generalized_plant import GeneralizedLPV, lmi_matrix
 from tmfem.control.lpv.plant import GriddedLPV, grid_point_text
+from tmfem.control.lpv.refinement import next_cut, resolve_on_points
 from tmfem.control.lpv.state_feedback import LPVStateFeedback
 from tmfem.control.lpv.verify import verify
 from tmfem.errors import InfeasibleController, InputError
@@ -317,44 +317,31 @@ def refine_certificate(certificate: RateBoundedCertificate, design, fine: Gridde
             rounds.append({"round": len(rounds), "fine_max_eig": worst, "fine_max_eig_at": at, "failing": 0,
                            "check_s": check_s})
             break
-        new = [k for k in sorted(fail, key=lambda k: -lmi[k]) if k not in imposed][:per_round]
         row = {"round": len(rounds), "fine_max_eig": worst, "fine_max_eig_at": at, "failing": len(fail),
-               "check_s": check_s,
-               "added_at": [[float(a[i]) for a, i in zip(gp.axes, k)] for k in new]}
-        if not new:                             # an imposed point fails its re-computation
+               "check_s": check_s}
+        new, stop = next_cut(fail, lmi, imposed, per_round=per_round, rounds_done=len(rounds),
+                             max_rounds=max_rounds, deadline=deadline, axes=gp.axes, row=row)
+        if stop:
             rounds.append(row)
-            stopped = "an imposed point fails"
-            break
-        if len(rounds) >= max_rounds or time.perf_counter() > deadline:
-            rounds.append(row)
-            stopped = "rounds" if len(rounds) > max_rounds else "time budget"
+            stopped = stop
             break
         imposed += new
-        e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=gamma, points=imposed,
-                   balance_on=co.coefficients_of(X, gp))
-        z0 = e.start_from(*co.coefficients_of(X, gp))
-        row["start_scaled_eig"] = e.largest(z0, gamma)
-        z, top, reason = e.solve(gamma, z0, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
-                                 deadline=deadline)
-        row.update(imposed=len(imposed), evaluations=e.evaluations, largest_scaled_eig=top,
-                   result="found" if top < 0 else ("unfinished (time budget)" if reason == "time" else "not found"),
-                   time_s=time.perf_counter() - t1, cpu_s=time.process_time() - c1)
+        found, reason = resolve_on_points(gp, co, co.coefficients_of(X, gp), gamma=gamma, points=imposed, row=row,
+                                          started=(t1, c1), what="certificate refinement", max_iter=max_iter,
+                                          margin=margin, t_schedule=t_schedule, deadline=deadline)
         rounds.append(row)
-        log.info("certificate refinement: round %d, %d points imposed: %s (%d evaluations, largest scaled "
-                 "eigenvalue %.3e, %.1f s)", row["round"], len(imposed), row["result"], e.evaluations, top,
-                 row["time_s"])
         if progress is not None:
             progress(len(rounds))
-        if top >= 0:
+        if found is None:
             stopped = "time budget" if reason == "time" else "not found"
             break
-        Ps, _ = e.coefficients(z)
+        Ps, _ = found
         X = LPVStateFeedback(gamma=gamma, P=[Tm_back(P, co.T) for P in Ps], Q=[np.zeros((0, gp.A.shape[-1]))] * len(Ps),
                              center=co.center, half_width=co.half, varying=co.varying,
                              axes=[a.copy() for a in X.axes], parameter_names=list(X.parameter_names),
                              rate_bounds=X.rate_bounds.copy(), state_names=list(X.state_names), solver="EIGOPT",
                              status=f"refined: {len(imposed)} points imposed", solve_time=0.0, build_time=0.0,
-                             sizes={}, max_lmi_eig=top, min_P_eig=np.nan)
+                             sizes={}, max_lmi_eig=row["largest_scaled_eig"], min_P_eig=np.nan)
     ref = {"passed": passed, "stopped": stopped, "rounds": rounds, "points_added": len(imposed) - len(design_idx),
            "points_imposed": len(imposed), "fine_grid": list(gp.grid_shape), "time_s": time.perf_counter() - t0,
            "cpu_s": time.process_time() - c0}

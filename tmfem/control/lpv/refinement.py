@@ -38,6 +38,49 @@ from tmfem.errors import InputError
 log = logging.getLogger(__name__)
 
 
+def next_cut(fail: list, score: np.ndarray, imposed: list, *, per_round: int, rounds_done: int,
+             max_rounds: int, deadline: float, axes, row: dict) -> tuple:
+    """The next cutting planes: the ``per_round`` failing points (index tuples) of largest
+    ``score`` not imposed yet, their parameter values recorded in ``row["added_at"]``; and why
+    the refinement stops instead ("an imposed point fails": none is new; "rounds": ``max_rounds``
+    re-solves done; "time budget": past ``deadline``), else None."""
+    new = [k for k in sorted(fail, key=lambda k: -score[k]) if k not in imposed][:per_round]
+    row["added_at"] = [[float(a[i]) for a, i in zip(axes, k)] for k in new]
+    if not new:
+        return new, "an imposed point fails"
+    if rounds_done >= max_rounds:
+        return new, "rounds"
+    return new, ("time budget" if time.perf_counter() > deadline else None)
+
+
+def resolve_on_points(gp: GeneralizedLPV, co: Coordinates, start, *, gamma: float, points: list, row: dict,
+                      started: tuple, what: str, max_iter: int, margin: float, t_schedule,
+                      deadline: float, sample_time: float | None = None) -> tuple:
+    """One cutting-plane re-solve: EIGOPT (:class:`~tmfem.control.lpv.eigopt.EigOpt`) on the
+    ``points`` (index tuples) of ``gp``'s grid at level ``gamma``, balanced on and started from
+    the coefficients ``start`` (P_k, Q_k in the coordinates ``co``). Records in ``row`` the
+    start's and the result's largest scaled eigenvalue, the points imposed, the evaluations,
+    the result ("found", "not found", "unfinished (time budget)") and the wall and CPU seconds
+    since ``started`` = (perf_counter, process_time); logs it under ``what``.
+
+    Returns
+    -------
+    (coefficients or None, reason)
+        The scaled (P_k, Q_k) found (None when not) and the solver's reason.
+    """
+    e = EigOpt(gp, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=gamma, points=points, sample_time=sample_time,
+               balance_on=start)
+    z0 = e.start_from(*start)
+    row["start_scaled_eig"] = e.largest(z0, gamma)
+    z, top, reason = e.solve(gamma, z0, t_schedule=t_schedule, max_iter=max_iter, margin=margin, deadline=deadline)
+    row.update(imposed=len(points), evaluations=e.evaluations, largest_scaled_eig=top,
+               result="found" if top < 0 else ("unfinished (time budget)" if reason == "time" else "not found"),
+               time_s=time.perf_counter() - started[0], cpu_s=time.process_time() - started[1])
+    log.info("%s: round %d, %d points imposed: %s (%d evaluations, largest scaled eigenvalue %.3e, %.1f s)",
+             what, row["round"], len(points), row["result"], e.evaluations, top, row["time_s"])
+    return (e.coefficients(z) if top < 0 else None), reason
+
+
 def refine_state_feedback(design: LPVStateFeedback, fine: GeneralizedLPV, *, per_round: int = 4,
                           max_rounds: int = 8, time_budget: float = 600.0, max_iter: int = 150,
                           margin: float = 1e-8, t_schedule=(1e-2, 1e-3, 1e-4), level_rtol: float = GAMMA_RTOL,
@@ -110,39 +153,27 @@ def refine_state_feedback(design: LPVStateFeedback, fine: GeneralizedLPV, *, per
             rounds.append(row)
             stopped = "passed"
             break
-        new = [k for k in sorted(fail, key=lambda k: -checks.lmi[k]) if k not in imposed][:per_round]
-        row["added_at"] = [[float(a[i]) for a, i in zip(fine.axes, k)] for k in new]
-        if not new:
+        new, stop = next_cut(fail, checks.lmi, imposed, per_round=per_round, rounds_done=len(rounds),
+                             max_rounds=max_rounds, deadline=deadline, axes=fine.axes, row=row)
+        if stop:
             rounds.append(row)
-            stopped = "an imposed point fails"
-            break
-        if len(rounds) >= max_rounds or time.perf_counter() > deadline:
-            rounds.append(row)
-            stopped = "rounds" if len(rounds) > max_rounds else "time budget"
+            stopped = stop
             break
         imposed += new
         optimum = max(state_feedback_gamma(*scaled_point(fine, k, co.T)) for k in new)
         gamma = max(current.gamma, (1 + level_rtol) * optimum)
-        start = co.coefficients_of(current, fine)
-        e = EigOpt(fine, T=co.T, c_of=co.c_of, dvs=co.dvs, gamma=gamma, points=imposed, sample_time=sample_time,
-                   balance_on=start)
-        z0 = e.start_from(*start)
-        row.update(level=gamma, pointwise_optimum=optimum, start_scaled_eig=e.largest(z0, gamma))
-        z, top, reason = e.solve(gamma, z0, t_schedule=t_schedule, max_iter=max_iter, margin=margin,
-                                 deadline=deadline)
-        row.update(imposed=len(imposed), evaluations=e.evaluations, largest_scaled_eig=top,
-                   result="found" if top < 0 else ("unfinished (time budget)" if reason == "time" else "not found"),
-                   time_s=time.perf_counter() - t1, cpu_s=time.process_time() - c1)
+        row.update(level=gamma, pointwise_optimum=optimum)
+        found, reason = resolve_on_points(fine, co, co.coefficients_of(current, fine), gamma=gamma, points=imposed,
+                                          row=row, started=(t1, c1), what="design refinement",
+                                          sample_time=sample_time, max_iter=max_iter, margin=margin,
+                                          t_schedule=t_schedule, deadline=deadline)
         rounds.append(row)
-        log.info("design refinement: round %d, %d points imposed: %s (%d evaluations, largest scaled "
-                 "eigenvalue %.3e, %.1f s)", row["round"], len(imposed), row["result"], e.evaluations, top,
-                 row["time_s"])
         if progress is not None:
             progress(len(rounds))
-        if top >= 0:
+        if found is None:
             stopped = "time budget" if reason == "time" else "not found"
             break
-        Ps, Qs = e.coefficients(z)
+        Ps, Qs = found
         min_p = min(float(np.linalg.eigvalsh(sum(c * P for c, P in zip(co.c_of(rho), Ps))).min())
                     for rho in itertools.product(*fine.axes))
         current = LPVStateFeedback(
@@ -153,7 +184,7 @@ def refine_state_feedback(design: LPVStateFeedback, fine: GeneralizedLPV, *, per
             status=f"{design.status}; refined: {len(imposed) - n_design} points of the "
                    f"{'x'.join(map(str, fine.grid_shape))} grid imposed",
             solve_time=design.solve_time + (time.perf_counter() - t0), build_time=design.build_time,
-            sizes=design.sizes, max_lmi_eig=float(top), min_P_eig=min_p)
+            sizes=design.sizes, max_lmi_eig=float(row["largest_scaled_eig"]), min_P_eig=min_p)
     record = {"passed": stopped == "passed", "design_gamma": design.gamma, "gamma": current.gamma,
               "stopped": stopped, "rounds": rounds,
               "points_added": len(imposed) - n_design, "fine_grid": list(fine.grid_shape),
