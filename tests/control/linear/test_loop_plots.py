@@ -78,3 +78,26 @@ def test_regulation_panel_is_the_closed_loop_released_from_an_offset(tmp_path):
     assert np.squeeze(step.outputs) == pytest.approx(0.5, abs=1e-6)  # x stays at 0
     plot_design(d, open_loop=P, path=tmp_path / "loop.png")
     assert (tmp_path / "loop.png").stat().st_size > 10_000
+
+
+def test_poles_panel_is_linear_with_ticks_when_the_poles_lie_within_one_per_second():
+    """A lightly damped structure with alpha_1 = 0.2 1/s puts every pole within |Re s| < 1, the
+    linear part of a symlog axis, which then carries only its two end ticks (-8.7e-1 and
+    4.2e-2 on an eight-bar system): the axis is linear there with readable ticks, and symlog
+    only when the real parts span decades (beyond 10 1/s)."""
+    from tmfem.control.linear.loop_plots import _poles
+    pol = np.array([0.0 + 2.0j, 0.0 - 2.0j, 0.0 + 80.0j, 0.0 - 80.0j])
+    pcl = np.array([-0.87 + 10j, -0.87 - 10j, -0.4 + 40j, -0.4 - 40j])
+    fig = new_figure(figsize=(6, 4))
+    a = fig.subplots()
+    _poles(a, pol, pcl, 0.2)
+    FigureCanvasAgg(fig).draw()
+    assert a.get_xscale() == "linear"
+    lo, hi = a.get_xlim()
+    ticks = [t for t in a.get_xticks() if lo <= t <= hi]
+    assert len(ticks) >= 3
+    assert "Re s = -alpha_1 = -0.2 1/s" in [ln.get_label() for ln in a.get_lines()]
+    fig = new_figure(figsize=(6, 4))
+    a = fig.subplots()
+    _poles(a, pol, np.array([-250.0 + 1j, -250.0 - 1j, -0.4 + 40j, -0.4 - 40j]), 0.2)
+    assert a.get_xscale() == "symlog"

@@ -53,6 +53,23 @@ def _sigma_max(sys, w):
     return np.linalg.svd(np.moveaxis(H, 2, 0), compute_uv=False)
 
 
+def _poles(a, pol, pcl, alpha) -> None:
+    """The poles panel: open-loop ``pol`` and closed-loop ``pcl`` in the s-plane with the line
+    Re s = -alpha_1 of eq. 5.66. The real axis is symmetric-logarithmic (linear within 1 1/s)
+    only when the real parts reach beyond 10 1/s; otherwise linear, since a symlog axis over its
+    linear part alone carries only its two end ticks."""
+    a.plot(pol.real, pol.imag, "x", color="0.5", label="open loop")
+    a.plot(pcl.real, pcl.imag, ".", color="C0", label="closed loop")
+    a.axvline(-alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-alpha:g} 1/s"
+              if alpha else "Re s = 0")
+    a.set_xlabel("Re s [1/s]")
+    a.set_ylabel("Im s [rad/s]")
+    if np.max(np.abs(np.concatenate([pol.real, pcl.real, [alpha or 0.0]]))) > 10.0:
+        a.set_xscale("symlog", linthresh=1.0)
+    a.legend(loc="best", fontsize=8)
+    a.set_title("poles")
+
+
 def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -> None:
     """Write the four-panel closed-loop analysis figure of ``design`` (HinfDesign) to ``path``.
 
@@ -67,19 +84,9 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
         routes = route_levels(P, alpha=design.alpha)
     fig = new_figure(figsize=(13, 9.5))
     ax = fig.subplots(2, 2)
-    # poles
-    a = ax[0, 0]
     pol = np.linalg.eigvals(P.A)
-    a.plot(pol.real, pol.imag, "x", color="0.5", label="open loop")
     pcl = T.poles()
-    a.plot(pcl.real, pcl.imag, ".", color="C0", label="closed loop")
-    a.axvline(-design.alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-design.alpha:g}"
-              if design.alpha else "Re s = 0")
-    a.set_xlabel("Re s [1/s]")
-    a.set_ylabel("Im s [rad/s]")
-    a.set_xscale("symlog", linthresh=1.0)
-    a.legend(loc="best", fontsize=8)
-    a.set_title("poles")
+    _poles(ax[0, 0], pol, pcl, design.alpha)
     # singular values
     a = ax[0, 1]
     lam = np.abs(np.concatenate([pol, pcl]))
