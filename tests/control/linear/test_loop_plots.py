@@ -101,3 +101,20 @@ def test_poles_panel_is_linear_with_ticks_when_the_poles_lie_within_one_per_seco
     a = fig.subplots()
     _poles(a, pol, np.array([-250.0 + 1j, -250.0 - 1j, -0.4 + 40j, -0.4 - 40j]), 0.2)
     assert a.get_xscale() == "symlog"
+
+
+def test_a_refusal_is_wrapped_at_words_and_shortened_visibly():
+    """The refusal of a 90-state plant by the LMI route was cut every 28 characters ("90 state"
+    / "s by the lmi route") and after 112 characters without a mark: the text is broken at word
+    boundaries only, at most six lines, and a shortened one ends in "..."."""
+    from tmfem.control.linear.loop_plots import _wrapped
+    msg = ("hinfsyn: a plant of 90 states by the lmi route: the LMI synthesis (an SDP in two n x n "
+           "symmetric unknowns) needs about 16 GiB, expected at most 40 states for this route; use "
+           "--method riccati or --method slicot, which take any size")
+    out = _wrapped(msg)
+    rows = out.split("\n")
+    assert len(rows) == 6 and all(len(r) <= 30 for r in rows)
+    assert out.endswith("...")
+    words = set(msg.split())
+    assert all(w in words for w in " ".join(rows)[:-4].split())      # no word cut in two
+    assert _wrapped("Solver 'CLARABEL' failed.") == "Solver 'CLARABEL' failed."

@@ -191,6 +191,13 @@ def _regulation(a, T, design) -> None:
     a.legend(loc="upper right", fontsize=7)
 
 
+def _wrapped(text: str, *, width: int = 30, lines: int = 6) -> str:
+    """``text`` broken at word boundaries into at most ``lines`` lines of ``width`` characters,
+    the last ending in "..." when the text is longer (a refusal's message inside a bar panel)."""
+    import textwrap
+    return "\n".join(textwrap.wrap(text, width=width, max_lines=lines, placeholder=" ..."))
+
+
 def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
     names = list(routes)
     ok = [(k, v) for k, v in routes.items() if not isinstance(v, str)]
@@ -199,8 +206,8 @@ def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
         v = routes[name]
         if isinstance(v, str):
             # at the foot of the panel whatever the gamma scale (x in data, y in axes units)
-            a.text(k, 0.02, "refused:\n" + "\n".join(v[i:i + 28] for i in range(0, min(len(v), 112), 28)),
-                   ha="center", va="bottom", fontsize=6, rotation=0, transform=a.get_xaxis_transform())
+            a.text(k, 0.02, "refused:\n" + _wrapped(v), ha="center", va="bottom", fontsize=6, rotation=0,
+                   transform=a.get_xaxis_transform(), bbox=dict(facecolor="white", edgecolor="0.7", pad=2))
             continue
         a.bar(k - 0.18, v[0], width=0.36, color="C0", label="gamma" if k == 0 else None)
         a.bar(k + 0.18, v[1], width=0.36, color="C1", label="verified ||T_pw||_inf" if k == 0 else None)
