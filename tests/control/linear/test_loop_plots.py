@@ -118,3 +118,20 @@ def test_a_refusal_is_wrapped_at_words_and_shortened_visibly():
     words = set(msg.split())
     assert all(w in words for w in " ".join(rows)[:-4].split())      # no word cut in two
     assert _wrapped("Solver 'CLARABEL' failed.") == "Solver 'CLARABEL' failed."
+
+
+def test_the_route_comparison_leaves_out_a_route_beyond_its_budget():
+    """`control hinf --plot` compares the synthesis routes on the design's plant; the LMI route
+    grows as n^5.5 (tmfem.resources.synthesis_seconds: 2.2 s at 20 states, about a minute at
+    36), so the figure leaves out a route whose estimate exceeds the budget and says so, and
+    runs the others (on the oscillator the Riccati route reaches the feedthrough bound W_e = 0.5
+    times (1 + 0.0005)^2: the bisection's margin and the central controller's)."""
+    from tmfem.control.linear.loop_plots import route_levels
+    from tmfem.resources import synthesis_seconds
+    P = oscillator_of_figure_7_1()
+    t_lmi = synthesis_seconds(route="lmi", n=2)
+    out = route_levels(P, alpha=0.5, routes=("lmi",), budget_s=0.5 * t_lmi)
+    assert out["lmi"].startswith("not run for this figure") and "2 states" in out["lmi"]
+    gamma, norm = route_levels(P, alpha=0.5, routes=("riccati",))["riccati"]
+    assert gamma == pytest.approx(0.5 * 1.0005 ** 2, rel=1e-6) and norm <= gamma
+    assert synthesis_seconds(route="lmi", n=36) > 10.0 > synthesis_seconds(route="lmi", n=20)

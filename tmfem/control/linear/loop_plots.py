@@ -35,11 +35,26 @@ def damping_table(sys) -> list:
     return sorted(rows)
 
 
-def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot")) -> dict:
+#: longest estimated synthesis [CPU s] (:func:`tmfem.resources.synthesis_seconds`) that the
+#: figure's comparison of routes runs; a longer route is left out of the figure, said so in its panel
+ROUTE_PLOT_BUDGET_S = 10.0
+
+
+def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot"),
+                 budget_s: float = ROUTE_PLOT_BUDGET_S) -> dict:
     """gamma and verified norm of each route of :func:`tmfem.control.linear.hinf_synthesis.hinfsyn`
-    on ``plant`` (GeneralizedPlant): name -> (gamma, norm) or the refusal's message."""
+    on ``plant`` (GeneralizedPlant): name -> (gamma, norm) or the refusal's message. A route
+    whose estimated time exceeds ``budget_s`` CPU seconds is not run (the LMI route grows as
+    n^5.5: about a minute at 36 states): its entry says so."""
+    from tmfem.resources import synthesis_seconds
     out = {}
+    n = plant.A.shape[0]
     for r in routes:
+        t = synthesis_seconds(route=r, n=n)
+        if t > budget_s:
+            out[r] = (f"not run for this figure: about {t:.0f} s of CPU for {n} states "
+                      f"(`--method {r}` designs with it)")
+            continue
         try:
             res = hinfsyn(plant, plant.C2.shape[0], plant.B2.shape[1], method=r, alpha=alpha)
             out[r] = (res.gamma, res.info["verified_norm"])
@@ -206,7 +221,7 @@ def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
         v = routes[name]
         if isinstance(v, str):
             # at the foot of the panel whatever the gamma scale (x in data, y in axes units)
-            a.text(k, 0.02, "refused:\n" + _wrapped(v), ha="center", va="bottom", fontsize=6, rotation=0,
+            a.text(k, 0.02, ("" if v.startswith("not run") else "refused:\n") + _wrapped(v), ha="center", va="bottom", fontsize=6, rotation=0,
                    transform=a.get_xaxis_transform(), bbox=dict(facecolor="white", edgecolor="0.7", pad=2))
             continue
         a.bar(k - 0.18, v[0], width=0.36, color="C0", label="gamma" if k == 0 else None)
