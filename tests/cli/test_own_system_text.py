@@ -1,6 +1,7 @@
-"""The text summary of `tmfem report` for a system of one's own: a deployment without a switch
-before its end, and the COM's disagreement with the FE model when K was chosen automatically
-(more membrane modes do not help then) or declared in the file (they may)."""
+"""Text outputs for a system of one's own: `tmfem report`'s deployment without a switch before
+its end and the COM's disagreement with the FE model when K was chosen automatically (more
+membrane modes do not help then) or declared in the file (they may); `tmfem modal --model com`'s
+column name."""
 import numpy as np
 
 from tmfem.cli.report import format_text
@@ -36,3 +37,14 @@ def test_the_hint_of_the_com_disagreement_follows_where_K_came_from():
     assert "[models.com]" not in auto and "more modes bring" not in auto
     declared = com_disagreement(freqs, "SBC", 4)["message"]
     assert "[models.com] membrane_modes in the system file): more modes bring" in declared
+
+
+def test_the_com_modal_table_names_its_column_by_the_model():
+    """`tmfem modal --model com` on a file without printed values: the column is 'COM [Hz]'
+    (the SBC and MTC tables name theirs so), not 'ours'."""
+    from tmfem.post.com import format_modal
+    r = {"system": "octagon", "sizes": {"n_z": 20, "n_q": 16}, "membrane_modes": 4,
+         "prestress_scale": 1.0, "freq_hz": [0.3159, 1.5050]}
+    text = format_modal(r)
+    assert "mode   COM [Hz]" in text and "ours" not in text
+    assert "   1     0.3159" in text
