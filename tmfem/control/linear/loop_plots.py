@@ -53,7 +53,7 @@ def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot"),
         t = synthesis_seconds(route=r, n=n)
         if t > budget_s:
             out[r] = (f"not run for this figure: about {t:.0f} s of CPU for {n} states "
-                      f"(`--method {r}` designs with it)")
+                      f"(`tmfem.control.hinfsyn(..., method='{r}')` runs it)")
             continue
         try:
             res = hinfsyn(plant, plant.C2.shape[0], plant.B2.shape[1], method=r, alpha=alpha)
