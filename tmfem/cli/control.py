@@ -144,7 +144,8 @@ def format_text(r: dict) -> str:
         return control_lpv.format_text(r)
     if r["action"] == "recheck":
         return (f"{r['file']}: gamma = {r['gamma']:.6g}, ||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}, "
-                f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} 1/s (alpha_1 = {r['alpha']:g} 1/s): ok")
+                f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} 1/s "
+                f"(alpha_1 = {r['alpha']:g} 1/s): ok")
     p = r["pbh"]
     from tmfem.models.com.mode_count import MembraneModeChoice
     lines = [f"system {r['system']}: {r['n_states']} states, {r['n_inputs']} inputs",

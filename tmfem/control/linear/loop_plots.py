@@ -221,7 +221,8 @@ def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
         v = routes[name]
         if isinstance(v, str):
             # at the foot of the panel whatever the gamma scale (x in data, y in axes units)
-            a.text(k, 0.02, ("" if v.startswith("not run") else "refused:\n") + _wrapped(v), ha="center", va="bottom", fontsize=6, rotation=0,
+            text = ("" if v.startswith("not run") else "refused:\n") + _wrapped(v)
+            a.text(k, 0.02, text, ha="center", va="bottom", fontsize=6, rotation=0,
                    transform=a.get_xaxis_transform(), bbox=dict(facecolor="white", edgecolor="0.7", pad=2))
             continue
         a.bar(k - 0.18, v[0], width=0.36, color="C0", label="gamma" if k == 0 else None)
