@@ -48,3 +48,24 @@ def test_the_com_modal_table_names_its_column_by_the_model():
     text = format_modal(r)
     assert "mode   COM [Hz]" in text and "ours" not in text
     assert "   1     0.3159" in text
+
+
+def _static(rest_lengths):
+    return {"tendon_stress_max": 3.0e7, "bar_load_max": 15.4, "membrane_max_sigma_p1": 6.1e6,
+            "membrane_max_von_mises": 5.4e6, "Delta": [5.3e-4] * 5, "rest_lengths": rest_lengths,
+            "tendon_slack": []}
+
+
+def test_the_report_statics_row_names_the_tendon_it_shows():
+    """The statics table of `tmfem report` shows one tendon's rest length: it was labelled
+    'rest length S_11' whatever the system, so a 1-N(D) system's SL_1 (0.44748 m) stood under
+    the saddle tendon's name. The label is the tendon's own, and a preset keeps its printed
+    value beside S_11 (1-4: S1 = 1.529 m, Table 6.3)."""
+    from tmfem.reference.report import _statics_rows
+    from tmfem.system import load_preset, load_system
+    mine = load_system("tests/data/systems/pentagon-1-5D.toml")
+    rows = _statics_rows(mine, {"designed": _static({"SL_1": 0.44748, "SU_1": 2.03858})})
+    assert rows[-1] == ["rest length SL_1", "m", 0.44748]
+    preset = load_preset("1-4")
+    rows = _statics_rows(preset, {"designed": _static({"S_11": 1.5025, "S_12": 1.5025})})
+    assert rows[-1][:4] == ["rest length S_11", "m", 1.529, 1.5025]

@@ -484,9 +484,12 @@ def _statics_rows_printed(system, statics: dict) -> list:
             v = briefs[label][key]
             row += [v, None if pr is None else v / (pr * f) - 1]
         rows.append(row)
-    r = ["rest length S_11", "m", (p.get("rest_lengths") or {}).get("S1")]
+    # the first tendon's rest length, named (S_11 of an M-N system, SL_1 of a 1-N(D) one)
+    first = next(iter(briefs[next(iter(statics))]["rest_lengths_m"]))
+    group = next((t.group for t in system.tendons if t.name == first), None)
+    r = [f"rest length {first}", "m", (p.get("rest_lengths") or {}).get(group)]
     for label in statics:
-        r += [next(iter(briefs[label]["rest_lengths_m"].values())), None]
+        r += [briefs[label]["rest_lengths_m"][first], None]
     rows.append(r)
     return rows
 
@@ -672,8 +675,8 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
               f"{g} = {v} m" for g, v in summary['implied_prestress']['rest_lengths'].items())
              + f" ({summary['implied_prestress']['source']})."
              if summary["implied_prestress"] else "."), "",
-          f"Files: {link('statics.csv')}, " + ", ".join(
-              link(f"static_{k}.vtu") for k in statics) + ".", ""]
+          "Files: " + ", ".join(link(k) for k in ["statics.csv", *(f"static_{c}.vtu" for c in statics)]
+                                if k in files) + ".", ""]
     rows = _statics_rows(system, statics)
     with_printed = has_printed(system=system)
     L.append(tabulate([[r[0], r[1]] + [_num(v) if not with_printed or j % 2 == 1 or j == 0 else
@@ -688,8 +691,9 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
         L += [img(f"static_{k}.png", f"{fe} equilibrium {k}"), "",
               img(f"static_{k}_stress.png", f"{fe} membrane stress {k}"), ""]
     L += ["## 3. Natural frequencies and mode shapes (6.4, eq. 5.32)", "",
-          f"Files: {link('frequencies.csv')}, {link('modes.vtu')} (ParaView: Warp By Vector "
-          "with `mode_k`; field data `mode_k_hz`; cell data `kind`).", ""]
+          f"Files: {link('frequencies.csv')}" + (f", {link('modes.vtu')} (ParaView: Warp By Vector "
+                                                 "with `mode_k`; field data `mode_k_hz`; cell data "
+                                                 "`kind`)" if "modes.vtu" in files else "") + ".", ""]
     head = ["mode"] + [f"{c} [Hz]" for c in freqs]
     if printed:
         head += [f"{m} printed [Hz]" for m in ("MTC", "SBC", "COM")]
