@@ -69,3 +69,22 @@ def test_the_report_statics_row_names_the_tendon_it_shows():
     preset = load_preset("1-4")
     rows = _statics_rows(preset, {"designed": _static({"S_11": 1.5025, "S_12": 1.5025})})
     assert rows[-1][:4] == ["rest length S_11", "m", 1.529, 1.5025]
+
+
+def test_a_deployment_beyond_its_strength_fails_the_report():
+    """A two-stage 2-6 of titanium, aramid and PEN deployed from 73 deg: its run left the tendons
+    at 24 GPa (yield 2.8 GPa), the bars at 2.3 x their Euler load and the membrane at 2.5 GPa;
+    `tmfem deploy` exits 1 on these checks, and the report said 'checks passed' with exit 0.
+    The report's failed checks carry the deployment's, as `deploy` names them."""
+    from tmfem.reference.report import deployment_failures
+    strength = ["tendon yield: D_24 at 2.396e+04 MPa (t = 0.36 s) above its yield stress 2800 MPa",
+                "bar buckling: compression 2.494e+04 N (t = 0.2 s) above the Euler load 1.079e+04 N (eq. 5.31)"]
+    assert deployment_failures({"failure": None, "strength_checks_failed": strength}) == [
+        "deployment: " + c for c in strength]
+    assert deployment_failures({"failure": "Newton diverged at t = 1.2 s", "strength_checks_failed": []}) == [
+        "deployment: diverged (Newton diverged at t = 1.2 s)"]
+    assert deployment_failures({"not_run": "slack tendon"}) == ["deployment not run"]
+    assert deployment_failures({"failure": None, "strength_checks_failed": []}) == []
+    assert deployment_failures(None) == []
+    text = format_text({**_result(), "failed_checks": ["deployment: " + strength[0]]})
+    assert text.startswith("report of mine: checks FAILED: deployment: tendon yield: D_24")

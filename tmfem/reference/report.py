@@ -322,7 +322,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     summary = {"system": name, "fe_model": fe, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
                "perturbation": perturb, "design_ok": bool(d.ok),
                "failed_checks": [c.name for c in d.failed] + _result_failures(statics, freqs, fe)
-               + (["deployment not run"] if deployment and "not_run" in deployment else []),
+               + deployment_failures(deployment),
                "implied_prestress": implied,
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
@@ -404,6 +404,18 @@ def _result_failures(statics: dict, freqs: dict, fe: str) -> list[str]:
 
 def _run_progress(factory, label):
     return None if factory is None else factory(label)
+
+
+def deployment_failures(deployment: dict | None) -> list[str]:
+    """The report's failed checks of its deployment (the checks `tmfem deploy` exits 1 on):
+    not run, a diverged run (``failure``), and the strength checks of the run (tendon and
+    membrane yield, bar buckling: ``strength_checks_failed``), each named "deployment: ..."."""
+    if not deployment:
+        return []
+    if "not_run" in deployment:
+        return ["deployment not run"]
+    out = [f"deployment: diverged ({deployment['failure']})"] if deployment.get("failure") else []
+    return out + [f"deployment: {c}" for c in deployment.get("strength_checks_failed") or []]
 
 
 def _deployment(out: Path, spec: dict, *, dt: float, add, progress) -> dict:
