@@ -8,7 +8,8 @@ from tmfem.io.run import column_header
 
 # exact keys, then suffix rules; first match wins
 _EXACT = {
-    "F_Delta": "N", "Delta": "m", "Delta_design": "m", "Delta_design_mean": "m", "Delta_mean": "m", "residual": "-",
+    "F_Delta": "N", "Delta": "m", "Delta_file": "m", "Delta_deployed": "m", "psi_deg_bands": "deg",
+    "Delta_design": "m", "Delta_design_mean": "m", "Delta_mean": "m", "residual": "-",
     "nodes": "m", "tendon_forces": "N", "tendon_force": "N", "tendon_lengths": "m",
     "length": "m", "force": "N", "force_density": "N/m", "force_densities": "N/m",
     "rest_lengths": "m", "rest_length": "m", "design_rest_lengths": "m",
