@@ -23,3 +23,13 @@ def test_design_assistance_json_states_every_unit(option, capsys):
         assert lo < d["psi_deg"] < hi      # the printed psi lies in a feasible band
     else:
         assert u["Delta_file"] == "m" and u["r_mb_max"] == "m"
+
+
+def test_the_bases_search_json_states_the_units_of_its_symmetric_table():
+    """`--bases` prints a `[symmetric]` table (r, l, z in m, angles in deg): its JSON's numbers
+    under `symmetric` carry them (the search itself: docs/guides/system-file.md)."""
+    from tmfem.io.units import unit_of
+    doc = {"Delta": 0.0067, "symmetric": {"theta_deg": [70.0, 70.0], "z": [0.0, 0.3865],
+                                          "r": [0.8, 1.011], "l": [2.0, 2.0]}}
+    assert _unitless_numbers(doc) == []
+    assert unit_of("symmetric").startswith("r, l, z in m")
