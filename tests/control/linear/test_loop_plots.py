@@ -135,3 +135,23 @@ def test_the_route_comparison_leaves_out_a_route_beyond_its_budget():
     gamma, norm = route_levels(P, alpha=0.5, routes=("riccati",))["riccati"]
     assert gamma == pytest.approx(0.5 * 1.0005 ** 2, rel=1e-6) and norm <= gamma
     assert synthesis_seconds(route="lmi", n=36) > 10.0 > synthesis_seconds(route="lmi", n=20)
+
+
+def test_the_route_comparison_takes_the_design_s_own_route_as_it_is(tmp_path, monkeypatch):
+    """`control hinf --plot` (method auto) designed with hinfsyn's Riccati route and then ran
+    that route again for the comparison panel (13 s more on a 90-state 2-6): the design's
+    own route enters the panel with its gamma and verified norm, the others are synthesised."""
+    from tmfem.control.linear import loop_plots
+    from tmfem.control.linear.hinf_synthesis import hinfsyn
+    P = oscillator_of_figure_7_1()
+    res = hinfsyn(P, 2, 1, alpha=0.5)
+    d = res.design
+    d.info["route"] = {"method": res.info["method"]}
+    called = []
+    real = loop_plots.hinfsyn
+    monkeypatch.setattr(loop_plots, "hinfsyn",
+                        lambda *a, method, **k: called.append(method) or real(*a, method=method, **k))
+    routes = loop_plots.route_levels(P, alpha=0.5, known=loop_plots._own_route(d))
+    assert res.info["method"] not in called and called
+    assert routes[res.info["method"]] == (pytest.approx(res.gamma), pytest.approx(res.info["verified_norm"]))
+    assert loop_plots._own_route(SimpleNamespace(info={}, gamma=1.0, closed_loop_norm=0.5)) == {}

@@ -41,15 +41,19 @@ ROUTE_PLOT_BUDGET_S = 10.0
 
 
 def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot"),
-                 budget_s: float = ROUTE_PLOT_BUDGET_S) -> dict:
+                 budget_s: float = ROUTE_PLOT_BUDGET_S, known: dict | None = None) -> dict:
     """gamma and verified norm of each route of :func:`tmfem.control.linear.hinf_synthesis.hinfsyn`
     on ``plant`` (GeneralizedPlant): name -> (gamma, norm) or the refusal's message. A route
     whose estimated time exceeds ``budget_s`` CPU seconds is not run (the LMI route grows as
-    n^5.5: about a minute at 36 states): its entry says so."""
+    n^5.5: about a minute at 36 states): its entry says so. ``known``: route -> (gamma, norm)
+    already computed on this plant (the design's own route), taken as they are."""
     from tmfem.resources import synthesis_seconds
     out = {}
     n = plant.A.shape[0]
     for r in routes:
+        if known and r in known:
+            out[r] = known[r]
+            continue
         t = synthesis_seconds(route=r, n=n)
         if t > budget_s:
             out[r] = (f"not run for this figure: about {t:.0f} s of CPU for {n} states "
@@ -85,6 +89,17 @@ def _poles(a, pol, pcl, alpha) -> None:
     a.set_title("poles")
 
 
+def _own_route(design) -> dict:
+    """{route: (gamma, verified norm)} of the :func:`hinfsyn` route that made ``design`` (its
+    ``info["route"]``, set by ``tmfem control hinf --method auto``), so the comparison of
+    routes does not synthesise it again; {} for a design of another origin."""
+    route = (design.info or {}).get("route") or {}
+    if "method" not in route:
+        return {}
+    norm = float(design.closed_loop_norm)
+    return {route["method"]: (max(float(design.gamma), norm), norm)}
+
+
 def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -> None:
     """Write the four-panel closed-loop analysis figure of ``design`` (HinfDesign) to ``path``.
 
@@ -96,7 +111,7 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
     T = design.closed_loop
     P = open_loop if open_loop is not None else design.plant
     if routes is None and open_loop is not None:
-        routes = route_levels(P, alpha=design.alpha)
+        routes = route_levels(P, alpha=design.alpha, known=_own_route(design))
     fig = new_figure(figsize=(13, 9.5))
     ax = fig.subplots(2, 2)
     pol = np.linalg.eigvals(P.A)
