@@ -134,7 +134,7 @@ def run(args) -> dict:
             from tmfem.control.linear.loop_plots import plot_design
             plot_design(res.design, open_loop=res.generalized, path=args.plot,
                         title=f"{system.name}: H-infinity design, gamma = {res.design.gamma:.4g}, "
-                              f"alpha_1 = {res.design.alpha:g}")
+                              f"alpha_1 = {res.design.alpha:g} 1/s")
             out["plot"] = args.plot
     return out
 
@@ -144,7 +144,8 @@ def format_text(r: dict) -> str:
         return control_lpv.format_text(r)
     if r["action"] == "recheck":
         return (f"{r['file']}: gamma = {r['gamma']:.6g}, ||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}, "
-                f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} (alpha_1 = {r['alpha']:g}): ok")
+                f"max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} 1/s "
+                f"(alpha_1 = {r['alpha']:g} 1/s): ok")
     p = r["pbh"]
     from tmfem.models.com.mode_count import MembraneModeChoice
     lines = [f"system {r['system']}: {r['n_states']} states, {r['n_inputs']} inputs",
@@ -159,7 +160,7 @@ def format_text(r: dict) -> str:
     if r["action"] == "hinf":
         s = r["solver"]
         lines += [f"gamma = {r['gamma']:.6g} (||T_pw||_inf = {r['closed_loop_hinf_norm']:.6g}), "
-                  f"alpha_1 = {r['alpha']:g}, max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g}",
+                  f"alpha_1 = {r['alpha']:g} 1/s, max Re(closed-loop poles) = {r['closed_loop_max_real_part']:.4g} 1/s",
                   f"{r['method']}, controller order {r['controller_order']}"
                   + ("" if r["cond_I_minus_RS"] is None else
                      f", cond(I - RS) = {r['cond_I_minus_RS']:.3g}"),

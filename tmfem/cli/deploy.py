@@ -310,6 +310,18 @@ def check_plant(args) -> int | None:
     return n
 
 
+#: the text of a result entry that is None (JSON null)
+_NONE_TEXT = {"switch_time_s": "none (the switch condition was not met before t_end)",
+              "failure": "none"}
+
+
+def _value_text(key: str, value) -> str:
+    """One value of the text summary: a float to 6 digits, None in words."""
+    if value is None:
+        return _NONE_TEXT.get(key, "none")
+    return f"{value:.6g}" if isinstance(value, float) else str(value)
+
+
 def format_text(r: dict) -> str:
     keys = ["switch_time_s", "t_end_s", "max_membrane_deflection_m", "peak_bar_compression_N",
             "bar_critical_load_N", "max_von_mises_Pa", "max_tendon_stress_Pa",
@@ -323,7 +335,7 @@ def format_text(r: dict) -> str:
         lines.append("  COM: " + MembraneModeChoice(**r["membrane_mode_choice"]).text)
     if "excluded_modes_hz" in r:
         lines.append("  " + excluded_text(r["excluded_modes_hz"]))
-    lines += [f"  {k}: {r[k]:.6g}" if isinstance(r[k], float) else f"  {k}: {r[k]}" for k in keys]
+    lines += [f"  {k}: {_value_text(k, r[k])}" for k in keys]
     if "compare" in r:
         c = r["compare"]
         lines.append(f"  on the {c['plant']} plant: switch_time_s {c['switch_time_s']}, "

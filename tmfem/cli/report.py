@@ -131,7 +131,8 @@ def format_text(r: dict) -> str:
         lines.insert(-1, "")
     elif d:
         lines.insert(-1, f"deployment {d['system']} ({d['controller']}, uncertainty "
-                         f"{d['uncertainty']}): switch at {d['switch_time_s']} s, max w "
+                         f"{d['uncertainty']}): " + ("no switch before t_end" if d['switch_time_s'] is None
+                                                     else f"switch at {d['switch_time_s']:.4g} s") + ", max w "
                          f"{1e3 * d['max_membrane_deflection_m']:.2f} mm, final tracking error "
                          f"{d['final_tracking_error']:.2g}")
         if d.get("excluded_modes_hz"):

@@ -8,7 +8,8 @@ from tmfem.io.run import column_header
 
 # exact keys, then suffix rules; first match wins
 _EXACT = {
-    "F_Delta": "N", "Delta": "m", "Delta_design": "m", "Delta_design_mean": "m", "Delta_mean": "m", "residual": "-",
+    "F_Delta": "N", "Delta": "m", "Delta_file": "m", "Delta_deployed": "m", "psi_deg_bands": "deg",
+    "Delta_design": "m", "Delta_design_mean": "m", "Delta_mean": "m", "residual": "-",
     "nodes": "m", "tendon_forces": "N", "tendon_force": "N", "tendon_lengths": "m",
     "length": "m", "force": "N", "force_density": "N/m", "force_densities": "N/m",
     "rest_lengths": "m", "rest_length": "m", "design_rest_lengths": "m",
@@ -36,6 +37,7 @@ _EXACT = {
     "symmetric_null": "- (null vector of eq. 3.16 per unit F_Delta)",
     "checks": "value and limit in the SI unit of the checked quantity (Pa, N, m)",
     "closed_form": "S1, delta, delta_3_36, r1_equilibrium, r_mb in m; A, det, ratio -",
+    "symmetric": "r, l, z in m; theta_deg, psi_deg, sigma_deg in deg (a [symmetric] table)",
     "final": "per state: rad, rad/s (theta, psi), kg^0.5 m, kg^0.5 m/s (eta_k), m (positions)",
     # LPV synthesis and deployment (docs/guides/lpv.md)
     "gamma": "-", "gamma_feasible": "-", "gamma_not_found": "-", "gamma_lower_bound_proven": "-",

@@ -84,7 +84,7 @@ def _default_k(model) -> int | None:
 
 
 def format_modal(r: dict) -> str:
-    """Text table of a :func:`modal_summary` result: ours beside the printed COM column."""
+    """Text table of a :func:`modal_summary` result: the COM column beside the printed one."""
     lines = [f"COM of {r['system']}: {r['sizes']['n_z']} coordinates (nq = {r['sizes']['n_q']}, "
              f"K = {r['membrane_modes']}), prestress x{r['prestress_scale']:g}, rest lengths "
              f"from the {r.get('rest_lengths_source', 'design')}"]
@@ -99,7 +99,7 @@ def format_modal(r: dict) -> str:
     if "printed_bar_load_prestress_scale" in r:
         lines.append(f"prestress implied by the printed stage-1 bar load: x{r['printed_bar_load_prestress_scale']:.4f}")
     ref = r.get("dissertation", {}).get("COM", [])
-    lines.append(f"{'mode':>4} {'ours [Hz]':>10}" + (f" {'printed':>10} {'rel.diff':>9}" if ref else ""))
+    lines.append(f"{'mode':>4} {'COM [Hz]':>10}" + (f" {'printed':>10} {'rel.diff':>9}" if ref else ""))
     for i, f in enumerate(r["freq_hz"]):
         if i < len(ref):
             lines.append(f"{i + 1:>4} {f:>10.4f} {ref[i]:>10.4f} {f / ref[i] - 1:>+9.2%}")

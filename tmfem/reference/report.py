@@ -270,7 +270,8 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
                                    mesh_n=mesh_n)
         freqs[f"COM x{scale:.4f}"] = np.array(com_implied["freq_hz"])
     step(STEPS[5])
-    disagreement = com_disagreement(freqs, fe, K)
+    disagreement = com_disagreement(freqs, fe, K, declared=system.model_defaults.get("com", {}).get(
+        "membrane_modes") is not None)
     if disagreement:
         log.warning("%s: %s", name, disagreement["message"])
     printed = printed_frequencies(system)
@@ -321,7 +322,7 @@ def write_report(system, out, *, mesh_n: int = 10, modes: int = 12, t_end: float
     summary = {"system": name, "fe_model": fe, "mesh_n": mesh_n, "modes": modes, "t_end_s": t_end, "dt_s": dt,
                "perturbation": perturb, "design_ok": bool(d.ok),
                "failed_checks": [c.name for c in d.failed] + _result_failures(statics, freqs, fe)
-               + (["deployment not run"] if deployment and "not_run" in deployment else []),
+               + deployment_failures(deployment),
                "implied_prestress": implied,
                "statics": {k: _static_brief(v) for k, v in statics.items()},
                "frequencies_hz": {k: v.tolist() for k, v in freqs.items()},
@@ -361,11 +362,13 @@ def monitored(system) -> tuple:
 COM_TOLERANCE = 0.05
 
 
-def com_disagreement(freqs: dict, fe: str, K: int) -> dict | None:
+def com_disagreement(freqs: dict, fe: str, K: int, *, declared: bool = True) -> dict | None:
     """Modes whose COM frequency (designed prestress) differs from the FE model's by more than
     :data:`COM_TOLERANCE`, with a hint: the K membrane modes of the COM (``[models.com]
     membrane_modes``) limit the membrane modes it represents (the 3 m Kapton 1-4 of the tests:
-    modes 8-12 at K = 4 differ by up to 35 %, at K = 8 by up to 7 %). None when all agree."""
+    modes 8-12 at K = 4 differ by up to 35 %, at K = 8 by up to 7 %). ``declared``: K is the
+    file's; otherwise it is the automatic choice, beyond which more modes no longer change the
+    frequencies, and the hint says so. None when all agree."""
     com, ref = freqs.get("COM designed"), freqs.get(f"{fe} designed")
     if com is None or ref is None:
         return None
@@ -378,8 +381,11 @@ def com_disagreement(freqs: dict, fe: str, K: int) -> dict | None:
         return None
     msg = (f"COM frequencies of modes {bad} differ from the {fe} model's by more than "
            f"{100 * COM_TOLERANCE:g} % (largest {100 * np.max(np.abs(rel)):.1f} %): the COM has K = "
-           f"{K} membrane modes ([models.com] membrane_modes in the system file): more modes bring "
-           "its higher membrane modes closer; what remains is the COM's own approximation "
+           + (f"{K} membrane modes ([models.com] membrane_modes in the system file): more modes bring "
+              "its higher membrane modes closer; what remains is " if declared else
+              f"{K} membrane modes (the automatic choice: more modes do not bring them closer): the "
+              "difference is ")
+           + "the COM's own approximation "
            "(rigid bars, linear tendon springs of eqs. 3.8-3.9, membrane modes about the designed "
            "prestress, ch. 5)")
     return {"modes": bad, "relative_difference": rel.tolist(), "tolerance": COM_TOLERANCE,
@@ -398,6 +404,18 @@ def _result_failures(statics: dict, freqs: dict, fe: str) -> list[str]:
 
 def _run_progress(factory, label):
     return None if factory is None else factory(label)
+
+
+def deployment_failures(deployment: dict | None) -> list[str]:
+    """The report's failed checks of its deployment (the checks `tmfem deploy` exits 1 on):
+    not run, a diverged run (``failure``), and the strength checks of the run (tendon and
+    membrane yield, bar buckling: ``strength_checks_failed``), each named "deployment: ..."."""
+    if not deployment:
+        return []
+    if "not_run" in deployment:
+        return ["deployment not run"]
+    out = [f"deployment: diverged ({deployment['failure']})"] if deployment.get("failure") else []
+    return out + [f"deployment: {c}" for c in deployment.get("strength_checks_failed") or []]
 
 
 def _deployment(out: Path, spec: dict, *, dt: float, add, progress) -> dict:
@@ -478,9 +496,12 @@ def _statics_rows_printed(system, statics: dict) -> list:
             v = briefs[label][key]
             row += [v, None if pr is None else v / (pr * f) - 1]
         rows.append(row)
-    r = ["rest length S_11", "m", (p.get("rest_lengths") or {}).get("S1")]
+    # the first tendon's rest length, named (S_11 of an M-N system, SL_1 of a 1-N(D) one)
+    first = next(iter(briefs[next(iter(statics))]["rest_lengths_m"]))
+    group = next((t.group for t in system.tendons if t.name == first), None)
+    r = [f"rest length {first}", "m", (p.get("rest_lengths") or {}).get(group)]
     for label in statics:
-        r += [next(iter(briefs[label]["rest_lengths_m"].values())), None]
+        r += [briefs[label]["rest_lengths_m"][first], None]
     rows.append(r)
     return rows
 
@@ -666,8 +687,8 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
               f"{g} = {v} m" for g, v in summary['implied_prestress']['rest_lengths'].items())
              + f" ({summary['implied_prestress']['source']})."
              if summary["implied_prestress"] else "."), "",
-          f"Files: {link('statics.csv')}, " + ", ".join(
-              link(f"static_{k}.vtu") for k in statics) + ".", ""]
+          "Files: " + ", ".join(link(k) for k in ["statics.csv", *(f"static_{c}.vtu" for c in statics)]
+                                if k in files) + ".", ""]
     rows = _statics_rows(system, statics)
     with_printed = has_printed(system=system)
     L.append(tabulate([[r[0], r[1]] + [_num(v) if not with_printed or j % 2 == 1 or j == 0 else
@@ -682,8 +703,9 @@ def _index(out: Path, system, summary: dict, files: dict, design_rows, notes, fr
         L += [img(f"static_{k}.png", f"{fe} equilibrium {k}"), "",
               img(f"static_{k}_stress.png", f"{fe} membrane stress {k}"), ""]
     L += ["## 3. Natural frequencies and mode shapes (6.4, eq. 5.32)", "",
-          f"Files: {link('frequencies.csv')}, {link('modes.vtu')} (ParaView: Warp By Vector "
-          "with `mode_k`; field data `mode_k_hz`; cell data `kind`).", ""]
+          f"Files: {link('frequencies.csv')}" + (f", {link('modes.vtu')} (ParaView: Warp By Vector "
+                                                 "with `mode_k`; field data `mode_k_hz`; cell data "
+                                                 "`kind`)" if "modes.vtu" in files else "") + ".", ""]
     head = ["mode"] + [f"{c} [Hz]" for c in freqs]
     if printed:
         head += [f"{m} printed [Hz]" for m in ("MTC", "SBC", "COM")]

@@ -35,11 +35,30 @@ def damping_table(sys) -> list:
     return sorted(rows)
 
 
-def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot")) -> dict:
+#: longest estimated synthesis [CPU s] (:func:`tmfem.resources.synthesis_seconds`) that the
+#: figure's comparison of routes runs; a longer route is left out of the figure, said so in its panel
+ROUTE_PLOT_BUDGET_S = 10.0
+
+
+def route_levels(plant, *, alpha: float, routes=("riccati", "lmi", "slicot"),
+                 budget_s: float = ROUTE_PLOT_BUDGET_S, known: dict | None = None) -> dict:
     """gamma and verified norm of each route of :func:`tmfem.control.linear.hinf_synthesis.hinfsyn`
-    on ``plant`` (GeneralizedPlant): name -> (gamma, norm) or the refusal's message."""
+    on ``plant`` (GeneralizedPlant): name -> (gamma, norm) or the refusal's message. A route
+    whose estimated time exceeds ``budget_s`` CPU seconds is not run (the LMI route grows as
+    n^5.5: about a minute at 36 states): its entry says so. ``known``: route -> (gamma, norm)
+    already computed on this plant (the design's own route), taken as they are."""
+    from tmfem.resources import synthesis_seconds
     out = {}
+    n = plant.A.shape[0]
     for r in routes:
+        if known and r in known:
+            out[r] = known[r]
+            continue
+        t = synthesis_seconds(route=r, n=n)
+        if t > budget_s:
+            out[r] = (f"not run for this figure: about {t:.0f} s of CPU for {n} states "
+                      f"(`tmfem.control.hinfsyn(..., method='{r}')` runs it)")
+            continue
         try:
             res = hinfsyn(plant, plant.C2.shape[0], plant.B2.shape[1], method=r, alpha=alpha)
             out[r] = (res.gamma, res.info["verified_norm"])
@@ -53,6 +72,34 @@ def _sigma_max(sys, w):
     return np.linalg.svd(np.moveaxis(H, 2, 0), compute_uv=False)
 
 
+def _poles(a, pol, pcl, alpha) -> None:
+    """The poles panel: open-loop ``pol`` and closed-loop ``pcl`` in the s-plane with the line
+    Re s = -alpha_1 of eq. 5.66. The real axis is symmetric-logarithmic (linear within 1 1/s)
+    only when the real parts reach beyond 10 1/s; otherwise linear, since a symlog axis over its
+    linear part alone carries only its two end ticks."""
+    a.plot(pol.real, pol.imag, "x", color="0.5", label="open loop")
+    a.plot(pcl.real, pcl.imag, ".", color="C0", label="closed loop")
+    a.axvline(-alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-alpha:g} 1/s"
+              if alpha else "Re s = 0")
+    a.set_xlabel("Re s [1/s]")
+    a.set_ylabel("Im s [rad/s]")
+    if np.max(np.abs(np.concatenate([pol.real, pcl.real, [alpha or 0.0]]))) > 10.0:
+        a.set_xscale("symlog", linthresh=1.0)
+    a.legend(loc="best", fontsize=8)
+    a.set_title("poles")
+
+
+def _own_route(design) -> dict:
+    """{route: (gamma, verified norm)} of the :func:`hinfsyn` route that made ``design`` (its
+    ``info["route"]``, set by ``tmfem control hinf --method auto``), so the comparison of
+    routes does not synthesise it again; {} for a design of another origin."""
+    route = (design.info or {}).get("route") or {}
+    if "method" not in route:
+        return {}
+    norm = float(design.closed_loop_norm)
+    return {route["method"]: (max(float(design.gamma), norm), norm)}
+
+
 def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -> None:
     """Write the four-panel closed-loop analysis figure of ``design`` (HinfDesign) to ``path``.
 
@@ -64,22 +111,12 @@ def plot_design(design, *, open_loop=None, path, title: str = "", routes=None) -
     T = design.closed_loop
     P = open_loop if open_loop is not None else design.plant
     if routes is None and open_loop is not None:
-        routes = route_levels(P, alpha=design.alpha)
+        routes = route_levels(P, alpha=design.alpha, known=_own_route(design))
     fig = new_figure(figsize=(13, 9.5))
     ax = fig.subplots(2, 2)
-    # poles
-    a = ax[0, 0]
     pol = np.linalg.eigvals(P.A)
-    a.plot(pol.real, pol.imag, "x", color="0.5", label="open loop")
     pcl = T.poles()
-    a.plot(pcl.real, pcl.imag, ".", color="C0", label="closed loop")
-    a.axvline(-design.alpha, color="C3", ls="--", label=f"Re s = -alpha_1 = {-design.alpha:g}"
-              if design.alpha else "Re s = 0")
-    a.set_xlabel("Re s [1/s]")
-    a.set_ylabel("Im s [rad/s]")
-    a.set_xscale("symlog", linthresh=1.0)
-    a.legend(loc="best", fontsize=8)
-    a.set_title("poles")
+    _poles(ax[0, 0], pol, pcl, design.alpha)
     # singular values
     a = ax[0, 1]
     lam = np.abs(np.concatenate([pol, pcl]))
@@ -184,6 +221,13 @@ def _regulation(a, T, design) -> None:
     a.legend(loc="upper right", fontsize=7)
 
 
+def _wrapped(text: str, *, width: int = 30, lines: int = 6) -> str:
+    """``text`` broken at word boundaries into at most ``lines`` lines of ``width`` characters,
+    the last ending in "..." when the text is longer (a refusal's message inside a bar panel)."""
+    import textwrap
+    return "\n".join(textwrap.wrap(text, width=width, max_lines=lines, placeholder=" ..."))
+
+
 def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
     names = list(routes)
     ok = [(k, v) for k, v in routes.items() if not isinstance(v, str)]
@@ -192,8 +236,9 @@ def _routes(a, routes: dict, design, bound: float, sets: bool) -> None:
         v = routes[name]
         if isinstance(v, str):
             # at the foot of the panel whatever the gamma scale (x in data, y in axes units)
-            a.text(k, 0.02, "refused:\n" + "\n".join(v[i:i + 28] for i in range(0, min(len(v), 112), 28)),
-                   ha="center", va="bottom", fontsize=6, rotation=0, transform=a.get_xaxis_transform())
+            text = ("" if v.startswith("not run") else "refused:\n") + _wrapped(v)
+            a.text(k, 0.02, text, ha="center", va="bottom", fontsize=6, rotation=0,
+                   transform=a.get_xaxis_transform(), bbox=dict(facecolor="white", edgecolor="0.7", pad=2))
             continue
         a.bar(k - 0.18, v[0], width=0.36, color="C0", label="gamma" if k == 0 else None)
         a.bar(k + 0.18, v[1], width=0.36, color="C1", label="verified ||T_pw||_inf" if k == 0 else None)
