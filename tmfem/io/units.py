@@ -49,7 +49,7 @@ _EXACT = {
     # the automatic deployment path (docs/guides/deployment.md)
     "min_margin": "-", "min_margin_progress": "-", "resolution": "- (progress s)", "hinf_gamma": "-",
     # stage bases and packaged configurations of `tmfem equilibrium` (docs/guides/system-file.md)
-    "r": "m", "z": "m", "l": "m", "Delta_deployed": "m", "height": "m",
+    "r": "m", "z": "m", "l": "m", "height": "m",
     # the COM's membrane-mode count (docs/guides/com.md)
     "membrane_mode_choice": "reference_hz, com_hz in Hz; tolerance and differences relative (-)",
     # the modes of compare paired by shape (docs/guides/sbc.md)
