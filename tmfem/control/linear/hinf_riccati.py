@@ -69,14 +69,42 @@ def gamma_lower_bound(P) -> float:
     return float(max(a, b))
 
 
+def hamiltonian_schur_care(A, B, Q, Rm, S) -> np.ndarray:
+    """The stabilising solution of A^T X + X A + Q - (X B + S) Rm^-1 (B^T X + S^T) = 0 by the
+    ordered real Schur form of the Hamiltonian matrix (Laub 1979), Rm invertible:
+
+        H = [[A_s, -B Rm^-1 B^T], [-(Q - S Rm^-1 S^T), -A_s^T]],   A_s = A - B Rm^-1 S^T,
+
+    with the n eigenvalues in the left half plane first, H [U1; U2] = [U1; U2] T11, and
+    X = U2 U1^-1. A matrix rather than a pencil: no QZ reordering, which fails where the
+    pencil is too far from generalized Schur form (lightly damped plants of ~100 states).
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        Not n stable eigenvalues (an eigenvalue on the imaginary axis), or U1 singular."""
+    n = A.shape[0]
+    Ri_BT = np.linalg.solve(Rm, B.T)
+    Ri_ST = np.linalg.solve(Rm, S.T)
+    As = A - B @ Ri_ST
+    H = np.block([[As, -B @ Ri_BT], [-(Q - S @ Ri_ST), -As.T]])
+    _, Z, sdim = sla.schur(H, sort="lhp")
+    if sdim != n:
+        raise np.linalg.LinAlgError(f"{sdim} of {2 * n} Hamiltonian eigenvalues in the open left half plane, "
+                                    f"expected {n}")
+    return np.linalg.solve(Z[:n, :n].T, Z[n:, :n].T).T
+
+
 def _stabilizing_care(A, B, Q, Rm, S) -> tuple:
     """(X, None) with X the stabilising solution of A^T X + X A + Q - (X B + S) Rm^-1
-    (B^T X + S^T) = 0, or (None, reason). Two independent solvers are tried: scipy's
+    (B^T X + S^T) = 0, or (None, reason). Three independent solvers are tried: scipy's
     (extended Hamiltonian pencil, QZ with the left half plane first; balanced, then
-    unbalanced) and SLICOT SG02AD (python-control ``care``), which does not share scipy's
-    symmetry test that rejects defective (repeated) eigenvalues. A result is accepted only
-    if it is finite and A - B Rm^-1 (B^T X + S^T) is Hurwitz (scipy does not check that the
-    ordered pencil has n stable eigenvalues, so a non-stabilising X can come back)."""
+    unbalanced), SLICOT SG02AD (python-control ``care``), which does not share scipy's
+    symmetry test that rejects defective (repeated) eigenvalues, and the ordered Schur form
+    of the Hamiltonian matrix (:func:`hamiltonian_schur_care`, no pencil reordering). A result
+    is accepted only if it is finite and A - B Rm^-1 (B^T X + S^T) is Hurwitz (scipy does not
+    check that the ordered pencil has n stable eigenvalues, so a non-stabilising X can come
+    back)."""
     import control
     reasons = []
 
@@ -85,6 +113,7 @@ def _stabilizing_care(A, B, Q, Rm, S) -> tuple:
             yield (f"scipy (balanced={balanced})",
                    lambda b=balanced: sla.solve_continuous_are(A, B, Q, Rm, s=S, balanced=b))
         yield "SLICOT SG02AD", lambda: np.asarray(control.care(A, B, Q, Rm, S, np.eye(A.shape[0]))[0])
+        yield "Hamiltonian Schur", lambda: hamiltonian_schur_care(A, B, Q, Rm, S)
 
     for name, fn in solvers():
         try:
