@@ -26,3 +26,16 @@ def test_a_switch_time_and_a_failure_are_printed_as_they_are():
     text = format_text(_result(switch_time_s=12.3456789, failure="slack tendon SL_2 at t = 3.1 s"))
     assert "  switch_time_s: 12.3457" in text
     assert "  failure: slack tendon SL_2 at t = 3.1 s" in text
+
+
+def test_a_run_that_never_switches_with_saturated_rest_lengths_says_why():
+    # a user 1-5(D) in CFRP/Dyneema/Kapton with omega_r = 0.5 rad/s: the rest lengths at their
+    # limits for 19.1 of 20 s and no switch; the hint names the reference's speed
+    from tmfem.cli.deploy import saturation_warning
+    hint = saturation_warning(_result(t_end_s=20.0, limits_active_s=19.1), omega_r=0.5)
+    assert "19.1 of 20 s" in hint and "omega_r = 0.5 rad/s" in hint and "[deployment] omega_r" in hint
+    # no hint: a switch, a short saturation, or the adaptive controller (no switch by design)
+    assert saturation_warning(_result(t_end_s=20.0, limits_active_s=19.1, switch_time_s=15.0), omega_r=0.5) is None
+    assert saturation_warning(_result(t_end_s=20.0, limits_active_s=9.9), omega_r=0.5) is None
+    assert saturation_warning(_result(t_end_s=20.0, limits_active_s=19.1, controller="adaptive"),
+                              omega_r=0.5) is None

@@ -219,7 +219,10 @@ def run(args) -> dict:
              f"uncertainty {s.adaptive.uncertainty}")
     out.update(write_outputs(s, r, preset=args.preset, csv_path=args.csv, plot=args.plot,
                              gif=args.gif, vtk=args.vtk, title=title, lpv=False))
-    out["warnings"] = warnings
+    saturated = saturation_warning(out, omega_r=args.system.problem.deployment.omega_r)
+    if saturated:
+        warn(NAME, saturated)
+    out["warnings"] = warnings + ([saturated] if saturated else [])
     out["membrane_mode_choice"] = membrane_modes_of(s.model.system).to_dict()
     if args.compare_plant:
         def rerun(kind):
@@ -239,6 +242,18 @@ def run(args) -> dict:
     out["failed_checks"] = (reference.diverged([(args.plant, out), (args.compare_plant, out.get("compare", {}))])
                             + out.get("strength_checks_failed", []))
     return out
+
+
+def saturation_warning(r: dict, *, omega_r: float) -> str | None:
+    """A hint when a deployment with a switch never met its switch condition while its rest
+    lengths sat at their limits for at least half the run (``limits_active_s`` of the result
+    ``r``): the reference of eq. 5.68 moves faster than the tendons can follow. None otherwise."""
+    t, active = r["t_end_s"], r.get("limits_active_s") or 0.0
+    if r.get("switch_time_s") is not None or r["controller"] == "adaptive" or active < 0.5 * t:
+        return None
+    return (f"no switch before t_end: the rest lengths sat at their limits for {active:.3g} of {t:.3g} s, so the "
+            f"reference (eq. 5.68, omega_r = {omega_r:g} rad/s) outruns what the tendons can do; a slower "
+            "reference ([deployment] omega_r) or a longer --t-end lets the deployment settle and switch")
 
 
 def _run_on(args, s, plant_kind: str, mesh_n):
