@@ -5,6 +5,8 @@ import csv
 import os
 from pathlib import Path
 
+import numpy as np
+
 from tmfem.cli.common import (add_attachment_args, add_membrane_law_arg, add_system_args,
                               check_attachment_options, check_model_budget, check_outputs,
                               system_from_args)
@@ -146,12 +148,15 @@ def format_text(r: dict) -> str:
                      + " ".join(f"{w[f'f{i + 1}']:7.4f}" for i in range(nf)))
     fit = r.get("fit")
     if fit and "frequency_rates" in fit:
-        lines.append("fitted rates |f(h) - f(h_min)| ~ h^p: "
-                     + ", ".join(f"{p:.2f}" for p in fit["frequency_rates"]))
+        lines.append("fitted rates |f(h) - f(h_min)| ~ h^p (the finest mesh as the limit): "
+                     + ", ".join(f"{p:.2f}" if np.isfinite(p) else "-" for p in fit["frequency_rates"]))
         lines.append("change between the two finest meshes: "
                      + ", ".join(f"{100 * c:.3f}%" for c in fit["frequency_change_last"]))
-        lines.append("successive changes per halving of h ~ h^q (q <= 0: no convergence), q: "
-                     + ", ".join(f"{q:.2f}" for q in fit["successive_change_rates"]))
+        if "successive_change_rates" in fit:
+            lines.append("successive changes per halving of h ~ h^q (q <= 0: no convergence), q: "
+                         + ", ".join(f"{q:.2f}" for q in fit["successive_change_rates"]))
+        else:
+            lines.append("successive changes per halving of h ~ h^q: from four meshes on")
         lines.append("change per halving between the two finest meshes: "
                      + ", ".join(f"{100 * c:.2f}%" for c in fit["frequency_change_per_halving_last"]))
         lines.append(f"peak stress ~ h^p: sigma_p1 p = {fit['sigma_p1_max_MPa_exponent']:.2f}, "

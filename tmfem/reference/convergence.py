@@ -148,10 +148,12 @@ def convergence_rows(system, *, meshes, tendon_elements, attachment: str = "poin
 def fit_convergence(rows, *, by: str = "h", modes: int = 12) -> dict:
     """Rates from ``np.polyfit`` on log h.
 
-    Frequencies: |f(h) - f(h_min)| ~ C h^p over all but the finest row (p > 0 converges),
+    Frequencies: |f(h) - f(h_min)| ~ C h^p over all but the finest row (p > 0 converges; the
+    finest mesh stands in for the limit, so p reads high when it is not converged itself),
     and the successive changes per halving of h ~ C h^q (``successive_change_rates``: q ~ p
     for a converging sequence, q <= 0 when every refinement moves the frequency as much as the
-    last; ``frequency_change_per_halving_last`` the finest pair's).
+    last; only from four meshes on, where three changes give the slope more than two points;
+    ``frequency_change_per_halving_last`` the finest pair's).
     Peak stresses: sigma_max ~ C h^p over all rows (p < 0: grows without bound as h -> 0).
     """
     rows = sorted(rows, key=lambda r: -r[by])
@@ -175,8 +177,9 @@ def fit_convergence(rows, *, by: str = "h", modes: int = 12) -> dict:
     per = np.abs(np.diff(F, axis=0)) / F[1:] * np.log(2) / np.log(h[:-1] / h[1:])[:, None]
     hm = np.sqrt(h[:-1] * h[1:])
     out["frequency_change_per_halving_last"] = per[-1].tolist()
-    out["successive_change_rates"] = [
-        float(np.polyfit(np.log(hm), np.log(np.maximum(per[:, c], 1e-16)), 1)[0]) for c in range(modes)]
+    if len(rows) >= 4:
+        out["successive_change_rates"] = [
+            float(np.polyfit(np.log(hm), np.log(np.maximum(per[:, c], 1e-16)), 1)[0]) for c in range(modes)]
     for key in ("sigma_p1_max_MPa", "von_mises_max_MPa", "sigma_p1_elem_max_MPa",
                 "von_mises_elem_max_MPa", "Delta_mm", "tendon_stress_max_MPa"):
         v = np.array([r[key] for r in rows])

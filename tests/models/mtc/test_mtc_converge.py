@@ -62,3 +62,25 @@ def test_study_rest_lengths_are_the_6_2_design_once():
     assert r[0] == pytest.approx(1.5089, abs=1e-4)
     assert resolve_rest_lengths(s, rest_lengths="mtc") == ("mtc", "mtc")
     assert resolve_rest_lengths(s, rest_lengths="design") == ("design", "design")   # per mesh
+
+
+def _rows(meshes, p=2.0):
+    """Synthetic study rows with f_k(h) = k (1 + 0.1 h^p), h = 1/n (closed form: both rates p)."""
+    rows = []
+    for n in meshes:
+        h = 1.0 / n
+        row = {"h": h, **{f"f{k}": k * (1 + 0.1 * h ** p) for k in (1, 2)}}
+        row.update({k: 1.0 + h for k in ("sigma_p1_max_MPa", "von_mises_max_MPa", "sigma_p1_elem_max_MPa",
+                                         "von_mises_elem_max_MPa", "Delta_mm", "tendon_stress_max_MPa")})
+        rows.append(row)
+    return rows
+
+
+def test_the_successive_change_rate_needs_four_meshes():
+    # two changes give a two-point slope that can have any sign (a user's 1-8 on meshes 4, 6, 8
+    # printed p = 2.1 beside q = -0.1 "no convergence"); from four meshes q follows the closed form
+    three = fit_convergence(_rows((4, 6, 8)), modes=2)
+    assert "successive_change_rates" not in three and len(three["frequency_rates"]) == 2
+    four = fit_convergence(_rows((4, 8, 16, 32)), modes=2)
+    # successive changes of c h^p fall like h^p (divided by f(h) = k (1 + 0.1 h^2): within 1e-3)
+    assert four["successive_change_rates"] == pytest.approx([2.0, 2.0], abs=2e-3)
