@@ -315,6 +315,7 @@ def test_compare_of_user_systems_sets_the_three_models_side_by_side(file, tmp_pa
     r, out = run(["compare", str(SYSTEMS / file), "--modes", "4", "--mesh", "6",
                   "--csv", str(tmp_path / "c.csv"), "--plot", str(tmp_path / "c.png")], capsys)
     assert r["printed"] is None and r["stated"] is None
+    assert r["models"] == ["SBC", "MTC", "COM"] and r["left_out"] == {}
     assert abs(r["vs_SBC"]["ours"]["MTC"][0]) < 0.01 and abs(r["vs_SBC"]["ours"]["COM"][0]) < 0.10
     assert (tmp_path / "c.csv").read_text().startswith("mode,SBC_ours_hz")
     assert (tmp_path / "c.png").stat().st_size > 10_000     # the three models, no printed markers
@@ -334,9 +335,44 @@ def test_compare_plot_without_printed_values_draws_the_three_models_only(tmp_pat
     assert png.stat().st_size > 10_000
 
 
-def test_compare_refuses_a_deployable(capsys):
-    assert main(["compare", str(SYSTEMS / "pentagon-1-5D.toml")]) == 2
-    assert "1-N(D)" in capsys.readouterr().err
+def test_compare_of_a_deployable_user_system_sets_the_sbc_and_com_models_side_by_side(tmp_path, capsys):
+    """`compare FILE` on the 1-5(D) (tendons at H_1j along the bars, which the MTC model cannot
+    represent): rc 0, the SBC and COM models only, a line saying why the MTC model is left out,
+    the SBC-COM pairs by shape, and no MTC column in the text, the CSV or the JSON. Each model's
+    frequencies are the ones `modal --model sbc|com` computes on its own at the same mesh; the
+    pentagon's SBC and COM modes 1-6 have the same shapes in order (MAC > 0.99, the degenerate
+    pairs 2-3 and 5-6 compared by their spans), so the paired differences are those by order."""
+    file = str(SYSTEMS / "pentagon-1-5D.toml")
+    csv_path, png = tmp_path / "c.csv", tmp_path / "c.png"
+    r, out = run(["compare", file, "--modes", "6", "--mesh", "6", "--csv", str(csv_path), "--plot", str(png)],
+                 capsys)
+    assert r["models"] == ["SBC", "COM"] and list(r["left_out"]) == ["MTC"] and "1-N(D)" in r["left_out"]["MTC"]
+    assert set(r["ours"]) == {"SBC", "COM"} and set(r["vs_SBC"]["ours"]) == {"COM"}
+    assert "MTC" not in r["mode_pairs"] and "MTC" not in r["max_abs_vs_SBC"]["paired"]
+    for model in ("sbc", "com"):
+        alone, _ = run(["modal", file, "--model", model, "--mesh", "6", "--modes", "6"], capsys)
+        np.testing.assert_allclose(r["ours"][model.upper()], alone["freq_hz"], rtol=1e-8)
+    pairs = r["mode_pairs"]["COM"]
+    assert pairs["mode"] == [1, 2, 3, 4, 5, 6] and min(pairs["mac"]) > 0.99 and pairs["identity"]
+    np.testing.assert_allclose(pairs["vs_SBC"], r["vs_SBC"]["ours"]["COM"], rtol=1e-12)
+    header = csv_path.read_text().splitlines()[0]
+    assert header == ("mode,SBC_ours_hz,COM_ours_hz,COM_vs_SBC,COM_paired_mode,COM_mac,COM_paired_hz,"
+                      "COM_paired_vs_SBC")
+    assert png.stat().st_size > 10_000
+    assert main(["compare", file, "--modes", "6", "--mesh", "6"]) == 0
+    text = capsys.readouterr().out
+    assert "pentagon-D: SBC and COM natural frequencies" in text
+    assert "MTC model left out: the MTC model cannot represent a 1-N(D) system" in text
+    assert "MTC ours" not in text and "nan" not in text.lower()
+    assert_no_dissertation(out)
+
+
+def test_compare_vibrate_refuses_a_deployable_and_says_why(capsys):
+    """The free vibration compares all three models: a 1-N(D) system is refused with the reason
+    and the command that compares the models that apply."""
+    assert main(["compare", str(SYSTEMS / "pentagon-1-5D.toml"), "--vibrate"]) == 2
+    err = capsys.readouterr().err
+    assert "MTC model cannot represent a 1-N(D) system" in err and "without --vibrate" in err
 
 
 def test_converge_sbc_of_a_deployable_user_system(capsys):

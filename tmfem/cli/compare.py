@@ -1,6 +1,8 @@
 """``tmfem compare``: the SBC, MTC and COM models side by side -- natural frequencies (beside
 the printed ones when the file has them: Tables 6.6/6.7 for 1-4 and 2-3, 6.4), or with
-``--vibrate`` free vibration from the same perturbation (6.5)."""
+``--vibrate`` free vibration from the same perturbation (6.5). The frequencies of a 1-N(D)
+system compare the SBC and COM models (the MTC model cannot represent it, and the output says
+so); ``--vibrate`` needs all three and refuses such a system."""
 from __future__ import annotations
 
 
@@ -12,7 +14,8 @@ from tmfem.solvers.backends import backend_names
 
 NAME = "compare"
 HELP = ("the three models (SBC, MTC, COM) side by side: frequencies (beside the printed ones, "
-        "Tables 6.6/6.7 for 1-4 and 2-3), or free vibration from one perturbation (--vibrate)")
+        "Tables 6.6/6.7 for 1-4 and 2-3; SBC and COM only for a 1-N(D) system), or free vibration "
+        "from one perturbation (--vibrate)")
 
 #: options of each mode, refused in the other
 FREQUENCY_ONLY = ("modes",)
@@ -45,11 +48,11 @@ def configure(parser) -> None:
 
 
 def run(args) -> dict:
-    from tmfem.reference.model_compare import compared_system
+    from tmfem.reference.model_compare import compared_system, loaded_system
     if args.as_printed:
         raise InputError("--as-printed: option does not apply: each model is taken at the "
                          "prestress the file names (docs/guides/system-file.md, [report])")
-    args.system = compared_system(system_from_args(args))
+    args.system = (compared_system if args.vibrate else loaded_system)(system_from_args(args))
     args.preset = args.system.name
     mine, other = (VIBRATE_ONLY, FREQUENCY_ONLY) if args.vibrate else (FREQUENCY_ONLY, VIBRATE_ONLY)
     wrong = [d for d in other if getattr(args, d) is not None]
@@ -66,8 +69,8 @@ def run(args) -> dict:
 
 
 def run_frequencies(args) -> dict:
-    from tmfem.reference.model_compare import compare_frequencies, write_compare_csv
-    with Progress(total=3, desc=f"compare {args.preset}") as bar:
+    from tmfem.reference.model_compare import applicable_models, compare_frequencies, write_compare_csv
+    with Progress(total=len(applicable_models(args.system)), desc=f"compare {args.preset}") as bar:
         r = compare_frequencies(args.system, modes=args.modes or 12, mesh_n=args.mesh,
                                 tendon_elements=args.tendon_elements, backend=args.backend,
                                 progress=bar.step)

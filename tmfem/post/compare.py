@@ -14,9 +14,11 @@ MODEL_COLORS = {"SBC": "black", "MTC": "tab:blue", "COM": "tab:orange"}
 
 
 def plot_model_frequencies(png, r: dict) -> Path:
-    """Top: the frequencies of the three models (ours: filled, printed: open markers) per
-    mode; bottom: each model against the SBC model [%] (ours solid, printed dashed) with the
-    bound 6.4 states. A system without printed frequencies gets its own three models only.
+    """Top: the frequencies of the models compared (``r["ours"]``: all three, or the SBC and
+    COM models of a 1-N(D) system, the model left out named in the title) per mode (ours:
+    filled, printed: open markers); bottom: each model against the SBC model [%] (ours solid,
+    printed dashed) with the bound 6.4 states. A system without printed frequencies gets its
+    own models only.
     With ``r["mode_pairs"]`` (:func:`tmfem.reference.model_compare.paired_modes`) ours are the
     differences of the modes paired by shape, at the SBC mode's number (a gap where it has no
     counterpart); the printed ones are by order, as the tables."""
@@ -25,16 +27,21 @@ def plot_model_frequencies(png, r: dict) -> Path:
     printed = r.get("printed")
     n = len(printed["SBC"]) if printed else len(r["ours"]["SBC"])
     k = np.arange(1, n + 1)
-    for m, c in MODEL_COLORS.items():
+    models = [m for m in MODEL_COLORS if m in r["ours"]]
+    for m in models:
+        c = MODEL_COLORS[m]
         ax.plot(k, r["ours"][m][:n], "o-", color=c, ms=5, lw=1, label=f"{m} ours" if printed else m)
         if printed:
             ax.plot(k, printed[m], "s", mfc="none", color=c, ms=8, label=f"{m} printed")
     ax.set_ylabel("natural frequency [Hz]")
-    ax.set_title(f"{r['system']}: three models" + (f" beside {r['source']}" if printed else ""), fontsize=10)
+    left_out = r.get("left_out") or {}
+    ax.set_title(f"{r['system']}: " + (" and ".join(models) if left_out else "three") + " models"
+                 + (f" beside {r['source']}" if printed else "")
+                 + "".join(f" ({m} left out: it cannot represent this system)" for m in left_out), fontsize=10)
     ax.legend(fontsize=7, ncol=3, loc="upper left")
     ax.grid(True, alpha=0.3)
     pairs = r.get("mode_pairs")
-    for m in ("MTC", "COM"):
+    for m in models[1:]:
         c = MODEL_COLORS[m]
         ours = pairs[m]["vs_SBC"] if pairs else r["vs_SBC"]["ours"][m]
         bx.plot(k, 100 * np.asarray(ours[:n], dtype=float), "o-", color=c, ms=5, lw=1,

@@ -25,6 +25,11 @@ counterpart (for example the bending of slender bars, which the MTC and COM mode
 straight or rigid bars, do not have) is named with the bars' share of its strain energy.
 The printed tables compare by order; at their mesh the presets' pairing is the identity (the
 test suite checks it), so both agree there.
+
+The models compared are those that apply to the system (:func:`applicable_models`): all three
+for an M-N system; the SBC and COM models for a 1-N(D) system, whose tendons are attached at
+H_1j along the bars, where the MTC model (truss bars, nodes only at the bar ends) has no node,
+so the MTC model is left out and the result says why (``left_out``).
 """
 from __future__ import annotations
 
@@ -46,23 +51,42 @@ log = logging.getLogger(__name__)
 MODELS = ("SBC", "MTC", "COM")
 
 
-def compared_system(system):
-    """``system`` (a System, or a preset name: the preset loader) for the comparison; the
-    MTC model has no nodes along its bars, so a 1-N(D) system is refused."""
+def loaded_system(system):
+    """``system`` (a System, or a preset name: the preset loader) for the comparison."""
     if isinstance(system, str):
         from tmfem.system import load_preset
         system = load_preset(system)
-    if system.deployable:
-        raise InputError(f"compare {system.name}: the MTC model cannot represent a 1-N(D) system "
-                         "(tendons attached at H_1j along the bars); expected an M-N system "
-                         "(compare the SBC and COM models with `tmfem modal --model sbc|com`)")
+    return system
+
+
+def left_out_models(system) -> dict:
+    """The models that cannot represent ``system``, each with the reason (module docstring)."""
+    if loaded_system(system).deployable:
+        return {"MTC": "the MTC model cannot represent a 1-N(D) system (tendons attached at H_1j "
+                       "along the bars, where its truss bars have no node)"}
+    return {}
+
+
+def applicable_models(system) -> tuple:
+    """The models of :data:`MODELS` that apply to ``system``, the SBC reference first."""
+    out = left_out_models(system)
+    return tuple(m for m in MODELS if m not in out)
+
+
+def compared_system(system):
+    """``system`` for a comparison that needs all three models (``--vibrate``): a system that
+    one of them cannot represent is refused with the reason."""
+    system = loaded_system(system)
+    for m, why in left_out_models(system).items():
+        raise InputError(f"compare --vibrate {system.name}: {why}; expected an M-N system (the "
+                         f"frequencies, `tmfem compare` without --vibrate, compare the models that apply)")
     return system
 
 
 def fe_system(system):
     """The system the FE models analyse: the file's ``[report] implied_rest_lengths`` when it
     gives them, else the system itself (module docstring)."""
-    system = compared_system(system)
+    system = loaded_system(system)
     rest = system.problem.report.implied_rest_lengths
     return system.with_rest_lengths(rest) if rest else system
 
@@ -71,7 +95,7 @@ def com_model(system, *, mesh_n: int = 10):
     """The control-oriented model of the comparison (module docstring; K the file's)."""
     from tmfem.models.com.model import ControlOrientedModel, default_membrane_modes
     from tmfem.post.com import printed_prestress_scale
-    s = compared_system(system)
+    s = loaded_system(system)
     K = default_membrane_modes(s)
     m = ControlOrientedModel(s, membrane_modes=K, mesh_n=mesh_n)
     if s.problem.report.com_prestress == "printed-tendon-stress":
@@ -81,12 +105,14 @@ def com_model(system, *, mesh_n: int = 10):
 
 
 def fe_models(system, *, mesh_n: int = 10, tendon_elements: int = 3, backend="scipy") -> dict:
-    """The SBC and MTC models of the comparison on the same mesh."""
+    """The FE models of the comparison that apply (:func:`applicable_models`: the SBC model,
+    and the MTC model for an M-N system) on the same mesh."""
     from tmfem.models.mtc.model import MTCModel
     from tmfem.models.sbc.model import SBCModel
     s = fe_system(system)
-    return {"SBC": SBCModel(s, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend),
-            "MTC": MTCModel(s, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend)}
+    kinds = {"SBC": SBCModel, "MTC": MTCModel}
+    return {k: kinds[k](s, mesh_n=mesh_n, tendon_elements=tendon_elements, backend=backend)
+            for k in applicable_models(s) if k in kinds}
 
 
 #: MTC and COM modes computed beyond ``modes`` for the pairing only: the partner of an SBC mode
@@ -97,7 +123,7 @@ PAIRING_EXTRA = 4
 
 def model_frequencies(system, *, modes: int = 12, mesh_n: int = 10, tendon_elements: int = 3,
                       backend="scipy", progress=None) -> dict:
-    """Natural frequencies [Hz] of the three models of ``system`` (module docstring):
+    """Natural frequencies [Hz] of the models of ``system`` that apply (module docstring):
     ``freq_hz`` by model (the ``modes`` lowest), the modes' ``shared_shapes`` by model (columns,
     :mod:`tmfem.reference.shared_shapes`; the MTC and COM models with :data:`PAIRING_EXTRA`
     more modes, whose frequencies are ``pairing_hz``), the bars' share of the SBC modes'
@@ -126,45 +152,48 @@ def model_frequencies(system, *, modes: int = 12, mesh_n: int = 10, tendon_eleme
     md = lin.modes(modes + PAIRING_EXTRA)
     out["COM"] = md.freq_hz
     times["COM"] = time.perf_counter() - t0
-    shapes["COM"] = com_shared_shapes(com, lin.z_e, md.shapes, mesh_nodes=fe["MTC"].topology.n_mesh)
-    return {"freq_hz": {k: np.asarray(out[k][:modes], dtype=float) for k in MODELS}, "time_s": times,
+    shapes["COM"] = com_shared_shapes(com, lin.z_e, md.shapes, mesh_nodes=fe["SBC"].topology.n_mesh)
+    return {"freq_hz": {k: np.asarray(out[k][:modes], dtype=float) for k in out}, "time_s": times,
             "shared_shapes": shapes, "pairing_hz": {k: np.asarray(v, dtype=float) for k, v in out.items()},
             "sbc_beam_energy_share": beam_share,
             "settings": {"mesh_n": mesh_n, "tendon_elements": tendon_elements,
                          "backend": {k: m.backend.name for k, m in fe.items()},
-                         "rest_lengths": fe["MTC"].rest_lengths.tolist(),
+                         "rest_lengths": fe["SBC"].rest_lengths.tolist(),
                          "com_membrane_modes": com.K, "com_prestress_scale": com.prestress_scale}}
 
 
 def compare_frequencies(system, *, modes: int = 12, **kwargs) -> dict:
-    """The three models (JSON-able): per mode ours per model, each model against the SBC model
-    and its largest difference; with the file's printed columns also those, ours against
-    them, the printed model-to-model differences and the bound the source states.
+    """The models that apply (JSON-able; ``models``, and ``left_out``: the others with the
+    reason): per mode ours per model, each model against the SBC model and its largest
+    difference; with the file's printed columns also those, ours against them, the printed
+    model-to-model differences and the bound the source states.
     ``kwargs``: :func:`model_frequencies`."""
     if not (isinstance(modes, int) and modes >= 1):
         raise InputError(f"--modes: expected an integer >= 1, found {modes!r}")
-    system = compared_system(system)
+    system = loaded_system(system)
+    models = applicable_models(system)
     r = model_frequencies(system, modes=modes, **kwargs)
     ours = r["freq_hz"]
     n = min(len(v) for v in ours.values())
-    vs_sbc_ours = {k: ours[k][:n] / ours["SBC"][:n] - 1 for k in ("MTC", "COM")}
+    vs_sbc_ours = {k: ours[k][:n] / ours["SBC"][:n] - 1 for k in models[1:]}
     pairs = paired_modes(r)
-    out = {"system": system.name, "modes": modes, "source": None,
+    out = {"system": system.name, "modes": modes, "models": list(models),
+           "left_out": left_out_models(system), "source": None,
            "ours": {k: v.tolist() for k, v in ours.items()},
            "vs_SBC": {"ours": {k: v.tolist() for k, v in vs_sbc_ours.items()}},
            "max_abs_vs_SBC": {"ours": {k: float(np.abs(v).max()) for k, v in vs_sbc_ours.items()},
-                              "paired": {k: _max_abs(pairs[k]["vs_SBC"]) for k in ("MTC", "COM")}},
+                              "paired": {k: _max_abs(pairs[k]["vs_SBC"]) for k in models[1:]}},
            "mode_pairs": pairs,
            "printed": None, "ours_vs_printed": None, "stated_bound": None, "stated": None,
            "settings": r["settings"], "time_s": r["time_s"]}
     printed = printed_frequencies(system)
-    if printed and all(k in printed for k in MODELS):
+    if printed and all(k in printed for k in models):
         n = min(modes, len(printed["SBC"]), n)
-        pr = {k: np.array(printed[k][:n]) for k in MODELS}
-        vs_sbc_printed = {k: pr[k] / pr["SBC"] - 1 for k in ("MTC", "COM")}
+        pr = {k: np.array(printed[k][:n]) for k in models}
+        vs_sbc_printed = {k: pr[k] / pr["SBC"] - 1 for k in models[1:]}
         out.update({"source": printed.get("source", "printed"),
                     "printed": {k: v.tolist() for k, v in pr.items()},
-                    "ours_vs_printed": {k: (ours[k][:n] / pr[k] - 1).tolist() for k in MODELS},
+                    "ours_vs_printed": {k: (ours[k][:n] / pr[k] - 1).tolist() for k in models},
                     "stated_bound": printed.get("stated_model_difference"),
                     "stated": printed.get("stated_model_difference_source")})
         out["vs_SBC"]["printed"] = {k: v.tolist() for k, v in vs_sbc_printed.items()}
@@ -174,18 +203,20 @@ def compare_frequencies(system, *, modes: int = 12, **kwargs) -> dict:
 
 
 def paired_modes(r: dict) -> dict:
-    """The MTC and COM modes paired with each SBC mode by shape (module docstring) from the
-    result of :func:`model_frequencies` (JSON-able): per model the 1-based partner ``mode``
+    """The modes of the other models (MTC, COM: those computed) paired with each SBC mode by
+    shape (module docstring) from the result of :func:`model_frequencies` (JSON-able): per
+    model the 1-based partner ``mode``
     (None: no counterpart), its ``mac``, its frequency ``freq_hz`` and its difference
     ``vs_SBC`` = f / f_SBC - 1 (the partner may be one of the :data:`PAIRING_EXTRA` modes
     above the table), the model's modes of the table paired with no SBC mode (``unpaired``)
     and whether the pairing is the identity; the bars' share of each SBC mode's strain energy
     (``SBC_beam_energy_fraction``); ``SBC_unpaired``: the SBC modes without a counterpart in
-    either model."""
+    any other model."""
     f, shapes = r["pairing_hz"], r["shared_shapes"]
+    others = _others(r["freq_hz"])
     out = {"rule": {"mac_threshold": MAC_THRESHOLD, "cluster_tolerance": CLUSTER_TOLERANCE,
                     "vector": "translations of the bar ends and of the membrane mesh nodes"}}
-    for k in ("MTC", "COM"):
+    for k in others:
         p = pair_modes(shapes["SBC"], shapes[k], reference_hz=f["SBC"], other_hz=f[k])
         out[k] = {"mode": [None if j is None else j + 1 for j in p.partner], "mac": p.mac,
                   "freq_hz": [None if j is None else float(f[k][j]) for j in p.partner],
@@ -196,11 +227,28 @@ def paired_modes(r: dict) -> dict:
     share = r["sbc_beam_energy_share"]
     out["SBC_beam_energy_fraction"] = [float(v) for v in share]
     out["SBC_unpaired"] = [{"mode": i + 1, "freq_hz": float(f["SBC"][i]),
-                            "without": [k for k in ("MTC", "COM") if out[k]["mode"][i] is None],
+                            "without": [k for k in others if out[k]["mode"][i] is None],
                             "beam_energy_fraction": float(share[i])}
                            for i in range(len(f["SBC"]))
-                           if any(out[k]["mode"][i] is None for k in ("MTC", "COM"))]
+                           if any(out[k]["mode"][i] is None for k in others)]
     return out
+
+
+def _others(by_model) -> list:
+    """The models of ``by_model`` (a dict keyed by model) compared with the SBC model, in the
+    order of :data:`MODELS`."""
+    return [m for m in MODELS[1:] if m in by_model]
+
+
+def _and(names) -> str:
+    """"A", "A and B", "A, B and C"."""
+    names = list(names)
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " and " + names[-1]
+
+
+def left_out_lines(r: dict) -> list[str]:
+    """One line per model left out of the comparison, with the reason."""
+    return [f"{m} model left out: {why}" for m, why in r.get("left_out", {}).items()]
 
 
 def _max_abs(values) -> float | None:
@@ -217,8 +265,9 @@ def pairing_notes(r: dict) -> list[str]:
     """Lines of text on the pairing: the rule, the unpaired modes of each model."""
     p = r["mode_pairs"]
     rule = p["rule"]
+    others = _others(p)
     lines = [f"modes paired by shape: MAC of the {rule['vector']} (no mass weighting), one-to-one "
-             f"assignment, pairs below MAC {rule['mac_threshold']:g} dropped; MTC and COM modes within "
+             f"assignment, pairs below MAC {rule['mac_threshold']:g} dropped; {_and(others)} modes within "
              f"{100 * rule['cluster_tolerance']:g} % in frequency compared as one span"]
     for u in p["SBC_unpaired"]:
         share = u["beam_energy_fraction"]
@@ -226,7 +275,7 @@ def pairing_notes(r: dict) -> list[str]:
                 else f"{100 * share:.0f} % of its strain energy in the bars")
         lines.append(f"SBC mode {u['mode']} ({u['freq_hz']:.4f} Hz): no counterpart in "
                      f"{' or '.join(u['without'])} among the computed modes ({kind})")
-    for k in ("MTC", "COM"):
+    for k in others:
         if p[k]["unpaired"]:
             lines.append(f"{k} modes {p[k]['unpaired']}: paired with no SBC mode among the computed modes")
     return lines
@@ -235,54 +284,55 @@ def pairing_notes(r: dict) -> list[str]:
 def _paired_table(r: dict) -> list[str]:
     """The paired modes: SBC mode, and per model its paired mode, frequency, MAC, difference."""
     p = r["mode_pairs"]
+    others = _others(p)
     lines = [f"{'mode':>4} {'SBC ours':>9} " + " ".join(f"{m:>4} {m + ' ours':>9} {'MAC':>5} {m + '/SBC':>8}"
-                                                        for m in ("MTC", "COM"))]
+                                                        for m in others)]
     for i, f in enumerate(r["ours"]["SBC"]):
         row = f"{i + 1:>4} {f:9.4f}"
-        for m in ("MTC", "COM"):
+        for m in others:
             j = p[m]["mode"][i]
             row += (f" {'-':>4} {'':9} {p[m]['mac'][i]:5.2f} {'none':>8}" if j is None else
                     f" {j:>4} {p[m]['freq_hz'][i]:9.4f} {p[m]['mac'][i]:5.2f} {100 * p[m]['vs_SBC'][i]:+7.2f}%")
         lines.append(row)
     mx = r["max_abs_vs_SBC"]["paired"]
     lines.append("largest |model / SBC - 1| of the pairs: " + ", ".join(
-        f"{m} {'-' if mx[m] is None else f'{100 * mx[m]:.2f} %'}" for m in ("MTC", "COM")))
+        f"{m} {'-' if mx[m] is None else f'{100 * mx[m]:.2f} %'}" for m in others))
     return lines + pairing_notes(r)
 
 
 def format_compare(r: dict) -> str:
     """Text table of :func:`compare_frequencies` (the printed columns when there are some)."""
     s = r["settings"]
-    head = (f"{r['system']}: SBC, MTC and COM natural frequencies [Hz]"
+    models, others = list(r["ours"]), _others(r["ours"])
+    head = (f"{r['system']}: {_and(models)} natural frequencies [Hz]"
             + (f" beside {r['source']}" if r["printed"] else "")
             + f" (mesh {s['mesh_n']}, {s['tendon_elements']} elements/tendon, backend "
             + ", ".join(f"{k} {v}" for k, v in s["backend"].items()) + ", COM K = "
             f"{s['com_membrane_modes']}, prestress x{s['com_prestress_scale']:.4f})")
     if not r["printed"]:
-        lines = [head] + _paired_table(r)
+        lines = [head] + left_out_lines(r) + _paired_table(r)
         lines.append("times [s]: " + ", ".join(f"{k} {v:.2f}" for k, v in r["time_s"].items()))
         return "\n".join(lines)
     n = len(r["printed"]["SBC"])
-    lines = [head,
-             f"{'mode':>4} " + " ".join(f"{m + ' ours':>9} {m + ' pr.':>9} {'diff':>7}" for m in MODELS)
-             + f" {'MTC/SBC':>8} {'pr.':>7} {'COM/SBC':>8} {'pr.':>7}"]
+    lines = [head] + left_out_lines(r) + [
+             f"{'mode':>4} " + " ".join(f"{m + ' ours':>9} {m + ' pr.':>9} {'diff':>7}" for m in models)
+             + "".join(f" {m + '/SBC':>8} {'pr.':>7}" for m in others)]
     for i in range(len(r["ours"]["SBC"])):
         row = f"{i + 1:>4} "
         if i < n:
             row += " ".join(f"{r['ours'][m][i]:9.4f} {r['printed'][m][i]:9.4f} "
-                            f"{100 * r['ours_vs_printed'][m][i]:+6.2f}%" for m in MODELS)
+                            f"{100 * r['ours_vs_printed'][m][i]:+6.2f}%" for m in models)
             row += " " + " ".join(f"{100 * r['vs_SBC']['ours'][m][i]:+7.2f}% "
-                                  f"{100 * r['vs_SBC']['printed'][m][i]:+6.2f}%" for m in ("MTC", "COM"))
+                                  f"{100 * r['vs_SBC']['printed'][m][i]:+6.2f}%" for m in others)
         else:
-            row += " ".join(f"{r['ours'][m][i]:9.4f} {'':9} {'':7}" for m in MODELS)
+            row += " ".join(f"{r['ours'][m][i]:9.4f} {'':9} {'':7}" for m in models)
         lines.append(row)
     mx = r["max_abs_vs_SBC"]
-    lines.append(f"largest |model / SBC - 1|: ours MTC {100 * mx['ours']['MTC']:.2f} %, COM "
-                 f"{100 * mx['ours']['COM']:.2f} %; printed MTC {100 * mx['printed']['MTC']:.2f} %, "
-                 f"COM {100 * mx['printed']['COM']:.2f} %"
+    lines.append("largest |model / SBC - 1|: " + "; ".join(
+        f"{kind} " + ", ".join(f"{m} {100 * mx[kind][m]:.2f} %" for m in others) for kind in ("ours", "printed"))
                  + (f" (stated, {r['stated']})" if r["stated"] else ""))
-    if all(r["mode_pairs"][m]["identity"] for m in ("MTC", "COM")):
-        lowest = min(min(r["mode_pairs"][m]["mac"]) for m in ("MTC", "COM"))
+    if all(r["mode_pairs"][m]["identity"] for m in others):
+        lowest = min(min(r["mode_pairs"][m]["mac"]) for m in others)
         lines.append(f"modes paired by shape: mode i with mode i in every model (smallest MAC {lowest:.2f}), "
                      "so the comparison by order above is the paired one")
     else:
@@ -295,37 +345,37 @@ def write_compare_csv(path, r: dict) -> Path:
     """One row per mode: ours and printed per model, the differences of :func:`compare_frequencies`
     (without printed values: ours and the differences to the SBC model)."""
     p = r["mode_pairs"]
+    models, others = list(r["ours"]), _others(r["ours"])
 
     def paired(i):
         """The paired columns of SBC mode i ("" where there is no pair)."""
-        return [x for m in ("MTC", "COM") for x in
+        return [x for m in others for x in
                 ("" if p[m]["mode"][i] is None else p[m]["mode"][i], p[m]["mac"][i],
                  "" if p[m]["mode"][i] is None else p[m]["freq_hz"][i],
                  "" if p[m]["mode"][i] is None else p[m]["vs_SBC"][i])]
 
-    paired_cols = [f"{m}_{c}" for m in ("MTC", "COM") for c in ("paired_mode", "mac", "paired_hz", "paired_vs_SBC")]
+    paired_cols = [f"{m}_{c}" for m in others for c in ("paired_mode", "mac", "paired_hz", "paired_vs_SBC")]
     if not r["printed"]:
         with atomic_open(path, "w", newline="") as fh:
             w = csv.writer(fh)
-            w.writerow(["mode"] + [f"{m}_ours_hz" for m in MODELS] + ["MTC_vs_SBC", "COM_vs_SBC"] + paired_cols)
-            for i in range(len(r["vs_SBC"]["ours"]["MTC"])):
-                w.writerow([i + 1] + [r["ours"][m][i] for m in MODELS]
-                           + [r["vs_SBC"]["ours"][m][i] for m in ("MTC", "COM")] + paired(i))
+            w.writerow(["mode"] + [f"{m}_ours_hz" for m in models] + [f"{m}_vs_SBC" for m in others] + paired_cols)
+            for i in range(len(r["vs_SBC"]["ours"][others[0]])):
+                w.writerow([i + 1] + [r["ours"][m][i] for m in models]
+                           + [r["vs_SBC"]["ours"][m][i] for m in others] + paired(i))
         return Path(path)
     n = len(r["printed"]["SBC"])
-    cols = (["mode"] + [f"{m}_ours_hz" for m in MODELS] + [f"{m}_printed_hz" for m in MODELS]
-            + [f"{m}_vs_printed" for m in MODELS] + ["MTC_vs_SBC", "COM_vs_SBC",
-                                                    "MTC_vs_SBC_printed", "COM_vs_SBC_printed"]
-            + paired_cols)
+    cols = (["mode"] + [f"{m}_ours_hz" for m in models] + [f"{m}_printed_hz" for m in models]
+            + [f"{m}_vs_printed" for m in models] + [f"{m}_vs_SBC" for m in others]
+            + [f"{m}_vs_SBC_printed" for m in others] + paired_cols)
     with atomic_open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for i in range(len(r["ours"]["SBC"])):
             has = i < n
-            vals = ([r["ours"][m][i] for m in MODELS]
-                    + [r["printed"][m][i] if has else "" for m in MODELS]
-                    + [r["ours_vs_printed"][m][i] if has else "" for m in MODELS]
-                    + [r["vs_SBC"]["ours"][m][i] if has else "" for m in ("MTC", "COM")]
-                    + [r["vs_SBC"]["printed"][m][i] if has else "" for m in ("MTC", "COM")])
+            vals = ([r["ours"][m][i] for m in models]
+                    + [r["printed"][m][i] if has else "" for m in models]
+                    + [r["ours_vs_printed"][m][i] if has else "" for m in models]
+                    + [r["vs_SBC"]["ours"][m][i] if has else "" for m in others]
+                    + [r["vs_SBC"]["printed"][m][i] if has else "" for m in others])
             w.writerow([i + 1] + vals + paired(i))
     return Path(path)
