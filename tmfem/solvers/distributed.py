@@ -155,6 +155,20 @@ def gather(vec) -> np.ndarray:
     return out
 
 
+def gather_rows(local: np.ndarray, comm) -> np.ndarray:
+    """Full array (n, m) on every rank of the row blocks (n_r, m) of the ranks, in rank
+    order (one ``Allgatherv`` into the result: no other full-size copy); ``local`` itself
+    on one rank."""
+    local = np.ascontiguousarray(local, dtype=float)
+    if comm.size == 1:
+        return local
+    m = local.shape[1]
+    counts = np.array(comm.allgather(local.shape[0])) * m
+    out = np.empty((int(counts.sum()) // m, m))
+    comm.Allgatherv(local, [out, counts])
+    return out
+
+
 def unique_inverse(keys: np.ndarray):
     """``(u, inverse)`` with u the sorted distinct values of the int64 array ``keys`` and
     ``u[inverse] == keys`` (``inverse`` int32 when it fits): ``np.unique(keys,

@@ -43,7 +43,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather
+from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
 from tmfem.solvers.petsc_loader import petsc_modules
 from tmfem.solvers.singular import SingularMatrix
 
@@ -468,9 +468,7 @@ class PetscBackend:
         local = np.array(Xm.getDenseArray())
         Bm.destroy()
         Xm.destroy()
-        if self.comm.size == 1:
-            return local
-        return np.concatenate(self.comm.tompi4py().allgather(local), axis=0)
+        return gather_rows(local, self.comm.tompi4py())
 
     def gather(self, vec) -> np.ndarray:
         """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
@@ -607,13 +605,15 @@ class PetscBackend:
             if nconv < k:
                 raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "
                                        f"sigma={sigma:g} in {E.getIterationNumber()} restarts")
+            # this rank's rows of the vectors; the full ones once SLEPc's basis is freed
             vr = Kp.createVecRight()
+            lo, hi = vr.getOwnershipRange()
             w = np.empty(nconv)
-            V = np.empty((n, nconv))
+            local = np.empty((hi - lo, nconv))
             for i in range(nconv):
                 w[i] = E.getEigenpair(i, vr).real
-                V[:, i] = self.gather(vr)
+                local[:, i] = vr.getArray(readonly=True)
             vr.destroy()
         finally:
             E.destroy()
-        return w, V
+        return w, gather_rows(local, self.comm.tompi4py())
