@@ -608,21 +608,28 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
 
 @needs_petsc
 def test_pattern_subset_check():
-    # source: the patterns themselves (a diagonal lies within a tridiagonal pattern, a
-    # corner entry does not), on the AIJ matrices the eigen solve's reuse check reads
+    # source: the patterns themselves (a diagonal lies within a tridiagonal pattern, an
+    # entry in the first or the last row outside the band does not), read from the
+    # assemblers' patterns or from PETSc's AIJ matrices, whole or a few rows at a time
     from petsc4py import PETSc
+    from tmfem.solvers.distributed import DistributedMatrix, Pattern
     from tmfem.solvers.petsc import PetscBackend
     n = 6
     tri = sp.diags([np.ones(n - 1), 2 * np.ones(n), np.ones(n - 1)], [-1, 0, 1], format="csr")
-    corner = sp.csr_matrix(sp.identity(n) + sp.csr_matrix(([1.0], ([0], [n - 1])), shape=(n, n)))
 
-    def aij(S):
-        return PETSc.Mat().createAIJ(size=S.shape, csr=(S.indptr.astype(PETSc.IntType),
-                                                        S.indices.astype(PETSc.IntType), S.data),
-                                     comm=PETSc.COMM_SELF)
+    def corner(i, j):
+        return sp.csr_matrix(sp.identity(n) + sp.csr_matrix(([1.0], ([i], [j])), shape=(n, n)))
+
+    def dist(S, carry):
+        ip, ix = S.indptr.astype(PETSc.IntType), S.indices.astype(PETSc.IntType)
+        mat = PETSc.Mat().createAIJ(size=S.shape, csr=(ip, ix, S.data), comm=PETSc.COMM_SELF)
+        return DistributedMatrix(mat, Pattern(ip, ix) if carry else Pattern(), S.shape)
     be = PetscBackend()
-    assert be._subset(aij(sp.identity(n, format="csr")), aij(tri))
-    assert not be._subset(aij(corner), aij(tri))
+    for carry in (True, False):
+        for chunk in (1 << 20, 2):
+            assert be._subset(dist(sp.identity(n, format="csr"), carry), dist(tri, carry), chunk=chunk)
+            assert not be._subset(dist(corner(0, n - 1), carry), dist(tri, carry), chunk=chunk)
+            assert not be._subset(dist(corner(n - 1, 0), carry), dist(tri, carry), chunk=chunk)
 
 
 @needs_petsc

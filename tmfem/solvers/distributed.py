@@ -200,9 +200,14 @@ def unique_inverse(keys: np.ndarray):
 
 class Pattern:
     """Identity of a sparsity pattern (one per :class:`DistributedAssembler`); the backend
-    keys its factorisations by it and frees them when the pattern is gone."""
+    keys its factorisations by it and frees them when the pattern is gone. ``indptr``,
+    ``indices``: this rank's rows of the pattern (CSR, columns sorted in each row; the
+    assembler's own arrays, not copies)."""
 
-    __slots__ = ("__weakref__",)
+    __slots__ = ("__weakref__", "indptr", "indices")
+
+    def __init__(self, indptr=None, indices=None):
+        self.indptr, self.indices = indptr, indices
 
 
 class DistributedMatrix:
@@ -354,7 +359,7 @@ class DistributedAssembler:
         self._indices = (okeys % self.N if self.N else okeys).astype(self.PETSc.IntType)
         self._indptr = np.zeros(self.hi - self.lo + 1, dtype=self.PETSc.IntType)
         np.cumsum(np.bincount(orow, minlength=self.hi - self.lo), out=self._indptr[1:])
-        self._pattern = Pattern()
+        self._pattern = Pattern(self._indptr, self._indices)
 
     def _route_own_entries(self) -> None:
         """Sum the entries of this rank's own rows in place (P > 1): each valid entry's

@@ -536,21 +536,33 @@ class PetscBackend:
             return None
         subset = entry.mass_within.get(M.pattern)
         if subset is None:
-            subset = entry.mass_within[M.pattern] = self._subset(M.mat, K.mat)
+            subset = entry.mass_within[M.pattern] = self._subset(M, K)
         return entry if subset else None
 
-    def _subset(self, B, A) -> bool:
-        """Whether the nonzero pattern of B lies within that of A (the same row layout);
-        the same answer on every rank."""
-        ia, ja, _ = A.getValuesCSR()
-        ib, jb, _ = B.getValuesCSR()
-        n = A.getSize()[1]
-        ka = np.repeat(np.arange(ia.size - 1, dtype=np.int64), np.diff(ia)) * n + ja
-        kb = np.repeat(np.arange(ib.size - 1, dtype=np.int64), np.diff(ib)) * n + jb
-        if not bool(np.all(ka[1:] >= ka[:-1])):   # AIJ rows come column-sorted: no sort then
-            ka.sort()
-        pos = np.minimum(np.searchsorted(ka, kb), max(ka.size - 1, 0))
-        mine = bool(kb.size == 0 or (ka.size > 0 and np.array_equal(ka[pos], kb)))
+    def _subset(self, B, A, *, chunk: int = 1 << 20) -> bool:
+        """Whether the nonzero pattern of the DistributedMatrix B lies within that of A
+        (the same row layout); the same answer on every rank. Read from the assemblers'
+        patterns (PETSc's CSR only where a pattern does not carry them), ``chunk`` entries
+        of B's rows at a time: no copy of the matrices' values or of their full keys."""
+        ia, ja = A.pattern.indptr, A.pattern.indices
+        if ia is None:
+            ia, ja, _ = A.mat.getValuesCSR()
+        ib, jb = B.pattern.indptr, B.pattern.indices
+        if ib is None:
+            ib, jb, _ = B.mat.getValuesCSR()
+        n = A.shape[1]
+        rows, r0, mine = ib.size - 1, 0, True
+        while mine and r0 < rows:
+            r1 = int(np.searchsorted(ib, ib[r0] + chunk, side="right")) - 1
+            r1 = min(rows, max(r0 + 1, r1))
+            r = np.arange(r0, r1, dtype=np.int64)
+            ka = np.repeat(r, np.diff(ia[r0:r1 + 1])) * n + ja[ia[r0]:ia[r1]]
+            kb = np.repeat(r, np.diff(ib[r0:r1 + 1])) * n + jb[ib[r0]:ib[r1]]
+            if not bool(np.all(ka[1:] >= ka[:-1])):   # AIJ rows come column-sorted
+                ka.sort()
+            pos = np.minimum(np.searchsorted(ka, kb), max(ka.size - 1, 0))
+            mine = bool(kb.size == 0 or (ka.size > 0 and np.array_equal(ka[pos], kb)))
+            r0 = r1
         if self.comm.size == 1:
             return mine
         return all(self.comm.tompi4py().allgather(mine))
