@@ -572,13 +572,18 @@ def test_eps_and_st_options_are_honoured(capfd):
 def test_block_pair_pattern_is_scipys_pattern_and_matrix(ranks):
     # source: scipy's T^T K T of the same element matrices and entries (its structure from
     # unit values and |T|, so no cancellation); the 4-node group is keyed per block pair
-    # (block size 3), the group of permuted local dofs and the entries per entry
+    # (block size 3), the group of permuted local dofs and the entries per entry; an
+    # assembly's values array on each rank: the entries of its rows plus those it sends
+    # (scipy's pattern of its rows and of its own share), not all distinct keys it touches
+    # plus the received and the summed ones
     p = _mpirun(ranks, program=[sys.executable, str(ROOT / "tests" / "mpi" / "assembler_pattern.py")])
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)
     assert out["block_sizes"] == [3, 1, 1]
     assert out["pattern_equal"]
     assert out["max_rel"] <= 1e-14
+    assert len(out["buffers"]) == ranks
+    assert all(size == expected for size, expected in out["buffers"])
 
 
 @needs_petsc
