@@ -539,11 +539,13 @@ class PetscBackend:
             subset = entry.mass_within[M.pattern] = self._subset(M, K)
         return entry if subset else None
 
-    def _subset(self, B, A, *, chunk: int = 1 << 20) -> bool:
+    def _subset(self, B, A, *, chunk: int = 1 << 17) -> bool:
         """Whether the nonzero pattern of the DistributedMatrix B lies within that of A
         (the same row layout); the same answer on every rank. Read from the assemblers'
         patterns (PETSc's CSR only where a pattern does not carry them), ``chunk`` entries
-        of B's rows at a time: no copy of the matrices' values or of their full keys."""
+        of B's rows at a time: no copy of the matrices' values or of their full keys (the
+        blocks of ~1 MB are reused from the heap, which keeps what larger blocks would
+        leave resident there after the check)."""
         ia, ja = A.pattern.indptr, A.pattern.indices
         if ia is None:
             ia, ja, _ = A.mat.getValuesCSR()
