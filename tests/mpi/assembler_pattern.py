@@ -4,7 +4,9 @@ block pair (4-node elements of 3 consecutive dofs per node), a group of permuted
 (no blocks: keyed per entry) and an entry group, with a constraint map that ties dofs with
 weights (up to 2 entries per row of T), maps two nodes' dofs to the same unknown and drops
 fixed ones. Rank 0 prints a JSON document: whether the patterns are equal, the largest
-relative value error and the groups' block sizes."""
+relative value error, the groups' block sizes and, for every rank, the size of the values
+array of an assembly against the entries of its own rows plus the distinct entries of its
+share in other ranks' rows (the ones it sends)."""
 import json
 import sys
 
@@ -78,8 +80,19 @@ def main():
     A.sort_indices()
     same = bool(np.array_equal(A.indptr, pat.indptr) and np.array_equal(A.indices, pat.indices))
     err = float(abs(A - ref).max() / abs(ref).max())
+    # this rank's share alone, mapped the same way: its entries in rows it does not own
+    S_mine = sp.csr_matrix((n, n))
+    for (dofs, _), (gdofs, _) in zip(elements, groups):
+        r = np.repeat(gdofs, gdofs.shape[1], axis=1).ravel()
+        c = np.tile(gdofs, (1, gdofs.shape[1])).ravel()
+        S_mine = S_mine + sp.csr_matrix((np.ones(r.size), (r, c)), shape=(n, n))
+    e = groups[-1][0]
+    S_mine = S_mine + sp.csr_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
+    mine = (abs(T).T @ S_mine @ abs(T)).tocsr()[keep][:, keep]
+    sent = mine.nnz - mine[asm.lo:asm.hi].nnz
+    buffers = comm.allgather([int(asm._nu), int(pat[asm.lo:asm.hi].nnz + sent)])
     return json.dumps({"pattern_equal": same, "max_rel": err, "nnz": int(A.nnz),
-                       "block_sizes": [g.block_size for g in asm._groups]})
+                       "block_sizes": [g.block_size for g in asm._groups], "buffers": buffers})
 
 
 if __name__ == "__main__":

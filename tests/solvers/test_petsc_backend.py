@@ -572,13 +572,18 @@ def test_eps_and_st_options_are_honoured(capfd):
 def test_block_pair_pattern_is_scipys_pattern_and_matrix(ranks):
     # source: scipy's T^T K T of the same element matrices and entries (its structure from
     # unit values and |T|, so no cancellation); the 4-node group is keyed per block pair
-    # (block size 3), the group of permuted local dofs and the entries per entry
+    # (block size 3), the group of permuted local dofs and the entries per entry; an
+    # assembly's values array on each rank: the entries of its rows plus those it sends
+    # (scipy's pattern of its rows and of its own share), not all distinct keys it touches
+    # plus the received and the summed ones
     p = _mpirun(ranks, program=[sys.executable, str(ROOT / "tests" / "mpi" / "assembler_pattern.py")])
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)
     assert out["block_sizes"] == [3, 1, 1]
     assert out["pattern_equal"]
     assert out["max_rel"] <= 1e-14
+    assert len(out["buffers"]) == ranks
+    assert all(size == expected for size, expected in out["buffers"])
 
 
 @needs_petsc
@@ -608,21 +613,28 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
 
 @needs_petsc
 def test_pattern_subset_check():
-    # source: the patterns themselves (a diagonal lies within a tridiagonal pattern, a
-    # corner entry does not), on the AIJ matrices the eigen solve's reuse check reads
+    # source: the patterns themselves (a diagonal lies within a tridiagonal pattern, an
+    # entry in the first or the last row outside the band does not), read from the
+    # assemblers' patterns or from PETSc's AIJ matrices, whole or a few rows at a time
     from petsc4py import PETSc
+    from tmfem.solvers.distributed import DistributedMatrix, Pattern
     from tmfem.solvers.petsc import PetscBackend
     n = 6
     tri = sp.diags([np.ones(n - 1), 2 * np.ones(n), np.ones(n - 1)], [-1, 0, 1], format="csr")
-    corner = sp.csr_matrix(sp.identity(n) + sp.csr_matrix(([1.0], ([0], [n - 1])), shape=(n, n)))
 
-    def aij(S):
-        return PETSc.Mat().createAIJ(size=S.shape, csr=(S.indptr.astype(PETSc.IntType),
-                                                        S.indices.astype(PETSc.IntType), S.data),
-                                     comm=PETSc.COMM_SELF)
+    def corner(i, j):
+        return sp.csr_matrix(sp.identity(n) + sp.csr_matrix(([1.0], ([i], [j])), shape=(n, n)))
+
+    def dist(S, carry):
+        ip, ix = S.indptr.astype(PETSc.IntType), S.indices.astype(PETSc.IntType)
+        mat = PETSc.Mat().createAIJ(size=S.shape, csr=(ip, ix, S.data), comm=PETSc.COMM_SELF)
+        return DistributedMatrix(mat, Pattern(ip, ix) if carry else Pattern(), S.shape)
     be = PetscBackend()
-    assert be._subset(aij(sp.identity(n, format="csr")), aij(tri))
-    assert not be._subset(aij(corner), aij(tri))
+    for carry in (True, False):
+        for chunk in (1 << 20, 2):
+            assert be._subset(dist(sp.identity(n, format="csr"), carry), dist(tri, carry), chunk=chunk)
+            assert not be._subset(dist(corner(0, n - 1), carry), dist(tri, carry), chunk=chunk)
+            assert not be._subset(dist(corner(n - 1, 0), carry), dist(tri, carry), chunk=chunk)
 
 
 @needs_petsc

@@ -155,6 +155,20 @@ def gather(vec) -> np.ndarray:
     return out
 
 
+def gather_rows(local: np.ndarray, comm) -> np.ndarray:
+    """Full array (n, m) on every rank of the row blocks (n_r, m) of the ranks, in rank
+    order (one ``Allgatherv`` into the result: no other full-size copy); ``local`` itself
+    on one rank."""
+    local = np.ascontiguousarray(local, dtype=float)
+    if comm.size == 1:
+        return local
+    m = local.shape[1]
+    counts = np.array(comm.allgather(local.shape[0])) * m
+    out = np.empty((int(counts.sum()) // m, m))
+    comm.Allgatherv(local, [out, counts])
+    return out
+
+
 def unique_inverse(keys: np.ndarray):
     """``(u, inverse)`` with u the sorted distinct values of the int64 array ``keys`` and
     ``u[inverse] == keys`` (``inverse`` int32 when it fits): ``np.unique(keys,
@@ -186,9 +200,14 @@ def unique_inverse(keys: np.ndarray):
 
 class Pattern:
     """Identity of a sparsity pattern (one per :class:`DistributedAssembler`); the backend
-    keys its factorisations by it and frees them when the pattern is gone."""
+    keys its factorisations by it and frees them when the pattern is gone. ``indptr``,
+    ``indices``: this rank's rows of the pattern (CSR, columns sorted in each row; the
+    assembler's own arrays, not copies)."""
 
-    __slots__ = ("__weakref__",)
+    __slots__ = ("__weakref__", "indptr", "indices")
+
+    def __init__(self, indptr=None, indices=None):
+        self.indptr, self.indices = indptr, indices
 
 
 class DistributedMatrix:
@@ -334,11 +353,39 @@ class DistributedAssembler:
             del recv
         del ukeys
         self._nnz = okeys.size
+        if P > 1:
+            self._route_own_entries()
         orow = okeys // self.N - self.lo if self.N else okeys
         self._indices = (okeys % self.N if self.N else okeys).astype(self.PETSc.IntType)
         self._indptr = np.zeros(self.hi - self.lo + 1, dtype=self.PETSc.IntType)
         np.cumsum(np.bincount(orow, minlength=self.hi - self.lo), out=self._indptr[1:])
-        self._pattern = Pattern()
+        self._pattern = Pattern(self._indptr, self._indices)
+
+    def _route_own_entries(self) -> None:
+        """Sum the entries of this rank's own rows in place (P > 1): each valid entry's
+        index (:attr:`_inverse`, into the distinct keys of this rank) becomes one into the
+        matrix' values (its own rows, ``_nnz``) followed by the keys of the other ranks'
+        rows, which alone are sent. An assembly then holds one array of this rank's values
+        (as on one rank) instead of the distinct keys' values, the received ones and the
+        summed ones; an entry's sum is the same (two ranks: bit for bit; more: the order of
+        the ranks' partial sums differs)."""
+        me = self.comm.rank
+        sdispl = np.concatenate([[0], np.cumsum(self._sendcounts)])
+        rdispl = np.concatenate([[0], np.cumsum(self._recvcounts)])
+        lo, n_own = int(sdispl[me]), int(self._sendcounts[me])
+        idx = np.int32 if self._nu + self._nnz < 2**31 else np.int64
+        # distinct key j -> its value slot: the owned row entry, or nnz + its place among
+        # the keys sent (the own block removed from the send order)
+        target = np.arange(self._nnz - n_own, self._nnz - n_own + self._nu, dtype=idx)
+        target[:lo] += n_own
+        target[lo:lo + n_own] = self._recv_inverse[rdispl[me]:rdispl[me] + n_own]
+        self._inverse = target[self._inverse]
+        self._nu = self._nnz + self._nu - n_own
+        self._recv_inverse = np.concatenate([self._recv_inverse[:rdispl[me]],
+                                             self._recv_inverse[rdispl[me] + n_own:]])
+        self._sendcounts = self._sendcounts.copy()
+        self._recvcounts = self._recvcounts.copy()
+        self._sendcounts[me] = self._recvcounts[me] = 0
 
     def _check(self, values, what):
         """Every rank agrees (one collective call) that the local arrays of all groups are
@@ -366,19 +413,18 @@ class DistributedAssembler:
         # sums in place, group by group in the order of the entries (np.add.at: the sums of
         # one np.bincount of all groups' values, without their concatenation and without
         # bincount's int64 copy of the int32 key indices)
+        # (P > 1: the entries of this rank's rows go straight into the matrix' values, the
+        # others into a send buffer behind them, :meth:`_route_own_entries`)
         vals = np.zeros(self._nu)
         off = 0
         for g, v in zip(self._groups, self._check(values, "distributed matrix")):
             part = g.weighted(v)
             np.add.at(vals, self._inverse[off:off + part.size], part)
             off += part.size
-        if self._recv_inverse is None:
-            data = vals
-        else:
+        data = vals[:self._nnz]
+        if self._recv_inverse is not None:
             recv = np.empty(int(self._recvcounts.sum()))
-            self.comm.Alltoallv([vals, self._sendcounts], [recv, self._recvcounts])
-            del vals                 # sent: the peak of an assembly is the matrix' own arrays
-            data = np.zeros(self._nnz)
+            self.comm.Alltoallv([vals[self._nnz:], self._sendcounts], [recv, self._recvcounts])
             np.add.at(data, self._recv_inverse, recv)
             del recv
         PETSc = self.PETSc

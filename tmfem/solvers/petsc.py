@@ -43,7 +43,7 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather
+from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
 from tmfem.solvers.petsc_loader import petsc_modules
 from tmfem.solvers.singular import SingularMatrix
 
@@ -468,9 +468,7 @@ class PetscBackend:
         local = np.array(Xm.getDenseArray())
         Bm.destroy()
         Xm.destroy()
-        if self.comm.size == 1:
-            return local
-        return np.concatenate(self.comm.tompi4py().allgather(local), axis=0)
+        return gather_rows(local, self.comm.tompi4py())
 
     def gather(self, vec) -> np.ndarray:
         """Full numpy copy (n,) of a distributed PETSc Vec on every rank."""
@@ -538,21 +536,35 @@ class PetscBackend:
             return None
         subset = entry.mass_within.get(M.pattern)
         if subset is None:
-            subset = entry.mass_within[M.pattern] = self._subset(M.mat, K.mat)
+            subset = entry.mass_within[M.pattern] = self._subset(M, K)
         return entry if subset else None
 
-    def _subset(self, B, A) -> bool:
-        """Whether the nonzero pattern of B lies within that of A (the same row layout);
-        the same answer on every rank."""
-        ia, ja, _ = A.getValuesCSR()
-        ib, jb, _ = B.getValuesCSR()
-        n = A.getSize()[1]
-        ka = np.repeat(np.arange(ia.size - 1, dtype=np.int64), np.diff(ia)) * n + ja
-        kb = np.repeat(np.arange(ib.size - 1, dtype=np.int64), np.diff(ib)) * n + jb
-        if not bool(np.all(ka[1:] >= ka[:-1])):   # AIJ rows come column-sorted: no sort then
-            ka.sort()
-        pos = np.minimum(np.searchsorted(ka, kb), max(ka.size - 1, 0))
-        mine = bool(kb.size == 0 or (ka.size > 0 and np.array_equal(ka[pos], kb)))
+    def _subset(self, B, A, *, chunk: int = 1 << 17) -> bool:
+        """Whether the nonzero pattern of the DistributedMatrix B lies within that of A
+        (the same row layout); the same answer on every rank. Read from the assemblers'
+        patterns (PETSc's CSR only where a pattern does not carry them), ``chunk`` entries
+        of B's rows at a time: no copy of the matrices' values or of their full keys (the
+        blocks of ~1 MB are reused from the heap, which keeps what larger blocks would
+        leave resident there after the check)."""
+        ia, ja = A.pattern.indptr, A.pattern.indices
+        if ia is None:
+            ia, ja, _ = A.mat.getValuesCSR()
+        ib, jb = B.pattern.indptr, B.pattern.indices
+        if ib is None:
+            ib, jb, _ = B.mat.getValuesCSR()
+        n = A.shape[1]
+        rows, r0, mine = ib.size - 1, 0, True
+        while mine and r0 < rows:
+            r1 = int(np.searchsorted(ib, ib[r0] + chunk, side="right")) - 1
+            r1 = min(rows, max(r0 + 1, r1))
+            r = np.arange(r0, r1, dtype=np.int64)
+            ka = np.repeat(r, np.diff(ia[r0:r1 + 1])) * n + ja[ia[r0]:ia[r1]]
+            kb = np.repeat(r, np.diff(ib[r0:r1 + 1])) * n + jb[ib[r0]:ib[r1]]
+            if not bool(np.all(ka[1:] >= ka[:-1])):   # AIJ rows come column-sorted
+                ka.sort()
+            pos = np.minimum(np.searchsorted(ka, kb), max(ka.size - 1, 0))
+            mine = bool(kb.size == 0 or (ka.size > 0 and np.array_equal(ka[pos], kb)))
+            r0 = r1
         if self.comm.size == 1:
             return mine
         return all(self.comm.tompi4py().allgather(mine))
@@ -607,13 +619,15 @@ class PetscBackend:
             if nconv < k:
                 raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "
                                        f"sigma={sigma:g} in {E.getIterationNumber()} restarts")
+            # this rank's rows of the vectors; the full ones once SLEPc's basis is freed
             vr = Kp.createVecRight()
+            lo, hi = vr.getOwnershipRange()
             w = np.empty(nconv)
-            V = np.empty((n, nconv))
+            local = np.empty((hi - lo, nconv))
             for i in range(nconv):
                 w[i] = E.getEigenpair(i, vr).real
-                V[:, i] = self.gather(vr)
+                local[:, i] = vr.getArray(readonly=True)
             vr.destroy()
         finally:
             E.destroy()
-        return w, V
+        return w, gather_rows(local, self.comm.tompi4py())
