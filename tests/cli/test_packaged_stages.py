@@ -17,6 +17,7 @@ from tmfem.cli.equilibrium import format_text
 from tmfem.system import load_system
 
 
+@pytest.mark.slow
 def test_packaged_of_the_2_6_is_its_own_and_pastes_into_the_file(capsys):
     f = SYSTEMS / "hexagon-2-6.toml"
     r, _ = run(["equilibrium", str(f), "--packaged", "70"], capsys)
@@ -48,6 +49,7 @@ def test_deploy_starts_from_the_packaged_configuration_found_for_a_2_4(tmp_path,
     assert dep["failure"] is None and np.isfinite(dep["final_tracking_error"])
 
 
+@pytest.mark.slow
 def test_a_theta_without_packaged_equilibria_is_one_line(capsys):
     rc = main(["equilibrium", str(SYSTEMS / "pentagon-2-5.toml"), "--packaged", "30"])
     err = capsys.readouterr().err.strip().splitlines()
