@@ -335,6 +335,7 @@ def test_compare_plot_without_printed_values_draws_the_three_models_only(tmp_pat
     assert png.stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_compare_of_a_deployable_user_system_sets_the_sbc_and_com_models_side_by_side(tmp_path, capsys):
     """`compare FILE` on the 1-5(D) (tendons at H_1j along the bars, which the MTC model cannot
     represent): rc 0, the SBC and COM models only, a line saying why the MTC model is left out,

@@ -46,6 +46,9 @@ def python_blocks(md: Path) -> list[str]:
 
 
 PAGES = sorted(p for p in DOCS.rglob("*.md") if python_blocks(p))
+#: pages whose blocks take long (the tutorial designs, deploys and reports a system of its own):
+#: they run with the studies
+SLOW_PAGES = {"tutorial.md"}
 
 
 def test_tutorial_and_guides_have_blocks():
@@ -53,7 +56,9 @@ def test_tutorial_and_guides_have_blocks():
     assert "tutorial.md" in names and sum(n.startswith("guides/") for n in names) >= 5
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: p.relative_to(DOCS).as_posix())
+@pytest.mark.parametrize("page", [pytest.param(p, marks=pytest.mark.slow)
+                                  if p.relative_to(DOCS).as_posix() in SLOW_PAGES else p for p in PAGES],
+                         ids=lambda p: p.relative_to(DOCS).as_posix())
 def test_page_python_blocks_run(page, tmp_path, monkeypatch):
     for name in ("examples", "meshes"):
         os.symlink(ROOT / name, tmp_path / name)

@@ -57,6 +57,7 @@ def check_packaged(f, r, theta_deg):
     assert rep.min_margin == pytest.approx(r["path"]["min_margin"], rel=1e-9)
 
 
+@pytest.mark.slow
 def test_packaged_stages_are_a_feasible_start_of_the_automatic_path():
     f, r = packaged("pentagon-2-5.toml", 78.0)
     check_packaged(f, r, 78.0)
