@@ -697,3 +697,24 @@ def test_cli_modal_under_two_ranks_takes_petsc_by_default():
     d = json.loads(p.stdout)
     assert d["backend"] == "petsc"
     assert np.allclose(d["freq_hz"], ref["freq_hz"], rtol=1e-8, atol=0)
+
+
+@needs_petsc
+@pytest.mark.parametrize("where", ["factorize", "eigsh"])
+def test_a_mumps_failure_other_than_singular_is_named(where):
+    # source: MUMPS' own return code (INFOG(1) = -19: the working memory limit ICNTL(23),
+    # here 1 MB, is below the need); the tridiagonal matrix is non-singular, so the error
+    # must not call it singular (the code a PETSc failed preconditioner hides)
+    from tmfem.errors import InputError
+    from tmfem.solvers.backends import SingularMatrix
+    from tmfem.solvers.petsc import PetscBackend
+    n = 3000
+    K = sp.diags([-np.ones(n - 1), 2.5 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+    prefix = "" if where == "factorize" else "st_"
+    be = PetscBackend(options=f"-{prefix}mat_mumps_icntl_23 1")
+    with pytest.raises(InputError, match=r"MUMPS INFOG\(1\) = -19.*ICNTL\(23\)") as err:
+        if where == "factorize":
+            be.factorize(K)
+        else:
+            be.eigsh(K, sp.identity(n, format="csr"), 3, 0.0)
+    assert not isinstance(err.value, SingularMatrix)

@@ -152,3 +152,17 @@ def test_sbc_snes_under_three_ranks_agrees_with_scipy():
     u = st.state.x - m.start_state().x
     assert np.linalg.norm(np.array(run["x"]) - st.state.x) <= 1e-9 * np.linalg.norm(u)
     assert np.abs(np.array(run["R"]) - st.state.R).max() <= 1e-9
+
+
+@needs_petsc
+def test_snes_stops_at_once_on_a_mumps_failure_a_shift_cannot_cure():
+    # source: MUMPS' return code INFOG(1) = -19 (a 1 MB working memory limit): the
+    # continuation's larger shifts cannot cure it, so the static solve names it after its
+    # first linear solve instead of raising the shift to 1e12 of its scale
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    m = MTCModel(load_preset("1-4"), mesh_n=10, backend=PetscBackend(options="-mat_mumps_icntl_23 1"))
+    with pytest.raises(InputError, match=r"SNES\): expected the MUMPS factorisation to succeed, "
+                                         r"found MUMPS INFOG\(1\) = -19"):
+        m.equilibrium()

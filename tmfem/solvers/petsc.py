@@ -44,6 +44,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
+from tmfem.solvers.mumps import SINGULAR, STRUCTURALLY_SINGULAR, mumps_error, mumps_failure
 from tmfem.solvers.petsc_loader import petsc_modules
 from tmfem.solvers.singular import SingularMatrix
 
@@ -88,11 +89,15 @@ def _is_number(tok: str) -> bool:
         return False
 
 
-def _shift_invert_failure(sigma: float, exc):
-    """The :class:`SingularMatrix` of a failing factorisation of K - sigma M (PETSc error
-    ``exc``) in an eigen solve."""
-    return SingularMatrix(f"eigen (petsc): expected K - sigma M non-singular for sigma={sigma:g}, "
-                          f"found the shift-invert factorisation failing (PETSc error {exc.ierr})")
+def _factorisation_failure(ksp, singular: str, what: str):
+    """The error of a failed factorisation by ``ksp``: MUMPS' named error when its code is
+    not that of a singular matrix (:mod:`tmfem.solvers.mumps`), else a
+    :class:`SingularMatrix` ``f"{what}: {singular}"``."""
+    failure = mumps_failure(ksp)
+    if failure is not None and failure[0] not in (SINGULAR, STRUCTURALLY_SINGULAR):
+        return mumps_error(*failure, what)
+    code = f" (MUMPS INFOG(1) = {failure[0]})" if failure is not None else ""
+    return SingularMatrix(f"{what}: {singular}{code}")
 
 
 @dataclass(eq=False)
@@ -372,19 +377,18 @@ class PetscBackend:
             ksp.setOperators(M)
         entry.generation += 1
         generation = entry.generation
+        where = f"linear solve (petsc {ksp.getType()}/{ksp.getPC().getType()})"
         try:
-            ksp.setUp()
+            # MUMPS reads its options (-mat_mumps_icntl_*) when the factor is created, here
+            with self._database({k: v for k, v in self.options.items()
+                                 if not k.startswith(("eps_", "st_"))}):
+                ksp.setUp()
         except PETSc.Error as exc:
-            raise SingularMatrix(f"linear solve (petsc {ksp.getPC().getType()}/mumps): expected a "
-                                 f"non-singular {n}x{n} matrix, found the factorisation failing "
-                                 f"(PETSc error {exc.ierr})") from None
-        pc = ksp.getPC()
-        if pc.getType() in ("lu", "cholesky") and pc.getFactorSolverType() == "mumps":
-            info = pc.getFactorMatrix().getMumpsInfog(1)
-            if info < 0:             # -10: numerically singular (a zero pivot)
-                raise SingularMatrix(f"linear solve (petsc {pc.getType()}/mumps): expected a "
-                                     f"non-singular {n}x{n} matrix, found a singular one (MUMPS "
-                                     f"INFOG(1) = {info})")
+            raise _factorisation_failure(ksp, f"expected a non-singular {n}x{n} matrix, found the "
+                                         f"factorisation failing (PETSc error {exc.ierr})", where) from None
+        if mumps_failure(ksp) is not None:
+            raise _factorisation_failure(ksp, f"expected a non-singular {n}x{n} matrix, found a "
+                                         "singular one", where)
         lo, hi = M.getOwnershipRange()
         x_vec, b_vec = M.createVecs()
 
@@ -614,7 +618,10 @@ class PetscBackend:
                 try:
                     E.solve()
                 except PETSc.Error as exc:
-                    raise _shift_invert_failure(sigma, exc) from None
+                    raise _factorisation_failure(
+                        st.getKSP(), f"expected K - sigma M non-singular for sigma={sigma:g}, found "
+                        f"the shift-invert factorisation failing (PETSc error {exc.ierr})",
+                        "eigen (petsc)") from None
             nconv = E.getConverged()
             if nconv < k:
                 raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "

@@ -46,6 +46,7 @@ import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather
+from tmfem.solvers.mumps import SINGULAR, STRUCTURALLY_SINGULAR, mumps_error, mumps_failure
 
 log = logging.getLogger(__name__)
 
@@ -157,6 +158,15 @@ class _Problem:
         X.set(0.0)
 
 
+def _refuse_mumps_failure(snes, what: str) -> None:
+    """Raise the named error of a failed MUMPS factorisation of the SNES' tangent that no
+    shift of the continuation can cure (anything but a singular matrix: a workspace that
+    ran short, memory, an option this MUMPS cannot honour, :mod:`tmfem.solvers.mumps`)."""
+    failure = mumps_failure(snes.getKSP())
+    if failure is not None and failure[0] not in (SINGULAR, STRUCTURALLY_SINGULAR):
+        raise mumps_error(*failure, f"{what} (SNES)")
+
+
 def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: float = 1e-9,
                      max_iter: int = 200, newton_first: bool = False, callback=None,
                      describe=None, what: str = "static solve", update=None):
@@ -223,7 +233,10 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                 return (*prob.evaluate(gather(X)), snes.getIterationNumber(), FLOOR)
             except PETSc.Error as exc:
                 log.debug("%s: SNES error %s", what, exc.ierr)
+                _refuse_mumps_failure(snes, what)
                 return None, None, None, snes.getIterationNumber(), -100
+        if snes.getConvergedReason() == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
+            _refuse_mumps_failure(snes, what)
         x = gather(X)
         un, rr, KK = prob.evaluate(x)
         return un, rr, KK, snes.getIterationNumber(), snes.getConvergedReason()
