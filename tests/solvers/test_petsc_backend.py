@@ -718,3 +718,21 @@ def test_a_mumps_failure_other_than_singular_is_named(where):
         else:
             be.eigsh(K, sp.identity(n, format="csr"), 3, 0.0)
     assert not isinstance(err.value, SingularMatrix)
+
+
+@needs_petsc
+def test_backend_options_no_solver_read_are_named():
+    # source: PETSc's own record of the options its objects read (PetscOptionsUsed): a
+    # misspelt option is never read; -ksp_rtol is read by an iterative KSP and ignored by
+    # the direct solve (KSP preonly); -eps_ncv is read once an eigen solve has run
+    from tmfem.solvers.petsc import PetscBackend
+    n = 50
+    K = sp.diags([-np.ones(n - 1), 2.5 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1], format="csr")
+    direct = PetscBackend(options="-ksp_tpye cg -ksp_rtol 1e-8 -mat_mumps_icntl_14 30 -eps_ncv 30")
+    direct.factorize(K)(np.ones(n))
+    assert direct.unused_options() == ["-ksp_tpye", "-ksp_rtol", "-eps_ncv"]
+    direct.eigsh(K, sp.identity(n, format="csr"), 3, 0.0)
+    assert direct.unused_options() == ["-ksp_tpye", "-ksp_rtol"]
+    iterative = PetscBackend(solver="iterative", options="-ksp_rtol 1e-8")
+    iterative.factorize(K)(np.ones(n))
+    assert iterative.unused_options() == []

@@ -83,6 +83,21 @@ def test_cli_snes_monitor_is_visible():
     assert p.returncode == 0, p.stderr
     assert "SNES Function norm" in p.stdout
     assert "backend petsc (" in p.stderr
+    assert "PETSc options" not in p.stderr          # the option was read: no warning
+
+
+@needs_petsc
+def test_cli_warns_of_petsc_options_no_solver_read():
+    # source: PETSc's own record of the options its objects read (PetscOptionsUsed): a
+    # misspelt SNES option and an eigen option in a static run (no eigen solve) change
+    # nothing, and the command says so once on stderr; the results are unchanged (exit 0)
+    env = dict(os.environ, PETSC_OPTIONS="-snes_monitr -eps_ncv 30 -snes_converged_reason")
+    p = subprocess.run([sys.executable, "-m", "tmfem", "static", "--preset", "2-3", "--mesh", "4",
+                        "--backend", "petsc"], capture_output=True, text=True, cwd=ROOT, env=env)
+    assert p.returncode == 0, p.stderr
+    warned = [line for line in p.stderr.splitlines() if "PETSc options that no solver" in line]
+    assert len(warned) == 1 and "-eps_ncv -snes_monitr (" in warned[0], p.stderr
+    assert "snes_converged_reason" not in warned[0]
 
 
 def test_auto_backend_chooses_by_the_crossover(monkeypatch):

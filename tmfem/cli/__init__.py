@@ -352,6 +352,7 @@ def main(argv=None) -> int:
             lock.acquire(d, label=f"tmfem {args.command}")
         mark = _mark_incomplete(args)
         result = mod.run(args)
+        _warn_unused_petsc_options(args.command)
         print(render(args, mod, result))
         if mark is not None:
             mark.unlink(missing_ok=True)
@@ -386,6 +387,21 @@ def render(args, mod, result) -> str:
         from tmfem.io.units import with_units
         return json.dumps(_finite(with_units(result)), default=json_default, allow_nan=False)
     return getattr(mod, "format_text", _default_text)(result)
+
+
+def _warn_unused_petsc_options(command: str) -> None:
+    """Warn of the solver options of PETSC_OPTIONS that no solver of the run read
+    (:func:`tmfem.solvers.petsc.unused_options`): a misspelt option, or one of a solver the
+    command does not create, would otherwise change nothing without a word."""
+    if "petsc4py.PETSc" not in sys.modules:
+        return
+    from tmfem.solvers.petsc import unused_options
+    left = unused_options()
+    if left:
+        logging.getLogger("tmfem").warning(
+            "PETSc options that no solver of this run read: %s (misspelt, or for a solver that "
+            "tmfem %s does not create, or that the default direct solve ignores, such as "
+            "-ksp_rtol)", " ".join(left), command)
 
 
 def _unwritable(exc: OSError) -> str:
@@ -478,6 +494,7 @@ def _run_ranks(args, mod, ranks, lock) -> int:
         with contextlib.redirect_stderr(sys.stderr if rank == 0 else io.StringIO()):
             try:
                 result["value"] = mod.run(args)
+                _warn_unused_petsc_options(args.command)
             except OSError as exc:             # rank 0's output that cannot be written
                 raise InputError(_unwritable(exc)) from None
             except MemoryError:

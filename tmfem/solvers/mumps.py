@@ -31,7 +31,8 @@ _MEANING = {
     -13: "memory ran out in the factorisation (an allocation of |INFOG(2)| entries, "
          "x 1e6 when INFOG(2) < 0, failed)",
     -19: "the working memory limit ICNTL(23) is below what the factorisation needs "
-         "(INFOG(2) entries short, x 1e6 when negative; -mat_mumps_icntl_23 sets the limit in MB)",
+         "(INFOG(2) entries short, x 1e6 when negative; -mat_mumps_icntl_23 sets the limit in MB, "
+         "-st_mat_mumps_icntl_23 that of the eigen solve's factorisation)",
     -38: "the parallel analysis ICNTL(28) = 2 asks for PT-SCOTCH or ParMETIS, which this "
          "MUMPS was not built with (-mat_mumps_icntl_28 1: the sequential analysis)",
 }
@@ -56,7 +57,8 @@ def describe(code: int, detail: int) -> str:
     if code in _WORKSPACE:
         what = ("the workspace that MUMPS estimated in its analysis ran short (the memory "
                 "relaxation ICNTL(14), in percent of the estimate: raise it with "
-                "-mat_mumps_icntl_14, for example 50 or 100)")
+                "-mat_mumps_icntl_14, for example 50 or 100; -st_mat_mumps_icntl_14 for the eigen "
+                "solve's factorisation)")
     else:
         what = _MEANING.get(code, "see the MUMPS users' guide, error diagnostics")
     return f"MUMPS INFOG(1) = {code}, INFOG(2) = {detail}: {what}"

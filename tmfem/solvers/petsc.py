@@ -30,10 +30,12 @@ SLEPc its ``eps_`` options (``-eps_tol``, ``-eps_ncv``).
 """
 from __future__ import annotations
 
+import ctypes
 import gc
 import hashlib
 import logging
 import shlex
+import sys
 import weakref
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -79,6 +81,33 @@ def parse_options(options) -> dict:
             out[key] = tok
             key = None
     return out
+
+
+#: prefixes of the options of the PETSc and SLEPc objects tmfem creates (SNES, KSP, PC, Mat
+#: and its MUMPS factorisation, EPS, ST): those :func:`unused_options` reports
+SOLVER_PREFIXES = ("snes_", "ksp_", "pc_", "mat_", "eps_", "st_")
+
+
+def _option_used(PETSc, name: str) -> bool:
+    """Whether a PETSc object has read the option ``name`` (without '-') of the options
+    database: PETSc's ``PetscOptionsUsed``, which petsc4py does not wrap (the library
+    handle of petsc4py's extension module resolves libpetsc's symbols)."""
+    used = ctypes.c_int(0)
+    ctypes.CDLL(PETSc.__file__).PetscOptionsUsed(None, name.encode(), ctypes.byref(used))
+    return bool(used.value)
+
+
+def unused_options() -> list[str]:
+    """The solver options (:data:`SOLVER_PREFIXES`) of PETSc's options database
+    (``PETSC_OPTIONS``, the command line) that no PETSc or SLEPc object has read so far, as
+    ``-name``: a misspelt option, or one of a solver the run did not create. Empty when
+    PETSc is not loaded. (The ``options=`` of a :class:`PetscBackend` live in the database
+    only while its solvers run: :meth:`PetscBackend.unused_options`.)"""
+    if "petsc4py.PETSc" not in sys.modules:
+        return []
+    PETSc = sys.modules["petsc4py.PETSc"]
+    return [f"-{name}" for name in sorted(PETSc.Options().getAll())
+            if name.startswith(SOLVER_PREFIXES) and not _option_used(PETSc, name)]
 
 
 def _is_number(tok: str) -> bool:
@@ -156,6 +185,7 @@ class PetscBackend:
         self.options = parse_options(options)
         self.eig_tol = float(eig_tol)
         self.comm = self.PETSc.COMM_WORLD
+        self._read = set()        # names of options= that a solver has read
         self._cache = {}          # sparsity pattern -> _Factorisation
         self._dead = []           # retired cache entries, destroyed by _reap
         self._serial = 0          # creation count of cache entries (the same on every rank)
@@ -336,11 +366,19 @@ class PetscBackend:
         try:
             yield
         finally:
+            self._read.update(name for name in saved
+                              if name in self.options and _option_used(self.PETSc, name))
             for name, old in saved.items():
                 if old is None:
                     opts.delValue(name)
                 else:
                     opts.setValue(name, old)
+
+    def unused_options(self) -> list[str]:
+        """The entries of ``options=`` (as ``-name``) that none of this backend's solvers
+        has read so far: misspelt, or for a solver not yet run (an ``-eps_*`` option before
+        the first eigen solve)."""
+        return [f"-{name}" for name in self.options if name not in self._read]
 
     # ------------------------------------------------------------------ linear solves
     def factorize(self, A):
@@ -487,6 +525,19 @@ class PetscBackend:
         from tmfem.solvers.petsc_snes import snes_equilibrium
         self.release_retired()
         return snes_equilibrium(self, residual, energy, u0, **kwargs)
+
+    def factor_memory_mb(self) -> dict:
+        """MUMPS' memory on this rank [MB] for the factorisations this backend holds, summed
+        (MUMPS users' guide: INFO(22), effectively used in the factorisation; INFO(16),
+        allocated for it): ``{"used": ..., "allocated": ...}``, zeros when it holds none."""
+        used = allocated = 0
+        for entry in self._cache.values():
+            pc = entry.ksp.getPC()
+            if pc.getType() in ("lu", "cholesky") and pc.getFactorSolverType() == "mumps":
+                F = pc.getFactorMatrix()
+                used += int(F.getMumpsInfo(22))
+                allocated += int(F.getMumpsInfo(16))
+        return {"used": float(used), "allocated": float(allocated)}
 
     def release_retired(self) -> None:
         """Free the factorisations (MUMPS factors, SNES) of patterns that are gone, also of
