@@ -47,6 +47,7 @@ import numpy as np
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather
 from tmfem.solvers.mumps import SINGULAR, STRUCTURALLY_SINGULAR, mumps_error, mumps_failure
+from tmfem.solvers.petsc import SOLVER_PREFIXES
 
 log = logging.getLogger(__name__)
 
@@ -156,6 +157,18 @@ class _Problem:
         self.offset = self.offset + x
         self.cache["x"] = np.zeros(x.size)
         X.set(0.0)
+
+
+def _options_note(backend) -> str:
+    """`` with the PETSc options ...``: the solver options in effect besides tmfem's
+    defaults (``PETSC_OPTIONS`` and the backend's ``options=``), which a failed solve may
+    owe to; empty when there are none."""
+    given = {**{k: v for k, v in backend.PETSc.Options().getAll().items()
+                if k.startswith(SOLVER_PREFIXES)}, **backend.options}
+    if not given:
+        return ""
+    return " with the PETSc options " + " ".join(
+        f"-{k}" + (f" {v}" if v not in (None, "") else "") for k, v in given.items())
 
 
 def _refuse_mumps_failure(snes, what: str) -> None:
@@ -283,7 +296,7 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                 raise ConvergenceError(
                     f"{what}: SNES {reason_name(PETSc, reason)} (expected an equilibrium with "
                     f"|r| <= {tol:g} x force scale, found |r| = {float(np.linalg.norm(r)):.3e} N "
-                    f"after {total} SNES iterations, mu = {mu:.3g}){note}")
+                    f"after {total} SNES iterations, mu = {mu:.3g}){note}{_options_note(backend)}")
     finally:
         # the SNES, its KSP (MUMPS' analysis of the tangent's pattern) and matrix stay with
         # the backend for the eigen solve about this equilibrium
@@ -297,5 +310,6 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
     if not rn <= 1e3 * tol * force_scale(u):
         note = f" ({describe(u)})" if describe is not None else ""
         raise ConvergenceError(f"{what}: SNES stopped after {total} iterations (max_iter {max_iter}) "
-                               f"at |r| = {rn:.3e} N, expected <= {tol:g} x force scale{note}")
+                               f"at |r| = {rn:.3e} N, expected <= {tol:g} x force scale{note}"
+                               f"{_options_note(backend)}")
     return dict(u=u, iterations=total, residual_history=res_hist, mu_history=mu_hist, tangent=K)
