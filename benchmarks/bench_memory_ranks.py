@@ -7,9 +7,13 @@ OPENBLAS_NUM_THREADS=1), so that the peak resident memory is that of the run. Pr
 free DOFs, wall time per phase (build: the model and its mesh; static: the equilibrium from
 the undeformed membrane with mesh sequencing; modes: 12 modes about it), and for every rank
 its resident memory (VmRSS of /proc/self/status) after start-up (Python, numpy, PETSc, MPI
-loaded) and after each phase, and its peak (``ru_maxrss``). Last: the ratio of the largest
-2-rank (P-rank) peak to the 1-rank peak on the same mesh; a model whose memory divides over
-ranks gives about 1/P plus the start-up's share (target for 2 ranks: at most 0.6).
+loaded) and after each phase, its peak (``ru_maxrss``) and MUMPS' own memory for the
+factorisation of the statics on the rank (INFO(22) effectively used, INFO(16) allocated).
+Last: the ratio of the largest 2-rank (P-rank) peak to the 1-rank peak on the same mesh (a
+model whose memory divides over ranks gives about 1/P plus the start-up's share; target for
+2 ranks: at most 0.6), and the ratio that the start-up and MUMPS alone leave
+(:func:`floor_ratio`: everything else divided exactly), which bounds what tmfem's own data
+can reach.
 """
 from __future__ import annotations
 
@@ -62,13 +66,31 @@ def run_one(mesh: int, rest_length: float, sequence: int) -> dict:
     t = time.perf_counter()
     res = m.equilibrium(sequence=sequence or None)
     phase("static", t)
+    mumps = m.backend.factor_memory_mb()
     t = time.perf_counter()
     modes = m.modes(k=12, at=res)
     phase("modes", t)
-    mine = dict(rank=comm.rank, rss_mb=rss, peak_mb=peak, wall_s=wall)
+    mine = dict(rank=comm.rank, rss_mb=rss, peak_mb=peak, wall_s=wall, mumps_mb=mumps)
     ranks = comm.gather(mine, root=0)
     return dict(mesh=f"4x{mesh}x{mesh}", n=mesh, ranks=comm.size, dofs=m.ndof,
                 f1_hz=float(modes.freq_hz[0]), per_rank=ranks)
+
+
+def floor_ratio(run: dict, ref: dict) -> tuple[int, float]:
+    """(P, bound) of a P-rank run against the reference run: its busiest rank's peak if
+    everything but the start-up and MUMPS' factorisation divided exactly over the ranks,
+
+        bound = (start_P + mumps_P + (peak_1 - start_1 - mumps_1) / P) / peak_1,
+
+    with start the resident memory after start-up (Python, numpy, PETSc, MPI: on every
+    rank) and mumps MUMPS' memory effectively used on the rank (INFO(22), its busiest
+    rank): what the start-up and MUMPS' own parallel overhead alone leave of the ratio."""
+    r1 = ref["per_rank"][0]
+    rest = r1["peak_mb"]["modes"] - r1["rss_mb"]["start"] - r1["mumps_mb"]["used"]
+    P = run["ranks"]
+    busiest = max(run["per_rank"], key=lambda r: r["peak_mb"]["modes"])
+    top = busiest["rss_mb"]["start"] + max(r["mumps_mb"]["used"] for r in run["per_rank"]) + rest / P
+    return P, top / r1["peak_mb"]["modes"]
 
 
 def launch(mesh: int, ranks: int, args) -> dict:
@@ -107,11 +129,13 @@ def main(argv=None) -> int:
               f"load average {os.getloadavg()[0]:.2f}")
         print("# memory: VmRSS [MB] after start-up / build / static / modes, and peak (ru_maxrss);"
               " time: wall s per phase (rank 0)")
+        print("# mumps: MUMPS' memory of the statics' factorisation on the rank [MB], effectively "
+              "used / allocated (INFO(22) / INFO(16))")
         print(f"{'mesh':>11s} {'dofs':>8s} {'P':>2s} {'rank':>4s} "
-              + " ".join(f"{p:>7s}" for p in PHASES) + f" {'peak':>7s} "
+              + " ".join(f"{p:>7s}" for p in PHASES) + f" {'peak':>7s} {'mumps':>9s} "
               + " ".join(f"{p + ' s':>8s}" for p in PHASES[1:]))
     for mesh in [int(v) for v in args.meshes.split(",")]:
-        ref = None
+        ref, ref_run = None, None
         for ranks in rank_counts:
             run = launch(mesh, ranks, args)
             runs.append(run)
@@ -123,7 +147,7 @@ def main(argv=None) -> int:
             peak = max(r["peak_mb"]["modes"] for r in run["per_rank"])
             run["peak_mb"] = peak
             if ref is None:
-                ref = peak
+                ref, ref_run = peak, run
             run["ratio"] = peak / ref
             if args.json:
                 continue
@@ -132,12 +156,18 @@ def main(argv=None) -> int:
                 print(f"{run['mesh']:>11s} {run['dofs']:8d} {ranks:2d} {r['rank']:4d} "
                       + " ".join(f"{r['rss_mb'][p]:7.0f}" for p in PHASES)
                       + f" {r['peak_mb']['modes']:7.0f} "
+                      + f"{r['mumps_mb']['used']:4.0f}/{r['mumps_mb']['allocated']:<4.0f} "
                       + " ".join(f"{w[p]:8.2f}" for p in PHASES[1:]), flush=True)
         if not args.json:
             ratios = ", ".join(f"P={r['ranks']}: {r['ratio']:.2f}" for r in runs
                                if r.get("mesh") == f"4x{mesh}x{mesh}" and "ratio" in r)
             print(f"# 4x{mesh}x{mesh}: peak per rank / {rank_counts[0]}-rank peak: {ratios}",
                   flush=True)
+            bounds = [floor_ratio(r, ref_run) for r in runs if r.get("mesh") == f"4x{mesh}x{mesh}"
+                      and "ratio" in r and r is not ref_run]
+            if bounds:
+                print(f"# 4x{mesh}x{mesh}: the ratio if all but the start-up and MUMPS divided exactly "
+                      "over the ranks: " + ", ".join(f"P={p}: {b:.2f}" for p, b in bounds), flush=True)
     if args.json:
         print(json.dumps(runs))
     return 0
