@@ -75,13 +75,20 @@ def test_snes_converged_reason_names_the_convergence_error():
         _petsc_model("-snes_max_funcs 1").equilibrium()
 
 
-@needs_petsc
-def test_cli_snes_monitor_is_visible():
-    # PETSC_OPTIONS reaches the SNES of the CLI's static solve; its monitor prints on stdout
-    env = dict(os.environ, PETSC_OPTIONS="-snes_monitor")
+def _cli_static(petsc_options: str):
+    """``tmfem static`` of the 2-3 at mesh 4 on the PETSc backend with PETSC_OPTIONS; the
+    finished process (exit 0 asserted)."""
+    env = dict(os.environ, PETSC_OPTIONS=petsc_options)
     p = subprocess.run([sys.executable, "-m", "tmfem", "static", "--preset", "2-3", "--mesh", "4",
                         "--backend", "petsc"], capture_output=True, text=True, cwd=ROOT, env=env)
     assert p.returncode == 0, p.stderr
+    return p
+
+
+@needs_petsc
+def test_cli_snes_monitor_is_visible():
+    # PETSC_OPTIONS reaches the SNES of the CLI's static solve; its monitor prints on stdout
+    p = _cli_static("-snes_monitor")
     assert "SNES Function norm" in p.stdout
     assert "backend petsc (" in p.stderr
     assert "PETSc options" not in p.stderr          # the option was read: no warning
@@ -92,10 +99,7 @@ def test_cli_warns_of_petsc_options_no_solver_read():
     # source: PETSc's own record of the options its objects read (PetscOptionsUsed): a
     # misspelt SNES option and an eigen option in a static run (no eigen solve) change
     # nothing, and the command says so once on stderr; the results are unchanged (exit 0)
-    env = dict(os.environ, PETSC_OPTIONS="-snes_monitr -eps_ncv 30 -snes_converged_reason")
-    p = subprocess.run([sys.executable, "-m", "tmfem", "static", "--preset", "2-3", "--mesh", "4",
-                        "--backend", "petsc"], capture_output=True, text=True, cwd=ROOT, env=env)
-    assert p.returncode == 0, p.stderr
+    p = _cli_static("-snes_monitr -eps_ncv 30 -snes_converged_reason")
     warned = [line for line in p.stderr.splitlines() if "PETSc options that no solver" in line]
     assert len(warned) == 1 and "-eps_ncv -snes_monitr (" in warned[0], p.stderr
     assert "snes_converged_reason" not in warned[0]
