@@ -10,9 +10,10 @@ Configurations (each run in a fresh process, so that peak memory is per run):
   petsc2   the same under ``mpiexec -n 2``: each rank evaluates and assembles half of the
            membrane elements into one parallel matrix; MUMPS on both ranks; eigen: SLEPc
            on the parallel factors (``petscP``: P ranks)
-The static solves run tmfem's trust-region Newton on the backend's factorisations (the
-timing wrapper has no SNES of its own), so that every factorisation and solve is timed; the
-SNES path of ``--backend petsc`` runs the same factorisations in about as many iterations.
+Each configuration runs the path ``--backend`` runs: the scipy backend's statics are tmfem's
+trust-region Newton on its factorisations (timed by a wrapper), the PETSc configurations'
+are PETSc's SNES (:mod:`tmfem.solvers.petsc_snes`), whose factorisations and solves are
+timed by PETSc's event log (wall time, also in the CPU columns).
 Columns: free DOFs, iterations of the static solve on the finest mesh, time per iteration
 (static time over all iterations, mesh sequencing from n = 10 included), static time, eigen
 time, time inside the backend's factorisations (incl. MUMPS/SuperLU analysis; their number)
@@ -49,6 +50,8 @@ class TimedBackend:
     def __init__(self, inner):
         self.inner, self.name = inner, inner.name
         self.distributed_assembly = getattr(inner, "distributed_assembly", False)
+        if hasattr(inner, "solve_equilibrium"):       # the SNES statics, as --backend petsc
+            self.solve_equilibrium = inner.solve_equilibrium
         self.t_factor = self.t_solve = self.t_eig = 0.0
         self.c_factor = self.c_solve = 0.0          # CPU time of this process
         self.n_factor = 0
@@ -105,6 +108,7 @@ PHASES = ("model", "patterns", "interp", "build", "factor", "solve", "rest")
 #: PETSc log events of the eigen split (third table): the factorisation of K - sigma M, the
 #: shift-invert solves, SLEPc's orthogonalisation of the Krylov basis
 EIGEN_EVENTS = {"factor": ("MatCholFctrSym", "MatCholFctrNum", "MatLUFactorSym", "MatLUFactorNum"),
+                "numeric": ("MatCholFctrNum", "MatLUFactorNum"),
                 "solves": ("MatSolve",), "orthogonalize": ("BVOrthogonalizeV",)}
 
 
@@ -181,12 +185,18 @@ def run_one(mesh: int, config: str, rest_length: float, sequence: int) -> dict:
     t0 = time.perf_counter()
     m = MTCModel(system, mesh_n=mesh, tendon_elements=3, backend=be)
     phases = PhaseTimer()
+    start = petsc_events() if comm is not None else None
     t1, c1 = time.perf_counter(), time.process_time()
     res = m.equilibrium(sequence=sequence or None)
     t2, c2 = time.perf_counter(), time.process_time()
     cpu_phases, wall_phases = dict(phases.cpu), dict(phases.wall)     # of the static solve
-    f_static, c_static, s_static, cs_static = be.t_factor, be.c_factor, be.t_solve, be.c_solve
     before = petsc_events() if comm is not None else None
+    if before is not None:             # the SNES' factorisations and solves (PETSc's log)
+        be.n_factor = before["numeric"][0] - start["numeric"][0]
+        be.t_factor = be.c_factor = before["factor"][1] - start["factor"][1]
+        be.t_solve = be.c_solve = before["solves"][1] - start["solves"][1]
+        be.mumps = mumps_work(inner)
+    f_static, c_static, s_static, cs_static = be.t_factor, be.c_factor, be.t_solve, be.c_solve
     modes = m.modes(k=12, at=res)
     t3, c3 = time.perf_counter(), time.process_time()
     eigen_split = None

@@ -33,7 +33,8 @@ factors, element arrays): with M_1 and M_Pm the 1- and P_m-rank peaks less M_0,
 R = (P_m M_Pm - M_1) / (P_m - 1) and D = M_1 - R (D taken to divide as 1/P), each
 extrapolated in n with its own exponent from the two meshes. The memory is that of the
 backend as the CLI runs it (SNES; ``bench_memory_ranks.py``), the times those of
-``bench_backends.py`` (the trust-region iteration on the same factorisations, each timed).
+``bench_backends.py`` (the same SNES path, its factorisations and solves timed by PETSc's
+event log).
 
 A model from two ranks on one machine predicts 64 ranks on a cluster only as far as its
 division exponents carry over: run it on the cluster with ``--ranks 1,4,16`` (the largest
