@@ -31,6 +31,7 @@ SLEPc its ``eps_`` options (``-eps_tol``, ``-eps_ncv``).
 from __future__ import annotations
 
 import ctypes
+import functools
 import gc
 import hashlib
 import logging
@@ -88,12 +89,18 @@ def parse_options(options) -> dict:
 SOLVER_PREFIXES = ("snes_", "ksp_", "pc_", "mat_", "eps_", "st_")
 
 
+@functools.cache
+def _library(path: str):
+    """ctypes handle of a loaded shared library (its dependencies' symbols resolve through it)."""
+    return ctypes.CDLL(path)
+
+
 def _option_used(PETSc, name: str) -> bool:
     """Whether a PETSc object has read the option ``name`` (without '-') of the options
     database: PETSc's ``PetscOptionsUsed``, which petsc4py does not wrap (the library
     handle of petsc4py's extension module resolves libpetsc's symbols)."""
     used = ctypes.c_int(0)
-    ctypes.CDLL(PETSc.__file__).PetscOptionsUsed(None, name.encode(), ctypes.byref(used))
+    _library(PETSc.__file__).PetscOptionsUsed(None, name.encode(), ctypes.byref(used))
     return bool(used.value)
 
 
