@@ -391,11 +391,11 @@ def render(args, mod, result) -> str:
 
 def _warn_unused_petsc_options(command: str) -> None:
     """Warn of the solver options of PETSC_OPTIONS that no solver of the run read
-    (:func:`tmfem.solvers.petsc.unused_options`): a misspelt option, or one of a solver the
+    (:func:`tmfem.solvers.petsc_options.unused_options`): a misspelt option, or one of a solver the
     command does not create, would otherwise change nothing without a word."""
     if "petsc4py.PETSc" not in sys.modules:
         return
-    from tmfem.solvers.petsc import unused_options
+    from tmfem.solvers.petsc_options import unused_options
     left = unused_options()
     if left:
         logging.getLogger("tmfem").warning(

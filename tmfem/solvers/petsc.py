@@ -30,13 +30,9 @@ SLEPc its ``eps_`` options (``-eps_tol``, ``-eps_ncv``).
 """
 from __future__ import annotations
 
-import ctypes
-import functools
 import gc
 import hashlib
 import logging
-import shlex
-import sys
 import weakref
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -49,6 +45,7 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
 from tmfem.solvers.mumps import SINGULAR, STRUCTURALLY_SINGULAR, mumps_error, mumps_failure
 from tmfem.solvers.petsc_loader import petsc_modules
+from tmfem.solvers.petsc_options import option_used, parse_options
 from tmfem.solvers.singular import SingularMatrix
 
 log = logging.getLogger(__name__)
@@ -59,70 +56,6 @@ _KSP_REASONS = {-2: "DIVERGED_NULL", -3: "DIVERGED_ITS", -4: "DIVERGED_DTOL",
                 -5: "DIVERGED_BREAKDOWN", -6: "DIVERGED_BREAKDOWN_BICG",
                 -7: "DIVERGED_NONSYMMETRIC", -8: "DIVERGED_INDEFINITE_PC", -9: "DIVERGED_NANORINF",
                 -10: "DIVERGED_INDEFINITE_MAT", -11: "DIVERGED_PC_FAILED"}
-
-
-def parse_options(options) -> dict:
-    """PETSc options as ``{name: value}`` (names without the leading '-') from a dict, a
-    string ``"-ksp_type cg -ksp_rtol 1e-9 -ksp_view"`` or None."""
-    if options is None:
-        return {}
-    if isinstance(options, dict):
-        return {str(k).lstrip("-"): ("" if v is None else str(v)) for k, v in options.items()}
-    if not isinstance(options, str):
-        raise InputError(f"petsc options: expected a dict or a string such as '-ksp_type cg', "
-                         f"found {type(options).__name__}")
-    out, key = {}, None
-    for tok in shlex.split(options):
-        if tok.startswith("-") and not _is_number(tok):
-            key = tok.lstrip("-")
-            out[key] = ""
-        elif key is None:
-            raise InputError(f"petsc options: expected '-name value' pairs, found {tok!r} first")
-        else:
-            out[key] = tok
-            key = None
-    return out
-
-
-#: prefixes of the options of the PETSc and SLEPc objects tmfem creates (SNES, KSP, PC, Mat
-#: and its MUMPS factorisation, EPS, ST): those :func:`unused_options` reports
-SOLVER_PREFIXES = ("snes_", "ksp_", "pc_", "mat_", "eps_", "st_")
-
-
-@functools.cache
-def _library(path: str):
-    """ctypes handle of a loaded shared library (its dependencies' symbols resolve through it)."""
-    return ctypes.CDLL(path)
-
-
-def _option_used(PETSc, name: str) -> bool:
-    """Whether a PETSc object has read the option ``name`` (without '-') of the options
-    database: PETSc's ``PetscOptionsUsed``, which petsc4py does not wrap (the library
-    handle of petsc4py's extension module resolves libpetsc's symbols)."""
-    used = ctypes.c_int(0)
-    _library(PETSc.__file__).PetscOptionsUsed(None, name.encode(), ctypes.byref(used))
-    return bool(used.value)
-
-
-def unused_options() -> list[str]:
-    """The solver options (:data:`SOLVER_PREFIXES`) of PETSc's options database
-    (``PETSC_OPTIONS``, the command line) that no PETSc or SLEPc object has read so far, as
-    ``-name``: a misspelt option, or one of a solver the run did not create. Empty when
-    PETSc is not loaded. (The ``options=`` of a :class:`PetscBackend` live in the database
-    only while its solvers run: :meth:`PetscBackend.unused_options`.)"""
-    if "petsc4py.PETSc" not in sys.modules:
-        return []
-    PETSc = sys.modules["petsc4py.PETSc"]
-    return [f"-{name}" for name in sorted(PETSc.Options().getAll())
-            if name.startswith(SOLVER_PREFIXES) and not _option_used(PETSc, name)]
-
-
-def _is_number(tok: str) -> bool:
-    try:
-        float(tok)
-        return True
-    except ValueError:
-        return False
 
 
 def _factorisation_failure(ksp, singular: str, what: str):
@@ -374,7 +307,7 @@ class PetscBackend:
             yield
         finally:
             self._read.update(name for name in saved
-                              if name in self.options and _option_used(self.PETSc, name))
+                              if name in self.options and option_used(self.PETSc, name))
             for name, old in saved.items():
                 if old is None:
                     opts.delValue(name)

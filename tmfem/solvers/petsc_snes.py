@@ -47,7 +47,7 @@ import numpy as np
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather
 from tmfem.solvers.mumps import SINGULAR, STRUCTURALLY_SINGULAR, mumps_error, mumps_failure
-from tmfem.solvers.petsc import SOLVER_PREFIXES
+from tmfem.solvers.petsc_options import SOLVER_PREFIXES
 
 log = logging.getLogger(__name__)
 
