@@ -67,6 +67,26 @@ def test_snes_with_a_loose_tolerance_stops_where_it_is_met(scipy_2_3):
 
 
 @needs_petsc
+def test_snes_from_an_interpolated_state_meets_a_loose_tolerance():
+    # source: the test |r| <= tol x force scale itself. A Newton step from the state
+    # interpolated off a coarser mesh (a level of the mesh sequencing) need not halve |r|;
+    # with tol = 1e-4 that happens well inside 1e3 tol x force scale, which is not the
+    # round-off floor (the step's predicted energy change is not round-off): the solve goes
+    # on to the tolerance instead of stopping there
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    # the 1-4 as printed, with the S-tendon rest length that Tables 6.3/6.6 imply
+    system = load_preset("1-4", as_printed=True).with_rest_lengths({"S1": 1.5025})
+    coarse = MTCModel(system, mesh_n=10, backend=PetscBackend()).equilibrium(tol=1e-4)
+    fine = MTCModel(system, mesh_n=20, backend=PetscBackend())
+    x0 = fine.interpolate_from(MTCModel(system, mesh_n=10), coarse.x)
+    res = fine.equilibrium(x0=x0, tol=1e-4)
+    assert res.residual_history[0] > 1e-4 * fine._force_scale(x0)
+    assert res.residual_history[-1] <= 1e-4 * fine._force_scale(res.x)
+
+
+@needs_petsc
 def test_snes_converged_reason_names_the_convergence_error():
     # every SNES solve stops after one function evaluation (-snes_max_funcs 1): the
     # continuation runs out and the error names PETSc's reason and the option it owes to

@@ -29,8 +29,9 @@ test accepts or rejects a step, is the globalisation; PETSc's backtracking on ||
 A final solve that does not converge within 20 iterations sends the iteration back to the
 continuation; when that runs out (mu beyond 1e12 of its scale, or ``max_iter`` SNES
 iterations), :class:`~tmfem.errors.ConvergenceError` names the last SNES converged reason.
-The final solve also stops on the round-off floor (a step that no longer halves ||r|| while
-||r|| <= 1e3 tol x force scale, as in the trust region: stiff shells put it near tol).
+The final solve also stops on the round-off floor (a step whose predicted energy change is
+round-off, below 1e-11 of the energy, and that no longer halves ||r|| while ||r|| <= 1e3 tol
+x force scale, as in the trust region: stiff shells put it near tol).
 
 The unknowns are the free dofs of a distributed assembly (``residual(u) -> (r, K)`` with K a
 :class:`tmfem.solvers.distributed.DistributedMatrix`); states that do not add (finite
@@ -213,6 +214,8 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
     snes.setType("newtonls")
     backend._configure(snes.getKSP(), backend._symmetric(K, K.mat))
 
+    last = {"r": r}            # the residual at the start of the current iteration
+
     def monitor(s, its, fnorm):
         if its == 0:
             return
@@ -224,13 +227,19 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         if callback is not None:
             callback(total + its, uu, rnorm, prob.mu, 1.0)
         log.debug("%s SNES it %3d |r| = %.3e N mu = %.3g", what, total + its, rnorm, prob.mu)
-        if prob.mu == 0.0 and rnorm > 0.5 * res_hist[-2] and rnorm <= 1e3 * tol * force_scale(uu):
+        # x is this iteration's step (the update hook zeroes it at each start): a Newton
+        # step du = -K^-1 r lowers the energy by -r.du / 2 to second order
+        r_start, last["r"] = last["r"], rr
+        tiny = abs(0.5 * float(r_start @ x)) < 1e-11 * max(abs(W), 1e-30)
+        if prob.mu == 0.0 and tiny and rnorm > 0.5 * res_hist[-2] \
+                and rnorm <= 1e3 * tol * force_scale(uu):
             raise _Floor    # the round-off floor: a Newton step no longer halves |r|
     snes.setMonitor(monitor)
 
     def solve(mu_step: float, atol: float):
         """One SNES solve from u with the shift mu_step: (state, r, K, its, reason)."""
         prob.start(u, mu_step)
+        last["r"] = r
         # full Newton steps unless -snes_linesearch_type is given (module docstring)
         search = {} if PETSc.Options().hasName("snes_linesearch_type") else \
             {"snes_linesearch_type": "basic"}
@@ -252,6 +261,9 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
             _refuse_mumps_failure(snes, what)
         x = gather(X)
         un, rr, KK = prob.evaluate(x)
+        log.debug("%s: SNES solve of %d unknowns with mu = %.3g: %s after %d iterations", what,
+                  prob.D.size, mu_step,
+                  reason_name(PETSc, snes.getConvergedReason()), snes.getIterationNumber())
         return un, rr, KK, snes.getIterationNumber(), snes.getConvergedReason()
 
     try:
