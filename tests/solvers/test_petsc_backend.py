@@ -252,7 +252,7 @@ def test_one_and_two_ranks_agree(models, equilibria):
 
 
 @needs_mpi
-@pytest.mark.parametrize("ranks", [2, 3])
+@pytest.mark.parametrize("ranks", [2, pytest.param(3, marks=pytest.mark.slow)])
 def test_model_on_petsc_under_ranks_agrees(models, ranks):
     # source: the scipy model (its trust-region continuation and ARPACK); the SNES
     # continuation from the undeformed membrane and the SLEPc modes under 2 and 3 ranks

@@ -64,6 +64,7 @@ def test_packaged_stages_are_a_feasible_start_of_the_automatic_path():
     assert r["candidates"] >= 1 and r["psi_step_deg"] == 10.0
 
 
+@pytest.mark.slow
 def test_the_2_5_gets_the_bases_found_by_hand():
     # the file's [packaged] was made by hand with r_2 from eq. 3.22 for the deployed Delta at
     # theta 78 deg, psi 20 deg, z_2 = 0.153 m and sigma_2 = 0 near the largest null vector; the
