@@ -126,13 +126,13 @@ def test_cli_warns_of_petsc_options_no_solver_read():
 
 
 def test_auto_backend_chooses_by_the_crossover(monkeypatch):
-    # source: AUTO_CROSSOVER_DOFS (5000, the measured crossover of the module's constant)
+    # source: AUTO_CROSSOVER_DOFS (6500, the measured crossover of the module's constant)
     from tmfem.solvers import backends as b
-    assert b.AUTO_CROSSOVER_DOFS == 5000
-    assert b.choose_backend(n_dofs=4999, ranks=1) == "scipy"
+    assert b.AUTO_CROSSOVER_DOFS == 6500
+    assert b.choose_backend(n_dofs=6499, ranks=1) == "scipy"
     assert b.choose_backend(n_dofs=100, ranks=2) == "petsc"          # under mpiexec
     monkeypatch.setattr(b, "petsc_available", lambda: True)
-    assert b.choose_backend(n_dofs=5000, ranks=1) == "petsc"
+    assert b.choose_backend(n_dofs=6500, ranks=1) == "petsc"
     monkeypatch.setattr(b, "petsc_available", lambda: False)
     assert b.choose_backend(n_dofs=10**6, ranks=1) == "scipy"       # PETSc not installed
     assert b.get_backend("auto", n_dofs=10**6).name == "scipy"
@@ -153,7 +153,7 @@ def test_auto_model_below_the_crossover_is_scipy():
     from tmfem.models.mtc.model import MTCModel
     from tmfem.system import load_preset
     m = MTCModel(load_preset("2-3"), mesh_n=4, backend="auto")
-    assert m.ndof < 5000 and m.backend.name == "scipy"
+    assert m.ndof < 6500 and m.backend.name == "scipy"
 
 
 @needs_mpi

@@ -54,14 +54,14 @@ def add_model_args(parser, command: str, *, default: str, capability: str | None
     each as an argument made from the option's data and saying which models take it; read them
     with :func:`model_from_args`, which refuses an option the chosen model does not take."""
     from tmfem.models.registry import model_options, models_with
-    from tmfem.solvers.backends import backend_names
+    from tmfem.solvers.backends import AUTO_CROSSOVER_DOFS, backend_names
     specs = models_with(capability)
     parser.add_argument("--model", choices=sorted(specs), default=default,
                         help="; ".join(f"{n}: {s.help}" for n, s in specs.items())
                         + f" (default {default})")
     parser.add_argument("--backend", choices=backend_names(), default=None,
                         help="linear-algebra backend of the finite-element models (default auto: "
-                             "petsc from 5000 free dofs when installed, else scipy; "
+                             f"petsc from {AUTO_CROSSOVER_DOFS} free dofs when installed, else scipy; "
                              "docs/guides/backends.md)")
     options, owners = {}, {}
     for name in specs:

@@ -17,7 +17,7 @@ from tmfem.models.fe.rest_lengths import describe_rule
 from tmfem.models.fe.rest_lengths import apply_rest_lengths
 from tmfem.models.registry import get_spec, models_with
 from tmfem.post.convergence import plot_convergence_study
-from tmfem.solvers.backends import backend_names
+from tmfem.solvers.backends import AUTO_CROSSOVER_DOFS, backend_names
 
 NAME = "converge"
 HELP = "mesh / tendon-subdivision convergence of frequencies and stresses (dissertation 6.3)"
@@ -46,8 +46,8 @@ def configure(parser) -> None:
                         help="finite-element model (" + "; ".join(
                             f"{n}: {spec.help}" for n, spec in specs.items()) + ")")
     parser.add_argument("--backend", choices=backend_names(), default="auto",
-                        help="linear-algebra backend (auto: PETSc from 5000 free dofs where installed; "
-                             "docs/guides/backends.md)")
+                        help=f"linear-algebra backend (auto: PETSc from {AUTO_CROSSOVER_DOFS} free dofs "
+                             "where installed; docs/guides/backends.md)")
     parser.add_argument("--mesh", default="10",
                         help="comma-separated membrane subdivisions n (N quads of n x n each)")
     parser.add_argument("--tendon-elements", default="3",

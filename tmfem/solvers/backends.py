@@ -196,11 +196,12 @@ def nested_dissection(A) -> np.ndarray:
 _BACKENDS = {"scipy": ScipyBackend, "petsc": PetscBackend}
 
 #: free dofs from which ``"auto"`` takes the PETSc backend. Below it the PETSc backend's fixed
-#: start-up cost (0.4-0.5 s more than scipy in building the model, at every size) outweighs
+#: start-up cost (0.3-0.4 s more than scipy in building the model, at every size) outweighs
 #: its faster factorisations and eigen solves: a 1-4 MTC static solve from the undeformed
-#: membrane with 12 modes was faster with scipy up to about 5k free dofs (4 x 20 x 20) and
-#: faster with PETSc from there on (``benchmarks/bench_backend_crossover.py`` measures it).
-AUTO_CROSSOVER_DOFS = 5000
+#: membrane with 12 modes was faster with scipy at 5,067 free dofs (4 x 20 x 20, by 12 %) and
+#: faster with PETSc from 7,227 (4 x 24 x 24, by 5 %) on; the crossover lies near 6,500
+#: (``benchmarks/bench_backend_crossover.py`` measures it).
+AUTO_CROSSOVER_DOFS = 6500
 
 
 def choose_backend(*, n_dofs: int, ranks: int | None = None) -> str:
