@@ -181,7 +181,8 @@ def test_failed_check_exits_1_unless_allowed(capsys):
 
 @pytest.mark.parametrize("argv", [
     ["vibrate", "--preset", "1-4", "--t-end", "1000", "--dt", "0.01"],
-    ["deploy", "--preset", "1-4D", "--t-end", "1000"],           # in the controller design
+    pytest.param(["deploy", "--preset", "1-4D", "--t-end", "1000"],   # in the controller design
+                 marks=pytest.mark.slow),
 ])
 def test_ctrl_c_is_one_line_exit_130(argv, tmp_path):
     env = dict(os.environ, PYTHONUNBUFFERED="1")

@@ -211,6 +211,7 @@ def test_page_loads_in_chromium_without_script_errors(report, browser, tmp_path)
     assert dom.count('type="range"') >= views - 1 and dom.count("<select") >= 2
 
 
+@pytest.mark.slow
 def test_screenshots_of_the_page_and_its_views(report, browser, tmp_path):  # noqa: F811
     from PIL import Image
     url = (report / "report.html").as_uri()

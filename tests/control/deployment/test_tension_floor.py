@@ -51,6 +51,7 @@ def test_the_pfl_refuses_a_floor_outside_zero_to_one():
         AdaptivePFL(model=None, reference=None, gains=None, rbf=None, w_bar=1.0, tension_floor=1.0)
 
 
+@pytest.mark.slow
 def test_the_floor_changes_the_run(tmp_path, capsys):
     # the first 2.4 s of the 3-3's PFL deployment (no switch): without a floor (f = 0, the
     # limits of 7.4) the solution closest to u_d lets tendons reach their tendon lengths

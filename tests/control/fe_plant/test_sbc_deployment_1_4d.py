@@ -78,6 +78,7 @@ def test_table_7_1_gains_stop_the_same_sbc_plant():
     assert r.failure is not None and r.t[-1] < 3.0
 
 
+@pytest.mark.slow
 def test_gains_option_sets_eq_5_69_and_is_refused_where_it_does_not_apply(capsys):
     """``--gains OMEGA_0,OMEGA_E,TAU,D_C`` replaces Table 7.1's row: the controller's
     d_q = 2 d_c omega and k_q = omega^2 (eq. 5.69) at t = 0 and as t -> infinity are the given

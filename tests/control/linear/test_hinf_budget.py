@@ -24,6 +24,7 @@ def plant(n, seed=1):
     return control.ss(A, B, C, D)
 
 
+@pytest.mark.slow
 def test_huge_plant_refused_at_once():
     P = plant(3000)
     Ps = control.ss(P.A, P.B, P.C[:2], P.D[:2])

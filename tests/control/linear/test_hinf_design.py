@@ -311,6 +311,7 @@ def test_cli_pbh_json_and_refusals(capsys):
     assert "apply to `tmfem control hinf` only" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_cli_hinf_json_save(tmp_path, capsys):
     from tmfem.cli import main
     k = tmp_path / "k.npz"

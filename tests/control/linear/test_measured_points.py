@@ -49,6 +49,7 @@ def test_default_points_lie_inside_away_from_edges(file):
     assert np.isfinite(p.model.T_veta_cond) and p.model.T_veta_cond < 1e6
 
 
+@pytest.mark.slow
 def test_presets_keep_the_points_of_their_plants():
     """1-6D and 2-3-deploy measure eq. 5.74/5.75's three points and complete K with the mesh
     nodes their file pins (`[control] coordinate_points`: edge nodes, as the greedy choice
