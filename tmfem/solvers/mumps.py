@@ -64,6 +64,12 @@ def describe(code: int, detail: int) -> str:
     return f"MUMPS INFOG(1) = {code}, INFOG(2) = {detail}: {what}"
 
 
+def is_singular(code: int) -> bool:
+    """Whether the MUMPS failure code is that of a singular matrix (numerically or
+    structurally), the one failure a shift of the matrix can cure."""
+    return code in (SINGULAR, STRUCTURALLY_SINGULAR)
+
+
 def mumps_error(code: int, detail: int, what: str) -> TmfemError:
     """The named error of a MUMPS failure other than a singular matrix: memory that ran
     out is a :class:`~tmfem.errors.ResourceLimit`, an option this MUMPS cannot honour (a

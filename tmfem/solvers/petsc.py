@@ -43,7 +43,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
-from tmfem.solvers.mumps import SINGULAR, STRUCTURALLY_SINGULAR, mumps_error, mumps_failure
+from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
 from tmfem.solvers.petsc_loader import petsc_modules
 from tmfem.solvers.petsc_options import option_used, parse_options
 from tmfem.solvers.singular import SingularMatrix
@@ -63,7 +63,7 @@ def _factorisation_failure(ksp, singular: str, what: str):
     not that of a singular matrix (:mod:`tmfem.solvers.mumps`), else a
     :class:`SingularMatrix` ``f"{what}: {singular}"``."""
     failure = mumps_failure(ksp)
-    if failure is not None and failure[0] not in (SINGULAR, STRUCTURALLY_SINGULAR):
+    if failure is not None and not is_singular(failure[0]):
         return mumps_error(*failure, what)
     code = f" (MUMPS INFOG(1) = {failure[0]})" if failure is not None else ""
     return SingularMatrix(f"{what}: {singular}{code}")

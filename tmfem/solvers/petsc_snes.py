@@ -47,7 +47,7 @@ import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather
-from tmfem.solvers.mumps import SINGULAR, STRUCTURALLY_SINGULAR, mumps_error, mumps_failure
+from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
 from tmfem.solvers.petsc_options import SOLVER_PREFIXES
 
 log = logging.getLogger(__name__)
@@ -177,7 +177,7 @@ def _refuse_mumps_failure(snes, what: str) -> None:
     shift of the continuation can cure (anything but a singular matrix: a workspace that
     ran short, memory, an option this MUMPS cannot honour, :mod:`tmfem.solvers.mumps`)."""
     failure = mumps_failure(snes.getKSP())
-    if failure is not None and failure[0] not in (SINGULAR, STRUCTURALLY_SINGULAR):
+    if failure is not None and not is_singular(failure[0]):
         raise mumps_error(*failure, f"{what} (SNES)")
 
 
