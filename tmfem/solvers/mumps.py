@@ -38,18 +38,26 @@ _MEANING = {
 }
 
 
-def mumps_failure(ksp) -> tuple[int, int] | None:
-    """``(INFOG(1), INFOG(2))`` of the failed MUMPS factorisation of a KSP, or None (the
-    preconditioner is not a MUMPS factorisation, has none yet, or it succeeded)."""
+def mumps_factor(ksp):
+    """The MUMPS factor matrix of a KSP, or None (the preconditioner is not a MUMPS
+    factorisation, or has no factor yet)."""
     pc = ksp.getPC()
     try:
         if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
             return None
-        F = pc.getFactorMatrix()
-        code = int(F.getMumpsInfog(1))
-        return (code, int(F.getMumpsInfog(2))) if code < 0 else None
+        return pc.getFactorMatrix()
     except Exception:                  # no factor matrix (the analysis never ran)
         return None
+
+
+def mumps_failure(ksp) -> tuple[int, int] | None:
+    """``(INFOG(1), INFOG(2))`` of the failed MUMPS factorisation of a KSP, or None (no
+    MUMPS factorisation, or it succeeded)."""
+    F = mumps_factor(ksp)
+    if F is None:
+        return None
+    code = int(F.getMumpsInfog(1))
+    return (code, int(F.getMumpsInfog(2))) if code < 0 else None
 
 
 def describe(code: int, detail: int) -> str:

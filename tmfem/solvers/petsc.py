@@ -43,7 +43,7 @@ import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
-from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
+from tmfem.solvers.mumps import is_singular, mumps_error, mumps_factor, mumps_failure
 from tmfem.solvers.petsc_loader import petsc_modules
 from tmfem.solvers.petsc_options import option_used, parse_options
 from tmfem.solvers.singular import SingularMatrix
@@ -472,9 +472,8 @@ class PetscBackend:
         allocated for it): ``{"used": ..., "allocated": ...}``, zeros when it holds none."""
         used = allocated = 0
         for entry in self._cache.values():
-            pc = entry.ksp.getPC()
-            if pc.getType() in ("lu", "cholesky") and pc.getFactorSolverType() == "mumps":
-                F = pc.getFactorMatrix()
+            F = mumps_factor(entry.ksp)
+            if F is not None:
                 used += int(F.getMumpsInfo(22))
                 allocated += int(F.getMumpsInfo(16))
         return {"used": float(used), "allocated": float(allocated)}
