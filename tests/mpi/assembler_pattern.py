@@ -6,7 +6,8 @@ weights (up to 2 entries per row of T), maps two nodes' dofs to the same unknown
 fixed ones. Rank 0 prints a JSON document: whether the patterns are equal, the largest
 relative value error, the groups' block sizes and, for every rank, the size of the values
 array of an assembly against the entries of its own rows plus the distinct entries of its
-share in other ranks' rows (the ones it sends)."""
+share in other ranks' rows (the ones it sends), and its rows of a summed force vector T^T f
+against scipy's (their size and largest relative error)."""
 import json
 import sys
 
@@ -91,8 +92,19 @@ def main():
     mine = (abs(T).T @ S_mine @ abs(T)).tocsr()[keep][:, keep]
     sent = mine.nnz - mine[asm.lo:asm.hi].nnz
     buffers = comm.allgather([int(asm._nu), int(pat[asm.lo:asm.hi].nnz + sent)])
+    # a force vector: each rank contributes its share of the element forces, and receives
+    # its rows of T^T f on the unknowns (the rows of its matrix rows)
+    fe = np.random.default_rng(5).standard_normal(elements[0][0].shape)
+    s = element_share(len(fe), comm)
+    f_mine = np.bincount(elements[0][0][s].ravel(), weights=fe[s].ravel(), minlength=n)
+    f_all = np.bincount(elements[0][0].ravel(), weights=fe.ravel(), minlength=n)
+    rows = asm.vector(f_mine)
+    f_ref = (T.T @ f_all)[keep][asm.lo:asm.hi]
+    vec = comm.allgather([rows.size, f_ref.size, float(np.abs(rows - f_ref).max(initial=0.0)
+                                                       / np.abs(T.T @ f_all).max())])
     return json.dumps({"pattern_equal": same, "max_rel": err, "nnz": int(A.nnz),
-                       "block_sizes": [g.block_size for g in asm._groups], "buffers": buffers})
+                       "block_sizes": [g.block_size for g in asm._groups], "buffers": buffers,
+                       "vector": vec, "N": int(keep.sum())})
 
 
 if __name__ == "__main__":

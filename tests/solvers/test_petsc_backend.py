@@ -575,7 +575,7 @@ def test_block_pair_pattern_is_scipys_pattern_and_matrix(ranks):
     # (block size 3), the group of permuted local dofs and the entries per entry; an
     # assembly's values array on each rank: the entries of its rows plus those it sends
     # (scipy's pattern of its rows and of its own share), not all distinct keys it touches
-    # plus the received and the summed ones
+    # plus the received and the summed ones; a force vector: each rank's rows of T^T f
     p = _mpirun(ranks, program=[sys.executable, str(ROOT / "tests" / "mpi" / "assembler_pattern.py")])
     assert p.returncode == 0, p.stderr
     out = json.loads(p.stdout)
@@ -584,6 +584,9 @@ def test_block_pair_pattern_is_scipys_pattern_and_matrix(ranks):
     assert out["max_rel"] <= 1e-14
     assert len(out["buffers"]) == ranks
     assert all(size == expected for size, expected in out["buffers"])
+    # a summed force vector: each rank its own rows of scipy's T^T f, together all N
+    assert sum(size for size, _, _ in out["vector"]) == out["N"]
+    assert all(size == expected and err <= 1e-14 for size, expected, err in out["vector"])
 
 
 @needs_petsc

@@ -108,9 +108,10 @@ class DistributedElements:
         return self.assembler.N
 
     def residual(self, state, *, tangent: bool = True, symmetric: bool = False):
-        """``(r, K)``: the internal force on the free dofs (N,), the same on every rank, and
-        the tangent (a :class:`~tmfem.solvers.distributed.DistributedMatrix`, refilled in a
-        later call only once the caller has dropped it), eqs. 4.4-4.6. ``symmetric``: the
+        """``(r, K)``: this rank's rows (those of its matrix rows) of the internal force on
+        the free dofs, and the tangent (a
+        :class:`~tmfem.solvers.distributed.DistributedMatrix`, refilled in a later call only
+        once the caller has dropped it), eqs. 4.4-4.6. ``symmetric``: the
         symmetric part (K + K^T) / 2 of the tangent instead (assembled from the symmetric
         parts of the element matrices: T^T K T commutes with the transposition), for the
         modes about a state of a tangent that is symmetric only at equilibrium (finite

@@ -9,9 +9,9 @@ the structure they come from.
   matrix ``u = T u_r`` and restricted to the unknowns ``keep``); they become one parallel
   PETSc AIJ matrix (:class:`DistributedMatrix`) preallocated exactly from the union of the
   ranks' patterns; vectors (each rank's contribution to the full force) are summed into
-  T^T f on the unknowns, a full array on every rank. The pattern is exchanged once: each
-  rank sends the (row, column) keys of its entries to the rank owning the row (PETSc's
-  default row split), which builds the CSR pattern of its rows; every later assembly is one
+  T^T f on the unknowns, each rank receiving its rows (those of its matrix rows). The
+  pattern is exchanged once: each rank sends the (row, column) keys of its entries to the
+  rank owning the row (PETSc's default row split), which builds the CSR pattern of its rows; every later assembly is one
   ``np.bincount`` per rank and one ``Alltoallv`` of values (the COO assembly of PETSc >=
   3.19, which the petsc4py 3.18 of Debian bookworm does not expose).
 * :class:`collective` -- a block every rank enters: an exception on any rank is raised on
@@ -21,7 +21,8 @@ the structure they come from.
   exit code on every rank, never a hang (the caller prints what it is handed: library
   code writes nothing).
 
-Vectors are replicated (O(n) per rank), matrices and factorisations distributed.
+Summed vectors (residuals) are held as each rank's rows; states (positions, iterates) are
+replicated (O(n) per rank); matrices and factorisations are distributed.
 """
 from __future__ import annotations
 
@@ -153,6 +154,19 @@ def gather(vec) -> np.ndarray:
     out = np.empty(int(counts.sum()))
     comm.Allgatherv(np.ascontiguousarray(local), [out, counts])
     return out
+
+
+def rows_norm(rows: np.ndarray, comm) -> float:
+    """The 2-norm of a vector held as each rank's rows (collective)."""
+    rows = np.asarray(rows, dtype=float)
+    return float(np.sqrt(comm.allreduce(float(rows @ rows)))) if comm.size > 1 \
+        else float(np.linalg.norm(rows))
+
+
+def rows_dot(a: np.ndarray, b: np.ndarray, comm) -> float:
+    """a . b of two vectors held as each rank's rows (collective)."""
+    d = float(np.asarray(a, dtype=float) @ np.asarray(b, dtype=float))
+    return comm.allreduce(d) if comm.size > 1 else d
 
 
 def gather_rows(local: np.ndarray, comm) -> np.ndarray:
@@ -341,6 +355,7 @@ class DistributedAssembler:
         base, extra = divmod(self.N, P)
         starts = np.array([r * base + min(r, extra) for r in range(P + 1)])
         self.lo, self.hi = int(starts[self.comm.rank]), int(starts[self.comm.rank + 1])
+        self._row_counts = np.diff(starts).tolist()
         owner = np.searchsorted(starts, ukeys // self.N, side="right") - 1 if self.N else ukeys
         self._sendcounts = np.bincount(owner, minlength=P)
         self._recvcounts = np.array(self.comm.alltoall(self._sendcounts.tolist()))
@@ -443,9 +458,10 @@ class DistributedAssembler:
         return out
 
     def vector(self, f_local: np.ndarray) -> np.ndarray:
-        """T^T f summed over the ranks and restricted to the unknowns: (N,) on every rank,
-        from this rank's contribution ``f_local`` (n,) to the full internal force."""
-        from mpi4py import MPI
+        """This rank's rows (``hi - lo``,) of T^T f summed over the ranks and restricted to
+        the unknowns (the rows of its matrix rows: a PETSc Vec's local part), from this
+        rank's contribution ``f_local`` (n,) to the full internal force: one
+        ``Reduce_scatter``, no full-length sum on any rank."""
         f_local = np.asarray(f_local, dtype=float)
         with collective(self.comm, "distributed vector"):
             if f_local.shape != (self.n,):
@@ -457,8 +473,8 @@ class DistributedAssembler:
         local = (self.T.T @ f_local)[self.keep]
         if self.comm.size == 1:
             return local
-        out = np.empty_like(local)
-        self.comm.Allreduce(local, out, op=MPI.SUM)
+        out = np.empty(self.hi - self.lo)
+        self.comm.Reduce_scatter(local, out, recvcounts=self._row_counts)
         return out
 
     def scipy(self, D: DistributedMatrix) -> sp.csr_matrix:

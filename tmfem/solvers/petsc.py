@@ -461,7 +461,8 @@ class PetscBackend:
         """The equilibrium r(u) = 0 of the energy W from u0 by PETSc's SNES with
         pseudo-transient continuation (:func:`tmfem.solvers.petsc_snes.snes_equilibrium`:
         the arguments of :func:`tmfem.solvers.trust_region.trust_region_newton` with every
-        dof free and a distributed tangent, the fields of its result as a dict)."""
+        dof free, a distributed tangent and the residual as this rank's rows of it, the
+        fields of its result as a dict)."""
         from tmfem.solvers.petsc_snes import snes_equilibrium
         self.release_retired()
         return snes_equilibrium(self, residual, energy, u0, **kwargs)

@@ -34,10 +34,12 @@ round-off, below 1e-11 of the energy, and that no longer halves ||r|| while ||r|
 x force scale, as in the trust region: stiff shells put it near tol).
 
 The unknowns are the free dofs of a distributed assembly (``residual(u) -> (r, K)`` with K a
-:class:`tmfem.solvers.distributed.DistributedMatrix`); states that do not add (finite
-rotations) advance by ``update(u, du)``: SNES iterates on the increment from a base state,
-which is moved to the current iterate at every Newton iteration (``SNESSetUpdate``), so that
-the tangent K_T(u) is the Jacobian of the increment.
+:class:`tmfem.solvers.distributed.DistributedMatrix` and r this rank's rows of the residual,
+those of K's rows: norms and dot products are collective, no rank holds the whole residual);
+the state u is whole on every rank. States that do not add (finite rotations) advance by
+``update(u, du)``: SNES iterates on the increment from a base state, which is moved to the
+current iterate at every Newton iteration (``SNESSetUpdate``), so that the tangent K_T(u) is
+the Jacobian of the increment.
 """
 from __future__ import annotations
 
@@ -46,7 +48,7 @@ import logging
 import numpy as np
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.solvers.distributed import DistributedMatrix, gather
+from tmfem.solvers.distributed import DistributedMatrix, gather, rows_dot, rows_norm
 from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
 from tmfem.solvers.petsc_options import SOLVER_PREFIXES
 
@@ -81,53 +83,56 @@ def reason_name(PETSc, reason: int) -> str:
 
 class _Problem:
     """The residual and Jacobian callbacks of one SNES: G(x) = r(u(x)) + mu D (offset + x)
-    with u(x) the base state advanced by the increment x (module docstring)."""
+    with u(x) the base state advanced by the increment x (module docstring). The residual
+    r, the scale D, the offset and the increment are held as this rank's rows; the state u,
+    which the model's residual reads, is whole."""
 
-    def __init__(self, backend, residual, u0, *, scale, update, first):
+    def __init__(self, backend, residual, u0, *, D, update, first):
         self.backend, self.residual, self.update = backend, residual, update
-        self.D = np.asarray(scale, dtype=float)
-        self.base, self.offset, self.mu = u0, np.zeros(self.D.size), 0.0
-        self.cache = {"x": np.zeros(self.D.size), "u": u0, "r": first[0], "K": first[1]}
-        self.J = None
-        self.symmetric = None
+        self.comm, self.D = backend.comm.tompi4py(), D
+        self.base, self.offset, self.mu = u0, np.zeros(D.size), 0.0
+        self.cache = {"x": np.zeros(D.size), "u": u0, "r": first[0], "K": first[1]}
 
     def state(self, x: np.ndarray):
-        """The state of the increment x from the base."""
+        """The state of the increment x (whole) from the base."""
         if self.update is None:
             return self.base + x
         return self.update(self.base, x)
 
-    def evaluate(self, x: np.ndarray):
-        """(u, r, K) at the increment x (the last evaluation reused)."""
-        c = self.cache
-        if not np.array_equal(c["x"], x):
-            u = self.state(x)
+    def evaluate(self, X):
+        """(u, r, K) at the increment X (a PETSc Vec; the last evaluation reused).
+        Collective: every rank evaluates, or none."""
+        c = self.comm
+        x = X.getArray(readonly=True)
+        new = not np.array_equal(self.cache["x"], x)
+        if (c.allreduce(int(new)) if c.size > 1 else new):
+            u = self.state(gather(X))
             r, K = self.residual(u)
-            c.update(x=x.copy(), u=u, r=np.asarray(r, dtype=float), K=K)
-        return c["u"], c["r"], c["K"]
+            self.cache.update(x=x.copy(), u=u, r=np.asarray(r, dtype=float), K=K)
+        return self.cache["u"], self.cache["r"], self.cache["K"]
 
-    def start(self, u, mu: float) -> None:
-        """A new solve from the state u (it is the cache's state) with the shift mu."""
+    def start(self, u, mu: float, r=None, K=None) -> None:
+        """A new solve from the state u with the shift mu; u is the cached state, or the
+        residual r and tangent K at u are given."""
         self.base, self.offset, self.mu = u, np.zeros(self.D.size), float(mu)
         self.cache["x"] = np.zeros(self.D.size)
+        if r is not None:
+            self.cache.update(u=u, r=r, K=K)
 
     def function(self, snes, X, F) -> None:
-        x = gather(X)
-        _, r, _ = self.evaluate(x)
-        lo, hi = F.getOwnershipRange()
-        g = r[lo:hi]
+        _, r, _ = self.evaluate(X)
+        g = r
         if self.mu > 0:
-            g = g + self.mu * self.D[lo:hi] * (self.offset[lo:hi] + x[lo:hi])
+            g = r + self.mu * self.D * (self.offset + X.getArray(readonly=True))
         F.setArray(g)
 
     def jacobian(self, snes, X, J, P) -> None:
         PETSc = self.backend.PETSc
-        _, _, K = self.evaluate(gather(X))
+        _, _, K = self.evaluate(X)
         K.mat.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         if self.mu > 0:
             d = P.createVecLeft()
-            lo, hi = P.getOwnershipRange()
-            d.setArray(self.mu * self.D[lo:hi])
+            d.setArray(self.mu * self.D)
             P.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
             d.destroy()         # petsc4py 3.18 frees a PETSc object on destroy() only
         sym = self.backend._symmetric(K, K.mat)
@@ -144,16 +149,17 @@ class _Problem:
         factorisation, holds this object through its callbacks, and must not keep the model
         (its assembler, whose lifetime ends the factorisation's: a coarse level of a mesh
         sequencing) alive."""
-        self.residual = self.update = self.J = None
+        self.residual = self.update = None
         self.cache = {}
 
     def rebase(self, snes, its: int) -> None:
         """SNESSetUpdate: move the base to the current iterate and the increment to 0."""
         X = snes.getSolution()
-        x = gather(X)
-        if not np.any(x):
+        x = X.getArray(readonly=True)
+        moved = bool(np.any(x))
+        if not (self.comm.allreduce(int(moved)) if self.comm.size > 1 else moved):
             return
-        u, _, _ = self.evaluate(x)
+        u, _, _ = self.evaluate(X)
         self.base = u
         self.offset = self.offset + x
         self.cache["x"] = np.zeros(x.size)
@@ -181,6 +187,13 @@ def _refuse_mumps_failure(snes, what: str) -> None:
         raise mumps_error(*failure, f"{what} (SNES)")
 
 
+def _mu_scale(K: DistributedMatrix, scale: np.ndarray) -> float:
+    """The stiffness-to-mass scale of the shift mu: median |K_ii| over the nonzero diagonal
+    entries of the tangent / median of the scale D (whole)."""
+    Kd = np.abs(K.diagonal())
+    return float(np.median(Kd[Kd > 0]) / np.median(scale)) if np.any(Kd > 0) else 1.0
+
+
 def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: float = 1e-9,
                      max_iter: int = 200, newton_first: bool = False, callback=None,
                      describe=None, what: str = "static solve", update=None):
@@ -189,17 +202,22 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
     dof free, the result the fields of its result: ``dict(u, iterations, residual_history,
     mu_history, tangent)``. ``max_iter`` bounds the SNES iterations over all solves."""
     PETSc = backend.PETSc
-    u = np.array(u0, dtype=float, copy=True) if update is None else u0
+    comm = backend.comm.tompi4py()
+    u = np.asarray(u0, dtype=float) if update is None else u0     # never changed in place
     r, K = residual(u)
     if not isinstance(K, DistributedMatrix):
         raise InputError(f"{what} (SNES): expected the tangent of a distributed assembly "
                          f"(DistributedMatrix), found {type(K).__name__}")
-    prob = _Problem(backend, residual, u, scale=scale, update=update, first=(r, K))
-    rn = float(np.linalg.norm(r))
+    rows = slice(*K.mat.getOwnershipRange())
+    if np.shape(r) != (rows.stop - rows.start,):
+        raise InputError(f"{what} (SNES): expected the residual as this rank's rows "
+                         f"({rows.stop - rows.start},), found shape {np.shape(r)}")
+    scale = np.asarray(scale, dtype=float)
+    mu_scale = _mu_scale(K, scale)
+    prob = _Problem(backend, residual, u, D=scale[rows].copy(), update=update, first=(r, K))
+    del scale
+    rn = rows_norm(r, comm)
     W = energy(u)
-    Kd = np.abs(K.diagonal())
-    Md = prob.D
-    mu_scale = float(np.median(Kd[Kd > 0]) / np.median(Md)) if np.any(Kd > 0) else 1.0
     mu = 0.0 if newton_first else 1e-3 * mu_scale
     mu_last = MU_NEWTON * mu_scale      # the shift to come back to after a failed Newton solve
     res_hist, mu_hist = [rn], []
@@ -219,9 +237,9 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
     def monitor(s, its, fnorm):
         if its == 0:
             return
-        x = gather(s.getSolution())
-        uu, rr, _ = prob.evaluate(x)
-        rnorm = float(np.linalg.norm(rr))
+        X = s.getSolution()
+        uu, rr, _ = prob.evaluate(X)
+        rnorm = rows_norm(rr, comm)
         res_hist.append(rnorm)
         mu_hist.append(prob.mu)
         if callback is not None:
@@ -230,7 +248,8 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         # x is this iteration's step (the update hook zeroes it at each start): a Newton
         # step du = -K^-1 r lowers the energy by -r.du / 2 to second order
         r_start, last["r"] = last["r"], rr
-        tiny = abs(0.5 * float(r_start @ x)) < 1e-11 * max(abs(W), 1e-30)
+        tiny = abs(0.5 * rows_dot(r_start, X.getArray(readonly=True), comm)) \
+            < 1e-11 * max(abs(W), 1e-30)
         if prob.mu == 0.0 and tiny and rnorm > 0.5 * res_hist[-2] \
                 and rnorm <= 1e3 * tol * force_scale(uu):
             raise _Floor    # the round-off floor: a Newton step no longer halves |r|
@@ -252,17 +271,16 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
             try:
                 snes.solve(None, X)
             except _Floor:
-                return (*prob.evaluate(gather(X)), snes.getIterationNumber(), FLOOR)
+                return (*prob.evaluate(X), snes.getIterationNumber(), FLOOR)
             except PETSc.Error as exc:
                 log.debug("%s: SNES error %s", what, exc.ierr)
                 _refuse_mumps_failure(snes, what)
                 return None, None, None, snes.getIterationNumber(), -100
         if snes.getConvergedReason() == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
             _refuse_mumps_failure(snes, what)
-        x = gather(X)
-        un, rr, KK = prob.evaluate(x)
+        un, rr, KK = prob.evaluate(X)
         log.debug("%s: SNES solve of %d unknowns with mu = %.3g: %s after %d iterations", what,
-                  prob.D.size, mu_step,
+                  X.getSize(), mu_step,
                   reason_name(PETSc, snes.getConvergedReason()), snes.getIterationNumber())
         return un, rr, KK, snes.getIterationNumber(), snes.getConvergedReason()
 
@@ -270,16 +288,16 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         while True:
             un, rr, KK, its, reason = solve(mu, tol * force_scale(u))
             total += its
-            ok = un is not None and np.all(np.isfinite(rr))
+            ok = un is not None and bool(np.isfinite(rows_norm(rr, comm)))
             if ok and mu == 0.0:
-                rnn = float(np.linalg.norm(rr))
+                rnn = rows_norm(rr, comm)
                 # converged: by the residual (tmfem's test, or -snes_atol/-snes_rtol given),
                 # or on the round-off floor
                 if reason == FLOOR or (reason > 0 and reason_name(PETSc, reason).startswith(
                         "CONVERGED_FNORM")):
                     u, r, K = un, rr, KK
                     break
-                if reason > 0 and rnn < float(np.linalg.norm(r)):
+                if reason > 0 and rnn < rows_norm(r, comm):
                     u, r, K = un, rr, KK      # stopped on a step test: Newton again from there
                     W = energy(u)
                     if total < max_iter:
@@ -301,13 +319,12 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                     continue
             # the step failed: regularise harder from the last accepted state
             mu = 4.0 * (mu if mu > 0 else mu_last)
-            prob.start(u, mu)
-            prob.cache.update(x=np.zeros(Md.size), u=u, r=r, K=K)
+            prob.start(u, mu, r, K)
             if mu > 1e12 * mu_scale or total >= max_iter:
                 note = f" ({describe(u)})" if describe is not None else ""
                 raise ConvergenceError(
                     f"{what}: SNES {reason_name(PETSc, reason)} (expected an equilibrium with "
-                    f"|r| <= {tol:g} x force scale, found |r| = {float(np.linalg.norm(r)):.3e} N "
+                    f"|r| <= {tol:g} x force scale, found |r| = {rows_norm(r, comm):.3e} N "
                     f"after {total} SNES iterations, mu = {mu:.3g}){note}{_options_note(backend)}")
     finally:
         # the SNES, its KSP (MUMPS' analysis of the tangent's pattern) and matrix stay with
@@ -318,7 +335,7 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         prob.release()
         F.destroy()
         X.destroy()
-    rn = float(np.linalg.norm(r))
+    rn = rows_norm(r, comm)
     if not rn <= 1e3 * tol * force_scale(u):
         note = f" ({describe(u)})" if describe is not None else ""
         raise ConvergenceError(f"{what}: SNES stopped after {total} iterations (max_iter {max_iter}) "

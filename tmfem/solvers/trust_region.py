@@ -60,7 +60,8 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     Parameters
     ----------
     residual : callable
-        ``residual(u) -> (r, K)`` on all dofs.
+        ``residual(u) -> (r, K)`` on all dofs (for a backend's own solver,
+        ``backend.solve_equilibrium``: K distributed and r this rank's rows of it).
     energy : callable
         ``energy(u) -> W`` [J].
     u0 : ndarray
