@@ -739,3 +739,32 @@ def test_backend_options_no_solver_read_are_named():
     iterative = PetscBackend(solver="iterative", options="-ksp_rtol 1e-8")
     iterative.factorize(K)(np.ones(n))
     assert iterative.unused_options() == []
+
+
+@needs_petsc
+def test_entries_tied_to_many_unknowns_are_keyed_apart():
+    # source: scipy's T^T M T on the unknowns. A mass-like group of 200 000 entries, 50 of
+    # them on a dof that T ties to 11 unknowns (an SBC corner): laid out as 11 x 11 pairs
+    # each, the group's keys alone would take 200 000 x 121 x 8 bytes = 194 MB; the tied
+    # entries apart, the construction and an assembly stay within a few entries' worth
+    import tracemalloc
+    from tmfem.solvers.distributed import DistributedAssembler
+    rng = np.random.default_rng(3)
+    n = 20000
+    rows, cols, vals = list(range(n)), list(range(n)), [1.0] * n
+    rows[0:1], cols[0:1], vals[0:1] = [0] * 11, list(range(100, 111)), list(rng.random(11))
+    T = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    keep = np.ones(n, bool)
+    keep[5] = False
+    ent = rng.integers(1, n, size=(200000, 2))
+    ent[:50, 0] = 0
+    ev = rng.standard_normal(len(ent))
+    tracemalloc.start()
+    asm = DistributedAssembler([(ent, "entry")], n, T=T, keep=keep)
+    A = asm.scipy(asm.matrix(ev))
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    M = sp.csr_matrix((ev, (ent[:, 0], ent[:, 1])), shape=(n, n))
+    ref = (T.T @ M @ T).tocsr()[keep][:, keep]
+    assert abs(A - ref).max() <= 1e-14 * abs(ref).max()
+    assert peak < 60 * 2**20, peak / 2**20

@@ -333,7 +333,7 @@ class DistributedAssembler:
         self._groups, keys, local = [], [], []
         offset = 0
         for dofs, kind in groups:
-            g = _EntryMap(np.asarray(dofs, dtype=np.int64), kind, n, T, number)
+            g = _entry_map(np.asarray(dofs, dtype=np.int64), kind, n, T, number)
             self._groups.append(g)
             gkeys, ginv = g.pattern(self.N)
             g.drop_pattern_tables()
@@ -619,6 +619,46 @@ class _EntryMap:
         else:
             v = (X[:, None, None] * W[:, 0, :, None] * W[:, 1, None, :]).ravel()
         return v if self.all_valid else v[self.valid]
+
+
+class _TiedEntries:
+    """An entry group some of whose entries touch a dof that T ties to several unknowns (a
+    corner tied to a bar top by a rigid link: up to 11 entries in its row of T): those
+    entries in an :class:`_EntryMap` of their own, the others in one with a single unknown
+    per dof. One map of the whole group would lay out every entry as p x p (row, column)
+    pairs, p the largest row count of T among the group's dofs: 121 keys and values for
+    each entry of a mass matrix with one such corner."""
+
+    kind = "entry"
+    block_size = 1
+
+    def __init__(self, dofs, n, T, number, tied):
+        self.value_shape = (dofs.shape[0],)
+        self.parts = [(idx, _EntryMap(dofs[idx], "entry", n, T, number))
+                      for idx in (np.flatnonzero(~tied), np.flatnonzero(tied))]
+
+    def pattern(self, N: int):
+        """``(keys, None)``: the keys of the untied entries, then of the tied ones."""
+        return np.concatenate([m.keys(N) for _, m in self.parts]), None
+
+    def drop_pattern_tables(self) -> None:
+        for _, m in self.parts:
+            m.drop_pattern_tables()
+
+    def weighted(self, X) -> np.ndarray:
+        """Values of the valid entries, in the order of :meth:`pattern`'s keys."""
+        return np.concatenate([m.weighted(X[idx]) for idx, m in self.parts])
+
+
+def _entry_map(dofs, kind, n, T, number):
+    """The map of one group (:class:`_EntryMap`), its tied entries apart when only some of
+    an entry group's entries touch dofs of more than one unknown (:class:`_TiedEntries`)."""
+    if kind == "entry" and dofs.ndim == 2 and dofs.shape[1] == 2 and dofs.size \
+            and 0 <= dofs.min() and dofs.max() < n:
+        tied = (np.diff(T.indptr)[dofs] > 1).any(axis=1)
+        if tied.any() and not tied.all():
+            return _TiedEntries(dofs, n, T, number, tied)
+    return _EntryMap(dofs, kind, n, T, number)
 
 
 def _block_size(dofs: np.ndarray) -> int:
