@@ -9,6 +9,7 @@ message names the input, the estimate and the limit (docs/guides/cli.md, "Limits
 """
 from __future__ import annotations
 
+import math
 import os
 
 from tmfem.errors import InputError, ResourceLimit
@@ -20,6 +21,16 @@ MEMORY_FRACTION = 0.6         # of the physical memory: the machine is shared
 # room for the fill of larger factorisations. Base: the interpreter with numpy/scipy/VTK.
 BYTES_PER_DOF = 16e3
 BASE_BYTES = 0.3e9
+#: The PETSc backend on one rank, by the model's DOFs per membrane node (the estimate's DOFs,
+#: :func:`mesh_dofs`). 3, the MTC membrane (benchmarks/bench_memory_ranks.py, 1-4 static +
+#: 12 modes): the peak grows by 4.8 / 4.6 / 4.6 kB per DOF above the start-up at 78k / 309k /
+#: 1.23 M DOFs; 6 kB leaves room for the fill of larger factorisations. 6, the SBC shells
+#: (`tmfem modal --model sbc --preset 1-4 --mesh n --backend petsc`, peak RSS): 0.50 / 1.48 /
+#: 3.14 GB at n = 30 / 60 / 90, 15 kB per DOF; 20 kB leaves room.
+PETSC_BYTES_PER_DOF = {3: 6e3, 6: 20e3}
+#: Under mpiexec every rank holds the mesh and the state whole (~0.2 kB per DOF, measured
+#: at 309k DOFs) beside its share of the rest.
+RANK_WHOLE_BYTES_PER_DOF = 0.2e3
 
 #: Largest K of the control-oriented model: its equations are built symbolically (CasADi)
 #: at a cost that grows faster than K^2 (1-4, measured under load: K = 10: 8 s, 20: 9 s,
@@ -51,6 +62,31 @@ def require_memory(need: float, *, given: str, what: str) -> float:
     return need
 
 
+def fe_bytes(dofs: int, *, backend: str = "scipy", ranks: int = 1,
+             ranks_here: int | None = None, dofs_per_node: int = 3) -> float:
+    """Peak memory [bytes] on this machine of a finite-element model of ``dofs`` DOFs
+    (``dofs_per_node`` per membrane node) solved with ``backend`` (``"scipy"`` or
+    ``"petsc"``) on ``ranks`` MPI ranks, ``ranks_here`` of them on this machine (default
+    all):
+
+        scipy:  BASE_BYTES + BYTES_PER_DOF dofs
+        petsc:  P_h (BASE_BYTES + w dofs) + b dofs (P_h / P) (1 + 0.15 log2 P)
+
+    with b = :data:`PETSC_BYTES_PER_DOF` of ``dofs_per_node`` (the largest for another
+    count), w = :data:`RANK_WHOLE_BYTES_PER_DOF` for P > 1 (0 on one rank): each rank's start-up
+    and what it holds whole, and its share of what divides, the busiest rank's share growing
+    with P (MUMPS' fronts divide unevenly: on 2 ranks the busiest holds 1.15-1.2 x half, on 8
+    ranks 0.18 of the factor entries against 1/8)."""
+    if backend != "petsc":
+        return BASE_BYTES + BYTES_PER_DOF * dofs
+    P = max(1, int(ranks))
+    here = P if ranks_here is None else min(P, max(1, int(ranks_here)))
+    whole = RANK_WHOLE_BYTES_PER_DOF * dofs if P > 1 else 0.0
+    per_dof = PETSC_BYTES_PER_DOF.get(dofs_per_node, max(PETSC_BYTES_PER_DOF.values()))
+    share = per_dof * dofs * (here / P) * (1.0 + 0.15 * math.log2(P))
+    return here * (BASE_BYTES + whole) + share
+
+
 def mesh_dofs(*, N: int, n: int, dofs_per_node: int = 3, extra_dofs: int = 0) -> int:
     """DOFs of N n x n quadrilateral membrane patches (about N (n + 1)^2 nodes) with
     ``dofs_per_node`` unknowns each, plus ``extra_dofs`` (members)."""
@@ -58,11 +94,13 @@ def mesh_dofs(*, N: int, n: int, dofs_per_node: int = 3, extra_dofs: int = 0) ->
 
 
 def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3,
-                      extra_dofs: int = 0, extra_text: str = "") -> int:
+                      extra_dofs: int = 0, extra_text: str = "", backend=None) -> int:
     """Refuse a membrane mesh whose FE model would not fit this machine.
 
-    The DOFs are :func:`mesh_dofs`; the estimated peak memory is ``BASE_BYTES +
-    BYTES_PER_DOF * dofs`` and must stay under :func:`memory_limit`. Returns the DOF estimate.
+    The DOFs are :func:`mesh_dofs`; the estimated peak memory, :func:`fe_bytes` of the
+    backend that will solve it, must stay under :func:`memory_limit`. ``backend``: None
+    (the scipy estimate) or a callable ``backend(dofs) -> (name, ranks, ranks_here)``.
+    Returns the DOF estimate.
 
     Raises
     ------
@@ -71,10 +109,14 @@ def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: 
     """
     dofs = mesh_dofs(N=N, n=n, dofs_per_node=dofs_per_node, extra_dofs=extra_dofs)
     given = option if " " in option else f"{option} {n}"    # "--mesh n ..." or the flag
-    require_memory(BASE_BYTES + BYTES_PER_DOF * dofs, given=given,
+    name, ranks, here = ("scipy", 1, 1) if backend is None else backend(dofs)
+    on = "" if name != "petsc" else (" with the PETSc backend" if ranks == 1 else
+                                     f" with the PETSc backend on {ranks} ranks ({here} here)")
+    require_memory(fe_bytes(dofs, backend=name, ranks=ranks, ranks_here=here,
+                            dofs_per_node=dofs_per_node), given=given,
                    what=f"the membrane mesh {N} x {n} x {n}"
                    + (f" with {extra_text}" if extra_text else "") + f" gives about {dofs:,} "
-                   "DOFs and")
+                   f"DOFs and{on}")
     return dofs
 
 

@@ -13,9 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from tmfem.errors import InputError, ResourceLimit, shorten
-from tmfem.resources import (BASE_BYTES, BYTES_PER_DOF, MAX_MEMBRANE_MODES,  # noqa: F401
-                             MEMORY_FRACTION, check_membrane_modes, check_mesh_budget,
-                             check_system_budget, machine_memory, require_memory)
+from tmfem.resources import (MEMORY_FRACTION, check_membrane_modes, check_mesh_budget,
+                             check_system_budget, fe_bytes, machine_memory, require_memory)
 from tmfem.system import System, load_preset, load_system
 
 log = logging.getLogger(__name__)
@@ -101,12 +100,14 @@ def model_options_from_args(args, command: str):
                          "the finite-element models)")
     system = system_from_args(args)
     if isinstance(options.get("mesh"), int):
+        backend = backend_from_args(args) if spec.uses_backend else "scipy"
         dofs = check_model_budget(system, mesh=options["mesh"],
                                   tendon_elements=options.get("tendon_elements") or 1,
                                   bar_elements=options.get("bar_elements"),
-                                  dofs_per_node=spec.dofs_per_node)
+                                  dofs_per_node=spec.dofs_per_node, backend=backend)
         if isinstance(getattr(args, "modes", None), int):     # modal: the exact DOFs later
-            check_modes_budget(dofs, modes=args.modes, given=f"--mesh {options['mesh']}")
+            check_modes_budget(dofs, modes=args.modes, given=f"--mesh {options['mesh']}",
+                               backend=backend, dofs_per_node=spec.dofs_per_node)
     if "attachment" in options:
         check_attachment_options(system, attachment=options["attachment"], patch=options["patch"])
     if options.get("membrane_modes") is not None:
@@ -369,15 +370,31 @@ def check_frames(*, steps: int, every: int, option: str | None = "--vtk-every") 
     return frames
 
 
+def backend_plan(name: str | None):
+    """``plan(dofs) -> (backend, ranks, ranks on this machine)``: what ``--backend name``
+    (None or ``auto``: :func:`tmfem.solvers.backends.choose_backend`) will solve a model of
+    about ``dofs`` DOFs with, under the launcher's ranks: the memory estimate's input
+    (:func:`tmfem.resources.fe_bytes`)."""
+    from tmfem.solvers.backends import choose_backend
+    from tmfem.solvers.petsc_loader import launched_local_ranks, launched_ranks
+
+    def plan(dofs: int):
+        chosen = choose_backend(n_dofs=dofs) if name in (None, "auto") else name
+        return chosen, launched_ranks(), launched_local_ranks()
+    return plan
+
+
 def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
                        bar_elements: int | None = None, modes: int | None = None,
-                       dofs_per_node: int = 3) -> int:
+                       dofs_per_node: int = 3, backend: str | None = None) -> int:
     """Refuse a finite-element model of ``system`` that would not fit this machine, before
     it is built: the membrane mesh (:func:`check_mesh_budget`, ``dofs_per_node`` 3 for the
     membrane elements, 6 for shells) plus 3 (k - 1) DOFs per tendon of k truss elements and,
     with ``bar_elements`` b (beam bars, 6 DOFs per node), 6 (3 b - 1) per bar; ``modes`` must
     stay below the DOF estimate, and the eigen solver's basis (2 ``modes`` vectors of the
-    DOFs, 8 bytes an entry) must fit beside the model. Returns the DOF estimate."""
+    DOFs, 8 bytes an entry) must fit beside the model. ``backend``: the ``--backend`` given
+    (None: auto), whose memory per DOF the estimate takes (:func:`backend_plan`). Returns
+    the DOF estimate."""
     extra = 3 * len(system.tendons) * (tendon_elements - 1)
     what = [f"{len(system.tendons)} tendons x {tendon_elements} elements"]
     if bar_elements is not None:
@@ -385,20 +402,26 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
         what.append(f"{system.M * system.N} bars x {bar_elements} beam elements")
     given = f"--mesh {mesh} --tendon-elements {tendon_elements}" + (
         f" --bar-elements {bar_elements}" if bar_elements is not None else "")
+    plan = backend_plan(backend)
     dofs = check_mesh_budget(N=system.N, n=mesh, option=given, dofs_per_node=dofs_per_node,
-                             extra_dofs=extra, extra_text=", ".join(what))
+                             extra_dofs=extra, extra_text=", ".join(what), backend=plan)
     if modes is not None and modes >= dofs:
         raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
                          "DOFs")
     if modes is not None:
-        check_modes_budget(dofs, modes=modes, given=given)
+        check_modes_budget(dofs, modes=modes, given=given, backend=backend,
+                           dofs_per_node=dofs_per_node)
     return dofs
 
 
-def check_modes_budget(dofs: int, *, modes: int, given: str = "") -> None:
+def check_modes_budget(dofs: int, *, modes: int, given: str = "", backend: str | None = None,
+                       dofs_per_node: int = 3) -> None:
     """Refuse ``--modes`` whose eigen-solver basis (2 ``modes`` vectors of ``dofs`` entries,
-    8 bytes each) does not fit beside the model (``BYTES_PER_DOF`` per DOF)."""
-    require_memory(BASE_BYTES + BYTES_PER_DOF * dofs + 16.0 * dofs * modes,
+    8 bytes each, on every rank) does not fit beside the model
+    (:func:`tmfem.resources.fe_bytes` of the backend, :func:`backend_plan`)."""
+    name, ranks, here = backend_plan(backend)(dofs)
+    require_memory(fe_bytes(dofs, backend=name, ranks=ranks, ranks_here=here,
+                            dofs_per_node=dofs_per_node) + here * 16.0 * dofs * modes,
                    given=f"--modes {modes} {given}".strip(),
                    what=f"the model's about {dofs:,} DOFs with a basis of 2 x {modes} vectors")
 

@@ -61,8 +61,8 @@ def run(args) -> dict:
         raise InputError(f"compare{' --vibrate' if args.vibrate else ''}: option does not apply: "
                          f"{flags} ({'without' if args.vibrate is False else 'with'} --vibrate)")
     # the SBC model is the larger of the two FE models (shells: 6 DOFs a node)
-    check_model_budget(args.system, mesh=args.mesh,
-                       tendon_elements=args.tendon_elements, modes=args.modes, dofs_per_node=6)
+    check_model_budget(args.system, mesh=args.mesh, tendon_elements=args.tendon_elements,
+                       modes=args.modes, dofs_per_node=6, backend=args.backend)
     output_file(args.csv, option="--csv", suffixes=(".csv",))
     output_file(args.plot, option="--plot", suffixes=(".png",))
     return run_vibration(args) if args.vibrate else run_frequencies(args)

@@ -79,7 +79,8 @@ def run(args) -> dict:
     for n in meshes:
         for k in tendons:
             check_model_budget(system, mesh=n, tendon_elements=k, modes=args.modes,
-                               dofs_per_node=get_spec(args.model).dofs_per_node)
+                               dofs_per_node=get_spec(args.model).dofs_per_node,
+                               backend=args.backend)
     check_outputs(args, NAME)
     rest, rule = resolve_rest_lengths(system, rest_lengths=rest)
     rows = []

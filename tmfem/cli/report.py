@@ -55,7 +55,8 @@ def run(args) -> dict:
         if args.modes < 12:
             say("report", f"{args.modes} modes: the control-oriented model of {system.name} "
                 f"has {args.modes} coordinates")
-    check_model_budget(system, mesh=args.mesh, tendon_elements=3, modes=args.modes)
+    check_model_budget(system, mesh=args.mesh, tendon_elements=3, modes=args.modes,
+                       backend="scipy")         # the report's FE models solve with scipy
     check_com_modes(system, modes=args.modes)
     check_time_steps(t_end=args.t_end, dt=args.dt)
     deployment = report_deployment(system)

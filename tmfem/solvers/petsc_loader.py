@@ -71,3 +71,11 @@ def launched_ranks() -> int:
     """Number of MPI ranks of this process's job as the launcher announces it (Open MPI's or
     MPICH's environment), 1 outside ``mpiexec``; does not initialise MPI."""
     return int(os.environ.get("OMPI_COMM_WORLD_SIZE") or os.environ.get("PMI_SIZE") or 1)
+
+
+def launched_local_ranks() -> int:
+    """Number of this job's ranks on this machine as the launcher announces it (Open MPI's
+    ``OMPI_COMM_WORLD_LOCAL_SIZE``, MPICH's ``MPI_LOCALNRANKS``), else
+    :func:`launched_ranks`; does not initialise MPI."""
+    return int(os.environ.get("OMPI_COMM_WORLD_LOCAL_SIZE") or os.environ.get("MPI_LOCALNRANKS")
+               or launched_ranks())
