@@ -73,10 +73,10 @@ def fe_bytes(dofs: int, *, backend: str = "scipy", ranks: int = 1,
         petsc:  P_h (BASE_BYTES + w dofs) + b dofs (P_h / P) (1 + 0.15 log2 P)
 
     with b = :data:`PETSC_BYTES_PER_DOF` of ``dofs_per_node`` (the largest for another
-    count), w = :data:`RANK_WHOLE_BYTES_PER_DOF` for P > 1 (0 on one rank): each rank's start-up
-    and what it holds whole, and its share of what divides, the busiest rank's share growing
-    with P (MUMPS' fronts divide unevenly: on 2 ranks the busiest holds 1.15-1.2 x half, on 8
-    ranks 0.18 of the factor entries against 1/8)."""
+    count) and w = :data:`RANK_WHOLE_BYTES_PER_DOF` for P > 1 (0 on one rank): each rank's
+    start-up and what it holds whole, and its share of what divides, the busiest rank's
+    share growing with P (MUMPS' fronts divide unevenly: on 2 ranks the busiest holds
+    1.15-1.2 x half, on 8 ranks 0.18 of the factor entries against 1/8)."""
     if backend != "petsc":
         return BASE_BYTES + BYTES_PER_DOF * dofs
     P = max(1, int(ranks))
@@ -94,12 +94,12 @@ def mesh_dofs(*, N: int, n: int, dofs_per_node: int = 3, extra_dofs: int = 0) ->
 
 
 def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: int = 3,
-                      extra_dofs: int = 0, extra_text: str = "", backend=None) -> int:
+                      extra_dofs: int = 0, extra_text: str = "", plan=None) -> int:
     """Refuse a membrane mesh whose FE model would not fit this machine.
 
     The DOFs are :func:`mesh_dofs`; the estimated peak memory, :func:`fe_bytes` of the
-    backend that will solve it, must stay under :func:`memory_limit`. ``backend``: None
-    (the scipy estimate) or a callable ``backend(dofs) -> (name, ranks, ranks_here)``.
+    backend that will solve it, must stay under :func:`memory_limit`. ``plan``: None (the
+    scipy estimate) or a callable ``plan(dofs) -> (backend, ranks, ranks_here)``.
     Returns the DOF estimate.
 
     Raises
@@ -109,7 +109,7 @@ def check_mesh_budget(*, N: int, n: int, option: str = "--mesh", dofs_per_node: 
     """
     dofs = mesh_dofs(N=N, n=n, dofs_per_node=dofs_per_node, extra_dofs=extra_dofs)
     given = option if " " in option else f"{option} {n}"    # "--mesh n ..." or the flag
-    name, ranks, here = ("scipy", 1, 1) if backend is None else backend(dofs)
+    name, ranks, here = ("scipy", 1, 1) if plan is None else plan(dofs)
     on = "" if name != "petsc" else (" with the PETSc backend" if ranks == 1 else
                                      f" with the PETSc backend on {ranks} ranks ({here} here)")
     require_memory(fe_bytes(dofs, backend=name, ranks=ranks, ranks_here=here,

@@ -402,9 +402,9 @@ def check_model_budget(system: System, *, mesh: int, tendon_elements: int = 1,
         what.append(f"{system.M * system.N} bars x {bar_elements} beam elements")
     given = f"--mesh {mesh} --tendon-elements {tendon_elements}" + (
         f" --bar-elements {bar_elements}" if bar_elements is not None else "")
-    plan = backend_plan(backend)
     dofs = check_mesh_budget(N=system.N, n=mesh, option=given, dofs_per_node=dofs_per_node,
-                             extra_dofs=extra, extra_text=", ".join(what), backend=plan)
+                             extra_dofs=extra, extra_text=", ".join(what),
+                             plan=backend_plan(backend))
     if modes is not None and modes >= dofs:
         raise InputError(f"--modes {modes}: expected fewer modes than the model's about {dofs:,} "
                          "DOFs")

@@ -11,9 +11,10 @@ the structure they come from.
   ranks' patterns; vectors (each rank's contribution to the full force) are summed into
   T^T f on the unknowns, each rank receiving its rows (those of its matrix rows). The
   pattern is exchanged once: each rank sends the (row, column) keys of its entries to the
-  rank owning the row (PETSc's default row split), which builds the CSR pattern of its rows; every later assembly is one
-  ``np.bincount`` per rank and one ``Alltoallv`` of values (the COO assembly of PETSc >=
-  3.19, which the petsc4py 3.18 of Debian bookworm does not expose).
+  rank owning the row (PETSc's default row split), which builds the CSR pattern of its
+  rows; every later assembly is one ``np.bincount`` per rank and one ``Alltoallv`` of
+  values (the COO assembly of PETSc >= 3.19, which the petsc4py 3.18 of Debian bookworm
+  does not expose).
 * :class:`collective` -- a block every rank enters: an exception on any rank is raised on
   all ranks (with the failing rank's message), so no rank waits in a collective call for a
   rank that has died (the assemblers check their element arrays so).
@@ -493,14 +494,6 @@ class _EntryMap:
     weight 0), an entry (i, j, v) to the entries (a, b, T_ia T_jb v) on the unknowns."""
 
     def __init__(self, dofs, kind, n, T, number):
-        if kind not in ("element", "entry"):
-            raise InputError(f"distributed assembly: expected group kind 'element' or 'entry', "
-                             f"found {kind!r}")
-        if dofs.ndim != 2 or (kind == "entry" and dofs.shape[1] != 2) or \
-                (dofs.size and (dofs.min() < 0 or dofs.max() >= n)):
-            raise InputError(f"distributed assembly: expected {kind} dofs (m, {'2' if kind == 'entry' else 'nd'}) "
-                             f"in [0, {n}), found shape {dofs.shape}"
-                             + (f", range [{dofs.min()}, {dofs.max()}]" if dofs.size else ""))
         self.kind = kind
         ne, nd = dofs.shape
         self.value_shape = (ne, nd, nd) if kind == "element" else (ne,)
@@ -652,9 +645,17 @@ class _TiedEntries:
 
 def _entry_map(dofs, kind, n, T, number):
     """The map of one group (:class:`_EntryMap`), its tied entries apart when only some of
-    an entry group's entries touch dofs of more than one unknown (:class:`_TiedEntries`)."""
-    if kind == "entry" and dofs.ndim == 2 and dofs.shape[1] == 2 and dofs.size \
-            and 0 <= dofs.min() and dofs.max() < n:
+    an entry group's entries touch dofs of more than one unknown (:class:`_TiedEntries`);
+    the group's kind and dofs checked first."""
+    if kind not in ("element", "entry"):
+        raise InputError(f"distributed assembly: expected group kind 'element' or 'entry', "
+                         f"found {kind!r}")
+    if dofs.ndim != 2 or (kind == "entry" and dofs.shape[1] != 2) or \
+            (dofs.size and (dofs.min() < 0 or dofs.max() >= n)):
+        raise InputError(f"distributed assembly: expected {kind} dofs (m, {'2' if kind == 'entry' else 'nd'}) "
+                         f"in [0, {n}), found shape {dofs.shape}"
+                         + (f", range [{dofs.min()}, {dofs.max()}]" if dofs.size else ""))
+    if kind == "entry" and dofs.size:
         tied = (np.diff(T.indptr)[dofs] > 1).any(axis=1)
         if tied.any() and not tied.all():
             return _TiedEntries(dofs, n, T, number, tied)
