@@ -87,9 +87,9 @@ class _Problem:
     r, the scale D, the offset and the increment are held as this rank's rows; the state u,
     which the model's residual reads, is whole."""
 
-    def __init__(self, backend, residual, u0, *, D, update, first):
+    def __init__(self, backend, residual, u0, *, comm, D, update, first):
         self.backend, self.residual, self.update = backend, residual, update
-        self.comm, self.D = backend.comm.tompi4py(), D
+        self.comm, self.D = comm, D
         self.base, self.offset, self.mu = u0, np.zeros(D.size), 0.0
         self.cache = {"x": np.zeros(D.size), "u": u0, "r": first[0], "K": first[1]}
 
@@ -214,7 +214,8 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                          f"({rows.stop - rows.start},), found shape {np.shape(r)}")
     scale = np.asarray(scale, dtype=float)
     mu_scale = _mu_scale(K, scale)
-    prob = _Problem(backend, residual, u, D=scale[rows].copy(), update=update, first=(r, K))
+    prob = _Problem(backend, residual, u, comm=comm, D=scale[rows].copy(), update=update,
+                    first=(r, K))
     del scale
     rn = rows_norm(r, comm)
     W = energy(u)
@@ -288,9 +289,9 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         while True:
             un, rr, KK, its, reason = solve(mu, tol * force_scale(u))
             total += its
-            ok = un is not None and bool(np.isfinite(rows_norm(rr, comm)))
+            rnn = rows_norm(rr, comm) if un is not None else np.nan
+            ok = bool(np.isfinite(rnn))
             if ok and mu == 0.0:
-                rnn = rows_norm(rr, comm)
                 # converged: by the residual (tmfem's test, or -snes_atol/-snes_rtol given),
                 # or on the round-off floor
                 if reason == FLOOR or (reason > 0 and reason_name(PETSc, reason).startswith(
