@@ -114,6 +114,32 @@ def test_iterative_cg_gamg_meets_the_unpreconditioned_tolerance(models, equilibr
 
 
 @needs_petsc
+@pytest.mark.parametrize("options, solver, reason", [
+    ("-ksp_type foo", "linear solver", "PETSc error 86: Unable to find requested KSP type foo"),
+    ("-pc_type foo", "linear solver", "PETSc error 86: Unable to find requested PC type foo"),
+    ("-pc_factor_mat_solver_type foo", "linear solve", "PETSc error 92: Could not locate solver "
+     "type foo"),
+    ("-eps_type foo", "eigen", "PETSc error 86: Unknown EPS type given: foo"),
+    ("-st_type foo", "eigen", "PETSc error 86: Unable to find requested ST type foo"),
+    ("-st_pc_factor_mat_solver_type foo", "eigen", "PETSc error 92: Could not locate solver "
+     "type foo"),
+])
+def test_petsc_options_that_petsc_refuses_are_input_errors(options, solver, reason):
+    # source: PETSc's own refusal (error code and reason) of a type or factorisation package
+    # it does not have, named as bad input in the solver that read it, not a traceback
+    from tmfem.solvers.petsc import PetscBackend
+    n = 20
+    K = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tocsr()
+    be = PetscBackend(options=options)
+    with pytest.raises(InputError, match=f"^{solver} .*expected .* in the PETSc options, found "
+                                         f"{reason}"):
+        if solver == "eigen":
+            be.eigsh(K, sp.identity(n, format="csr"), 3, 0.0)
+        else:
+            be.factorize(K)(np.ones(n))
+
+
+@needs_petsc
 def test_petsc_options_are_honoured():
     # an unpreconditioned CG capped at 2 iterations cannot solve a 200-dof Laplacian: the
     # options reach the KSP (from options=, and from PETSC_OPTIONS in a fresh process)
@@ -215,7 +241,7 @@ def _mpirun(n, *args, timeout=120, program=None):
 
 
 @needs_mpi
-def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
+def test_cli_under_two_ranks_prints_once_and_refuses_serial_solves():
     # source: the same command on 1 process (rank-0 output must be the serial document)
     tmfem = [sys.executable, "-m", "tmfem"]
     argv = ["modal", "--model", "mtc", "--preset", "2-3", "--mesh", "4", "--modes", "4", "--json"]
@@ -226,6 +252,10 @@ def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
     assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
     p = _mpirun(2, *argv, "--backend", "scipy", program=tmfem)
     assert p.returncode == 2 and p.stderr.count("expected --backend petsc") == 1
+    # a command without --backend is not told to pass one
+    p = _mpirun(2, "equilibrium", "--preset", "2-3", program=tmfem)
+    assert p.returncode == 2 and p.stderr.count("run it without mpiexec") == 1
+    assert "--backend scipy" not in p.stderr
 
 
 @needs_mpi

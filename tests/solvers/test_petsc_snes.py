@@ -95,6 +95,20 @@ def test_snes_converged_reason_names_the_convergence_error():
         _petsc_model("-snes_max_funcs 1").equilibrium()
 
 
+@needs_petsc
+@pytest.mark.parametrize("options, reason", [
+    ("-snes_type foo", "86: Unable to find requested SNES type foo"),
+    ("-snes_linesearch_type foo", "86: Unable to find requested Line Search type foo"),
+])
+def test_snes_options_that_petsc_refuses_are_input_errors(options, reason):
+    # source: PETSc's refusal of an unknown SNES or line-search type when the SNES reads
+    # the database: bad input named with PETSc's reason, before any iteration
+    with pytest.raises(InputError, match=f"^MTC static solve \\(SNES\\): expected a type this "
+                                         f"PETSc knows in the PETSc options, found PETSc error "
+                                         f"{reason}$"):
+        _petsc_model(options).equilibrium()
+
+
 def _cli_static(petsc_options: str):
     """``tmfem static`` of the 2-3 at mesh 4 on the PETSc backend with PETSC_OPTIONS; the
     finished process (exit 0 asserted)."""
@@ -112,6 +126,20 @@ def test_cli_snes_monitor_is_visible():
     assert "SNES Function norm" in p.stdout
     assert "backend petsc (" in p.stderr
     assert "PETSc options" not in p.stderr          # the option was read: no warning
+
+
+@needs_petsc
+def test_cli_refuses_a_petsc_option_petsc_refuses_in_one_line():
+    # an unknown KSP type in PETSC_OPTIONS: exit 2 (bad input) with PETSc's reason on one
+    # line, no traceback
+    env = dict(os.environ, PETSC_OPTIONS="-ksp_type foo")
+    p = subprocess.run([sys.executable, "-m", "tmfem", "static", "--preset", "2-3", "--mesh", "4",
+                        "--backend", "petsc"], capture_output=True, text=True, cwd=ROOT, env=env)
+    errors = [line for line in p.stderr.splitlines() if "error" in line]
+    assert p.returncode == 2 and "Traceback" not in p.stderr, p.stderr
+    assert errors == ["tmfem static: error: linear solver (petsc): expected a type this PETSc "
+                      "knows in the PETSc options, found PETSc error 86: Unable to find requested "
+                      "KSP type foo"], p.stderr
 
 
 @needs_petsc

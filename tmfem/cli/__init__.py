@@ -436,13 +436,17 @@ def _main_mpi(args, mod) -> int:
     at once. SIGINT or SIGTERM to mpiexec or to any rank ends every rank with one line and
     exit 130 / 143 (:func:`_install_interrupt_handler`)."""
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
-    backend = getattr(args, "backend", "scipy")   # a command without --backend solves with scipy
-    if backend is None:
-        backend = "auto"                   # the default of the commands that take --backend
-    if backend not in ("petsc", "auto"):
+    if not hasattr(args, "backend"):       # a command without --backend solves with scipy
         if rank == 0:
             print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
-                  f"--backend petsc, found --backend {getattr(args, 'backend', None) or 'scipy'} "
+                  "a command with a distributed backend (--backend petsc), found "
+                  f"`tmfem {args.command}`, which runs on one process: run it without mpiexec",
+                  file=sys.stderr)
+        return 2
+    if args.backend not in ("petsc", "auto", None):    # None: the default, auto
+        if rank == 0:
+            print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
+                  f"--backend petsc, found --backend {args.backend} "
                   "(every rank would solve the whole problem alone)", file=sys.stderr)
         return 2
     from tmfem.io.atomic import remove_pending

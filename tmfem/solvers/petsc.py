@@ -45,7 +45,7 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
 from tmfem.solvers.mumps import is_singular, mumps_error, mumps_factor, mumps_failure
 from tmfem.solvers.petsc_loader import petsc_modules
-from tmfem.solvers.petsc_options import option_used, parse_options
+from tmfem.solvers.petsc_options import option_error, option_used, parse_options, set_from_options
 from tmfem.solvers.singular import SingularMatrix
 
 log = logging.getLogger(__name__)
@@ -276,7 +276,7 @@ class PetscBackend:
             v.destroy()
         return symmetric
 
-    def _configure(self, ksp, symmetric: bool, prefix: str = "") -> None:
+    def _configure(self, ksp, symmetric: bool) -> None:
         """Defaults of the module docstring, then the options database (PETSC_OPTIONS and
         ``options=``, which wins)."""
         PETSc = self.PETSc
@@ -290,9 +290,8 @@ class PetscBackend:
             pc.setType("gamg")
             ksp.setNormType(PETSc.KSP.NormType.UNPRECONDITIONED)
             ksp.setTolerances(rtol=self.rtol, atol=0.0, max_it=10000)
-        with self._database({(prefix + k if not k.startswith(("eps_", "st_")) else k): v
-                             for k, v in self.options.items()}):
-            ksp.setFromOptions()
+        with self._database(self.options):
+            set_from_options(ksp, "linear solver (petsc)")
 
     @contextmanager
     def _database(self, entries: dict):
@@ -362,6 +361,8 @@ class PetscBackend:
                                  if not k.startswith(("eps_", "st_"))}):
                 ksp.setUp()
         except PETSc.Error as exc:
+            if (refused := option_error(exc, where)) is not None:
+                raise refused from None
             raise _factorisation_failure(ksp, f"expected a non-singular {n}x{n} matrix, found the "
                                          f"factorisation failing (PETSc error {exc.ierr})", where) from None
         if mumps_failure(ksp) is not None:
@@ -601,7 +602,7 @@ class PetscBackend:
             # (-eps_view, -eps_error_relative ::ascii_info_detail) at its end
             with self._database({key: v for key, v in self.options.items()
                                  if key.startswith(("eps_", "st_"))}):
-                E.setFromOptions()
+                set_from_options(E, "eigen (petsc)")
                 if reuse is not None:
                     st.setMatMode(SLEPc.ST.MatMode.INPLACE)
                     st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
@@ -609,6 +610,8 @@ class PetscBackend:
                 try:
                     E.solve()
                 except PETSc.Error as exc:
+                    if (refused := option_error(exc, "eigen (petsc)")) is not None:
+                        raise refused from None
                     raise _factorisation_failure(
                         st.getKSP(), f"expected K - sigma M non-singular for sigma={sigma:g}, found "
                         f"the shift-invert factorisation failing (PETSc error {exc.ierr})",

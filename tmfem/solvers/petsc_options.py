@@ -78,3 +78,43 @@ def _is_number(tok: str) -> bool:
         return True
     except ValueError:
         return False
+
+
+#: PETSc error codes that a value of the options database causes: an unknown type
+#: (``-ksp_type foo``: PETSC_ERR_UNKNOWN_TYPE) and a factorisation package PETSc does not
+#: have for the matrix (``-pc_factor_mat_solver_type foo``: PETSC_ERR_MISSING_FACTOR)
+OPTION_ERRORS = {86: "a type this PETSc knows", 92: "a factorisation package this PETSc has "
+                 "for the matrix (-pc_factor_mat_solver_type)"}
+
+
+def petsc_reason(exc) -> str:
+    """PETSc's own reason for the error ``exc`` (a ``petsc4py.PETSc.Error``): the last line
+    of its traceback without the rank prefix, such as ``Unable to find requested KSP type
+    foo``; ``error code N`` when it has no traceback."""
+    lines = [line.split("] ", 1)[-1] for line in str(exc).splitlines() if line.strip()]
+    return lines[-1] if lines else f"error code {getattr(exc, 'ierr', '?')}"
+
+
+def option_error(exc, what: str, *, any_code: bool = False) -> InputError | None:
+    """The :class:`~tmfem.errors.InputError` of a PETSc error that an option value caused
+    (:data:`OPTION_ERRORS`; every code with ``any_code``, for errors raised while an object
+    reads the database), else None."""
+    code = getattr(exc, "ierr", None)
+    if code not in OPTION_ERRORS and not any_code:
+        return None
+    expected = OPTION_ERRORS.get(code, "option values this PETSc accepts")
+    return InputError(f"{what}: expected {expected} in the PETSc options, found PETSc error "
+                      f"{code}: {petsc_reason(exc)}")
+
+
+def set_from_options(obj, what: str) -> None:
+    """``obj.setFromOptions()`` (a SNES, KSP or EPS): the options database read into a
+    solver; an option that PETSc refuses (an unknown type or value) is an
+    :class:`~tmfem.errors.InputError` with PETSc's reason, not a PETSc traceback."""
+    try:
+        obj.setFromOptions()
+    except Exception as exc:          # petsc4py.PETSc.Error (PETSc need not be importable here)
+        err = option_error(exc, what, any_code=True) if hasattr(exc, "ierr") else None
+        if err is None:
+            raise
+        raise err from None

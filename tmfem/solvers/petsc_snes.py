@@ -50,7 +50,7 @@ import numpy as np
 from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather, rows_dot, rows_norm
 from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
-from tmfem.solvers.petsc_options import SOLVER_PREFIXES
+from tmfem.solvers.petsc_options import SOLVER_PREFIXES, option_error, set_from_options
 
 log = logging.getLogger(__name__)
 
@@ -267,13 +267,15 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
             snes.setTolerances(atol=atol, rtol=STEP_RTOL if mu_step > 0 else 0.0, stol=0.0,
                                max_it=max(1, min(STEP_MAX_IT if mu_step > 0 else NEWTON_MAX_IT,
                                                  max_iter - total)))
-            snes.setFromOptions()
+            set_from_options(snes, f"{what} (SNES)")
             X.set(0.0)
             try:
                 snes.solve(None, X)
             except _Floor:
                 return (*prob.evaluate(X), snes.getIterationNumber(), FLOOR)
             except PETSc.Error as exc:
+                if (refused := option_error(exc, f"{what} (SNES)")) is not None:
+                    raise refused from None
                 log.debug("%s: SNES error %s", what, exc.ierr)
                 _refuse_mumps_failure(snes, what)
                 return None, None, None, snes.getIterationNumber(), -100
