@@ -123,10 +123,13 @@ def test_iterative_cg_gamg_meets_the_unpreconditioned_tolerance(models, equilibr
     ("-st_type foo", "eigen", "PETSc error 86: Unable to find requested ST type foo"),
     ("-st_pc_factor_mat_solver_type foo", "eigen", "PETSc error 92: Could not locate solver "
      "type foo"),
+    ("-eps_nev -2", "eigen", "PETSc error 63: Illegal value of nev. Must be > 0"),
+    ("-mat_mumps_icntl_7 99", "linear solve", "PETSc error 63: Valid values are 0=AMD"),
 ])
 def test_petsc_options_that_petsc_refuses_are_input_errors(options, solver, reason):
-    # source: PETSc's own refusal (error code and reason) of a type or factorisation package
-    # it does not have, named as bad input in the solver that read it, not a traceback
+    # source: PETSc's own refusal (error code and reason) of a type, a factorisation package
+    # it does not have or a value out of range (MUMPS reads its options at the
+    # factorisation), named as bad input in the solver that read it, not a traceback
     from tmfem.solvers.petsc import PetscBackend
     n = 20
     K = sp.diags([-np.ones(n - 1), 2 * np.ones(n), -np.ones(n - 1)], [-1, 0, 1]).tocsr()

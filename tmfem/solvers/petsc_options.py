@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import ctypes
 import functools
+import re
 import shlex
 import sys
 
@@ -80,9 +81,9 @@ def _is_number(tok: str) -> bool:
         return False
 
 
-#: PETSc error codes that a value of the options database causes: an unknown type
-#: (``-ksp_type foo``: PETSC_ERR_UNKNOWN_TYPE) and a factorisation package PETSc does not
-#: have for the matrix (``-pc_factor_mat_solver_type foo``: PETSC_ERR_MISSING_FACTOR)
+#: PETSc error codes that a value of the options database causes wherever it is read: an
+#: unknown type (``-ksp_type foo``: PETSC_ERR_UNKNOWN_TYPE) and a factorisation package PETSc
+#: does not have for the matrix (``-pc_factor_mat_solver_type foo``: PETSC_ERR_MISSING_FACTOR)
 OPTION_ERRORS = {86: "a type this PETSc knows", 92: "a factorisation package this PETSc has "
                  "for the matrix (-pc_factor_mat_solver_type)"}
 
@@ -95,12 +96,14 @@ def petsc_reason(exc) -> str:
     return lines[-1] if lines else f"error code {getattr(exc, 'ierr', '?')}"
 
 
-def option_error(exc, what: str, *, any_code: bool = False) -> InputError | None:
-    """The :class:`~tmfem.errors.InputError` of a PETSc error that an option value caused
-    (:data:`OPTION_ERRORS`; every code with ``any_code``, for errors raised while an object
-    reads the database), else None."""
+def option_error(exc, what: str) -> InputError | None:
+    """The :class:`~tmfem.errors.InputError` of a PETSc error that a value of the options
+    database caused, else None: a code of :data:`OPTION_ERRORS`, or any error raised where
+    an object reads the database (a ``...SetFromOptions...()`` in PETSc's traceback: a value
+    out of range, such as ``-eps_nev -2``, or MUMPS' ``-mat_mumps_icntl_7 99``, which MUMPS
+    reads at its factorisation)."""
     code = getattr(exc, "ierr", None)
-    if code not in OPTION_ERRORS and not any_code:
+    if code not in OPTION_ERRORS and not re.search(r"SetFromOptions\w*\(\)", str(exc)):
         return None
     expected = OPTION_ERRORS.get(code, "option values this PETSc accepts")
     return InputError(f"{what}: expected {expected} in the PETSc options, found PETSc error "
@@ -110,11 +113,12 @@ def option_error(exc, what: str, *, any_code: bool = False) -> InputError | None
 def set_from_options(obj, what: str) -> None:
     """``obj.setFromOptions()`` (a SNES, KSP or EPS): the options database read into a
     solver; an option that PETSc refuses (an unknown type or value) is an
-    :class:`~tmfem.errors.InputError` with PETSc's reason, not a PETSc traceback."""
+    :class:`~tmfem.errors.InputError` with PETSc's reason (:func:`option_error`), not a
+    PETSc traceback."""
     try:
         obj.setFromOptions()
-    except Exception as exc:          # petsc4py.PETSc.Error (PETSc need not be importable here)
-        err = option_error(exc, what, any_code=True) if hasattr(exc, "ierr") else None
+    except RuntimeError as exc:          # petsc4py.PETSc.Error
+        err = option_error(exc, what)
         if err is None:
             raise
         raise err from None
