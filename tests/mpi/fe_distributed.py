@@ -3,7 +3,7 @@ backend, its tangent and mass assembled rank by rank (tmfem.fem.distributed: eac
 evaluates its share of the membrane or shell elements), static equilibrium and 12 modes;
 rank 0 prints one JSON document.
 
-usage: python tests/mpi/fe_distributed.py PRESET MESH_N [--model mtc|sbc]
+usage: python tests/mpi/fe_distributed.py PRESET|SYSTEM.toml MESH_N [--model mtc|sbc]
                                           [--start design|undeformed] [--fail-rank R] [--nan-rank R]
                                           [--options="-snes_type newtonls ..."] [--sequence N]
 --model: the MTC model (membrane, bars, tendons; default) or the SBC model (MITC4 shells,
@@ -37,16 +37,17 @@ def main():
     ap.add_argument("--sequence", type=int, default=None)
     args = ap.parse_args()
     from tmfem.solvers.petsc import PetscBackend
-    from tmfem.system import load_preset
+    from tmfem.system import load_preset, load_system
     comm = comm_world()
+    system = load_system(args.preset) if args.preset.endswith(".toml") else load_preset(args.preset)
     backend = PetscBackend(options=args.options)
     if args.model == "mtc":
         from tmfem.models.mtc.model import MTCModel
-        model = MTCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend=backend)
+        model = MTCModel(system, mesh_n=args.mesh_n, backend=backend)
         element = model.membrane_element
     else:
         from tmfem.models.sbc.model import SBCModel
-        model = SBCModel(load_preset(args.preset), mesh_n=args.mesh_n, backend=backend)
+        model = SBCModel(system, mesh_n=args.mesh_n, backend=backend)
         element = model.shell
     kernel = element.element_arrays
     if args.fail_rank is not None and comm.rank == args.fail_rank:

@@ -234,3 +234,23 @@ def test_snes_stops_at_once_on_a_mumps_failure_a_shift_cannot_cure():
     with pytest.raises(InputError, match=r"SNES\): expected the MUMPS factorisation to succeed, "
                                          r"found MUMPS INFOG\(1\) = -19"):
         m.equilibrium()
+
+
+@needs_mpi
+def test_sbc_on_more_ranks_than_shells_agrees_with_scipy():
+    # source: the scipy SBC model of a system of our own (a one-stage triangle) whose
+    # membrane has 3 shells: on 4 ranks the last has none, and the static solve and the
+    # modes still agree with scipy's
+    from tmfem.models.sbc.model import SBCModel
+    from tmfem.system import load_system
+    system = ROOT / "tests" / "data" / "systems" / "triangle-1-3.toml"
+    m = SBCModel(load_system(system), mesh_n=1)
+    st = m.equilibrium()
+    w2 = m.modes(k=12, at=st).omega2
+    p = _mpirun(4, str(system), "1", "--model", "sbc")
+    assert p.returncode == 0, p.stderr
+    run = json.loads(p.stdout.strip().splitlines()[-1])
+    assert run["ranks"] == 4
+    u = st.state.x - m.start_state().x
+    assert np.linalg.norm(np.array(run["x"]) - st.state.x) <= 1e-9 * np.linalg.norm(u)
+    assert np.allclose(run["omega2"], w2, rtol=1e-8, atol=0)

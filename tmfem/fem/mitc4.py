@@ -436,7 +436,7 @@ class MITC4Shell:
         if not tangent:
             return fe, None
         Bf = B.reshape(ne, nq * nz * 5, 24)
-        CB = np.einsum("eqzst,eqztj->eqzsj", C * pts.dV[..., None, None], B).reshape(ne, -1, 24)
+        CB = np.einsum("eqzst,eqztj->eqzsj", C * pts.dV[..., None, None], B).reshape(ne, nq * nz * 5, 24)
         Kx = np.matmul(np.swapaxes(Bf, 1, 2), CB)                            # (ne, 24, 24)
         # initial-stress part: scalar couplings of (x_k, d_k) pairs, times I_3
         Smat = np.empty((ne, nq, nz, 2, 2))
