@@ -244,7 +244,7 @@ def _mpirun(n, *args, timeout=120, program=None):
 
 
 @needs_mpi
-def test_cli_under_two_ranks_prints_once_and_refuses_serial_solves():
+def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
     # source: the same command on 1 process (rank-0 output must be the serial document)
     tmfem = [sys.executable, "-m", "tmfem"]
     argv = ["modal", "--model", "mtc", "--preset", "2-3", "--mesh", "4", "--modes", "4", "--json"]
@@ -255,10 +255,17 @@ def test_cli_under_two_ranks_prints_once_and_refuses_serial_solves():
     assert np.allclose(d2["freq_hz"], d1["freq_hz"], rtol=1e-8, atol=0)
     p = _mpirun(2, *argv, "--backend", "scipy", program=tmfem)
     assert p.returncode == 2 and p.stderr.count("expected --backend petsc") == 1
-    # a command without --backend is not told to pass one
-    p = _mpirun(2, "equilibrium", "--preset", "2-3", program=tmfem)
-    assert p.returncode == 2 and p.stderr.count("run it without mpiexec") == 1
-    assert "--backend scipy" not in p.stderr
+
+
+def test_a_command_without_backend_under_mpiexec_is_refused_as_serial(monkeypatch, capsys):
+    # under mpiexec (2 ranks launched) a command that has no --backend runs on one process:
+    # refused before any work, without advice to pass an option it does not have
+    import tmfem.cli as cli
+    monkeypatch.setattr(cli, "_mpi_size", lambda: 2)
+    assert cli.main(["equilibrium", "--preset", "2-3"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("`tmfem equilibrium`, which runs on one process: run it without mpiexec") == 1
+    assert "--backend scipy" not in err
 
 
 @needs_mpi

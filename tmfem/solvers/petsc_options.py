@@ -1,10 +1,12 @@
-"""PETSc's options database as tmfem reads it: options given as a string or a dict, and
-which of them a solver has read.
+"""PETSc's options database as tmfem reads it: options given as a string or a dict, which
+of them a solver has read, and which values PETSc refused.
 
 A PETSc option changes a solver only if the solver reads it; a misspelt one, or one of a
 solver the run does not create, changes nothing. PETSc records which options its objects
 read (``PetscOptionsUsed``); :func:`unused_options` lists the solver options nobody read, so
-that the CLI can say so instead of ignoring them.
+that the CLI can say so instead of ignoring them. A value that PETSc refuses (an unknown
+type, a value out of range) raises a PETSc error where it is read; :func:`option_error`
+turns it into an :class:`~tmfem.errors.InputError` with PETSc's reason.
 """
 from __future__ import annotations
 

@@ -59,13 +59,20 @@ def _run(P, ny, nu, method, **kw):
         return exc
 
 
+class _Results(dict):
+    """Every route's result on each plant of FAMILY, computed at a plant's first use (so
+    that parallel test workers share the plants out instead of each running all of them)."""
+
+    def __missing__(self, name):
+        P, ny, nu, ref = FAMILY[name]
+        routes = [r for r in ROUTES if not (r == "slicot" and name.startswith(SLOW_SLICOT))]
+        self[name] = {r: _run(P, ny, nu, r) for r in routes}
+        return self[name]
+
+
 @pytest.fixture(scope="module")
 def results():
-    out = {}
-    for name, (P, ny, nu, ref) in FAMILY.items():
-        routes = [r for r in ROUTES if not (r == "slicot" and name.startswith(SLOW_SLICOT))]
-        out[name] = {r: _run(P, ny, nu, r) for r in routes}
-    return out
+    return _Results()
 
 
 def _bracket(name, res):
