@@ -169,40 +169,35 @@ class DistributedElements:
                 local += e.energy(state)
         return float(self.comm.allreduce(local))
 
-    def mass(self, M=None):
-        """Mass matrix (T^T M T)[free][:, free] (a DistributedMatrix) of the full mass M
-        (n, n), the same on every rank, its entries shared out over the ranks; by default
-        the sum of the sets' masses, assembled once and kept (pass M for a mass that
-        depends on the state: the rotary inertia of shells and beams at the current
-        directors).
+    def mass(self, state=None):
+        """Mass matrix (T^T M T)[free][:, free] (a DistributedMatrix) at ``state``: the
+        rotary inertia of shells and beams turns with their triads (the sets' ``mass(state)``
+        of :mod:`tmfem.fem.element`). The reference mass (``state`` None) is assembled once
+        and kept; a mass at a state is a new matrix each call.
 
-        The default mass of sets that provide ``element_mass(elements=slice)`` (element
-        mass matrices (ne, nd, nd) of a block, like ``element_arrays``; the membrane) comes
-        from each rank's element masses (no full mass matrix on any rank), their entries
-        where any element of the share has one (the membrane's node blocks are diagonal: 48
-        of 144), the other sets' from their assembled masses as above."""
-        if M is None and self._M is not None:
+        Sets that provide ``element_mass(state, elements=slice)`` (element mass matrices
+        (ne, nd, nd) of a block, like ``element_arrays``: the membrane, the shells)
+        contribute each rank's element masses (no full mass matrix on any rank), their
+        entries where any element of the share has one (the membrane's node blocks are
+        diagonal: 48 of 144); the other sets (trusses and beams, evaluated whole on every
+        rank as in :meth:`residual`) this rank's share of the entries of their assembled
+        mass."""
+        if state is None and self._M is not None:
             return self._M
-        keep = M is None
-        if keep and all(entries is not None or hasattr(e, "element_mass")
-                        for e, entries in zip(self.elements, self._entries)):
-            groups, values = [], []
-            for e, entries, dofs, share in zip(self.elements, self._entries, self._dofs, self._shares):
-                if entries is None:
-                    Me = np.asarray(e.element_mass(elements=share))
-                    I, J = np.nonzero(np.any(Me != 0.0, axis=0))
-                    groups.append((np.stack([dofs[:, I].ravel(), dofs[:, J].ravel()], axis=1), "entry"))
-                    values.append(Me[:, I, J].ravel())
-                else:
-                    rows, cols, data = self._entry_share(e.mass())
-                    groups.append((np.stack([rows, cols], axis=1), "entry"))
-                    values.append(data)
-        else:
-            rows, cols, data = self._entry_share(sum(e.mass() for e in self.elements) if keep else M)
-            groups, values = [(np.stack([rows, cols], axis=1), "entry")], [data]
-        asm = DistributedAssembler(groups, self.n, T=self.T, keep=self.free, comm=self.comm)
-        Md = asm.matrix(*values)
-        if keep:
+        groups, values = [], []
+        for e, entries, dofs, share in zip(self.elements, self._entries, self._dofs, self._shares):
+            if entries is None and hasattr(e, "element_mass"):
+                Me = np.asarray(e.element_mass(state, elements=share))
+                I, J = np.nonzero(np.any(Me != 0.0, axis=0))
+                groups.append((np.stack([dofs[:, I].ravel(), dofs[:, J].ravel()], axis=1), "entry"))
+                values.append(Me[:, I, J].ravel())
+            else:
+                rows, cols, data = self._entry_share(e.mass(state))
+                groups.append((np.stack([rows, cols], axis=1), "entry"))
+                values.append(data)
+        Md = DistributedAssembler(groups, self.n, T=self.T, keep=self.free,
+                                  comm=self.comm).matrix(*values)
+        if state is None:
             self._M = Md
         return Md
 

@@ -6,7 +6,10 @@ and returns, for a :class:`State`,
 ``internal(state, tangent=True) -> (f, K)``   internal force (ndof,) and tangent (csr) of
                                               eqs. 4.4-4.6 in the global numbering;
 ``energy(state) -> float``                    strain energy [J] (the potential of eq. 4.9);
-``mass() -> csr``                              mass matrix (ndof, ndof).
+``mass(state=None) -> csr``                    mass matrix (ndof, ndof) at ``state`` (the
+                                              rotary inertia of shells and beams turns with
+                                              their triads; the reference by default; the
+                                              same at every state for translations only).
 
 The truss (:class:`tmfem.fem.truss.TrussElement`) and the membrane
 (:class:`tmfem.fem.membrane.MembraneElement`) implement it; the MITC4 shell and the beam
@@ -120,7 +123,7 @@ class Element(Protocol):
 
     def energy(self, state: State) -> float: ...
 
-    def mass(self) -> sp.csr_matrix: ...
+    def mass(self, state: State | None = None) -> sp.csr_matrix: ...
 
 
 def assemble(elements: Sequence[Element], state: State, *, tangent: bool = True):

@@ -488,13 +488,15 @@ class MembraneElement:
         return self.membrane.element_arrays(state.x[:, self.nodes], tangent=tangent,
                                             elements=elements)
 
-    def element_mass(self, *, elements: slice = slice(None)) -> np.ndarray:
+    def element_mass(self, state=None, *, elements: slice = slice(None)) -> np.ndarray:
         """Element mass matrices (ne, 12, 12) of the ``elements`` (:meth:`MembraneTL.element_mass`),
-        local dofs ordered as :attr:`element_dofs`."""
+        local dofs ordered as :attr:`element_dofs`; the same at every ``state`` (translations
+        only: the mass of the share protocol at a state, as the shells')."""
         return self.membrane.element_mass(elements=elements)
 
-    def mass(self) -> sp.csr_matrix:
-        """Consistent mass (:meth:`MembraneTL.mass`) on the global dofs."""
+    def mass(self, state=None) -> sp.csr_matrix:
+        """Consistent mass (:meth:`MembraneTL.mass`) on the global dofs, the same at every
+        ``state``."""
         if self._M is None:
             g = self.dofmap.translation_dofs(self.nodes).ravel()
             P = sp.csr_matrix((np.ones(g.size), (g, np.arange(g.size))),

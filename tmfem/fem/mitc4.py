@@ -534,9 +534,24 @@ class MITC4Shell:
 
     def mass(self, state=None) -> sp.csr_matrix:
         """Consistent mass with rotary inertia int rho N^T N dV (ndof, ndof); the rotational
-        dofs are mapped with the triads of ``state`` (default: the reference triads)."""
+        dofs are mapped with the triads of ``state`` (default: the reference triads): the
+        assembled :meth:`element_mass`."""
         if state is None and self._M is not None:
             return self._M
+        M = self._asm.matrix(self.element_mass(state))
+        if state is None:
+            self._M = M
+        return M
+
+    def element_mass(self, state=None, *, elements: slice = slice(None)) -> np.ndarray:
+        """Element mass matrices (ne, 20, 20) of the ``elements`` (a slice; default all) at
+        the triads of ``state`` (default: the reference triads), local dofs as in
+        :meth:`element_arrays` (the share protocol of
+        :class:`tmfem.fem.distributed.DistributedElements`)."""
+        return self._part(elements)._element_mass(state)
+
+    def _element_mass(self, state) -> np.ndarray:
+        """:meth:`element_mass` of all elements of this set."""
         pts = self._gauss
         rho = self.section.rho
         hh = np.einsum("kq,lq->qkl", pts.h, pts.h)
@@ -550,11 +565,7 @@ class MITC4Shell:
         else:
             V = self._nodal(state)[3]
         Lb = self._lam_block(self._lam(V))
-        Me = np.matmul(np.swapaxes(Lb, 1, 2), np.matmul(Mx, Lb))
-        M = self._asm.matrix(Me)
-        if state is None:
-            self._M = M
-        return M
+        return np.matmul(np.swapaxes(Lb, 1, 2), np.matmul(Mx, Lb))
 
     # ------------------------------------------------------------------ results
     def stresses(self, state, *, xi=(0.5, 0.5)):
@@ -682,6 +693,6 @@ class ShellPressure:
         tr = self.dofmap.translation_dofs(np.arange(self.dofmap.n_nodes))
         return -float(f[tr.ravel()] @ u.ravel())
 
-    def mass(self):
-        """A load carries no mass."""
+    def mass(self, state=None):
+        """A load carries no mass (at any ``state``)."""
         return sp.csr_matrix((self.dofmap.ndof,) * 2)

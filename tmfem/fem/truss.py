@@ -202,8 +202,9 @@ class TrussElement:
         """Strain energy (:func:`truss_energy`)."""
         return truss_energy(state.x, self.trusses)
 
-    def mass(self) -> sp.csr_matrix:
-        """Consistent or lumped mass (:func:`truss_mass`)."""
+    def mass(self, state=None) -> sp.csr_matrix:
+        """Consistent or lumped mass (:func:`truss_mass`); the same at every ``state``
+        (translations only: the mass at a state, as the beams' and shells')."""
         return truss_mass(self.trusses, self.dofmap, lumped=self.lumped_mass)
 
 

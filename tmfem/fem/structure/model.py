@@ -923,11 +923,7 @@ class Structure:
     def mass(self, state: State | None = None) -> sp.csr_matrix:
         """Mass matrix (ndof, ndof): sum of the element sets' masses (shell and beam rotary
         inertia mapped with the triads of ``state``)."""
-        M = None
-        for e in self.elements:
-            Me = e.mass(state) if (state is not None and isinstance(e, (MITC4Shell, BeamElement))) else e.mass()
-            M = Me if M is None else M + Me
-        return M
+        return sum(e.mass(state) for e in self.elements)
 
     def modes(self, *, k: int = 6, at: StructureState | None = None):
         """Lowest k modes about ``at`` (default: the reference state) with the tangent there

@@ -232,11 +232,7 @@ class SBCModel(FEModel, Tendons, Placement):
     def mass(self, state: State | None = None) -> sp.csr_matrix:
         """Reduced mass T^T M T: shell (with rotary inertia) and beams at the directors of
         ``state`` (reference by default), consistent tendon mass."""
-        return self.constraints.tangent(self._full_mass(state))
-
-    def _full_mass(self, state: State | None = None) -> sp.csr_matrix:
-        """The mass of :meth:`mass` on all dofs (before the constraint map)."""
-        return self.shell.mass(state) + self.beam.mass(state) + self.tendon_element.mass()
+        return self.constraints.tangent(sum(e.mass(state) for e in self.elements))
 
     def member_forces(self, state: State) -> dict:
         """Tendon axial forces [N] (per tendon, mean of its elements; per element
@@ -311,7 +307,13 @@ class SBCModel(FEModel, Tendons, Placement):
             s0 = self.start_state()
         idx = {lab: self.node(lab) for lab in monitor}
         hist = {lab: [s0.x[:, n].copy()] for lab, n in idx.items()}
-        Md = np.asarray(self.mass().diagonal())[self.free]
+        dist = self.distributed
+        if dist is None:
+            Md = np.asarray(self.mass().diagonal())[self.free]
+        else:       # the reference mass for its diagonal only (the modes take it at their state)
+            M0 = dist.mass(self.start_state())
+            Md = M0.diagonal()
+            M0.destroy()
 
         def record(it, s, rn, mu, rho):
             for lab, n in idx.items():
@@ -319,7 +321,6 @@ class SBCModel(FEModel, Tendons, Placement):
             if callable(progress):
                 progress(it, rn, mu, rho)
 
-        dist = self.distributed
         if dist is None:                   # unknowns: the reduced dofs, scipy matrices
             residual, energy, advance, unknowns = self.residual, self.energy, self.advance, self.free
         else:                              # unknowns: the free dofs, assembled rank by rank
@@ -362,7 +363,7 @@ class SBCModel(FEModel, Tendons, Placement):
             return lowest_modes(K.tocsr(), self.mass(state), k=k, free=self.free, sigma=sigma,
                                 backend=self.backend)
         _, K = dist.residual(state, symmetric=True)
-        return dist.modes(K, dist.mass(self._full_mass(state)), k=k, sigma=sigma,
+        return dist.modes(K, dist.mass(state), k=k, sigma=sigma,
                           backend=self.backend)
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
