@@ -14,12 +14,13 @@ How an element set is shared out over the ranks:
 
 * sets that provide the *share protocol* -- ``element_dofs`` (ne, nd) and
   ``element_arrays(state, tangent=, elements=slice)``, ``energy(state, elements=slice)``
-  (the membrane, :class:`tmfem.fem.membrane.MembraneElement`) -- evaluate only the
-  contiguous block of elements of this rank (:func:`~tmfem.solvers.distributed.element_share`):
-  the kernel work, the element arrays and the matrix entries are split P ways;
-* any other set (trusses: a few hundred elements) is evaluated whole on every rank, and each
-  rank contributes its block of the entries of its assembled tangent (the set's CSR pattern
-  is fixed) and, on rank 0, its force and energy.
+  and, optionally, ``element_mass(state, elements=slice)`` (the membrane, the MITC4 shells,
+  the trusses) -- evaluate only the contiguous block of elements of this rank
+  (:func:`~tmfem.solvers.distributed.element_share`): the kernel work, the element arrays
+  and the matrix entries are split P ways;
+* any other set (the beams: a few hundred elements) is evaluated whole on every rank, and
+  each rank contributes its block of the entries of its assembled tangent (the set's CSR
+  pattern is fixed) and, on rank 0, its force and energy.
 
 Every rank holds the full state (vectors are replicated, O(n) per rank). A tangent that a
 caller still references is never refilled (:meth:`DistributedElements.residual` reuses an

@@ -80,6 +80,11 @@ class TrussSet:
     def ne(self) -> int:
         return self.conn.shape[1]
 
+    def take(self, elements: slice) -> "TrussSet":
+        """The elements ``elements`` (a slice) of this set, as a set of their own."""
+        return TrussSet(self.conn[:, elements], self.L[elements], self.EA[elements],
+                        self.rhoA[elements], self.tension_only[elements])
+
     def assembler(self, dofmap: DofMap) -> Assembler:
         """Sparse assembler on the translations of ``dofmap``, cached by dof layout."""
         key = dofmap.counts.tobytes()
@@ -111,9 +116,9 @@ class TrussResponse:
     length: np.ndarray
 
 
-def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True,
-                   dofmap: DofMap | None = None) -> TrussResponse:
-    """Total-Lagrangian internal force and tangent of all truss elements (eqs. 4.4-4.7, 4.23-4.24).
+def truss_element_arrays(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True):
+    """Total-Lagrangian element forces and tangents of the truss elements (eqs. 4.4-4.7,
+    4.23-4.24) with their member state.
 
     Parameters
     ----------
@@ -121,28 +126,31 @@ def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True,
         Current nodal positions.
     trusses : TrussSet
     tangent : bool
-        If False, ``K`` is None (residual only, e.g. inside a line search).
-    dofmap : DofMap, optional
-        Global dof numbering (default: three translations per node, dof = 3 node + component).
+        If False, ``Ke`` is None.
+
+    Returns
+    -------
+    fe : (ne, 6) forces at the end nodes [x_1, x_2], three components each
+    Ke : (ne, 6, 6) tangents, or None
+    N, strain, slack, length : (ne,) as in :class:`TrussResponse`
     """
     x = np.asarray(x, dtype=float)
     if x.ndim != 2 or x.shape[0] != 3:
         raise InputError(f"truss: expected positions of shape (3, nn), found {x.shape}")
-    asm = trusses.assembler(dofmap or DofMap.translations(x.shape[1]))
+    if trusses.ne and trusses.conn.max() >= x.shape[1]:
+        raise InputError(f"truss: expected node indices < {x.shape[1]}, found {trusses.conn.max()}")
     d = x[:, trusses.conn[1]] - x[:, trusses.conn[0]]          # (3, ne)
     l2 = np.einsum("ie,ie->e", d, d)
     L = trusses.L
     E = (l2 - L**2) / (2.0 * L**2)
     slack = trusses.tension_only & (E <= 0.0)
-    active = ~slack
-    EAe = np.where(active, trusses.EA, 0.0)
+    EAe = np.where(~slack, trusses.EA, 0.0)
     s = EAe * E / L                                            # f_2 = s d
     f2 = (s * d).T                                             # (ne, 3)
     fe = np.concatenate([-f2, f2], axis=1)
-    f = asm.vector(fe)
     l = np.sqrt(l2)
     N = EAe * E * l / L
-    K = None
+    Ke = None
     if tangent:
         K22 = (EAe / L**3)[:, None, None] * np.einsum("ie,je->eij", d, d) \
             + s[:, None, None] * np.eye(3)[None]
@@ -151,8 +159,19 @@ def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True,
         Ke[:, 3:, 3:] = K22
         Ke[:, :3, 3:] = -K22
         Ke[:, 3:, :3] = -K22
-        K = asm.matrix(Ke)
-    return TrussResponse(f=f, K=K, N=N, strain=E, slack=slack, length=l)
+    return fe, Ke, N, E, slack, l
+
+
+def truss_internal(x: np.ndarray, trusses: TrussSet, *, tangent: bool = True,
+                   dofmap: DofMap | None = None) -> TrussResponse:
+    """Internal force and tangent of all truss elements (:func:`truss_element_arrays` of
+    ``x``, ``trusses`` and ``tangent``; ``K`` None without it: the residual only, e.g.
+    inside a line search) assembled on the global dofs of ``dofmap`` (default: three
+    translations per node, dof = 3 node + component)."""
+    fe, Ke, N, E, slack, l = truss_element_arrays(x, trusses, tangent=tangent)
+    asm = trusses.assembler(dofmap or DofMap.translations(np.shape(x)[1]))
+    return TrussResponse(f=asm.vector(fe), K=None if Ke is None else asm.matrix(Ke), N=N,
+                         strain=E, slack=slack, length=l)
 
 
 def truss_energy(x: np.ndarray, trusses: TrussSet) -> float:
@@ -166,25 +185,33 @@ def truss_energy(x: np.ndarray, trusses: TrussSet) -> float:
     return 0.5 * float(np.sum(trusses.EA * L * E**2))
 
 
-def truss_mass(trusses: TrussSet, nn: int | DofMap, *, lumped: bool = False) -> sp.csr_matrix:
-    """Mass matrix of the truss elements, total mass rho A L per element, on ``nn``
-    translational nodes or on the translations of a :class:`DofMap`.
+def truss_element_mass(trusses: TrussSet, *, lumped: bool = False) -> np.ndarray:
+    """Element mass matrices (ne, 6, 6) of the truss elements, total mass rho A L per
+    element, local dofs as in :func:`truss_element_arrays`.
 
     Consistent (eq. 4.6 with the shape functions of eq. 4.24): (rho A L / 6) [[2I, I], [I, 2I]];
     lumped: (rho A L / 2) I at each end.
     """
-    asm = trusses.assembler(nn if isinstance(nn, DofMap) else DofMap.translations(nn))
     m = trusses.rhoA * trusses.L
     if lumped:
         pattern = np.kron(np.eye(2), np.eye(3)) / 2.0
     else:
         pattern = np.kron(np.array([[2.0, 1.0], [1.0, 2.0]]), np.eye(3)) / 6.0
-    return asm.matrix(m[:, None, None] * pattern[None])
+    return m[:, None, None] * pattern[None]
+
+
+def truss_mass(trusses: TrussSet, nn: int | DofMap, *, lumped: bool = False) -> sp.csr_matrix:
+    """Mass matrix of the truss elements (:func:`truss_element_mass`) on ``nn``
+    translational nodes or on the translations of a :class:`DofMap`."""
+    asm = trusses.assembler(nn if isinstance(nn, DofMap) else DofMap.translations(nn))
+    return asm.matrix(truss_element_mass(trusses, lumped=lumped))
 
 
 class TrussElement:
     """A :class:`TrussSet` behind the element interface of :mod:`tmfem.fem.element`, on the
-    translations of ``dofmap`` (its nodes may carry rotations too: a truss ignores them)."""
+    translations of ``dofmap`` (its nodes may carry rotations too: a truss ignores them),
+    and the share protocol of :class:`tmfem.fem.distributed.DistributedElements` (its
+    elements split over the ranks like the membrane's)."""
 
     def __init__(self, trusses: TrussSet, dofmap: DofMap, *, lumped_mass: bool = False):
         self.trusses, self.dofmap, self.lumped_mass = trusses, dofmap, lumped_mass
@@ -198,9 +225,25 @@ class TrussElement:
         r = self.response(state, tangent=tangent)
         return r.f, r.K
 
-    def energy(self, state) -> float:
-        """Strain energy (:func:`truss_energy`)."""
-        return truss_energy(state.x, self.trusses)
+    @property
+    def element_dofs(self) -> np.ndarray:
+        """(ne, 6) global dofs of each element, the translations of its end nodes."""
+        return self.dofmap.element_dofs(self.trusses.conn)
+
+    def element_arrays(self, state, *, tangent: bool = True, elements: slice = slice(None)):
+        """Element forces (ne, 6) and tangents (ne, 6, 6) (or None) of the ``elements``
+        (:func:`truss_element_arrays`), local dofs as :attr:`element_dofs`."""
+        fe, Ke, *_ = truss_element_arrays(state.x, self.trusses.take(elements), tangent=tangent)
+        return fe, Ke
+
+    def energy(self, state, *, elements: slice = slice(None)) -> float:
+        """Strain energy of the ``elements`` (:func:`truss_energy`)."""
+        return truss_energy(state.x, self.trusses.take(elements))
+
+    def element_mass(self, state=None, *, elements: slice = slice(None)) -> np.ndarray:
+        """Element mass matrices (ne, 6, 6) of the ``elements`` (:func:`truss_element_mass`),
+        the same at every ``state``."""
+        return truss_element_mass(self.trusses.take(elements), lumped=self.lumped_mass)
 
     def mass(self, state=None) -> sp.csr_matrix:
         """Consistent or lumped mass (:func:`truss_mass`); the same at every ``state``
