@@ -363,8 +363,11 @@ class SBCModel(FEModel, Tendons, Placement):
             return lowest_modes(K.tocsr(), self.mass(state), k=k, free=self.free, sigma=sigma,
                                 backend=self.backend)
         _, K = dist.residual(state, symmetric=True)
-        return dist.modes(K, dist.mass(state), k=k, sigma=sigma,
-                          backend=self.backend)
+        M = dist.mass(state)
+        try:
+            return dist.modes(K, M, k=k, sigma=sigma, backend=self.backend)
+        finally:
+            M.destroy()    # the mass at this state is this solve's (petsc4py frees on destroy())
 
     def full_shapes(self, shapes: np.ndarray) -> np.ndarray:
         """Translations (3, n_nodes, k) of the mode shapes from reduced vectors (n_red, k)."""
