@@ -7,22 +7,6 @@ import re
 
 import pytest
 
-from tmfem.cli import main
-
-
-@pytest.fixture(scope="module")
-def report(tmp_path_factory):
-    from tmfem.reference import report as rep
-    out = tmp_path_factory.mktemp("report") / "1-4"
-    with pytest.MonkeyPatch.context() as mp:
-        own = rep.report_deployment
-        mp.setattr(rep, "report_deployment",
-                   lambda s: {**own(s), "t_end": 0.3, "controller": "adaptive-lqr"})
-        rc = main(["report", "--preset", "1-4", "--out", str(out), "--mesh", "4", "--t-end", "0.2",
-                   "--modes", "6", "--no-render", "--json"])
-    assert rc == 0
-    return out
-
 
 def test_index_links_every_file(report):
     index = (report / "index.md").read_text()

@@ -2,7 +2,7 @@
 directory and opened in headless Chromium (Debian's ``chromium``, installed by
 scripts/install_browser.sh; the browser tests skip where it is absent).
 
-The page is the reduced report of tests/reference/test_report.py. In the browser: the page
+The page is the reduced report of tests/reference/conftest.py (its ``report`` fixture). In the browser: the page
 loads without script errors (its own error handler and Chromium's console log), every image
 decodes, every table and 3-D view is there and drew its elements, and (through the DevTools
 protocol) every control, rotation, zoom, pick and playback of every view changes it;
@@ -20,7 +20,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.reference.test_report import report  # noqa: F401  (the reduced report directory)
 
 BROWSERS = ("chromium", "chromium-browser", "google-chrome")
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",

@@ -177,12 +177,11 @@ class DistributedElements:
         and kept; a mass at a state is a new matrix each call.
 
         Sets that provide ``element_mass(state, elements=slice)`` (element mass matrices
-        (ne, nd, nd) of a block, like ``element_arrays``: the membrane, the shells)
-        contribute each rank's element masses (no full mass matrix on any rank), their
-        entries where any element of the share has one (the membrane's node blocks are
-        diagonal: 48 of 144); the other sets (trusses and beams, evaluated whole on every
-        rank as in :meth:`residual`) this rank's share of the entries of their assembled
-        mass."""
+        (ne, nd, nd) of a block, like ``element_arrays``: the membrane, the shells, the
+        trusses) contribute each rank's element masses (no full mass matrix on any rank),
+        their entries where any element of the share has one (the membrane's node blocks
+        are diagonal: 48 of 144); the other sets (the beams, evaluated whole on every rank
+        as in :meth:`residual`) this rank's share of the entries of their assembled mass."""
         if state is None and self._M is not None:
             return self._M
         groups, values = [], []
