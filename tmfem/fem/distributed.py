@@ -174,7 +174,8 @@ class DistributedElements:
         """Mass matrix (T^T M T)[free][:, free] (a DistributedMatrix) at ``state``: the
         rotary inertia of shells and beams turns with their triads (the sets' ``mass(state)``
         of :mod:`tmfem.fem.element`). The reference mass (``state`` None) is assembled once
-        and kept; a mass at a state is a new matrix each call.
+        and kept (freed by :meth:`release`); a mass at a state is a new matrix each call, which
+        the caller destroys (``destroy()``: petsc4py frees a matrix on it only).
 
         Sets that provide ``element_mass(state, elements=slice)`` (element mass matrices
         (ne, nd, nd) of a block, like ``element_arrays``: the membrane, the shells, the
