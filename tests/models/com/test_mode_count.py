@@ -25,12 +25,25 @@ def kapton():
 
 def test_truncated_search_model_has_the_frequencies_of_a_com_built_with_k():
     """The search evaluates K < 16 as the leading blocks of the K = 16 linearisation (eq. 5.33);
-    a COM built with K = 5 has the same frequencies (the same first five fixed-corner modes)."""
+    a COM built with K = 6 has the same frequencies (the same first six fixed-corner modes: K = 6
+    keeps the triangle's 3.6062 Hz pair, modes 5 and 6, whole)."""
     s = load_system(SYSTEMS / "triangle-1-3.toml")
     big = ControlOrientedModel(s, membrane_modes=16, output_points=[])
-    small = ControlOrientedModel(s, membrane_modes=5, output_points=[])
-    f = mode_count._truncated_hz(big.linearization(), big.nq + 5, 11)
+    small = ControlOrientedModel(s, membrane_modes=6, output_points=[])
+    f = mode_count._truncated_hz(big.linearization(), big.nq + 6, 11)
     assert f == pytest.approx(small.linearization().frequencies_hz()[:11], rel=1e-6)
+
+
+def test_the_search_never_keeps_part_of_a_repeated_membrane_frequency():
+    """The triangle's membrane has the pairs 2-3, 5-6, 8-9 (three-fold symmetry, equal to 1e-9):
+    K = 2, 5, 8 would keep one vector of a pair, an arbitrary one of its eigenspace."""
+    s = load_system(SYSTEMS / "triangle-1-3.toml")
+    omega = ControlOrientedModel(s, membrane_modes=10, output_points=[]).membrane.omega
+    assert np.allclose(omega[[1, 4, 7]], omega[[2, 5, 8]], rtol=1e-9)
+    split = [K for K in range(1, 10) if mode_count.splits_repeated(omega, K)]
+    assert split == [2, 5, 8]
+    c = mode_count.choose_membrane_modes(s, model_class=ControlOrientedModel)
+    assert c.K not in split and all(c.max_difference_by_K[K] is None for K in (5, 8))
 
 
 def test_kapton_gets_the_smallest_k_that_matches_the_mtc_band(kapton):

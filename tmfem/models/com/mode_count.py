@@ -5,7 +5,8 @@ The COM's frequencies converge towards the finite-element models' as K grows, un
 remains is its own approximation (rigid bars, membrane modes about the designed prestress,
 ch. 5). The default K is the smallest one whose frequencies in the *band of interest* -- the
 :data:`BAND_MODES` lowest modes, those ``tmfem modal`` and ``tmfem report`` show by default --
-agree with the finite-element model's within :data:`TOLERANCE`:
+agree with the finite-element model's within :data:`TOLERANCE`, among the K that keep every
+repeated membrane frequency whole (:func:`splits_repeated`):
 
     max_i |f_i^COM(K) / f_i^FE - 1| <= TOLERANCE,   i = 1 .. BAND_MODES,
 
@@ -49,6 +50,9 @@ K_MIN = 3
 K_SEARCH = 16
 #: membrane elements per side of each patch of the finite-element model compared with (6.2: 10)
 FE_MESH = 10
+#: relative gap below which neighbouring membrane frequencies are one repeated frequency (the
+#: pairs of a cyclically symmetric membrane): the automatic K never keeps part of one
+REPEATED = 1e-6
 
 
 @dataclass
@@ -163,7 +167,7 @@ def _cache_key(fingerprint: str) -> dict:
     """Everything the automatic choice depends on: the system's content and this module's
     constants (tmfem's version is added by the cache)."""
     return {"system": fingerprint, "BAND_MODES": BAND_MODES, "TOLERANCE": TOLERANCE, "CONVERGED": CONVERGED,
-            "K_MIN": K_MIN, "K_SEARCH": K_SEARCH, "FE_MESH": FE_MESH}
+            "K_MIN": K_MIN, "K_SEARCH": K_SEARCH, "FE_MESH": FE_MESH, "REPEATED": REPEATED}
 
 
 def _stored_choice(system, fingerprint: str, *, model_class) -> MembraneModeChoice:
@@ -215,7 +219,7 @@ def choose_membrane_modes(system, *, model_class, band_modes: int = BAND_MODES,
     hi = _truncated_hz(lin, nq + k_hi, n)
     worst, bands = {}, {}
     for K in range(min(K_MIN, k_hi), k_hi + 1):
-        if nq + K < n:
+        if nq + K < n or splits_repeated(com.membrane.omega, K):
             worst[K] = None
             continue
         f = _truncated_hz(lin, nq + K, n)
@@ -258,6 +262,13 @@ def _relative(f, ref) -> np.ndarray:
     f, ref = np.asarray(f, dtype=float), np.asarray(ref, dtype=float)
     ok = (f > 0) & (ref > 0)
     return np.where(ok, f / np.where(ok, ref, 1.0) - 1.0, np.inf)
+
+
+def splits_repeated(omega, K: int) -> bool:
+    """Whether the first K membrane modes of frequencies ``omega`` (ascending) keep part of a
+    repeated frequency (omega_K and omega_K+1 within :data:`REPEATED` of each other): such a
+    COM depends on which vectors of the frequency's eigenspace the eigensolver returned."""
+    return 0 < K < len(omega) and abs(omega[K] - omega[K - 1]) <= REPEATED * abs(omega[K])
 
 
 def _truncated_hz(lin, m: int, n: int) -> np.ndarray:
