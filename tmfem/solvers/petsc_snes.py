@@ -51,6 +51,7 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather, rows_dot, rows_norm
 from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
 from tmfem.solvers.petsc_options import SOLVER_PREFIXES, option_error, set_from_options
+from tmfem.solvers.trust_region import floor_hint
 
 log = logging.getLogger(__name__)
 
@@ -328,7 +329,8 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                 raise ConvergenceError(
                     f"{what}: SNES {reason_name(PETSc, reason)} (expected an equilibrium with "
                     f"|r| <= {tol:g} x force scale, found |r| = {rows_norm(r, comm):.3e} N "
-                    f"after {total} SNES iterations, mu = {mu:.3g}){note}{_options_note(backend)}")
+                    f"after {total} SNES iterations, mu = {mu:.3g}){note}{_options_note(backend)}"
+                    f"{floor_hint(rows_norm(r, comm), force_scale(u), tol)}")
     finally:
         # the SNES, its KSP (MUMPS' analysis of the tangent's pattern) and matrix stay with
         # the backend for the eigen solve about this equilibrium
@@ -343,5 +345,5 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         note = f" ({describe(u)})" if describe is not None else ""
         raise ConvergenceError(f"{what}: SNES stopped after {total} iterations (max_iter {max_iter}) "
                                f"at |r| = {rn:.3e} N, expected <= {tol:g} x force scale{note}"
-                               f"{_options_note(backend)}")
+                               f"{_options_note(backend)}{floor_hint(rn, force_scale(u), tol)}")
     return dict(u=u, iterations=total, residual_history=res_hist, mu_history=mu_hist, tangent=K)

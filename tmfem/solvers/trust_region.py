@@ -152,7 +152,8 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
                 converged = True
                 break
             raise ConvergenceError(f"{what}: no descent step at iteration {it} (|r| = {rn:.3e} N, "
-                                   f"mu = {mu:.3e}); residual history {np.array(res_hist[-6:])} N")
+                                   f"mu = {mu:.3e}); residual history {np.array(res_hist[-6:])} N"
+                                   f"{floor_hint(rn, force_scale(u), tol)}")
         mu_used = mu
         u, r, K, W, rn = ut, rt, Kt, Wt, rtn
         if rho > 0.75:
@@ -173,6 +174,19 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     if not converged:
         note = f" ({describe(u)})" if describe is not None else ""
         raise ConvergenceError(f"{what}: no equilibrium after {it} iterations{note}; residual "
-                               f"history {np.array(res_hist[-6:])} N, mu = {mu:.3g}")
+                               f"history {np.array(res_hist[-6:])} N, mu = {mu:.3g}"
+                               f"{floor_hint(rn, force_scale(u), tol)}")
     return TrustRegionResult(u=u, iterations=it, residual_history=res_hist, mu_history=mu_hist,
                              tangent=K)
+
+
+def floor_hint(rn: float, fs: float, tol: float) -> str:
+    """The cause of a failure that ends with |r| = rn at most 1e-6 of the force scale fs (no
+    step improved it, or no tenfold progress in 40 iterations): the model's round-off floor
+    lies above the 1e3 tol fs that the iteration accepts as one, and a tol ten times above
+    rn / (1e3 fs) ends on it; else empty."""
+    rel = rn / fs if fs > 0 else np.inf
+    if not rel <= 1e-6:
+        return ""
+    return (f"; the residual stalled at {rel:.2g} of the force scale: the model's round-off floor "
+            f"lies above the 1e3 x tol = {1e3 * tol:g} taken as one, use tol >= {10 * rel / 1e3:.0e}")
