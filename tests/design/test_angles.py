@@ -30,12 +30,13 @@ SQUARE, TRIANGLE, PENTAGON_D = DATA / "square-2-4.toml", DATA / "triangle-1-3.to
 NAMES = [n for n in SCALARS if n != "surface_rms"] + VECTORS        # flat membranes by symmetry
 
 
-def fd_check(system, variables, Model=MTCModel, names=NAMES, **options):
+def fd_check(system, variables, Model=MTCModel, names=NAMES, tol=1e-12, **options):
     """Exact and Richardson-extrapolated derivatives of ``names`` on ``Model`` (MTCModel or
-    SBCModel) at mesh_n=4 with the model's ``options``, with the values and the design."""
+    SBCModel) at mesh_n=4 with the model's ``options``, equilibria to ``tol`` of the member
+    forces, with the values and the design."""
     m = Model(system, mesh_n=4, **options)
     r0 = m.rest_lengths.copy()
-    eq = m.equilibrium(tol=1e-12)
+    eq = m.equilibrium(tol=tol)
     vs = parse_variables(system, variables)
     p0 = variable_values(system, r0, vs)
     f0, exact = stacked(design_sensitivities(m, equilibrium=eq, variables=variables, **OPTIONS), names)
@@ -44,7 +45,7 @@ def fd_check(system, variables, Model=MTCModel, names=NAMES, **options):
     def values(p):
         sj, rj = apply_design(system, r0, vs, p, redesign=redesign)
         mj = Model(sj, mesh_n=4, rest_lengths=rj, **options)
-        ej = mj.equilibrium(tol=1e-12, **warm_start(mj, eq.state))
+        ej = mj.equilibrium(tol=tol, **warm_start(mj, eq.state))
         return stacked(design_sensitivities(mj, equilibrium=ej, variables=variables, **OPTIONS), names)[0]
 
     steps = []

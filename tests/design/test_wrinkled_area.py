@@ -38,8 +38,11 @@ def test_wrinkled_area_tends_to_the_tension_field_area_as_the_width_shrinks():
 
 
 def test_wrinkled_area_derivatives_match_finite_differences(monkeypatch):
-    # width 1 kPa: the area changes smoothly over the difference steps
-    monkeypatch.setitem(test_responses.OPTIONS, "wrinkle_width", 1e3)
+    # width 10 kPa: the area changes smoothly over the difference steps, and its derivative
+    # stays clear of the equilibrium's round-off (which H_w' / w amplifies in the wrinkled
+    # regions: at 1 kPa, d A_w / d r_mb moved by 3e-5 between equilibria re-solved at the
+    # round-off floor, at 10 kPa by 3e-7)
+    monkeypatch.setitem(test_responses.OPTIONS, "wrinkle_width", 1e4)
     exact, fd, f0, p0 = test_responses.fd_check(load_preset("1-4"), ["S1", "h_membrane", "d_bar", "d_S", "r_mb"],
                                                 ["wrinkled_area"])
     assert f0[0] > 0.1 and np.all(np.abs(exact) > 0)
