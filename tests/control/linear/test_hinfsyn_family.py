@@ -20,7 +20,8 @@ Stated tolerances (relative, on the verified norm above the optimum): "auto" and
 3e-3 (gamma_tol = 1e-3 and a bisection to gamma_tol / 2), "lmi" 0.1 (its recovery backs off
 up to 10 % above the LMI optimum, LMI_BACKOFF), "slicot" 0.1 (SB10AD's own gamma iteration);
 the reported level gamma is at most 10 % above the verified norm; an absolute 1e-7 (the SDP
-solver's resolution) where the optimum is near 0.
+solver's resolution) where the optimum is near 0, and 1e-5 where it lies below what the routes
+resolve (NEAR_ZERO: COMPleib AC1).
 
 COMPleib plants (tests/data/compleib.py, F. Leibfritz, COMPleib 1.1): published tables of
 their full-order optimum could not be consulted, so their reference is the bracket above
@@ -46,8 +47,15 @@ FAMILY = family()
 ROUTES = ("auto", "riccati", "lmi", "slicot")
 TOL = {"auto": 3e-3, "riccati": 3e-3, "lmi": 0.1, "slicot": 0.1}
 #: absolute tolerance: the resolution of the SDP solver (Clarabel's tolerances 1e-8 on data of
-#: unit size); COMPleib AC1 has the optimum 6e-7, known to about 2e-8
+#: unit size)
 ATOL = 1e-7
+#: plants whose optimum lies below what the routes resolve, and their absolute tolerance.
+#: COMPleib AC1 (singular: D12 of rank 2 of 3, D21 = 0): its LMI optimum moves with the LMIs'
+#: strictness margin eps (1.5e-6, 8.3e-7, 5.1e-7, 4.8e-7 at eps = 1e-6 ... 1e-9) and by 6e-7 /
+#: 8.3e-7 between two CPUs at eps = 1e-7; where the recovery of eq. 5.67 fails at its tiny
+#: gamma (cond(I - RS) 8e6 at every back-off up to 11 gamma_LMI), the verified controller is the
+#: regularised Riccati route's, 6e-6: the optimum is zero to within 1e-5 of data of unit size
+NEAR_ZERO = {"compleib-AC1": 1e-5}
 # SB10AD stalls (> 30 s) on the near-integrating weights: its time bound is tested below
 SLOW_SLICOT = ("near-integrator",)
 
@@ -98,8 +106,9 @@ def test_every_route_is_verified_and_near_the_optimum(name, results):
     if P.nstates <= 20:                       # the speed target of the family (2 shared cores)
         assert res["auto"].info["time_s"] < 10.0
     lower, upper = _bracket(name, res)
-    # the optimum is known to 0.3 % (or ATOL) from independent evidence
-    assert lower <= upper * (1 + 1e-6) and upper <= lower * (1 + 3e-3) + ATOL
+    atol = NEAR_ZERO.get(name, ATOL)
+    # the optimum is known to 0.3 % (or atol) from independent evidence
+    assert lower <= upper * (1 + 1e-6) and upper <= lower * (1 + 3e-3) + atol
     for route, r in res.items():
         if isinstance(r, Exception):
             assert route != "auto"
@@ -114,9 +123,9 @@ def test_every_route_is_verified_and_near_the_optimum(name, results):
         assert nrm == pytest.approx(r.info["verified_norm"], rel=3e-4)
         assert r.gamma >= nrm * (1 - 1e-9)                      # never below the verified norm
         assert nrm >= lower * (1 - 1e-6)                       # nobody beats the optimum
-        assert nrm <= lower * (1 + TOL[route]) + ATOL, (route, nrm, lower)
+        assert nrm <= lower * (1 + TOL[route]) + atol, (route, nrm, lower)
         # the reported level: at most the LMI route's last back-off above the achieved norm
-        assert r.gamma <= nrm * (1 + LMI_BACKOFF[-1]) + ATOL, (route, r.gamma, nrm)
+        assert r.gamma <= nrm * (1 + LMI_BACKOFF[-1]) + atol, (route, r.gamma, nrm)
         assert list(r.K.input_labels) == list(P.output_labels[-ny:])     # named signals
         assert list(r.K.output_labels) == list(P.input_labels[-nu:])
         assert list(r.CL.input_labels) == list(P.input_labels[:-nu])
