@@ -51,7 +51,7 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather, rows_dot, rows_norm
 from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
 from tmfem.solvers.petsc_options import SOLVER_PREFIXES, option_error, set_from_options
-from tmfem.solvers.trust_region import floor_hint
+from tmfem.solvers.roundoff import floor_hint
 
 log = logging.getLogger(__name__)
 

@@ -31,6 +31,7 @@ import scipy.sparse as sp
 from tmfem.errors import ConvergenceError
 from tmfem.solvers.backends import SingularMatrix, get_backend
 from tmfem.solvers.newton import free_index, submatrix
+from tmfem.solvers.roundoff import floor_hint
 
 log = logging.getLogger(__name__)
 
@@ -179,14 +180,3 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
     return TrustRegionResult(u=u, iterations=it, residual_history=res_hist, mu_history=mu_hist,
                              tangent=K)
 
-
-def floor_hint(rn: float, fs: float, tol: float) -> str:
-    """The cause of a failure that ends with |r| = rn at most 1e-6 of the force scale fs (no
-    step improved it, or no tenfold progress in 40 iterations): the model's round-off floor
-    lies above the 1e3 tol fs that the iteration accepts as one, and a tol ten times above
-    rn / (1e3 fs) ends on it; else empty."""
-    rel = rn / fs if fs > 0 else np.inf
-    if not rel <= 1e-6:
-        return ""
-    return (f"; the residual stalled at {rel:.2g} of the force scale: the model's round-off floor "
-            f"lies above the 1e3 x tol = {1e3 * tol:g} taken as one, use tol >= {10 * rel / 1e3:.0e}")
