@@ -218,28 +218,43 @@ def animate_deployment(gif, model, result, *, frames: int = 40) -> Path:
               Line2D([], [], color="0.5", lw=0, marker="s", ms=8,
                      label=f"membrane, deflection x {scale:g}")]
 
+    # the axes, lines, legend and layout are made once; a frame moves the lines and redraws
+    # the membrane and the title (the limits are those of the whole run)
+    X0 = Xs[0]
+    bar_lines = [ax.plot(*X0[:, [a, b]], color="saddlebrown", lw=3)[0] for a, b in bars.T]
+    tendon_lines = [ax.plot(*X0[:, [a, b]], color="tab:blue", lw=0.8)[0] for a, b in tends.T]
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_autoscale_on(False)
+    ax.set_box_aspect(box, zoom=0.8)
+    ax.locator_params(axis="z", nbins=3)
+    for axis, lab in ((ax.xaxis, "x [m]"), (ax.yaxis, "y [m]"), (ax.zaxis, "z [m]")):
+        axis.set_label_text(lab)
+        axis.labelpad = 10
+    ax.tick_params(labelsize=7, pad=2)
+    ax.legend(handles=legend, loc="upper left", fontsize=7, frameon=False)
+    surface = []
+
     def draw(i):
-        ax.cla()
+        if i == 1:
+            # the first frame was saved with the constrained layout (at the writer's dpi):
+            # the later ones keep it
+            fig.set_layout_engine("none")
         X = Xs[i]
-        for a, b in bars.T:
-            ax.plot(*X[:, [a, b]], color="saddlebrown", lw=3)
-        for a, b in tends.T:
-            ax.plot(*X[:, [a, b]], color="tab:blue", lw=0.8)
+        for line, (a, b) in zip(bar_lines, bars.T):
+            line.set_data_3d(*X[:, [a, b]])
+        for line, (a, b) in zip(tendon_lines, tends.T):
+            line.set_data_3d(*X[:, [a, b]])
+        if surface:
+            surface.pop().remove()
         surf = ax.plot_trisurf(XM[i, 0], XM[i, 1], XM[i, 2], triangles=tri, linewidth=0,
                                antialiased=False, shade=False)
         surf.set_facecolor(cmap(norm(wmm[i][tri].mean(axis=1))))
-        ax.set_xlim(lo[0], hi[0])
-        ax.set_ylim(lo[1], hi[1])
-        ax.set_zlim(lo[2], hi[2])
-        ax.set_box_aspect(box, zoom=0.8)
-        ax.locator_params(axis="z", nbins=3)
-        for axis, lab in ((ax.xaxis, "x [m]"), (ax.yaxis, "y [m]"), (ax.zaxis, "z [m]")):
-            axis.set_label_text(lab)
-            axis.labelpad = 10
-        ax.tick_params(labelsize=7, pad=2)
-        ax.legend(handles=legend, loc="upper left", fontsize=7, frameon=False)
+        surface.append(surf)
         ax.set_title(f"{system.name} deployment, t = {r.t[idx[i]]:.2f} s\ncontroller: "
                      f"{r.controller[min(idx[i], len(r.controller) - 1)]}", fontsize=10)
+
     anim = FuncAnimation(fig, draw, frames=len(idx))
     anim.save(str(gif), writer=PillowWriter(fps=8))
     return Path(gif)
