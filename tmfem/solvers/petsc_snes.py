@@ -51,7 +51,7 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.distributed import DistributedMatrix, gather, rows_dot, rows_norm
 from tmfem.solvers.mumps import is_singular, mumps_error, mumps_failure
 from tmfem.solvers.petsc_options import SOLVER_PREFIXES, option_error, set_from_options
-from tmfem.solvers.roundoff import floor_hint
+from tmfem.solvers.roundoff import FLOOR_FACTOR, floor_hint
 
 log = logging.getLogger(__name__)
 
@@ -253,7 +253,7 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         tiny = abs(0.5 * rows_dot(r_start, X.getArray(readonly=True), comm)) \
             < 1e-11 * max(abs(W), 1e-30)
         if prob.mu == 0.0 and tiny and rnorm > 0.5 * res_hist[-2] \
-                and rnorm <= 1e3 * tol * force_scale(uu):
+                and rnorm <= FLOOR_FACTOR * tol * force_scale(uu):
             raise _Floor    # the round-off floor: a Newton step no longer halves |r|
     snes.setMonitor(monitor)
 
@@ -326,11 +326,12 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
             prob.start(u, mu, r, K)
             if mu > 1e12 * mu_scale or total >= max_iter:
                 note = f" ({describe(u)})" if describe is not None else ""
+                rn = rows_norm(r, comm)
                 raise ConvergenceError(
                     f"{what}: SNES {reason_name(PETSc, reason)} (expected an equilibrium with "
-                    f"|r| <= {tol:g} x force scale, found |r| = {rows_norm(r, comm):.3e} N "
+                    f"|r| <= {tol:g} x force scale, found |r| = {rn:.3e} N "
                     f"after {total} SNES iterations, mu = {mu:.3g}){note}{_options_note(backend)}"
-                    f"{floor_hint(rows_norm(r, comm), force_scale(u), tol)}")
+                    f"{floor_hint(rn, force_scale(u), tol)}")
     finally:
         # the SNES, its KSP (MUMPS' analysis of the tangent's pattern) and matrix stay with
         # the backend for the eigen solve about this equilibrium
@@ -341,7 +342,7 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
         F.destroy()
         X.destroy()
     rn = rows_norm(r, comm)
-    if not rn <= 1e3 * tol * force_scale(u):
+    if not rn <= FLOOR_FACTOR * tol * force_scale(u):
         note = f" ({describe(u)})" if describe is not None else ""
         raise ConvergenceError(f"{what}: SNES stopped after {total} iterations (max_iter {max_iter}) "
                                f"at |r| = {rn:.3e} N, expected <= {tol:g} x force scale{note}"

@@ -31,7 +31,7 @@ import scipy.sparse as sp
 from tmfem.errors import ConvergenceError
 from tmfem.solvers.backends import SingularMatrix, get_backend
 from tmfem.solvers.newton import free_index, submatrix
-from tmfem.solvers.roundoff import floor_hint
+from tmfem.solvers.roundoff import FLOOR_FACTOR, floor_hint
 
 log = logging.getLogger(__name__)
 
@@ -134,7 +134,7 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
                 if np.isfinite(Wt) and (actual > 0 or tiny):
                     rt, Kt = residual(ut)
                     rtn = float(np.linalg.norm(rt[free]))
-                    if tiny and rtn > 0.5 * rn and rn <= 1e3 * tol * force_scale(u):
+                    if tiny and rtn > 0.5 * rn and rn <= FLOOR_FACTOR * tol * force_scale(u):
                         # the round-off floor: neither the energy nor |r| can fall further;
                         # the last (round-off sized) step is taken and the iteration ends
                         floor, rho = True, 1.0
@@ -149,7 +149,7 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
             ok = False
         if not ok or mu > 1e12 * mu_scale:
             # no step improves the state: accept it if we sit on the round-off floor
-            if rn <= 1e3 * tol * force_scale(u):
+            if rn <= FLOOR_FACTOR * tol * force_scale(u):
                 converged = True
                 break
             raise ConvergenceError(f"{what}: no descent step at iteration {it} (|r| = {rn:.3e} N, "
@@ -179,4 +179,3 @@ def trust_region_newton(residual: Callable, energy: Callable, u0, *, free, scale
                                f"{floor_hint(rn, force_scale(u), tol)}")
     return TrustRegionResult(u=u, iterations=it, residual_history=res_hist, mu_history=mu_hist,
                              tangent=K)
-
