@@ -43,5 +43,6 @@ def test_a_floor_below_1e3_tol_ends_the_iteration_on_it():
 
 
 def test_a_floor_above_1e3_tol_is_named_with_the_tol_that_ends_on_it():
-    with pytest.raises(ConvergenceError, match=r"round-off floor lies above the 1000 x tol = 1e-09 .* use tol >= 1e-09"):
+    floor = r"round-off floor lies above the 1000 x tol = 1e-09 .* use tol >= 1e-09"
+    with pytest.raises(ConvergenceError, match=floor):
         solve(NOISE, 1e-12)             # 1e3 x tol = 1e-9 of F, below the floor 1e-7
