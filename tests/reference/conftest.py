@@ -1,16 +1,22 @@
 """The reduced report directory of `tmfem report` shared by tests/reference/test_report.py
-and tests/reference/test_report_html.py (built once per test process)."""
+and tests/reference/test_report_html.py.
+
+It is built once per test run: under pytest-xdist the first worker that needs it builds it in
+the base temp directory the workers share, holding a lock file, and the others wait for the
+lock and read the same directory (the tests only read it)."""
+import fcntl
+import os
+import shutil
+
 import pytest
 
 from tmfem.cli import main
 
 
-@pytest.fixture(scope="session")
-def report(tmp_path_factory):
+def _build(out):
     """The report of the 1-4 at mesh 4 (0.2 s of vibration, 0.3 s of deployment under the
-    LQR switch instead of the LMI H-infinity design, no renders): its directory."""
+    LQR switch instead of the LMI H-infinity design, no renders) into ``out``."""
     from tmfem.reference import report as rep
-    out = tmp_path_factory.mktemp("report") / "1-4"
     with pytest.MonkeyPatch.context() as mp:
         own = rep.report_deployment
         mp.setattr(rep, "report_deployment",
@@ -18,4 +24,21 @@ def report(tmp_path_factory):
         rc = main(["report", "--preset", "1-4", "--out", str(out), "--mesh", "4", "--t-end", "0.2",
                    "--modes", "6", "--no-render", "--json"])
     assert rc == 0
+
+
+@pytest.fixture(scope="session")
+def report(tmp_path_factory):
+    """The reduced report's directory (:func:`_build`), shared by the xdist workers of this run
+    (their base temp directories have one parent per run; a run without xdist builds its own)."""
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    root = shared / "shared-report"
+    root.mkdir(exist_ok=True)
+    out, done = root / "1-4", root / "done"
+    with open(root / "lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)            # released when the file is closed
+        if not done.exists():
+            shutil.rmtree(out, ignore_errors=True)  # what a failed build of another worker left
+            _build(out)
+            done.touch()
     return out
