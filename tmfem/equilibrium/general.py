@@ -303,7 +303,8 @@ def symmetric_matrix(system, q=None) -> SymmetricMatrix:
     cols = [E.A_T[:, gid == g].sum(axis=1) for g in groups]
     cols.append(E.A_F @ symmetric_corner_direction(system.N))
     A = np.column_stack(cols)[rows]
-    return SymmetricMatrix(A=A, rows=[system.q_names[r] for r in rows], cols=groups + ["F_Delta"])
+    names = system.q_names
+    return SymmetricMatrix(A=A, rows=[names[r] for r in rows], cols=groups + ["F_Delta"])
 
 
 def expand_symmetric_forces(system, T_groups: np.ndarray, F_delta: float) -> np.ndarray:

@@ -8,6 +8,8 @@ and their direction:
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 
@@ -25,7 +27,12 @@ def q_stages(n_q: int, N: int) -> int:
 
 def q_index(M: int, N: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Indices into q of (x, y, z) of A_ij (3, M, N; -1 for stage 1), theta_ij and psi_ij
-    (M, N each)."""
+    (M, N each); copies of the layout computed once per (M, N), which a caller may change."""
+    return tuple(a.copy() for a in _q_index(int(M), int(N)))
+
+
+@lru_cache(maxsize=None)
+def _q_index(M: int, N: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     xyz = -np.ones((3, M, N), dtype=int)
     th = np.empty((M, N), dtype=int)
     ps = np.empty((M, N), dtype=int)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -35,6 +36,19 @@ def rest_length_array(values, n_tendons: int) -> np.ndarray:
         raise InputError(f"expected rest lengths within {lo:g}..{hi:g} {unit} (docs/guides/equilibrium.md, "
                          f"limits), found {r[k]:.4g} {unit} (tendon {k + 1} of {n_tendons})")
     return r
+
+
+@lru_cache(maxsize=None)
+def _q_names(M: int, N: int) -> tuple[str, ...]:
+    """Names of the generalised coordinates of an M-N system (:attr:`System.q_names`)."""
+    xyz, th, ps = q_index(M, N)
+    names = [""] * q_size(M, N)
+    for (i, j), k in np.ndenumerate(th):
+        names[k], names[ps[i, j]] = label("theta", i + 1, j + 1), label("psi", i + 1, j + 1)
+        for c, comp in enumerate("xyz"):
+            if xyz[c, i, j] >= 0:
+                names[xyz[c, i, j]] = label(comp, i + 1, j + 1)
+    return tuple(names)
 
 
 @dataclass(frozen=True)
@@ -219,15 +233,9 @@ class System:
     # ------------------------------------------------------------------ coordinates
     @property
     def q_names(self) -> list[str]:
-        """Names of the generalised coordinates, e.g. ``theta_11``, ``psi_11``, ``x_21``."""
-        xyz, th, ps = q_index(self.M, self.N)
-        names = [""] * q_size(self.M, self.N)
-        for (i, j), k in np.ndenumerate(th):
-            names[k], names[ps[i, j]] = label("theta", i + 1, j + 1), label("psi", i + 1, j + 1)
-            for c, comp in enumerate("xyz"):
-                if xyz[c, i, j] >= 0:
-                    names[xyz[c, i, j]] = label(comp, i + 1, j + 1)
-        return names
+        """Names of the generalised coordinates, e.g. ``theta_11``, ``psi_11``, ``x_21`` (a new
+        list of the names made once per (M, N))."""
+        return list(_q_names(int(self.M), int(self.N)))
 
     def split_q(self, q=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Lower ends A (3, M, N), declinations theta (M, N) and azimuths psi (M, N) from q."""
