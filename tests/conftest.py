@@ -13,6 +13,8 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402  (after the BLAS thread count is set)
 import pytest  # noqa: E402
 
+from tests.shared import Once, shared_dir  # noqa: E402
+
 
 @pytest.fixture(scope="session", autouse=True)
 def _isolated_cache(tmp_path_factory):
@@ -21,6 +23,14 @@ def _isolated_cache(tmp_path_factory):
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("TMFEM_CACHE_DIR", str(tmp_path_factory.mktemp("tmfem-cache")))
         yield
+
+
+@pytest.fixture(scope="session")
+def once(tmp_path_factory):
+    """``once(key, compute)``: ``compute()`` run by one process of this test run for ``key``
+    and its (pickled) value shared by every xdist worker (tests.shared.Once): for runs that
+    several tests read, such as a command's reference run."""
+    return Once(shared_dir(tmp_path_factory))
 
 
 @pytest.fixture(scope="session")

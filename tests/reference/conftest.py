@@ -4,12 +4,11 @@ and tests/reference/test_report_html.py.
 It is built once per test run: under pytest-xdist the first worker that needs it builds it in
 the base temp directory the workers share, holding a lock file, and the others wait for the
 lock and read the same directory (the tests only read it)."""
-import fcntl
-import os
 import shutil
 
 import pytest
 
+from tests.shared import locked, shared_dir
 from tmfem.cli import main
 
 
@@ -28,15 +27,11 @@ def _build(out):
 
 @pytest.fixture(scope="session")
 def report(tmp_path_factory):
-    """The reduced report's directory (:func:`_build`), shared by the xdist workers of this run
-    (their base temp directories have one parent per run; a run without xdist builds its own)."""
-    base = tmp_path_factory.getbasetemp()
-    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
-    root = shared / "shared-report"
+    """The reduced report's directory (:func:`_build`), shared by the xdist workers of this run."""
+    root = shared_dir(tmp_path_factory) / "report"
     root.mkdir(exist_ok=True)
     out, done = root / "1-4", root / "done"
-    with open(root / "lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)            # released when the file is closed
+    with locked(root / "lock"):
         if not done.exists():
             shutil.rmtree(out, ignore_errors=True)  # what a failed build of another worker left
             _build(out)

@@ -268,13 +268,21 @@ def test_a_command_without_backend_under_mpiexec_is_refused_as_serial(monkeypatc
     assert "--backend scipy" not in err
 
 
+@pytest.fixture(scope="module")
+def design_run(once):
+    """run(n): tests/mpi/fe_distributed.py on the 1-4 at mesh 6 from the design under n ranks,
+    one run per n shared by the tests that read it."""
+    return lambda n: once(("fe_distributed", n, "1-4", "6", "--start", "design"),
+                          lambda: _mpirun(n, "1-4", "6", "--start", "design"))
+
+
 @needs_mpi
-def test_one_and_two_ranks_agree(models, equilibria):
+def test_one_and_two_ranks_agree(models, equilibria, design_run):
     # source: the scipy model's own static solve from the design and its 12 modes; the
     # PETSc model assembles rank by rank (each rank its share of the membrane elements)
     runs = {}
     for n in (1, 2):
-        p = _mpirun(n, "1-4", "6", "--start", "design")
+        p = design_run(n)
         assert p.returncode == 0, p.stderr
         lines = p.stdout.strip().splitlines()
         assert len(lines) == 1          # one document, from rank 0 only
@@ -308,22 +316,29 @@ def test_model_on_petsc_under_ranks_agrees(models, ranks):
     assert np.allclose(run["omega2"], m.modes(k=12, at=st.x).omega2, rtol=2e-8, atol=0)
 
 
-@needs_mpi
-@pytest.mark.parametrize("ranks", [1, 2])
-def test_mesh_sequencing_under_ranks_agrees_with_scipy(ranks):
-    # source: the scipy model's own sequenced static solve (levels 4 -> 8) and its modes; the
-    # PETSc levels build, solve and release their distributed matrices on every rank
+@pytest.fixture(scope="module")
+def sequenced_8():
+    # the scipy model's own sequenced static solve (levels 4 -> 8) and its 12 modes
     from tmfem.models.mtc.model import MTCModel
     from tmfem.system import load_preset
+    m = MTCModel(load_preset("1-4"), mesh_n=8)
+    st = m.equilibrium(sequence=4)
+    return m, st, m.modes(k=12, at=st.x)
+
+
+@needs_mpi
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_mesh_sequencing_under_ranks_agrees_with_scipy(sequenced_8, ranks):
+    # source: the scipy model's own sequenced static solve (levels 4 -> 8) and its modes; the
+    # PETSc levels build, solve and release their distributed matrices on every rank
     p = _mpirun(ranks, "1-4", "8", "--sequence", "4")
     assert p.returncode == 0, p.stderr
     run = json.loads(p.stdout.strip())
-    m = MTCModel(load_preset("1-4"), mesh_n=8)
-    st = m.equilibrium(sequence=4)
+    m, st, md = sequenced_8
     x0 = m.reduce(m.initial_positions("undeformed"))
     xs = m.reduce(st.x)
     assert np.linalg.norm(np.array(run["x"]) - xs) <= 1e-9 * np.linalg.norm(xs - x0)
-    assert np.allclose(run["omega2"], m.modes(k=12, at=st.x).omega2, rtol=2e-8, atol=0)
+    assert np.allclose(run["omega2"], md.omega2, rtol=2e-8, atol=0)
 
 
 @needs_petsc
@@ -596,12 +611,12 @@ def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
 
 @needs_mpi
 @pytest.mark.parametrize("ranks", [2, 3])
-def test_slepc_eigen_under_ranks_agrees_with_scipy(models, equilibria, ranks):
+def test_slepc_eigen_under_ranks_agrees_with_scipy(models, equilibria, design_run, ranks):
     # source: the scipy model's 12 modes at its own equilibrium from the design (ARPACK on
     # the scipy matrices) and the model's scipy mass for the M-orthonormality; SLEPc's
     # Krylov-Schur on the distributed MUMPS factors of K - sigma M
     ref = models["1-4"].modes(k=12, at=equilibria["1-4"])
-    p = _mpirun(ranks, "1-4", "6", "--start", "design")
+    p = design_run(ranks)
     assert p.returncode == 0, p.stderr
     run = json.loads(p.stdout.strip())
     freq = np.sqrt(run["omega2"]) / (2 * np.pi)
@@ -732,6 +747,14 @@ def _modal_cli(*argv):
     return p
 
 
+@pytest.fixture(scope="module")
+def modal_1_4_scipy(once):
+    """`tmfem modal --preset 1-4 --mesh 12 --modes 6 --json --backend scipy` (one run, the
+    reference of the two PETSc runs below)."""
+    argv = ("--preset", "1-4", "--mesh", "12", "--modes", "6", "--json", "--backend", "scipy")
+    return once(("modal", *argv), lambda: _modal_cli(*argv))
+
+
 def test_cli_eig_solver_is_not_an_option():
     # the PETSc backend has one eigen solver (SLEPc): the option is gone, argparse refuses it
     p = _modal_cli("--preset", "2-3", "--mesh", "4", "--modes", "4", "--eig-solver", "slepc")
@@ -740,11 +763,11 @@ def test_cli_eig_solver_is_not_an_option():
 
 
 @needs_petsc
-def test_cli_petsc_modes_agree_with_scipy_and_name_the_backend():
+def test_cli_petsc_modes_agree_with_scipy_and_name_the_backend(modal_1_4_scipy):
     # source: the same command with scipy (ARPACK shift-invert on the scipy matrices):
     # frequencies to 1e-8; the JSON and a stderr line name the backend that ran
     argv = ["--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
-    ref = _modal_cli(*argv, "--backend", "scipy")
+    ref = modal_1_4_scipy
     assert json.loads(ref.stdout)["backend"] == "scipy"
     assert "backend scipy (" in ref.stderr
     p = _modal_cli(*argv, "--backend", "petsc")
@@ -755,11 +778,11 @@ def test_cli_petsc_modes_agree_with_scipy_and_name_the_backend():
 
 
 @needs_mpi
-def test_cli_modal_under_two_ranks_takes_petsc_by_default():
+def test_cli_modal_under_two_ranks_takes_petsc_by_default(modal_1_4_scipy):
     # source: the 1-process scipy command (frequencies to 1e-8); under 2 ranks the default
     # backend "auto" takes PETSc (SLEPc on the distributed factors) whatever the size
     argv = ["modal", "--preset", "1-4", "--mesh", "12", "--modes", "6", "--json"]
-    ref = json.loads(_modal_cli(*argv[1:], "--backend", "scipy").stdout)
+    ref = json.loads(modal_1_4_scipy.stdout)
     tmfem = [sys.executable, "-m", "tmfem"]
     p = _mpirun(2, *argv, program=tmfem)
     assert p.returncode == 0, p.stderr
