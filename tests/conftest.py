@@ -18,10 +18,14 @@ from tests.shared import Once, shared_dir  # noqa: E402
 
 @pytest.fixture(scope="session", autouse=True)
 def _isolated_cache(tmp_path_factory):
-    """The suite's on-disk cache (tmfem.cache) is a directory of its own, shared by the session
-    and by the commands it starts (the environment is inherited): never the user's cache."""
+    """The suite's on-disk cache (tmfem.cache) is a directory of its own, shared by the session,
+    its xdist workers and the commands it starts (the environment is inherited): never the
+    user's cache. (Its entries are written atomically, so workers may share it; the tests of
+    the cache itself give it a directory of their own.)"""
     with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("TMFEM_CACHE_DIR", str(tmp_path_factory.mktemp("tmfem-cache")))
+        cache = shared_dir(tmp_path_factory) / "tmfem-cache"
+        cache.mkdir(exist_ok=True)
+        mp.setenv("TMFEM_CACHE_DIR", str(cache))
         yield
 
 
