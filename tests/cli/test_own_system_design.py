@@ -102,20 +102,30 @@ def test_packaged_configuration_of_a_user_1_6d_deploys_along_a_feasible_path(cap
     assert ref.check_equilibria(checker=equilibrium_checker(s), n=101).size == 101
 
 
-def test_packaged_psi_of_a_1_3d_skips_a_start_whose_path_leaves_the_equilibria(capsys):
+def test_packaged_psi_of_a_1_3d_skips_a_start_whose_path_leaves_the_equilibria(capsys, monkeypatch):
     """The 1-3(D) at theta = 80 deg: the psi of smallest Delta (30 deg = 90 - 180/N, where
     eq. 3.22 puts the bar ends closest to the axis) has no feasible delta-rule path to the
     deployed configuration, so another psi of the band is suggested, whose path is feasible;
     above theta_max = asin((r_mb + Delta_e + r_1) / l) the deployed Delta is out of reach and
-    the text says so."""
+    the text says so. (The command runs twice, for its JSON and for its text; the scan of
+    the same file at the same theta is computed once and the second run prints it.)"""
     import dataclasses
 
     import numpy as np
 
+    from tmfem.control.deployment import packaged
     from tmfem.control.deployment.reference_trajectory import DeploymentReference
     from tmfem.control.deployment.run import equilibrium_checker
     from tmfem.errors import InfeasibleDesign
     from tmfem.system import load_system
+    scans, scan = {}, packaged.packaged_configurations
+
+    def once(system, *, theta_deg, **kw):
+        key = (system.name, theta_deg, tuple(sorted(kw.items())))
+        if key not in scans:
+            scans[key] = scan(system, theta_deg=theta_deg, **kw)
+        return scans[key]
+    monkeypatch.setattr(packaged, "packaged_configurations", once)
     f = str(SYSTEMS / "triangle-1-3D.toml")
     r, _ = run(["equilibrium", f, "--packaged", "80"], capsys)
     s = load_system(f)
@@ -132,7 +142,7 @@ def test_packaged_psi_of_a_1_3d_skips_a_start_whose_path_leaves_the_equilibria(c
     assert path_from(r["psi_deg"]).size == 101 and r["psi_deg"] != 30.0
     Delta_e = r["Delta_deployed"]
     assert r["theta_max_deg"] == pytest.approx(np.degrees(np.arcsin((s.r_mb + Delta_e + c.r[0]) / c.l[0])))
-    assert main(["equilibrium", f, "--packaged", "80"]) == 0
+    assert main(["equilibrium", f, "--packaged", "80"]) == 0 and len(scans) == 1
     assert f"reachable only for theta <= {r['theta_max_deg']:.4g} deg" in capsys.readouterr().out
 
 
