@@ -38,18 +38,23 @@ def once(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
-def design21(tmp_path_factory):
+def design21(tmp_path_factory, once):
     """A 2 x 1 grid LPV design of the 2-3-lpv preset at gamma = 20 with the sampled-loop LMI at
-    dt = 0.01 s, saved (shared by the LPV deployment tests of the library, the FE plants and the CLI)."""
-    from tmfem.control.lpv.plant import com_lpv_plant
-    from tmfem.control.lpv.generalized_plant import interconnection_8_1
-    from tmfem.control.lpv.synthesis import synthesize_state_feedback
-    from tmfem.reference.tables import deployment_bases
-    from tmfem.system import load_preset
-    s = load_preset("2-3-lpv")
-    pl = com_lpv_plant(s, theta=np.radians([63.0, 77.32]), psi=np.radians([8.36]), bases=deployment_bases(s))
-    d = synthesize_state_feedback(interconnection_8_1(pl, tracked=s.q_names), solver="EIGOPT", gamma=20.0,
-                                  sample_time=0.01)
+    dt = 0.01 s, saved (shared by the LPV deployment tests of the library, the FE plants and the CLI;
+    the plant and the design computed once per run, :func:`once`)."""
+
+    def compute():
+        from tmfem.control.lpv.plant import com_lpv_plant
+        from tmfem.control.lpv.generalized_plant import interconnection_8_1
+        from tmfem.control.lpv.synthesis import synthesize_state_feedback
+        from tmfem.reference.tables import deployment_bases
+        from tmfem.system import load_preset
+        s = load_preset("2-3-lpv")
+        pl = com_lpv_plant(s, theta=np.radians([63.0, 77.32]), psi=np.radians([8.36]), bases=deployment_bases(s))
+        d = synthesize_state_feedback(interconnection_8_1(pl, tracked=s.q_names), solver="EIGOPT", gamma=20.0,
+                                      sample_time=0.01)
+        return pl, d
+    pl, d = once("design21", compute)
     path = tmp_path_factory.mktemp("lpv") / "d21.npz"
     d.save(path)
     return pl, d, path
