@@ -36,7 +36,10 @@ _odd = st.one_of(
     st.lists(st.floats(-10, 10), max_size=40),
     st.lists(st.fixed_dictionaries({"name": st.sampled_from(["S_11", "S_12", "T"]),
                                     "family": st.sampled_from(["S", "V", "X", "SU"]),
-                                    "ends": st.just(["A_11", "B_13"])}), max_size=3),
+                                    # a new list per draw: st.just would put one list object
+                                    # into every document, so that a later mutation of it
+                                    # changed the strategy (and could make it contain itself)
+                                    "ends": st.builds(lambda: ["A_11", "B_13"])}), max_size=3),
     st.integers(min_value=0, max_value=10**6))
 
 
