@@ -436,19 +436,21 @@ def _main_mpi(args, mod) -> int:
     at once. SIGINT or SIGTERM to mpiexec or to any rank ends every rank with one line and
     exit 130 / 143 (:func:`_install_interrupt_handler`)."""
     rank = int(os.environ.get("OMPI_COMM_WORLD_RANK") or os.environ.get("PMI_RANK") or 0)
+
+    def refuse(found: str) -> int:
+        # before MPI starts: rank 0 prints and exits 2, the others end quietly with 0 (a
+        # non-zero exit of another rank makes mpiexec kill rank 0, its line perhaps unwritten)
+        if rank != 0:
+            return 0
+        print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
+              f"{found}", file=sys.stderr, flush=True)
+        return 2
     if not hasattr(args, "backend"):       # a command without --backend solves with scipy
-        if rank == 0:
-            print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
-                  "a command with a distributed backend (--backend petsc), found "
-                  f"`tmfem {args.command}`, which runs on one process: run it without mpiexec",
-                  file=sys.stderr)
-        return 2
+        return refuse(f"a command with a distributed backend (--backend petsc), found "
+                      f"`tmfem {args.command}`, which runs on one process: run it without mpiexec")
     if args.backend not in ("petsc", "auto", None):    # None: the default, auto
-        if rank == 0:
-            print(f"tmfem {args.command}: error: under mpiexec with {_mpi_size()} ranks expected "
-                  f"--backend petsc, found --backend {args.backend} "
-                  "(every rank would solve the whole problem alone)", file=sys.stderr)
-        return 2
+        return refuse(f"--backend petsc, found --backend {args.backend} (every rank would "
+                      "solve the whole problem alone)")
     from tmfem.io.atomic import remove_pending
     from tmfem.io.lock import OutputLock
     lock, ranks = OutputLock(), _Ranks(rank)
