@@ -34,15 +34,23 @@ import numpy as np
 from tmfem.errors import InputError, ResourceLimit, TmfemError
 
 
-def _subcommands() -> dict:
-    mods = {}
-    for info in pkgutil.iter_modules(__path__):
-        if info.name.startswith("_") or info.name == "common":
-            continue
-        mod = importlib.import_module(f"{__name__}.{info.name}")
-        if all(hasattr(mod, a) for a in ("NAME", "HELP", "configure", "run")):
-            mods[mod.NAME] = mod
-    return dict(sorted(mods.items()))
+def subcommands() -> dict:
+    """Every subcommand: its name and module, all of them imported."""
+    mods = (command_module(info.name) for info in pkgutil.iter_modules(__path__))
+    return dict(sorted((mod.NAME, mod) for mod in mods if mod is not None))
+
+
+def command_module(name: str):
+    """The module of subcommand ``name`` (imported), or None when no module of this package
+    of that name defines ``NAME``, ``HELP``, ``configure`` and ``run``."""
+    if name.startswith("_") or name == "common" or name not in _MODULE_NAMES:
+        return None
+    mod = importlib.import_module(f"{__name__}.{name}")
+    return mod if all(hasattr(mod, a) for a in ("NAME", "HELP", "configure", "run")) else None
+
+
+#: Names of the modules of this package (found without importing them).
+_MODULE_NAMES = frozenset(info.name for info in pkgutil.iter_modules(__path__))
 
 
 class _HelpWithDefaults(argparse.HelpFormatter):
@@ -57,12 +65,17 @@ class _HelpWithDefaults(argparse.HelpFormatter):
         return text
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command=None) -> argparse.ArgumentParser:
+    """The parser of ``tmfem``: every subcommand, or only ``command`` (its module, from
+    :func:`command_module`), which is all a command line of that command needs. Importing a
+    command's module imports the library it runs, so a run imports only its own command's
+    (``tmfem --help`` and an unknown command import them all, to list them)."""
     parser = argparse.ArgumentParser(prog="tmfem", description="Tensegrity-membrane systems: "
                                      "equilibrium, finite-element and control-oriented models, control.")
     sub = parser.add_subparsers(dest="command", metavar="<command>")
     sub.required = True
-    for name, mod in _subcommands().items():
+    commands = {command.NAME: command} if command is not None else subcommands()
+    for name, mod in commands.items():
         p = sub.add_parser(name, help=mod.HELP, description=mod.HELP,
                            formatter_class=_HelpWithDefaults)
         p.add_argument("--json", action="store_true", help="print one JSON document on stdout")
@@ -330,8 +343,9 @@ def output_directories(args) -> list:
 
 def main(argv=None) -> int:
     """Entry point of the ``tmfem`` console script; returns the exit code (docs/guides/cli.md)."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    words = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(command_module(words[0]) if words else None)
+    args = parser.parse_args(words)
     mod = args._module
     show_warning = warnings.showwarning          # put back when main returns
     _setup_logging(quiet=args.quiet)
