@@ -34,10 +34,19 @@ Formulation (see docs/guides/control.md):
   the margin of [[R, I], [I, S]] (bounded R, S), which moves R away from S^-1.
 
 All results are verified on the assembled closed loop (poles, ``control.norm(..., 'inf')``).
+
+The gamma minimisation depends on the plant and the options only, not on the level of the
+recovery: the last :data:`STAGE1_MEMO_SIZE` results are kept in memory, so the back-off
+levels of :func:`tmfem.control.linear.hinf_synthesis.hinfsyn`'s LMI route and a
+:func:`hinf_gamma` of the same plant solve the SDP once (each caller gets its own copy).
 """
 from __future__ import annotations
 
+import copy
+import hashlib
 import logging
+from collections import OrderedDict
+
 import numpy as np
 
 from tmfem.control.linear.verification import (HinfDesign, check_loop, controller_ss,
@@ -216,7 +225,7 @@ def _controller_from_RS(P: GeneralizedPlant, alpha: float, R, S, gamma: float):
     return (Ak, Bk, Ck, Dk), cond, lam
 
 
-def _minimize_gamma(plant, *, alpha, solver, eps, regularization, scale, residual_tol):
+def _solve_stage1(plant, *, alpha, solver, eps, regularization, scale, residual_tol):
     """Stage 1 of :func:`hinf_lmi`: minimise gamma over the eliminated LMIs (eq. 5.65 form)."""
     Ps, t = plant.scaled() if scale else (plant, np.ones(plant.A.shape[0]))
     if solver.upper() == "ARE":
@@ -241,6 +250,37 @@ def _minimize_gamma(plant, *, alpha, solver, eps, regularization, scale, residua
                                    f"{scale_RS:.3g}), found residuals {rep.residuals} "
                                    f"(solver status {rep.status!r})")
     return g_opt, rep, (Ps, Rv, Sv, sizes, NR, NS, scale_RS)
+
+
+#: number of gamma minimisations :func:`_minimize_gamma` keeps (module docstring)
+STAGE1_MEMO_SIZE = 8
+_stage1_memo: OrderedDict = OrderedDict()
+
+
+def _stage1_key(plant: GeneralizedPlant, options: dict) -> str:
+    """Digest of what the gamma minimisation depends on: the plant's matrices (shapes and
+    bytes), its signal names and the options."""
+    h = hashlib.sha256(repr(sorted(options.items())).encode())
+    for k in ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22"):
+        M = np.ascontiguousarray(getattr(plant, k))
+        h.update(repr(M.shape).encode())
+        h.update(M.tobytes())
+    h.update(repr([plant.state_names, plant.w_names, plant.u_names, plant.p_names,
+                   plant.y_names]).encode())
+    return h.hexdigest()
+
+
+def _minimize_gamma(plant, **options):
+    """:func:`_solve_stage1`, solved once per plant and options among the last
+    :data:`STAGE1_MEMO_SIZE` (module docstring); the caller owns the returned copy."""
+    key = _stage1_key(plant, options)
+    if key in _stage1_memo:
+        _stage1_memo.move_to_end(key)
+    else:
+        _stage1_memo[key] = _solve_stage1(plant, **options)
+        while len(_stage1_memo) > STAGE1_MEMO_SIZE:
+            _stage1_memo.popitem(last=False)
+    return copy.deepcopy(_stage1_memo[key])
 
 
 def hinf_gamma(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLARABEL",
