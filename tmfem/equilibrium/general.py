@@ -19,6 +19,7 @@ give the (5M-3) x (6M-4) matrix of 3.3.2 acting on the force vector of eq. 3.26.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -26,41 +27,53 @@ from tmfem.errors import ConvergenceError, InputError
 from tmfem.solvers.newton import newton
 from tmfem.system.geometry import (beta, euler_angles_321, free_corner_components,
                                   rotation_ef)
-from tmfem.system.coordinates import q_index
+from tmfem.system.coordinates import q_index, q_size
 from tmfem.system.topology import FAMILIES_MN
 
 
 # ---------------------------------------------------------------------------- kinematics
+@lru_cache(maxsize=None)
+def _lower_end_jacobian(M: int, N: int) -> np.ndarray:
+    """dA_ij/dq of the lower bar ends, shape (3, M N, n_q), made once per (M, N) (read-only):
+    1 at the coordinates x_ij, y_ij, z_ij of the stages i >= 2 (eq. 3.2), 0 elsewhere."""
+    xyz = q_index(M, N)[0].reshape(3, M * N)
+    J = np.zeros((3, M * N, q_size(M, N)))
+    c, n = np.nonzero(xyz >= 0)
+    J[c, n, xyz[c, n]] = 1.0
+    J.flags.writeable = False
+    return J
+
+
 def node_jacobian(system, q=None) -> np.ndarray:
-    """Derivatives dX/dq of all node coordinates, shape (3, n_nodes, n_q) (eqs. 3.1-3.2)."""
+    """Derivatives dX/dq of all node coordinates, shape (3, n_nodes, n_q) (eqs. 3.1-3.2).
+
+    dA_ij/dq is 1 at the coordinates of A_ij; B_ij = A_ij + l_ij e(theta_ij, psi_ij) with
+    e = (sin theta cos psi, sin theta sin psi, cos theta) gives dB_ij/dq = dA_ij/dq plus
+    l_ij de/dtheta_ij and l_ij de/dpsi_ij in the columns of theta_ij and psi_ij; the points
+    H_1j of a 1-N(D) system, H = A + k_H (B - A), give dH/dq = dA/dq + k_H (dB/dq - dA/dq).
+    """
     q = system.q if q is None else np.asarray(q, dtype=float)
     M, N = system.M, system.N
-    _, theta, psi = system.split_q(q)
-    l = system.l
-    xyz, th, ps = q_index(system.M, system.N)
-    nq = q.size
-    st, ct, sp, cp = np.sin(theta), np.cos(theta), np.sin(psi), np.cos(psi)
-    du_dth = np.array([ct * cp, ct * sp, -st])        # (3, M, N)
-    du_dps = np.array([-st * sp, st * cp, np.zeros_like(st)])
-    JA = np.zeros((3, M, N, nq))
-    JB = np.zeros((3, M, N, nq))
-    ii, jj = np.meshgrid(np.arange(M), np.arange(N), indexing="ij")
-    for c in range(3):
-        mask = xyz[c] >= 0
-        JA[c, ii[mask], jj[mask], xyz[c][mask]] = 1.0
-    JB[:] = JA
-    for c in range(3):
-        JB[c, ii, jj, th] += l * du_dth[c]
-        JB[c, ii, jj, ps] += l * du_dps[c]
-    parts = [JA.reshape(3, M * N, nq), JB.reshape(3, M * N, nq)]
+    _, th, ps = q_index(M, N)
+    th, ps = th.ravel(), ps.ravel()
+    st, ct, sp, cp = np.sin(q[th]), np.cos(q[th]), np.sin(q[ps]), np.cos(q[ps])
+    l = system.l.ravel()
+    JA = _lower_end_jacobian(M, N)
+    JB = JA.copy()
+    bars = np.arange(M * N)
+    JB[:, bars, th] += l * np.array([ct * cp, ct * sp, -st])
+    JB[:, bars, ps] += l * np.array([-st * sp, st * cp, np.zeros_like(st)])
+    parts = [JA, JB]
     if system.deployable:
-        parts.append(JA[:, 0] + system.k_H * (JB[:, 0] - JA[:, 0]))
+        parts.append(JA[:, :N] + system.k_H * (JB[:, :N] - JA[:, :N]))
     return np.concatenate(parts, axis=1)
 
 
-def tendon_length_gradient(system, q=None) -> np.ndarray:
-    """d|d_k|/dq of every tendon, shape (n_q, n_tendons) (the tendon columns of eq. 3.16)."""
-    J = node_jacobian(system, q)
+def tendon_length_gradient(system, q=None, J=None) -> np.ndarray:
+    """d|d_k|/dq of every tendon, shape (n_q, n_tendons) (the tendon columns of eq. 3.16):
+    n_k . (dX_end/dq - dX_start/dq) with n_k = d_k / |d_k|. ``J``: the node Jacobian of
+    :func:`node_jacobian` at q when the caller has it."""
+    J = node_jacobian(system, q) if J is None else J
     d = system.tendon_vectors(q)
     L = np.linalg.norm(d, axis=0)
     if np.any(L <= 0):
@@ -92,21 +105,31 @@ def corner_force_names(N: int) -> list[str]:
     return [f"F_{'uvw'[c]}{i + 1}" for i, c in free_corner_components(N)]
 
 
+@lru_cache(maxsize=None)
+def _free_index(N: int) -> tuple[np.ndarray, np.ndarray]:
+    """Corner and component indices of the 3N-6 free corner displacements
+    (:func:`tmfem.system.geometry.free_corner_components`), made once per N (read-only)."""
+    corner, comp = np.array(free_corner_components(N), dtype=int).reshape(-1, 2).T
+    corner.flags.writeable = comp.flags.writeable = False
+    return corner, comp
+
+
 def free_components(X) -> np.ndarray:
     """The 3N-6 free entries of a corner array X (2 or 3, N), in the order of eq. 3.4
     (:func:`tmfem.system.geometry.free_corner_components`); a missing w row counts as 0."""
     X = np.asarray(X, dtype=float)
     if X.shape[0] == 2:
         X = np.vstack([X, np.zeros((1, X.shape[1]))])
-    return np.array([X[c, i] for i, c in free_corner_components(X.shape[1])])
+    corner, comp = _free_index(X.shape[1])
+    return X[comp, corner]
 
 
 def corner_array(free, N: int) -> np.ndarray:
     """The corner array (3, N) of eq. 3.4 with the 3N-6 free entries ``free`` and zeros
     elsewhere (the inverse of :func:`free_components`)."""
     D = np.zeros((3, N))
-    for k, (i, c) in enumerate(free_corner_components(N)):
-        D[c, i] = free[k]
+    corner, comp = _free_index(N)
+    D[comp, corner] = free
     return D
 
 
@@ -126,12 +149,16 @@ class CornerState:
     iterations: int = 0
 
 
+def _undeformed_corners(system) -> np.ndarray:
+    """The undeformed corners P_i (3, N) in O_f (eq. 3.5; w = 0)."""
+    return np.vstack([system.membrane_corners, np.zeros((1, system.N))])
+
+
 def _corner_data(system, q):
     B = system.membrane_corners_inertial(q)
     N = system.N
-    P = np.vstack([system.membrane_corners, np.zeros((1, N))])
     X = B[:, :N - 1] - B[:, [N - 1]]
-    return X, P
+    return X, _undeformed_corners(system)
 
 
 def corner_state(system, q=None) -> CornerState:
@@ -158,14 +185,13 @@ def _G(gamma, free, P, N):
 def corner_constraint_jacobian(gamma, free, P, N) -> np.ndarray:
     """Jacobian d vec(G)/d(gamma, free) of the corner constraints of eq. 3.5 (G of :func:`_G`),
     shape (3(N-1), 3N-3); vec is column-major over corners."""
-    comps = free_corner_components(N)
+    corner, comp = _free_index(N)
     R = rotation_ef(gamma)
     dR = euler_R_derivatives(gamma)
     Y = (P + corner_array(free, N))[:, :N - 1]
-    J = np.zeros((3, N - 1, 3 + len(comps)))
+    J = np.zeros((3, N - 1, 3 + corner.size))
     J[:, :, :3] = np.einsum("abk,bi->aik", dR, Y)
-    for k, (i, c) in enumerate(comps):
-        J[:, i, 3 + k] = R[:, c]
+    J[:, corner, 3 + np.arange(corner.size)] = R[:, comp]
     return J.transpose(1, 0, 2).reshape(3 * (N - 1), -1)
 
 
@@ -205,17 +231,18 @@ def solve_corner_constraints(system, q=None, *, gamma0=None, free0=None, tol: fl
                        free=y[3:].copy(), iterations=res.iterations)
 
 
-def delta_gradient(system, q=None, state: CornerState | None = None) -> np.ndarray:
+def delta_gradient(system, q=None, state: CornerState | None = None, J=None) -> np.ndarray:
     """dDelta_c/dq of the 3N-6 free corner displacements, shape (n_q, 3N-6) (eq. 3.11).
 
     Implicit differentiation of eq. 3.5: dX(q) = dG(gamma, Delta), so
-    d(gamma, Delta)/dq = G_(gamma,Delta)^-1 X_q.
+    d(gamma, Delta)/dq = G_(gamma,Delta)^-1 X_q. ``state`` and ``J`` (the node Jacobian of
+    :func:`node_jacobian`): those at q when the caller has them.
     """
     q = system.q if q is None else np.asarray(q, dtype=float)
     st = corner_state(system, q) if state is None else state
     N = system.N
-    _, P = _corner_data(system, q)
-    J = node_jacobian(system, q)
+    P = _undeformed_corners(system)
+    J = node_jacobian(system, q) if J is None else J
     M = system.M
     b = system.M * system.N + (M - 1) * N        # index of B_M1 in the node order
     JB = J[:, b:b + N, :]
@@ -257,8 +284,9 @@ def equilibrium_matrix(system, q=None) -> EquilibriumMatrix:
     """
     q = system.q if q is None else np.asarray(q, dtype=float)
     st = corner_state(system, q)
-    AF = delta_gradient(system, q, st)
-    AT = tendon_length_gradient(system, q)
+    J = node_jacobian(system, q)
+    AF = delta_gradient(system, q, st, J)
+    AT = tendon_length_gradient(system, q, J)
     return EquilibriumMatrix(A=np.hstack([AF, AT]), rows=list(system.q_names),
                              cols=corner_force_names(system.N) + system.tendon_names(),
                              n_F=AF.shape[1], state=st)
@@ -294,17 +322,31 @@ def symmetric_matrix(system, q=None) -> SymmetricMatrix:
         raise InputError(f"system {system.name!r}: expected a symmetric system (3.3.1), found "
                          "no symmetric parametrisation")
     E = equilibrium_matrix(system, q)
-    xyz, th, ps = q_index(system.M, system.N)
-    rows = [th[0, -1], ps[0, -1]]
-    for i in range(1, system.M):
-        rows += [xyz[0, i, -1], xyz[1, i, -1], xyz[2, i, -1], th[i, -1], ps[i, -1]]
+    rows = _bar_N_rows(system.M, system.N)
     groups = symmetric_groups(system)
-    gid = np.array([t.group for t in system.tendons])
-    cols = [E.A_T[:, gid == g].sum(axis=1) for g in groups]
+    cols = [E.A_T[:, k].sum(axis=1) for k in _group_members(system.tendons, tuple(groups))]
     cols.append(E.A_F @ symmetric_corner_direction(system.N))
     A = np.column_stack(cols)[rows]
     names = system.q_names
     return SymmetricMatrix(A=A, rows=[names[r] for r in rows], cols=groups + ["F_Delta"])
+
+
+@lru_cache(maxsize=None)
+def _bar_N_rows(M: int, N: int) -> np.ndarray:
+    """Indices into q of the coordinates of the bars b_iN (eq. 3.24): theta_1N, psi_1N, then
+    x_iN, y_iN, z_iN, theta_iN, psi_iN of each stage i >= 2 (read-only)."""
+    xyz, th, ps = q_index(M, N)
+    rows = np.concatenate([[th[0, -1], ps[0, -1]], np.column_stack(
+        [xyz[0, 1:, -1], xyz[1, 1:, -1], xyz[2, 1:, -1], th[1:, -1], ps[1:, -1]]).ravel()])
+    rows.flags.writeable = False
+    return rows
+
+
+@lru_cache(maxsize=256)
+def _group_members(tendons: tuple, groups: tuple) -> tuple[np.ndarray, ...]:
+    """Indices of the tendons of each group of ``groups``, in the order of ``tendons``."""
+    gid = np.array([t.group for t in tendons])
+    return tuple(np.flatnonzero(gid == g) for g in groups)
 
 
 def expand_symmetric_forces(system, T_groups: np.ndarray, F_delta: float) -> np.ndarray:

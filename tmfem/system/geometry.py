@@ -43,11 +43,17 @@ def base_centre(N: int, r1: float) -> np.ndarray:
     return np.array([r1 * np.sin(np.pi / N), r1 * np.cos(np.pi / N), 0.0])
 
 
-def regular_polygon(N: int, radius: float, centre, rotation: float = 0.0) -> np.ndarray:
-    """Vertices (3, N) of a horizontal regular N-gon at angles beta_j + rotation."""
-    b = beta(N) + rotation
-    c = np.asarray(centre, dtype=float)
-    return c[:, None] + radius * np.array([np.cos(b), np.sin(b), np.zeros(N)])
+def regular_polygon(N: int, radius, centre, rotation=0.0) -> np.ndarray:
+    """Vertices of horizontal regular N-gons at the angles beta_j + rotation about their centres,
+
+        X_j = centre + radius (cos(beta_j + rotation), sin(beta_j + rotation), 0),
+
+    shape (3, N) for one polygon, or (3, K, N) for K polygons (``radius`` and ``rotation`` of
+    shape (K,), ``centre`` of shape (3, K))."""
+    b = beta(N) + np.asarray(rotation, dtype=float)[..., None]
+    c = np.asarray(centre, dtype=float)[..., None]
+    radius = np.asarray(radius, dtype=float)[..., None]
+    return c + radius * np.array([np.cos(b), np.sin(b), np.zeros_like(b)])
 
 
 def membrane_corners_regular(N: int, r_mb: float) -> np.ndarray:
@@ -57,6 +63,13 @@ def membrane_corners_regular(N: int, r_mb: float) -> np.ndarray:
     """
     xy = regular_polygon(N, r_mb, (0.0, 0.0, 0.0))[:2]
     return xy - xy[:, [-1]]
+
+
+def cross3(a, b) -> np.ndarray:
+    """The cross product a x b = (a_y b_z - a_z b_y, a_z b_x - a_x b_z, a_x b_y - a_y b_x) of two
+    3-vectors: the products and differences of ``np.cross`` without its set-up for stacks of
+    vectors, which costs ten times as much for one pair."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 def floating_frame(corners_3d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -92,14 +105,14 @@ def floating_frame(corners_3d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     x1, v = c[:, 0] - o, c[:, -2] - o
     n1, nv = np.linalg.norm(x1), np.linalg.norm(v)
     ex = x1 / n1 if n1 > 0 else x1
-    ez = np.cross(ex, v)
+    ez = cross3(ex, v)
     nz = np.linalg.norm(ez)
     if n1 == 0 or nz == 0 or nz < 1e-12 * nv:
         raise InputError("corners B_MN, B_M1, B_M,N-1 are collinear: the floating frame O_f "
                          f"of 3.2 is undefined (|B_M1 - B_MN| = {n1:.3g} m, "
                          f"|B_M,N-1 - B_MN| = {nv:.3g} m, sine of their angle {nz / max(nv, 1e-300):.3g})")
     ez = ez / nz
-    return o, np.column_stack([ex, np.cross(ez, ex), ez])
+    return o, np.column_stack([ex, cross3(ez, ex), ez])
 
 
 def free_corner_components(N: int) -> list[tuple[int, int]]:
@@ -203,9 +216,9 @@ class SymmetricConfig:
 
     def base_nodes(self, N: int) -> np.ndarray:
         """Lower bar ends A_ij, shape (3, M, N)."""
-        c = base_centre(N, self.r[0])
-        return np.stack([regular_polygon(N, self.r[i], c + [0, 0, self.z[i]], self.sigma[i])
-                         for i in range(self.M)], axis=1)
+        c = np.repeat(base_centre(N, self.r[0])[:, None], self.M, axis=1)
+        c[2] += self.z
+        return regular_polygon(N, self.r, c, self.sigma)
 
     def angles(self, N: int) -> tuple[np.ndarray, np.ndarray]:
         """theta_ij and psi_ij, each (M, N), from eqs. 3.19-3.20."""

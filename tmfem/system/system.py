@@ -51,6 +51,39 @@ def _q_names(M: int, N: int) -> tuple[str, ...]:
     return tuple(names)
 
 
+@lru_cache(maxsize=None)
+def _node_label_set(M: int, N: int, deployable: bool) -> frozenset:
+    """The node labels of an M-N (or 1-N(D)) system as a set, made once per topology."""
+    return frozenset(node_labels(M, N, deployable))
+
+
+@lru_cache(maxsize=256)
+def _tendon_connectivity(M: int, N: int, deployable: bool, tendons: tuple) -> np.ndarray:
+    """End-node indices (2, n_tendons) of ``tendons`` in the node order of
+    :func:`tmfem.system.topology.node_labels`, made once per topology (read-only); InputError
+    for a tendon end that is no node of the system."""
+    idx = {n: k for k, n in enumerate(node_labels(M, N, deployable))}
+    for t in tendons:
+        for e in t.ends:
+            if e not in idx:
+                raise InputError(f"tendon {t.name}: expected end nodes among the "
+                                 f"{len(idx)} nodes of a {M}-{N} system, found {e!r}")
+    c = np.array([[idx[t.ends[0]] for t in tendons], [idx[t.ends[1]] for t in tendons]],
+                 dtype=int).reshape(2, len(tendons))
+    c.flags.writeable = False
+    return c
+
+
+@lru_cache(maxsize=256)
+def _section_representatives(tendons: tuple) -> tuple:
+    """The first tendon of each (group, family) of ``tendons``, in their order: the tendons
+    whose cross sections (:meth:`System.tendon_section`) stand for all of them."""
+    first = {}
+    for t in tendons:
+        first.setdefault((t.group, t.family), t)
+    return tuple(first.values())
+
+
 @dataclass(frozen=True)
 class System:
     """A tensegrity-membrane system and its design configuration.
@@ -149,12 +182,7 @@ class System:
         if corners.shape != (2, N):
             raise InputError(f"expected membrane corners of shape (2, {N}), found {corners.shape}")
         tendons = tuple(self.tendons) or tuple(tendon_topology(M, N, self.deployable))
-        labels = set(node_labels(M, N, self.deployable))
-        for t in tendons:
-            for e in t.ends:
-                if e not in labels:
-                    raise InputError(f"tendon {t.name}: expected end nodes among the "
-                                     f"{len(labels)} nodes of a {M}-{N} system, found {e!r}")
+        _tendon_connectivity(M, N, self.deployable, tendons)
         object.__setattr__(self, "base", base)
         object.__setattr__(self, "l", l)
         object.__setattr__(self, "q", q)
@@ -165,12 +193,13 @@ class System:
         if not np.all(np.isfinite(pts)):
             raise InputError(f"expected finite monitored membrane points, found {pts.T.tolist()}")
         object.__setattr__(self, "monitor_points", pts)
+        labels = _node_label_set(M, N, self.deployable)
         for n in self.monitor_nodes:
             if n not in labels:
                 raise InputError(f"monitored node: expected one of the nodes of a {M}-{N} system, "
                                  f"found {n!r}")
         object.__setattr__(self, "monitor_nodes", tuple(self.monitor_nodes))
-        for t in tendons:
+        for t in _section_representatives(tendons):
             self.tendon_section(t)
         if self.rest_lengths is not None:
             object.__setattr__(self, "rest_lengths", rest_length_array(self.rest_lengths,
@@ -268,10 +297,8 @@ class System:
 
     @property
     def tendon_connectivity(self) -> np.ndarray:
-        """Tendon end-node indices, shape (2, n_tendons)."""
-        idx = {n: k for k, n in enumerate(self.node_labels)}
-        return np.array([[idx[t.ends[0]] for t in self.tendons],
-                         [idx[t.ends[1]] for t in self.tendons]], dtype=int)
+        """Tendon end-node indices, shape (2, n_tendons) (a new array)."""
+        return _tendon_connectivity(self.M, self.N, self.deployable, self.tendons).copy()
 
     @property
     def bar_connectivity(self) -> np.ndarray:

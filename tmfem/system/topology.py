@@ -14,6 +14,7 @@ Bar indices are cyclic: j-1 of j=1 is N, j+1 of j=N is 1.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 FAMILIES_MN = ("S", "V", "D", "C", "P", "R")
 FAMILIES_D = ("SL", "SU")
@@ -53,8 +54,13 @@ def node_labels(M: int, N: int, deployable: bool) -> list[str]:
 
 
 def tendon_topology(M: int, N: int, deployable: bool) -> list[Tendon]:
-    """All tendons of an M-N system, or of a 1-N(D) system when ``deployable``."""
+    """All tendons of an M-N system, or of a 1-N(D) system when ``deployable`` (a new list of
+    the tendons made once per topology, so that systems of one topology share them)."""
+    return list(_tendon_topology(int(M), int(N), bool(deployable)))
 
+
+@lru_cache(maxsize=None)
+def _tendon_topology(M: int, N: int, deployable: bool) -> tuple[Tendon, ...]:
     def cyc(j: int) -> int:
         return (j - 1) % N + 1
 
@@ -65,7 +71,7 @@ def tendon_topology(M: int, N: int, deployable: bool) -> list[Tendon]:
                for j in range(1, N + 1)]
         out += [Tendon(f"SU_{j}", "SU", 1, j, (label("B", 1, j), label("H", 1, cyc(j - 1))))
                 for j in range(1, N + 1)]
-        return out
+        return tuple(out)
 
     out = [Tendon(label("S", 1, j), "S", 1, j, (label("A", 1, j), label("B", 1, cyc(j - 1))))
            for j in range(1, N + 1)]
@@ -80,4 +86,4 @@ def tendon_topology(M: int, N: int, deployable: bool) -> list[Tendon]:
                 "R": (label("B", i, j), label("B", i - 1, cyc(j - 1))),
             }
             out += [Tendon(label(f, i, j), f, i, j, ends[f]) for f in FAMILIES_MN]
-    return out
+    return tuple(out)
