@@ -304,6 +304,7 @@ class MITC4Shell:
         self._asm = Assembler(dofmap.element_dofs(conn, rotations=True), dofmap.ndof)
         self._M = None
         self._part_cache = None
+        self._result_points = {}
 
     # ------------------------------------------------------------------ kinematics
     def _tie_weights(self, xi):
@@ -389,6 +390,7 @@ class MITC4Shell:
             setattr(part, name, getattr(self, name)[elements])
         part._gauss = self._gauss.take(elements)
         part._part_cache = None
+        part._result_points = {}
         self._part_cache = (key, part)
         return part
 
@@ -568,6 +570,25 @@ class MITC4Shell:
         return np.matmul(np.swapaxes(Lb, 1, 2), np.matmul(Mx, Lb))
 
     # ------------------------------------------------------------------ results
+    #: thickness points and weights of the results: the surfaces r_3 = -1, 0, 1 and the
+    #: 2-point Gauss rule
+    _THICKNESS = {"surf": (np.array([-1.0, 0.0, 1.0]), np.ones(3)),
+                  "gauss": np.polynomial.legendre.leggauss(2)}
+
+    def _results_at(self, xi, thickness: str) -> _Points:
+        """The reference quantities (:class:`_Points`, results frame of eq. 4.16) at one
+        in-plane point xi and the ``thickness`` points of :attr:`_THICKNESS`; they depend on
+        the reference geometry only, so they are made once per point (the last 32 kept)."""
+        xi = np.asarray(xi, dtype=float).reshape(2, 1)
+        key = (float(xi[0, 0]), float(xi[1, 0]), thickness)
+        pts = self._result_points.get(key)
+        if pts is None:
+            if len(self._result_points) >= 32:
+                self._result_points.clear()
+            pts = self._result_points[key] = _Points(self, xi, np.ones(1), *self._THICKNESS[thickness],
+                                                     output_frame=True)
+        return pts
+
     def stresses(self, state, *, xi=(0.5, 0.5)):
         """Local 2nd Piola-Kirchhoff stresses at one in-plane point of every element.
 
@@ -582,13 +603,11 @@ class MITC4Shell:
         [N11, N22, N12] and ``M`` (ne, 3) bending moments [M11, M22, M12] per unit length
         (2-point Gauss through the thickness) and ``Qs`` (ne, 2) transverse shear forces.
         """
-        xi = np.asarray(xi, dtype=float).reshape(2, 1)
         u, d, w, _ = self._nodal(state)
         D = self.section.lamina_matrix()
         out = {}
-        for key, r3, wz in (("surf", np.array([-1.0, 0.0, 1.0]), np.ones(3)),
-                            ("gauss", *np.polynomial.legendre.leggauss(2))):
-            pts = _Points(self, xi, np.ones(1), r3, wz, output_frame=True)
+        for key in ("surf", "gauss"):
+            pts = self._results_at(xi, key)
             c = self._strains(pts, u, d, w)[0][:, 0]                          # (ne, nz, 5)
             if self.law.name == "svk":
                 out[key] = np.einsum("ab,ezbc,ezc->eza", D, pts.Q[:, 0], c)
@@ -596,7 +615,7 @@ class MITC4Shell:
                 out[key] = self._local_law(np.einsum("ezbc,ezc->ezb", pts.Q[:, 0], c), tangent=False)[0]
         sig = out["surf"]
         vm = von_mises(np.moveaxis(sig, -1, 0))
-        zg = np.polynomial.legendre.leggauss(2)[0] * self.half                # physical z of the Gauss points
+        zg = self._THICKNESS["gauss"][0] * self.half                          # physical z of the Gauss points
         sg = out["gauss"]
         N = self.half * sg[..., :3].sum(axis=1)
         M = self.half * np.einsum("eza,z->ea", sg[..., :3], zg)
@@ -615,8 +634,7 @@ class MITC4Shell:
         thickness), a material direction of the reference surface as the Green-Lagrange
         strain it comes from."""
         u, d, w, _ = self._nodal(state)
-        pts = _Points(self, np.asarray(xi, dtype=float).reshape(2, 1), np.ones(1),
-                      *np.polynomial.legendre.leggauss(2), output_frame=True)
+        pts = self._results_at(xi, "gauss")
         c = self._strains(pts, u, d, w)[0]
         eps = np.einsum("...ap,...p->...a", pts.Q, c).reshape(self.ne, -1, 5)
         out = element_wrinkling(self.law, _in_plane(eps))
