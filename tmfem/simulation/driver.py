@@ -56,6 +56,8 @@ class _ClosedLoop:
         if hasattr(plant, "newton_matrix"):
             self.newton_matrix = lambda x, v, a, t, cv, ca: plant.newton_matrix(x, v, a, t, cv, ca,
                                                                                   self.u)
+        if hasattr(plant, "mass_matrix"):
+            self.mass_matrix = plant.mass_matrix
 
     def residual(self, x, v, a, t):
         return self.plant.residual(x, v, a, t, self.u)

@@ -25,7 +25,9 @@ The residual and its Jacobians come from a *system* object with two methods:
 An optional ``newton_matrix(x, v, a, t, cv, ca)`` returning ``K + cv C + ca M`` directly
 (dense or sparse) is used when present (cheaper for models that assemble it at once), and an
 optional ``factorize(S) -> solve`` replaces the default LU of the Newton matrix (e.g. a
-symmetric-mode sparse LU for finite-element tangents).
+symmetric-mode sparse LU for finite-element tangents). An optional ``mass_matrix(x, v, t)``
+returning M = dr/da alone is used for the acceleration of a state (:func:`initial_acceleration`)
+instead of the three Jacobians (for models whose K costs an assembly).
 """
 from __future__ import annotations
 
@@ -75,14 +77,25 @@ def _newton_matrix(system, x, v, a, t, cv, ca):
     return K + cv * C + ca * M
 
 
+def _mass_matrix(system, x, v, a, t):
+    """M = dr/da at (x, v, a, t): the system's ``mass_matrix`` when it has one, else the
+    third of its ``jacobians``."""
+    if hasattr(system, "mass_matrix"):
+        return system.mass_matrix(x, v, t)
+    return system.jacobians(x, v, a, t)[2]
+
+
 def initial_acceleration(system, x0, v0, t0=0.0, *, a0=None, tol=1e-12, max_iter=20) -> np.ndarray:
-    """Solve r(x0, v0, a, t0) = 0 for the acceleration a (Newton on a, from ``a0`` or 0)."""
+    """Solve r(x0, v0, a, t0) = 0 for the acceleration a by the iteration a <- a - M^-1 r(a)
+    from ``a0`` or 0, with M = dr/da evaluated and factored once at the start: the residual
+    is affine in a (M(x) a + F(x, v, t)), so this is Newton's method, converged after one
+    step up to round-off (the further steps remove that)."""
     x0 = np.asarray(x0, dtype=float)
     a = np.zeros_like(x0) if a0 is None else np.array(a0, dtype=float)
+    solve = _solver(_mass_matrix(system, x0, v0, a, t0), system)
     for it in range(max_iter):
         r = system.residual(x0, v0, a, t0)
-        _, _, M = system.jacobians(x0, v0, a, t0)
-        da = -_solver(M, system)(r)
+        da = -solve(r)
         a = a + da
         if np.linalg.norm(da) <= tol * (1.0 + np.linalg.norm(a)):
             return a

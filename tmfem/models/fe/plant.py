@@ -175,6 +175,10 @@ class FEPlant(ABC):
         C = self.C if self.C is not None else sp.csc_matrix(K.shape)
         return K, C, self.M
 
+    def mass_matrix(self, x, v, t):
+        """dr/da = M, the reduced mass matrix (constant)."""
+        return self.M
+
     def newton_matrix(self, x, v, a, t, cv, ca, u=None):
         """K_T + cv C + ca M, the Newton matrix of Park's method (eq. 5.34)."""
         self._inputs(u)
