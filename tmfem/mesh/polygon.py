@@ -8,6 +8,7 @@ gmsh with a transfinite n x n grid. The square membrane with n = 10 gives the
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -53,6 +54,9 @@ def _check_convex(corners: np.ndarray) -> None:
 def polygon_quad_mesh(corners, n: int) -> MembraneMesh:
     """Mesh a convex polygon into N quadrilaterals of n x n elements each (gmsh, transfinite).
 
+    The mesh of given corners and n is made by gmsh once and kept (the last 64); every call
+    returns arrays of its own.
+
     Parameters
     ----------
     corners : array_like (2, N)
@@ -60,15 +64,23 @@ def polygon_quad_mesh(corners, n: int) -> MembraneMesh:
     n : int
         Elements along each side of each of the N quadrilaterals.
     """
-    import gmsh
-
     corners = np.asarray(corners, dtype=float)
     if corners.ndim != 2 or corners.shape[0] != 2 or corners.shape[1] < 3:
         raise InputError(f"membrane polygon: expected corners of shape (2, N>=3), found {corners.shape}")
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise InputError(f"mesh: expected n >= 1 subdivisions, found {n!r}")
     _check_convex(corners)
-    N = corners.shape[1]
+    p, t, corner_nodes = _gmsh_polygon_mesh(np.ascontiguousarray(corners).tobytes(), corners.shape[1], int(n))
+    return MembraneMesh(p=p.copy(), t=t.copy(), corners=corner_nodes.copy(), n=int(n))
+
+
+@lru_cache(maxsize=64)
+def _gmsh_polygon_mesh(corner_bytes: bytes, N: int, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Nodes p (2, n_nodes), counter-clockwise quadrilaterals t (4, n_elements) and corner
+    nodes (N,) of :func:`polygon_quad_mesh` for the corners (2, N) given by their bytes."""
+    import gmsh
+
+    corners = np.frombuffer(corner_bytes, dtype=float).reshape(2, N)
     centre = corners.mean(axis=1)
     mids = 0.5 * (corners + np.roll(corners, -1, axis=1))  # mid j between corner j and j+1
 
@@ -115,4 +127,4 @@ def polygon_quad_mesh(corners, n: int) -> MembraneMesh:
     x, y = p[0, t], p[1, t]
     area2 = np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y, axis=0)
     t[:, area2 < 0] = t[::-1, area2 < 0]
-    return MembraneMesh(p=p, t=t, corners=index[np.asarray(corner_tags, dtype=np.int64)], n=int(n))
+    return p, t, index[np.asarray(corner_tags, dtype=np.int64)]
