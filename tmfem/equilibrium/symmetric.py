@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from tmfem.errors import InfeasibleDesign, InputError, SlackMembrane, SlackTendon
+from tmfem.system.geometry import cross3
 from tmfem.system.geometry import membrane_delta  # noqa: F401 (eq. 3.22, re-exported)
 
 
@@ -167,7 +168,7 @@ def A_1ND(*, l1, theta1, psi1, r1, k_H, N) -> np.ndarray:
 def null_vector_1ND(A: np.ndarray) -> np.ndarray:
     """Null vector of a full-rank 2 x 3 matrix (cross product of its rows), scaled so that
     the last entry (the averaged membrane force) is 1 when it is nonzero."""
-    v = np.cross(A[0], A[1])
+    v = cross3(A[0], A[1])
     if abs(v[2]) > 1e-14 * np.linalg.norm(v):
         v = v / v[2]
     return v

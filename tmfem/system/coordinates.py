@@ -64,7 +64,6 @@ def join_q(A, theta, psi) -> np.ndarray:
     xyz, th, ps = q_index(M, N)
     q = np.empty(q_size(M, N))
     q[th], q[ps] = theta, psi
-    stages = xyz[0] >= 0
-    for c in range(3):
-        q[xyz[c][stages]] = np.asarray(A)[c][stages]
+    stages = xyz >= 0
+    q[xyz[stages]] = np.asarray(A)[stages]
     return q

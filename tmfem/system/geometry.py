@@ -196,14 +196,14 @@ class SymmetricConfig:
             if v.shape != (M,):
                 raise InputError(f"symmetric configuration: expected {k} of length M={M}, "
                                  f"found shape {v.shape}")
-            if not np.all(np.isfinite(v)):
+            if not np.isfinite(v).all():
                 raise InputError(f"symmetric configuration: {k} has non-finite entries {v}")
             object.__setattr__(self, k, v)
         for k in ("r", "l"):
-            if np.any(arrays[k] <= 0):
+            if (arrays[k] <= 0).any():
                 raise InputError(f"symmetric configuration: expected {k} > 0, found {arrays[k]}")
         th = arrays["theta"]
-        if np.any((th <= 0) | (th >= np.pi / 2)):
+        if ((th <= 0) | (th >= np.pi / 2)).any():
             raise InputError("symmetric configuration: expected 0 < theta < 90 deg, found "
                              f"{np.degrees(th)} deg")
         if arrays["sigma"][0] != 0 or arrays["z"][0] != 0:
@@ -235,7 +235,8 @@ class SymmetricConfig:
     def system_arrays(self, N: int) -> dict:
         """The :class:`tmfem.system.System` fields this configuration fixes: ``q`` (eqs.
         3.1-3.2), ``base`` A_1j (3, N) and the bar lengths ``l`` (M, N)."""
-        return {"q": self.to_q(N), "base": self.base_nodes(N)[:, 0, :],
+        A = self.base_nodes(N)
+        return {"q": join_q(A, *self.angles(N)), "base": A[:, 0, :],
                 "l": np.repeat(self.l[:, None], N, axis=1)}
 
     def membrane_delta(self, N: int, r_mb: float) -> float:

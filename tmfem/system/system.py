@@ -173,10 +173,10 @@ class System:
         corners = np.asarray(self.membrane_corners, dtype=float)
         if base.shape != (3, N):
             raise InputError(f"expected base A_1j of shape (3, {N}), found {base.shape}")
-        if np.any(~np.isfinite(l)) or np.any(l <= 0):
+        if not (np.isfinite(l).all() and (l > 0).all()):
             raise InputError(f"expected bar lengths l > 0, found {l.ravel()}")
         nq = q_size(M, N)
-        if q.shape != (nq,) or not np.all(np.isfinite(q)):
+        if q.shape != (nq,) or not np.isfinite(q).all():
             raise InputError(f"expected q of length {nq} (eqs. 3.1-3.2) with finite entries, "
                              f"found shape {q.shape}")
         if corners.shape != (2, N):
@@ -190,7 +190,7 @@ class System:
         object.__setattr__(self, "tendons", tendons)
         pts = np.asarray(self.monitor_points, dtype=float).reshape(2, -1) \
             if np.size(self.monitor_points) else np.zeros((2, 0))
-        if not np.all(np.isfinite(pts)):
+        if not np.isfinite(pts).all():
             raise InputError(f"expected finite monitored membrane points, found {pts.T.tolist()}")
         object.__setattr__(self, "monitor_points", pts)
         labels = _node_label_set(M, N, self.deployable)
