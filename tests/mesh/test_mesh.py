@@ -30,3 +30,23 @@ def test_square_quadrant_is_the_bilinear_transfinite_grid():
 def test_non_convex_polygon_is_rejected():
     with pytest.raises(InputError, match="convex"):
         polygon_quad_mesh(np.array([[0, 1, 0.2, 0], [0, 0, 0.2, 1.0]]), 2)
+
+
+
+def test_small_meshes_are_kept_and_large_ones_made_anew():
+    """A mesh of at most KEPT_ELEMENTS elements is gmsh's once per corners and n; a larger one
+    is not kept. Either way each call gets arrays of its own, equal to gmsh's mesh."""
+    from tmfem.mesh import polygon
+    corners = np.array([[1.0, -0.5, -0.6], [0.1, 0.9, -0.8]])
+    for n, kept in [(4, True), (24, False)]:     # 3 n^2 elements: 48 and 1728
+        assert (3 * n * n <= polygon.KEPT_ELEMENTS) == kept
+        fresh = polygon._gmsh_polygon_mesh(corners.tobytes(), 3, n)
+        before = polygon._kept_polygon_mesh.cache_info()
+        a, b = polygon_quad_mesh(corners, n), polygon_quad_mesh(corners, n)
+        after = polygon._kept_polygon_mesh.cache_info()
+        assert (after.misses - before.misses, after.hits - before.hits) == ((1, 1) if kept else (0, 0))
+        for m in (a, b):
+            np.testing.assert_array_equal(m.p, fresh[0])
+            np.testing.assert_array_equal(m.t, fresh[1])
+        a.p[0, 0] += 1.0                         # a caller's change reaches no other call
+        assert polygon_quad_mesh(corners, n).p[0, 0] == fresh[0][0, 0]

@@ -54,8 +54,10 @@ def _check_convex(corners: np.ndarray) -> None:
 def polygon_quad_mesh(corners, n: int) -> MembraneMesh:
     """Mesh a convex polygon into N quadrilaterals of n x n elements each (gmsh, transfinite).
 
-    The mesh of given corners and n is made by gmsh once and kept (the last 64); every call
-    returns arrays of its own.
+    A mesh of at most :data:`KEPT_ELEMENTS` elements is made by gmsh once per corners and n
+    and kept (the last 64), since gmsh's set-up is most of its time; a larger one is made
+    anew each call, so that a run holds no large mesh it has left behind (the coarse levels
+    of a mesh sequencing). Every call returns arrays of its own.
 
     Parameters
     ----------
@@ -70,11 +72,16 @@ def polygon_quad_mesh(corners, n: int) -> MembraneMesh:
     if not (isinstance(n, (int, np.integer)) and n >= 1):
         raise InputError(f"mesh: expected n >= 1 subdivisions, found {n!r}")
     _check_convex(corners)
-    p, t, corner_nodes = _gmsh_polygon_mesh(np.ascontiguousarray(corners).tobytes(), corners.shape[1], int(n))
+    N = corners.shape[1]
+    make = _kept_polygon_mesh if N * n * n <= KEPT_ELEMENTS else _gmsh_polygon_mesh
+    p, t, corner_nodes = make(np.ascontiguousarray(corners).tobytes(), N, int(n))
     return MembraneMesh(p=p.copy(), t=t.copy(), corners=corner_nodes.copy(), n=int(n))
 
 
-@lru_cache(maxsize=64)
+#: Largest number of elements of a membrane mesh that :func:`polygon_quad_mesh` keeps
+KEPT_ELEMENTS = 1600
+
+
 def _gmsh_polygon_mesh(corner_bytes: bytes, N: int, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Nodes p (2, n_nodes), counter-clockwise quadrilaterals t (4, n_elements) and corner
     nodes (N,) of :func:`polygon_quad_mesh` for the corners (2, N) given by their bytes."""
@@ -128,3 +135,6 @@ def _gmsh_polygon_mesh(corner_bytes: bytes, N: int, n: int) -> tuple[np.ndarray,
     area2 = np.sum(x * np.roll(y, -1, axis=0) - np.roll(x, -1, axis=0) * y, axis=0)
     t[:, area2 < 0] = t[::-1, area2 < 0]
     return p, t, index[np.asarray(corner_tags, dtype=np.int64)]
+
+
+_kept_polygon_mesh = lru_cache(maxsize=64)(_gmsh_polygon_mesh)
