@@ -21,6 +21,7 @@ imply at the design geometry (positive strain: taut; negative: slack).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -180,7 +181,8 @@ def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembra
     :class:`PlaneStressMembrane`, 10 % of the membrane's circumradius r_mb, as in the MTC
     model). ``backend``: the linear-algebra backend of its solves. ``membrane_law``:
     plane-stress law (``"svk"``, eq. 5.8, or ``"tension-field"``, :mod:`tmfem.fem.tension_field`).
-    These are those of ``model`` when it is given.
+    These are those of ``model`` when it is given; else the model of the scipy backend is
+    built and factorised once per membrane and options (:func:`_shared_membrane_model`).
 
     Returns
     -------
@@ -188,12 +190,28 @@ def membrane_state(system, q=None, *, mesh_n: int = 10, model: PlaneStressMembra
     """
     q = system.q if q is None else np.asarray(q, dtype=float)
     E = equilibrium_matrix(system, q)
-    if model is None:
+    if model is None and backend == "scipy":
+        corners = np.ascontiguousarray(system.membrane_corners, dtype=float)
+        model = _shared_membrane_model(corners.tobytes(), corners.shape[1], system.membrane, mesh_n,
+                                      attachment, patch, membrane_law)
+    elif model is None:
         model = PlaneStressMembrane(corners=system.membrane_corners, material=system.membrane,
                                     n=mesh_n, attachment=attachment, patch=patch, backend=backend,
                                     law=membrane_law)
     sol = model.solve(E.state.delta[:2])
     return E, model, sol
+
+
+@lru_cache(maxsize=8)
+def _shared_membrane_model(corner_bytes: bytes, N: int, material, mesh_n: int, attachment: str,
+                          patch: float | None, membrane_law: str) -> PlaneStressMembrane:
+    """The plane-stress membrane (scipy backend) of the corners (2, N) given by their bytes,
+    made once per membrane and options and kept (the last 8): its stiffness and its
+    factorisation depend on nothing else, and every design of a system in a study or an
+    optimisation solves the same membrane for other corner displacements."""
+    return PlaneStressMembrane(corners=np.frombuffer(corner_bytes, dtype=float).reshape(2, N),
+                               material=material, n=mesh_n, attachment=attachment, patch=patch,
+                               backend="scipy", law=membrane_law)
 
 
 def free_forces(F: np.ndarray) -> np.ndarray:
