@@ -167,11 +167,23 @@ def A_1ND(*, l1, theta1, psi1, r1, k_H, N) -> np.ndarray:
 
 def null_vector_1ND(A: np.ndarray) -> np.ndarray:
     """Null vector of a full-rank 2 x 3 matrix (cross product of its rows), scaled so that
-    the last entry (the averaged membrane force) is 1 when it is nonzero."""
+    the last entry (the averaged membrane force) is 1 when it is nonzero; A of shape
+    (2, 3, ...) gives the null vectors (3, ...) of a stack of matrices."""
     v = cross3(A[0], A[1])
-    if abs(v[2]) > 1e-14 * np.linalg.norm(v):
-        v = v / v[2]
-    return v
+    scaled = np.abs(v[2]) > 1e-14 * np.sqrt(np.sum(v * v, axis=0))
+    return np.where(scaled, v / np.where(scaled, v[2], 1.0), v)
+
+
+def feasible_1ND(system, *, theta1, psi1) -> tuple[np.ndarray, np.ndarray]:
+    """The conditions of :func:`check_1ND` for the symmetric 1-N(D) ``system`` moved to the
+    declinations ``theta1`` and azimuths ``psi1`` [rad] (arrays that broadcast; its r_1, l_1,
+    k_H and r_mb held): a null vector of A_1N^D (eq. 3.40) with all entries positive and
+    Delta > 0 (eq. 3.22). Returns the mask of the feasible configurations and their Delta."""
+    c = _sym(system)
+    v = null_vector_1ND(A_1ND(l1=c.l[0], theta1=theta1, psi1=psi1, r1=c.r[0], k_H=system.k_H, N=system.N))
+    D = membrane_delta(l_M=c.l[0], theta_M=theta1, psi_M=psi1, sigma_M=c.sigma[0], r_M=c.r[0],
+                       r_mb=system.r_mb, N=system.N)
+    return np.all(v > 0, axis=0) & (D > 0), D
 
 
 def r1_bounds_1ND(*, l1, theta1, psi1, k_H, N):

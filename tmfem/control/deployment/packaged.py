@@ -18,8 +18,7 @@ from scipy.optimize import minimize
 from tmfem.control.deployment.reference_trajectory import DeploymentReference
 from tmfem.control.deployment.run import equilibrium_checker
 from tmfem.equilibrium.assist import symmetric_parameters
-from tmfem.equilibrium.symmetric import check_1ND, membrane_delta_system
-from tmfem.equilibrium.symmetric_map import with_configuration
+from tmfem.equilibrium.symmetric import feasible_1ND, membrane_delta_system
 from tmfem.errors import InfeasibleDesign, InputError
 from tmfem.system.geometry import wrap_angle
 from tmfem.system.problem import DeploymentParameters
@@ -31,7 +30,8 @@ def packaged_configurations(system, *, theta_deg: float, step_deg: float = 0.05,
                             path_points: int = 101) -> dict:
     """The psi band [deg] at ``theta_deg`` where the 1-N(D) ``system`` is a feasible
     equilibrium (positive null vector of eq. 3.40, Delta > 0: :func:`tmfem.equilibrium.
-    symmetric.check_1ND`), and in it a packaged configuration for ``[packaged] symmetric``: the
+    symmetric.feasible_1ND`, the conditions of :func:`tmfem.equilibrium.symmetric.check_1ND`,
+    at every psi of the grid at once), and in it a packaged configuration for ``[packaged] symmetric``: the
     psi whose Delta is closest to the deployed configuration's among those from which the
     deployment path (psi_r from eq. 3.22 with Delta linear in the progress, the ``delta`` rule
     of :class:`tmfem.control.deployment.reference_trajectory.DeploymentReference`) is a
@@ -54,15 +54,10 @@ def packaged_configurations(system, *, theta_deg: float, step_deg: float = 0.05,
     target = membrane_delta_system(system)
     x = (system.r_mb + target + c.r[0]) / c.l[0]
     theta_max = float(np.degrees(np.arcsin(x))) if x < 1 else 90.0
-    rows = []
-    for p in np.arange(-89.0, 89.0 + 1e-9, step_deg):
-        cfg = dataclasses.replace(c, theta=np.radians([theta_deg]), psi=np.radians([p]))
-        s = with_configuration(system, cfg)
-        try:
-            check_1ND(s)
-        except InfeasibleDesign:
-            continue
-        rows.append((float(p), float(membrane_delta_system(s)), cfg))
+    scan = np.arange(-89.0, 89.0 + 1e-9, step_deg)
+    ok, scan_delta = feasible_1ND(system, theta1=np.radians(theta_deg), psi1=np.radians(scan))
+    rows = [(float(p), float(D), dataclasses.replace(c, theta=np.radians([theta_deg]), psi=np.radians([p])))
+            for p, D in zip(scan[ok], scan_delta[ok])]
     if not rows:
         raise InfeasibleDesign(f"packaged configuration: no psi in (-89, 89) deg gives a feasible "
                                f"1-N(D) equilibrium at theta = {theta_deg:g} deg (eq. 3.40 and "
