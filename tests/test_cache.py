@@ -71,3 +71,40 @@ def test_an_unwritable_directory_warns_once_and_goes_on(monkeypatch, tmp_path, c
     warnings = [r for r in caplog.records if r.levelno == logging.WARNING]
     assert len(warnings) == 1 and "TMFEM_CACHE_DIR" in warnings[0].getMessage()
     assert store.get({"a": 1}) is None
+
+
+def test_content_digest_follows_the_content_not_the_objects():
+    import dataclasses
+    import numpy as np
+
+    @dataclasses.dataclass
+    class Pair:
+        a: np.ndarray
+        names: list
+
+    one = Pair(np.arange(3.0), ["x", "y"])
+    assert cache.content_digest(one, {"k": 1.0}) == cache.content_digest(Pair(np.arange(3.0), ["x", "y"]),
+                                                                           {"k": 1.0})
+    changed = Pair(np.arange(3.0), ["x", "y"])
+    changed.a[2] = np.nextafter(2.0, 3.0)                        # one bit of one entry
+    assert cache.content_digest(changed) != cache.content_digest(one)
+    assert cache.content_digest(np.zeros(2)) != cache.content_digest(np.zeros((2, 1)))
+    assert cache.content_digest(1) != cache.content_digest(1.0)
+    with pytest.raises(TypeError, match="found object"):
+        cache.content_digest(object())
+
+
+def test_memory_memo_keeps_the_last_values_and_computes_what_it_cannot_digest():
+    memo, calls = cache.MemoryMemo(2), []
+
+    def compute(v):
+        calls.append(v)
+        return v * 10
+
+    for v in (1, 2, 1, 3, 1, 2):                 # 3 drops 2 (least recently used), 1 stays
+        assert memo.get(v, lambda: compute(v)) == v * 10
+    assert calls == [1, 2, 3, 2]
+    obj = object()
+    memo.get(obj, lambda: compute(0))
+    memo.get(obj, lambda: compute(0))
+    assert calls == [1, 2, 3, 2, 0, 0]

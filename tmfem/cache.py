@@ -14,6 +14,9 @@ written to a temporary name in the same directory and renamed (``os.replace``, a
 POSIX): a reader never sees half an entry. (:mod:`tmfem.io.atomic` does the same for the
 commands' outputs; it lives in a layer above the models, which use this cache.) Deleting the
 directory is always safe.
+
+Within one process, :class:`MemoryMemo` keeps the last few values of a computation by the
+:func:`content_digest` of its inputs (values that are not JSON, such as casadi Functions).
 """
 from __future__ import annotations
 
@@ -22,7 +25,12 @@ import json
 import logging
 import os
 import tempfile
+from collections import OrderedDict
+from dataclasses import fields, is_dataclass
 from pathlib import Path
+from typing import Callable
+
+import numpy as np
 
 from tmfem import __version__
 
@@ -120,3 +128,74 @@ class JsonCache:
                 os.unlink(tmp)
         log.debug("cache entry %s written", path)
         return path
+
+
+def _feed(h, value) -> None:
+    """Add ``value`` to the hash ``h``, tagged by its type (:func:`content_digest`)."""
+    if value is None or isinstance(value, (bool, int, float, complex, str, bytes, np.generic)):
+        h.update(f"{type(value).__name__}:{value!r};".encode())
+    elif isinstance(value, np.ndarray):
+        a = np.ascontiguousarray(value)
+        h.update(f"ndarray:{a.dtype.str}:{a.shape};".encode())
+        h.update(a.tobytes())
+    elif is_dataclass(value) and not isinstance(value, type):
+        h.update(f"{type(value).__qualname__}(".encode())
+        for f in fields(value):
+            h.update(f"{f.name}=".encode())
+            _feed(h, getattr(value, f.name))
+        h.update(b")")
+    elif isinstance(value, dict):
+        h.update(f"dict{len(value)}{{".encode())
+        for k in sorted(value, key=repr):
+            _feed(h, k)
+            _feed(h, value[k])
+        h.update(b"}")
+    elif isinstance(value, (list, tuple)):
+        h.update(f"{type(value).__name__}{len(value)}[".encode())
+        for v in value:
+            _feed(h, v)
+        h.update(b"]")
+    else:
+        raise TypeError(f"content_digest: expected numbers, strings, arrays, dataclasses, dicts, "
+                        f"lists or tuples of them, found {type(value).__name__}")
+
+
+def content_digest(*values) -> str:
+    """SHA-256 (hex) of the content of ``values``: numbers and strings by type and repr,
+    arrays by dtype, shape and bytes, dataclasses field by field, dicts (by sorted key),
+    lists and tuples element by element, recursively. Equal content gives equal digests
+    whatever the objects; TypeError for any other type (its content is unknown)."""
+    h = hashlib.sha256()
+    for v in values:
+        _feed(h, v)
+    return h.hexdigest()
+
+
+class MemoryMemo:
+    """The values of the last ``size`` distinct inputs of one computation in this process, by
+    their :func:`content_digest`, the least recently used dropped first.
+
+    Parameters
+    ----------
+    size : int
+        How many values are kept.
+    """
+
+    def __init__(self, size: int):
+        self.size = size
+        self._values: OrderedDict = OrderedDict()
+
+    def get(self, inputs, compute: Callable):
+        """The value kept for ``inputs`` (anything :func:`content_digest` takes), else
+        ``compute()`` kept and returned; inputs it cannot digest are computed every time."""
+        try:
+            key = content_digest(inputs)
+        except TypeError:
+            return compute()
+        if key in self._values:
+            self._values.move_to_end(key)
+            return self._values[key]
+        value = self._values[key] = compute()
+        while len(self._values) > self.size:
+            self._values.popitem(last=False)
+        return value

@@ -43,12 +43,11 @@ levels of :func:`tmfem.control.linear.hinf_synthesis.hinfsyn`'s LMI route and a
 from __future__ import annotations
 
 import copy
-import hashlib
 import logging
-from collections import OrderedDict
 
 import numpy as np
 
+from tmfem.cache import MemoryMemo
 from tmfem.control.linear.verification import (HinfDesign, check_loop, controller_ss,
                                               verify)
 from tmfem.control.linear.hinf_central import verified_gamma
@@ -254,33 +253,13 @@ def _solve_stage1(plant, *, alpha, solver, eps, regularization, scale, residual_
 
 #: number of gamma minimisations :func:`_minimize_gamma` keeps (module docstring)
 STAGE1_MEMO_SIZE = 8
-_stage1_memo: OrderedDict = OrderedDict()
-
-
-def _stage1_key(plant: GeneralizedPlant, options: dict) -> str:
-    """Digest of what the gamma minimisation depends on: the plant's matrices (shapes and
-    bytes), its signal names and the options."""
-    h = hashlib.sha256(repr(sorted(options.items())).encode())
-    for k in ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22"):
-        M = np.ascontiguousarray(getattr(plant, k))
-        h.update(repr(M.shape).encode())
-        h.update(M.tobytes())
-    h.update(repr([plant.state_names, plant.w_names, plant.u_names, plant.p_names,
-                   plant.y_names]).encode())
-    return h.hexdigest()
+_stage1_memo = MemoryMemo(STAGE1_MEMO_SIZE)
 
 
 def _minimize_gamma(plant, **options):
     """:func:`_solve_stage1`, solved once per plant and options among the last
     :data:`STAGE1_MEMO_SIZE` (module docstring); the caller owns the returned copy."""
-    key = _stage1_key(plant, options)
-    if key in _stage1_memo:
-        _stage1_memo.move_to_end(key)
-    else:
-        _stage1_memo[key] = _solve_stage1(plant, **options)
-        while len(_stage1_memo) > STAGE1_MEMO_SIZE:
-            _stage1_memo.popitem(last=False)
-    return copy.deepcopy(_stage1_memo[key])
+    return copy.deepcopy(_stage1_memo.get((plant, options), lambda: _solve_stage1(plant, **options)))
 
 
 def hinf_gamma(plant: GeneralizedPlant, *, alpha: float = 0.0, solver: str = "CLARABEL",
