@@ -16,15 +16,19 @@ Substituted formulation (a check): zeta(q) in closed form
 (:func:`tmfem.models.com.constraints.zeta_closed_form_sx`) substituted into the Lagrangian
 before differentiation, Lagrange's equations then taken in z directly.
 
-All derivatives are casadi's automatic differentiation on SX graphs.
+All derivatives are casadi's automatic differentiation on SX graphs. Building them takes most
+of a model's set-up, so the graphs of the last :data:`GRAPHS_MEMO_SIZE` distinct inputs are kept
+in memory and shared (casadi Functions are immutable): models of the same system and options
+are built once per process.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import casadi as ca
 import numpy as np
 
+from tmfem.cache import MemoryMemo
 from tmfem.errors import InputError
 from tmfem.models.com.constraints import phi_sx, zeta_closed_form_sx
 from tmfem.models.com.energies import (lagrange_terms_sx, membrane_kinetic_energy_sx,
@@ -102,9 +106,20 @@ class COMGraphs:
     fast_mg: ca.Function | None = None
 
 
+#: number of distinct model inputs whose graphs :func:`build_graphs` keeps (module docstring)
+GRAPHS_MEMO_SIZE = 4
+_graphs_memo = MemoryMemo(GRAPHS_MEMO_SIZE)
+
+#: fields of a MembraneBasis left out of the graphs' key: the scikit-fem mesh and basis (not
+#: digestible; the shapes and invariants on that mesh are in the key) and the nodal mass
+#: (no term of the graphs)
+_MESH_FIELDS = ("plane", "scalar_basis", "node_mass")
+
+
 def build_graphs(system, membrane, layout, *, k, damping: float, prestress_scale: float,
                  delta0, formulation: str) -> COMGraphs:
-    """Build the graphs of eqs. 5.19-5.28 and 5.34 for one model.
+    """The graphs of eqs. 5.19-5.28 and 5.34 for one model (:func:`_graphs`), shared by the
+    models of equal inputs among the last :data:`GRAPHS_MEMO_SIZE` (module docstring).
 
     Parameters
     ----------
@@ -120,6 +135,15 @@ def build_graphs(system, membrane, layout, *, k, damping: float, prestress_scale
         :func:`tmfem.models.com.energies.membrane_potential_sx`.
     formulation : {"partitioned", "substituted"}
     """
+    basis = {f.name: getattr(membrane, f.name) for f in fields(membrane) if f.name not in _MESH_FIELDS}
+    options = dict(k=k, damping=damping, prestress_scale=prestress_scale, delta0=delta0,
+                   formulation=formulation)
+    return _graphs_memo.get((system, basis, layout, options),
+                            lambda: _graphs(system, membrane, layout, **options))
+
+
+def _graphs(system, membrane, layout, *, k, damping, prestress_scale, delta0, formulation) -> COMGraphs:
+    """Build the graphs of eqs. 5.19-5.28 and 5.34 (parameters of :func:`build_graphs`)."""
     nq, K, nzeta, n_t = len(system.q_names), membrane.K, layout.n, len(k)
     q = ca.SX.sym("q", nq)
     qd = ca.SX.sym("qd", nq)
