@@ -267,10 +267,15 @@ class Certificate:
     rate_bounds: np.ndarray
 
     def scaled_at(self, rho, rho_dot=None) -> dict:
-        out = {}
+        """M(rho) = sum_i f~_i(rho) M_i of every variable (scaled states), and dM/dt =
+        sum_i (grad f~_i . rho') M_i of X, Y, P (rho' = 0 when not given); the basis values
+        are evaluated once per basis (the gain variables share one)."""
+        out, values = {}, {}
         for name, coeffs in self.coefficients.items():
             gb = self.bases[name]
-            out[name] = _combine(coeffs, gb.values(rho))
+            if id(gb) not in values:
+                values[id(gb)] = gb.values(rho)
+            out[name] = _combine(coeffs, values[id(gb)])
             if name in ("X", "Y", "P"):
                 dv = gb.derivatives(rho) @ (np.zeros(self.n_parameters) if rho_dot is None
                                             else np.asarray(rho_dot, dtype=float).reshape(-1))
