@@ -18,7 +18,7 @@ import logging
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.interpolate import make_interp_spline
+from scipy.interpolate import RegularGridInterpolator, make_interp_spline
 
 from tmfem.equilibrium.deployment_path import lpv_grid_point
 from tmfem.equilibrium.symmetric_map import configuration_5_97, with_configuration
@@ -56,32 +56,6 @@ def grid_point_text(names, rho, *, rates: bool = False) -> str:
     tick, unit = ("'", " deg/s") if rates else ("", " deg")
     return ", ".join(f"{nm}{tick} = {np.degrees(v):.4g}{unit}" if nm.startswith(ANGLE_KINDS)
                      else f"{nm}{tick} = {v:.4g}" for nm, v in zip(names, np.atleast_1d(np.asarray(rho, dtype=float))))
-
-
-def multilinear(axes, values: np.ndarray, rho) -> np.ndarray:
-    """The multilinear interpolant of ``values`` (n_1, ..., n_d, ...) on the grid ``axes``
-    (d strictly increasing arrays of at least 2 points) at ``rho`` (d,) inside the grid.
-
-    With i_k the cell of rho_k (a_k[i_k] <= rho_k < a_k[i_k + 1], the last cell at the upper
-    end) and t_k = (rho_k - a_k[i_k]) / (a_k[i_k + 1] - a_k[i_k]),
-
-        f(rho) = sum over the 2^d corners c in {0, 1}^d of
-                 values[i_1 + c_1, ..., i_d + c_d] prod_k (t_k if c_k else 1 - t_k),
-
-    summed and multiplied in the order of scipy's ``RegularGridInterpolator`` (method
-    "linear"), whose values it repeats bit for bit without its per-call set-up.
-    """
-    cell = []
-    for a, r in zip(axes, rho):
-        i = min(max(int(np.searchsorted(a, r, side="right")) - 1, 0), a.size - 2)
-        cell.append((i, (r - a[i]) / (a[i + 1] - a[i])))
-    out = 0.0
-    for corner in itertools.product((0, 1), repeat=len(cell)):
-        w = 1.0
-        for (_, t), c in zip(cell, corner):
-            w = w * (t if c else 1 - t)
-        out = out + values[tuple(i + c for (i, _), c in zip(cell, corner))] * w
-    return out
 
 
 @dataclass
@@ -241,12 +215,13 @@ class GriddedLPV:
         M = getattr(self, name)
         if not keep:
             return M[(0,) * len(self.axes)].copy()
-        Mk = M[tuple(slice(None) if k in keep else 0 for k in range(len(self.axes)))]
-        axes = [self.axes[k] for k in keep]
-        if self.interpolation == "multilinear":
-            return multilinear(axes, Mk, rho[keep])
         if name not in self._interp:
-            self._interp[name] = make_interp_spline(axes[0], Mk, k=min(3, axes[0].size - 1), axis=0)
+            Mk = M[tuple(slice(None) if k in keep else 0 for k in range(len(self.axes)))]
+            axes = [self.axes[k] for k in keep]
+            self._interp[name] = (RegularGridInterpolator(axes, Mk) if self.interpolation == "multilinear"
+                                  else make_interp_spline(axes[0], Mk, k=min(3, axes[0].size - 1), axis=0))
+        if self.interpolation == "multilinear":
+            return self._interp[name](rho[keep])[0]
         out = self._interp[name](rho[keep[0]])
         for k in keep[1:]:
             out = make_interp_spline(self.axes[k], out, k=min(3, self.axes[k].size - 1), axis=0)(rho[k])
