@@ -153,6 +153,23 @@ def test_spline_interpolation_is_exact_for_a_cubic_quadratic_field():
         _polynomial_plant("cubic")
 
 
+
+@pytest.mark.parametrize("interpolation", ["multilinear", "spline"])
+def test_names_interpolated_together_are_those_interpolated_one_at_a_time(interpolation):
+    """interpolate(("A", "B", "C", "D"), rho): one interpolant of the stacked values gives
+    each matrix bitwise as its own interpolant does (source: one name at a time, a fresh plant
+    for each name, so that nothing it built for another name is reused)."""
+    _, pl = _polynomial_plant(interpolation)
+    rng = np.random.default_rng(3)
+    pl.A = pl.A + rng.standard_normal(pl.A.shape)              # four different fields
+    pl.B, pl.C, pl.D = (M + rng.standard_normal(M.shape) for M in (pl.B, pl.C, pl.D))
+    for rho in ([0.3, 0.2], [1.7, 1.1], [2.0, 1.5], [0.0, 0.5]):
+        together = pl.interpolate(("A", "B", "C", "D"), rho)
+        for nm, value in zip("ABCD", together):
+            _, one = _polynomial_plant(interpolation)
+            setattr(one, nm, getattr(pl, nm))
+            np.testing.assert_array_equal(value, one.interpolate(nm, rho))
+
 def test_off_grid_verification_passes_and_refuses_a_wrong_plant():
     pl = oscillator_plant()
     ctrl = synthesize_state_feedback(gp_of(pl))

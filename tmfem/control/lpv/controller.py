@@ -102,8 +102,8 @@ class LPVController(Scheduled):
         y = np.asarray(y, dtype=float)
         r = self.rho(y)
         re = self.operating_rho(t, r)
-        x = np.concatenate([y[self.state_index] - self.plant.interpolate("x_e", re), xc])
-        return self.plant.interpolate("u_e", re) + self.design.gain(r) @ x
+        x_e, u_e = self.plant.interpolate(("x_e", "u_e"), re)
+        return u_e + self.design.gain(r) @ np.concatenate([y[self.state_index] - x_e, xc])
 
     def update(self, t, y, xc):
         return xc + self._dt * (np.asarray(self.reference(t), dtype=float) - np.asarray(y)[self.q_index])

@@ -429,12 +429,12 @@ class LPVOutputController(Scheduled):
         ym = np.asarray(y, dtype=float)[self.measured_index]
         rho = self.rho(y) if self._from_estimate is None else \
             np.clip(xc[self._from_estimate], self._lo, self._hi)
-        x_e = est.interpolate("x_e", rho)
-        ue = est.interpolate("u_e", rho)[:self.design.nu]
+        x_e, ue = est.interpolate(("x_e", "u_e"), rho)
+        ue = ue[:self.design.nu]
         x_c, u_c = x_e, ue
         if self.reference_rho is not None:
-            r = self.operating_rho(t, rho)
-            x_c, u_c = est.interpolate("x_e", r), est.interpolate("u_e", r)[:self.design.nu]
+            x_c, u_c = est.interpolate(("x_e", "u_e"), self.operating_rho(t, rho))
+            u_c = u_c[:self.design.nu]
         u = u_c + self.design.state_feedback.gain(rho) @ np.concatenate([xc[:n] - x_c, xc[n:]])
         return ym, rho, xc[:n] - x_e, ue, u, x_e
 
