@@ -10,9 +10,12 @@ from __future__ import annotations
 
 import ctypes
 import functools
+import logging
 import os
 
 from tmfem.errors import BackendUnavailable
+
+log = logging.getLogger(__name__)
 
 PETSC_INSTALL = "make install  (runs scripts/install_petsc.sh; see docs/guides/backends.md)"
 
@@ -34,28 +37,55 @@ def petsc_modules():
     return PETSc, SLEPc
 
 
+#: glibc's malloc parameters that :func:`_restore_malloc` sets: (``mallopt`` number,
+#: ``GLIBC_TUNABLES`` name, tmfem's value)
+MALLOC_PARAMETERS = ((-4, "glibc.malloc.mmap_max", 65536),
+                     (-3, "glibc.malloc.mmap_threshold", 32 << 20),
+                     (-1, "glibc.malloc.trim_threshold", 64 << 20))
+
+
+def malloc_parameters(tunables: str) -> list[tuple[int, int]]:
+    """``(mallopt number, value)`` of :data:`MALLOC_PARAMETERS`: the value a ``GLIBC_TUNABLES``
+    string ``name=value:name=value`` gives (an integer, decimal or 0x hexadecimal, as glibc
+    reads it), else tmfem's. A value that is not a non-negative integer is left out, as glibc
+    leaves it out, with a warning."""
+    given = dict(item.partition("=")[::2] for item in tunables.split(":") if "=" in item)
+    chosen = []
+    for number, name, default in MALLOC_PARAMETERS:
+        value = default
+        if name in given:
+            try:
+                value = int(given[name], 0)
+                if value < 0:
+                    raise ValueError
+            except ValueError:
+                log.warning("GLIBC_TUNABLES: %s=%s is not a non-negative integer; using %d",
+                            name, given[name], default)
+                value = default
+        chosen.append((number, value))
+    return chosen
+
+
 @functools.cache
 def _restore_malloc() -> None:
     """Give freed memory back to the system again after PETSc has loaded (once).
 
     A library PETSc links (SuperLU_DIST's CombBLAS, in Debian's build) sets glibc's
-    ``M_MMAP_MAX`` to 0 and ``M_TRIM_THRESHOLD`` to -1 when it loads: every allocation then
-    comes from the heap and the heap never shrinks, so each transient array (a pattern
-    set-up's keys, an assembly's element matrices) stays resident to the end of the run.
-    This puts back what glibc's own adaptive thresholds settle at for arrays of this size
-    (blocks from 32 MB up mapped on their own and unmapped when freed, the heap top trimmed
-    beyond 64 MB free): smaller blocks are reused from the heap without new page faults (with
-    glibc's initial 128 kB threshold every transient array is mapped afresh, ~15 % more CPU
-    time at 78k dofs)."""
+    ``M_MMAP_MAX`` to 0 and ``M_TRIM_THRESHOLD`` to -1 when it loads, over glibc's defaults
+    and over the user's ``GLIBC_TUNABLES``: every allocation then comes from the heap and
+    the heap never shrinks, so each transient array (a pattern set-up's keys, an assembly's
+    element matrices) stays resident to the end of the run. This puts back the values of
+    ``GLIBC_TUNABLES`` (:func:`malloc_parameters`), else what glibc's own adaptive
+    thresholds settle at for arrays of this size (blocks from 32 MB up mapped on their own
+    and unmapped when freed, the heap top trimmed beyond 64 MB free): smaller blocks are
+    reused from the heap without new page faults (with glibc's initial 128 kB threshold
+    every transient array is mapped afresh, ~15 % more CPU time at 78k dofs)."""
     try:
-        libc = ctypes.CDLL(None)
-        mallopt = libc.mallopt
+        mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError):       # not glibc
         return
-    M_TRIM_THRESHOLD, M_MMAP_THRESHOLD, M_MMAP_MAX = -1, -3, -4
-    mallopt(M_MMAP_MAX, 65536)
-    mallopt(M_MMAP_THRESHOLD, 32 << 20)
-    mallopt(M_TRIM_THRESHOLD, 64 << 20)
+    for number, value in malloc_parameters(os.environ.get("GLIBC_TUNABLES", "")):
+        mallopt(number, value)
 
 
 def petsc_available() -> bool:
