@@ -26,13 +26,12 @@ across runs.
 """
 from __future__ import annotations
 
-import hashlib
 import logging
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from tmfem.cache import JsonCache
+from tmfem.cache import JsonCache, content_digest
 from tmfem.errors import TmfemError
 
 log = logging.getLogger(__name__)
@@ -298,12 +297,8 @@ def _fe_band(system, n: int, rest: str):
 
 
 def _fingerprint(system) -> str:
-    """A key of everything the choice depends on: geometry, materials, tendons, rest lengths."""
-    h = hashlib.sha256()
-    for a in (system.base, system.l, system.q, system.membrane_corners,
-              system.rest_lengths if system.rest_lengths is not None else np.zeros(0)):
-        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
-        h.update(b"|")
-    h.update(repr((system.M, system.N, system.deployable, system.k_H, system.membrane, system.bar,
-                   sorted(system.tendon_sections.items()), system.tendons)).encode())
-    return h.hexdigest()
+    """A key of everything the choice depends on: geometry, materials, tendons, rest lengths
+    (:func:`tmfem.cache.content_digest`)."""
+    return content_digest(system.base, system.l, system.q, system.membrane_corners, system.rest_lengths,
+                          system.M, system.N, system.deployable, system.k_H, system.membrane, system.bar,
+                          system.tendon_sections, system.tendons)
