@@ -67,6 +67,7 @@ import copy
 import numpy as np
 import scipy.sparse as sp
 
+from tmfem.cache import MemoryMemo
 from tmfem.errors import InputError
 from tmfem.fem.assembly import Assembler
 from tmfem.fem.dofmap import DofMap
@@ -74,6 +75,10 @@ from tmfem.fem.element import skew
 from tmfem.fem.plane_stress import von_mises
 from tmfem.fem.shell_section import ShellSection
 from tmfem.fem.tension_field import element_wrinkling, membrane_law
+
+#: in-plane result points of a shell whose reference quantities are kept
+RESULT_POINTS_KEPT = 32
+
 
 def director_frames(normals: np.ndarray) -> np.ndarray:
     """Nodal triads [V_1 V_2 V_n] (n, 3, 3), columns, from unit directors (3, n) (eq. 4.16):
@@ -304,7 +309,7 @@ class MITC4Shell:
         self._asm = Assembler(dofmap.element_dofs(conn, rotations=True), dofmap.ndof)
         self._M = None
         self._part_cache = None
-        self._result_points = {}
+        self._result_points = MemoryMemo(RESULT_POINTS_KEPT)
 
     # ------------------------------------------------------------------ kinematics
     def _tie_weights(self, xi):
@@ -390,7 +395,7 @@ class MITC4Shell:
             setattr(part, name, getattr(self, name)[elements])
         part._gauss = self._gauss.take(elements)
         part._part_cache = None
-        part._result_points = {}
+        part._result_points = MemoryMemo(RESULT_POINTS_KEPT)
         self._part_cache = (key, part)
         return part
 
@@ -578,16 +583,11 @@ class MITC4Shell:
     def _results_at(self, xi, thickness: str) -> _Points:
         """The reference quantities (:class:`_Points`, results frame of eq. 4.16) at one
         in-plane point xi and the ``thickness`` points of :attr:`_THICKNESS`; they depend on
-        the reference geometry only, so they are made once per point (the last 32 kept)."""
+        the reference geometry only, so they are made once per point (the last :data:`RESULT_POINTS_KEPT` kept)."""
         xi = np.asarray(xi, dtype=float).reshape(2, 1)
         key = (float(xi[0, 0]), float(xi[1, 0]), thickness)
-        pts = self._result_points.get(key)
-        if pts is None:
-            if len(self._result_points) >= 32:
-                self._result_points.clear()
-            pts = self._result_points[key] = _Points(self, xi, np.ones(1), *self._THICKNESS[thickness],
-                                                     output_frame=True)
-        return pts
+        return self._result_points.get(key, lambda: _Points(self, xi, np.ones(1), *self._THICKNESS[thickness],
+                                                            output_frame=True))
 
     def stresses(self, state, *, xi=(0.5, 0.5)):
         """Local 2nd Piola-Kirchhoff stresses at one in-plane point of every element.
