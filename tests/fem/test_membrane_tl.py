@@ -254,6 +254,19 @@ def test_point_matrix_reproduces_bilinear_fields_and_rejects_outside_points(mem)
         point_matrix(mem.skmesh, np.zeros((3, 2)))
 
 
+def test_point_matrix_equals_scikit_fem_probes_on_the_whole_mesh(mem):
+    # source: scikit-fem's Basis(mesh, ElementQuad1()).probes on the whole distorted mesh, at
+    # points inside elements, at nodes and on edges (where two elements hold the point)
+    from skfem import Basis, ElementQuad1
+    from tmfem.fem.membrane import point_matrix
+    p, t = mem.mesh.p, mem.mesh.t
+    w = np.random.default_rng(3).dirichlet(np.ones(4), t.shape[1])          # (ne, 4)
+    inside = np.einsum("ine,en->ie", p[:, t], w)
+    pts = np.hstack([inside, p, 0.5 * (p[:, t[0]] + p[:, t[1]])])
+    whole = Basis(mem.skmesh, ElementQuad1(), intorder=1).probes(pts).toarray()
+    assert np.abs(point_matrix(mem.skmesh, pts).toarray() - whole).max() < 1e-13
+
+
 def test_zero_area_reference_element_is_rejected():
     # an element whose four nodes coincide has zero area (shoelace formula): InputError with
     # the count found, before scikit-fem fails on its zero Jacobian

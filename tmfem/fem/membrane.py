@@ -138,22 +138,30 @@ def point_matrix(skmesh, points) -> sp.csr_matrix:
     mesh at reference points: the bilinear interpolation of eqs. 4.25-4.26 (scikit-fem probes
     of ``ElementQuad1``, whose dof k is node k).
 
+    The elements that hold the points are found on the whole mesh (scikit-fem's element
+    finder) and the probes made on a mesh of those elements alone, so that the cost does not
+    grow with the mesh beyond the search.
+
     Parameters
     ----------
     skmesh : skfem.MeshQuad
     points : array_like (2, n_points)
         Reference coordinates (x_f, y_f) [m].
     """
-    from skfem import Basis, ElementQuad1
+    from skfem import Basis, ElementQuad1, MeshQuad
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     if pts.shape[0] != 2:
         raise InputError(f"membrane points: expected shape (2, n) of (x_f, y_f), found {pts.shape}")
-    basis = Basis(skmesh, ElementQuad1(), intorder=1)
     try:
-        return sp.csr_matrix(basis.probes(pts))
+        cells = skmesh.element_finder()(*pts)
     except ValueError as exc:
         raise InputError(f"membrane points {pts.T.tolist()}: outside the undeformed membrane "
                          f"({exc})") from None
+    t = skmesh.t[:, np.unique(cells)]
+    nodes, local = np.unique(t.ravel(), return_inverse=True)
+    near = MeshQuad(skmesh.p[:, nodes], local.reshape(t.shape))
+    P = Basis(near, ElementQuad1(), intorder=1).probes(pts).tocoo()
+    return sp.csr_matrix((P.data, (P.row, nodes[P.col])), shape=(pts.shape[1], skmesh.p.shape[1]))
 
 
 #: elements per chunk of the membrane kernel (:meth:`MembraneTL.element_arrays`)
