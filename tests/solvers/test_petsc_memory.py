@@ -70,12 +70,14 @@ def test_the_users_glibc_tunables_hold_after_petsc_has_loaded():
 
 def test_malloc_parameters_read_glibc_tunables_and_keep_tmfems_values_otherwise(caplog):
     from tmfem.solvers.petsc_loader import MALLOC_PARAMETERS, malloc_parameters
-    defaults = [(number, value) for number, _, value in MALLOC_PARAMETERS]
-    assert malloc_parameters("") == defaults
-    assert malloc_parameters("glibc.malloc.mmap_threshold=0x100000:glibc.malloc.arena_max=1") == \
-        [(-4, 65536), (-3, 1 << 20), (-1, 64 << 20)]
-    assert malloc_parameters("glibc.malloc.trim_threshold=2097152") == [(-4, 65536), (-3, 32 << 20), (-1, 2 << 20)]
+    assert malloc_parameters("") == list(MALLOC_PARAMETERS)
+    values = [v for _, _, v in malloc_parameters("glibc.malloc.mmap_threshold=0x100000:glibc.malloc.arena_max=1")]
+    assert values == [65536, 1 << 20, 64 << 20]
+    values = [v for _, _, v in malloc_parameters("glibc.malloc.trim_threshold=2097152")]
+    assert values == [65536, 32 << 20, 2 << 20]
     with caplog.at_level("WARNING", logger="tmfem.solvers.petsc_loader"):
-        assert malloc_parameters("glibc.malloc.trim_threshold=lots:glibc.malloc.mmap_max=-1") == defaults
-    assert "glibc.malloc.trim_threshold=lots is not a non-negative integer" in caplog.text
-    assert "glibc.malloc.mmap_max=-1 is not a non-negative integer" in caplog.text
+        tunables = "glibc.malloc.trim_threshold=lots:glibc.malloc.mmap_max=-1:glibc.malloc.mmap_threshold=0x80000000"
+        assert malloc_parameters(tunables) == list(MALLOC_PARAMETERS)
+    for given in ("trim_threshold=lots", "mmap_max=-1", "mmap_threshold=0x80000000"):
+        assert f"glibc.malloc.{given} is not an integer from 0 to 2147483647" in caplog.text
+

@@ -39,16 +39,19 @@ def petsc_modules():
 
 #: glibc's malloc parameters that :func:`_restore_malloc` sets: (``mallopt`` number,
 #: ``GLIBC_TUNABLES`` name, tmfem's value)
-MALLOC_PARAMETERS = ((-4, "glibc.malloc.mmap_max", 65536),
-                     (-3, "glibc.malloc.mmap_threshold", 32 << 20),
-                     (-1, "glibc.malloc.trim_threshold", 64 << 20))
+MALLOC_PARAMETERS = ((-4, "glibc.malloc.mmap_max", 65536),             # M_MMAP_MAX
+                     (-3, "glibc.malloc.mmap_threshold", 32 << 20),    # M_MMAP_THRESHOLD
+                     (-1, "glibc.malloc.trim_threshold", 64 << 20))    # M_TRIM_THRESHOLD
+
+#: the largest value ``mallopt`` takes (a C int)
+MALLOPT_MAX = 2**31 - 1
 
 
-def malloc_parameters(tunables: str) -> list[tuple[int, int]]:
-    """``(mallopt number, value)`` of :data:`MALLOC_PARAMETERS`: the value a ``GLIBC_TUNABLES``
-    string ``name=value:name=value`` gives (an integer, decimal or 0x hexadecimal, as glibc
-    reads it), else tmfem's. A value that is not a non-negative integer is left out, as glibc
-    leaves it out, with a warning."""
+def malloc_parameters(tunables: str) -> list[tuple[int, str, int]]:
+    """``(mallopt number, name, value)`` of :data:`MALLOC_PARAMETERS`: the value a
+    ``GLIBC_TUNABLES`` string ``name=value:name=value`` gives (an integer, decimal or 0x
+    hexadecimal, as glibc reads it), else tmfem's. A value that is not an integer from 0 to
+    2**31 - 1 (``mallopt`` takes a C int) is left out and named in a warning."""
     given = dict(item.partition("=")[::2] for item in tunables.split(":") if "=" in item)
     chosen = []
     for number, name, default in MALLOC_PARAMETERS:
@@ -56,13 +59,13 @@ def malloc_parameters(tunables: str) -> list[tuple[int, int]]:
         if name in given:
             try:
                 value = int(given[name], 0)
-                if value < 0:
+                if not 0 <= value <= MALLOPT_MAX:
                     raise ValueError
             except ValueError:
-                log.warning("GLIBC_TUNABLES: %s=%s is not a non-negative integer; using %d",
-                            name, given[name], default)
+                log.warning("GLIBC_TUNABLES: %s=%s is not an integer from 0 to %d; using %d",
+                            name, given[name], MALLOPT_MAX, default)
                 value = default
-        chosen.append((number, value))
+        chosen.append((number, name, value))
     return chosen
 
 
@@ -84,7 +87,7 @@ def _restore_malloc() -> None:
         mallopt = ctypes.CDLL(None).mallopt
     except (OSError, AttributeError):       # not glibc
         return
-    for number, value in malloc_parameters(os.environ.get("GLIBC_TUNABLES", "")):
+    for number, _, value in malloc_parameters(os.environ.get("GLIBC_TUNABLES", "")):
         mallopt(number, value)
 
 
