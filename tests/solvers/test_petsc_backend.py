@@ -374,6 +374,19 @@ def test_rank_local_pattern_changes_neither_hang_nor_mislead():
 
 
 @needs_mpi
+def test_a_tangent_that_one_rank_still_holds_is_refilled_on_no_rank():
+    # source: the first tangent's Frobenius norm at the same configuration. Rank 1 holds the
+    # first tangent: every rank assembles a new one (one rank refilling while another
+    # creates are different collective calls: the job would hang to the timeout)
+    p = _mpirun(2, "1-4", "4", timeout=60,
+                program=[sys.executable, str(ROOT / "tests" / "mpi" / "tangent_reuse.py")])
+    assert p.returncode == 0, p.stderr
+    doc = json.loads(p.stdout)
+    assert doc["new"] == [True, True]
+    assert doc["second"] == pytest.approx(doc["first"], rel=1e-14)
+
+
+@needs_mpi
 @pytest.mark.slow
 def test_failure_on_one_rank_one_error_nonzero_exit():
     # non-finite element matrices on rank 1: caught collectively, one message from rank 0

@@ -144,12 +144,23 @@ class DistributedElements:
             return r, None
         # a tangent the caller still holds (the iterate's, while it evaluates trial points)
         # is never overwritten: refill one that nobody references, else assemble a new one
-        for K in self._K:
-            if sys.getrefcount(K) <= 3:        # the list's, the loop's, the argument's
-                return r, self.assembler.matrix(*values, out=K)
+        free = self._unreferenced_tangents()
+        if free:
+            return r, self.assembler.matrix(*values, out=self._K[free[0]])
         K = self.assembler.matrix(*values)
         self._K.append(K)
         return r, K
+
+    def _unreferenced_tangents(self) -> list[int]:
+        """Indices of the kept tangents that nothing references on any rank. Collective:
+        whether a rank still references one (a frame or traceback kept alive, an object in
+        a reference cycle the garbage collector has not reached yet) differs between ranks,
+        and refilling a tangent on one rank while another assembles a new one are different
+        collective calls."""
+        free = [sys.getrefcount(K) <= 3 for K in self._K]   # the list's, the loop's, the argument's
+        if self.comm.size > 1:
+            free = [all(column) for column in zip(*self.comm.allgather(free))]
+        return [i for i, f in enumerate(free) if f]
 
     def release(self) -> None:
         """Free the PETSc matrices (tangents, mass) and work vectors assembled here
