@@ -14,6 +14,13 @@ model whose memory divides over ranks gives about 1/P plus the start-up's share;
 2 ranks: at most 0.6), and the ratio that the start-up and MUMPS alone leave
 (:func:`floor_ratio`: everything else divided exactly), which bounds what tmfem's own data
 can reach.
+
+``--petsc-memory`` runs every job a second time with PETSc's ``-memory_view -malloc_debug``
+and prints the largest memory PETSc itself allocated on a rank (``PetscMalloc``: matrices,
+vectors, the KSP, SNES and EPS objects and PETSc's copies of the matrices for MUMPS; not
+MUMPS' own factor and work space, not numpy's arrays): PETSc's share of the peak and how it
+divides. (Debug allocation changes the resident memory and the time, so the first run's
+figures stand alone.)
 """
 from __future__ import annotations
 
@@ -93,10 +100,32 @@ def floor_ratio(run: dict, ref: dict) -> tuple[int, float]:
     return P, top / r1["peak_mb"]["modes"]
 
 
-def launch(mesh: int, ranks: int, args) -> dict:
+#: PETSc's options of the ``--petsc-memory`` runs: its memory summary at the end of the job,
+#: with PetscMalloc's usage tracked
+PETSC_MEMORY_OPTIONS = "-memory_view -malloc_debug"
+
+
+def petsc_malloc_mb(stdout: str) -> dict | None:
+    """The largest memory PETSc allocated (``PetscMalloc``) on the busiest and on the least
+    busy rank over the job [MB], from ``-memory_view``'s summary on ``stdout``; None when
+    the summary has no such line (tracking off)."""
+    for line in stdout.splitlines():
+        if line.startswith("Maximum (over computational time) space PetscMalloc()ed:"):
+            words = line.split()
+            return {"max": float(words[words.index("max") + 1]) / 2**20,
+                    "min": float(words[words.index("min") + 1]) / 2**20}
+    return None
+
+
+def launch(mesh: int, ranks: int, args, *, petsc_memory: bool = False) -> dict:
+    """One job of ``ranks`` ranks on the 4 x mesh x mesh membrane: its result (:func:`run_one`),
+    or ``{"error": ...}``; with ``petsc_memory`` run under :data:`PETSC_MEMORY_OPTIONS`,
+    ``{"petsc_malloc_mb": ...}`` of :func:`petsc_malloc_mb` only."""
     env = {k: v for k, v in os.environ.items()
            if not k.startswith(("OMPI_", "PMIX_", "OPAL_", "ORTE_")) or "ALLOW_RUN_AS_ROOT" in k}
     env["OPENBLAS_NUM_THREADS"] = "1"
+    if petsc_memory:
+        env["PETSC_OPTIONS"] = f"{env.get('PETSC_OPTIONS', '')} {PETSC_MEMORY_OPTIONS}".strip()
     cmd = [shutil.which("mpiexec"), "--allow-run-as-root", "--oversubscribe", "-n", str(ranks),
            sys.executable, HERE, "--run", str(mesh), "--rest-length", str(args.rest_length),
            "--sequence", str(args.sequence)]
@@ -104,7 +133,9 @@ def launch(mesh: int, ranks: int, args) -> dict:
     if p.returncode != 0:
         return dict(mesh=f"4x{mesh}x{mesh}", ranks=ranks,
                     error=(p.stderr.strip().splitlines() or ["exit %d" % p.returncode])[-1])
-    return json.loads(p.stdout.strip().splitlines()[-1])
+    if petsc_memory:
+        return {"petsc_malloc_mb": petsc_malloc_mb(p.stdout)}
+    return json.loads(next(line for line in p.stdout.splitlines() if line.startswith("{")))
 
 
 def main(argv=None) -> int:
@@ -115,6 +146,9 @@ def main(argv=None) -> int:
                     help="rest length of the S tendons [m] (the value Tables 6.3/6.6 imply)")
     ap.add_argument("--sequence", type=int, default=10, help="coarsest mesh of the mesh sequencing")
     ap.add_argument("--run", type=int, metavar="MESH", help=argparse.SUPPRESS)
+    ap.add_argument("--petsc-memory", action="store_true",
+                    help="run every job again under PETSc's -memory_view -malloc_debug and print "
+                         "the largest memory PETSc allocated per rank")
     ap.add_argument("--json", action="store_true", help="one JSON document of all runs")
     args = ap.parse_args(argv)
     if args.run:
@@ -139,6 +173,8 @@ def main(argv=None) -> int:
         for ranks in rank_counts:
             run = launch(mesh, ranks, args)
             runs.append(run)
+            if args.petsc_memory and "error" not in run:
+                run.update(launch(mesh, ranks, args, petsc_memory=True))
             if "error" in run:
                 if not args.json:
                     print(f"4x{mesh}x{mesh}".rjust(11) + f" P={ranks} error: {run['error']}",
@@ -168,6 +204,14 @@ def main(argv=None) -> int:
             if bounds:
                 print(f"# 4x{mesh}x{mesh}: the ratio if all but the start-up and MUMPS divided exactly "
                       "over the ranks: " + ", ".join(f"P={p}: {b:.2f}" for p, b in bounds), flush=True)
+            petsc = [(r["ranks"], r["petsc_malloc_mb"]) for r in runs if r.get("mesh") == f"4x{mesh}x{mesh}"
+                     and r.get("petsc_malloc_mb")]
+            if petsc:
+                one = petsc[0][1]["max"]
+                print(f"# 4x{mesh}x{mesh}: PETSc's own memory (PetscMalloc, largest over the job, "
+                      f"{PETSC_MEMORY_OPTIONS} runs), busiest / least busy rank: "
+                      + ", ".join(f"P={p}: {m['max']:.0f} / {m['min']:.0f} MB ({m['max'] / one:.2f})"
+                                  for p, m in petsc), flush=True)
     if args.json:
         print(json.dumps(runs))
     return 0
