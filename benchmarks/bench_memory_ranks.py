@@ -174,7 +174,10 @@ def main(argv=None) -> int:
             run = launch(mesh, ranks, args)
             runs.append(run)
             if args.petsc_memory and "error" not in run:
-                run.update(launch(mesh, ranks, args, petsc_memory=True))
+                tracked = launch(mesh, ranks, args, petsc_memory=True)
+                if "error" in tracked:
+                    tracked["error"] = f"the {PETSC_MEMORY_OPTIONS} run: {tracked['error']}"
+                run.update(tracked)
             if "error" in run:
                 if not args.json:
                     print(f"4x{mesh}x{mesh}".rjust(11) + f" P={ranks} error: {run['error']}",
