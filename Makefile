@@ -4,7 +4,8 @@
 #   make test   -- install, then run the fast test suite (every feature, a few minutes)
 # and beside them:
 #   make test-full     -- every test, the studies at full scale (about 40 min)
-#   make test-studies  -- only the studies, at the size given by TMFEM_SLOW_SCALE (CI: reduced)
+#   make test-studies  -- only the studies and the longest end-to-end runs (the studies at the
+#                         size given by TMFEM_SLOW_SCALE; CI: reduced)
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin

@@ -67,6 +67,7 @@ def on_terminal(**env):
     return b"".join(chunks).decode(errors="replace")
 
 
+@pytest.mark.slow
 def test_progress_bar_on_a_terminal_only(tmp_path):
     assert "/300" in on_terminal()
     log = tmp_path / "log.txt"

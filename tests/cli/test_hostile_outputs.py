@@ -73,6 +73,7 @@ def scan_vtu(path):
             assert nan.all() or not nan.any(), (path, name, g)
 
 
+@pytest.mark.slow
 def test_no_nonfinite_value_in_any_output(tmp_path, capsys):
     for argv in battery(tmp_path):
         rc, out, err = run([str(a) for a in argv], capsys)

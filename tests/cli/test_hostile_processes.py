@@ -35,7 +35,7 @@ def rows(path):
     return path.read_text().count("\n") if path.exists() else 0
 
 
-@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated"),
+@pytest.mark.parametrize("sig, code, word", [pytest.param(signal.SIGTERM, 143, "terminated", marks=pytest.mark.slow),
                                              (signal.SIGINT, 130, "interrupted")])
 def test_second_run_refused_and_signal_leaves_partial_files(tmp_path, sig, code, word):
     out = tmp_path / "out"
@@ -81,6 +81,7 @@ def test_second_run_refused_and_signal_leaves_partial_files(tmp_path, sig, code,
     assert csv.read_text().count("\n") == 12         # header, t = 0 and 10 steps of 0.01 s
 
 
+@pytest.mark.slow
 def test_two_study_runs_into_one_directory(tmp_path):
     out = tmp_path / "study"
     first = tmfem("study", "--preset", "2-3", "--out", out, "--map-grid", "60")

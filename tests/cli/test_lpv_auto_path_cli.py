@@ -30,6 +30,7 @@ def test_the_three_stage_grid_gives_its_pointwise_bound(capsys):
     assert g.max() * (1 - 1e-4) <= nrm <= 1.01 * g.max() * (1 + 1e-6)
 
 
+@pytest.mark.slow
 def test_a_grid_point_off_the_region_is_refused_with_its_angles(tmp_path, capsys):
     text = re.sub(r"^psi_grid_deg = .*$", "psi_grid_deg = [10.0, 30.0]", TOWER.read_text(), flags=re.M)
     f = tmp_path / "t.toml"

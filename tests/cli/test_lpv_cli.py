@@ -24,6 +24,7 @@ def test_lpv_cli_refuses_bad_input(argv, msg, capsys):
     assert msg in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_lpv_cli_bound_only_on_one_point(capsys):
     # one grid point (theta = 71.59 deg, psi = 8.36 deg of P_D: one point of an axis is its middle): the pointwise
     # state-feedback optimum (Riccati test) is tight: a static gain designed at 1.01 x it has a

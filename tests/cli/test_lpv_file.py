@@ -27,6 +27,7 @@ def bound_only(argv, capsys) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow
 def test_a_renamed_copy_of_the_preset_gives_the_preset_numbers(tmp_path, capsys):
     # the same [lpv] grid and rate bound read from a user file: the same frozen plants and
     # pointwise optima (Riccati) as the preset; without [printed] no printed bound is shown

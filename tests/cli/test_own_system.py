@@ -58,7 +58,7 @@ def assert_no_dissertation(text: str):
     assert not found, found
 
 
-@pytest.mark.parametrize("which", [0, 1])
+@pytest.mark.parametrize("which", [0, pytest.param(1, marks=pytest.mark.slow)])
 def test_modal_of_a_renamed_preset_prints_no_table(which, impostors, capsys):
     """`modal` (MTC and COM): no 'dissertation' columns, no differences to Table 6.6."""
     f = str(impostors[which])
@@ -70,7 +70,7 @@ def test_modal_of_a_renamed_preset_prints_no_table(which, impostors, capsys):
     assert_no_dissertation(out)
 
 
-@pytest.mark.parametrize("which", [0, 1])
+@pytest.mark.parametrize("which", [0, pytest.param(1, marks=pytest.mark.slow)])
 def test_report_of_a_renamed_preset_is_its_own(which, impostors, tmp_path, capsys):
     """`report`: one prestress case (designed), no printed columns, no notes, no deployment."""
     out = tmp_path / "r"
@@ -97,8 +97,10 @@ def test_hinf_of_a_deployable_named_like_a_preset_uses_its_own_scales(impostors,
     assert_no_dissertation(out)
 
 
-@pytest.mark.parametrize("file, modes", [("triangle-1-3.toml", 6), ("pentagon-1-5.toml", 12),
-                                         ("square-2-4.toml", 12), ("kapton-1-4.toml", 12)])
+@pytest.mark.parametrize("file, modes", [("triangle-1-3.toml", 6),
+                                         pytest.param("pentagon-1-5.toml", 12, marks=pytest.mark.slow),
+                                         pytest.param("square-2-4.toml", 12, marks=pytest.mark.slow),
+                                         pytest.param("kapton-1-4.toml", 12, marks=pytest.mark.slow)])
 def test_user_system_modes_and_design(file, modes, capsys):
     """`equilibrium` and `modal` (MTC, COM) on each user system, rc 0, finite positive
     frequencies, the MTC's two lowest beside the COM's within 10 % (both models of the same
@@ -264,6 +266,7 @@ def test_report_of_a_deployable_uses_sbc_com_and_its_own_deployment(tmp_path, ca
     assert_no_dissertation(text.replace('"implied_prestress": null', "") + index)
 
 
+@pytest.mark.slow
 def test_report_with_a_failed_check_does_not_say_passed(tmp_path, capsys):
     """The 1-5 with a tendon yield stress of 1 MPa (its design stresses the tendons to ~52 MPa):
     the FE statics' yield check fails, so the report lists it, exits 1 and never says
@@ -304,7 +307,8 @@ def test_com_disagreement_names_the_modes():
     assert com_disagreement({k: v[:2] for k, v in freqs.items()}, "MTC", 4) is None
 
 
-@pytest.mark.parametrize("file", ["triangle-1-3.toml", "square-2-4.toml"])
+@pytest.mark.parametrize("file", ["triangle-1-3.toml",
+                                  pytest.param("square-2-4.toml", marks=pytest.mark.slow)])
 def test_compare_of_user_systems_sets_the_three_models_side_by_side(file, tmp_path, capsys):
     """`compare FILE`: the SBC, MTC and COM frequencies of a user system with their differences
     to the SBC model, no printed columns; the two FE models agree within 1 % in the lowest mode
@@ -421,6 +425,7 @@ def test_static_text_of_a_user_system_has_units_and_no_printed_column(model, cap
         assert any("vs 61 MPa" in c for c in checks) and any("vs 94.8 MPa" in c for c in checks)
 
 
+@pytest.mark.slow
 def test_report_of_a_deployable_system_whose_switch_cannot_be_designed(tmp_path, capsys):
     """A 1-4(D) whose COM (K = 4) has a membrane mode that no tendon reaches (PBH margin 0,
     eq. 5.71): the deployment's H-infinity switch cannot be designed, and the report still

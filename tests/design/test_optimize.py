@@ -112,6 +112,7 @@ def test_example_2_minimises_the_mass_of_a_1_3_system_with_buckling_and_slack_li
     assert resid < 1e-5 and np.all(mu > 0), (resid, mu)
 
 
+@pytest.mark.slow
 def test_example_3_maximises_the_first_frequency_of_the_two_stage_2_3():
     system = load_preset("2-3")
     r0 = MTCModel(system, mesh_n=4).rest_lengths
@@ -178,6 +179,7 @@ def test_membrane_radius_optimum_written_back_reads_as_the_same_design(tmp_path)
     assert m.modes(k=1, at=m.equilibrium()).freq_hz[0] == pytest.approx(res.optimum_responses["freq"][0], rel=1e-6)
 
 
+@pytest.mark.slow
 def test_sbc_membrane_radius_optimum_reads_back_as_the_same_design(tmp_path):
     # the same problem on the SBC model: its optimal system, read back, gives the optimiser's
     # first frequency on a fresh SBC model (with the refined modes of the sensitivities: the

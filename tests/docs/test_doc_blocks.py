@@ -48,7 +48,7 @@ def python_blocks(md: Path) -> list[str]:
 PAGES = sorted(p for p in DOCS.rglob("*.md") if python_blocks(p))
 #: pages whose blocks take long (the tutorial designs, deploys and reports a system of its own):
 #: they run with the studies
-SLOW_PAGES = {"tutorial.md"}
+SLOW_PAGES = {"tutorial.md", "guides/system-file.md", "guides/shells.md", "guides/lpvsyn.md"}
 
 
 def test_tutorial_and_guides_have_blocks():

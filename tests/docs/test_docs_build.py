@@ -33,12 +33,14 @@ def site(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_site_builds_strict(site):
     for page in ["index.html", "tutorial/index.html", "architecture/index.html",
                  "validation/errata/index.html", "reference/cli/index.html"]:
         assert (site / page).is_file(), page
 
 
+@pytest.mark.slow
 def test_every_markdown_page_is_in_the_site(site):
     """No page of docs/ is left out of the build (a guide nobody can reach)."""
     docs = ROOT / "docs"
@@ -49,6 +51,7 @@ def test_every_markdown_page_is_in_the_site(site):
         assert html.is_file(), md
 
 
+@pytest.mark.slow
 def test_api_reference_has_every_package_and_module(site):
     """Each subpackage of tmfem has a page that documents each of its public modules."""
     hook = _hook()
@@ -61,6 +64,7 @@ def test_api_reference_has_every_package_and_module(site):
                 assert f'id="{mod}"' in html, mod
 
 
+@pytest.mark.slow
 def test_cli_reference_has_every_subcommand(site):
     from tmfem.cli import build_parser
     hook = _hook()

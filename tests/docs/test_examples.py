@@ -47,6 +47,7 @@ def test_own_system(monkeypatch, tmp_path, capsys):
     assert "MTC frequencies" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_control_model(monkeypatch, tmp_path):
     """The ss has one input per tendon and the LQR closed loop is stable (python-control's
     own poles of A - B K)."""

@@ -11,6 +11,7 @@ import pytest
 from tmfem.reference.benchmarks.shell_hinged_roof import model
 
 
+@pytest.mark.slow
 def test_thin_roof_snaps_back_through_two_limit_points():
     s, c = model(n=8, h=6.35)
     path = s.solve_arc_length(dl=0.5, dl_max=1.0, max_steps=800, lam_max=1.0)

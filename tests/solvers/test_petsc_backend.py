@@ -244,6 +244,7 @@ def _mpirun(n, *args, timeout=120, program=None):
 
 
 @needs_mpi
+@pytest.mark.slow
 def test_cli_under_two_ranks_prints_once_and_refuses_scipy():
     # source: the same command on 1 process (rank-0 output must be the serial document)
     tmfem = [sys.executable, "-m", "tmfem"]
@@ -437,6 +438,7 @@ def test_cli_static_writes_each_output_once_from_rank_0(tmp_path):
 
 
 @needs_mpi
+@pytest.mark.slow
 def test_cli_converge_writes_csv_and_plot_once_from_rank_0(tmp_path):
     # source: the serial scipy run of the same study (frequencies to 1e-8)
     conv = ["converge", "--preset", "2-3", "--mesh", "2,3", "--tendon-elements", "1",
@@ -604,6 +606,7 @@ def test_sbc_failure_on_one_rank_one_error_nonzero_exit():
 
 
 @needs_mpi
+@pytest.mark.slow
 def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
     # source: the same command on 1 process with scipy (frequencies to their round-off
     # floor); the VTK file written once, by rank 0. The floor: entries
@@ -623,7 +626,7 @@ def test_cli_sbc_modal_under_two_ranks_prints_once_and_agrees(tmp_path):
 
 
 @needs_mpi
-@pytest.mark.parametrize("ranks", [2, 3])
+@pytest.mark.parametrize("ranks", [2, pytest.param(3, marks=pytest.mark.slow)])
 def test_slepc_eigen_under_ranks_agrees_with_scipy(models, equilibria, design_run, ranks):
     # source: the scipy model's 12 modes at its own equilibrium from the design (ARPACK on
     # the scipy matrices) and the model's scipy mass for the M-orthonormality; SLEPc's

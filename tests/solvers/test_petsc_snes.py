@@ -185,7 +185,7 @@ def test_auto_model_below_the_crossover_is_scipy():
 
 
 @needs_mpi
-@pytest.mark.parametrize("ranks", [2, 3])
+@pytest.mark.parametrize("ranks", [2, pytest.param(3, marks=pytest.mark.slow)])
 def test_snes_under_ranks_honours_options_and_reports_its_reason_once(scipy_2_3, ranks):
     # source: the scipy trust region's equilibrium (displacements to 1e-9); under mpiexec the
     # SNES monitor prints from rank 0 and a SNES failure on every rank is one error
@@ -205,6 +205,7 @@ def test_snes_under_ranks_honours_options_and_reports_its_reason_once(scipy_2_3,
 
 
 @needs_mpi
+@pytest.mark.slow
 def test_sbc_snes_under_three_ranks_agrees_with_scipy():
     # source: the scipy SBC model's static solve from the undeformed membrane (MTC predictor,
     # then the SBC trust region); the SNES continuation on 3 ranks, the shells assembled rank
@@ -237,6 +238,7 @@ def test_snes_stops_at_once_on_a_mumps_failure_a_shift_cannot_cure():
 
 
 @needs_mpi
+@pytest.mark.slow
 def test_sbc_on_more_ranks_than_shells_agrees_with_scipy():
     # source: the scipy SBC model of a system of our own (a one-stage triangle) whose
     # membrane has 3 shells: on 4 ranks the last has none, and the static solve and the

@@ -77,6 +77,7 @@ def test_the_2_5_gets_the_bases_found_by_hand():
     assert r["symmetric"]["sigma_deg"][1] == pytest.approx(np.degrees(hand.sigma[1]), abs=5.0)
 
 
+@pytest.mark.slow
 def test_the_bases_keep_half_the_largest_margin_nearer_the_deployed_ones():
     # the largest-margin bases at the chosen psi and r_2 (best_bases, the same search): the
     # packaged bases keep at least half its margin (up to the rounding of the printed values)

@@ -201,6 +201,7 @@ def test_undamped_sbc_plant_fails_under_the_com_rest_lengths(dep):
     assert runs[1e-3].failure is None and runs[1e-3].t[-1] == pytest.approx(2.5)
 
 
+@pytest.mark.slow
 def test_1_4d_on_the_sbc_plant_with_the_rigid_measurement_follows_the_com_run(dep):
     """The 7.4 1-4(D) controller (uncertainty 'initial' of eq. 5.72, the PFL at the
     reference, the CLI's defaults with an FE plant) on the 4 x 4 x 4 SBC plant measured

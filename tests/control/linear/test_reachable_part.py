@@ -63,6 +63,7 @@ def test_invariant_zeros_where_slycots_default_workspace_is_too_small():
     assert z.size == 1 and z[0] == pytest.approx(-2.0, abs=1e-12)
 
 
+@pytest.mark.slow
 def test_deployed_design_names_unreachable_modes_and_leaves_them_out_on_request(capsys):
     """kapton-1-4 (user system): two membrane modes no tendon reaches (4.644 and 6.457 Hz);
     `control hinf` refuses naming them and the option; with --exclude-uncontrollable it designs

@@ -49,6 +49,7 @@ def test_a_plant_on_its_turn_is_returned_unchanged():
     assert p.on_turn([1.0, 0.0], {"psi_1": 2.4}) is p
 
 
+@pytest.mark.slow
 def test_the_towers_lpv_deployment_takes_the_grids_equilibria_on_the_reference():
     # the 3 x 1 grid of the file (theta 55, 57.5, 60 deg at psi 10 deg): along the reference
     # of eq. 5.100 the interpolated x_e(rho_r(t)) follows q_d(t) to the grid's interpolation

@@ -93,6 +93,7 @@ def test_the_auto_path_needs_a_packaged_configuration(tmp_path):
         lpv_bases(load_system(f))
 
 
+@pytest.mark.slow
 def test_the_grids_equilibria_are_the_paths_designs(tower):
     # a 3 x 2 grid (theta 55, 57.5, 60 deg; psi 10, 12 deg) of COM linearisations: at psi =
     # 10 deg the equilibrium q_e of every point is the path's configuration (eqs. 3.19-3.20),

@@ -1,5 +1,6 @@
 """The gridded LPV plant of the 2-3 system (8.3) from COM linearisations."""
 import numpy as np
+import pytest
 
 from tmfem.control.lpv.plant import com_lpv_plant
 from tmfem.control.lpv.generalized_plant import interconnection_8_1
@@ -10,6 +11,7 @@ from tmfem.reference.tables import deployment_bases
 from tmfem.system import load_preset
 
 
+@pytest.mark.slow
 def test_com_lpv_plant_point_coordinates_keep_the_frequencies_and_integrators_are_stabilizable():
     s = load_preset("2-3-lpv")
     th, ps = np.radians([63.0, 77.32]), np.radians([8.36])

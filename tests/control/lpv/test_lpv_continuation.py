@@ -48,6 +48,7 @@ def test_collapsed_grid_is_the_middle_line():
     assert sub.state_names == gp.state_names
 
 
+@pytest.mark.slow
 def test_sampled_bisection_starts_from_the_collapsed_grid_design():
     # dt = 0.9 s on the oscillator's 3 x 3 grid: by default the bisection first runs on the
     # 3 x 1 grid (b = 0.5); the full grid's first level starts from that design extended with

@@ -135,6 +135,7 @@ def _check_follows_the_com_run(runs, plant, bound):
     return out
 
 
+@pytest.mark.slow
 def test_lpv_deployment_compared_on_two_plants(design21, tmp_path, capsys):
     """`tmfem deploy --preset 2-3-lpv --plant mtc --compare-plant com --compare-plot`: the same
     design (a fresh controller) on the 3 x 2 x 2 MTC and the COM plant over 0.3 s; the JSON's

@@ -99,6 +99,7 @@ def test_off_grid_verification_passes_and_refuses_a_wrong_plant(design):
     assert not verify_output_feedback(d, bad, W_e=W_E, W_u=W_U, allow_failure=True).passed
 
 
+@pytest.mark.slow
 def test_controller_steps_are_the_sampled_loop_and_track_a_step(design):
     pl, d = design
     rho, dt = 1.3, 0.01

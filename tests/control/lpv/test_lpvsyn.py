@@ -218,6 +218,7 @@ def test_a_design_that_fails_between_grid_points_is_refused():
     assert np.min(np.abs(grid - rho_bad)) > 0.1                     # between design points
 
 
+@pytest.mark.slow
 def test_closed_loop_with_the_parameter_turning_at_its_rate_bound(trig_design):
     # time domain, independent of the LMIs: rho(t) = 0.5 t (the rate bound), a disturbance
     # burst w; the L2 gain of this one signal is a lower bound of the induced norm <= gamma,

@@ -17,6 +17,7 @@ def _fresh(system, **kw):
         return ControlOrientedModel(system, **kw)
 
 
+@pytest.mark.slow
 def test_equal_inputs_share_the_graphs_and_other_inputs_get_their_own():
     s = load_preset("1-4")
     a = ControlOrientedModel(s, membrane_modes=4)

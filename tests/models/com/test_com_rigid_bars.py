@@ -8,6 +8,7 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from tmfem.models.com.model import ControlOrientedModel
 from tmfem.models.sbc.model import SBCModel
@@ -16,6 +17,7 @@ from tmfem.system import load_system
 SYSTEMS = Path(__file__).resolve().parents[2] / "data" / "systems"
 
 
+@pytest.mark.slow
 def test_com_meets_the_sbc_when_the_bars_do_not_bend():
     """The 1-5(D) test system's wooden bars (E = 11 GPa, d = 30 mm, l = 2.2 m): the COM is
     9-13 % above the SBC model in modes 2-8; with the bars' E x 100 within 1.5 % in modes 1-8."""

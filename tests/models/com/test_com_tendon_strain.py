@@ -41,6 +41,7 @@ def test_the_2_4_tendons_are_strained_by_percents(tower):
     assert 0.015 < strain.min() and 0.07 < strain.max() < 0.08
 
 
+@pytest.mark.slow
 def test_com_meets_the_mtc_when_the_tendon_strain_is_small(tower):
     """As designed, the COM is 4-6 % below the MTC in every one of the six lowest modes; with the
     tendons 100 x stiffer (the same geometry and prestress, strains below 0.08 %) the two tendon

@@ -46,6 +46,7 @@ def test_the_search_never_keeps_part_of_a_repeated_membrane_frequency():
     assert c.K not in split and all(c.max_difference_by_K[K] is None for K in (5, 8))
 
 
+@pytest.mark.slow
 def test_kapton_gets_the_smallest_k_that_matches_the_mtc_band(kapton):
     """The 3 m Kapton 1-4 (a floppy membrane: many membrane modes among the 12 lowest): K = 4
     puts modes 8-12 up to 50 % above the MTC's; the chosen K brings all twelve within 5 % of an

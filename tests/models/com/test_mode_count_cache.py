@@ -125,6 +125,7 @@ def test_an_unwritable_cache_still_gives_the_choice(monkeypatch, tmp_path, caplo
     assert c.source == "automatic" and not c.cached and "not writable" in caplog.text
 
 
+@pytest.mark.slow
 def test_a_cached_choice_repeats_its_warning(fresh, monkeypatch, caplog):
     """The 2-4 test system's band disagrees whatever K (test_mode_count): the warning naming
     the modes comes also when the choice is read from disk."""

@@ -54,6 +54,7 @@ def test_initial_state_is_the_rigid_bar_rotation(mtc_1_4):
             np.testing.assert_allclose(V[:, n], (1 - sfrac) * va + sfrac * vb, atol=1e-7)
 
 
+@pytest.mark.slow
 def test_energy_conserved_without_damping_and_decays_with_mass_damping(mtc_1_4):
     m, x = mtc_1_4
     pert = {"theta_12_dot": 0.01}
@@ -120,6 +121,7 @@ def test_small_vibration_frequency_is_the_first_modal_frequency(mtc_1_4):
     assert fit_frequency(r.t, psi, f_min=0.5 * f1, f_max=1.5 * f1) == pytest.approx(f1, rel=3e-3)
 
 
+@pytest.mark.slow
 def test_mtc_and_com_bar_responses_agree_1_4():
     # 6.5.1 (Figs. 6.21-6.22): theta_12' = 0.01 rad/s; the COM (ch. 5, rigid bars, massless
     # tendons, 5 membrane modes) is the independent formulation. Same rest lengths (the COM's

@@ -160,6 +160,7 @@ def test_deploy_on_the_sbc_plant_records_the_com_columns(tmp_path, capsys):
     assert _header(a) == _header(b)
 
 
+@pytest.mark.slow
 def test_compare_mtc_with_com_2_3(tmp_path, capsys):
     """`tmfem deploy --preset 2-3-deploy --plant mtc --compare-plant com --compare-plot`: the
     same adaptive PFL deployment on both plants (MTC 3 x 4 x 4, the COM's fixed-rate tendons,

@@ -192,6 +192,7 @@ def test_sbc_vtk_and_png(tmp_path, capsys):
     assert "--stress-plot" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_three_model_vibration(tmp_path, capsys):
     # 6.5.1 in the three models from the same perturbation (reduced: FE mesh 4, 0.3 s)
     rc = main(["compare", "--preset", "1-4", "--vibrate", "--mesh", "4", "--t-end", "0.3",
