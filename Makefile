@@ -39,8 +39,9 @@ demo: $(STAMP)
 # written even where PYTHONDONTWRITEBYTECODE is set: without them every worker rewrites the
 # test modules' asserts and every command a test starts (the CLI, each MPI rank) compiles
 # the package anew (the editable install is compiled at install time; cached files are in
-# __pycache__/, which git ignores).
-PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -q -n 2
+# __pycache__/, which git ignores). The tests of one xdist_group run on one worker (those of
+# the shared report: no worker idles while the other builds it).
+PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -q -n 2 --dist loadgroup
 
 test: $(STAMP)
 	$(PYTEST) -m "not slow"

@@ -7,6 +7,9 @@ import re
 
 import pytest
 
+# one worker runs the tests of the shared report (no worker waits for another's build)
+pytestmark = pytest.mark.xdist_group("report")
+
 
 def test_index_links_every_file(report):
     index = (report / "index.md").read_text()

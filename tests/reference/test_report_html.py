@@ -20,6 +20,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+# one worker runs the tests of the shared report (no worker waits for another's build)
+pytestmark = pytest.mark.xdist_group("report")
+
 
 BROWSERS = ("chromium", "chromium-browser", "google-chrome")
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
