@@ -48,6 +48,26 @@ def test_snes_options_are_honoured_and_reach_the_same_equilibrium(scipy_2_3, cap
 
 
 @needs_petsc
+def test_one_tangent_of_the_model_serves_the_static_solve(scipy_2_3):
+    # source: the scipy trust region's equilibrium; the SNES evaluations let go of each
+    # tangent before the next (tmfem.solvers.petsc_snes, "Memory"), so the model assembled
+    # one tangent matrix, refilled it at every evaluation, and returns it at the equilibrium
+    m, st = scipy_2_3
+    pm = _petsc_model()
+    res = pm.equilibrium()
+    x0 = m.initial_positions("undeformed")
+    assert np.linalg.norm(res.x - st.x) <= 1e-9 * np.linalg.norm(st.x - x0)
+    dist = pm.distributed
+    assert len(dist._K) == 1 and res.tangent is dist._K[0] and res.tangent.version > 5
+    from tmfem.fem.element import State
+    _, K = dist.residual(State(x=res.x))
+    assert K is not res.tangent      # the caller holds it: the model assembles another
+    d = K.mat.copy()
+    d.axpy(-1.0, res.tangent.mat)
+    assert d.norm() <= 1e-12 * K.mat.norm()
+
+
+@needs_petsc
 def test_snes_with_a_loose_tolerance_stops_where_it_is_met(scipy_2_3):
     # source: the test |r| <= tol x force scale itself, and the scipy trust region's
     # equilibrium, which the tight solve from the loose state (the coarse levels of a mesh

@@ -24,8 +24,9 @@ How an element set is shared out over the ranks:
 
 Every rank holds the full state (vectors are replicated, O(n) per rank). A tangent that a
 caller still references is never refilled (:meth:`DistributedElements.residual` reuses an
-unreferenced one, else assembles a new one): a solver holds the tangent of its iterate
-while it evaluates trial points (two or three matrices in all).
+unreferenced one, else assembles a new one): a solver that holds the tangent of its iterate
+while it evaluates trial points has two; the SNES statics let go of each tangent before the
+next evaluation (:mod:`tmfem.solvers.petsc_snes`), so one serves the whole solve.
 """
 from __future__ import annotations
 

@@ -201,15 +201,16 @@ class PetscBackend:
             d.destroy()         # petsc4py 3.18 frees a PETSc object on destroy() only
         return M, key
 
-    def adopt(self, A, mat, ksp, symmetric: bool, owner=None) -> None:
+    def adopt(self, pattern, mat, ksp, symmetric: bool, owner=None) -> None:
         """Make ``mat`` and ``ksp`` (a KSP of this backend's configuration that has
-        factorised a matrix of the DistributedMatrix A's pattern: the one of the statics'
-        SNES ``owner``, kept alive with it) the cache entry of that pattern, so that later
-        solves and the eigen solve reuse MUMPS' analysis (:meth:`_analyzed`). Collective."""
-        key = ("dist", id(A.pattern))
+        factorised a matrix of the sparsity ``pattern`` of DistributedMatrix objects: the
+        one of the statics' SNES ``owner``, kept alive with it) the cache entry of that
+        pattern, so that later solves and the eigen solve reuse MUMPS' analysis
+        (:meth:`_analyzed`). Collective."""
+        key = ("dist", id(pattern))
         old = self._cache.pop(key, None)
         if old is None:
-            weakref.finalize(A.pattern, self._drop, key).atexit = False
+            weakref.finalize(pattern, self._drop, key).atexit = False
         else:
             self._dead.append(old)
         self._serial += 1

@@ -40,6 +40,12 @@ the state u is whole on every rank. States that do not add (finite rotations) ad
 ``update(u, du)``: SNES iterates on the increment from a base state, which is moved to the
 current iterate at every Newton iteration (``SNESSetUpdate``), so that the tangent K_T(u) is
 the Jacobian of the increment.
+
+Memory: the SNES's preconditioner matrix is a copy of the tangent (shifted by mu D during
+the continuation), which MUMPS factorises; the model's tangent itself is refilled in place
+at every evaluation (nothing holds the last one: an evaluation's r and K are cached until
+the next), so a solve holds two tangent-sized matrices besides MUMPS' factors. A step that
+fails costs one evaluation more: the accepted state's r and K are computed again.
 """
 from __future__ import annotations
 
@@ -102,23 +108,37 @@ class _Problem:
 
     def evaluate(self, X):
         """(u, r, K) at the increment X (a PETSc Vec; the last evaluation reused).
-        Collective: every rank evaluates, or none."""
+        Collective: every rank evaluates, or none.
+
+        The tangent of the last evaluation is let go before the next one, so that the
+        model refills it in place (:meth:`tmfem.fem.distributed.DistributedElements.residual`
+        reuses a tangent nobody references): one tangent of the model lives through the
+        solve, beside the SNES's preconditioner matrix. Callers hold K only while they use it."""
         c = self.comm
         x = X.getArray(readonly=True)
-        new = not np.array_equal(self.cache["x"], x)
+        new = self.cache["x"] is None or not np.array_equal(self.cache["x"], x)
         if (c.allreduce(int(new)) if c.size > 1 else new):
             u = self.state(gather(X))
+            self.cache = {"x": None}
             r, K = self.residual(u)
             self.cache.update(x=x.copy(), u=u, r=np.asarray(r, dtype=float), K=K)
         return self.cache["u"], self.cache["r"], self.cache["K"]
 
-    def start(self, u, mu: float, r=None, K=None) -> None:
-        """A new solve from the state u with the shift mu; u is the cached state, or the
-        residual r and tangent K at u are given."""
+    def start(self, u, mu: float) -> None:
+        """A new solve from the state u with the shift mu: the cached evaluation when it is
+        u's, else the first evaluation computes r and K at u again (a rejected step's
+        evaluation is the last one)."""
         self.base, self.offset, self.mu = u, np.zeros(self.D.size), float(mu)
-        self.cache["x"] = np.zeros(self.D.size)
-        if r is not None:
-            self.cache.update(u=u, r=r, K=K)
+        if self.cache.get("u") is u:
+            self.cache["x"] = np.zeros(self.D.size)
+        else:
+            self.cache = {"x": None}
+
+    def tangent_at(self, u):
+        """The tangent K at the state u: the cached one when the last evaluation was u's."""
+        if self.cache.get("u") is u:
+            return self.cache["K"]
+        return self.residual(u)[1]
 
     def function(self, snes, X, F) -> None:
         _, r, _ = self.evaluate(X)
@@ -233,6 +253,8 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
     snes.setUpdate(prob.rebase)
     snes.setType("newtonls")
     backend._configure(snes.getKSP(), backend._symmetric(K, K.mat))
+    pattern = K.pattern
+    del K                      # the solve's evaluations hold the tangent (_Problem.evaluate)
 
     last = {"r": r}            # the residual at the start of the current iteration
 
@@ -258,7 +280,7 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
     snes.setMonitor(monitor)
 
     def solve(mu_step: float, atol: float):
-        """One SNES solve from u with the shift mu_step: (state, r, K, its, reason)."""
+        """One SNES solve from u with the shift mu_step: (state, r, its, reason)."""
         prob.start(u, mu_step)
         last["r"] = r
         # full Newton steps unless -snes_linesearch_type is given (module docstring)
@@ -273,24 +295,24 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
             try:
                 snes.solve(None, X)
             except _Floor:
-                return (*prob.evaluate(X), snes.getIterationNumber(), FLOOR)
+                return (*prob.evaluate(X)[:2], snes.getIterationNumber(), FLOOR)
             except PETSc.Error as exc:
                 if (refused := option_error(exc, f"{what} (SNES)")) is not None:
                     raise refused from None
                 log.debug("%s: SNES error %s", what, exc.ierr)
                 _refuse_mumps_failure(snes, what)
-                return None, None, None, snes.getIterationNumber(), -100
+                return None, None, snes.getIterationNumber(), -100
         if snes.getConvergedReason() == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
             _refuse_mumps_failure(snes, what)
-        un, rr, KK = prob.evaluate(X)
+        un, rr, _ = prob.evaluate(X)
         log.debug("%s: SNES solve of %d unknowns with mu = %.3g: %s after %d iterations", what,
                   X.getSize(), mu_step,
                   reason_name(PETSc, snes.getConvergedReason()), snes.getIterationNumber())
-        return un, rr, KK, snes.getIterationNumber(), snes.getConvergedReason()
+        return un, rr, snes.getIterationNumber(), snes.getConvergedReason()
 
     try:
         while True:
-            un, rr, KK, its, reason = solve(mu, tol * force_scale(u))
+            un, rr, its, reason = solve(mu, tol * force_scale(u))
             total += its
             rnn = rows_norm(rr, comm) if un is not None else np.nan
             ok = bool(np.isfinite(rnn))
@@ -299,10 +321,10 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                 # or on the round-off floor
                 if reason == FLOOR or (reason > 0 and reason_name(PETSc, reason).startswith(
                         "CONVERGED_FNORM")):
-                    u, r, K = un, rr, KK
+                    u, r = un, rr
                     break
                 if reason > 0 and rnn < rows_norm(r, comm):
-                    u, r, K = un, rr, KK      # stopped on a step test: Newton again from there
+                    u, r = un, rr      # stopped on a step test: Newton again from there
                     W = energy(u)
                     if total < max_iter:
                         continue
@@ -314,16 +336,16 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                     continue
                 Wn = energy(un)
                 if np.isfinite(Wn) and Wn < W:
-                    u, r, K, W = un, rr, KK, Wn
+                    u, r, W = un, rr, Wn
                     mu_last = mu
                     if reason > 0:       # the step's system solved: a longer pseudo time step
                         mu = mu / 8.0 if mu / 8.0 >= MU_NEWTON * mu_scale else 0.0
                     if total >= max_iter:
                         break
                     continue
-            # the step failed: regularise harder from the last accepted state
+            # the step failed: regularise harder from the last accepted state (the next
+            # solve's first evaluation is u's again, :meth:`_Problem.start`)
             mu = 4.0 * (mu if mu > 0 else mu_last)
-            prob.start(u, mu, r, K)
             if mu > 1e12 * mu_scale or total >= max_iter:
                 note = f" ({describe(u)})" if describe is not None else ""
                 rn = rows_norm(r, comm)
@@ -332,12 +354,13 @@ def snes_equilibrium(backend, residual, energy, u0, *, scale, force_scale, tol: 
                     f"|r| <= {tol:g} x force scale, found |r| = {rn:.3e} N "
                     f"after {total} SNES iterations, mu = {mu:.3g}){note}{_options_note(backend)}"
                     f"{floor_hint(rn, force_scale(u), tol)}")
+        K = prob.tangent_at(u)
     finally:
         # the SNES, its KSP (MUMPS' analysis of the tangent's pattern) and matrix stay with
         # the backend for the eigen solve about this equilibrium
         ksp = snes.getKSP()
         snes.cancelMonitor()
-        backend.adopt(K, P, ksp, symmetric=ksp.getPC().getType() == "cholesky", owner=snes)
+        backend.adopt(pattern, P, ksp, symmetric=ksp.getPC().getType() == "cholesky", owner=snes)
         prob.release()
         F.destroy()
         X.destroy()
