@@ -23,7 +23,7 @@ BYTES_PER_DOF = 16e3
 BASE_BYTES = 0.3e9
 #: The PETSc backend on one rank, by the model's DOFs per membrane node (the estimate's DOFs,
 #: :func:`mesh_dofs`). 3, the MTC membrane (benchmarks/bench_memory_ranks.py, 1-4 static +
-#: 12 modes): the peak grows by 4.8 / 4.6 / 4.6 kB per DOF above the start-up at 78k / 309k /
+#: 12 modes): the peak grows by 4.1 / 3.9 / 3.9 kB per DOF above the start-up at 78k / 309k /
 #: 1.23 M DOFs; 6 kB leaves room for the fill of larger factorisations. 6, the SBC shells
 #: (`tmfem modal --model sbc --preset 1-4 --mesh n --backend petsc`, peak RSS): 0.50 / 1.48 /
 #: 3.14 GB at n = 30 / 60 / 90, 15 kB per DOF; 20 kB leaves room.
