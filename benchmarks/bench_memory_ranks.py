@@ -19,8 +19,10 @@ can reach.
 and prints the largest memory PETSc itself allocated on a rank (``PetscMalloc``: matrices,
 vectors, the KSP, SNES and EPS objects and PETSc's copies of the matrices for MUMPS; not
 MUMPS' own factor and work space, not numpy's arrays): PETSc's share of the peak and how it
-divides. (Debug allocation changes the resident memory and the time, so the first run's
-figures stand alone.)
+divides; and the ratio the run would have if all of tmfem's own memory divided exactly, the
+libraries' parts as measured (:func:`model_ratio`): the lowest that a change of tmfem's data
+structures could reach. (Debug allocation changes the resident memory and the time, so the
+first run's figures stand alone.)
 """
 from __future__ import annotations
 
@@ -39,13 +41,19 @@ sys.path.insert(0, os.path.dirname(HERE))
 PHASES = ("start", "build", "static", "modes")
 
 
-def vm_rss_mb() -> float:
-    """Current resident memory of this process [MB] (VmRSS of /proc/self/status)."""
+def status_mb(key: str = "VmRSS") -> float:
+    """A memory figure of this process from /proc/self/status [MB]: ``VmRSS`` (resident),
+    ``RssFile`` (its file-backed part: pages of the shared libraries and modules loaded)."""
     with open("/proc/self/status") as f:
         for line in f:
-            if line.startswith("VmRSS:"):
+            if line.startswith(key + ":"):
                 return int(line.split()[1]) / 1024.0
     return float("nan")
+
+
+def vm_rss_mb() -> float:
+    """Current resident memory of this process [MB] (VmRSS of /proc/self/status)."""
+    return status_mb("VmRSS")
 
 
 def peak_rss_mb() -> float:
@@ -61,6 +69,7 @@ def run_one(mesh: int, rest_length: float, sequence: int) -> dict:
     from tmfem.solvers.petsc import PetscBackend
     comm = comm_world()
     rss, peak, wall = {"start": vm_rss_mb()}, {"start": peak_rss_mb()}, {}
+    files = status_mb("RssFile")
     system = system_1_4(rest_length)
 
     def phase(name, t0):
@@ -77,7 +86,8 @@ def run_one(mesh: int, rest_length: float, sequence: int) -> dict:
     t = time.perf_counter()
     modes = m.modes(k=12, at=res)
     phase("modes", t)
-    mine = dict(rank=comm.rank, rss_mb=rss, peak_mb=peak, wall_s=wall, mumps_mb=mumps)
+    mine = dict(rank=comm.rank, rss_mb=rss, peak_mb=peak, wall_s=wall, mumps_mb=mumps,
+                libraries_mb=status_mb("RssFile") - files)
     ranks = comm.gather(mine, root=0)
     return dict(mesh=f"4x{mesh}x{mesh}", n=mesh, ranks=comm.size, dofs=m.ndof,
                 f1_hz=float(modes.freq_hz[0]), per_rank=ranks)
@@ -98,6 +108,29 @@ def floor_ratio(run: dict, ref: dict) -> tuple[int, float]:
     busiest = max(run["per_rank"], key=lambda r: r["peak_mb"]["modes"])
     top = busiest["rss_mb"]["start"] + max(r["mumps_mb"]["used"] for r in run["per_rank"]) + rest / P
     return P, top / r1["peak_mb"]["modes"]
+
+
+def model_ratio(run: dict, ref: dict) -> tuple[int, float]:
+    """(P, bound) of a P-rank run against the reference run, both with PETSc's memory
+    measured (``--petsc-memory``): its busiest rank's peak if all of tmfem's own memory
+    (numpy arrays, the heap it leaves) divided exactly over the ranks and the libraries'
+    parts stayed as measured,
+
+        bound = (fixed_P + (peak_1 - fixed_1) / P) / peak_1,
+        fixed = start + libraries + mumps + petsc,
+
+    with libraries the file-backed pages loaded after start-up (RssFile's growth: MUMPS',
+    SLEPc's code, the same on every rank), mumps MUMPS' memory effectively used (INFO(22)) and
+    petsc PETSc's own (``PetscMalloc``, largest over the job), busiest ranks: the lowest
+    ratio that any change of tmfem's own data structures could reach (each part's largest
+    over the run, so an estimate)."""
+    def fixed(run):
+        rows = run["per_rank"]
+        return (max(r["rss_mb"]["start"] + r["libraries_mb"] for r in rows)
+                + max(r["mumps_mb"]["used"] for r in rows) + run["petsc_malloc_mb"]["max"])
+    peak_1 = ref["per_rank"][0]["peak_mb"]["modes"]
+    P = run["ranks"]
+    return P, (fixed(run) + (peak_1 - fixed(ref)) / P) / peak_1
 
 
 #: PETSc's options of the ``--petsc-memory`` runs: its memory summary at the end of the job,
@@ -209,6 +242,14 @@ def main(argv=None) -> int:
                       "over the ranks: " + ", ".join(f"P={p}: {b:.2f}" for p, b in bounds), flush=True)
             petsc = [(r["ranks"], r["petsc_malloc_mb"]) for r in runs if r.get("mesh") == f"4x{mesh}x{mesh}"
                      and r.get("petsc_malloc_mb")]
+            if petsc and ref_run.get("petsc_malloc_mb"):
+                bounds = [model_ratio(r, ref_run) for r in runs if r.get("mesh") == f"4x{mesh}x{mesh}"
+                          and r.get("petsc_malloc_mb") and r is not ref_run]
+                libraries = max(r["libraries_mb"] for r in ref_run["per_rank"])
+                print(f"# 4x{mesh}x{mesh}: the ratio if all of tmfem's own memory divided exactly "
+                      f"(start-up, libraries loaded after it ({libraries:.0f} MB on 1 rank), MUMPS "
+                      "and PETSc as measured): "
+                      + ", ".join(f"P={p}: {b:.3f}" for p, b in bounds), flush=True)
             if petsc:
                 one = petsc[0][1]["max"]
                 print(f"# 4x{mesh}x{mesh}: PETSc's own memory (PetscMalloc, largest over the job, "
