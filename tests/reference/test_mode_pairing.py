@@ -134,6 +134,7 @@ def test_the_same_system_with_stiff_bars_pairs_in_order(capsys):
     assert p["SBC_unpaired"] == [] and max(p["SBC_beam_energy_fraction"]) < 0.05
 
 
+@pytest.mark.slow
 def test_a_preset_whose_pairing_is_not_the_identity_keeps_the_printed_comparison_by_order(capsys):
     """1-4 at mesh 4 (6 modes): the SBC model's mode 5 (2.087 Hz) is the singlet that the MTC
     and COM models have above their degenerate pair (MTC mode 7, COM mode 8; MAC >= 0.98), and

@@ -49,6 +49,7 @@ def test_trigonometric_basis_certifies_and_verifies_off_the_grid(trig_design):
     assert control.norm(T, p="inf") <= r.gamma
 
 
+@pytest.mark.slow
 def test_affine_basis_is_worse_than_the_trigonometric_one(trig_design):
     # the affine basis in rho cannot follow the turning axis: with the same rate bounds on the
     # same grid its optimum is far above the trigonometric basis' certified level

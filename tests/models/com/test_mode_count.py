@@ -65,6 +65,7 @@ def test_kapton_gets_the_smallest_k_that_matches_the_mtc_band(kapton):
     assert old > 0.3
 
 
+@pytest.mark.slow
 def test_a_band_that_no_k_brings_within_tolerance_is_named(caplog):
     """The 2-4 test system: its COM is 6 % below the MTC in modes 1-2 whatever K (rigid bars
     and a membrane attached at its corners only: docs/validation/errata.md); the choice keeps
