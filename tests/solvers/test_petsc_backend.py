@@ -712,6 +712,36 @@ def test_modes_reuse_the_static_analysis_and_agree_with_scipy(models, equilibria
 
 
 @needs_petsc
+def test_the_modes_of_a_distributed_model_hold_at_most_two_copies_of_the_eigenvectors():
+    # source: the sizes of the arrays themselves (k vectors of n float64: 8 n k bytes), and
+    # the scipy backend's modes of the same model. SLEPc's vectors stay in PETSc and in the
+    # ranks' rows through the Rayleigh-Ritz step (rows_gram), the k wanted are gathered once,
+    # lowest_modes keeps one product with them at a time and sets their signs in place: the
+    # numpy arrays of the modes phase peak at two full copies and a few vectors (n,), 4.4
+    # copies when the converged vectors, the products and |V| were full arrays each
+    import tracemalloc
+    from tmfem.models.mtc.model import MTCModel
+    from tmfem.solvers.petsc import PetscBackend
+    from tmfem.system import load_preset
+    system = load_preset("1-4")
+    m = MTCModel(system, mesh_n=16, backend=PetscBackend())
+    st = m.equilibrium(start="design")
+    m.modes(k=2, at=st)                  # the mass, assembled once and kept by the model
+    k = 12
+    tracemalloc.start()
+    try:
+        base = tracemalloc.get_traced_memory()[0]
+        modes = m.modes(k=k, at=st)
+        peak = tracemalloc.get_traced_memory()[1] - base
+    finally:
+        tracemalloc.stop()
+    copy = 8 * m.distributed.N * k
+    assert copy <= peak <= 2.5 * copy, peak / copy
+    ref = MTCModel(system, mesh_n=16).modes(k=k, at=st.x)
+    assert np.allclose(modes.omega2, ref.omega2, rtol=1e-8, atol=0)
+
+
+@needs_petsc
 def test_pattern_subset_check():
     # source: the patterns themselves (a diagonal lies within a tridiagonal pattern, an
     # entry in the first or the last row outside the band does not), read from the

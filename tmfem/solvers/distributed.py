@@ -170,6 +170,25 @@ def rows_dot(a: np.ndarray, b: np.ndarray, comm) -> float:
     return comm.allreduce(d) if comm.size > 1 else d
 
 
+def rows_gram(A, X: np.ndarray, comm) -> np.ndarray:
+    """X^T A X (m, m) of a block of m vectors held as each rank's rows X (n_r, m) of a
+    parallel PETSc Mat A (rows laid out as A's), summed over the ranks (collective): the
+    matrices of a Rayleigh-Ritz step without a full-length array on any rank."""
+    X = np.asarray(X, dtype=float)
+    x, y = A.createVecs()
+    AX = np.empty_like(X)
+    try:
+        for j in range(X.shape[1]):
+            x.setArray(np.ascontiguousarray(X[:, j]))
+            A.mult(x, y)
+            AX[:, j] = y.getArray(readonly=True)
+    finally:
+        x.destroy()             # petsc4py 3.18 frees a PETSc object on destroy() only
+        y.destroy()
+    G = X.T @ AX
+    return comm.allreduce(G) if comm.size > 1 else G
+
+
 def gather_rows(local: np.ndarray, comm) -> np.ndarray:
     """Full array (n, m) on every rank of the row blocks (n_r, m) of the ranks, in rank
     order (one ``Allgatherv`` into the result: no other full-size copy); ``local`` itself

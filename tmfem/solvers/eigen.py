@@ -77,19 +77,19 @@ def lowest_modes(K, M, *, k: int, free=None, sigma: float | None = None, backend
         sigma = -1e-6 * float(np.mean(np.abs(dK) / dM))
     be = get_backend(backend)
     w, V = be.eigsh(Kf, Mf, int(k), float(sigma))
-    # Rayleigh-Ritz in span(V): M-orthonormal vectors, also within repeated eigenvalues
-    KV = Kf @ V
-    MV = Mf @ V
-    Kr = V.T @ KV
-    Mr = V.T @ MV
+    # Rayleigh-Ritz in span(V): M-orthonormal vectors, also within repeated eigenvalues (one
+    # product of a matrix with V alive at a time; eigh's pairs come ascending)
+    Kr = V.T @ (Kf @ V)
+    Mr = V.T @ (Mf @ V)
     w, Y = la.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
     V = V @ Y
-    order = np.argsort(w)
-    w, V = w[order], V[:, order]
-    # deterministic sign: largest component positive
-    j = np.argmax(np.abs(V), axis=0)
-    V = V * np.sign(V[j, np.arange(V.shape[1])])
-    shapes = np.zeros((n, V.shape[1]))
-    shapes[idx] = V
+    # deterministic sign: largest component positive (column by column: no copy of V)
+    for c in range(V.shape[1]):
+        V[:, c] *= np.sign(V[np.argmax(np.abs(V[:, c])), c])
+    if nf == n:
+        shapes = V
+    else:
+        shapes = np.zeros((n, V.shape[1]))
+        shapes[idx] = V
     omega = np.sign(w) * np.sqrt(np.abs(w))
     return Modes(omega2=w, omega=omega, freq_hz=omega / (2 * np.pi), shapes=shapes)

@@ -13,8 +13,9 @@ Implements the :class:`tmfem.solvers.backends.Backend` protocol through petsc4py
     with shift-and-invert about ``sigma`` (ST ``sinvert``, the factorisation of K - sigma M
     by MUMPS Cholesky), on one rank and on the distributed factors under ``mpiexec -n P``;
     the k eigenvalues nearest to sigma, then a Rayleigh-Ritz step in the span of their
-    vectors, so that the vectors are M-orthonormal (the B-inner product) and repeated
-    eigenvalues come out as full M-orthonormal pairs.
+    vectors (from each rank's rows, :func:`~tmfem.solvers.distributed.rows_gram`), so that
+    the vectors are M-orthonormal (the B-inner product) and repeated eigenvalues come out
+    as full M-orthonormal pairs; V is gathered once, at the end.
 
 Matrices are scipy sparse matrices (the same on every rank) or a
 :class:`tmfem.solvers.distributed.DistributedMatrix` assembled rank by rank. Vectors in
@@ -42,7 +43,8 @@ import scipy.linalg as la
 import scipy.sparse as sp
 
 from tmfem.errors import ConvergenceError, InputError
-from tmfem.solvers.distributed import DistributedMatrix, ShiftedMatrix, gather, gather_rows
+from tmfem.solvers.distributed import (DistributedMatrix, ShiftedMatrix, gather, gather_rows,
+                                       rows_gram)
 from tmfem.solvers.mumps import is_singular, mumps_error, mumps_factor, mumps_failure
 from tmfem.solvers.petsc_loader import petsc_modules
 from tmfem.solvers.petsc_options import option_error, option_used, parse_options, set_from_options
@@ -501,16 +503,13 @@ class PetscBackend:
             raise InputError(f"eigen (petsc): expected 1 <= k < {n} (matrix size), found k={k}")
         sym = self._symmetric(K, Kp) and self._symmetric(M, Mp)
         reuse = self._analyzed(K, M) if sym else None
-        w, V = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym, reuse)
-        order = np.argsort(np.abs(w - sigma), kind="stable")[:k]
-        w, V = w[order], V[:, order]
-        # Rayleigh-Ritz in span(V) (the matrices applied to the full arrays): exactly
-        # M-orthonormal, also inside clusters of equal eigenvalues
-        Kr, Mr = V.T @ (K @ V), V.T @ (M @ V)
+        w, local = self._slepc_eigsh(Kp, Mp, k, float(sigma), sym, reuse)
+        # Rayleigh-Ritz in span(V) from each rank's rows of V: exactly M-orthonormal, also
+        # inside clusters of equal eigenvalues; ascending (eigh); the full V gathered once
+        comm = self.comm.tompi4py()
+        Kr, Mr = rows_gram(Kp, local, comm), rows_gram(Mp, local, comm)
         w, Y = la.eigh(0.5 * (Kr + Kr.T), 0.5 * (Mr + Mr.T))
-        V = V @ Y
-        o = np.argsort(w)
-        return w[o], V[:, o]
+        return w, gather_rows(local @ Y, comm)
 
     def _analyzed(self, K, M):
         """The cache entry (Mat, KSP: MUMPS' analysis done) of the tangent K's pattern when
@@ -567,8 +566,8 @@ class PetscBackend:
         return all(self.comm.tompi4py().allgather(mine))
 
     def _slepc_eigsh(self, Kp, Mp, k: int, sigma: float, sym: bool, reuse=None):
-        """(w, V) of K v = w M v, the converged eigenvalues nearest to sigma (at least k) and
-        their vectors (full arrays on every rank), by SLEPc (module docstring). With
+        """(w, V) of K v = w M v: the k converged eigenvalues nearest to sigma and this
+        rank's rows of their vectors, by SLEPc (module docstring). With
         ``reuse`` (:meth:`_analysed`) K - sigma M is formed in place in that entry's Mat
         and factorised by its KSP (SLEPc's ``ST`` mat mode ``inplace``, subset pattern):
         MUMPS' analysis of the static solve is reused."""
@@ -621,15 +620,16 @@ class PetscBackend:
             if nconv < k:
                 raise ConvergenceError(f"eigen (petsc): SLEPc converged {nconv} of k={k} modes near "
                                        f"sigma={sigma:g} in {E.getIterationNumber()} restarts")
-            # this rank's rows of the vectors; the full ones once SLEPc's basis is freed
+            # the k converged pairs nearest to sigma, this rank's rows of their vectors
+            w = np.array([E.getEigenvalue(i).real for i in range(nconv)])
+            order = np.argsort(np.abs(w - sigma), kind="stable")[:k]
             vr = Kp.createVecRight()
             lo, hi = vr.getOwnershipRange()
-            w = np.empty(nconv)
-            local = np.empty((hi - lo, nconv))
-            for i in range(nconv):
-                w[i] = E.getEigenpair(i, vr).real
-                local[:, i] = vr.getArray(readonly=True)
+            local = np.empty((hi - lo, k))
+            for c, i in enumerate(order):
+                E.getEigenvector(int(i), vr)
+                local[:, c] = vr.getArray(readonly=True)
             vr.destroy()
         finally:
             E.destroy()
-        return w, gather_rows(local, self.comm.tompi4py())
+        return w[order], local
