@@ -170,12 +170,12 @@ def rows_dot(a: np.ndarray, b: np.ndarray, comm) -> float:
     return comm.allreduce(d) if comm.size > 1 else d
 
 
-def rows_gram(A, X: np.ndarray, comm) -> np.ndarray:
-    """X^T A X (m, m) of a block of m vectors held as each rank's rows X (n_r, m) of a
-    parallel PETSc Mat A (rows laid out as A's), summed over the ranks (collective): the
-    matrices of a Rayleigh-Ritz step without a full-length array on any rank."""
+def rows_product(A, X: np.ndarray, vecs=None) -> np.ndarray:
+    """This rank's rows (n_r, m) of A X, from its rows X (n_r, m) of a block of m vectors
+    and a parallel PETSc Mat A (rows laid out as A's; collective). ``vecs``: work vectors
+    (x, y) of A's layout to use, else created and freed here."""
     X = np.asarray(X, dtype=float)
-    x, y = A.createVecs()
+    x, y = A.createVecs() if vecs is None else vecs
     AX = np.empty_like(X)
     try:
         for j in range(X.shape[1]):
@@ -183,9 +183,17 @@ def rows_gram(A, X: np.ndarray, comm) -> np.ndarray:
             A.mult(x, y)
             AX[:, j] = y.getArray(readonly=True)
     finally:
-        x.destroy()             # petsc4py 3.18 frees a PETSc object on destroy() only
-        y.destroy()
-    G = X.T @ AX
+        if vecs is None:
+            x.destroy()         # petsc4py 3.18 frees a PETSc object on destroy() only
+            y.destroy()
+    return AX
+
+
+def rows_gram(A, X: np.ndarray, comm) -> np.ndarray:
+    """X^T A X (m, m) of a block of m vectors held as each rank's rows X (n_r, m) of a
+    parallel PETSc Mat A (:func:`rows_product`), summed over the ranks (collective): the
+    matrices of a Rayleigh-Ritz step without a full-length array on any rank."""
+    G = np.asarray(X, dtype=float).T @ rows_product(A, X)
     return comm.allreduce(G) if comm.size > 1 else G
 
 
@@ -285,14 +293,8 @@ class DistributedMatrix:
         if x.shape[0] != n or x.ndim > 2:
             raise InputError(f"distributed matrix: expected x of {n} rows, found shape {x.shape}")
         lo, hi = self.mat.getOwnershipRange()
-        xv, yv = self.vecs()
-        cols = x.reshape(n, -1)
-        out = np.empty_like(cols)
-        for j in range(cols.shape[1]):
-            xv.setArray(cols[lo:hi, j])
-            self.mat.mult(xv, yv)
-            out[:, j] = gather(yv)
-        return out.reshape(x.shape)
+        local = rows_product(self.mat, x.reshape(n, -1)[lo:hi], self.vecs())
+        return gather_rows(local, self.mat.getComm().tompi4py()).reshape(x.shape)
 
     def __add__(self, D):
         if not (sp.issparse(D) and D.shape == self.shape
