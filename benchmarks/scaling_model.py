@@ -34,7 +34,7 @@ R = (P_m M_Pm - M_1) / (P_m - 1) and D = M_1 - R (D taken to divide as 1/P), eac
 extrapolated in n with its own exponent from the two meshes. The measured peaks fall in the
 static solve; the modes add, on every rank, the k = 12 eigenvectors gathered whole and one
 product with them (``tmfem.solvers.eigen.lowest_modes``): E = 2 x 8 n k bytes, which the
-prediction adds (M_0 + R + D / P + E: at the measured sizes E is 15 MB, at 20 M dofs 3.6 GB,
+prediction adds (M_0 + R + D / P + E: at the measured sizes E is 15 MB, at 20 M dofs 3.7 GB,
 more than all the rest on 64 ranks). The memory is that of the
 backend as the CLI runs it (SNES; ``bench_memory_ranks.py``), the times those of
 ``bench_backends.py`` (the same SNES path, its factorisations and solves timed by PETSc's
