@@ -93,44 +93,42 @@ def run_one(mesh: int, rest_length: float, sequence: int) -> dict:
                 f1_hz=float(modes.freq_hz[0]), per_rank=ranks)
 
 
-def floor_ratio(run: dict, ref: dict) -> tuple[int, float]:
-    """(P, bound) of a P-rank run against the reference run: its busiest rank's peak if
-    everything but the start-up and MUMPS' factorisation divided exactly over the ranks,
+def divided_ratio(run: dict, ref: dict, fixed) -> tuple[int, float]:
+    """(P, bound) of a P-rank run against the reference (1-rank) run: its busiest rank's peak
+    if all but ``fixed(run)`` [MB] (what a rank holds whatever the rank count) divided
+    exactly over the ranks,
 
-        bound = (start_P + mumps_P + (peak_1 - start_1 - mumps_1) / P) / peak_1,
-
-    with start the resident memory after start-up (Python, numpy, PETSc, MPI: on every
-    rank) and mumps MUMPS' memory effectively used on the rank (INFO(22), its busiest
-    rank): what the start-up and MUMPS' own parallel overhead alone leave of the ratio."""
-    r1 = ref["per_rank"][0]
-    rest = r1["peak_mb"]["modes"] - r1["rss_mb"]["start"] - r1["mumps_mb"]["used"]
+        bound = (fixed_P + (peak_1 - fixed_1) / P) / peak_1."""
+    peak_1 = ref["per_rank"][0]["peak_mb"]["modes"]
     P = run["ranks"]
-    busiest = max(run["per_rank"], key=lambda r: r["peak_mb"]["modes"])
-    top = busiest["rss_mb"]["start"] + max(r["mumps_mb"]["used"] for r in run["per_rank"]) + rest / P
-    return P, top / r1["peak_mb"]["modes"]
+    return P, (fixed(run) + (peak_1 - fixed(ref)) / P) / peak_1
+
+
+def floor_ratio(run: dict, ref: dict) -> tuple[int, float]:
+    """:func:`divided_ratio` with fixed = start + mumps: the start-up's resident memory
+    (Python, numpy, PETSc, MPI: on every rank; the busiest rank's) and MUMPS' memory
+    effectively used (INFO(22), its busiest rank): what the start-up and MUMPS' own
+    parallel overhead alone leave of the ratio."""
+    def fixed(run):
+        busiest = max(run["per_rank"], key=lambda r: r["peak_mb"]["modes"])
+        return busiest["rss_mb"]["start"] + max(r["mumps_mb"]["used"] for r in run["per_rank"])
+    return divided_ratio(run, ref, fixed)
 
 
 def model_ratio(run: dict, ref: dict) -> tuple[int, float]:
-    """(P, bound) of a P-rank run against the reference run, both with PETSc's memory
-    measured (``--petsc-memory``): its busiest rank's peak if all of tmfem's own memory
-    (numpy arrays, the heap it leaves) divided exactly over the ranks and the libraries'
-    parts stayed as measured,
-
-        bound = (fixed_P + (peak_1 - fixed_1) / P) / peak_1,
-        fixed = start + libraries + mumps + petsc,
-
-    with libraries the file-backed pages loaded after start-up (RssFile's growth: MUMPS',
-    SLEPc's code, the same on every rank), mumps MUMPS' memory effectively used (INFO(22)) and
-    petsc PETSc's own (``PetscMalloc``, largest over the job), busiest ranks: the lowest
-    ratio that any change of tmfem's own data structures could reach (each part's largest
-    over the run, so an estimate)."""
+    """:func:`divided_ratio` of runs with PETSc's memory measured (``--petsc-memory``), with
+    fixed = start + libraries + mumps + petsc: the busiest rank's peak if all of tmfem's own
+    memory (numpy arrays, the heap it leaves) divided exactly over the ranks and the
+    libraries' parts stayed as measured; libraries the file-backed pages loaded after
+    start-up (RssFile's growth: MUMPS', SLEPc's code, the same on every rank), mumps MUMPS'
+    memory effectively used (INFO(22)) and petsc PETSc's own (``PetscMalloc``, largest over
+    the job), busiest ranks: the lowest ratio that any change of tmfem's own data
+    structures could reach (each part's largest over the run, so an estimate)."""
     def fixed(run):
         rows = run["per_rank"]
         return (max(r["rss_mb"]["start"] + r["libraries_mb"] for r in rows)
                 + max(r["mumps_mb"]["used"] for r in rows) + run["petsc_malloc_mb"]["max"])
-    peak_1 = ref["per_rank"][0]["peak_mb"]["modes"]
-    P = run["ranks"]
-    return P, (fixed(run) + (peak_1 - fixed(ref)) / P) / peak_1
+    return divided_ratio(run, ref, fixed)
 
 
 #: PETSc's options of the ``--petsc-memory`` runs: its memory summary at the end of the job,
